@@ -1,0 +1,161 @@
+"""The ``haptic`` command.
+
+Every subcommand turns a :class:`~haptic.errors.HapticError` into one line on stderr and a non-zero exit.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+from collections.abc import Callable, Sequence
+
+from haptic.errors import HapticError
+
+Runner = Callable[[argparse.Namespace], int]
+
+
+def _add_models(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("models", help="list, show and check polyhedral models")
+    msub = p.add_subparsers(dest="models_cmd", required=True, metavar="{list,show,check}")
+
+    lp = msub.add_parser("list", help="the models of a library: V/E/F, genus, convexity, symmetry order")
+    lp.add_argument("--models", metavar="DIR", help="library directory (default: the shipped assets/models)")
+    lp.add_argument("--json", action="store_true", help="one JSON object per line instead of a table")
+    lp.set_defaults(run=_models_list)
+
+    sp = msub.add_parser("show", help="one model in full: faces, edges, vertices, symmetry")
+    sp.add_argument("name", help="a model name in the library, or a path to a model file")
+    sp.add_argument("--models", metavar="DIR", help="library directory (default: the shipped assets/models)")
+    sp.set_defaults(run=_models_show)
+
+    cp = msub.add_parser("check", help="validate model files; exit 1 if any is bad")
+    cp.add_argument("files", nargs="+", metavar="FILE")
+    cp.set_defaults(run=_models_check)
+
+
+def _library(args: argparse.Namespace):
+    from haptic.geometry import load_library
+
+    return load_library(getattr(args, "models", None))
+
+
+def _models_list(args: argparse.Namespace) -> int:
+    lib = _library(args)
+    rows = [m.summary() for m in lib.values()]
+    if args.json:
+        for r in rows:
+            print(json.dumps(r))
+        return 0
+    head = f"{'name':<12} {'V':>3} {'E':>3} {'F':>3} {'V-E+F':>5} {'genus':>5} {'convex':>6} {'sym':>4}  size [mm]"
+    print(head)
+    print("-" * len(head))
+    for r in rows:
+        size = " x ".join(f"{x:g}" for x in r["extents_mm"])
+        print(
+            f"{r['name']:<12} {r['V']:>3} {r['E']:>3} {r['F']:>3} {r['euler']:>5} {r['genus']:>5} "
+            f"{'yes' if r['convex'] else 'no':>6} {r['symmetry']:>4}  {size}"
+        )
+    print(f"{len(rows)} models")
+    return 0
+
+
+def _models_show(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from haptic.geometry import convex_decomposition, resolve_model, symmetry_group
+
+    lib = _library(args) if not os.path.exists(args.name) else None
+    m = resolve_model(args.name, lib)
+    s = m.summary()
+    print(f"{m.name}  ({m.source})")
+    print(
+        f"  V={s['V']} E={s['E']} F={s['F']}  V-E+F={s['euler']}  genus={s['genus']}  "
+        f"convex={'yes' if s['convex'] else 'no'}  volume={s['volume_cm3']:g} cm^3"
+    )
+    print(f"  size {' x '.join(f'{x:g}' for x in s['extents_mm'])} mm; convex pieces: {len(convex_decomposition(m))}")
+    sym = symmetry_group(m)
+    angles = sorted(round(float(np.degrees(np.arccos(np.clip((np.trace(t.rotation) - 1) / 2, -1, 1))))) for t in sym)
+    print(f"  symmetry group: {len(sym)} proper rotations (angles {angles} deg)")
+    print("  faces  (n, d [mm], vertex loop):")
+    for f, loop in enumerate(m.faces):
+        n = m.face_normals[f]
+        print(f"    F{f:<3} n=({n[0]:+.3f}, {n[1]:+.3f}, {n[2]:+.3f})  d={m.face_offsets[f] * 1e3:+8.2f}  {list(loop)}")
+    print("  edges  (source->dest, length [mm], left/right face, convex/concave):")
+    for e, (a, b) in enumerate(m.edges):
+        kind = "convex" if m.edge_convexity[e] > 0 else "concave"
+        print(
+            f"    E{a}/{b:<4} l={m.edge_lengths[e] * 1e3:7.2f}  left F{m.edge_left_face[e]:<3} "
+            f"right F{m.edge_right_face[e]:<3} {kind}"
+        )
+    return 0
+
+
+def _models_check(args: argparse.Namespace) -> int:
+    from haptic.geometry import load_model
+
+    bad = 0
+    for f in args.files:
+        try:
+            m = load_model(f)
+        except HapticError as exc:
+            print(f"haptic: {exc}", file=sys.stderr)
+            bad += 1
+        else:
+            print(f"{f}: ok  V={m.n_vertices} E={m.n_edges} F={m.n_faces} genus={m.genus}")
+    return 1 if bad else 0
+
+
+def _optional_subcommands() -> list[Callable[[argparse._SubParsersAction], None]]:
+    """Subcommands whose modules may pull in heavy dependencies are imported only when present."""
+    out = []
+    for module in ("haptic.sim.cli", "haptic.episode_cli", "haptic.bench.cli"):
+        try:
+            mod = __import__(module, fromlist=["add_parser"])
+        except ModuleNotFoundError as exc:
+            if exc.name and (exc.name == module or module.startswith(exc.name + ".")):
+                continue
+            raise
+        out.append(mod.add_parser)
+    return out
+
+
+def build_parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(
+        prog="haptic",
+        description="Recognise and localise polyhedral objects by active touch with a simulated robot hand.",
+    )
+    sub = ap.add_subparsers(dest="cmd", required=True)
+    _add_models(sub)
+    for add in _optional_subcommands():
+        add(sub)
+    return ap
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    ap = build_parser()
+    args = ap.parse_args(argv)
+    try:
+        return int(args.run(args) or 0)
+    except HapticError as exc:
+        print(f"haptic: error: {exc}", file=sys.stderr)
+        return 1
+    except BrokenPipeError:  # output piped into head & co.
+        sys.stderr.close()
+        return 0
+    except KeyboardInterrupt:
+        print("haptic: interrupted", file=sys.stderr)
+        return 130
+    except Exception as exc:  # a bug, not bad input: one line unless asked for the traceback
+        if os.environ.get("HAPTIC_DEBUG"):
+            raise
+        print(
+            f"haptic: internal error: {type(exc).__name__}: {exc} (set HAPTIC_DEBUG=1 for the traceback)",
+            file=sys.stderr,
+        )
+        return 2
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,480 @@
+"""A closed polyhedral solid in the winged-edge representation of seed §2.2.
+
+Faces are ``(n, d)`` with the outward unit normal ``n`` and the plane ``n·w − d = 0``, and a counter-clockwise
+vertex loop as seen from outside. Edges are ``(b, p, l)``: ``p`` the source vertex, ``b`` the unit direction
+toward the destination vertex, ``l`` the length; each edge knows its left and right face as seen from outside
+relative to ``b``. Vertices know their edges and faces.
+
+Left and right: walking a face's counter-clockwise loop keeps the face on the walker's left (seen from
+outside), so the face whose loop holds ``source → dest`` is the edge's *left* face and the face whose loop holds
+``dest → source`` is its *right* face.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import numpy as np
+
+from haptic.errors import ModelError
+from haptic.geometry.tolerances import tol
+
+
+def _readonly(a: np.ndarray) -> np.ndarray:
+    a.setflags(write=False)
+    return a
+
+
+def newell_normal(points: np.ndarray) -> np.ndarray:
+    """Area-weighted normal of a closed polygon loop by Newell's method (length = twice the area)."""
+    nxt = np.roll(points, -1, axis=0)
+    return np.cross(points, nxt).sum(axis=0)
+
+
+@dataclass(frozen=True, eq=False)
+class Polyhedron:
+    """A validated closed, connected, consistently oriented polyhedral solid (any genus, any convexity).
+
+    Build one with :meth:`from_faces` (which validates); the fields below are derived once and read-only.
+    """
+
+    name: str
+    """Model name (the file stem when loaded from a library)."""
+    vertices: np.ndarray
+    """Vertex positions in the model frame, shape (V, 3) [m]."""
+    faces: tuple[tuple[int, ...], ...]
+    """Vertex loops, counter-clockwise seen from outside, one per face."""
+    source: str | None = None
+    """Where the model came from (a file path), for messages."""
+
+    face_normals: np.ndarray = field(init=False, repr=False)
+    """Outward unit normals ``n``, shape (F, 3)."""
+    face_offsets: np.ndarray = field(init=False, repr=False)
+    """Plane offsets ``d`` with ``n·w − d = 0``, shape (F,) [m]."""
+    face_areas: np.ndarray = field(init=False, repr=False)
+    """Face areas, shape (F,) [m^2]."""
+    edges: np.ndarray = field(init=False, repr=False)
+    """Source and destination vertex of each edge, shape (E, 2), source < destination."""
+    edge_left_face: np.ndarray = field(init=False, repr=False)
+    """Face on the left of each edge seen from outside, relative to ``b``, shape (E,)."""
+    edge_right_face: np.ndarray = field(init=False, repr=False)
+    """Face on the right of each edge, shape (E,)."""
+    face_edges: tuple[tuple[int, ...], ...] = field(init=False, repr=False)
+    """Edge ids of each face, in loop order (edge k joins loop vertex k to loop vertex k+1)."""
+
+    # ----------------------------------------------------------------------------------------- construction
+
+    @classmethod
+    def from_faces(
+        cls, vertices, faces, name: str = "model", source: str | None = None
+    ) -> Polyhedron:
+        """Validate and build a polyhedron from vertex positions [m] and CCW-from-outside face loops.
+
+        Raises :class:`ModelError` naming the model and the offending element when the input is not a closed,
+        connected, consistently outward-oriented 2-manifold with planar, non-degenerate faces.
+        """
+        where = source or name
+        try:
+            v = np.array(vertices, dtype=float)
+        except (TypeError, ValueError) as exc:
+            raise ModelError(f"{where}: vertices are not a list of [x, y, z] numbers ({exc})") from None
+        if v.ndim != 2 or v.shape[1] != 3 or len(v) < 4:
+            raise ModelError(f"{where}: vertices must be a list of at least 4 [x, y, z] triples, got shape {v.shape}")
+        bad = np.flatnonzero(~np.isfinite(v).all(axis=1))
+        if len(bad):
+            raise ModelError(f"{where}: vertex {bad[0]} has a non-finite coordinate {v[bad[0]].tolist()}")
+        loops: list[tuple[int, ...]] = []
+        for fi, f in enumerate(faces):
+            try:
+                loop = tuple(int(i) for i in f)
+            except (TypeError, ValueError):
+                raise ModelError(f"{where}: face {fi} is not a list of vertex indices: {f!r}") from None
+            if len(loop) < 3:
+                raise ModelError(f"{where}: face {fi} has {len(loop)} vertices; a face needs at least 3")
+            if len(set(loop)) != len(loop):
+                raise ModelError(f"{where}: face {fi} repeats a vertex in its loop {list(loop)}")
+            if min(loop) < 0 or max(loop) >= len(v):
+                raise ModelError(f"{where}: face {fi} names a vertex outside 0..{len(v) - 1}: {list(loop)}")
+            loops.append(loop)
+        if len(loops) < 4:
+            raise ModelError(f"{where}: a closed polyhedron needs at least 4 faces, got {len(loops)}")
+        poly = cls(name=name, vertices=_readonly(v), faces=tuple(loops), source=source)
+        return poly
+
+    def __post_init__(self) -> None:
+        where = self.source or self.name
+        v = self.vertices
+        set_ = object.__setattr__
+
+        seen: dict[frozenset, int] = {}
+        for fi, loop in enumerate(self.faces):
+            key = frozenset(loop)
+            if key in seen:
+                raise ModelError(f"{where}: faces {seen[key]} and {fi} are duplicates (same vertices {sorted(key)})")
+            seen[key] = fi
+
+        # edges and their left/right faces from the directed half-edges
+        half: dict[tuple[int, int], int] = {}
+        for fi, loop in enumerate(self.faces):
+            for k, a in enumerate(loop):
+                b = loop[(k + 1) % len(loop)]
+                if np.linalg.norm(v[a] - v[b]) < tol.merge:
+                    raise ModelError(f"{where}: face {fi} has a zero-length edge between vertices {a} and {b}")
+                if (a, b) in half:
+                    other = half[(a, b)]
+                    undirected = sum(
+                        1
+                        for lp in self.faces
+                        for j, x in enumerate(lp)
+                        if {x, lp[(j + 1) % len(lp)]} == {a, b}
+                    )
+                    if undirected > 2:
+                        raise ModelError(
+                            f"{where}: edge {a}-{b} is non-manifold: {undirected} faces meet on it (a closed "
+                            "2-manifold has exactly 2)"
+                        )
+                    raise ModelError(
+                        f"{where}: faces {other} and {fi} both run edge {a}->{b} in the same direction: "
+                        "inconsistent face orientation (loops must all be counter-clockwise seen from outside)"
+                    )
+                half[(a, b)] = fi
+        edges, left, right, index = [], [], [], {}
+        for (a, b), fi in half.items():
+            if (b, a) not in half:
+                raise ModelError(
+                    f"{where}: edge {a}-{b} of face {fi} has no second face: the surface is open (not watertight)"
+                )
+            if a < b:
+                index[(a, b)] = len(edges)
+                edges.append((a, b))
+                left.append(fi)
+                right.append(half[(b, a)])
+        face_edges = tuple(
+            tuple(index[(min(a, b), max(a, b))] for a, b in zip(loop, loop[1:] + loop[:1], strict=True))
+            for loop in self.faces
+        )
+        used = np.zeros(len(v), dtype=bool)
+        for loop in self.faces:
+            used[list(loop)] = True
+        if not used.all():
+            raise ModelError(f"{where}: vertex {int(np.flatnonzero(~used)[0])} is used by no face")
+
+        # plane of each face, planarity and area
+        normals, offsets, areas = [], [], []
+        for fi, loop in enumerate(self.faces):
+            pts = v[list(loop)]
+            nn = newell_normal(pts)
+            area = 0.5 * np.linalg.norm(nn)
+            if area < tol.area:
+                raise ModelError(f"{where}: face {fi} has zero area (vertices {list(loop)})")
+            n = nn / np.linalg.norm(nn)
+            d = float(np.mean(pts @ n))
+            dev = np.abs(pts @ n - d).max()
+            if dev > tol.planar:
+                raise ModelError(
+                    f"{where}: face {fi} is not planar: vertex off its plane by {dev * 1e3:.4g} mm "
+                    f"(tolerance {tol.planar * 1e3:g} mm)"
+                )
+            normals.append(n)
+            offsets.append(d)
+            areas.append(area)
+
+        set_(self, "face_normals", _readonly(np.array(normals)))
+        set_(self, "face_offsets", _readonly(np.array(offsets)))
+        set_(self, "face_areas", _readonly(np.array(areas)))
+        set_(self, "edges", _readonly(np.array(edges, dtype=int).reshape(-1, 2)))
+        set_(self, "edge_left_face", _readonly(np.array(left, dtype=int)))
+        set_(self, "edge_right_face", _readonly(np.array(right, dtype=int)))
+        set_(self, "face_edges", face_edges)
+
+        # coplanar neighbours would be an edge no finger can feel
+        for e, (fl, fr) in enumerate(zip(left, right, strict=True)):
+            if np.dot(normals[fl], normals[fr]) > np.cos(tol.angle) and abs(offsets[fl] - offsets[fr]) < tol.planar:
+                raise ModelError(
+                    f"{where}: faces {fl} and {fr} are coplanar and share edge {edges[e][0]}-{edges[e][1]}: "
+                    "merge them into one face"
+                )
+
+        # each vertex's faces must form a single fan (no pinched vertices)
+        nxt: dict[int, dict[int, int]] = {}
+        for loop in self.faces:
+            for k, a in enumerate(loop):
+                prev = loop[k - 1]
+                b = loop[(k + 1) % len(loop)]
+                # around vertex a: from half-edge (a,b) of face fi, the next face around a owns (prev... )
+                nxt.setdefault(a, {})[b] = prev
+        for a, ring in nxt.items():
+            start = next(iter(ring))
+            cur, count = start, 0
+            while True:
+                cur = ring[cur]
+                count += 1
+                if cur == start or count > len(ring):
+                    break
+            if count != len(ring):
+                raise ModelError(
+                    f"{where}: vertex {a} is non-manifold: its faces form more than one fan (a pinch point)"
+                )
+
+        # connectivity over faces
+        parent = list(range(len(self.faces)))
+
+        def find(i: int) -> int:
+            while parent[i] != i:
+                parent[i] = parent[parent[i]]
+                i = parent[i]
+            return i
+
+        for fl, fr in zip(left, right, strict=True):
+            parent[find(fl)] = find(fr)
+        roots = {find(i) for i in range(len(self.faces))}
+        if len(roots) > 1:
+            raise ModelError(f"{where}: the surface is not connected: it has {len(roots)} separate parts")
+
+        try:
+            volume = self.volume
+        except ModelError as exc:
+            raise ModelError(f"{where}: {exc}") from None
+        if volume <= 0:
+            raise ModelError(
+                f"{where}: the faces are oriented inward (signed volume {self.volume:.4g} m^3); loops must be "
+                "counter-clockwise seen from outside"
+            )
+
+    # ------------------------------------------------------------------------------------------ counts
+
+    @property
+    def n_vertices(self) -> int:
+        return len(self.vertices)
+
+    @property
+    def n_edges(self) -> int:
+        return len(self.edges)
+
+    @property
+    def n_faces(self) -> int:
+        return len(self.faces)
+
+    @property
+    def euler_characteristic(self) -> int:
+        """V − E + F (= 2 − 2g for a closed orientable surface)."""
+        return self.n_vertices - self.n_edges + self.n_faces
+
+    @property
+    def genus(self) -> int:
+        """Number of handles (0 for a sphere-like solid, 1 for a frame with a hole)."""
+        return (2 - self.euler_characteristic) // 2
+
+    # ------------------------------------------------------------------------------------------ edges
+
+    @cached_property
+    def edge_points(self) -> np.ndarray:
+        """``p``: the source vertex of each edge, shape (E, 3) [m]."""
+        return _readonly(self.vertices[self.edges[:, 0]].copy())
+
+    @cached_property
+    def edge_lengths(self) -> np.ndarray:
+        """``l``: edge lengths, shape (E,) [m]."""
+        return _readonly(np.linalg.norm(self.vertices[self.edges[:, 1]] - self.vertices[self.edges[:, 0]], axis=1))
+
+    @cached_property
+    def edge_directions(self) -> np.ndarray:
+        """``b``: unit edge directions from source to destination, shape (E, 3)."""
+        d = self.vertices[self.edges[:, 1]] - self.vertices[self.edges[:, 0]]
+        return _readonly(d / np.linalg.norm(d, axis=1)[:, None])
+
+    @cached_property
+    def edge_convexity(self) -> np.ndarray:
+        """+1 for a convex edge (the surface falls away), −1 for a concave one, shape (E,)."""
+        nl = self.face_normals[self.edge_left_face]
+        nr = self.face_normals[self.edge_right_face]
+        s = np.einsum("ij,ij->i", np.cross(nl, nr), self.edge_directions)
+        return _readonly(np.where(s > 0, 1, -1))
+
+    @cached_property
+    def edge_dihedral(self) -> np.ndarray:
+        """Interior dihedral angle at each edge, in (0, 2π): < π convex, > π concave [rad]."""
+        nl = self.face_normals[self.edge_left_face]
+        nr = self.face_normals[self.edge_right_face]
+        between = np.arccos(np.clip(np.einsum("ij,ij->i", nl, nr), -1.0, 1.0))
+        return _readonly(np.pi - self.edge_convexity * between)
+
+    # ------------------------------------------------------------------------------------------ adjacency
+
+    def face_vertices(self, f: int) -> tuple[int, ...]:
+        """Vertices of face ``f`` in counter-clockwise order seen from outside."""
+        return self.faces[f]
+
+    def edge_faces(self, e: int) -> tuple[int, int]:
+        """(left, right) faces of edge ``e``."""
+        return int(self.edge_left_face[e]), int(self.edge_right_face[e])
+
+    def edge_vertices(self, e: int) -> tuple[int, int]:
+        """(source, destination) vertices of edge ``e``."""
+        return int(self.edges[e, 0]), int(self.edges[e, 1])
+
+    @cached_property
+    def vertex_edges(self) -> tuple[tuple[int, ...], ...]:
+        """Edge ids incident on each vertex."""
+        out: list[list[int]] = [[] for _ in range(self.n_vertices)]
+        for e, (a, b) in enumerate(self.edges):
+            out[a].append(e)
+            out[b].append(e)
+        return tuple(tuple(x) for x in out)
+
+    @cached_property
+    def vertex_faces(self) -> tuple[tuple[int, ...], ...]:
+        """Face ids incident on each vertex."""
+        out: list[list[int]] = [[] for _ in range(self.n_vertices)]
+        for f, loop in enumerate(self.faces):
+            for a in loop:
+                out[a].append(f)
+        return tuple(tuple(x) for x in out)
+
+    @cached_property
+    def face_neighbors(self) -> tuple[tuple[int, ...], ...]:
+        """Faces sharing an edge with each face, in loop order."""
+        left, right = self.edge_left_face, self.edge_right_face
+        return tuple(
+            tuple(int(right[e] if left[e] == f else left[e]) for e in fe) for f, fe in enumerate(self.face_edges)
+        )
+
+    # ------------------------------------------------------------------------------------------ solid
+
+    @cached_property
+    def triangles(self) -> np.ndarray:
+        """A triangulation of the faces (ear clipping, so non-convex faces are fine), shape (T, 3)."""
+        tris: list[tuple[int, int, int]] = []
+        for f, loop in enumerate(self.faces):
+            tris.extend(triangulate_polygon(self.vertices, loop, self.face_normals[f]))
+        return _readonly(np.array(tris, dtype=int))
+
+    @cached_property
+    def triangle_faces(self) -> np.ndarray:
+        """Face id of each row of :attr:`triangles`."""
+        ids = [f for f, loop in enumerate(self.faces) for _ in range(len(loop) - 2)]
+        return _readonly(np.array(ids, dtype=int))
+
+    @cached_property
+    def volume(self) -> float:
+        """Signed volume (positive when faces point outward) [m^3]."""
+        t = self.vertices[self.triangles]
+        return float(np.einsum("ij,ij->i", t[:, 0], np.cross(t[:, 1], t[:, 2])).sum() / 6.0)
+
+    @cached_property
+    def centroid(self) -> np.ndarray:
+        """Centre of mass of the solid (uniform density) [m]."""
+        t = self.vertices[self.triangles]
+        vol = np.einsum("ij,ij->i", t[:, 0], np.cross(t[:, 1], t[:, 2])) / 6.0
+        c = t.sum(axis=1) / 4.0
+        return _readonly((vol[:, None] * c).sum(axis=0) / vol.sum())
+
+    @property
+    def is_convex(self) -> bool:
+        """True when every edge is convex and the solid has no handle."""
+        return bool(self.genus == 0 and (self.edge_convexity > 0).all())
+
+    @cached_property
+    def extents(self) -> np.ndarray:
+        """Axis-aligned bounding box size in the model frame [m]."""
+        return _readonly(self.vertices.max(axis=0) - self.vertices.min(axis=0))
+
+    def contains(self, points: np.ndarray) -> np.ndarray:
+        """Inside test by the generalised winding number (robust for any closed oriented surface)."""
+        p = np.atleast_2d(np.asarray(points, dtype=float))
+        t = self.vertices[self.triangles]  # (T,3,3)
+        a = t[None, :, 0, :] - p[:, None, :]
+        b = t[None, :, 1, :] - p[:, None, :]
+        c = t[None, :, 2, :] - p[:, None, :]
+        la, lb, lc = (np.linalg.norm(x, axis=2) for x in (a, b, c))
+        num = np.einsum("ptk,ptk->pt", a, np.cross(b, c))
+        den = (
+            la * lb * lc
+            + np.einsum("ptk,ptk->pt", a, b) * lc
+            + np.einsum("ptk,ptk->pt", b, c) * la
+            + np.einsum("ptk,ptk->pt", c, a) * lb
+        )
+        w = 2.0 * np.arctan2(num, den).sum(axis=1) / (4.0 * np.pi)
+        return w > 0.5
+
+    # ------------------------------------------------------------------------------------------ transforms
+
+    def transformed(self, rotation: np.ndarray, translation: np.ndarray, name: str | None = None) -> Polyhedron:
+        """The same solid with vertices mapped by ``w' = R w + t`` (R a proper rotation)."""
+        v = self.vertices @ np.asarray(rotation).T + np.asarray(translation)
+        return Polyhedron.from_faces(v, self.faces, name=name or self.name, source=self.source)
+
+    def mirrored(self, name: str | None = None) -> Polyhedron:
+        """The mirror image through the x = 0 plane (face loops reversed to stay outward)."""
+        v = self.vertices * np.array([-1.0, 1.0, 1.0])
+        faces = [tuple(reversed(loop)) for loop in self.faces]
+        return Polyhedron.from_faces(v, faces, name=name or f"{self.name}_mirror", source=self.source)
+
+    def to_trimesh(self):
+        """A triangulated :class:`trimesh.Trimesh` with outward winding (for export and simulation)."""
+        import trimesh
+
+        return trimesh.Trimesh(vertices=np.array(self.vertices), faces=np.array(self.triangles), process=False)
+
+    def summary(self) -> dict:
+        """Counts and properties for listings."""
+        from haptic.geometry.symmetry import symmetry_group
+
+        return {
+            "name": self.name,
+            "V": self.n_vertices,
+            "E": self.n_edges,
+            "F": self.n_faces,
+            "euler": self.euler_characteristic,
+            "genus": self.genus,
+            "convex": self.is_convex,
+            "symmetry": len(symmetry_group(self)),
+            "extents_mm": [round(float(x) * 1e3, 2) for x in self.extents],
+            "volume_cm3": round(self.volume * 1e6, 3),
+        }
+
+    def __repr__(self) -> str:
+        return f"Polyhedron({self.name!r}, V={self.n_vertices}, E={self.n_edges}, F={self.n_faces})"
+
+
+def triangulate_polygon(vertices: np.ndarray, loop: tuple[int, ...], normal: np.ndarray) -> list[tuple[int, int, int]]:
+    """Ear-clip a simple planar polygon (CCW about ``normal``) into triangles of vertex ids."""
+    n = normal / np.linalg.norm(normal)
+    u = np.cross(n, [1.0, 0.0, 0.0])
+    if np.linalg.norm(u) < 0.1:
+        u = np.cross(n, [0.0, 1.0, 0.0])
+    u /= np.linalg.norm(u)
+    w = np.cross(n, u)
+    pts = {i: np.array([vertices[i] @ u, vertices[i] @ w]) for i in loop}
+    idx = list(loop)
+    out: list[tuple[int, int, int]] = []
+
+    def cross2(o, a, b) -> float:
+        return float((a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]))
+
+    guard = 0
+    while len(idx) > 3 and guard < 10 * len(loop) ** 2:
+        guard += 1
+        m = len(idx)
+        for k in range(m):
+            i0, i1, i2 = idx[k - 1], idx[k], idx[(k + 1) % m]
+            a, b, c = pts[i0], pts[i1], pts[i2]
+            if cross2(a, b, c) <= 1e-18:
+                continue  # reflex or collinear corner
+            inside = False
+            for j in idx:
+                if j in (i0, i1, i2):
+                    continue
+                p = pts[j]
+                if cross2(a, b, p) >= 0 and cross2(b, c, p) >= 0 and cross2(c, a, p) >= 0:
+                    inside = True
+                    break
+            if not inside:
+                out.append((i0, i1, i2))
+                idx.pop(k)
+                break
+        else:
+            raise ModelError(f"face loop {list(loop)} is self-intersecting or not simple: cannot triangulate")
+    out.append((idx[0], idx[1], idx[2]))
+    return out

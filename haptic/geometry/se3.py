@@ -1,0 +1,109 @@
+"""Rigid transforms as rotation matrix plus translation: ``w_d = R w_m + t`` (seed §2.1).
+
+A transform named ``a_from_b`` maps coordinates in frame b to frame a.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True, eq=False)
+class SE3:
+    """A proper rigid transform ``x ↦ R x + t``."""
+
+    rotation: np.ndarray
+    """Proper rotation matrix R, shape (3, 3)."""
+    translation: np.ndarray
+    """Translation t, shape (3,) [m]."""
+
+    @classmethod
+    def identity(cls) -> SE3:
+        return cls(np.eye(3), np.zeros(3))
+
+    @classmethod
+    def from_rotation_and_translation(cls, rotation, translation) -> SE3:
+        return cls(np.asarray(rotation, dtype=float), np.asarray(translation, dtype=float))
+
+    @classmethod
+    def random(cls, rng: np.random.Generator, translation_scale: float = 0.0) -> SE3:
+        """A uniformly random rotation and a translation drawn uniformly in a cube of half-size ``scale``."""
+        return cls(random_rotation(rng), rng.uniform(-translation_scale, translation_scale, 3))
+
+    def apply(self, points: np.ndarray) -> np.ndarray:
+        """Map points (…, 3)."""
+        return np.asarray(points) @ self.rotation.T + self.translation
+
+    def rotate(self, vectors: np.ndarray) -> np.ndarray:
+        """Map free vectors (…, 3) (normals, directions)."""
+        return np.asarray(vectors) @ self.rotation.T
+
+    def inverse(self) -> SE3:
+        return SE3(self.rotation.T, -self.rotation.T @ self.translation)
+
+    def __matmul__(self, other: SE3) -> SE3:
+        return SE3(self.rotation @ other.rotation, self.rotation @ other.translation + self.translation)
+
+    def as_matrix(self) -> np.ndarray:
+        m = np.eye(4)
+        m[:3, :3] = self.rotation
+        m[:3, 3] = self.translation
+        return m
+
+    def rotation_angle_to(self, other: SE3) -> float:
+        """Angle of the rotation taking this orientation to the other's [rad]."""
+        return rotation_angle(self.rotation.T @ other.rotation)
+
+
+def rotation_angle(r: np.ndarray) -> float:
+    """Angle of a rotation matrix [rad]."""
+    return float(np.arccos(np.clip((np.trace(r) - 1.0) / 2.0, -1.0, 1.0)))
+
+
+def random_rotation(rng: np.random.Generator) -> np.ndarray:
+    """A rotation drawn uniformly from SO(3) (unit quaternion from a 4-D Gaussian)."""
+    q = rng.normal(size=4)
+    q /= np.linalg.norm(q)
+    return quat_to_matrix(q)
+
+
+def quat_to_matrix(q: np.ndarray) -> np.ndarray:
+    """Rotation matrix of a unit quaternion (w, x, y, z)."""
+    w, x, y, z = q
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+
+
+def matrix_to_quat(r: np.ndarray) -> np.ndarray:
+    """Unit quaternion (w, x, y, z), w ≥ 0, of a rotation matrix."""
+    m = np.asarray(r, dtype=float)
+    tr = np.trace(m)
+    if tr > 0:
+        s = np.sqrt(tr + 1.0) * 2
+        q = np.array([0.25 * s, (m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s])
+    elif m[0, 0] > m[1, 1] and m[0, 0] > m[2, 2]:
+        s = np.sqrt(1.0 + m[0, 0] - m[1, 1] - m[2, 2]) * 2
+        q = np.array([(m[2, 1] - m[1, 2]) / s, 0.25 * s, (m[0, 1] + m[1, 0]) / s, (m[0, 2] + m[2, 0]) / s])
+    elif m[1, 1] > m[2, 2]:
+        s = np.sqrt(1.0 + m[1, 1] - m[0, 0] - m[2, 2]) * 2
+        q = np.array([(m[0, 2] - m[2, 0]) / s, (m[0, 1] + m[1, 0]) / s, 0.25 * s, (m[1, 2] + m[2, 1]) / s])
+    else:
+        s = np.sqrt(1.0 + m[2, 2] - m[0, 0] - m[1, 1]) * 2
+        q = np.array([(m[1, 0] - m[0, 1]) / s, (m[0, 2] + m[2, 0]) / s, (m[1, 2] + m[2, 1]) / s, 0.25 * s])
+    q /= np.linalg.norm(q)
+    return q if q[0] >= 0 else -q
+
+
+def frame_from_edge(direction: np.ndarray, face_normal: np.ndarray) -> np.ndarray:
+    """Orthonormal frame (columns b, n⊥, b × n⊥) from an edge direction and an adjacent face normal."""
+    b = direction / np.linalg.norm(direction)
+    n = face_normal - (face_normal @ b) * b
+    n /= np.linalg.norm(n)
+    return np.column_stack([b, n, np.cross(b, n)])

@@ -1,0 +1,1 @@
+"""Matching data components against models (seed §2.3–2.6)."""

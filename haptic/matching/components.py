@@ -1,0 +1,147 @@
+"""Data components: what the explorer reports to the matcher (seed §2.3).
+
+Every component has an ``id`` (its position in the order of acquisition, starting at 0), the ids of earlier
+components it is known to be adjacent to, and error bounds. The same records come from the geometric
+executor and from the physics executor's segmenter, so the matcher does not know which produced them.
+
+Edges are reported with the interval actually explored: ``p`` is one end of that interval, not in general a
+vertex, and ``l`` is its length. An edge may be reported again with the same id when a later move extends its
+explored interval (an edge move that runs to a vertex); the matcher then re-tests the interpretations that
+hold it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+def _vec(x) -> np.ndarray:
+    a = np.array(x, dtype=float)
+    a.setflags(write=False)
+    return a
+
+
+@dataclass(frozen=True, eq=False)
+class DataFace:
+    """A face touched by the sensor: a plane with an outward normal and the points touched on it."""
+
+    id: int
+    """Order of acquisition (0-based)."""
+    normal: np.ndarray
+    """Outward unit normal ``n_d`` in the world frame, shape (3,)."""
+    points: np.ndarray
+    """Contact points on the face in the world frame, shape (k, 3), k ≥ 1 [m]."""
+    normal_bound: float
+    """Error bound on the normal direction [rad]."""
+    position_bound: float
+    """Error bound on each point's distance from the true plane [m]."""
+    adjacent: tuple[int, ...] = ()
+    """Ids of earlier components known to be adjacent (for a face: the edges it shares)."""
+
+    kind = "face"
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "normal", _vec(self.normal))
+        object.__setattr__(self, "points", _vec(np.atleast_2d(self.points)))
+        object.__setattr__(self, "adjacent", tuple(int(i) for i in self.adjacent))
+
+    @property
+    def offset(self) -> float:
+        """Plane offset ``d`` with ``n·w − d = 0`` from the touched points [m]."""
+        return float(np.mean(self.points @ self.normal))
+
+
+@dataclass(frozen=True, eq=False)
+class DataEdge:
+    """An explored interval of an edge: ``{p + s b : 0 ≤ s ≤ l}``."""
+
+    id: int
+    """Order of acquisition; an extended edge is re-reported with its first id."""
+    direction: np.ndarray
+    """Unit direction ``b_d`` along the explored interval, world frame, shape (3,)."""
+    point: np.ndarray
+    """``p_d``: one end of the explored interval, world frame, shape (3,) [m]."""
+    length: float
+    """``l_d``: length of the explored interval (≥ 0) [m]."""
+    direction_bound: float
+    """Error bound on the direction [rad]."""
+    position_bound: float
+    """Error bound on the position of the line, perpendicular to it [m]."""
+    length_bound: float
+    """Error bound on each end of the explored interval, along the line [m]."""
+    start_vertex: int | None = None
+    """Id of the data vertex at ``p`` when the interval starts at a known vertex, else None."""
+    end_vertex: int | None = None
+    """Id of the data vertex at ``p + l b`` when the interval ends at a known vertex, else None."""
+    adjacent: tuple[int, ...] = ()
+    """Ids of earlier components known to be adjacent (its faces, its vertices)."""
+
+    kind = "edge"
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "direction", _vec(self.direction))
+        object.__setattr__(self, "point", _vec(self.point))
+        object.__setattr__(self, "adjacent", tuple(int(i) for i in self.adjacent))
+
+    @property
+    def end_point(self) -> np.ndarray:
+        """``p + l b`` [m]."""
+        return self.point + self.length * self.direction
+
+
+@dataclass(frozen=True, eq=False)
+class DataVertex:
+    """A vertex met by the sensor."""
+
+    id: int
+    """Order of acquisition."""
+    position: np.ndarray
+    """Position in the world frame, shape (3,) [m]."""
+    position_bound: float
+    """Error bound on the position [m]."""
+    adjacent: tuple[int, ...] = ()
+    """Ids of earlier components known to be adjacent (its edges)."""
+
+    kind = "vertex"
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "position", _vec(self.position))
+        object.__setattr__(self, "adjacent", tuple(int(i) for i in self.adjacent))
+
+
+DataComponent = DataFace | DataEdge | DataVertex
+
+
+@dataclass(frozen=True)
+class SensorNoise:
+    """The sensor-noise model; error bounds are ``k`` standard deviations.
+
+    The defaults are those of the physics notes' fingertip (σn 1°, σp 0.2 mm) at the level of a segmented
+    component (fits over many samples are tighter than single samples).
+    """
+
+    normal_sigma: float = np.deg2rad(0.3)
+    """Standard deviation of a face normal's direction [rad]."""
+    direction_sigma: float = np.deg2rad(0.3)
+    """Standard deviation of an edge direction [rad]."""
+    position_sigma: float = 0.2e-3
+    """Standard deviation of a position perpendicular to a component [m]."""
+    length_sigma: float = 0.3e-3
+    """Standard deviation of an interval end along an edge [m]."""
+    k: float = 3.0
+    """Error bound = k σ."""
+
+    def scaled(self, level: float) -> SensorNoise:
+        """The same model with every σ multiplied by ``level`` (0 = noiseless)."""
+        return SensorNoise(
+            self.normal_sigma * level,
+            self.direction_sigma * level,
+            self.position_sigma * level,
+            self.length_sigma * level,
+            self.k,
+        )
+
+
+__all__ = ["DataComponent", "DataEdge", "DataFace", "DataVertex", "SensorNoise"]

@@ -1,0 +1,124 @@
+"""The seed's three admissible moves (§4), the sensor state they start from, their results, and their costs
+(§3.1).
+
+A move is chosen by the planner and carried out by an executor (geometric or physics); both return the same
+:class:`MoveResult`. Distances are in metres; costs are in cost units.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from haptic.matching.components import DataComponent
+
+
+@dataclass(frozen=True)
+class CostModel:
+    """Cost constants of seed §3.1. ``c_f``, ``c_e``, ``c_v`` multiply distance; the rest are per event.
+
+    Defaults: 1 unit per cm across a face, 2 per cm along an edge (more care), 1.5 per cm around a vertex.
+    """
+
+    c_f: float = 100.0
+    """Tracing across a face [units/m]."""
+    c_e: float = 200.0
+    """Tracing along an edge [units/m]."""
+    c_v: float = 150.0
+    """Circling a vertex [units/m]."""
+    c_j: float = 0.4
+    """Detecting contact with an edge while on a face [units]."""
+    c_k: float = 0.4
+    """Detecting a vertex while on an edge [units]."""
+    c_n: float = 0.5
+    """Acquiring a face normal (a short 2-D stroke) [units]."""
+    c_b: float = 0.5
+    """Acquiring an edge direction [units]."""
+
+    def face_move(self, s: float) -> float:
+        """``c_f s + c_j + c_b + c_n`` (§4, face move)."""
+        return self.c_f * s + self.c_j + self.c_b + self.c_n
+
+    def edge_move(self, s: float) -> float:
+        """``c_e s + c_k`` (§4, edge move)."""
+        return self.c_e * s + self.c_k
+
+    def vertex_move(self, s: float) -> float:
+        """``c_v s + c_j + c_b + c_n`` (§4, vertex move)."""
+        return self.c_v * s + self.c_j + self.c_b + self.c_n
+
+
+@dataclass(frozen=True, eq=False)
+class SensorState:
+    """Where the sensor is, in data terms: what a robot knows without the model."""
+
+    position: np.ndarray
+    """Sensor (contact) position in the world frame, shape (3,) [m]."""
+    face: int
+    """Id of the data face the sensor is on or nearest."""
+    edge: int | None = None
+    """Id of the data edge the sensor is on or near, else None."""
+    vertex: int | None = None
+    """Id of the data vertex the sensor is at or near, else None."""
+    edge_faces: tuple[int, ...] = ()
+    """Ids of the data faces on either side of ``edge`` (those acquired)."""
+
+
+@dataclass(frozen=True, eq=False)
+class FaceMove:
+    """Trace straight across the current face in ``direction`` until an edge; acquire its direction; step
+    onto the next face for its normal; end near that edge (§4 item 1)."""
+
+    direction: np.ndarray
+    """Unit direction of travel in the world frame, in the plane of the current face, shape (3,)."""
+
+    kind = "face"
+
+
+@dataclass(frozen=True)
+class EdgeMove:
+    """Trace along the current edge in a sense until a vertex (§4 item 2)."""
+
+    sense: int
+    """+1 along the data edge's direction ``b_d``, −1 against it."""
+
+    kind = "edge"
+
+
+@dataclass(frozen=True)
+class VertexMove:
+    """Circle the current vertex across one face of the current edge until the next edge; acquire its
+    direction; step onto the next face for its normal; end near the new edge and the vertex (§4 item 3)."""
+
+    across_face: int
+    """Id of the data face (one of the current edge's two faces) that the circular path crosses."""
+
+    kind = "vertex"
+
+
+Move = FaceMove | EdgeMove | VertexMove
+
+
+@dataclass(frozen=True, eq=False)
+class MoveResult:
+    """What a move yielded."""
+
+    move: Move
+    """The move as asked."""
+    status: str
+    """"ok", or why it failed: "no-contact", "unreachable", "timeout", "unstable", "invalid"."""
+    components: tuple[DataComponent, ...] = ()
+    """New components, and re-reported (extended) edges, in order of acquisition."""
+    distance: float = 0.0
+    """Distance travelled by the move's main trace (``s`` of the cost formula) [m]."""
+    cost: float = 0.0
+    """Cost of the move by the cost model [units]."""
+    state: SensorState | None = None
+    """Sensor state after the move (None when the move failed and the state is unknown)."""
+    info: dict = field(default_factory=dict)
+    """Executor-specific extras (trace, simulated time)."""
+
+    @property
+    def ok(self) -> bool:
+        return self.status == "ok"

@@ -1,0 +1,137 @@
+"""The shipped library: counts, Euler characteristic, orientation, symmetry, round trips."""
+
+import numpy as np
+import pytest
+
+from haptic.geometry import (
+    are_congruent,
+    convex_decomposition,
+    load_library,
+    load_model,
+    save_model,
+    symmetry_group,
+)
+from haptic.geometry.se3 import random_rotation
+
+LIB = load_library()
+
+# name: (V, E, F, genus) — counted by hand from the designs in assets/models/README.md
+EXPECTED = {
+    "BOX01": (8, 12, 6, 0),
+    "WEDGE01": (6, 9, 5, 0),
+    "BOX01N": (16, 24, 10, 0),
+    "BOX01P": (16, 24, 10, 0),
+    "PYR01": (5, 8, 5, 0),
+    "TETRA01L": (4, 6, 4, 0),
+    "TETRA01R": (4, 6, 4, 0),
+    "HEXPRISM01": (12, 18, 8, 0),
+    "LBLOCK01": (12, 18, 8, 0),
+    "FRAME01": (16, 32, 16, 1),
+}
+
+
+def test_library_holds_the_expected_models():
+    assert set(LIB) == set(EXPECTED)
+
+
+@pytest.mark.parametrize("name", sorted(EXPECTED))
+def test_counts_and_euler_characteristic(name):
+    m = LIB[name]
+    v, e, f, g = EXPECTED[name]
+    assert (m.n_vertices, m.n_edges, m.n_faces) == (v, e, f)
+    assert m.euler_characteristic == 2 - 2 * g
+    assert m.genus == g
+
+
+@pytest.mark.parametrize("name", sorted(EXPECTED))
+def test_face_normals_point_outward(name):
+    m = LIB[name]
+    assert m.volume > 0
+    # a point just outside each face's centre is outside the solid, just inside is inside
+    for f, loop in enumerate(m.faces):
+        tri = m.vertices[m.triangles[m.triangle_faces == f][0]]
+        c = tri.mean(axis=0)
+        n = m.face_normals[f]
+        assert not m.contains(c + 1e-4 * n)[0], f"face {f} of {name} points inward"
+        assert m.contains(c - 1e-4 * n)[0], f"face {f} of {name} points inward"
+        assert np.allclose(m.vertices[list(loop)] @ n, m.face_offsets[f], atol=1e-9)
+
+
+@pytest.mark.parametrize("name", sorted(EXPECTED))
+def test_winged_edge_adjacency_is_consistent(name):
+    m = LIB[name]
+    for e, (a, b) in enumerate(m.edges):
+        left, right = m.edge_faces(e)
+        assert e in m.face_edges[left] and e in m.face_edges[right]
+        loop_l, loop_r = m.faces[left], m.faces[right]
+        # left face runs source -> dest, right face dest -> source
+        assert any(loop_l[k] == a and loop_l[(k + 1) % len(loop_l)] == b for k in range(len(loop_l)))
+        assert any(loop_r[k] == b and loop_r[(k + 1) % len(loop_r)] == a for k in range(len(loop_r)))
+        assert e in m.vertex_edges[a] and e in m.vertex_edges[b]
+    for v, faces in enumerate(m.vertex_faces):
+        assert len(faces) == len(m.vertex_edges[v]) >= 3
+
+
+def test_notched_and_bumped_boxes_differ_in_concave_edges():
+    n_concave = {k: int((LIB[k].edge_convexity < 0).sum()) for k in ("BOX01", "BOX01N", "BOX01P")}
+    assert n_concave == {"BOX01": 0, "BOX01N": 2, "BOX01P": 2}
+    assert not LIB["BOX01N"].is_convex and not LIB["BOX01P"].is_convex and LIB["BOX01"].is_convex
+    # the notch's concave edges run along its floor, the bump's along its foot
+    zn = LIB["BOX01N"].vertices[LIB["BOX01N"].edges[LIB["BOX01N"].edge_convexity < 0]][:, :, 2]
+    zp = LIB["BOX01P"].vertices[LIB["BOX01P"].edges[LIB["BOX01P"].edge_convexity < 0]][:, :, 2]
+    assert np.allclose(zn, 0.040) and np.allclose(zp, 0.060)
+
+
+@pytest.mark.parametrize(
+    "name,order",
+    [("BOX01", 4), ("TETRA01L", 1), ("TETRA01R", 1), ("HEXPRISM01", 12), ("PYR01", 2), ("WEDGE01", 1),
+     ("FRAME01", 8), ("LBLOCK01", 1)],
+)
+def test_symmetry_group_order(name, order):
+    group = symmetry_group(LIB[name])
+    assert len(group) == order
+    assert np.allclose(group[0].rotation, np.eye(3))
+    for s in group:
+        assert np.isclose(np.linalg.det(s.rotation), 1.0)
+        assert np.allclose(s.apply(LIB[name].centroid), LIB[name].centroid, atol=1e-9)
+
+
+def test_cube_has_24_symmetries():
+    from haptic.geometry.shapes import box
+
+    assert len(symmetry_group(box(0.05, 0.05, 0.05))) == 24
+
+
+def test_mirror_tetrahedra_are_not_related_by_any_rotation():
+    left, right = LIB["TETRA01L"], LIB["TETRA01R"]
+    assert not are_congruent(left, right)
+    assert not are_congruent(right, left)
+    assert np.allclose(sorted(left.edge_lengths), sorted(right.edge_lengths))  # same shape, mirrored
+    rng = np.random.default_rng(3)
+    r = random_rotation(rng)
+    assert are_congruent(left, left.transformed(r, [0.1, -0.2, 0.05]))
+
+
+@pytest.mark.parametrize("name", sorted(EXPECTED))
+@pytest.mark.parametrize("suffix", [".json", ".obj", ".stl", ".ply"])
+def test_round_trip_export_import(name, suffix, tmp_path):
+    m = LIB[name]
+    back = load_model(save_model(m, tmp_path / f"{name}{suffix}"))
+    assert (back.n_vertices, back.n_edges, back.n_faces) == (m.n_vertices, m.n_edges, m.n_faces)
+    assert np.isclose(back.volume, m.volume, rtol=1e-6)
+    assert are_congruent(m, back)
+
+
+@pytest.mark.parametrize("name", sorted(EXPECTED))
+def test_convex_decomposition_is_exact(name):
+    from scipy.spatial import ConvexHull
+
+    m = LIB[name]
+    pieces = convex_decomposition(m)
+    assert (len(pieces) == 1) == m.is_convex
+    total = sum(ConvexHull(p).volume for p in pieces)
+    assert np.isclose(total, m.volume, rtol=1e-6)
+    # every piece is inside the solid: its centroid and its vertices nudged toward the centroid
+    for p in pieces:
+        c = p.mean(axis=0)
+        assert m.contains(c + 0.98 * (p - c)).all()
