@@ -1,0 +1,346 @@
+"""The one owner of the MuJoCo simulation, and the robot-side sensor readout.
+
+:class:`Simulation` holds the ``MjModel`` / ``MjData`` and resolves every id once, at construction.
+What a robot senses -- joint encoders, forward kinematics of the fingertips, fingertip touch force and the
+per-fingertip contact readout (point, normal, force vector via ``mj_contactForce``) -- is returned as plain
+frozen records (:class:`SensorReading`, :class:`FingertipContact`) that hold numbers only, never a handle
+to the model or data, so nothing read through them can reveal the object's pose or geometry. Ground truth
+(the object and its pose) is a separate method, :meth:`Simulation.ground_truth`, for evaluation code.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from haptic.errors import SceneError
+from haptic.sim.scene import (
+    ARM_HOME,
+    ARM_JOINTS,
+    ARM_PREFIX,
+    FINGER_PREFIX,
+    FINGERS,
+    HAND_JOINTS,
+    HAND_PREFIX,
+    HAND_TRACE,
+    ComposedScene,
+    SceneObject,
+)
+
+N_ARM = len(ARM_JOINTS)
+N_HAND = len(HAND_JOINTS)
+
+WARNINGS = {name: int(w) for name, w in mujoco.mjtWarning.__members__.items() if name != "mjNWARNING"}
+"""MuJoCo warning kinds by name (``mjWARN_*``) -> index into ``data.warning``."""
+
+
+@dataclass(frozen=True)
+class SensorNoise:
+    """Zero-mean Gaussian noise of the robot's sensors (all zero: ideal sensors)."""
+
+    force_std: float = 0.0
+    """σF: touch / contact normal force [N]."""
+    normal_std: float = 0.0
+    """σn: contact normal direction, per tangent axis [rad]."""
+    point_std: float = 0.0
+    """σp: contact point, per axis [m]."""
+    joint_std: float = 0.0
+    """Joint encoder [rad]."""
+
+    @property
+    def any(self) -> bool:
+        """True when some sensor is noisy."""
+        return self.force_std > 0 or self.normal_std > 0 or self.point_std > 0 or self.joint_std > 0
+
+    @classmethod
+    def from_notes(cls) -> SensorNoise:
+        """The levels of PHYSICS_NOTES: σF 0.02 N, σn 1°, σp 0.2 mm."""
+        return cls(force_std=0.02, normal_std=np.deg2rad(1.0), point_std=2e-4)
+
+
+@dataclass(frozen=True)
+class FingertipContact:
+    """One contact of a fingertip pad with anything, as the fingertip senses it (world frame)."""
+
+    point_in_world: np.ndarray
+    """Contact point (3,) [m]."""
+    normal_in_world: np.ndarray
+    """Unit normal (3,) of the touched surface, pointing out of it towards the fingertip."""
+    force_in_world: np.ndarray
+    """Force (3,) exerted on the fingertip by the touched surface [N] (normal + friction)."""
+    normal_force: float
+    """Component of the force along the normal [N] (>= 0 while pressing)."""
+
+
+@dataclass(frozen=True)
+class SensorReading:
+    """A snapshot of what the robot senses. Per-finger arrays follow ``FINGERS`` order."""
+
+    time: float
+    """Simulation time of the reading [s]."""
+    arm_q: np.ndarray
+    """Arm joint angles (6,) [rad] (encoders)."""
+    arm_qd: np.ndarray
+    """Arm joint velocities (6,) [rad/s]."""
+    hand_q: np.ndarray
+    """Hand joint angles (16,) [rad] (encoders), ``HAND_JOINTS`` order."""
+    hand_qd: np.ndarray
+    """Hand joint velocities (16,) [rad/s]."""
+    fingertip_in_world: np.ndarray
+    """Fingertip pad centres (4, 3) [m], forward kinematics of the encoders."""
+    touch: np.ndarray
+    """Touch sensor per fingertip (4,) [N]: sum of normal forces inside the tip site."""
+    contacts: tuple[tuple[FingertipContact, ...], ...]
+    """Per fingertip, its pad's contacts (possibly none)."""
+
+    def finger(self, name: str) -> int:
+        """Index of finger ``name`` in the per-finger arrays."""
+        return finger_index(name)
+
+
+@dataclass(frozen=True)
+class ContactSummary:
+    """The aggregated contact of one fingertip, as the controller uses it (sensed, with noise)."""
+
+    normal_force: float
+    """Sum of pad normal forces [N] (0 without contact)."""
+    normal_in_world: np.ndarray | None
+    """Force-weighted mean unit normal (3,) out of the touched surface, or None without contact."""
+    point_in_world: np.ndarray | None
+    """Force-weighted mean contact point (3,) [m], or None without contact."""
+    count: int
+    """Number of pad contacts."""
+
+
+_NO_CONTACT = ContactSummary(0.0, None, None, 0)
+
+
+@dataclass(frozen=True)
+class GroundTruth:
+    """What the simulator knows and the robot does not. For evaluation code only."""
+
+    object: SceneObject | None
+    """The object (name and convex pieces in its own frame)."""
+    world_from_object: np.ndarray
+    """Object pose (4, 4) [m]."""
+
+
+def finger_index(name: str) -> int:
+    """Index of a finger name in ``FINGERS``; :class:`SceneError` lists the valid names."""
+    try:
+        return FINGERS.index(name)
+    except ValueError:
+        raise SceneError(f"unknown finger {name!r}; valid fingers: {', '.join(FINGERS)}") from None
+
+
+class Simulation:
+    """The one owner of the MuJoCo model and data of a composed scene.
+
+    Ids, addresses and slices are resolved once here; everything else uses them.
+    """
+
+    def __init__(
+        self,
+        scene: ComposedScene,
+        *,
+        noise: SensorNoise | None = None,
+        seed: int = 0,
+    ) -> None:
+        self._scene = scene
+        self.model: mujoco.MjModel = scene.compile()
+        self.data: mujoco.MjData = mujoco.MjData(self.model)
+        self.noise = noise or SensorNoise()
+        self._seed = seed
+        self._rng = np.random.default_rng(seed)
+        m = self.model
+
+        def jid(name: str) -> int:
+            i = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, name)
+            if i < 0:
+                raise SceneError(f"scene: joint {name!r} not found; is the robot attached (arm at 'arm_mount')?")
+            return i
+
+        arm_j = [jid(ARM_PREFIX + n) for n in ARM_JOINTS]
+        hand_j = [jid(HAND_PREFIX + n) for n in HAND_JOINTS]
+        qadr = np.array([m.jnt_qposadr[j] for j in arm_j + hand_j])
+        dadr = np.array([m.jnt_dofadr[j] for j in arm_j + hand_j])
+        n = N_ARM + N_HAND
+        if not (np.array_equal(qadr, np.arange(n)) and np.array_equal(dadr, np.arange(n))) or m.nv != n:
+            raise SceneError(
+                f"scene: expected the robot's {n} hinge joints to be the first and only dofs (arm then hand), "
+                f"got qpos addresses {qadr.tolist()} with nv={m.nv}; the object must be static"
+            )
+        self.arm = slice(0, N_ARM)
+        """Slice of the arm joints in qpos / qvel / ctrl."""
+        self.hand = slice(N_ARM, N_ARM + N_HAND)
+        """Slice of the hand joints in qpos / qvel / ctrl."""
+        act_j = m.actuator_trnid[:, 0]
+        if m.nu != n or not np.array_equal(act_j, np.array(arm_j + hand_j)):
+            raise SceneError(f"scene: expected {n} actuators, one per robot joint in order; got {m.nu}")
+        self.hand_kp = m.actuator_gainprm[self.hand, 0].copy()
+        """Position-servo stiffness of the hand motors [N m/rad]."""
+
+        def oid(kind: mujoco.mjtObj, name: str) -> int:
+            i = mujoco.mj_name2id(m, kind, name)
+            if i < 0:
+                raise SceneError(f"scene: {kind.name[6:].lower()} {name!r} not found in the hand")
+            return i
+
+        pre = [HAND_PREFIX + FINGER_PREFIX[f] for f in FINGERS]
+        self.tip_site = np.array([oid(mujoco.mjtObj.mjOBJ_SITE, p + "_tip") for p in pre])
+        self.pad_geom = np.array([oid(mujoco.mjtObj.mjOBJ_GEOM, p + "_pad") for p in pre])
+        touch = [oid(mujoco.mjtObj.mjOBJ_SENSOR, p + "_touch") for p in pre]
+        self.touch_adr = np.array([m.sensor_adr[s] for s in touch])
+        self.flange_site = oid(mujoco.mjtObj.mjOBJ_SITE, ARM_PREFIX + "flange")
+        self._geom_finger = np.full(m.ngeom, -1, dtype=int)
+        self._geom_finger[self.pad_geom] = np.arange(len(FINGERS))
+        self._geom_finger_list: list[int] = self._geom_finger.tolist()
+        self.home_key = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_KEY, "home")
+        self._force6 = np.zeros(6)
+        self.reset()
+
+    # -- state ---------------------------------------------------------------------------------------------
+    def reset(self, arm_q: np.ndarray | None = None, hand_q: np.ndarray | None = None) -> None:
+        """Reset to the ``home`` keyframe (or the given postures [rad]) at rest; re-seed the sensor noise."""
+        m, d = self.model, self.data
+        mujoco.mj_resetData(m, d)
+        d.qpos[self.arm] = ARM_HOME if arm_q is None else arm_q
+        d.qpos[self.hand] = HAND_TRACE if hand_q is None else hand_q
+        d.ctrl[self.hand] = d.qpos[self.hand]
+        self._rng = np.random.default_rng(self._seed)
+        mujoco.mj_forward(m, d)
+
+    def step(self, n: int = 1) -> None:
+        """Advance ``n`` physics steps with the current controls (``mj_step`` with ``nstep``)."""
+        mujoco.mj_step(self.model, self.data, nstep=n)
+
+    @property
+    def time(self) -> float:
+        """Simulation time [s]."""
+        return float(self.data.time)
+
+    @property
+    def timestep(self) -> float:
+        """Physics time step [s]."""
+        return float(self.model.opt.timestep)
+
+    def warnings(self) -> dict[str, int]:
+        """MuJoCo warning counters that are non-zero, by name."""
+        w = self.data.warning
+        return {name: int(w[i].number) for name, i in WARNINGS.items() if w[i].number}
+
+    def state_is_finite(self) -> bool:
+        d = self.data
+        return bool(np.all(np.isfinite(d.qpos)) and np.all(np.isfinite(d.qvel)) and np.all(np.isfinite(d.qacc)))
+
+    def ground_truth(self) -> GroundTruth:
+        """The object and its pose -- for evaluation only; never hand this to an executor."""
+        return GroundTruth(object=self._scene.object, world_from_object=self._scene.world_from_object.copy())
+
+    # -- robot-side readout -----------------------------------------------------------------------------------
+    def _noisy_normal(self, n: np.ndarray) -> np.ndarray:
+        s = self.noise.normal_std
+        if s <= 0:
+            return n
+        out = n + s * self._rng.standard_normal(3)
+        out -= np.dot(out - n, n) * n  # perturb in the tangent plane only
+        return out / np.linalg.norm(out)
+
+    def _pad_contacts(self, finger: int | None):
+        """Raw (finger, point, normal-out-of-surface, force-on-pad) for pad contacts, ideal sensing."""
+        d = self.data
+        out = []
+        if d.ncon == 0:
+            return out
+        owner = self._geom_finger_list
+        for i, (g1, g2) in enumerate(d.contact.geom.tolist()):
+            k1, k2 = owner[g1], owner[g2]
+            if finger is None:
+                if k1 < 0 and k2 < 0:
+                    continue
+            elif k1 != finger and k2 != finger:
+                continue
+            c = d.contact[i]
+            if c.efc_address < 0:  # excluded or inactive contact
+                continue
+            mujoco.mj_contactForce(self.model, d, i, self._force6)
+            frame = c.frame.reshape(3, 3)
+            f = self._force6[:3] @ frame  # force of geom1 on geom2, world frame
+            if k1 >= 0 and (finger is None or k1 == finger):
+                # the pad is geom1: flip into "on the pad, out of the touched surface" (normal: geom1 -> geom2)
+                out.append((k1, c.pos.copy(), -frame[0], -f))
+            else:
+                out.append((k2, c.pos.copy(), frame[0].copy(), f))
+        return out
+
+    def contact_summary(self, finger: int) -> ContactSummary:
+        """Aggregated sensed contact of one fingertip (noise applied): total normal force, force-weighted
+        mean normal and point."""
+        return ContactSummary(*self.sense_contact(finger))
+
+    def sense_contact(self, finger: int) -> tuple[float, np.ndarray | None, np.ndarray | None, int]:
+        """:meth:`contact_summary` as a plain tuple (the controller's fast path)."""
+        raw = self._pad_contacts(finger)
+        if not raw:
+            return 0.0, None, None, 0
+        if len(raw) == 1:
+            _, point, normal, f = raw[0]
+            total = max(float(f @ normal), 0.0)
+        else:
+            fn = np.array([max(float(f @ n), 0.0) for _, _, n, f in raw])
+            w = fn / fn.sum() if fn.sum() > 0 else np.full(len(raw), 1.0 / len(raw))
+            normal = w @ np.array([n for _, _, n, _ in raw])
+            normal /= math.sqrt(float(normal @ normal))
+            point = w @ np.array([p for _, p, _, _ in raw])
+            total = float(fn.sum())
+        nz = self.noise
+        if nz.any:
+            z = self._rng.standard_normal(7)
+            total += nz.force_std * float(z[0])
+            if nz.point_std > 0:
+                point = point + nz.point_std * z[1:4]
+            if nz.normal_std > 0:
+                pert = nz.normal_std * z[4:7]
+                normal = normal + (pert - (pert @ normal) * normal)  # tangent-plane perturbation
+                normal /= math.sqrt(float(normal @ normal))
+        return total, normal, point, len(raw)
+
+    def touch(self) -> np.ndarray:
+        """Touch force per fingertip (4,) [N], noise applied (clipped at 0)."""
+        t = self.data.sensordata[self.touch_adr].copy()
+        if self.noise.force_std > 0:
+            t = np.maximum(t + self.noise.force_std * self._rng.standard_normal(len(t)), 0.0)
+        return t
+
+    def fingertip_positions(self) -> np.ndarray:
+        """Fingertip pad centres (4, 3) in the world [m] (forward kinematics)."""
+        return self.data.site_xpos[self.tip_site].copy()
+
+    def read_sensors(self) -> SensorReading:
+        """Everything the robot senses now, as a plain snapshot (noise applied)."""
+        d, nz = self.data, self.noise
+        q = d.qpos[: N_ARM + N_HAND].copy()
+        if nz.joint_std > 0:
+            q += nz.joint_std * self._rng.standard_normal(len(q))
+        per: list[list[FingertipContact]] = [[] for _ in FINGERS]
+        for k, p, n, f in self._pad_contacts(None):
+            fn = float(np.dot(f, n))
+            if nz.force_std > 0:
+                f = f + nz.force_std * self._rng.standard_normal() * n
+                fn = float(np.dot(f, n))
+            if nz.point_std > 0:
+                p = p + nz.point_std * self._rng.standard_normal(3)
+            per[k].append(FingertipContact(p, self._noisy_normal(n), f, fn))
+        return SensorReading(
+            time=float(d.time),
+            arm_q=q[self.arm],
+            arm_qd=d.qvel[self.arm].copy(),
+            hand_q=q[self.hand],
+            hand_qd=d.qvel[self.hand].copy(),
+            fingertip_in_world=self.fingertip_positions(),
+            touch=self.touch(),
+            contacts=tuple(tuple(c) for c in per),
+        )

@@ -1,0 +1,92 @@
+"""The robot as an executor sees it: commands to the controller and sensor readings, nothing else.
+
+:class:`RobotInterface` is the handle an executor gets. It has no public path to the MuJoCo model or
+data, the scene, or the ground truth: its readings are :class:`~haptic.sim.physics.SensorReading`
+snapshots (joint encoders, fingertip forward kinematics, touch, per-fingertip contact point / normal /
+force), and its commands go to the :class:`~haptic.sim.control.Controller`. Evaluation code that needs
+the object's pose asks the :class:`~haptic.sim.physics.Simulation` (``ground_truth()``), which an
+executor is never given.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from haptic.sim.control import Controller, HybridStatus, IKResult, solve_fingertip_ik
+from haptic.sim.physics import ContactSummary, SensorReading, Simulation
+from haptic.sim.scene import FINGERS
+
+
+class RobotInterface:
+    """Robot-side handle: read sensors, command the controller, advance time."""
+
+    __slots__ = ("_ctl", "_sim")
+
+    def __init__(self, sim: Simulation, controller: Controller | None = None) -> None:
+        self._sim = sim
+        self._ctl = controller or Controller(sim)
+
+    fingers = FINGERS
+    """Finger names, in the order of every per-finger array."""
+
+    # -- sensing ----------------------------------------------------------------------------------------------
+    def read(self) -> SensorReading:
+        """What the robot senses now (encoders, fingertip kinematics, touch, contacts), noise applied."""
+        return self._sim.read_sensors()
+
+    def sense_contact(self, finger: str) -> ContactSummary:
+        """Aggregated contact of one fingertip (total normal force, mean normal and point), noise applied."""
+        return self._sim.contact_summary(self._ctl_finger_index(finger))
+
+    @property
+    def time(self) -> float:
+        """Simulation time [s]."""
+        return self._sim.time
+
+    @property
+    def tick_period(self) -> float:
+        """Duration of one control tick [s]."""
+        return self._ctl.tick_period
+
+    # -- commanding ---------------------------------------------------------------------------------------------
+    @property
+    def finger(self) -> str:
+        """The active finger of the task-space modes."""
+        return self._ctl.finger
+
+    def set_finger(self, finger: str) -> None:
+        self._ctl.set_finger(finger)
+
+    def set_hand_posture(self, hand_q: np.ndarray) -> None:
+        self._ctl.set_hand_posture(hand_q)
+
+    def hold_posture(self, arm_q: np.ndarray | None = None, hand_q: np.ndarray | None = None) -> None:
+        self._ctl.hold_posture(arm_q, hand_q)
+
+    def move_fingertip(self, point_in_world: np.ndarray, rotation_in_world: np.ndarray | str | None = "hold") -> None:
+        self._ctl.move_fingertip(point_in_world, rotation_in_world)
+
+    def set_hybrid(self, force: float, velocity_in_world: np.ndarray, **kwargs) -> None:
+        self._ctl.set_hybrid(force, velocity_in_world, **kwargs)
+
+    def hybrid_status(self) -> HybridStatus | None:
+        return self._ctl.hybrid_status()
+
+    def fingertip_pose(self) -> tuple[np.ndarray, np.ndarray]:
+        """Active fingertip position (3,) [m] and hand rotation (3, 3), from the joint encoders."""
+        return self._ctl.fingertip_pose()[0], self._ctl.hand_rotation()
+
+    def reachable(
+        self, finger: str, point_in_world: np.ndarray, rotation_in_world: np.ndarray | None = None
+    ) -> IKResult:
+        """Whether ``finger`` can put its pad centre at ``point_in_world`` (hand held as commanded)."""
+        return solve_fingertip_ik(self._sim, finger, point_in_world, rotation_in_world, hand_q=self._ctl.hand_posture())
+
+    def step(self, ticks: int = 1) -> None:
+        """Advance ``ticks`` control ticks."""
+        self._ctl.step(ticks)
+
+    def _ctl_finger_index(self, finger: str) -> int:
+        from haptic.sim.physics import finger_index
+
+        return finger_index(finger)

@@ -1,0 +1,322 @@
+"""Scene composition with ``dm_control.mjcf``: tabletop + PUMA-like arm + four-finger hand + object.
+
+The arm (``assets/mjcf/arm``) is attached to the stand of ``scenes/tabletop.xml``, the hand
+(``assets/mjcf/hand``) to the arm's flange, and the object -- one static convex mesh geom per convex piece
+(MuJoCo collides a mesh as its convex hull) -- into the scene's ``object`` body at ``world_from_object``.
+:func:`export_scene` writes a standalone MJCF with its mesh files beside it that plain
+``mujoco.MjModel.from_xml_path`` (and ``python -m mujoco.viewer``) loads.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import tempfile
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import trimesh
+from dm_control import mjcf
+from scipy.spatial import ConvexHull, QhullError
+
+from haptic.errors import HapticError, SceneError
+
+REPO_ROOT = Path(__file__).resolve().parents[2]
+ARM_XML = REPO_ROOT / "assets" / "mjcf" / "arm" / "puma560.xml"
+HAND_XML = REPO_ROOT / "assets" / "mjcf" / "hand" / "hand.xml"
+TABLETOP_XML = REPO_ROOT / "scenes" / "tabletop.xml"
+
+ARM_PREFIX = "arm/"
+HAND_PREFIX = "arm/hand/"
+ARM_JOINTS = ("waist", "shoulder", "elbow", "wrist_roll", "wrist_pitch", "flange_roll")
+FINGERS = ("index", "middle", "ring", "thumb")
+"""Finger names, in the order every per-finger array of this package uses."""
+FINGER_PREFIX = {"index": "ff", "middle": "mf", "ring": "rf", "thumb": "th"}
+HAND_JOINTS = tuple(f"{FINGER_PREFIX[f]}_j{k}" for f in FINGERS for k in range(4))
+
+TABLE_TOP_Z = 0.35
+"""Height of the table's top surface in the world frame [m] (see scenes/tabletop.xml)."""
+OBJECT_REGION = ((0.46, 0.62), (-0.10, 0.10))
+"""Where a random object centre is placed on the table: ((x_min, x_max), (y_min, y_max)) in world [m]."""
+
+ARM_HOME = np.array([0.2069, 0.4832, 0.2084, 0.0, 0.8792, 0.2069])
+"""Arm posture [rad] with the flange pointing down and the index fingertip at (0.54, 0, 0.55) m, hand pointing down."""
+HAND_TRACE = np.array(
+    [
+        0.0,
+        0.0,
+        0.0,
+        0.0,  # index: straight, the tracing finger
+        0.0,
+        1.45,
+        1.6,
+        1.4,  # middle: curled into the palm
+        0.0,
+        1.45,
+        1.6,
+        1.4,  # ring: curled into the palm
+        0.0,
+        0.9,
+        0.3,
+        0.3,  # thumb: folded along the palm, out of the way
+    ]
+)
+"""Hand posture [rad] (order of ``HAND_JOINTS``) for tracing with the index finger, the others curled away."""
+
+
+@dataclass(frozen=True)
+class SceneObject:
+    """A polyhedral object ready for MuJoCo: a name and its convex pieces."""
+
+    name: str
+    """Model name (library file stem)."""
+    parts: tuple[np.ndarray, ...]
+    """Vertex sets (n_i, 3) of convex pieces in the object frame [m]; their union is the solid."""
+
+    @property
+    def vertices(self) -> np.ndarray:
+        """All piece vertices stacked (N, 3) in the object frame [m]."""
+        return np.vstack(self.parts)
+
+
+@dataclass(frozen=True)
+class ComposedScene:
+    """A composed scene: the ``mjcf`` model and the ground truth it was built from (evaluation only)."""
+
+    mjcf_model: mjcf.RootElement
+    """The composed dm_control MJCF root."""
+    object: SceneObject | None
+    """The object placed on the table, or None for an empty table."""
+    world_from_object: np.ndarray = field(default_factory=lambda: np.eye(4))
+    """Homogeneous transform (4, 4) of the object in the world [m]."""
+
+    def to_xml_string(self) -> str:
+        return self.mjcf_model.to_xml_string()
+
+    def compile(self) -> mujoco.MjModel:
+        """The plain MuJoCo model of this scene."""
+        try:
+            return mujoco.MjModel.from_xml_string(self.to_xml_string(), assets=self.mjcf_model.get_assets())
+        except ValueError as exc:  # mujoco compile errors
+            raise SceneError(f"scene {self.mjcf_model.model!r} does not compile: {exc}") from exc
+
+
+def scene_object_from_parts(name: str, parts: Sequence[np.ndarray]) -> SceneObject:
+    """A :class:`SceneObject` from convex vertex sets [m]; each must span a volume."""
+    checked = []
+    for i, p in enumerate(parts):
+        arr = np.asarray(p, dtype=float)
+        if arr.ndim != 2 or arr.shape[1] != 3 or len(arr) < 4 or not np.all(np.isfinite(arr)):
+            raise SceneError(f"object {name!r}, part {i}: expected an (n>=4, 3) finite vertex array, got {arr.shape}")
+        try:
+            hull = ConvexHull(arr)
+        except QhullError as exc:
+            raise SceneError(f"object {name!r}, part {i}: the vertices span no volume (flat or degenerate)") from exc
+        if hull.volume < 1e-9:
+            raise SceneError(f"object {name!r}, part {i}: volume {hull.volume:.3g} m^3 is below 1e-9 m^3")
+        checked.append(arr[hull.vertices])
+    if not checked:
+        raise SceneError(f"object {name!r}: no convex parts; give at least one (n>=4, 3) vertex array")
+    return SceneObject(name=name, parts=tuple(checked))
+
+
+def scene_object_from_polyhedron(poly) -> SceneObject:
+    """A :class:`SceneObject` from a ``haptic.geometry.Polyhedron`` (convex pieces for non-convex solids)."""
+    from haptic.geometry import convex_decomposition
+
+    parts = [np.asarray(poly.vertices, dtype=float)] if poly.is_convex else convex_decomposition(poly)
+    return scene_object_from_parts(poly.name, parts)
+
+
+def load_object(name: str, models_dir: str | os.PathLike | None = None) -> SceneObject:
+    """The library model ``name`` (or a model file path) as a :class:`SceneObject`.
+
+    Raises :class:`SceneError` naming the valid model names when ``name`` is unknown.
+    """
+    from haptic.geometry import load_library, resolve_model
+
+    try:
+        library = load_library(models_dir)
+        poly = resolve_model(name, library)
+    except HapticError as exc:
+        raise SceneError(f"cannot load object {name!r}: {exc}") from exc
+    return scene_object_from_polyhedron(poly)
+
+
+def _solid_centroid(parts: Sequence[np.ndarray]) -> np.ndarray:
+    vols, cents = [], []
+    for p in parts:
+        m = trimesh.convex.convex_hull(p)
+        vols.append(m.volume)
+        cents.append(m.center_mass)
+    return np.average(np.asarray(cents), axis=0, weights=np.asarray(vols))
+
+
+def _rotation_taking(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The smallest rotation (3, 3) taking unit vector a to unit vector b."""
+    v = np.cross(a, b)
+    c = float(np.dot(a, b))
+    if c < -1 + 1e-12:  # antiparallel: half turn about any axis perpendicular to a
+        axis = np.cross(a, [1.0, 0.0, 0.0])
+        if np.linalg.norm(axis) < 1e-6:
+            axis = np.cross(a, [0.0, 1.0, 0.0])
+        axis /= np.linalg.norm(axis)
+        return 2 * np.outer(axis, axis) - np.eye(3)
+    vx = np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
+    return np.eye(3) + vx + vx @ vx / (1 + c)
+
+
+def stable_resting_rotations(obj: SceneObject, margin: float = 0.002) -> list[np.ndarray]:
+    """Rotations (3, 3) ``world_from_object`` that rest the object on a hull facet, stably.
+
+    A facet is stable when the solid's centroid projects into it at least ``margin`` [m] from its border.
+    """
+    points = obj.vertices
+    hull = ConvexHull(points)
+    centroid = _solid_centroid(obj.parts)
+    planes = np.unique(np.round(hull.equations, 9), axis=0)
+    out = []
+    seen: list[np.ndarray] = []
+    for n_d in planes:
+        n, d = n_d[:3], n_d[3]
+        if any(np.dot(n, s) > 1 - 1e-6 for s in seen):
+            continue
+        seen.append(n)
+        p = centroid - (np.dot(n, centroid) + d) * n  # projection on the facet plane
+        others = planes[np.einsum("ij,j->i", planes[:, :3], n) < 1 - 1e-6]
+        if np.all(others[:, :3] @ p + others[:, 3] <= -margin):
+            out.append(_rotation_taking(n, np.array([0.0, 0.0, -1.0])))
+    if not out:  # no facet is stable by the margin: fall back to the largest-area support
+        out.append(_rotation_taking(hull.equations[0, :3], np.array([0.0, 0.0, -1.0])))
+    return out
+
+
+def random_object_pose(obj: SceneObject, rng: np.random.Generator) -> np.ndarray:
+    """A seeded random ``world_from_object`` (4, 4): resting stably on the table, random yaw, within reach."""
+    rotations = stable_resting_rotations(obj)
+    r0 = rotations[int(rng.integers(len(rotations)))]
+    yaw = rng.uniform(0.0, 2 * np.pi)
+    rz = np.array([[np.cos(yaw), -np.sin(yaw), 0.0], [np.sin(yaw), np.cos(yaw), 0.0], [0.0, 0.0, 1.0]])
+    rot = rz @ r0
+    (x0, x1), (y0, y1) = OBJECT_REGION
+    xy = np.array([rng.uniform(x0, x1), rng.uniform(y0, y1)])
+    v = obj.vertices @ rot.T
+    centre = 0.5 * (v.min(axis=0) + v.max(axis=0))
+    t = np.array([xy[0] - centre[0], xy[1] - centre[1], TABLE_TOP_Z - v[:, 2].min()])
+    out = np.eye(4)
+    out[:3, :3] = rot
+    out[:3, 3] = t
+    return out
+
+
+def _check_pose(world_from_object: np.ndarray) -> np.ndarray:
+    t = np.asarray(world_from_object, dtype=float)
+    if t.shape != (4, 4) or not np.all(np.isfinite(t)):
+        raise SceneError(f"world_from_object: expected a finite (4, 4) transform, got shape {t.shape}")
+    r = t[:3, :3]
+    if not np.allclose(r.T @ r, np.eye(3), atol=1e-6) or np.linalg.det(r) < 0:
+        raise SceneError("world_from_object: the upper-left (3, 3) block must be a proper rotation")
+    return t
+
+
+def _mesh_asset(part: np.ndarray) -> mjcf.Asset:
+    mesh = trimesh.convex.convex_hull(part)
+    return mjcf.Asset(contents=mesh.export(file_type="stl"), extension=".stl")
+
+
+def _load_xml(path: Path) -> mjcf.RootElement:
+    try:
+        return mjcf.from_path(str(path))
+    except Exception as exc:  # dm_control raises several parser error types
+        raise SceneError(f"{path}: cannot parse MJCF: {exc}") from exc
+
+
+def compose_scene(
+    obj: SceneObject | None = None,
+    world_from_object: np.ndarray | None = None,
+    *,
+    seed: int = 0,
+) -> ComposedScene:
+    """Compose tabletop + arm + hand (+ object). Without a pose, the object gets a seeded random one.
+
+    The composed model carries a keyframe ``home`` (``ARM_HOME`` + ``HAND_TRACE``).
+    """
+    scene = _load_xml(TABLETOP_XML)
+    arm = _load_xml(ARM_XML)
+    hand = _load_xml(HAND_XML)
+    arm.model = ARM_PREFIX.rstrip("/")
+    hand.model = "hand"
+
+    flange = arm.find("site", "flange")
+    mount = scene.find("site", "arm_mount")
+    slot = scene.find("body", "object")
+    if flange is None or mount is None or slot is None:
+        raise SceneError(f"{ARM_XML} / {TABLETOP_XML}: sites 'flange', 'arm_mount' and body 'object' are required")
+    flange.attach(hand)
+    mount.attach(arm)
+
+    pose = np.eye(4)
+    if obj is not None:
+        pose = (
+            random_object_pose(obj, np.random.default_rng(seed))
+            if world_from_object is None
+            else (_check_pose(world_from_object))
+        )
+        slot.pos = pose[:3, 3]
+        quat = np.zeros(4)
+        mujoco.mju_mat2Quat(quat, pose[:3, :3].reshape(-1).copy())
+        slot.quat = quat
+        for i, part in enumerate(obj.parts):
+            mesh_name = f"object_part{i}"
+            scene.asset.add("mesh", name=mesh_name, file=_mesh_asset(part))
+            slot.add(
+                "geom",
+                name=f"object_part{i}",
+                type="mesh",
+                mesh=mesh_name,
+                dclass="scene",
+                rgba=(0.25, 0.6, 0.35, 1.0),
+                group=0,
+            )
+    scene.model = f"haptic_{obj.name}" if obj is not None else "haptic_empty"
+
+    n_act = 6 + len(HAND_JOINTS)
+    ctrl = np.zeros(n_act)
+    ctrl[6:] = HAND_TRACE
+    scene.keyframe.add("key", name="home", qpos=np.concatenate([ARM_HOME, HAND_TRACE]), ctrl=ctrl)
+    return ComposedScene(mjcf_model=scene, object=obj, world_from_object=pose)
+
+
+def export_scene(scene: ComposedScene, path: str | os.PathLike) -> Path:
+    """Write ``scene`` as a standalone MJCF at ``path`` with its mesh files beside it; return the path.
+
+    Files are written to a temporary directory first; the XML is renamed into place last, so a failure
+    never leaves a half-written scene behind.
+    """
+    out = Path(path)
+    if out.suffix.lower() != ".xml":
+        raise SceneError(f"{out}: the export path must name an .xml file, e.g. out/scene.xml")
+    out_dir = out.parent if str(out.parent) else Path(".")
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise SceneError(f"{out_dir}: cannot create the export directory: {exc}") from exc
+    tmp = Path(tempfile.mkdtemp(prefix=".scene-", dir=out_dir))
+    try:
+        mjcf.export_with_assets(scene.mjcf_model, str(tmp), out_file_name=out.name)
+        try:
+            mujoco.MjModel.from_xml_path(str(tmp / out.name))
+        except ValueError as exc:
+            raise SceneError(f"{out}: the exported scene does not load in MuJoCo: {exc}") from exc
+        for f in sorted(tmp.iterdir()):
+            if f.name != out.name:
+                os.replace(f, out_dir / f.name)
+        os.replace(tmp / out.name, out)
+    except OSError as exc:
+        raise SceneError(f"{out}: cannot write the scene: {exc}") from exc
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    return out

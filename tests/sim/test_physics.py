@@ -1,0 +1,118 @@
+"""The simulation owner and the robot-side readout: contact sensing, noise, and no peeking."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import mujoco
+import numpy as np
+import pytest
+from conftest import BOX_CENTRE, BOX_HALF, box_parts, box_pose
+
+from haptic.errors import SceneError
+from haptic.sim.control import Controller
+from haptic.sim.physics import FingertipContact, SensorNoise, SensorReading, Simulation
+from haptic.sim.robot import RobotInterface
+from haptic.sim.scene import FINGERS, compose_scene, scene_object_from_parts
+
+TOP_Z = BOX_CENTRE[2] + BOX_HALF[2]
+
+
+def _press_index_on_top(sim: Simulation, force: float = 1.0) -> Controller:
+    ctl = Controller(sim)
+    ctl.move_fingertip(np.array([BOX_CENTRE[0], BOX_CENTRE[1], TOP_Z + 0.015]))
+    ctl.step(int(0.5 / ctl.tick_period))
+    ctl.set_hybrid(force, np.zeros(3), normal_hint=np.array([0.0, 0.0, 1.0]))
+    ctl.step(int(1.0 / ctl.tick_period))
+    return ctl
+
+
+def test_ids_are_resolved_and_home_is_loaded(box_scene):
+    sim = Simulation(box_scene)
+    assert len(sim.tip_site) == len(sim.pad_geom) == len(sim.touch_adr) == 4
+    r = sim.read_sensors()
+    assert r.arm_q.shape == (6,) and r.hand_q.shape == (16,)
+    assert r.fingertip_in_world.shape == (4, 3)
+    assert np.all(r.touch == 0) and all(len(c) == 0 for c in r.contacts)
+
+
+def test_contact_readout_on_a_top_face(box_scene):
+    sim = Simulation(box_scene)
+    _press_index_on_top(sim, 1.0)
+    r = sim.read_sensors()
+    (c,) = r.contacts[FINGERS.index("index")]
+    assert isinstance(c, FingertipContact)
+    np.testing.assert_allclose(c.normal_in_world, [0, 0, 1], atol=1e-6)  # out of the face
+    assert c.force_in_world[2] > 0  # the face pushes the fingertip up
+    assert c.normal_force == pytest.approx(1.0, abs=0.1)
+    assert c.point_in_world[2] == pytest.approx(TOP_Z, abs=5e-4)
+    assert r.touch[0] == pytest.approx(c.normal_force, rel=0.05)
+    assert np.all(r.touch[1:] == 0)
+
+
+def test_sensor_noise_is_seeded(box_scene):
+    def reading(seed):
+        sim = Simulation(box_scene, noise=SensorNoise.from_notes(), seed=seed)
+        _press_index_on_top(sim)
+        return sim.read_sensors()
+
+    a, b, c = reading(1), reading(1), reading(2)
+    np.testing.assert_array_equal(a.contacts[0][0].normal_in_world, b.contacts[0][0].normal_in_world)
+    assert not np.array_equal(a.contacts[0][0].normal_in_world, c.contacts[0][0].normal_in_world)
+    angle = np.degrees(np.arccos(np.clip(a.contacts[0][0].normal_in_world[2], -1, 1)))
+    assert 0 < angle < 5
+
+
+def test_unknown_finger_names_the_valid_ones(box_scene):
+    with pytest.raises(SceneError, match="index, middle, ring, thumb"):
+        Controller(Simulation(box_scene), finger="pinky")
+
+
+# -- no peeking ------------------------------------------------------------------------------------------------
+ROBOT_FIELDS = {"time", "arm_q", "arm_qd", "hand_q", "hand_qd", "fingertip_in_world", "touch", "contacts"}
+
+
+def test_sensor_reading_holds_robot_quantities_only():
+    assert {f.name for f in dataclasses.fields(SensorReading)} == ROBOT_FIELDS
+    assert {f.name for f in dataclasses.fields(FingertipContact)} == {
+        "point_in_world",
+        "normal_in_world",
+        "force_in_world",
+        "normal_force",
+    }
+
+
+def test_robot_interface_has_no_path_to_the_object(box_scene):
+    sim = Simulation(box_scene)
+    robot = RobotInterface(sim)
+    assert not hasattr(robot, "__dict__")  # slots only: nothing can be hung on it
+    public = [n for n in dir(robot) if not n.startswith("_")]
+    for name in public:
+        assert not any(w in name.lower() for w in ("object", "truth", "scene", "model", "data", "sim", "physics"))
+        value = getattr(robot, name)
+        assert not isinstance(value, mujoco.MjModel | mujoco.MjData | Simulation)
+    reading = robot.read()
+    for f in dataclasses.fields(reading):
+        v = getattr(reading, f.name)
+        assert isinstance(v, float | np.ndarray | tuple)
+
+
+def test_readings_do_not_depend_on_where_the_object_is():
+    """Without contact, nothing the robot reads changes when the object moves: it cannot sense its pose."""
+    obj = scene_object_from_parts("box", box_parts())
+    readings = []
+    for dx in (0.0, 0.05):
+        sim = Simulation(compose_scene(obj, box_pose(BOX_CENTRE + [dx, -0.03, 0.0])))
+        robot = RobotInterface(sim)
+        robot.hold_posture()
+        robot.step(50)
+        readings.append(robot.read())
+    a, b = readings
+    for f in dataclasses.fields(SensorReading):
+        va, vb = getattr(a, f.name), getattr(b, f.name)
+        if isinstance(va, np.ndarray):
+            np.testing.assert_array_equal(va, vb)
+        else:
+            assert va == vb
+    gt = [Simulation(compose_scene(obj, box_pose(BOX_CENTRE + [dx, 0, 0]))).ground_truth() for dx in (0, 0.05)]
+    assert gt[1].world_from_object[0, 3] - gt[0].world_from_object[0, 3] == pytest.approx(0.05)

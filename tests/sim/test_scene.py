@@ -1,0 +1,117 @@
+"""Scene composition, seeded placement and export."""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+import pytest
+from conftest import box_parts, l_shape_parts
+
+from haptic.errors import SceneError
+from haptic.sim import scene as sc
+from haptic.sim.scene import (
+    OBJECT_REGION,
+    TABLE_TOP_Z,
+    compose_scene,
+    export_scene,
+    load_object,
+    random_object_pose,
+    scene_object_from_parts,
+)
+
+
+def _world_vertices(obj, t):
+    return obj.vertices @ t[:3, :3].T + t[:3, 3]
+
+
+@pytest.mark.parametrize("parts", [box_parts(), l_shape_parts()], ids=["box", "L"])
+def test_random_pose_is_seeded_resting_and_within_reach(parts):
+    obj = scene_object_from_parts("thing", parts)
+    a = random_object_pose(obj, np.random.default_rng(7))
+    b = random_object_pose(obj, np.random.default_rng(7))
+    c = random_object_pose(obj, np.random.default_rng(8))
+    np.testing.assert_array_equal(a, b)
+    assert not np.allclose(a, c)
+    for seed in range(20):
+        t = random_object_pose(obj, np.random.default_rng(seed))
+        v = _world_vertices(obj, t)
+        assert v[:, 2].min() == pytest.approx(TABLE_TOP_Z, abs=1e-9)
+        centre = 0.5 * (v.min(axis=0) + v.max(axis=0))
+        (x0, x1), (y0, y1) = OBJECT_REGION
+        assert x0 - 1e-9 <= centre[0] <= x1 + 1e-9 and y0 - 1e-9 <= centre[1] <= y1 + 1e-9
+
+
+def test_object_meshes_sit_where_the_pose_puts_them():
+    obj = scene_object_from_parts("L", l_shape_parts())
+    scene = compose_scene(obj, seed=3)
+    m = scene.compile()
+    d = mujoco.MjData(m)
+    mujoco.mj_forward(m, d)
+    for i, part in enumerate(obj.parts):
+        g = m.geom(f"object_part{i}")
+        adr, n = m.mesh_vertadr[g.dataid[0]], m.mesh_vertnum[g.dataid[0]]
+        got = m.mesh_vert[adr : adr + n] @ d.geom_xmat[g.id].reshape(3, 3).T + d.geom_xpos[g.id]
+        want = part @ scene.world_from_object[:3, :3].T + scene.world_from_object[:3, 3]
+        np.testing.assert_allclose(np.sort(got, axis=0), np.sort(want, axis=0), atol=1e-6)
+
+
+def test_library_object_loads_with_convex_pieces():
+    obj = load_object("LBLOCK01")
+    assert obj.name == "LBLOCK01" and len(obj.parts) >= 2  # non-convex: several convex mesh geoms
+    assert len(load_object("BOX01").parts) == 1
+
+
+def test_unknown_object_names_the_valid_ones():
+    with pytest.raises(SceneError, match="valid names: .*BOX01"):
+        load_object("NO_SUCH_MODEL")
+
+
+def test_degenerate_part_is_refused():
+    flat = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]], float) * 0.05
+    with pytest.raises(SceneError, match="part 0"):
+        scene_object_from_parts("flat", [flat])
+
+
+def test_bad_pose_is_refused():
+    t = np.eye(4)
+    t[:3, :3] *= 2.0
+    with pytest.raises(SceneError, match="rotation"):
+        compose_scene(scene_object_from_parts("box", box_parts()), t)
+
+
+def test_export_loads_in_plain_mujoco(tmp_path):
+    scene = compose_scene(load_object("LBLOCK01"), seed=5)
+    path = export_scene(scene, tmp_path / "out" / "scene.xml")
+    m = mujoco.MjModel.from_xml_path(str(path))
+    names = [m.joint(i).name for i in range(m.njnt)]
+    assert sum(n.startswith("arm/") and "/hand/" not in n for n in names) == 6
+    assert sum("/hand/" in n for n in names) == 16
+    assert sum(m.sensor_type[i] == mujoco.mjtSensor.mjSENS_TOUCH for i in range(m.nsensor)) == 4
+    assert sorted(p.suffix for p in path.parent.iterdir()) == [".stl", ".stl", ".xml"]
+    assert mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_KEY, "home") >= 0
+
+
+def test_failed_export_leaves_nothing_behind(tmp_path, monkeypatch):
+    scene = compose_scene(scene_object_from_parts("box", box_parts()), seed=0)
+
+    def boom(*args, **kwargs):
+        raise OSError("disk full")
+
+    monkeypatch.setattr(sc.mjcf, "export_with_assets", boom)
+    with pytest.raises(SceneError, match="disk full"):
+        export_scene(scene, tmp_path / "scene.xml")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_export_path_must_be_xml(tmp_path):
+    scene = compose_scene(None)
+    with pytest.raises(SceneError, match=r"\.xml"):
+        export_scene(scene, tmp_path / "scene")
+
+
+def test_checked_in_scene_matches_the_composition():
+    m = mujoco.MjModel.from_xml_path(str(sc.REPO_ROOT / "scenes" / "scene.xml"))
+    fresh = compose_scene(None).compile()
+    for attr in ("njnt", "nbody", "ngeom", "nsite", "nsensor", "nu", "nkey"):
+        assert getattr(m, attr) == getattr(fresh, attr), attr
+    np.testing.assert_allclose(m.body_pos, fresh.body_pos, atol=1e-9)
