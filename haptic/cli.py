@@ -48,13 +48,14 @@ def _models_list(args: argparse.Namespace) -> int:
         for r in rows:
             print(json.dumps(r))
         return 0
-    head = f"{'name':<12} {'V':>3} {'E':>3} {'F':>3} {'V-E+F':>5} {'genus':>5} {'convex':>6} {'sym':>4}  size [mm]"
+    w = max(12, *(len(r["name"]) for r in rows))
+    head = f"{'name':<{w}} {'V':>3} {'E':>3} {'F':>3} {'V-E+F':>5} {'genus':>5} {'convex':>6} {'sym':>4}  size [mm]"
     print(head)
     print("-" * len(head))
     for r in rows:
         size = " x ".join(f"{x:g}" for x in r["extents_mm"])
         print(
-            f"{r['name']:<12} {r['V']:>3} {r['E']:>3} {r['F']:>3} {r['euler']:>5} {r['genus']:>5} "
+            f"{r['name']:<{w}} {r['V']:>3} {r['E']:>3} {r['F']:>3} {r['euler']:>5} {r['genus']:>5} "
             f"{'yes' if r['convex'] else 'no':>6} {r['symmetry']:>4}  {size}"
         )
     print(f"{len(rows)} models")

@@ -135,3 +135,24 @@ def test_convex_decomposition_is_exact(name):
     for p in pieces:
         c = p.mean(axis=0)
         assert m.contains(c + 0.98 * (p - c)).all()
+
+
+def test_lookalike_library_has_30_or_more_pairwise_distinct_models():
+    from pathlib import Path
+
+    lib = load_library(Path(__file__).resolve().parents[2] / "assets" / "libraries" / "lookalike")
+    assert len(lib) >= 30
+    names = sorted(lib)
+    for i, a in enumerate(names):
+        for b in names[i + 1 :]:
+            assert not are_congruent(lib[a], lib[b]), (a, b)
+
+
+def test_shipped_files_are_what_the_generator_makes():
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[2]
+    r = subprocess.run([sys.executable, str(root / "scripts" / "make_models.py"), "--check"], capture_output=True)
+    assert r.returncode == 0, r.stderr.decode()
