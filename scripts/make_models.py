@@ -73,9 +73,8 @@ def lookalike_models() -> list[Polyhedron]:
                  (100, 80, 54), (80, 80, 60)]:
         out.append(box(*(d * mm for d in dims), name="LA_BOX_{}x{}x{}".format(*dims)))
     for base, height, depth in [(100, 60, 80), (100, 54, 80), (94, 60, 80), (100, 60, 74)]:
-        out.append(
-            extrusion_xz([(0, 0), (base * mm, 0), (0, height * mm)], depth * mm, name=f"LA_WEDGE_{base}x{height}x{depth}")
-        )
+        profile = [(0, 0), (base * mm, 0), (0, height * mm)]
+        out.append(extrusion_xz(profile, depth * mm, name=f"LA_WEDGE_{base}x{height}x{depth}"))
     out += [
         regular_prism(5, 0.045, 0.060, name="LA_PENTPRISM_r45h60"),
         regular_prism(6, 0.040, 0.060, name="LA_HEXPRISM_r40h60"),

@@ -77,6 +77,13 @@ class DataEdge:
     """Id of the data vertex at ``p + l b`` when the interval ends at a known vertex, else None."""
     adjacent: tuple[int, ...] = ()
     """Ids of earlier components known to be adjacent (its faces, its vertices)."""
+    side_points: tuple[tuple[int, np.ndarray], ...] = ()
+    """Optional ``(face id, point)`` pairs: a contact point on that face close to this edge, world frame [m].
+
+    It tells on which side of the edge the face lies (seed §2.4: the sign of the determinant of face normal,
+    edge direction and relative position). The executor knows it (where the sensor crossed onto or off the
+    edge). The face may be reported after the edge. Without one, the matcher uses the face's touched point
+    nearest to the explored interval."""
 
     kind = "edge"
 
@@ -84,6 +91,7 @@ class DataEdge:
         object.__setattr__(self, "direction", _vec(self.direction))
         object.__setattr__(self, "point", _vec(self.point))
         object.__setattr__(self, "adjacent", tuple(int(i) for i in self.adjacent))
+        object.__setattr__(self, "side_points", tuple((int(f), _vec(q)) for f, q in self.side_points))
 
     @property
     def end_point(self) -> np.ndarray:

@@ -1,0 +1,172 @@
+"""Symmetry grouping and the recognition status (seed §2.3, §2.5).
+
+Interpretations of one model whose poses differ by a symmetry of the model (a proper rigid self-map,
+:func:`~haptic.geometry.symmetry_group`) describe the same solid in the world: they form one *pose class*, and
+no touch data can tell them apart (BOX01 has 4). The object is *recognized* when every survivor belongs to one
+model and one pose class; *ambiguous* when the survivors fall in several classes that all describe the same
+solid in the world (models congruent by a proper rigid motion), so no further data can separate them;
+*no-match* when none survive; otherwise still *exploring*.
+"""
+
+from __future__ import annotations
+
+import weakref
+from dataclasses import dataclass
+
+import numpy as np
+
+from haptic.geometry.polyhedron import Polyhedron
+from haptic.geometry.se3 import SE3, rotation_angle
+from haptic.geometry.symmetry import congruences, symmetry_group
+from haptic.matching.tree import Interpretation, InterpretationTree
+
+RECOGNIZED, AMBIGUOUS, NO_MATCH, EXPLORING = "recognized", "ambiguous", "no-match", "exploring"
+
+_SYMMETRY: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+_CONGRUENCE: dict[tuple[int, int], list[SE3]] = {}
+
+
+def model_symmetries(model: Polyhedron) -> list[SE3]:
+    """The model's symmetry group (cached per model object)."""
+    if model not in _SYMMETRY:
+        _SYMMETRY[model] = symmetry_group(model)
+    return _SYMMETRY[model]
+
+
+@dataclass(frozen=True)
+class PoseTolerance:
+    """When two poses are the same (up to noise): derived from the data's error bounds by :meth:`from_data`."""
+
+    angle: float = np.deg2rad(3.0)
+    """Largest rotation between equal poses [rad]."""
+    distance: float = 3e-3
+    """Largest displacement of the model centroid between equal poses [m]."""
+
+    @classmethod
+    def from_data(cls, data) -> PoseTolerance:
+        """``max(3°, 6 × the largest angular bound)`` and ``max(3 mm, 6 × the largest position bound)``: distinct
+        pose classes of a rigid solid differ by far more than the pose noise."""
+        ang, pos = 0.0, 0.0
+        for c in data:
+            ang = max(ang, getattr(c, "normal_bound", 0.0), getattr(c, "direction_bound", 0.0))
+            pos = max(pos, getattr(c, "position_bound", 0.0), getattr(c, "length_bound", 0.0))
+        return cls(max(np.deg2rad(3.0), 6 * ang), max(3e-3, 6 * pos))
+
+
+def same_pose(a: SE3, b: SE3, model: Polyhedron, tol: PoseTolerance) -> bool:
+    """True when two ``world_from_model`` poses place the model alike (rotation and centroid within ``tol``)."""
+    c = model.centroid
+    return (
+        rotation_angle(a.rotation.T @ b.rotation) <= tol.angle
+        and float(np.linalg.norm(a.apply(c) - b.apply(c))) <= tol.distance
+    )
+
+
+def equivalent_by_symmetry(a: SE3, b: SE3, model: Polyhedron, tol: PoseTolerance) -> bool:
+    """True when ``b ≈ a ∘ S`` for a symmetry S of the model: the two poses put the same solid in the world."""
+    return any(same_pose(a @ s, b, model, tol) for s in model_symmetries(model))
+
+
+@dataclass(frozen=True, eq=False)
+class PoseClass:
+    """Interpretations of one model whose poses differ by a model symmetry."""
+
+    model: Polyhedron
+    """The model."""
+    leaves: tuple[int, ...]
+    """Leaf indices (in the tree) of the interpretations in the class."""
+    world_from_model: SE3
+    """Pose of the class's first interpretation (least-squares refined)."""
+
+    @property
+    def name(self) -> str:
+        return self.model.name
+
+
+@dataclass(frozen=True, eq=False)
+class Recognition:
+    """The matcher's verdict after the data so far."""
+
+    status: str
+    """"recognized", "ambiguous", "no-match" or "exploring"."""
+    model: str | None
+    """The recognised model's name (status "recognized"), else None."""
+    world_from_model: SE3 | None
+    """The recognised pose (status "recognized"), else None."""
+    classes: tuple[PoseClass, ...]
+    """Pose classes of the survivors (empty while some pose is undetermined or there are too many)."""
+    count: int
+    """Number of surviving interpretations."""
+    models: tuple[str, ...]
+    """Names of the models with surviving interpretations."""
+
+
+def group_pose_classes(interpretations: list[Interpretation], tol: PoseTolerance) -> list[PoseClass] | None:
+    """Group interpretations into pose classes; None when some interpretation has no pose yet."""
+    reps: list[tuple[Interpretation, list[int]]] = []
+    for it in interpretations:
+        if it.world_from_model is None:
+            return None
+        for rep, members in reps:
+            if rep.model_index == it.model_index and equivalent_by_symmetry(
+                rep.world_from_model, it.world_from_model, it.model, tol
+            ):
+                members.append(it.leaf)
+                break
+        else:
+            reps.append((it, [it.leaf]))
+    return [PoseClass(rep.model, tuple(m), rep.world_from_model) for rep, m in reps]
+
+
+def same_solid(a: PoseClass, b: PoseClass, tol: PoseTolerance) -> bool:
+    """True when two pose classes put congruent solids at the same place (no touch can separate them)."""
+    if a.model is b.model:
+        return equivalent_by_symmetry(a.world_from_model, b.world_from_model, a.model, tol)
+    key = (id(a.model), id(b.model))
+    if key not in _CONGRUENCE:
+        _CONGRUENCE[key] = congruences(a.model, b.model)
+    # T_a(A) = T_b(B) with B = C(A)  ⇔  T_a ≈ T_b ∘ C
+    return any(same_pose(b.world_from_model @ c, a.world_from_model, a.model, tol) for c in _CONGRUENCE[key])
+
+
+def recognize(tree: InterpretationTree, max_interpretations: int = 64, tol: PoseTolerance | None = None) -> Recognition:
+    """The recognition status of a tree (poses are computed only for up to ``max_interpretations``)."""
+    models = tree.models_alive()
+    n = tree.count
+    if n == 0:
+        return Recognition(NO_MATCH, None, None, (), 0, ())
+    if n > max_interpretations:
+        return Recognition(EXPLORING, None, None, (), n, models)
+    tol = tol if tol is not None else PoseTolerance.from_data(tree.data)
+    interps = [tree.interpretation(i, with_pose=True, refine=False) for i in range(n)]
+    classes = group_pose_classes(interps, tol)
+    if classes is None:
+        return Recognition(EXPLORING, None, None, (), n, models)
+    refined = []
+    for c in classes:
+        it = tree.interpretation(c.leaves[0], with_pose=True, refine=True)
+        refined.append(PoseClass(c.model, c.leaves, it.world_from_model or c.world_from_model))
+    classes = refined
+    if len(classes) == 1:
+        c = classes[0]
+        return Recognition(RECOGNIZED, c.name, c.world_from_model, tuple(classes), n, models)
+    if all(same_solid(classes[0], c, tol) for c in classes[1:]):
+        return Recognition(AMBIGUOUS, None, None, tuple(classes), n, models)
+    return Recognition(EXPLORING, None, None, tuple(classes), n, models)
+
+
+__all__ = [
+    "AMBIGUOUS",
+    "EXPLORING",
+    "NO_MATCH",
+    "RECOGNIZED",
+    "PoseClass",
+    "PoseTolerance",
+    "Recognition",
+    "equivalent_by_symmetry",
+    "group_pose_classes",
+    "model_symmetries",
+    "recognize",
+    "same_pose",
+    "same_solid",
+]
