@@ -122,8 +122,15 @@ def _optional_subcommands() -> list[Callable[[argparse._SubParsersAction], None]
     return out
 
 
+class _Parser(argparse.ArgumentParser):
+    """Usage errors as one line on stderr (exit 2), like every other error of the command."""
+
+    def error(self, message: str):
+        self.exit(2, f"{self.prog}: error: {message} (see '{self.prog} --help')\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    ap = argparse.ArgumentParser(
+    ap = _Parser(
         prog="haptic",
         description="Recognise and localise polyhedral objects by active touch with a simulated robot hand.",
     )

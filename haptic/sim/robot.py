@@ -72,6 +72,15 @@ class RobotInterface:
     def hybrid_status(self) -> HybridStatus | None:
         return self._ctl.hybrid_status()
 
+    def last_contact(self) -> ContactSummary:
+        """The active fingertip's contact as the controller sensed it at its last hybrid tick (noise applied);
+        in the other modes, sensed now."""
+        return self._ctl.last_contact()
+
+    def is_stable(self) -> bool:
+        """False when the simulation state is not finite or MuJoCo has raised a warning (instability)."""
+        return self._sim.state_is_finite() and not self._sim.warnings()
+
     def fingertip_pose(self) -> tuple[np.ndarray, np.ndarray]:
         """Active fingertip position (3,) [m] and hand rotation (3, 3), from the joint encoders."""
         return self._ctl.fingertip_pose()[0], self._ctl.hand_rotation()

@@ -1,0 +1,1 @@
+"""Benchmarks: many episodes across models, poses, noise levels and policies; tables and plots."""

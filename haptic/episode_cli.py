@@ -1,0 +1,93 @@
+"""``haptic explore``: one episode, a summary on stdout, optionally its JSON record and a rerun recording."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+from haptic.errors import HapticError
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    from haptic.planning.policies import POLICY_NAMES
+
+    p = sub.add_parser(
+        "explore",
+        help="run one episode: explore an object by touch until it is recognised",
+        description="One episode. Exit 0 when the episode ends normally, whatever its outcome.",
+    )
+    p.add_argument("--object", required=True, help="model name in the library, or a path to a model file")
+    p.add_argument("--models", metavar="DIR", help="library directory (default: the shipped assets/models)")
+    p.add_argument("--executor", choices=("geometric", "physics"), default="geometric")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--policy", default="planner", choices=POLICY_NAMES)
+    p.add_argument("--noise", type=float, default=1.0, help="sensor-noise level (x default sigma)")
+    p.add_argument("--max-moves", type=int, default=40)
+    p.add_argument("--json", metavar="OUT", help="write the episode's JSON record here")
+    p.add_argument("--record", metavar="OUT.rrd", help="write a rerun recording here")
+    p.add_argument("--spawn", action="store_true", help="open the rerun viewer (where one is installed)")
+    p.set_defaults(run=run)
+
+
+def summary_lines(rec: dict) -> list[str]:
+    lines = [
+        f"object      {rec['model']}  (executor {rec['executor']}, policy {rec['policy']}, seed {rec['seed']})",
+        f"outcome     {rec['outcome']}" + (f": {rec['recognized']}" if rec["recognized"] else "")
+        + ("  [correct]" if rec["correct"] else "  [wrong]" if rec["outcome"] == "recognized" else ""),
+        f"moves       {rec['moves']} ({', '.join(rec['move_kinds'][1:]) or 'none'})",
+        f"path cost   {rec['path_cost']:.1f} units",
+        f"data        {rec['faces']} faces, {rec['edges']} edges, {rec['vertices']} vertices",
+        "interpret.  " + " -> ".join(str(c) for c in rec["interpretations"]),
+    ]
+    if rec["pose_error_mm"] is not None:
+        lines.append(f"pose error  {rec['pose_error_mm']:.3f} mm, {rec['pose_error_deg']:.3f} deg")
+    time_line = f"wall time   {rec['wall_time_s']:.2f} s"
+    if rec.get("sim_time_s") is not None:
+        time_line += f"; simulated {rec['sim_time_s']:.2f} s"
+    lines.append(time_line)
+    if rec.get("perception"):
+        p = rec["perception"]
+        lines.append(
+            "perception  " + ", ".join(f"{k} {v:.3g}" for k, v in p.items() if isinstance(v, int | float))
+        )
+    if rec.get("detail"):
+        lines.append(f"detail      {rec['detail']}")
+    return lines
+
+
+def run(args: argparse.Namespace) -> int:
+    from haptic.bench.runner import EpisodeSpec
+    from haptic.episode import run_episode
+    from haptic.geometry import load_library
+    from haptic.geometry.io import atomic_write
+
+    if args.max_moves < 1:
+        raise HapticError(f"--max-moves must be at least 1, got {args.max_moves}")
+    if args.noise < 0:
+        raise HapticError(f"--noise must be >= 0, got {args.noise}")
+    library = load_library(args.models)
+    spec = EpisodeSpec(
+        model=args.object, seed=args.seed, policy=args.policy, executor=args.executor, noise=args.noise,
+        models=args.models, max_moves=args.max_moves, record=args.record,
+    )
+    observer = None
+    recorder = None
+    if args.record or args.spawn:
+        from haptic.recording import EpisodeRecorder
+
+        recorder = EpisodeRecorder(args.record, spawn=args.spawn)
+        observer = recorder.observer()
+    try:
+        record = run_episode(spec, library=library, observer=observer).to_json()
+    finally:
+        if recorder is not None:
+            recorder.close()
+    for line in summary_lines(record):
+        print(line)
+    if args.json:
+        atomic_write(Path(args.json), json.dumps(record, indent=2) + "\n")
+        print(f"json        {args.json}")
+    if args.record:
+        print(f"recording   {args.record}  (open with: rerun {args.record})")
+    return 0

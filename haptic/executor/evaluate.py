@@ -1,0 +1,208 @@
+"""Scoring of data components against ground truth -- evaluation code, OUTSIDE the executor.
+
+Given the true model and its pose (``Simulation.ground_truth()``), each data component is matched to the nearest
+true component of its kind: a face by normal and plane distance, an edge by the distance of its explored interval
+from the true edge segment and its direction, a vertex by position. Errors: face normal [deg], edge direction
+[deg], edge position [mm] (largest distance of the interval's ends from the true edge line), vertex position
+[mm]. A component farther than the tolerances from every true component of its kind is *spurious*. A move whose
+reported edge (vertex) is not the first true edge (vertex) on the ideal path from where the move started -- it
+crossed a true edge without reporting it -- counts one *missed* component.
+
+The executor and the segmenter never import this module.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from haptic.geometry import tracing
+from haptic.geometry.polyhedron import Polyhedron
+from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex
+
+
+@dataclass(frozen=True)
+class EvaluationTolerances:
+    """Beyond these a data component matches no true component (spurious)."""
+
+    normal: float = math.radians(5.0)
+    """Face normal [rad]."""
+    plane: float = 0.003
+    """Mean distance of a face's points from the true plane [m]."""
+    direction: float = math.radians(5.0)
+    """Edge direction [rad]."""
+    position: float = 0.003
+    """Edge interval from the true edge segment; vertex from the true vertex [m]."""
+
+
+@dataclass(frozen=True)
+class ComponentScore:
+    """One data component against its nearest true component."""
+
+    id: int
+    """Data id."""
+    kind: str
+    """``face`` | ``edge`` | ``vertex``."""
+    true_id: int | None
+    """Index of the matched true component in the model, None when spurious."""
+    angle_deg: float
+    """Normal / direction error [deg] (NaN for a vertex)."""
+    position_mm: float
+    """Plane / line / point distance [mm]."""
+
+
+@dataclass(frozen=True)
+class PerceptionScore:
+    """All component scores of an exploration and the counts of spurious and missed components."""
+
+    components: tuple[ComponentScore, ...]
+    """Latest report of every data id."""
+    spurious: int
+    """Data components with no true counterpart within tolerance."""
+    missed: int
+    """True edges / vertices crossed without being reported (see module doc)."""
+    concave_edges_found: int = 0
+    """Data edges matched to concave true edges."""
+    details: dict = field(default_factory=dict)
+    """Per-move checks."""
+
+    def errors(self, kind: str, what: str) -> np.ndarray:
+        """Errors of matched components of ``kind``: ``what`` is ``angle`` or ``position``."""
+        vals = [c.angle_deg if what == "angle" else c.position_mm for c in self.components
+                if c.kind == kind and c.true_id is not None]  # fmt: skip
+        return np.array(vals, dtype=float)
+
+    def summary(self) -> dict:
+        """Median and max of each error (JSON-friendly; NaN when there is none)."""
+
+        def stats(a: np.ndarray) -> dict:
+            return {
+                "median": float(np.median(a)) if len(a) else math.nan,
+                "max": float(a.max()) if len(a) else math.nan,
+            }
+
+        return {
+            "face_normal_deg": stats(self.errors("face", "angle")),
+            "edge_direction_deg": stats(self.errors("edge", "angle")),
+            "edge_position_mm": stats(self.errors("edge", "position")),
+            "vertex_position_mm": stats(self.errors("vertex", "position")),
+            "spurious": self.spurious,
+            "missed": self.missed,
+            "concave_edges_found": self.concave_edges_found,
+        }
+
+
+def _latest(components) -> list[DataComponent]:
+    out: dict[int, DataComponent] = {}
+    for c in components:
+        out[c.id] = c
+    return [out[i] for i in sorted(out)]
+
+
+def _segment_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
+    ab = b - a
+    s = float(np.clip((p - a) @ ab / (ab @ ab), 0.0, 1.0))
+    return float(np.linalg.norm(p - (a + s * ab)))
+
+
+def score_face(c: DataFace, model: Polyhedron, rot: np.ndarray, trans: np.ndarray, tol: EvaluationTolerances):
+    normals = model.face_normals @ rot.T
+    offsets = model.face_offsets + normals @ trans
+    ang = np.degrees(np.arccos(np.clip(normals @ c.normal, -1, 1)))
+    dist = np.abs(c.points @ normals.T - offsets).mean(axis=0)
+    cost = ang / math.degrees(tol.normal) + dist / tol.plane
+    k = int(np.argmin(cost))
+    ok = ang[k] <= math.degrees(tol.normal) and dist[k] <= tol.plane
+    return ComponentScore(c.id, "face", k if ok else None, float(ang[k]), float(dist[k] * 1e3))
+
+
+def score_edge(c: DataEdge, model: Polyhedron, rot: np.ndarray, trans: np.ndarray, tol: EvaluationTolerances):
+    best = None
+    for e in range(model.n_edges):
+        a = rot @ model.vertices[model.edges[e, 0]] + trans
+        b = rot @ model.vertices[model.edges[e, 1]] + trans
+        u = (b - a) / np.linalg.norm(b - a)
+        ang = math.degrees(math.acos(min(1.0, abs(float(u @ c.direction)))))
+        line = max(float(np.linalg.norm(np.cross(q - a, u))) for q in (c.point, c.end_point))
+        seg = max(_segment_distance(q, a, b) for q in (c.point, c.end_point))
+        cost = ang / math.degrees(tol.direction) + seg / tol.position
+        if best is None or cost < best[0]:
+            best = (cost, e, ang, line, seg)
+    _, e, ang, line, seg = best
+    ok = ang <= math.degrees(tol.direction) and seg <= tol.position
+    return ComponentScore(c.id, "edge", e if ok else None, ang, line * 1e3)
+
+
+def score_vertex(c: DataVertex, model: Polyhedron, rot: np.ndarray, trans: np.ndarray, tol: EvaluationTolerances):
+    v = model.vertices @ rot.T + trans
+    d = np.linalg.norm(v - c.position, axis=1)
+    k = int(np.argmin(d))
+    return ComponentScore(c.id, "vertex", k if d[k] <= tol.position else None, math.nan, float(d[k] * 1e3))
+
+
+def score_components(
+    components,
+    model: Polyhedron,
+    world_from_model: np.ndarray,
+    results=None,
+    tolerances: EvaluationTolerances | None = None,
+) -> PerceptionScore:
+    """Score ``components`` (every report; the latest of each id counts) against ``model`` at
+    ``world_from_model`` (4, 4). With the move ``results`` (``MoveResult`` records, start first), also count
+    missed components: the first true edge on a face move's ideal straight path, and the true vertex an edge
+    move runs to, must be the ones reported."""
+    tol = tolerances or EvaluationTolerances()
+    t = np.asarray(world_from_model, dtype=float)
+    rot, trans = t[:3, :3], t[:3, 3]
+    scores = []
+    for c in _latest(components):
+        if isinstance(c, DataFace):
+            scores.append(score_face(c, model, rot, trans, tol))
+        elif isinstance(c, DataEdge):
+            scores.append(score_edge(c, model, rot, trans, tol))
+        else:
+            scores.append(score_vertex(c, model, rot, trans, tol))
+    by_id = {s.id: s for s in scores}
+    convexity = model.edge_convexity
+    concave = sum(1 for s in scores if s.kind == "edge" and s.true_id is not None and convexity[s.true_id] < 0)
+    missed, details = 0, {}
+    if results:
+        missed, details = _missed(results, model, rot, trans, by_id)
+    return PerceptionScore(tuple(scores), sum(1 for s in scores if s.true_id is None), missed, concave, details)
+
+
+def _missed(results, model: Polyhedron, rot: np.ndarray, trans: np.ndarray, by_id: dict) -> tuple[int, dict]:
+    missed = 0
+    checks = []
+    prev_state = None
+    for r in results:
+        if r.ok and r.move.kind == "face" and prev_state is not None and r.components:
+            f_score = by_id.get(prev_state.face)
+            e_score = by_id.get(r.components[0].id)
+            trace = r.info.get("trace")
+            if f_score and f_score.true_id is not None and e_score and trace is not None:
+                rows = trace.in_contact & (trace.phase == 3)  # "face" rows: where the straight trace began
+                if rows.any():
+                    start = trace.point_in_world[np.flatnonzero(rows)[0]]
+                    d = np.asarray(r.move.direction, float)
+                    start_m = rot.T @ (start - trans)
+                    d_m = rot.T @ d
+                    n = model.face_normals[f_score.true_id]
+                    d_m = d_m - (d_m @ n) * n
+                    start_m = start_m - (start_m @ n - model.face_offsets[f_score.true_id]) * n
+                    try:
+                        hit = tracing.trace_face(model, f_score.true_id, start_m, d_m)
+                    except (ValueError, IndexError):
+                        hit = None
+                    if hit is not None:
+                        ok = e_score.true_id == hit.edge
+                        missed += 0 if ok else 1
+                        checks.append(("face", r.components[0].id, hit.edge, e_score.true_id, ok))
+        if r.ok:
+            prev_state = r.state
+    return missed, {"checks": checks}
+
+
+__all__ = ["ComponentScore", "EvaluationTolerances", "PerceptionScore", "score_components"]

@@ -1,0 +1,569 @@
+"""The physics executor: the seed's three moves (§4) carried out by the simulated hand under force control.
+
+:class:`PhysicsExecutor` has the interface of the geometric executor -- ``start()`` and ``execute(move)``
+returning :class:`~haptic.planning.moves.MoveResult` records with the same components, ids, adjacency and
+sensor states -- so the matcher and the planner do not know which executor they talk to. It is built on the
+primitives of :mod:`haptic.executor.primitives` and the segmenter of :mod:`haptic.executor.segment`, and
+it is given a :class:`~haptic.sim.robot.RobotInterface` only: joint encoders / forward kinematics and the
+fingertip's sensed contact. It never sees the simulation, the scene, the object or its pose; the only prior
+it uses is the workspace (the table's height and the region where objects are placed).
+
+Costs are computed from the distances actually travelled by each move's main trace (seed §3.1). Faults --
+contact lost, joint limit / unreachable target, blocked motion, timeout, simulation instability -- end the
+move with a status; no exception escapes :meth:`PhysicsExecutor.execute`.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from haptic.errors import HapticError
+from haptic.executor.primitives import (
+    PHASES,
+    ContactTrace,
+    PrimitiveResult,
+    TouchConfig,
+    Toucher,
+    angle,
+    perpendicular,
+)
+from haptic.executor.segment import FaceFit, SegmentBounds, Segmenter, fit_face
+from haptic.matching.components import DataComponent
+from haptic.planning.moves import CostModel, EdgeMove, FaceMove, Move, MoveResult, SensorState, VertexMove
+from haptic.sim.robot import RobotInterface
+from haptic.sim.scene import OBJECT_REGION, TABLE_TOP_Z
+
+
+@dataclass(frozen=True)
+class PhysicsSettings:
+    """Geometry of the moves and of the start (workspace prior)."""
+
+    touch: TouchConfig = field(default_factory=TouchConfig)
+    """Forces, speeds and detection thresholds of the primitives."""
+    approach_height: float = 0.11
+    """Start: the pad centre descends from this height above the table [m]."""
+    search_floor: float = 0.018
+    """Start: ... down to this height of the pad centre above the table (nothing touched: no object there) [m]."""
+    search_speed: float = 0.10
+    """Start: speed of the fast guarded descent [m/s]."""
+    search_spacing: float = 0.025
+    """Start: spacing of the landing grid over the object region [m]."""
+    search_margin: float = 0.04
+    """Start: the grid extends this far beyond the object region [m]."""
+    max_landings: int = 40
+    """Start: landing attempts before giving up."""
+    normal_stroke: float = 0.004
+    """Start: length of each leg of the L stroke for the first face's normal [m]."""
+    max_face_trace: float = 0.25
+    """Longest trace across a face before a face move gives up [m]."""
+    max_edge_trace: float = 0.25
+    """Longest trace along an edge [m]."""
+    vertex_radius: float = 0.008
+    """Radius of the circle around a vertex (contact point) [m]."""
+    vertex_start_angle: float = math.radians(25.0)
+    """The circle starts this far from the current edge [rad]."""
+    vertex_standoff: float = 0.004
+    """After an edge move the pad rests on the current face this far back along the edge and in from it [m]."""
+    table_margin: float = 0.003
+    """A contact below the table top plus this, with an upward normal, is the table [m]."""
+
+
+@dataclass
+class _FaceData:
+    points: np.ndarray
+    normals: np.ndarray
+    anchor: np.ndarray  # a contact point known to be on the face
+
+
+class PhysicsExecutor:
+    """Executes face, edge and vertex moves with the simulated hand and segments what it senses."""
+
+    def __init__(
+        self,
+        robot: RobotInterface,
+        bounds: SegmentBounds | None = None,
+        costs: CostModel | None = None,
+        rng: np.random.Generator | None = None,
+        settings: PhysicsSettings | None = None,
+        finger: str = "index",
+    ) -> None:
+        if not isinstance(robot, RobotInterface):
+            raise TypeError(
+                f"PhysicsExecutor takes a RobotInterface (sensors and commands only), not {type(robot).__name__}; "
+                "wrap a Simulation as RobotInterface(sim)"
+            )
+        self.robot = robot
+        self.bounds = bounds or SegmentBounds()
+        self.costs = costs or CostModel()
+        self.rng = rng if rng is not None else np.random.default_rng(0)
+        s = settings or PhysicsSettings()
+        if s.touch.force_sigma != self.bounds.force_sigma:
+            s = PhysicsSettings(
+                **{**s.__dict__, "touch": TouchConfig(**{**s.touch.__dict__, "force_sigma": self.bounds.force_sigma})}
+            )
+        self.settings = s
+        self.toucher = Toucher(robot, s.touch, finger)
+        self.segmenter = Segmenter(self.bounds)
+        self.state: SensorState | None = None
+        """Sensor state after the last move (None before :meth:`start`)."""
+        self.traces: list[ContactTrace] = []
+        """Every contact trace recorded, one per move (start included)."""
+        self._faces: dict[int, _FaceData] = {}
+        self._on_face: int | None = None  # data face the pad is known to rest on
+        self._finger = finger
+
+    @property
+    def components(self) -> list[DataComponent]:
+        """Every component reported so far, in order (re-reported edges appear again)."""
+        return self.segmenter.components
+
+    # ------------------------------------------------------------------------------------------ plumbing
+    def _run(self, move: Move, body) -> MoveResult:
+        t0, w0 = self.robot.time, time.perf_counter()
+        pieces: list[PrimitiveResult] = []
+        try:
+            res = body(pieces)
+        except (HapticError, FloatingPointError, ValueError, np.linalg.LinAlgError) as exc:
+            self._on_face = None
+            res = MoveResult(move=move, status="unstable", state=self.state, info={"reason": str(exc)})
+        except Exception as exc:  # noqa: BLE001 -- mujoco raises plain exceptions on a diverged state
+            self._on_face = None
+            res = MoveResult(move=move, status="unstable", state=self.state,
+                             info={"reason": f"{type(exc).__name__}: {exc}"})  # fmt: skip
+        trace = ContactTrace.concatenate([p.trace for p in pieces])
+        self.traces.append(trace)
+        info = dict(res.info)
+        info.update(trace=trace, sim_time=self.robot.time - t0, wall_time=time.perf_counter() - w0)
+        return MoveResult(move=res.move, status=res.status, components=res.components, distance=res.distance,
+                          cost=res.cost, state=res.state, info=info)  # fmt: skip
+
+    def _fail(self, move: Move, res: PrimitiveResult | str, reason: str) -> MoveResult:
+        status = res if isinstance(res, str) else res.status
+        if status == "ok":
+            status = "unreachable"
+        self._on_face = None
+        return MoveResult(move=move, status=status, state=self.state, info={"reason": reason})
+
+    def _face_fit(self, fid: int, extra: ContactTrace | None = None) -> FaceFit:
+        """The fit of a data face from all rows recorded on it (plus rows of ``extra`` that agree with it)."""
+        fd = self._faces[fid]
+        pts, nrm = fd.points, fd.normals
+        if extra is not None and len(extra):
+            n0 = self.segmenter.faces[fid].component.normal
+            ok = extra.in_contact
+            keep = ok & (np.where(ok[:, None], extra.normal_in_world, 0.0) @ n0 > math.cos(self.bounds.face_cone))
+            keep &= extra.phase != PHASES.index("roll")
+            if keep.sum():
+                pts = np.vstack([pts, extra.point_in_world[keep]])
+                nrm = np.vstack([nrm, extra.normal_in_world[keep]])
+        return fit_face(pts, nrm, self.bounds)
+
+    def _store_face(self, fid: int, trace: ContactTrace, fit: FaceFit) -> None:
+        from haptic.executor.segment import face_rows
+
+        mask = face_rows(trace, fit.normal, self.bounds.face_cone)
+        pts, nrm = trace.point_in_world[mask], trace.normal_in_world[mask]
+        self._faces[fid] = _FaceData(pts, nrm, pts[-1].copy())
+
+    def _touching_table(self) -> bool:
+        k = self.robot.fingers.index(self._finger)
+        for c in self.robot.read().contacts[k]:
+            if c.point_in_world[2] < TABLE_TOP_Z + self.settings.table_margin and c.normal_in_world[2] > 0.95:
+                return True
+        return False
+
+    def _is_table(self, normal: np.ndarray, point: np.ndarray | None) -> bool:
+        return point is not None and normal[2] > 0.99 and point[2] < TABLE_TOP_Z + self.settings.table_margin
+
+    def _contact_point(self) -> np.ndarray:
+        t = self.toucher
+        return t.contact[2].copy() if t.contact[2] is not None else t.tip.copy()
+
+    # ------------------------------------------------------------------------------------------ start
+    def start(self) -> MoveResult:
+        """Descend from above the object region (a workspace prior; the object's pose is unknown) until the
+        pad touches the object -- searching a grid of landing points, nearest the region's centre first --,
+        then acquire the touched face's normal with a short L stroke. Reports one data face."""
+        move = FaceMove(np.zeros(3))
+        return self._run(move, lambda pieces: self._start(move, pieces))
+
+    def _landing_points(self) -> list[np.ndarray]:
+        s = self.settings
+        (x0, x1), (y0, y1) = OBJECT_REGION
+        xs = np.arange(x0 - s.search_margin, x1 + s.search_margin + 1e-9, s.search_spacing)
+        ys = np.arange(y0 - s.search_margin, y1 + s.search_margin + 1e-9, s.search_spacing)
+        centre = np.array([(x0 + x1) / 2, (y0 + y1) / 2])
+        pts = np.array([[x, y] for x in xs for y in ys])
+        pts = pts + self.rng.uniform(-0.3, 0.3, pts.shape) * s.search_spacing
+        order = np.argsort(np.linalg.norm(pts - centre, axis=1) + self.rng.uniform(0, 0.01, len(pts)))
+        return [pts[i] for i in order]
+
+    def _start(self, move: Move, pieces: list[PrimitiveResult]) -> MoveResult:
+        s, t = self.settings, self.toucher
+        z_top = TABLE_TOP_Z + s.approach_height
+        last = "no-contact"
+        landings = self._landing_points()
+        i = -1
+        while i + 1 < min(len(landings), s.max_landings):
+            i += 1
+            xy = landings[i]
+            above = np.array([xy[0], xy[1], z_top])
+            if t.tip[2] < z_top - 0.01:  # lift straight up first
+                up = t.tip.copy()
+                up[2] = z_top
+                pieces.append(t.move_free(up, timeout=3.0, tol=3e-3))
+            r = t.move_free(above, timeout=4.0, tol=3e-3)
+            pieces.append(r)
+            if not r.ok:
+                last = r.status
+                if r.status == "unstable":
+                    break
+                continue
+            # fast guarded descent to just above the table, then back off and touch again slowly
+            r = t.approach(
+                np.array([0.0, 0.0, -1.0]), s.approach_height - s.search_floor, speed=s.search_speed, settle=False
+            )
+            pieces.append(r)
+            if r.ok:
+                back = t.tip + np.array([0.0, 0.0, 0.005])
+                pieces.append(t.move_free(back, timeout=1.0, tol=1e-3))
+                r = t.approach(np.array([0.0, 0.0, -1.0]), 0.015)
+                pieces.append(r)
+            if not r.ok:
+                last = r.status
+                if r.status == "unstable":
+                    break
+                continue
+            if self._is_table(r.info["normal"], r.info["point"]):
+                continue
+            fit, trace = self._normal_stroke(r.info["normal"], pieces)
+            if fit is None:  # touched the object near an edge: try close by first
+                near = r.info["point"][:2] + self.rng.normal(0.0, 0.012, (2, 2))
+                landings[i + 1 : i + 1] = list(near)
+                continue
+            face = self.segmenter.add_face(fit, ())
+            self._store_face(face.id, trace, fit)
+            self._on_face = face.id
+            self.state = SensorState(position=self._contact_point(), face=face.id)
+            return MoveResult(move=move, status="ok", components=(face,), state=self.state,
+                              info={"travel": sum(p.distance for p in pieces)})  # fmt: skip
+        return MoveResult(move=move, status=last if last != "ok" else "no-contact", state=None,
+                          info={"reason": "no face found over the object region"})  # fmt: skip
+
+    def _normal_stroke(self, n0: np.ndarray, pieces: list[PrimitiveResult]) -> tuple[FaceFit | None, ContactTrace]:
+        """An L stroke from the landing point for the face's normal; tries other headings when it meets an edge."""
+        s, t = self.settings, self.toucher
+        a = perpendicular(n0)
+        phi0 = self.rng.uniform(0, 2 * np.pi)
+        for k in range(4):
+            phi = phi0 + k * np.pi / 2
+            d1 = math.cos(phi) * a + math.sin(phi) * np.cross(n0, a)
+            d2 = np.cross(n0, d1)
+            legs = []
+            for d in (d1, d2):
+                r = t.trace_face(d, n0, s.normal_stroke, phase="stroke")
+                legs.append(r)
+                pieces.append(r)
+                if not r.ok or r.event != "done":
+                    break
+            if all(r.ok and r.event == "done" for r in legs) and len(legs) == 2:
+                trace = ContactTrace.concatenate([r.trace for r in legs])
+                fit = self.segmenter.fit_face_trace(trace, legs[-1].info["face_normal"])
+                return fit, trace
+            if legs[-1].status == "unstable":
+                return None, ContactTrace.concatenate([])
+            # met an edge: back off the way it came and turn
+            back = (
+                t.trace_face(-legs[-1].info.get("direction", d1), n0, s.normal_stroke, phase="stroke")
+                if (legs[-1].ok)
+                else None
+            )
+            if back is not None:
+                pieces.append(back)
+            if t.contact[1] is None:
+                return None, ContactTrace.concatenate([])
+            n0 = t.normal.copy()
+        return None, ContactTrace.concatenate([])
+
+    # ------------------------------------------------------------------------------------------ moves
+    def execute(self, move: Move) -> MoveResult:
+        """Carry out a move from the current state; a failure is a status, never an exception."""
+        if self.state is None:
+            return MoveResult(move=move, status="invalid", info={"reason": "call start() first"})
+        if isinstance(move, FaceMove):
+            return self._run(move, lambda pieces: self._face_move(move, pieces))
+        if isinstance(move, EdgeMove):
+            return self._run(move, lambda pieces: self._edge_move(move, pieces))
+        if isinstance(move, VertexMove):
+            return self._run(move, lambda pieces: self._vertex_move(move, pieces))
+        return MoveResult(move=move, status="invalid", state=self.state, info={"reason": f"unknown move {move!r}"})
+
+    def _invalid(self, move: Move, reason: str) -> MoveResult:
+        return MoveResult(move=move, status="invalid", state=self.state, info={"reason": reason})
+
+    def _ensure_on_face(self, fid: int, pieces: list[PrimitiveResult], near: np.ndarray | None = None) -> str:
+        """Put the pad on data face ``fid`` (at ``near`` when given, else where it last touched it)."""
+        t = self.toucher
+        n = self.segmenter.faces[fid].component.normal
+        if (near is None and self._on_face == fid and t.contact[1] is not None
+                and angle(t.normal, n) < math.radians(5.0)):  # fmt: skip
+            return "ok"
+        target = self._faces[fid].anchor if near is None else near
+        r = t.lift_and_approach(target, n)
+        pieces.append(r)
+        if not r.ok:
+            return r.status
+        if angle(r.info["normal"], n) > math.radians(6.0):
+            return "unreachable"
+        self._on_face = fid
+        return "ok"
+
+    def _cross_and_acquire(
+        self, kind: str, n_a: np.ndarray, direction: np.ndarray, pieces: list[PrimitiveResult], away_from=None
+    ):
+        """Roll over / climb out of the edge just met, then stroke on the next face. Returns (status, reason,
+        roll trace, stroke trace, next face fit)."""
+        t = self.toucher
+        if kind == "concave" and self._touching_table():
+            return "unreachable", "the finger met the table", None, None, None
+        r = t.cross_edge(kind, n_a, direction)
+        pieces.append(r)
+        if not r.ok:
+            return r.status, f"crossing the {kind} edge: {r.event}", None, None, None
+        n_b = r.info["normal"]
+        if self._is_table(n_b, t.contact[2]):
+            return "unreachable", "the edge lies on the table", None, None, None
+        along = r.info["edge_direction"]
+        if away_from is not None and float((t.tip - away_from) @ along) < 0:
+            along = -along
+        st = t.stroke(n_b, r.info["away"], along)
+        pieces.append(st)
+        if not st.ok:
+            return st.status, "stroke on the next face failed", None, None, None
+        fit = self.segmenter.fit_face_trace(st.trace, st.info["normal"])
+        if fit is None:
+            return "unreachable", "too few contacts on the next face", None, None, None
+        return "ok", "", r.trace, st.trace, fit
+
+    def _face_move(self, move: FaceMove, pieces: list[PrimitiveResult]) -> MoveResult:
+        st, t, seg = self.state, self.toucher, self.segmenter
+        d = np.asarray(move.direction, dtype=float)
+        if d.shape != (3,) or not np.all(np.isfinite(d)):
+            return self._invalid(move, "direction must be a finite 3-vector")
+        n_a = seg.faces[st.face].component.normal
+        inplane = d - (d @ n_a) * n_a
+        if np.linalg.norm(inplane) < 0.1 * max(np.linalg.norm(d), 1e-12):
+            return self._invalid(move, "direction is not in the plane of the current face")
+        status = self._ensure_on_face(st.face, pieces)
+        if status != "ok":
+            return self._fail(move, status, "could not return to the current face")
+        r = t.trace_face(inplane, n_a, self.settings.max_face_trace)
+        pieces.append(r)
+        if not r.ok:
+            return self._fail(move, r, f"trace across the face: {r.event}")
+        if r.event == "done":
+            return self._fail(move, "unreachable", "no edge within the longest trace")
+        kind = r.info["kind"]
+        side_a = self._last_on(r.trace, n_a)
+        corner = self._contact_point()
+        status, reason, roll, stroke, fit_b = self._cross_and_acquire(kind, r.info["face_normal"], r.info["direction"],
+                                                                      pieces)  # fmt: skip
+        if status != "ok":
+            return self._fail(move, status, reason)
+        fit_a = self._face_fit(st.face, r.trace)
+        roll_all = ContactTrace.concatenate([r.trace.select(r.trace.phase == PHASES.index("face")).tail(8), roll])
+        line = seg.edge_line(fit_a, fit_b, kind == "convex", roll_all, corner)
+        new_face = seg.next_id + 1
+        side_b = fit_b.points[len(fit_b.points) // 2]
+        edge = seg.add_edge(line, (st.face, new_face), kind == "convex", [(st.face, side_a), (new_face, side_b)],
+                            adjacent=(st.face,))  # fmt: skip
+        face = seg.add_face(fit_b, adjacent=(edge.id,))
+        self._store_face(face.id, stroke, fit_b)
+        self._on_face = face.id
+        self.state = SensorState(position=self._contact_point(), face=face.id, edge=edge.id,
+                                 edge_faces=(st.face, face.id))  # fmt: skip
+        return MoveResult(move=move, status="ok", components=(edge, face), distance=r.distance,
+                          cost=self.costs.face_move(r.distance), state=self.state, info={"kind": kind})  # fmt: skip
+
+    @staticmethod
+    def _last_on(trace: ContactTrace, normal: np.ndarray) -> np.ndarray:
+        ok = trace.in_contact
+        on = ok & (np.where(ok[:, None], trace.normal_in_world, 0.0) @ normal > math.cos(math.radians(4.0)))
+        idx = np.flatnonzero(on)
+        return trace.point_in_world[idx[-1]].copy() if len(idx) else trace.point_in_world[np.flatnonzero(ok)[0]]
+
+    def _edge_frame(self, eid: int):
+        rec = self.segmenter.edges[eid]
+        fa, fb = rec.faces
+        n_a = self.segmenter.faces[fa].component.normal
+        n_b = self.segmenter.faces[fb].component.normal
+        toward_a = rec.inward.get(fa, np.zeros(3)) - rec.inward.get(fb, np.zeros(3))
+        return rec, n_a, n_b, toward_a
+
+    def _edge_move(self, move: EdgeMove, pieces: list[PrimitiveResult]) -> MoveResult:
+        st, t, seg, s = self.state, self.toucher, self.segmenter, self.settings
+        if st.edge is None:
+            return self._invalid(move, "no current edge: an edge move starts on or near an edge")
+        if move.sense not in (1, -1):
+            return self._invalid(move, f"sense must be +1 or -1, got {move.sense!r}")
+        rec, n_a, n_b, toward_a = self._edge_frame(st.edge)
+        if st.vertex is not None and st.vertex in rec.vertices:
+            s_v = rec.vertices[st.vertex]
+            lo, hi = rec.interval
+            if (move.sense > 0 and s_v >= hi - 1e-9) or (move.sense < 0 and s_v <= lo + 1e-9):
+                return self._invalid(move, "the sensor is already at the vertex in that sense")
+        u = move.sense * rec.direction
+        on_clean = t.normal is not None and any(
+            angle(t.normal, seg.faces[f].component.normal) < math.radians(4.0) for f in rec.faces
+        )
+        if self._on_face not in rec.faces or self._line_distance(rec, t.tip) > 0.03 or not on_clean:
+            fid = st.face if st.face in rec.faces else rec.faces[1]
+            here = rec.at(rec.param(self._contact_point()))
+            status = self._ensure_on_face(fid, pieces, near=here + 0.004 * rec.inward[fid])
+            if status != "ok":
+                return self._fail(move, status, "could not return next to the edge")
+        acq = t.follow_edge(u, n_a, n_b, toward_a, 0.0, acquire_only=True)
+        pieces.append(acq)
+        if not acq.ok:
+            return self._fail(move, acq, f"acquiring the ridge: {acq.event}")
+        s_from = rec.param(self._contact_point())
+        r = t.follow_edge(u, n_a, n_b, toward_a, s.max_edge_trace)
+        pieces.append(r)
+        if not r.ok:
+            return self._fail(move, r, f"following the edge: {r.event}")
+        hold = t.hold(0.05)
+        pieces.append(hold)
+        rows = ContactTrace.concatenate([r.trace, hold.trace])
+        s_v, s_sigma = self._vertex_param(rec, rows, u, r.info.get("event_sign", 1))
+        if s_v is None:
+            return self._fail(move, "unreachable", "could not locate the vertex")
+        # refine the line with the ridge contacts (convex edges), then extend it to the vertex
+        ok = rows.in_contact
+        along = np.where(ok[:, None], rows.normal_in_world, 0.0) @ u
+        ridge = ok & (np.abs(along) < math.sin(math.radians(4.0))) & (rows.phase == PHASES.index("ridge"))
+        w_v, w_from = rec.at(s_v), rec.at(s_from)
+        seg.refine_edge(st.edge, rows.point_in_world[ridge] if ridge.sum() >= 10 else None,
+                        (self._face_fit(rec.faces[0]), self._face_fit(rec.faces[1])))  # fmt: skip
+        s_v, s_from = rec.param(w_v), rec.param(w_from)
+        edge, vertex = seg.extend_edge(st.edge, s_from, s_v, s_sigma)
+        # rest on the current face next to the vertex (the state the next move starts from)
+        fid = st.face if st.face in rec.faces else rec.faces[1]
+        rest = vertex.position - s.vertex_standoff * u + s.vertex_standoff * rec.inward[fid]
+        status = self._ensure_on_face(fid, pieces, near=rest)
+        position = self._contact_point() if status == "ok" else vertex.position.copy()
+        self.state = SensorState(position=position, face=st.face, edge=st.edge, vertex=vertex.id,
+                                 edge_faces=st.edge_faces)  # fmt: skip
+        return MoveResult(move=move, status="ok", components=(edge, vertex), distance=r.distance,
+                          cost=self.costs.edge_move(r.distance), state=self.state,
+                          info={"vertex_event": r.info.get("event_sign", 1)})  # fmt: skip
+
+    @staticmethod
+    def _line_distance(rec, w: np.ndarray) -> float:
+        q = w - rec.at(rec.param(w))
+        return float(np.linalg.norm(q))
+
+    def _vertex_param(self, rec, rows: ContactTrace, u: np.ndarray, event_sign: int):
+        """Parameter of the vertex along the edge line, and its σ. Surface fell away: the contact points
+        stayed at the vertex while the normal tilted along the edge. Blocked: where the edge line meets the
+        plane of the blocking contact."""
+        ok = rows.in_contact
+        n = np.where(ok[:, None], rows.normal_in_world, 0.0)
+        c = n @ u
+        b = self.bounds
+        if event_sign > 0:
+            at_v = ok & (c > math.sin(math.radians(5.0)))
+            if at_v.sum() < 3:  # contact was lost: the last contacts
+                idx = np.flatnonzero(ok)[-5:]
+                at_v = np.zeros(len(rows), bool)
+                at_v[idx] = True
+            if not at_v.any():
+                return None, 0.0
+            s = (rows.point_in_world[at_v] - rec.point) @ rec.direction
+            return float(np.median(s)), max(float(np.std(s)), b.point_sigma) / math.sqrt(len(s))
+        k = self.robot.fingers.index(self._finger)
+        contacts = self.robot.read().contacts[k]
+        if not contacts:
+            return None, 0.0
+        blk = min(contacts, key=lambda cc: float(cc.normal_in_world @ u))
+        denom = float(blk.normal_in_world @ rec.direction)
+        if abs(denom) < 0.2:
+            return None, 0.0
+        s = float((blk.point_in_world - rec.point) @ blk.normal_in_world) / denom
+        return s, b.point_sigma / abs(denom)
+
+    def _vertex_move(self, move: VertexMove, pieces: list[PrimitiveResult]) -> MoveResult:
+        st, t, seg, s = self.state, self.toucher, self.segmenter, self.settings
+        if st.vertex is None or st.edge is None:
+            return self._invalid(move, "no current vertex: a vertex move starts near a vertex on a known edge")
+        if move.across_face not in st.edge_faces:
+            return self._invalid(move, f"face {move.across_face} is not a face of the current edge (faces "
+                                       f"{st.edge_faces})")  # fmt: skip
+        rec = seg.edges[st.edge]
+        f = move.across_face
+        if f not in rec.inward or st.vertex not in rec.vertices:
+            return self._invalid(move, "the current edge does not know that face or vertex")
+        vtx = seg.vertices[st.vertex].position
+        s_v = rec.vertices[st.vertex]
+        lo, hi = rec.interval
+        u = rec.direction if s_v >= 0.5 * (lo + hi) else -rec.direction  # along the edge, towards the vertex
+        w_f = rec.inward[f]
+        n_f = seg.faces[f].component.normal
+        rho, beta = s.vertex_radius, s.vertex_start_angle
+        p0 = vtx + rho * (-math.cos(beta) * u + math.sin(beta) * w_f)
+        status = self._ensure_on_face(f, pieces, near=p0)
+        if status != "ok":
+            return self._fail(move, status, "could not reach the face next to the vertex")
+        tangent = math.sin(beta) * u + math.cos(beta) * w_f
+        r = t.circle_vertex(vtx, n_f, tangent, rho)
+        pieces.append(r)
+        if not r.ok:
+            return self._fail(move, r, f"circling the vertex: {r.event}")
+        kind = r.info["kind"]
+        side_f = self._last_on(r.trace, n_f)
+        corner = self._contact_point()
+        status, reason, roll, stroke, fit_g = self._cross_and_acquire(
+            kind, r.info["face_normal"], r.info["direction"], pieces, away_from=vtx
+        )
+        if status != "ok":
+            return self._fail(move, status, reason)
+        fit_f = self._face_fit(f, r.trace)
+        roll_all = ContactTrace.concatenate([r.trace.select(r.trace.phase == PHASES.index("circle")).tail(8), roll])
+        line = seg.edge_line(fit_f, fit_g, kind == "convex", roll_all, corner)
+        new_face = seg.next_id + 1
+        side_g = fit_g.points[len(fit_g.points) // 2]
+        s_vtx = float((vtx - line.point) @ line.direction)
+        edge = seg.add_edge(line, (f, new_face), kind == "convex", [(f, side_f), (new_face, side_g)],
+                            adjacent=(st.vertex, f), vertex=(st.vertex, s_vtx))  # fmt: skip
+        face = seg.add_face(fit_g, adjacent=(edge.id,))
+        self._store_face(face.id, stroke, fit_g)
+        self._on_face = face.id
+        self.state = SensorState(position=self._contact_point(), face=face.id, edge=edge.id, vertex=st.vertex,
+                                 edge_faces=(f, face.id))  # fmt: skip
+        return MoveResult(move=move, status="ok", components=(edge, face), distance=r.distance,
+                          cost=self.costs.vertex_move(r.distance), state=self.state, info={"kind": kind})  # fmt: skip
+
+    # ------------------------------------------------------------------------------------------ helpers
+    def admissible_moves(self, rng: np.random.Generator, n_directions: int = 8) -> list[Move]:
+        """Candidate moves from the current state (as the geometric executor's): face moves in random
+        in-plane directions, edge moves both ways on an edge, vertex moves across either face at a vertex."""
+        st = self.state
+        if st is None:
+            return []
+        n = self.segmenter.faces[st.face].component.normal
+        a = perpendicular(n)
+        b = np.cross(n, a)
+        moves: list[Move] = [
+            FaceMove(math.cos(x) * a + math.sin(x) * b) for x in rng.uniform(0, 2 * np.pi, n_directions)
+        ]
+        if st.edge is not None:
+            moves.extend([EdgeMove(1), EdgeMove(-1)])
+        if st.vertex is not None:
+            moves.extend(VertexMove(f) for f in st.edge_faces)
+        return moves
+
+
+__all__ = ["PhysicsExecutor", "PhysicsSettings"]

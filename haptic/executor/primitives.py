@@ -1,0 +1,671 @@
+"""Force-controlled exploration primitives on the simulated hand (seed §3.1).
+
+Each primitive is a small state machine run one control tick at a time through a
+:class:`~haptic.sim.robot.RobotInterface` -- the only handle it has: commands to the controller, the joint
+encoders' forward kinematics, and the fingertip's sensed contact (force, normal, point, noise applied). It
+ends with an *event* (why it stopped: ``"contact"``, ``"convex-edge"``, ``"concave-edge"``, ``"vertex"``,
+``"done"``) or a failure status (``"no-contact"``, ``"unreachable"``, ``"timeout"``, ``"unstable"``), and
+returns the contact trace it recorded (time, fingertip pose, contact point, normal, force, phase) and the
+distance the fingertip travelled.
+
+Detection follows ``PHYSICS_NOTES.md``: contact when the sensed force exceeds max(0.1 F, 5 σF) for 3 samples
+with a valid normal (pitfall 5); an edge when the filtered normal leaves the running face normal by more
+than 10° for 3 samples (convex when it tilts towards the direction of travel -- the surface falls away --,
+concave when it tilts against it -- the finger is blocked) or, as a backup, when the force stays below
+0.3 F for 20 ms (the surface fell away) or progress stalls (blocked); a vertex while following an edge when
+the filtered normal gains a component along the edge above sin 15°, or contact is lost (pitfall 8).
+Ridge following presses along the sensed normal and servos sideways to keep it on the bisector of the two
+face normals.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from haptic.sim.robot import RobotInterface
+
+DOWN = np.diag([-1.0, 1.0, -1.0])
+"""Hand rotation ``world_from_hand`` with the fingers pointing down (the tracing posture)."""
+
+FAILURES = ("no-contact", "unreachable", "timeout", "unstable")
+"""Failure statuses of a primitive (the move statuses of :class:`~haptic.planning.moves.MoveResult`)."""
+
+PHASES = ("free", "approach", "settle", "face", "roll", "stroke", "ridge", "vertex", "circle")
+"""Phase labels of the trace samples (``ContactTrace.phase`` holds indices into this tuple)."""
+
+
+@dataclass(frozen=True)
+class TouchConfig:
+    """Speeds, forces and detection thresholds of the primitives (one home for the executor's numbers)."""
+
+    force: float = 1.0
+    """Normal force target while tracing [N]."""
+    force_sigma: float = 0.02
+    """σF of the touch sensor, for the contact threshold [N]."""
+    face_speed: float = 0.02
+    """Tracing speed across a face [m/s] (friction × speed / force ≤ 0.012 (m/s)/N, pitfall 1)."""
+    edge_speed: float = 0.015
+    """Ridge-following speed along an edge [m/s]."""
+    roll_speed: float = 0.015
+    """Speed of the pad centre while rolling over an edge [m/s]."""
+    approach_speed: float = 0.02
+    """Guarded-approach speed [m/s]."""
+    free_speed: float = 0.20
+    """Speed of free-space moves [m/s]."""
+    contact_fraction: float = 0.1
+    """Contact is sensed above max(contact_fraction × force, 5 σF) [-]."""
+    debounce: int = 3
+    """Consecutive samples a detection must hold [ticks]."""
+    normal_filter: float = 0.25
+    """Per-tick low-pass weight of a new normal sample (0..1]."""
+    edge_angle: float = math.radians(10.0)
+    """Edge: the filtered normal leaves the face normal by more than this [rad]."""
+    loss_fraction: float = 0.3
+    """Edge backup / contact loss: force below this fraction of the target ... [-]"""
+    loss_time: float = 0.02
+    """... for this long [s]."""
+    stall_time: float = 0.3
+    """Blocked: over this window [s] ..."""
+    stall_fraction: float = 0.2
+    """... the fingertip advanced less than this fraction of the commanded travel [-]."""
+    vertex_sin: float = math.sin(math.radians(15.0))
+    """Vertex: the filtered normal's component along the edge exceeds this [-]."""
+    roll_window: float = 0.001
+    """A roll is over when the normal turned less than ``roll_settled`` over this much travel [m] ..."""
+    roll_settled: float = math.radians(1.5)
+    """... [rad]."""
+    roll_max: float = 0.04
+    """Longest pad travel while rolling over or climbing onto an edge [m]."""
+    step_in: float = 0.0015
+    """Travel onto a new face, away from the edge, after the roll settled [m]."""
+    stroke: float = 0.006
+    """Length of the stroke along the edge on a new face (the second leg of the L for its normal) [m]."""
+    ridge_gain: float = 12.0
+    """Sideways servo of ridge following: pad speed per radian of normal error, per metre of pad radius [1/s]."""
+    settle_time: float = 0.12
+    """Hold after a guarded contact before moving [s]."""
+    lift: float = 0.008
+    """Clearance of a repositioning move above the surface [m]."""
+    hand_rotation: np.ndarray = field(default_factory=lambda: DOWN.copy())
+    """Hand rotation held while exploring (3, 3)."""
+
+    @property
+    def contact_threshold(self) -> float:
+        """Sensed force above which a contact counts [N]."""
+        return max(self.contact_fraction * self.force, 5.0 * self.force_sigma)
+
+
+@dataclass(frozen=True, eq=False)
+class ContactTrace:
+    """What the fingertip recorded, one row per control tick (world frame)."""
+
+    time: np.ndarray
+    """Simulation time (n,) [s]."""
+    tip_in_world: np.ndarray
+    """Pad centre (n, 3) [m] (forward kinematics of the encoders)."""
+    hand_rotation: np.ndarray
+    """Hand rotation ``world_from_hand`` (n, 3, 3)."""
+    point_in_world: np.ndarray
+    """Sensed contact point (n, 3) [m]; NaN without contact."""
+    normal_in_world: np.ndarray
+    """Sensed unit normal (n, 3), out of the touched surface; NaN without contact."""
+    force: np.ndarray
+    """Sensed normal force (n,) [N]."""
+    phase: np.ndarray
+    """Phase index (n,) into :data:`PHASES`."""
+
+    def __len__(self) -> int:
+        return len(self.time)
+
+    @property
+    def in_contact(self) -> np.ndarray:
+        """Rows with a valid contact (n,) bool."""
+        return np.isfinite(self.normal_in_world[:, 0])
+
+    def select(self, mask: np.ndarray) -> ContactTrace:
+        """The rows where ``mask`` holds."""
+        return ContactTrace(*(a[mask] for a in self._arrays()))
+
+    def tail(self, k: int) -> ContactTrace:
+        """The last ``k`` rows."""
+        return ContactTrace(*(a[max(len(self) - k, 0) :] for a in self._arrays()))
+
+    def _arrays(self):
+        return (self.time, self.tip_in_world, self.hand_rotation, self.point_in_world, self.normal_in_world,
+                self.force, self.phase)  # fmt: skip
+
+    @staticmethod
+    def concatenate(traces: list[ContactTrace]) -> ContactTrace:
+        traces = [t for t in traces if len(t)]
+        if not traces:
+            return empty_trace()
+        return ContactTrace(*(np.concatenate(cols) for cols in zip(*(t._arrays() for t in traces), strict=True)))
+
+
+def empty_trace() -> ContactTrace:
+    return ContactTrace(np.zeros(0), np.zeros((0, 3)), np.zeros((0, 3, 3)), np.zeros((0, 3)), np.zeros((0, 3)),
+                        np.zeros(0), np.zeros(0, dtype=int))  # fmt: skip
+
+
+@dataclass(frozen=True, eq=False)
+class PrimitiveResult:
+    """How a primitive ended, what it recorded and how far it went."""
+
+    status: str
+    """``"ok"`` or a failure in :data:`FAILURES`."""
+    event: str
+    """Why it stopped: ``"contact"``, ``"convex-edge"``, ``"concave-edge"``, ``"vertex"``, ``"done"``,
+    ``"blocked"``, ``"lost"``, ``"limit"`` (a failure's detail)."""
+    trace: ContactTrace
+    """The samples recorded."""
+    distance: float
+    """Path length of the pad centre [m]."""
+    info: dict = field(default_factory=dict)
+    """Primitive-specific results (estimated normals, directions)."""
+
+    @property
+    def ok(self) -> bool:
+        return self.status == "ok"
+
+
+def unit(v: np.ndarray) -> np.ndarray:
+    n = math.sqrt(float(v @ v))
+    return v / n if n > 0 else v
+
+
+def angle(a: np.ndarray, b: np.ndarray) -> float:
+    """Angle between unit vectors [rad]."""
+    return math.acos(max(-1.0, min(1.0, float(a @ b))))
+
+
+def perpendicular(v: np.ndarray) -> np.ndarray:
+    """A unit vector perpendicular to ``v``."""
+    a = np.cross(v, [1.0, 0.0, 0.0])
+    if a @ a < 0.01:
+        a = np.cross(v, [0.0, 1.0, 0.0])
+    return unit(a)
+
+
+class Toucher:
+    """Runs the primitives with one finger of the robot and records everything it senses.
+
+    The toucher keeps the filtered normal, the contact debouncer and the path length across primitives; each
+    primitive returns the trace rows it recorded.
+    """
+
+    def __init__(self, robot: RobotInterface, config: TouchConfig | None = None, finger: str = "index") -> None:
+        if not isinstance(robot, RobotInterface):
+            raise TypeError(f"Toucher needs a RobotInterface (the robot-side handle), got {type(robot).__name__}")
+        self.robot = robot
+        self.config = config or TouchConfig()
+        self.finger = finger
+        robot.set_finger(finger)
+        self.dt = robot.tick_period
+        self.threshold = self.config.contact_threshold
+        self.normal: np.ndarray | None = None  # filtered sensed normal
+        self.contact_ticks = 0  # consecutive valid-contact samples
+        self.weak_ticks = 0  # consecutive samples with force below loss_fraction × force
+        self.hybrid = False
+        self.pad_radius = 0.012  # refined from the sensed contact (|tip − contact point|)
+        self._rows: list[tuple] = []
+        tip, rot = robot.fingertip_pose()
+        self.tip = tip
+        self.rotation = rot
+        self.contact: tuple[float, np.ndarray | None, np.ndarray | None] = (0.0, None, None)
+        self._unhealthy = False
+
+    # -- the tick ---------------------------------------------------------------------------------------------
+    def tick(self, phase: str) -> None:
+        """Advance one control tick, sense, record a row."""
+        r = self.robot
+        r.step(1)
+        c = r.last_contact() if self.hybrid else r.sense_contact(self.finger)
+        tip, rot = r.fingertip_pose()
+        self.tip, self.rotation = tip, rot
+        f, n, p = c.normal_force, c.normal_in_world, c.point_in_world
+        valid = n is not None and f > self.threshold and bool(np.all(np.isfinite(n)))
+        if valid:
+            self.contact_ticks += 1
+            if self.normal is None or self.contact_ticks == 1:
+                self.normal = n.copy()
+            else:
+                nf = self.normal + self.config.normal_filter * (n - self.normal)
+                self.normal = unit(nf)
+            d = math.sqrt(float((tip - p) @ (tip - p)))
+            if 0.005 < d < 0.03:
+                self.pad_radius += 0.02 * (d - self.pad_radius)
+        else:
+            self.contact_ticks = 0
+        self.weak_ticks = self.weak_ticks + 1 if f < self.config.loss_fraction * self.config.force else 0
+        self.contact = (f, n if valid else None, p if valid else None)
+        nan3 = (math.nan, math.nan, math.nan)
+        self._rows.append((r.time, tip, rot, p if valid else nan3, n if valid else nan3, f, PHASES.index(phase)))
+        if not (np.all(np.isfinite(tip)) and math.isfinite(f)):
+            self._unhealthy = True
+        elif len(self._rows) % 20 == 0 and not r.is_stable():
+            self._unhealthy = True
+
+    @property
+    def touching(self) -> bool:
+        """Debounced contact with a valid normal."""
+        return self.contact_ticks >= self.config.debounce
+
+    @property
+    def unhealthy(self) -> bool:
+        return self._unhealthy
+
+    def take_trace(self) -> ContactTrace:
+        """The rows recorded since the last call."""
+        rows, self._rows = self._rows, []
+        if not rows:
+            return empty_trace()
+        t, tip, rot, p, n, f, ph = zip(*rows, strict=True)
+        return ContactTrace(np.array(t), np.array(tip), np.array(rot), np.array(p, dtype=float),
+                            np.array(n, dtype=float), np.array(f), np.array(ph, dtype=int))  # fmt: skip
+
+    def _result(self, status: str, event: str, start_distance: float, **info) -> PrimitiveResult:
+        trace = self.take_trace()
+        return PrimitiveResult(status, event, trace, _path_length(trace.tip_in_world, start_distance), info)
+
+    def _press(self, velocity: np.ndarray, hint: np.ndarray | None = None) -> None:
+        cfg = self.config
+        self.robot.set_hybrid(cfg.force, velocity, normal_hint=hint, rotation_in_world=cfg.hand_rotation)
+        self.hybrid = True
+
+    # -- free space ----------------------------------------------------------------------------------------------
+    def move_free(self, point: np.ndarray, timeout: float = 4.0, tol: float = 7e-4) -> PrimitiveResult:
+        """Move the pad centre to ``point`` [m] in free space along a straight line (position control)."""
+        cfg = self.config
+        start = self.tip.copy()
+        self.hybrid = False
+        self.normal = None
+        if not self.robot.reachable(self.finger, point, cfg.hand_rotation).reachable:
+            return self._result("unreachable", "limit", 0.0, target=point)
+        dist = float(np.linalg.norm(point - start))
+        n_ticks = max(1, int(dist / cfg.free_speed / self.dt))
+        for k in range(1, int(timeout / self.dt)):
+            s = min(1.0, k / n_ticks)
+            self.robot.move_fingertip(start + s * (point - start), cfg.hand_rotation)
+            self.tick("free")
+            if self._unhealthy:
+                return self._result("unstable", "nan", 0.0)
+            if s >= 1.0 and np.linalg.norm(self.tip - point) < tol:
+                return self._result("ok", "done", 0.0)
+        return self._result("timeout", "limit", 0.0)
+
+    def approach(
+        self,
+        direction: np.ndarray,
+        max_distance: float,
+        timeout: float | None = None,
+        speed: float | None = None,
+        settle: bool = True,
+    ) -> PrimitiveResult:
+        """Guarded move of the pad along ``direction`` until a debounced contact, then press with the force
+        target and settle. ``info["normal"]``: the settled sensed normal; ``info["point"]``: the contact point."""
+        cfg = self.config
+        d = unit(np.asarray(direction, dtype=float))
+        self.hybrid = False
+        self.normal = None
+        self.contact_ticks = 0
+        start = self.tip.copy()
+        target = start.copy()
+        speed = speed or cfg.approach_speed
+        timeout = timeout or (max_distance / speed + 2.0)
+        step = speed * self.dt
+        touched = False
+        for _ in range(int(timeout / self.dt)):
+            if float((target - start) @ d) < max_distance:
+                target = target + step * d
+            self.robot.move_fingertip(target, cfg.hand_rotation)
+            self.tick("approach")
+            if self._unhealthy:
+                return self._result("unstable", "nan", 0.0)
+            if self.touching:
+                touched = True
+                break
+            if float((self.tip - start) @ d) >= max_distance - 1e-4:
+                return self._result("no-contact", "done", 0.0)
+        if not touched:
+            return self._result("timeout", "limit", 0.0)
+        if not settle:  # a probe: stop where it touched
+            self.robot.move_fingertip(self.tip.copy(), cfg.hand_rotation)
+            return self._result("ok", "contact", 0.0, normal=self.normal.copy(), point=self.contact[2].copy())
+        self._press(np.zeros(3), hint=-d)
+        for _ in range(int(cfg.settle_time / self.dt)):
+            self.tick("settle")
+            if self._unhealthy:
+                return self._result("unstable", "nan", 0.0)
+        if self.contact[1] is None:
+            return self._result("no-contact", "lost", 0.0)
+        return self._result("ok", "contact", 0.0, normal=self.normal.copy(), point=self.contact[2].copy())
+
+    def lift_and_approach(self, point_on_surface: np.ndarray, normal: np.ndarray) -> PrimitiveResult:
+        """Reposition: lift off along the sensed normal, move above ``point_on_surface`` along ``normal`` and
+        touch it again with a guarded approach."""
+        cfg = self.config
+        up = self.normal if self.normal is not None else np.array([0.0, 0.0, 1.0])
+        pieces = []
+        lifted = self.tip + (cfg.lift + 0.004) * up
+        lifted[2] = max(lifted[2], self.tip[2])
+        res = self.move_free(lifted, timeout=2.0, tol=2e-3)
+        pieces.append(res)
+        if res.ok:
+            clear = cfg.lift + self.pad_radius
+            above = point_on_surface + clear * normal
+            mid = np.maximum(lifted, above) if normal[2] > 0.3 else None
+            if mid is not None:
+                mid = np.array([above[0], above[1], max(lifted[2], above[2])])
+                res = self.move_free(mid, timeout=3.0, tol=2e-3)
+                pieces.append(res)
+            if res.ok:
+                res = self.move_free(above, timeout=3.0, tol=1.5e-3)
+                pieces.append(res)
+            if res.ok:
+                res = self.approach(-normal, 2 * cfg.lift)
+                pieces.append(res)
+        return PrimitiveResult(res.status, res.event, ContactTrace.concatenate([p.trace for p in pieces]),
+                               sum(p.distance for p in pieces), res.info)  # fmt: skip
+
+    # -- on a face -------------------------------------------------------------------------------------------
+    def trace_face(
+        self, direction: np.ndarray, face_normal: np.ndarray, max_distance: float, phase: str = "face"
+    ) -> PrimitiveResult:
+        """Slide across the face of normal ``face_normal`` along ``direction`` until an edge (convex: the
+        surface falls away; concave: the finger is blocked), or ``max_distance`` (event ``"done"``).
+
+        ``info``: ``face_normal`` (the running mean of the sensed normals on the face), ``direction`` (the
+        in-plane travel direction), ``kind`` of the edge."""
+        cfg = self.config
+        n_f = unit(np.asarray(face_normal, dtype=float))
+        d = np.asarray(direction, dtype=float)
+        d = unit(d - (d @ n_f) * n_f)
+        self._press(cfg.face_speed * d)
+        start = self.tip.copy()
+        over = 0
+        progress: list[float] = []
+        window = max(2, int(cfg.stall_time / self.dt))
+        n_sum = np.zeros(3)
+        n_run = n_f
+        timeout = max_distance / cfg.face_speed * 2.0 + 2.0
+        for k in range(int(timeout / self.dt)):
+            self._press(cfg.face_speed * d)
+            self.tick(phase)
+            if self._unhealthy:
+                return self._result("unstable", "nan", 0.0)
+            travelled = float((self.tip - start) @ d)
+            progress.append(travelled)
+            if self.weak_ticks * self.dt >= cfg.loss_time:
+                return self._result("ok", "convex-edge", 0.0, face_normal=unit(n_sum) if n_sum.any() else n_run,
+                                    direction=d, kind="convex", lost=True)  # fmt: skip
+            n = self.normal
+            if n is not None and self.contact[1] is not None:
+                a = angle(n, n_run)
+                if a > cfg.edge_angle:
+                    over += 1
+                    if over >= cfg.debounce:
+                        kind = "convex" if float((n - n_run) @ d) > 0 else "concave"
+                        return self._result("ok", f"{kind}-edge", 0.0, face_normal=n_run, direction=d, kind=kind)
+                else:
+                    over = 0
+                    if a < math.radians(3.0):
+                        n_sum += self.contact[1]
+                        if k > 10:
+                            n_run = unit(n_sum)
+            if travelled >= max_distance:
+                return self._result("ok", "done", 0.0, face_normal=n_run, direction=d)
+            if len(progress) > window and progress[-1] - progress[-1 - window] < (
+                cfg.stall_fraction * cfg.face_speed * cfg.stall_time
+            ):
+                return self._result("unreachable", "blocked", 0.0, face_normal=n_run, direction=d)
+        return self._result("timeout", "limit", 0.0)
+
+    def cross_edge(self, kind: str, n_a: np.ndarray, direction: np.ndarray) -> PrimitiveResult:
+        """Roll over a convex edge, or climb out of a concave one, from face ``n_a`` onto the next face, until
+        the sensed normal settles. ``info``: ``normal`` (the next face's normal, coarse), ``edge_direction``
+        (n_a × n_b), ``away`` (the in-plane direction on the new face pointing away from the edge)."""
+        cfg = self.config
+        n_a = unit(np.asarray(n_a, dtype=float))
+        d = np.asarray(direction, dtype=float)
+        e = unit(np.cross(n_a, self.normal)) if self.normal is not None else perpendicular(n_a)
+        if e @ e < 0.5:
+            e = unit(np.cross(n_a, d))
+        sign = -1.0 if kind == "convex" else 1.0
+        hist: list[tuple[float, np.ndarray]] = []
+        travelled = 0.0
+        last = self.tip.copy()
+        lost = 0
+        for _ in range(int(cfg.roll_max / cfg.roll_speed * 2.0 / self.dt)):
+            n = self.normal if self.normal is not None else n_a
+            if angle(n, n_a) > math.radians(3.0):
+                e_new = np.cross(n_a, n)
+                if e_new @ e_new > 1e-4:
+                    e = unit(e_new)
+            t = unit(np.cross(n, e))
+            if sign * float(t @ n_a) < 0:
+                t = -t
+            if kind == "convex" and float(t @ n_a) > 0:  # never climb back onto face a
+                t = unit(t - float(t @ n_a) * n_a)
+            self._press(cfg.roll_speed * t)
+            self.tick("roll")
+            if self._unhealthy:
+                return self._result("unstable", "nan", 0.0)
+            travelled += float(np.linalg.norm(self.tip - last))
+            last = self.tip.copy()
+            if self.contact[1] is None:
+                lost += 1
+                if lost * self.dt > 0.15:
+                    return self._result("no-contact", "lost", 0.0)
+                continue
+            lost = 0
+            hist.append((travelled, self.normal.copy()))
+            if angle(self.normal, n_a) > cfg.edge_angle:
+                # settled: the normal turned less than roll_settled over the last roll_window of travel
+                old = [nn for s, nn in hist if s <= travelled - cfg.roll_window]
+                if old and angle(old[-1], self.normal) < cfg.roll_settled:
+                    n_b = self.normal.copy()
+                    away = unit(np.cross(n_b, e))
+                    if float(away @ t) < 0:
+                        away = -away
+                    return self._result("ok", "done", 0.0, normal=n_b, edge_direction=unit(np.cross(n_a, n_b)),
+                                        away=away)  # fmt: skip
+            if travelled > cfg.roll_max:
+                return self._result("unreachable", "limit", 0.0)
+        return self._result("timeout", "limit", 0.0)
+
+    def stroke(self, normal: np.ndarray, away: np.ndarray, along: np.ndarray) -> PrimitiveResult:
+        """A short L on a face for its normal: ``step_in`` along ``away``, then ``stroke`` along ``along`` (the
+        other way if an edge comes first). ``info["normal"]``: mean sensed normal on the face."""
+        cfg = self.config
+        n_f = unit(np.asarray(normal, dtype=float))
+        pieces = [self.trace_face(away, n_f, cfg.step_in, phase="stroke")]
+        if pieces[-1].status != "ok":
+            return pieces[-1]
+        pieces.append(self.trace_face(along, n_f, cfg.stroke, phase="stroke"))
+        if pieces[-1].ok and pieces[-1].event != "done":
+            back = self.trace_face(-along, n_f, cfg.stroke * 2.0, phase="stroke")
+            pieces.append(back)
+        trace = ContactTrace.concatenate([p.trace for p in pieces])
+        ok_rows = trace.in_contact & (trace.phase == PHASES.index("stroke"))
+        nn = trace.normal_in_world[ok_rows]
+        keep = nn @ n_f > math.cos(math.radians(4.0))
+        n_mean = unit(nn[keep].sum(axis=0)) if keep.any() else n_f
+        status = "ok" if all(p.status == "ok" for p in pieces) else pieces[-1].status
+        return PrimitiveResult(status, "done", trace, sum(p.distance for p in pieces), {"normal": n_mean})
+
+    # -- along an edge -----------------------------------------------------------------------------------------
+    def follow_edge(
+        self,
+        along: np.ndarray,
+        n_a: np.ndarray,
+        n_b: np.ndarray,
+        toward_a: np.ndarray,
+        max_distance: float,
+        acquire_only: bool = False,
+    ) -> PrimitiveResult:
+        """Ridge following: press along the sensed normal, servo sideways to keep it on the bisector of
+        ``n_a`` and ``n_b``, move along ``along`` until a vertex (the normal gains a component along the edge
+        above sin 15°, or contact is lost, or progress stalls). ``toward_a``: the sideways direction that turns
+        the normal towards ``n_a``. With ``acquire_only`` it stops once the normal is on the bisector.
+
+        ``info``: ``event_sign`` (+1 the surface fell away at the vertex, −1 the finger was blocked)."""
+        cfg = self.config
+        u = unit(np.asarray(along, dtype=float))
+        n_a, n_b = unit(np.asarray(n_a, float)), unit(np.asarray(n_b, float))
+        m = n_a - (n_a @ n_b) * n_b
+        m = unit(m - (m @ u) * u)
+        nb_p = unit(n_b - (n_b @ u) * u)
+        theta = math.atan2(float(n_a @ m), float(n_a @ nb_p))
+        target = 0.5 * theta
+        side = unit(toward_a - (toward_a @ u) * u)
+        start = self.tip.copy()
+        speed = 0.0 if acquire_only else cfg.edge_speed
+        over = 0
+        on_ridge = 0
+        progress: list[float] = []
+        window = max(2, int(cfg.stall_time / self.dt))
+        timeout = (max_distance / cfg.edge_speed if not acquire_only else 0.0) * 2.0 + 3.0
+        err = 0.0
+        for _ in range(int(timeout / self.dt)):
+            n = self.normal if self.normal is not None else n_b
+            alpha = math.atan2(float(n @ m), float(n @ nb_p))
+            err = target - alpha
+            v_side = cfg.ridge_gain * self.pad_radius * err
+            lim = 0.025
+            v_side = max(-lim, min(lim, v_side))
+            s_dir = unit(side - float(side @ n) * n)
+            ridge_ok = abs(err) < math.radians(8.0)
+            v = v_side * s_dir + (speed * u if (ridge_ok or on_ridge > 0) else 0.0 * u)
+            self._press(v)
+            self.tick("ridge")
+            if self._unhealthy:
+                return self._result("unstable", "nan", 0.0)
+            if ridge_ok:
+                on_ridge += 1
+                if acquire_only and on_ridge >= 10:
+                    return self._result("ok", "done", 0.0, error=err)
+            travelled = float((self.tip - start) @ u)
+            progress.append(travelled)
+            if on_ridge == 0:
+                if len(progress) > 4 * window:
+                    return self._result("timeout", "limit", 0.0, error=err)
+                continue
+            if self.weak_ticks * self.dt >= cfg.loss_time:
+                return self._result("ok", "vertex", 0.0, event_sign=1, lost=True)
+            if self.normal is not None:
+                c = float(self.normal @ u)
+                if abs(c) > cfg.vertex_sin:
+                    over += 1
+                    if over >= cfg.debounce:
+                        return self._result("ok", "vertex", 0.0, event_sign=1 if c > 0 else -1)
+                else:
+                    over = 0
+            if travelled > max_distance:
+                return self._result("unreachable", "limit", 0.0)
+            if len(progress) > window + 20 and progress[-1] - progress[-1 - window] < (
+                cfg.stall_fraction * speed * cfg.stall_time
+            ):
+                return self._result("ok", "vertex", 0.0, event_sign=-1, stalled=True)
+        return self._result("timeout", "limit", 0.0, error=err)
+
+    def hold(self, seconds: float, phase: str = "vertex") -> PrimitiveResult:
+        """Press in place (zero tangential velocity) for ``seconds``."""
+        self._press(np.zeros(3))
+        for _ in range(max(1, int(seconds / self.dt))):
+            self.tick(phase)
+            if self._unhealthy:
+                return self._result("unstable", "nan", 0.0)
+        return self._result("ok", "done", 0.0)
+
+    # -- around a vertex ---------------------------------------------------------------------------------------
+    def circle_vertex(
+        self, vertex: np.ndarray, normal: np.ndarray, start_direction: np.ndarray, radius: float
+    ) -> PrimitiveResult:
+        """Slide on the face of ``normal`` along a circle of ``radius`` about ``vertex``, leaving along
+        ``start_direction`` (the in-plane tangent at the start), until the next edge (convex or concave).
+        ``info``: like :meth:`trace_face`, plus ``arc`` (the angle swept [rad])."""
+        cfg = self.config
+        n_f = unit(np.asarray(normal, dtype=float))
+        vtx = np.asarray(vertex, dtype=float)
+        p0 = self.contact[2] if self.contact[2] is not None else self.tip - self.pad_radius * n_f
+        r0 = p0 - vtx
+        r0 = unit(r0 - (r0 @ n_f) * n_f)
+        t0 = unit(start_direction - (start_direction @ n_f) * n_f)
+        axis = np.cross(r0, t0)  # ± n_f: the sense of the circle
+        over = 0
+        swept = 0.0
+        prev = r0
+        n_sum = np.zeros(3)
+        n_run = n_f
+        timeout = 2.0 * math.pi * radius / cfg.face_speed * 1.5 + 2.0
+        progress_t: list[float] = []
+        window = max(2, int(cfg.stall_time / self.dt))
+        start_tip = self.tip.copy()
+        path = 0.0
+        for k in range(int(timeout / self.dt)):
+            p = self.contact[2] if self.contact[2] is not None else self.tip - self.pad_radius * n_run
+            r = p - vtx
+            r = r - (r @ n_f) * n_f
+            rad = math.sqrt(float(r @ r))
+            rh = r / rad if rad > 1e-6 else r0
+            t = unit(np.cross(axis, rh))
+            v = cfg.face_speed * t + 4.0 * (radius - rad) * rh
+            self._press(v)
+            prev_tip = self.tip.copy()
+            self.tick("circle")
+            if self._unhealthy:
+                return self._result("unstable", "nan", 0.0)
+            path += float(np.linalg.norm(self.tip - prev_tip))
+            progress_t.append(path)
+            swept += angle(prev, rh)
+            prev = rh
+            if self.weak_ticks * self.dt >= cfg.loss_time:
+                return self._result("ok", "convex-edge", 0.0, face_normal=n_run, direction=t, kind="convex",
+                                    arc=swept, lost=True)  # fmt: skip
+            n = self.normal
+            if n is not None and self.contact[1] is not None:
+                a = angle(n, n_run)
+                if a > cfg.edge_angle:
+                    over += 1
+                    if over >= cfg.debounce:
+                        kind = "convex" if float((n - n_run) @ t) > 0 else "concave"
+                        return self._result("ok", f"{kind}-edge", 0.0, face_normal=n_run, direction=t, kind=kind,
+                                            arc=swept)  # fmt: skip
+                else:
+                    over = 0
+                    if a < math.radians(3.0):
+                        n_sum += self.contact[1]
+                        if k > 10:
+                            n_run = unit(n_sum)
+            if swept > 1.9 * math.pi:
+                return self._result("timeout", "limit", 0.0, arc=swept)
+            if len(progress_t) > window and path - progress_t[-1 - window] < (
+                cfg.stall_fraction * cfg.face_speed * cfg.stall_time
+            ):
+                return self._result("unreachable", "blocked", 0.0, arc=swept)
+        del start_tip
+        return self._result("timeout", "limit", 0.0, arc=swept)
+
+
+def _path_length(points: np.ndarray, offset: float = 0.0) -> float:
+    if len(points) < 2:
+        return offset
+    return offset + float(np.linalg.norm(np.diff(points, axis=0), axis=1).sum())
+
+
+__all__ = [
+    "DOWN",
+    "FAILURES",
+    "PHASES",
+    "ContactTrace",
+    "PrimitiveResult",
+    "TouchConfig",
+    "Toucher",
+    "angle",
+    "empty_trace",
+    "perpendicular",
+    "unit",
+]

@@ -1,0 +1,421 @@
+"""Segmentation: contact traces → data faces, edges and vertices with error bounds and adjacency (seed §2.3).
+
+A face is the set of trace rows whose sensed normals agree (within a few σ): its normal combines the mean of the
+sensed normals with a plane fit of the contact points (inverse-variance weights, the plane fit counting only
+when the points span two dimensions -- PHYSICS_NOTES pitfall 6); its points are the contact points projected
+onto the fitted plane. An edge is the line ``n_a × n_b`` through (convex) the contact points recorded while the
+pad rolled over it -- they stay on the edge -- or (concave, where the pad cannot reach the corner) the
+intersection of the two face planes; a long ridge trace refines both by a line fit. A vertex is the point of
+the edge line where the pad's contacts stopped advancing along it.
+
+Every error bound is ``k`` times the root sum of squares of a statistical σ (sensor noise over the samples
+used, plus the fit residuals) and a systematic floor (pad compliance, contact-point bias), all in
+:class:`SegmentBounds`. The segmenter reads only contact traces; it never sees the object.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from haptic.executor.primitives import ContactTrace, unit
+from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex
+
+
+@dataclass(frozen=True)
+class SegmentBounds:
+    """The sensor-noise model and the systematic floors from which error bounds are derived."""
+
+    normal_sigma: float = math.radians(1.0)
+    """σn of one sensed contact normal, per tangent axis [rad]."""
+    point_sigma: float = 2e-4
+    """σp of one sensed contact point, per axis [m]."""
+    force_sigma: float = 0.02
+    """σF of the sensed normal force [N]."""
+    k: float = 3.0
+    """A bound is k standard deviations."""
+    normal_floor: float = math.radians(0.25)
+    """Systematic σ of a face normal (pad compliance, contact-frame bias) [rad]."""
+    direction_floor: float = math.radians(0.3)
+    """Systematic σ of an edge direction [rad]."""
+    position_floor: float = 2.5e-4
+    """Systematic σ of a position across a face or an edge (contact-point bias ≈ half the pad penetration) [m]."""
+    length_floor: float = 1.0e-3
+    """Systematic σ of an explored interval's end along its edge (detection delay) [m]."""
+    vertex_floor: float = 4e-4
+    """Systematic σ of a vertex position [m]."""
+    max_points: int = 24
+    """Most contact points kept on a data face."""
+    min_face_rows: int = 15
+    """Fewest contact rows a face is fitted from."""
+    face_cone: float = math.radians(4.0)
+    """A row belongs to a face when its sensed normal is within this of the face normal [rad]."""
+
+    @classmethod
+    def from_noise(cls, force_std: float, normal_std: float, point_std: float, **kw) -> SegmentBounds:
+        """Bounds for a sensor with these standard deviations [N, rad, m]."""
+        return cls(normal_sigma=normal_std, point_sigma=point_std, force_sigma=force_std, **kw)
+
+    def bound(self, sigma: float, floor: float) -> float:
+        return self.k * math.sqrt(sigma * sigma + floor * floor)
+
+
+@dataclass(frozen=True, eq=False)
+class FaceFit:
+    """A plane estimated from contact rows."""
+
+    normal: np.ndarray
+    """Outward unit normal (3,)."""
+    offset: float
+    """``n · w = offset`` on the plane [m]."""
+    points: np.ndarray
+    """Contact points projected onto the plane (k, 3) [m]."""
+    normal_sigma: float
+    """Statistical σ of the normal [rad]."""
+    offset_sigma: float
+    """Statistical σ of the plane position [m]."""
+    count: int
+    """Rows used."""
+
+
+@dataclass(frozen=True, eq=False)
+class LineFit:
+    """A line estimated for an edge, with the explored parameter interval."""
+
+    point: np.ndarray
+    """A point on the line (3,) [m]."""
+    direction: np.ndarray
+    """Unit direction (3,)."""
+    direction_sigma: float
+    """[rad]."""
+    position_sigma: float
+    """[m]."""
+    s_range: tuple[float, float]
+    """Explored interval ``[s_lo, s_hi]`` along ``direction`` from ``point`` [m]."""
+
+
+def face_rows(trace: ContactTrace, normal_guess: np.ndarray, cone: float) -> np.ndarray:
+    """Mask of the rows whose sensed normal lies within ``cone`` of the face normal (refined once)."""
+    ok = trace.in_contact
+    n = np.where(ok[:, None], trace.normal_in_world, 0.0)
+    c = math.cos(cone)
+    mask = ok & (n @ normal_guess > c)
+    if mask.sum() >= 3:
+        mask = ok & (n @ unit(n[mask].sum(axis=0)) > c)
+    return mask
+
+
+def fit_face(points: np.ndarray, normals: np.ndarray, bounds: SegmentBounds) -> FaceFit:
+    """Combine the mean sensed normal (σn/√N) with the plane fit of the points (residual / spread) by inverse
+    variance; the plane fit counts only when the points span two dimensions (pitfall 6)."""
+    nn = len(normals)
+    n_mean = unit(normals.sum(axis=0))
+    s_mean = bounds.normal_sigma / math.sqrt(max(nn, 1))
+    centroid = points.mean(axis=0)
+    normal, s_n = n_mean, s_mean
+    if len(points) >= 6:
+        q = points - centroid
+        _, sv, vt = np.linalg.svd(q, full_matrices=False)
+        spread2 = sv[1] / math.sqrt(len(points))  # rms extent along the second axis [m]
+        resid = sv[2] / math.sqrt(len(points))
+        if spread2 > 1e-3:
+            n_fit = vt[2] if vt[2] @ n_mean > 0 else -vt[2]
+            s_fit = max(resid, bounds.point_sigma) / (spread2 * math.sqrt(len(points)))
+            if angle_between(n_fit, n_mean) < 5 * math.hypot(s_fit, s_mean) + math.radians(1.0):
+                w1, w2 = 1.0 / s_mean**2, 1.0 / s_fit**2
+                normal = unit(w1 * n_mean + w2 * n_fit)
+                s_n = 1.0 / math.sqrt(w1 + w2)
+    d = points @ normal
+    offset = float(d.mean())
+    resid = float(np.sqrt(np.mean((d - offset) ** 2))) if len(d) > 1 else bounds.point_sigma
+    s_off = max(resid, bounds.point_sigma) / math.sqrt(len(d))
+    projected = points - (d - offset)[:, None] * normal
+    return FaceFit(normal, offset, projected, s_n, s_off, nn)
+
+
+def angle_between(a: np.ndarray, b: np.ndarray) -> float:
+    return math.acos(max(-1.0, min(1.0, float(unit(a) @ unit(b)))))
+
+
+def edge_direction(face_a: FaceFit, face_b: FaceFit) -> tuple[np.ndarray, float]:
+    """``n_a × n_b`` normalised, and its σ from the normals' σ and the dihedral angle."""
+    c = np.cross(face_a.normal, face_b.normal)
+    s = math.sqrt(float(c @ c))
+    sigma = math.hypot(face_a.normal_sigma, face_b.normal_sigma) / max(s, 0.2)
+    return c / s, sigma
+
+
+def plane_intersection(face_a: FaceFit, face_b: FaceFit, near: np.ndarray) -> tuple[np.ndarray, float]:
+    """The point of the intersection line of two planes nearest ``near``, and its position σ."""
+    na, nb = face_a.normal, face_b.normal
+    b = unit(np.cross(na, nb))
+    a = np.vstack([na, nb, b])
+    rhs = np.array([face_a.offset, face_b.offset, float(b @ near)])
+    p = np.linalg.solve(a, rhs)
+    s = math.sqrt(float(np.cross(na, nb) @ np.cross(na, nb)))
+    # plane offsets and the normals' tilt over the distance to the touched points
+    lever = max(float(np.linalg.norm(face_a.points.mean(axis=0) - p)), float(np.linalg.norm(face_b.points.mean(0) - p)))
+    tilt = lever * math.hypot(face_a.normal_sigma, face_b.normal_sigma)
+    sigma = math.hypot(math.hypot(face_a.offset_sigma, face_b.offset_sigma), tilt) / max(s, 0.2)
+    return p, sigma
+
+
+def line_from_points(
+    points: np.ndarray, direction: np.ndarray, direction_sigma: float, bounds: SegmentBounds
+) -> LineFit:
+    """A line through contact points on an edge: direction ``direction`` (from the faces), refined by the
+    points' principal axis when they are spread along it; the explored interval is the points' extent."""
+    c = points.mean(axis=0)
+    b, s_b = unit(direction), direction_sigma
+    q = points - c
+    if len(points) >= 10:
+        _, sv, vt = np.linalg.svd(q, full_matrices=False)
+        length_rms = sv[0] / math.sqrt(len(points))
+        if length_rms > 2e-3:
+            b_fit = vt[0] if vt[0] @ b > 0 else -vt[0]
+            resid = math.hypot(sv[1], sv[2]) / math.sqrt(len(points))
+            s_fit = max(resid, bounds.point_sigma) / (length_rms * math.sqrt(len(points)))
+            if angle_between(b_fit, b) < 5 * math.hypot(s_fit, s_b) + math.radians(1.0):
+                w1, w2 = 1.0 / s_b**2, 1.0 / s_fit**2
+                b = unit(w1 * b + w2 * b_fit)
+                s_b = 1.0 / math.sqrt(w1 + w2)
+    s = q @ b
+    perp = q - np.outer(s, b)
+    resid = float(np.sqrt(np.mean(np.sum(perp**2, axis=1)))) if len(points) > 1 else bounds.point_sigma
+    s_pos = max(resid, bounds.point_sigma) / math.sqrt(len(points))
+    return LineFit(c, b, s_b, s_pos, (float(s.min()), float(s.max())))
+
+
+# ----------------------------------------------------------------------------------------------------------- book
+
+
+@dataclass
+class FaceRecord:
+    """What the segmenter keeps of a data face."""
+
+    fit: FaceFit
+    component: DataFace
+
+
+@dataclass
+class EdgeRecord:
+    """What the segmenter keeps of a data edge: its line, explored interval and neighbours."""
+
+    point: np.ndarray  # base point on the line
+    direction: np.ndarray  # b_d (fixed sign from the first report)
+    direction_sigma: float
+    position_sigma: float
+    interval: tuple[float, float]  # explored [s_lo, s_hi] along direction from point
+    faces: tuple[int, int]  # (face traced from, face stepped onto)
+    convex: bool
+    inward: dict[int, np.ndarray] = field(default_factory=dict)  # face id -> in-plane unit vector into the face
+    side_points: list[tuple[int, np.ndarray]] = field(default_factory=list)
+    vertices: dict[int, float] = field(default_factory=dict)  # data vertex id -> s
+    adjacent: tuple[int, ...] = ()
+    component: DataEdge | None = None
+
+    def at(self, s: float) -> np.ndarray:
+        return self.point + s * self.direction
+
+    def param(self, w: np.ndarray) -> float:
+        return float((w - self.point) @ self.direction)
+
+
+class Segmenter:
+    """Turns primitive traces into data components; assigns ids in order of acquisition and adjacency (§2.3).
+
+    Conventions, shared with the geometric executor: a face move reports the new edge (adjacent to the face
+    traced from) and then the new face (adjacent to the edge); an edge move re-reports its edge with the
+    explored interval extended to the vertex, then the new vertex (adjacent to the edge); a vertex move
+    reports the new edge (adjacent to the vertex and the face circled across) and the new face.
+    """
+
+    def __init__(self, bounds: SegmentBounds | None = None) -> None:
+        self.bounds = bounds or SegmentBounds()
+        self.faces: dict[int, FaceRecord] = {}
+        self.edges: dict[int, EdgeRecord] = {}
+        self.vertices: dict[int, DataVertex] = {}
+        self.components: list[DataComponent] = []
+        self._next = 0
+
+    def _id(self) -> int:
+        i = self._next
+        self._next += 1
+        return i
+
+    @property
+    def next_id(self) -> int:
+        return self._next
+
+    # -- faces ---------------------------------------------------------------------------------------------
+    def fit_face_trace(self, trace: ContactTrace, normal_guess: np.ndarray) -> FaceFit | None:
+        """The plane of the rows of ``trace`` that agree with ``normal_guess``; None with fewer than 5 rows."""
+        mask = face_rows(trace, unit(np.asarray(normal_guess, float)), self.bounds.face_cone)
+        if mask.sum() < self.bounds.min_face_rows:
+            return None
+        normals = trace.normal_in_world[mask]
+        mean = unit(normals.sum(axis=0))
+        spread = float(np.sqrt(np.mean(np.sum((normals - mean) ** 2, axis=1))))  # rms angle [rad]
+        if spread > 2.0 * math.sqrt(2.0) * self.bounds.normal_sigma + math.radians(0.5):
+            return None  # the rows do not come from one plane (a roll, a vertex)
+        return fit_face(trace.point_in_world[mask], normals, self.bounds)
+
+    def add_face(self, fit: FaceFit, adjacent: tuple[int, ...] = ()) -> DataFace:
+        b = self.bounds
+        pts = fit.points
+        if len(pts) > b.max_points:
+            pts = pts[np.linspace(0, len(pts) - 1, b.max_points).round().astype(int)]
+        comp = DataFace(
+            id=self._id(),
+            normal=fit.normal,
+            points=pts,
+            normal_bound=b.bound(fit.normal_sigma, b.normal_floor),
+            position_bound=b.bound(fit.offset_sigma, b.position_floor),
+            adjacent=adjacent,
+        )
+        self.faces[comp.id] = FaceRecord(fit, comp)
+        self.components.append(comp)
+        return comp
+
+    # -- edges ---------------------------------------------------------------------------------------------
+    def edge_line(
+        self, fit_a: FaceFit, fit_b: FaceFit, convex: bool, roll: ContactTrace, corner_hint: np.ndarray
+    ) -> LineFit:
+        """The line of the edge between faces a and b. Convex: through the contact points recorded while the
+        pad rolled over it (normals between the two faces); concave: the planes' intersection, the explored
+        interval where the pad was in the corner (``roll`` rows)."""
+        b_dir, s_b = edge_direction(fit_a, fit_b)
+        bounds = self.bounds
+        if convex:
+            ok = roll.in_contact
+            n = roll.normal_in_world[ok]
+            pts = roll.point_in_world[ok]
+            c = math.cos(math.radians(3.0))
+            between = (n @ fit_a.normal < c) & (n @ fit_b.normal < c)
+            if between.sum() >= 3:
+                return line_from_points(pts[between], b_dir, s_b, bounds)
+        p, s_p = plane_intersection(fit_a, fit_b, corner_hint)
+        ok = roll.in_contact
+        if ok.any():
+            s = (roll.point_in_world[ok] - p) @ b_dir
+            rng = (float(s.min()), float(s.max()))
+        else:
+            rng = (0.0, 0.0)
+        return LineFit(p, b_dir, s_b, s_p, rng)
+
+    def add_edge(
+        self,
+        line: LineFit,
+        faces: tuple[int, int],
+        convex: bool,
+        side_points: list[tuple[int, np.ndarray]],
+        adjacent: tuple[int, ...],
+        vertex: tuple[int, float] | None = None,
+    ) -> DataEdge:
+        """Report a new edge (``faces[1]`` may be the id the next face will get). ``vertex``: a known data
+        vertex on this edge and its parameter."""
+        eid = self._id()
+        rec = EdgeRecord(
+            point=line.point, direction=line.direction, direction_sigma=line.direction_sigma,
+            position_sigma=line.position_sigma, interval=line.s_range, faces=faces, convex=convex,
+            side_points=list(side_points), adjacent=adjacent,
+        )  # fmt: skip
+        if vertex is not None:
+            rec.vertices[vertex[0]] = vertex[1]
+        for fid, q in side_points:
+            w = q - rec.at(rec.param(q))
+            rec.inward[fid] = unit(w)
+        self.edges[eid] = rec
+        return self._emit_edge(eid)
+
+    def _emit_edge(self, eid: int) -> DataEdge:
+        rec = self.edges[eid]
+        b = self.bounds
+        lo, hi = rec.interval
+        start = next((v for v, s in rec.vertices.items() if abs(s - lo) < 1e-9), None)
+        end = next((v for v, s in rec.vertices.items() if abs(s - hi) < 1e-9), None)
+        comp = DataEdge(
+            id=eid,
+            direction=rec.direction,
+            point=rec.at(lo),
+            length=max(hi - lo, 0.0),
+            direction_bound=b.bound(rec.direction_sigma, b.direction_floor),
+            position_bound=b.bound(rec.position_sigma, b.position_floor),
+            length_bound=b.bound(0.0, b.length_floor),
+            start_vertex=start,
+            end_vertex=end,
+            adjacent=rec.adjacent,
+            side_points=tuple(rec.side_points),
+        )
+        rec.component = comp
+        self.components.append(comp)
+        return comp
+
+    def refine_edge(self, eid: int, ridge_points: np.ndarray | None, fits: tuple[FaceFit, FaceFit]) -> None:
+        """Refine an edge's line with the contact points of a ridge trace along it (convex edges), keeping the
+        sign of its direction."""
+        rec = self.edges[eid]
+        if ridge_points is None or len(ridge_points) < 10 or not rec.convex:
+            return
+        b_dir, s_b = edge_direction(*fits)
+        if b_dir @ rec.direction < 0:
+            b_dir = -b_dir
+        old_ends = [rec.at(s) for s in rec.interval]
+        old_v = {v: rec.at(s) for v, s in rec.vertices.items()}
+        line = line_from_points(ridge_points, b_dir, s_b, self.bounds)
+        rec.point, rec.direction = line.point, line.direction
+        rec.direction_sigma, rec.position_sigma = line.direction_sigma, line.position_sigma
+        ends = [rec.param(w) for w in old_ends] + list(line.s_range)
+        rec.interval = (min(ends), max(ends))
+        rec.vertices = {v: rec.param(w) for v, w in old_v.items()}
+
+    def extend_edge(self, eid: int, s_from: float, s_vertex: float, vertex_sigma: float) -> tuple[DataEdge, DataVertex]:
+        """An edge move reached a vertex at parameter ``s_vertex`` having started at ``s_from``: re-report the
+        edge with its interval extended to the vertex, and report the vertex (adjacent to the edge)."""
+        rec = self.edges[eid]
+        b = self.bounds
+        vid = self._id()
+        lo, hi = rec.interval
+        if s_vertex >= s_from:
+            hi_new = s_vertex
+            lo_new = min(lo, s_from)
+            for v, s in list(rec.vertices.items()):
+                if s > hi_new:
+                    del rec.vertices[v]
+        else:
+            lo_new = s_vertex
+            hi_new = max(hi, s_from)
+            for v, s in list(rec.vertices.items()):
+                if s < lo_new:
+                    del rec.vertices[v]
+        rec.interval = (lo_new, hi_new)
+        rec.vertices[vid] = s_vertex
+        pos = rec.at(s_vertex)
+        vertex = DataVertex(
+            id=vid,
+            position=pos,
+            position_bound=b.bound(math.hypot(vertex_sigma, rec.position_sigma), b.vertex_floor),
+            adjacent=(eid,),
+        )
+        # the edge first (same id, extended), then the vertex -- the edge's end refers to the new vertex id
+        edge = self._emit_edge(eid)
+        self.components.append(vertex)
+        self.vertices[vid] = vertex
+        return edge, vertex
+
+
+__all__ = [
+    "EdgeRecord",
+    "FaceFit",
+    "FaceRecord",
+    "LineFit",
+    "SegmentBounds",
+    "Segmenter",
+    "edge_direction",
+    "face_rows",
+    "fit_face",
+    "line_from_points",
+    "plane_intersection",
+]

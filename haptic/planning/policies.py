@@ -1,0 +1,196 @@
+"""Policies that choose the next move: the efficiency planner (§4.1) and its baselines.
+
+- ``planner``: the candidate of highest efficiency (expected pose classes eliminated per expected cost).
+- ``greedy``: the candidate of most expected eliminations, whatever it costs.
+- ``random``: a random admissible move (a random move type, then a random move of that type).
+- ``optimal``: exhaustive search over move sequences (discretised directions, limited depth) for the least
+  expected path cost to recognition; see :mod:`haptic.planning.search`.
+
+Every policy sees only data-side information (hypotheses derived from the data, the sensor state, the data
+components) and draws any random choice from the generator it is given.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from haptic.errors import PlanningError
+from haptic.matching.components import DataComponent, SensorNoise
+from haptic.planning.efficiency import class_weights, expected_eliminations, move_efficiency
+from haptic.planning.moves import Move, SensorState
+from haptic.planning.predict import Hypothesis, PlannerConfig, Prediction, candidate_moves, predict
+
+
+@dataclass(frozen=True, eq=False)
+class Context:
+    """What a policy decides from."""
+
+    hypotheses: Sequence[Hypothesis]
+    """Surviving pose classes."""
+    state: SensorState
+    """Where the sensor is."""
+    components: Mapping[int, DataComponent]
+    """Data components so far, by id (latest version of re-reported edges)."""
+    noise: SensorNoise
+    """Sensor-noise model (for outcome bounds)."""
+    config: PlannerConfig = field(default_factory=PlannerConfig)
+    """Candidate generation and cost options."""
+
+
+@dataclass(frozen=True, eq=False)
+class Scored:
+    """A candidate move with its score under the deciding policy."""
+
+    move: Move
+    score: float
+    """Efficiency, expected eliminations, or negative expected cost, by policy."""
+    expected_cost: float
+    """Weighted mean predicted cost [units]."""
+    expected_eliminated: float
+    """Weighted mean pose classes eliminated."""
+
+
+@dataclass(frozen=True, eq=False)
+class Decision:
+    """The chosen move and every candidate considered, for recording and analysis."""
+
+    move: Move
+    candidates: tuple[Scored, ...] = ()
+
+
+def _score_all(ctx: Context) -> list[tuple[Prediction, float, float, float]]:
+    weights = class_weights([h.model for h in ctx.hypotheses])
+    out = []
+    for move in _fresh_moves(ctx):
+        pred = predict(ctx.hypotheses, move, ctx.state, ctx.components, ctx.noise, ctx.config)
+        eff, _ = move_efficiency(pred.outcomes, pred.bounds, pred.costs, weights)
+        elim = expected_eliminations(pred.outcomes, pred.bounds, weights)
+        out.append((pred, eff, elim, float(pred.costs @ weights)))
+    return out
+
+
+def _fresh_moves(ctx: Context) -> list[Move]:
+    """Candidate moves, less vertex moves that every hypothesis says circle back to an explored edge."""
+    from haptic.planning.search import simulate
+
+    out = []
+    for move in candidate_moves(ctx.state, ctx.components, ctx.config):
+        if move.kind == "vertex" and ctx.hypotheses and all(
+            simulate(h, move, ctx.state, ctx.components, ctx.config) is None for h in ctx.hypotheses
+        ):
+            continue
+        out.append(move)
+    return out
+
+
+class Policy:
+    """Base: ``choose(ctx, rng) -> Decision``."""
+
+    name = "policy"
+
+    def choose(self, ctx: Context, rng: np.random.Generator) -> Decision:  # pragma: no cover - interface
+        raise NotImplementedError
+
+
+class PlannerPolicy(Policy):
+    """Highest efficiency. When no single move is expected to eliminate anything (what separates the
+    hypotheses is further away), the first move of the most efficient sequence of ``lookahead`` moves; failing
+    that, the cheapest move that reaches a new edge and face. Ties are broken at random."""
+
+    name = "planner"
+
+    def __init__(self, lookahead: int = 3) -> None:
+        self.lookahead = lookahead
+
+    def choose(self, ctx: Context, rng: np.random.Generator) -> Decision:
+        scored = _score_all(ctx)
+        if not scored:
+            raise PlanningError("no admissible move from the current sensor state")
+        cands = tuple(Scored(p.move, eff, cost, elim) for p, eff, elim, cost in scored)
+        effs = np.array([c.score for c in cands])
+        if effs.max() <= 0:
+            return Decision(_further(ctx, cands, rng, self.lookahead), cands)
+        best = np.flatnonzero(effs >= effs.max() * (1 - 1e-9))
+        return Decision(cands[int(rng.choice(best))].move, cands)
+
+
+class GreedyPolicy(Policy):
+    """Most expected eliminations, ignoring cost (ties: the cheaper); with nothing to gain from one move, the
+    same look-ahead as the planner."""
+
+    name = "greedy"
+
+    def __init__(self, lookahead: int = 3) -> None:
+        self.lookahead = lookahead
+
+    def choose(self, ctx: Context, rng: np.random.Generator) -> Decision:
+        scored = _score_all(ctx)
+        if not scored:
+            raise PlanningError("no admissible move from the current sensor state")
+        cands = tuple(Scored(p.move, elim, cost, elim) for p, _eff, elim, cost in scored)
+        elims = np.array([c.score for c in cands])
+        if elims.max() <= 0:
+            return Decision(_further(ctx, cands, rng, self.lookahead), cands)
+        best = np.flatnonzero(elims >= elims.max() * (1 - 1e-9))
+        costs = np.array([cands[i].expected_cost for i in best])
+        return Decision(cands[int(best[int(np.argmin(costs))])].move, cands)
+
+
+class RandomPolicy(Policy):
+    """A random admissible move: a random move type among those available, then a random one of it."""
+
+    name = "random"
+
+    def choose(self, ctx: Context, rng: np.random.Generator) -> Decision:
+        moves = candidate_moves(ctx.state, ctx.components, ctx.config)
+        if not moves:
+            raise PlanningError("no admissible move from the current sensor state")
+        kinds = sorted({m.kind for m in moves})
+        kind = kinds[int(rng.integers(len(kinds)))]
+        of_kind = [m for m in moves if m.kind == kind]
+        return Decision(of_kind[int(rng.integers(len(of_kind)))])
+
+
+def _further(ctx: Context, cands: Sequence[Scored], rng: np.random.Generator, depth: int) -> Move:
+    from haptic.planning.search import lookahead_choice
+
+    for d in range(2, depth + 1):
+        move = lookahead_choice(ctx, depth=d)
+        if move is not None:
+            return move
+    return _cheapest_exploring(cands, rng)
+
+
+def _cheapest_exploring(cands: Sequence[Scored], rng: np.random.Generator) -> Move:
+    """With nothing to gain now, move on to new components: face and vertex moves reach a new edge and face."""
+    pool = [c for c in cands if c.move.kind in ("face", "vertex")] or list(cands)
+    costs = np.array([c.expected_cost for c in pool])
+    costs = np.where(np.isfinite(costs), costs, np.inf)
+    best = np.flatnonzero(costs <= costs.min() * (1 + 1e-9)) if np.isfinite(costs).any() else np.arange(len(pool))
+    return pool[int(rng.choice(best))].move
+
+
+POLICIES: dict[str, type[Policy]] = {
+    "planner": PlannerPolicy,
+    "greedy": GreedyPolicy,
+    "random": RandomPolicy,
+}
+
+
+def make_policy(name: str, **options) -> Policy:
+    """A policy by name: planner, greedy, random, optimal."""
+    if name == "optimal":
+        from haptic.planning.search import OptimalPolicy
+
+        return OptimalPolicy(**options)
+    try:
+        return POLICIES[name](**options)
+    except KeyError:
+        valid = ", ".join([*POLICIES, "optimal"])
+        raise PlanningError(f"unknown policy {name!r}; valid: {valid}") from None
+
+
+POLICY_NAMES = (*POLICIES, "optimal")

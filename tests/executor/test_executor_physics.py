@@ -1,0 +1,123 @@
+"""The physics executor: start + face move on a seed object, no peeking, faults as statuses, matcher accepts."""
+
+from __future__ import annotations
+
+import dataclasses
+import inspect
+
+import numpy as np
+import pytest
+
+import haptic.executor.physics as physics_module
+import haptic.executor.primitives as primitives_module
+import haptic.executor.segment as segment_module
+from haptic.executor.evaluate import score_components
+from haptic.executor.physics import PhysicsExecutor
+from haptic.geometry import load_library
+from haptic.planning.moves import EdgeMove, FaceMove, VertexMove
+from haptic.sim import RobotInterface, SensorNoise, Simulation, compose_scene, random_object_pose
+from haptic.sim.scene import scene_object_from_polyhedron
+
+FACE_DIRECTIONS = 6
+
+
+def _setup(name: str, seed: int):
+    poly = load_library()[name]
+    obj = scene_object_from_polyhedron(poly)
+    pose = random_object_pose(obj, np.random.default_rng(seed))
+    sim = Simulation(compose_scene(obj, pose), noise=SensorNoise.from_notes(), seed=seed)
+    return poly, sim
+
+
+def _start_and_face_move(sim: Simulation, seed: int):
+    ex = PhysicsExecutor(RobotInterface(sim), rng=np.random.default_rng(seed))
+    results = [ex.start()]
+    assert results[0].ok, results[0].info
+    rng = np.random.default_rng(seed + 1)
+    for _ in range(FACE_DIRECTIONS):
+        r = ex.execute(ex.admissible_moves(rng, 1)[0])
+        results.append(r)
+        if r.ok:
+            break
+    return ex, results
+
+
+@pytest.fixture(scope="module")
+def box_run():
+    poly, sim = _setup("BOX01", 3)
+    ex, results = _start_and_face_move(sim, 3)
+    return poly, sim, ex, results
+
+
+def test_start_and_face_move_report_accurate_components(box_run):
+    poly, sim, ex, results = box_run
+    assert results[-1].ok, [r.info.get("reason") for r in results]
+    kinds = [c.kind for c in results[-1].components]
+    assert kinds == ["edge", "face"]
+    edge, face = results[-1].components
+    assert edge.adjacent == (results[0].components[0].id,) and face.adjacent == (edge.id,)
+    st = results[-1].state
+    assert st.face == face.id and st.edge == edge.id and st.edge_faces == (results[0].components[0].id, face.id)
+    score = score_components(ex.components, poly, sim.ground_truth().world_from_object, results)
+    assert score.spurious == 0 and score.missed == 0
+    assert score.errors("face", "angle").max() < 0.5
+    assert score.errors("edge", "angle").max() < 1.0
+    assert score.errors("edge", "position").max() < 1.0
+    # the cost is the seed's formula over the distance actually travelled
+    r = results[-1]
+    assert r.distance > 0 and r.cost == pytest.approx(ex.costs.face_move(r.distance))
+    # bounds hold the true errors
+    assert np.radians(score.errors("face", "angle")).max() < min(
+        c.normal_bound for c in ex.components if c.kind == "face"
+    )
+
+
+def test_matcher_keeps_the_true_model(box_run):
+    from haptic.matching.tree import InterpretationTree
+
+    poly, _, ex, results = box_run
+    tree = InterpretationTree(load_library())
+    for r in results:
+        for c in r.components:
+            tree.add(c)
+            assert poly.name in tree.models_alive(), f"{poly.name} pruned by component {c}"
+
+
+def test_invalid_moves_are_statuses_not_exceptions(box_run):
+    _, _, ex, _ = box_run
+    state = ex.state
+    assert ex.execute(FaceMove(np.array([np.nan, 0.0, 0.0]))).status == "invalid"
+    assert ex.execute(FaceMove(ex.segmenter.faces[state.face].component.normal)).status == "invalid"
+    assert ex.execute(EdgeMove(0)).status == "invalid"
+    assert ex.execute(VertexMove(state.face)).status == "invalid"  # no vertex yet
+    assert ex.state is state
+
+
+def test_no_peeking_constructor_refuses_the_simulation():
+    _, sim = _setup("BOX01", 3)
+    with pytest.raises(TypeError, match="RobotInterface"):
+        PhysicsExecutor(sim)
+
+
+@pytest.mark.parametrize("module", [physics_module, primitives_module, segment_module])
+def test_no_peeking_sources_never_touch_ground_truth(module):
+    src = inspect.getsource(module)
+    for name in ("ground_truth", "GroundTruth", "world_from_object", "Simulation(", "._sim", "compose_scene",
+                 "SceneObject", "load_object", "load_library"):  # fmt: skip
+        assert name not in src, f"{module.__name__} mentions {name}"
+
+
+def test_no_peeking_output_does_not_depend_on_the_ground_truth_record():
+    """Replacing the object's ground-truth record (name, pose) changes nothing the executor reports."""
+    _, sim_a = _setup("WEDGE01", 5)
+    _, sim_b = _setup("WEDGE01", 5)
+    fake = dataclasses.replace(sim_b._scene, world_from_object=np.eye(4), object=None)
+    sim_b._scene = fake
+    assert sim_b.ground_truth().object is None
+    ex_a = PhysicsExecutor(RobotInterface(sim_a), rng=np.random.default_rng(5))
+    ex_b = PhysicsExecutor(RobotInterface(sim_b), rng=np.random.default_rng(5))
+    ra, rb = ex_a.start(), ex_b.start()
+    assert ra.status == rb.status
+    for ca, cb in zip(ex_a.components, ex_b.components, strict=True):
+        np.testing.assert_array_equal(ca.normal, cb.normal)
+        np.testing.assert_array_equal(ca.points, cb.points)

@@ -1,0 +1,61 @@
+"""Primitives on a box at a known pose: guarded approach, trace to a convex edge, roll over, stroke."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from haptic.executor.primitives import ContactTrace, Toucher
+from haptic.executor.segment import SegmentBounds, fit_face
+from haptic.sim import RobotInterface, SensorNoise, Simulation, compose_scene
+from haptic.sim.scene import TABLE_TOP_Z, scene_object_from_parts
+
+HALF = np.array([0.05, 0.04, 0.03])
+CENTRE = np.array([0.56, 0.0, TABLE_TOP_Z + 0.03])
+
+
+def _box_sim(seed: int = 0) -> Simulation:
+    parts = [np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]) * HALF]
+    pose = np.eye(4)
+    pose[:3, 3] = CENTRE
+    return Simulation(compose_scene(scene_object_from_parts("box", parts), pose), noise=SensorNoise.from_notes(),
+                      seed=seed)  # fmt: skip
+
+
+def test_approach_trace_roll_stroke_on_a_box():
+    sim = _box_sim()
+    t = Toucher(RobotInterface(sim))
+    top = CENTRE[2] + HALF[2]
+    assert t.move_free(np.array([CENTRE[0] - 0.02, CENTRE[1], top + 0.03])).ok
+    a = t.approach(np.array([0.0, 0.0, -1.0]), 0.05)
+    assert a.ok and a.event == "contact"
+    assert abs(a.info["point"][2] - top) < 1e-3
+    # missing the surface is a status, not a hang
+    r = t.trace_face(np.array([1.0, 0.0, 0.0]), a.info["normal"], 0.2)
+    assert r.ok and r.event == "convex-edge"
+    x_edge = CENTRE[0] + HALF[0]
+    assert abs(t.contact[2][0] - x_edge) < 2e-3  # detected at the edge
+    c = t.cross_edge("convex", r.info["face_normal"], r.info["direction"])
+    assert c.ok
+    np.testing.assert_allclose(c.info["normal"], [1, 0, 0], atol=np.sin(np.radians(3)))
+    np.testing.assert_allclose(np.abs(c.info["edge_direction"]), [0, 1, 0], atol=np.sin(np.radians(3)))
+    roll = c.trace.select(c.trace.in_contact)
+    mid = (roll.normal_in_world @ [1, 0, 0] > 0.2) & (roll.normal_in_world @ [0, 0, 1] > 0.2)
+    pts = roll.point_in_world[mid]
+    assert len(pts) > 10
+    assert np.abs(pts[:, 0] - x_edge).mean() < 5e-4 and np.abs(pts[:, 2] - top).mean() < 5e-4  # on the edge
+    s = t.stroke(c.info["normal"], c.info["away"], c.info["edge_direction"])
+    assert s.ok
+    rows = s.trace.select(s.trace.in_contact)
+    fit = fit_face(rows.point_in_world, rows.normal_in_world, SegmentBounds())
+    assert np.degrees(np.arccos(fit.normal @ [1, 0, 0])) < 0.5
+    assert abs(fit.offset - x_edge) < 5e-4
+    assert c.distance > 0 and s.distance > 0
+    assert isinstance(ContactTrace.concatenate([a.trace, r.trace, c.trace, s.trace]), ContactTrace)
+
+
+def test_approach_into_free_space_reports_no_contact():
+    sim = _box_sim()
+    t = Toucher(RobotInterface(sim))
+    assert t.move_free(np.array([CENTRE[0] - 0.1, 0.1, TABLE_TOP_Z + 0.08])).ok
+    r = t.approach(np.array([0.0, 0.0, -1.0]), 0.03)
+    assert r.status == "no-contact"

@@ -1,0 +1,48 @@
+"""Predictions of move outcomes agree with what the geometric executor then measures."""
+
+import numpy as np
+
+from haptic.executor.geometric import GeometricExecutor
+from haptic.geometry import SE3, load_library
+from haptic.matching.components import SensorNoise
+from haptic.planning.moves import CostModel
+from haptic.planning.predict import Hypothesis, PlannerConfig, candidate_moves, predict_one
+
+LIB = load_library()
+
+
+def _truth_hypothesis(ex: GeometricExecutor, model) -> Hypothesis:
+    faces = {d: m for d, (k, m) in ex.truth.items() if k == "face"}
+    edges = {d: m for d, (k, m) in ex.truth.items() if k == "edge"}
+    vertices = {d: m for d, (k, m) in ex.truth.items() if k == "vertex"}
+    return Hypothesis(model.name, model, ex.world_from_model, faces, edges, vertices)
+
+
+def test_true_hypothesis_predicts_the_executed_distance():
+    rng = np.random.default_rng(4)
+    config = PlannerConfig()
+    checked = 0
+    for name in ("BOX01", "WEDGE01", "LBLOCK01", "TETRA01L", "BOX01N"):
+        model = LIB[name]
+        for _ in range(4):
+            pose = SE3.random(rng, 0.1)
+            ex = GeometricExecutor(model, pose, noise=SensorNoise().scaled(0.0), rng=rng, costs=CostModel())
+            res = ex.start()
+            comps = {c.id: c for c in res.components}
+            state = res.state
+            for _step in range(6):
+                moves = candidate_moves(state, comps, config)
+                move = moves[int(rng.integers(len(moves)))]
+                h = _truth_hypothesis(ex, model)
+                outcome, cost = predict_one(h, move, state, comps, config)
+                res = ex.execute(move)
+                if not res.ok:
+                    continue
+                if not np.isnan(outcome[0]) and move.kind in ("face", "edge"):
+                    assert np.isclose(outcome[0], res.distance, atol=1e-6), (name, move)
+                    assert np.isclose(cost, res.cost, atol=1e-6)
+                    checked += 1
+                for c in res.components:
+                    comps[c.id] = c
+                state = res.state
+    assert checked >= 40
