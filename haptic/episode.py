@@ -74,6 +74,7 @@ class EpisodeObserver:
     on_start: Callable[[Polyhedron, SE3], None] | None = None
     on_move: Callable[[int, MoveResult, int, Recognition | None], None] | None = None
     on_decision: Callable[[int, Decision], None] | None = None
+    on_failed_move: Callable[[int, MoveResult], None] | None = None
     on_end: Callable[[EpisodeRecord], None] | None = None
 
 
@@ -231,6 +232,8 @@ def run_loop(
                 failed_total += 1
                 failed_in_a_row += 1
                 cost += result.cost
+                if obs.on_failed_move:
+                    obs.on_failed_move(n_moves, result)
                 if result.state is not None:
                     state = result.state
                 if failed_in_a_row >= MAX_FAILED_MOVES:

@@ -31,3 +31,7 @@ class PlanningError(HapticError):
 
 class BenchError(HapticError):
     """A benchmark or results file cannot be written or read."""
+
+
+class RecordingError(HapticError):
+    """A recording cannot be written, or the viewer cannot be opened."""

@@ -236,6 +236,9 @@ def atomic_write(path: str | os.PathLike, data: bytes | str) -> None:
     mode = "wb" if isinstance(data, bytes) else "w"
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
+        umask = os.umask(0)
+        os.umask(umask)
+        os.fchmod(fd, 0o666 & ~umask)  # mkstemp makes the file owner-only; give it the usual mode
         with os.fdopen(fd, mode) as fh:
             fh.write(data)
         os.replace(tmp, path)

@@ -175,8 +175,13 @@ def expected_cost_to_go(
     best, best_move = np.inf, None
     total = float(weights.sum())
     for move in candidate_moves(state, components, config):
-        value = 0.0
-        for br in branches(hyps, weights, move, state, components, noise, config):
+        bs = branches(hyps, weights, move, state, components, noise, config)
+        covered = sum(float(br.weights.sum()) for br in bs) / total
+        if covered < 1e-9:
+            continue  # no hypothesis can carry the move out (or it only circles back)
+        # hypotheses that cannot simulate the move learn nothing from it: they stay where they were
+        value = (1.0 - covered) * (max((br.cost for br in bs), default=0.0) + leaf_cost * float(np.log2(n)))
+        for br in sorted(bs, key=lambda b: -float(b.weights.sum())):
             p = float(br.weights.sum()) / total
             rest, _ = expected_cost_to_go(
                 br.hypotheses, br.weights, br.state, br.components, noise, config, depth - 1, leaf_cost

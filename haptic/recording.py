@@ -1,0 +1,874 @@
+"""Rerun recordings of episodes: the only module of the package that imports ``rerun``.
+
+:class:`EpisodeRecorder` turns the hooks of :class:`~haptic.episode.EpisodeObserver` into a rerun recording,
+saved to an ``.rrd`` file (written to a temporary file beside the target and renamed when the episode ended,
+so a failed episode never leaves a partial recording at the target path) and/or streamed to a spawned viewer.
+
+Timelines: ``move`` (sequence: 0 is the start, then one step per move) and, when the executor reports contact
+traces (the physics executor's ``info["trace"]``), ``sim_time`` (simulated time [s]).
+
+Entities (world frame, metres, Z up):
+
+- ``world/truth``: Transform3D ``world_from_model`` of the true pose (static)
+- ``world/truth/object``: the true model's mesh, model frame (static; the ground-truth layer)
+- ``world/truth/edges``: its edges as line strips (static)
+- ``world/estimate``, ``.../edges``: the recognised model at its estimated pose, once recognised
+- ``world/trace/path``: the sensor's path, one line strip per move, accumulated
+- ``world/trace/failed``: fingertip paths of failed moves, accumulated (physics)
+- ``world/sensor``: sensor position after the latest move
+- ``world/contacts/points``, ``/normals``: the latest move's contact points and their normals (arrows)
+- ``world/data/faces/patches``: data faces as small patches in their planes, accumulated
+- ``world/data/faces/normals``: one arrow per data face (its normal), labelled ``f<id>``
+- ``world/data/faces/points``: the points touched on the data faces
+- ``world/data/edges``: one segment per data edge (its explored interval), ``e<id>``
+- ``world/data/vertices``: one point per data vertex, ``v<id>``
+- ``world/decision/candidates``: each candidate move of the latest decision, coloured by score
+- ``world/decision/chosen``: the chosen move
+- ``world/hand/pad``: fingertip pad pose per control tick (``sim_time``; physics only)
+- ``world/hand/fingertip``: pad centre per control tick (physics only)
+- ``world/hand/contact/points``, ``/normals``: sensed contact per control tick (physics only)
+- ``world/hand/links``: hand link origins per control tick, labelled (``info["hand_links"]``)
+- ``plots/interpretations``: surviving interpretations after each move
+- ``plots/pose_classes``: pose classes after each move (when known)
+- ``plots/path_cost``: cumulative path cost [units]
+- ``plots/force``: sensed normal force per control tick [N] (physics only)
+- ``plots/candidates``: bar chart of the latest decision's candidate scores
+- ``log/moves``, ``log/decisions``, ``log/episode``: text logs
+
+Read a recording back with :func:`load_recording` (rerun's :class:`rerun.chunk.RrdReader`).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import shutil
+import sys
+import tempfile
+import uuid
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+from types import TracebackType
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import rerun as rr
+import rerun.blueprint as rrb
+
+from haptic.errors import RecordingError
+from haptic.geometry import SE3, Polyhedron
+from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex
+
+if TYPE_CHECKING:
+    from haptic.episode import EpisodeObserver, EpisodeRecord
+    from haptic.matching.recognition import Recognition
+    from haptic.planning.moves import Move, MoveResult, SensorState
+    from haptic.planning.policies import Decision
+
+APPLICATION_ID = "haptic"
+"""Rerun application id of every episode recording (the viewer keeps one blueprint per application)."""
+
+VIEWER_PORT = 9876
+"""Port of a spawned viewer."""
+
+PATCH_RADIUS = 0.006
+"""Half-size of a data face's patch beyond its touched points [m]."""
+NORMAL_LENGTH = 0.012
+"""Length of a face-normal arrow [m]."""
+CONTACT_NORMAL_LENGTH = 0.006
+"""Length of a contact-normal arrow [m]."""
+CANDIDATE_LENGTH = 0.02
+"""Length of the best candidate move's arrow (the others scale down with their score, to half of it) [m]."""
+TRACE_MAX_POINTS = 400
+"""Most points of one move's strip in ``world/trace/path`` (a physics trace is subsampled to it)."""
+
+KIND_COLORS: dict[str, tuple[int, int, int]] = {
+    "start": (160, 160, 160),
+    "face": (70, 130, 230),
+    "edge": (240, 150, 40),
+    "vertex": (180, 80, 200),
+}
+"""Colour of each move kind (path strips, candidate labels)."""
+FACE_COLOR = (70, 130, 230, 140)
+EDGE_COLOR = (240, 150, 40)
+VERTEX_COLOR = (220, 40, 60)
+CONTACT_COLOR = (250, 220, 50)
+TRUTH_COLOR = (150, 150, 150, 90)
+ESTIMATE_COLOR = (60, 200, 90)
+
+
+# ---------------------------------------------------------------------------------------------- blueprint
+
+
+def default_blueprint() -> rrb.Blueprint:
+    """The layout a recording opens with: the 3-D scene on the left; the interpretation count, the path cost,
+    the latest decision's candidate scores and the logs on the right; the time panel on the ``move``
+    timeline."""
+    return rrb.Blueprint(
+        rrb.Horizontal(
+            rrb.Spatial3DView(origin="world", name="scene"),
+            rrb.Vertical(
+                rrb.TimeSeriesView(
+                    origin="plots", contents=["plots/interpretations", "plots/pose_classes"], name="interpretations"
+                ),
+                rrb.TimeSeriesView(origin="plots", contents=["plots/path_cost", "plots/force"], name="cost and force"),
+                rrb.BarChartView(origin="plots/candidates", name="candidate scores"),
+                rrb.TextLogView(origin="log", name="log"),
+                row_shares=[3, 2, 2, 2],
+            ),
+            column_shares=[3, 2],
+        ),
+        rrb.TimePanel(timeline="move"),
+        rrb.SelectionPanel(state="collapsed"),
+    )
+
+
+# ---------------------------------------------------------------------------------------------- recorder
+
+
+def _viewer_executable() -> str:
+    """The ``rerun`` viewer executable (on PATH, or beside this Python's executable), or raise."""
+    found = shutil.which("rerun") or shutil.which("rerun", path=str(Path(sys.executable).parent))
+    if found is None:
+        raise RecordingError(
+            "--spawn: no rerun viewer executable found on PATH or beside "
+            f"{sys.executable}; install it (pip install rerun-sdk) or use --record OUT.rrd"
+        )
+    return found
+
+
+def _check_display() -> None:
+    """Raise when no window can be opened (Linux without X11 or Wayland)."""
+    if sys.platform.startswith("linux") and not any(
+        os.environ.get(v) for v in ("DISPLAY", "WAYLAND_DISPLAY", "WAYLAND_SOCKET")
+    ):
+        raise RecordingError(
+            "--spawn: no display to open the rerun viewer on (DISPLAY and WAYLAND_DISPLAY are unset); "
+            "use --record OUT.rrd and open it with `rerun OUT.rrd` where there is a display"
+        )
+
+
+def _listening(port: int, timeout: float = 2.0) -> bool:
+    """Whether something accepts connections on ``127.0.0.1:port`` (the spawned viewer is up)."""
+    import socket
+
+    try:
+        with socket.create_connection(("127.0.0.1", port), timeout=timeout):
+            return True
+    except OSError:
+        return False
+
+
+@dataclass
+class _State:
+    """What the recorder has seen so far in the episode."""
+
+    components: dict[int, DataComponent] = field(default_factory=dict)
+    strips: list[np.ndarray] = field(default_factory=list)
+    strip_kinds: list[str] = field(default_factory=list)
+    failed_strips: list[np.ndarray] = field(default_factory=list)
+    position: np.ndarray | None = None
+    sim_time: float | None = None
+    cost: float = 0.0
+    decided: set[int] = field(default_factory=set)
+    state: SensorState | None = None
+    link_labels_logged: bool = False
+    pad_axes_logged: bool = False
+    decision_shown: bool = False
+
+
+class EpisodeRecorder:
+    """Records one episode for the rerun viewer.
+
+    ``EpisodeRecorder(path)`` saves headless to ``path`` (an ``.rrd``); ``spawn=True`` also opens a viewer
+    (raises :class:`RecordingError` with one line when none can start). Pass :meth:`observer` to
+    :func:`~haptic.episode.run_episode`, then call :meth:`close`: the file appears at ``path`` only when the
+    episode ended (``on_end`` was called) or ``close(keep=True)``; otherwise the temporary file is removed.
+    Also a context manager (an exception discards the recording).
+    """
+
+    def __init__(self, path: str | os.PathLike | None = None, *, spawn: bool = False, name: str | None = None) -> None:
+        if path is None and not spawn:
+            raise RecordingError("a recording needs a file (--record OUT.rrd) or a viewer (--spawn)")
+        self.path: Path | None = Path(path) if path is not None else None
+        """Target .rrd file (None: viewer only)."""
+        self.completed = False
+        """Whether the episode ended (``on_end`` was called)."""
+        self._tmp: Path | None = None
+        self._closed = False
+        self._kept = False
+        self._s = _State()
+        if spawn:
+            _check_display()
+            exe = _viewer_executable()
+        self.stream = rr.RecordingStream(APPLICATION_ID, recording_id=uuid.uuid4(), send_properties=True)
+        """The rerun recording stream (log more to it if you like)."""
+        if not rr.is_enabled(self.stream):
+            raise RecordingError("rerun logging is disabled (the RERUN environment variable is set to off)")
+        self.stream.set_log_time_enabled(False)
+        sinks: list[Any] = []
+        if self.path is not None:
+            if self.path.is_dir():
+                raise RecordingError(f"--record {self.path}: is a directory; give a file name such as episode.rrd")
+            try:
+                self.path.parent.mkdir(parents=True, exist_ok=True)
+                fd, tmp = tempfile.mkstemp(prefix=f".{self.path.name}.", suffix=".part", dir=self.path.parent)
+            except OSError as exc:
+                raise RecordingError(f"--record {self.path}: cannot write there ({exc.strerror})") from exc
+            os.close(fd)
+            self._tmp = Path(tmp)
+            sinks.append(rr.FileSink(self._tmp))
+        if spawn:
+            try:
+                rr.spawn(port=VIEWER_PORT, connect=False, executable_path=exe, recording=self.stream)
+            except (RuntimeError, OSError) as exc:
+                self._discard()
+                first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+                raise RecordingError(f"--spawn: the rerun viewer did not start: {first}") from exc
+            if not _listening(VIEWER_PORT):
+                self._discard()
+                raise RecordingError(
+                    f"--spawn: the rerun viewer did not start (nothing listens on port {VIEWER_PORT}); "
+                    "use --record OUT.rrd and open it with `rerun OUT.rrd`"
+                )
+            sinks.append(rr.GrpcSink(f"rerun+http://127.0.0.1:{VIEWER_PORT}/proxy"))
+        self.stream.set_sinks(*sinks, default_blueprint=default_blueprint())
+        if name:
+            self.stream.send_recording_name(name)
+        self._log_static()
+
+    # ------------------------------------------------------------------------------------------ lifecycle
+
+    def observer(self) -> EpisodeObserver:
+        """The :class:`~haptic.episode.EpisodeObserver` that feeds this recorder."""
+        from dataclasses import fields
+
+        from haptic.episode import EpisodeObserver
+
+        hooks = {
+            "on_start": self.on_start,
+            "on_move": self.on_move,
+            "on_decision": self.on_decision,
+            "on_end": self.on_end,
+            "on_failed_move": self.on_failed_move,
+        }
+        known = {f.name for f in fields(EpisodeObserver)}
+        return EpisodeObserver(**{k: v for k, v in hooks.items() if k in known})
+
+    def close(self, keep: bool | None = None) -> Path | None:
+        """Finish the recording. ``keep`` (default: whether the episode ended) renames the complete file to
+        :attr:`path` and returns it; otherwise the temporary file is removed and None returned. Idempotent."""
+        if self._closed:
+            return self.path if self.path is not None and self.path.exists() and self._kept else None
+        self._closed = True
+        self._kept = self.completed if keep is None else bool(keep)
+        try:
+            self.stream.flush(timeout_sec=30.0)
+        finally:
+            self.stream.disconnect()
+        if self._tmp is None or self.path is None:
+            return None
+        if not self._kept:
+            self._discard()
+            return None
+        try:
+            from rerun.chunk import RrdReader
+
+            RrdReader(self._tmp).store()  # the footer (manifest) is there: the file is complete
+        except Exception as exc:  # noqa: BLE001 -- any failure to read it back means it is incomplete
+            self._discard()
+            raise RecordingError(f"--record {self.path}: the recording was not written completely ({exc})") from exc
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(self._tmp, 0o666 & ~umask)  # mkstemp makes it private; a recording is an ordinary file
+        os.replace(self._tmp, self.path)
+        self._tmp = None
+        return self.path
+
+    def _discard(self) -> None:
+        if self._tmp is not None:
+            self._tmp.unlink(missing_ok=True)
+            self._tmp = None
+
+    def __enter__(self) -> EpisodeRecorder:
+        return self
+
+    def __exit__(
+        self, exc_type: type[BaseException] | None, exc: BaseException | None, tb: TracebackType | None
+    ) -> None:
+        self.close(keep=False if exc_type is not None else None)
+
+    # ------------------------------------------------------------------------------------------ hooks
+
+    def on_start(self, true_model: Polyhedron, world_from_model: SE3) -> None:
+        """The ground-truth layer: the true model in its true pose (static)."""
+        rec = self.stream
+        rec.send_recording_name(f"{true_model.name}")
+        rec.log("world/truth", _transform(world_from_model), static=True)
+        rec.log("world/truth/object", _mesh(true_model, TRUTH_COLOR), static=True)
+        rec.log("world/truth/edges", _wireframe(true_model, (120, 120, 120), 0.0004), static=True)
+
+    def on_move(
+        self, i: int, result: MoveResult, n_interpretations: int, recognition: Recognition | None = None
+    ) -> None:
+        """One successful move (``i`` = 0 for the start): path, contacts, components, counts."""
+        rec, s = self.stream, self._s
+        trace = _trace_of(result)
+        if trace is not None and len(trace.time):
+            s.sim_time = float(trace.time[-1])
+        self._set_time(i)
+        for c in result.components:
+            s.components[c.id] = c
+        kind = getattr(result.move, "kind", "start") if i > 0 else "start"
+        prev = s.position
+        new = np.asarray(result.state.position, dtype=float) if result.state is not None else None
+
+        # the path: the physics trace when there is one, else the sensed waypoints
+        if trace is not None and len(trace.time):
+            path = _subsample(np.asarray(trace.tip_in_world, dtype=float), TRACE_MAX_POINTS)
+        else:
+            path = _waypoints(prev, result, new)
+        if len(path) == 1:
+            path = np.vstack([path, path])
+        if len(path):
+            s.strips.append(path)
+            s.strip_kinds.append(kind)
+            rec.log(
+                "world/trace/path",
+                rr.LineStrips3D(
+                    s.strips,
+                    colors=[KIND_COLORS.get(k, KIND_COLORS["start"]) for k in s.strip_kinds],
+                    radii=0.0006,
+                    labels=[f"{j}: {k}" for j, k in enumerate(s.strip_kinds)],
+                    show_labels=False,
+                ),
+            )
+        if result.state is not None:
+            s.state = result.state
+        if new is not None:
+            s.position = new
+            rec.log("world/sensor", rr.Points3D([new], radii=0.002, colors=[(255, 255, 255)], labels=["sensor"]))
+
+        # contacts of this move
+        if trace is not None and len(trace.time):
+            ok = np.isfinite(np.asarray(trace.normal_in_world, dtype=float)[:, 0])
+            pts = _subsample(np.asarray(trace.point_in_world, dtype=float)[ok], 60)
+            nrm = _subsample(np.asarray(trace.normal_in_world, dtype=float)[ok], 60)
+            self._log_trace(trace)
+        else:
+            pts, nrm = _contacts(result.components)
+        rec.log("world/contacts/points", rr.Points3D(pts, radii=0.0008, colors=[CONTACT_COLOR]))
+        rec.log(
+            "world/contacts/normals",
+            rr.Arrows3D(origins=pts, vectors=nrm * CONTACT_NORMAL_LENGTH, colors=[CONTACT_COLOR], radii=0.0002),
+        )
+        links = result.info.get("hand_links") if isinstance(result.info, dict) else None
+        if links:
+            self._log_links(links, trace)
+
+        self._log_components()
+
+        # the counts
+        s.cost += float(result.cost)
+        rec.log("plots/interpretations", rr.Scalars(float(n_interpretations)))
+        rec.log("plots/path_cost", rr.Scalars(s.cost))
+        n_classes = len(recognition.classes) if recognition is not None and recognition.classes else None
+        if n_classes is not None:
+            rec.log("plots/pose_classes", rr.Scalars(float(n_classes)))
+        if recognition is not None and recognition.status == "recognized" and recognition.world_from_model:
+            model = next((c.model for c in recognition.classes if c.name == recognition.model), None)
+            if model is not None:
+                rec.log("world/estimate", _transform(recognition.world_from_model))
+                rec.log("world/estimate/edges", _wireframe(model, ESTIMATE_COLOR, 0.0005))
+        if i not in s.decided and s.decision_shown:
+            rec.log("world/decision", rr.Clear(recursive=True))
+            s.decision_shown = False
+
+        status = recognition.status if recognition is not None else "-"
+        comps = ", ".join(f"{c.kind} {c.id}" for c in result.components) or "none"
+        rec.log(
+            "log/moves",
+            rr.TextLog(
+                f"move {i} ({kind}): {comps}; {n_interpretations} interpretations"
+                + (f", {n_classes} pose classes" if n_classes is not None else "")
+                + f"; cost {float(result.cost):.2f} (total {s.cost:.2f}); {status}",
+                level=rr.TextLogLevel.INFO,
+            ),
+        )
+
+    def on_failed_move(self, i: int, result: MoveResult) -> None:
+        """A move that failed (no components): its trace, when there is one, in ``world/trace/failed``, and a
+        warning in ``log/moves``. (Called by the loop when :class:`~haptic.episode.EpisodeObserver` has an
+        ``on_failed_move`` hook.)"""
+        rec, s = self.stream, self._s
+        trace = _trace_of(result)
+        if trace is not None and len(trace.time):
+            s.sim_time = float(trace.time[-1])
+        self._set_time(i)
+        if trace is not None and len(trace.time):
+            self._log_trace(trace)
+            path = _subsample(np.asarray(trace.tip_in_world, dtype=float), TRACE_MAX_POINTS)
+            if len(path) >= 2:
+                s.failed_strips.append(path)
+                rec.log("world/trace/failed", rr.LineStrips3D(s.failed_strips, colors=[(230, 50, 50)], radii=0.0006))
+        if result.state is not None:
+            s.state = result.state
+            s.position = np.asarray(result.state.position, dtype=float)
+        s.cost += float(result.cost)
+        rec.log("plots/path_cost", rr.Scalars(s.cost))
+        reason = result.info.get("reason", "") if isinstance(result.info, dict) else ""
+        rec.log(
+            "log/moves",
+            rr.TextLog(
+                f"move {i} ({_move_name(result.move)}) failed: {result.status}" + (f" ({reason})" if reason else ""),
+                level=rr.TextLogLevel.WARN,
+            ),
+        )
+
+    def on_decision(self, i: int, decision: Decision) -> None:
+        """The planner's choice for move ``i``: every candidate with its score, as arrows, bars and text."""
+        rec, s = self.stream, self._s
+        self._set_time(i)
+        s.decided.add(i)
+        cands = list(decision.candidates)
+        if cands:
+            scores = np.array([float(c.score) for c in cands])
+            finite = np.isfinite(scores)
+            lo, hi = (float(scores[finite].min()), float(scores[finite].max())) if finite.any() else (0.0, 0.0)
+            rel = np.where(finite, (scores - lo) / (hi - lo), 0.0) if hi > lo else np.ones(len(cands))
+            rec.log("plots/candidates", rr.BarChart(np.where(finite, scores, 0.0), color=(70, 130, 230)))
+            origins, vectors, colors, labels = [], [], [], []
+            for c, r in zip(cands, rel, strict=True):
+                d = self._move_direction(c.move)
+                if d is None:
+                    continue
+                origins.append(s.position)
+                vectors.append(d * CANDIDATE_LENGTH * (0.5 + 0.5 * r))
+                colors.append(_score_color(r))
+                labels.append(f"{_move_name(c.move)} {c.score:.3g}")
+            if origins:
+                rec.log(
+                    "world/decision/candidates",
+                    rr.Arrows3D(origins=origins, vectors=vectors, colors=colors, labels=labels, radii=0.0004,
+                                show_labels=False),
+                )  # fmt: skip
+            lines = [
+                f"  {_move_name(c.move):<16} score {c.score:10.4g}  cost {c.expected_cost:7.2f}  "
+                f"eliminated {c.expected_eliminated:6.2f}"
+                for c in sorted(cands, key=lambda c: -c.score if math.isfinite(c.score) else math.inf)
+            ]
+        else:
+            lines = []
+        d = self._move_direction(decision.move)
+        if d is not None and s.position is not None:
+            rec.log(
+                "world/decision/chosen",
+                rr.Arrows3D(origins=[s.position], vectors=[d * CANDIDATE_LENGTH * 1.2], colors=[(255, 255, 255)],
+                            radii=0.0008, labels=[_move_name(decision.move)]),
+            )  # fmt: skip
+        s.decision_shown = True
+        rec.log(
+            "log/decisions",
+            rr.TextLog(
+                f"move {i}: chose {_move_name(decision.move)} among {len(cands)} candidates"
+                + ("\n" + "\n".join(lines) if lines else ""),
+                level=rr.TextLogLevel.INFO,
+            ),
+        )
+
+    def on_end(self, record: EpisodeRecord) -> None:
+        """The outcome, as a text log; marks the recording complete."""
+        r = record
+        text = (
+            f"{r.outcome}" + (f": {r.recognized}" if r.recognized else "") + f" (true {r.model}); "
+            f"{r.moves} moves, path cost {r.path_cost:.1f}, interpretations "
+            + " -> ".join(str(c) for c in r.interpretations)
+        )
+        if r.pose_error_mm is not None:
+            text += f"; pose error {r.pose_error_mm:.2f} mm, {r.pose_error_deg:.2f} deg"
+        level = rr.TextLogLevel.INFO if r.correct else rr.TextLogLevel.WARN
+        self.stream.log("log/episode", rr.TextLog(text, level=level))
+        self.completed = True
+
+    # ------------------------------------------------------------------------------------------ helpers
+
+    def _log_static(self) -> None:
+        rec = self.stream
+        rec.log("world", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
+        series = {
+            "plots/interpretations": ((230, 90, 60), "interpretations"),
+            "plots/pose_classes": ((60, 160, 230), "pose classes"),
+            "plots/path_cost": ((120, 200, 90), "path cost [units]"),
+            "plots/force": ((200, 120, 220), "normal force [N]"),
+        }
+        for path, (color, label) in series.items():
+            rec.log(path, rr.SeriesLines(colors=[color], names=[label], widths=[2.0]), static=True)
+
+    def _set_time(self, i: int) -> None:
+        self.stream.set_time("move", sequence=int(i))
+        if self._s.sim_time is not None:
+            self.stream.set_time("sim_time", duration=self._s.sim_time)
+
+    def _log_components(self) -> None:
+        """The data components so far (edges at their latest explored interval)."""
+        rec = self.stream
+        comps = sorted(self._s.components.values(), key=lambda c: c.id)
+        faces = [c for c in comps if isinstance(c, DataFace)]
+        edges = [c for c in comps if isinstance(c, DataEdge)]
+        vertices = [c for c in comps if isinstance(c, DataVertex)]
+        if faces:
+            verts, tris = [], []
+            for f in faces:
+                v, t = _patch(f)
+                tris.append(t + sum(len(x) for x in verts))
+                verts.append(v)
+            rec.log(
+                "world/data/faces/patches",
+                rr.Mesh3D(
+                    vertex_positions=np.vstack(verts), triangle_indices=np.vstack(tris), albedo_factor=FACE_COLOR
+                ),
+            )
+            centres = np.array([f.points.mean(axis=0) for f in faces])
+            rec.log(
+                "world/data/faces/normals",
+                rr.Arrows3D(origins=centres, vectors=np.array([f.normal for f in faces]) * NORMAL_LENGTH,
+                            colors=[FACE_COLOR[:3]], radii=0.0004, labels=[f"f{f.id}" for f in faces]),
+            )  # fmt: skip
+            rec.log(
+                "world/data/faces/points",
+                rr.Points3D(np.vstack([f.points for f in faces]), radii=0.0006, colors=[FACE_COLOR[:3]]),
+            )
+        if edges:
+            rec.log(
+                "world/data/edges",
+                rr.LineStrips3D([np.array([e.point, e.end_point]) for e in edges], colors=[EDGE_COLOR],
+                                radii=0.0008, labels=[f"e{e.id}" for e in edges]),
+            )  # fmt: skip
+        if vertices:
+            rec.log(
+                "world/data/vertices",
+                rr.Points3D([v.position for v in vertices], radii=0.0015, colors=[VERTEX_COLOR],
+                            labels=[f"v{v.id}" for v in vertices]),
+            )  # fmt: skip
+
+    def _log_trace(self, trace: Any) -> None:
+        """A physics contact trace, one row per control tick on the ``sim_time`` timeline."""
+        rec = self.stream
+        t = rr.TimeColumn("sim_time", duration=np.asarray(trace.time, dtype=float))
+        tip = np.asarray(trace.tip_in_world, dtype=float)
+        n = len(tip)
+        rec.send_columns("world/hand/fingertip", indexes=[t], columns=rr.Points3D.columns(positions=tip))
+        rot = np.asarray(trace.hand_rotation, dtype=float)
+        if rot.shape == (n, 3, 3):
+            if not self._s.pad_axes_logged:
+                rec.log("world/hand/pad", rr.TransformAxes3D(0.01), static=True)
+                self._s.pad_axes_logged = True
+            rec.send_columns("world/hand/pad", indexes=[t], columns=rr.Transform3D.columns(translation=tip, mat3x3=rot))
+        rec.send_columns("plots/force", indexes=[t], columns=rr.Scalars.columns(scalars=np.asarray(trace.force)))
+        pts = np.asarray(trace.point_in_world, dtype=float)
+        nrm = np.asarray(trace.normal_in_world, dtype=float)
+        ok = np.isfinite(nrm[:, 0]) & np.isfinite(pts[:, 0])
+        lengths = ok.astype(int)
+        rec.send_columns(
+            "world/hand/contact/points", indexes=[t],
+            columns=rr.Points3D.columns(positions=pts[ok]).partition(lengths),
+        )  # fmt: skip
+        rec.send_columns(
+            "world/hand/contact/normals", indexes=[t],
+            columns=rr.Arrows3D.columns(origins=pts[ok], vectors=nrm[ok] * CONTACT_NORMAL_LENGTH).partition(lengths),
+        )  # fmt: skip
+
+    def _log_links(self, links: dict, trace: Any) -> None:
+        """``info["hand_links"]``: link name -> (n, 3) positions, (n, 4, 4) poses or (n, 7) position +
+        quaternion (w, x, y, z), world frame; n rows aligned with the trace's ticks (or 1: the pose at the
+        end of the move). Malformed entries are skipped with a warning."""
+        rec, s = self.stream, self._s
+        names, positions = [], []
+        for name, value in links.items():
+            a = np.asarray(value, dtype=float)
+            if a.ndim == 1:
+                a = a[None]
+            if a.ndim == 2 and a.shape[1] in (3, 7):
+                p = a[:, :3]
+            elif a.ndim == 3 and a.shape[1:] == (4, 4):
+                p = a[:, :3, 3]
+            else:
+                warnings.warn(f"hand_links[{name!r}]: shape {a.shape} is not (n, 3), (n, 7) or (n, 4, 4); skipped",
+                              stacklevel=2)  # fmt: skip
+                continue
+            names.append(str(name))
+            positions.append(p)
+        if not positions or len({len(p) for p in positions}) != 1:
+            if positions:
+                warnings.warn("hand_links: links with different numbers of rows; skipped", stacklevel=2)
+            return
+        n, k = len(positions[0]), len(positions)
+        stacked = np.stack(positions, axis=1)  # (n, k, 3)
+        if not s.link_labels_logged:
+            rec.log("world/hand/links", rr.Points3D.from_fields(labels=names, radii=0.003, show_labels=False),
+                    static=True)  # fmt: skip
+            s.link_labels_logged = True
+        if trace is not None and len(trace.time) == n and n > 1:
+            rec.send_columns(
+                "world/hand/links",
+                indexes=[rr.TimeColumn("sim_time", duration=np.asarray(trace.time, dtype=float))],
+                columns=rr.Points3D.columns(positions=stacked.reshape(-1, 3)).partition([k] * n),
+            )
+        else:
+            rec.log("world/hand/links", rr.Points3D(stacked[-1]))
+
+    def _move_direction(self, move: Move) -> np.ndarray | None:
+        """A unit world direction for drawing a move from the sensor's position (None when unknown)."""
+        s = self._s
+        if s.position is None:
+            return None
+        kind = getattr(move, "kind", None)
+        if kind == "face":
+            d = np.asarray(move.direction, dtype=float)
+        elif kind == "edge":
+            st_edge = self._current("edge")
+            if st_edge is None:
+                return None
+            d = np.asarray(st_edge.direction, dtype=float) * int(move.sense)
+        elif kind == "vertex":
+            f = s.components.get(int(move.across_face))
+            if not isinstance(f, DataFace):
+                return None
+            d = f.points.mean(axis=0) - s.position
+            d = d - (d @ f.normal) * f.normal
+        else:
+            return None
+        norm = float(np.linalg.norm(d))
+        return d / norm if norm > 1e-9 and math.isfinite(norm) else None
+
+    def _current(self, kind: str) -> DataComponent | None:
+        """The component of the sensor's state of that kind (the latest reported state)."""
+        st = self._s.state
+        cid = getattr(st, kind, None) if st is not None else None
+        return self._s.components.get(cid) if cid is not None else None
+
+
+# ---------------------------------------------------------------------------------------------- geometry
+
+
+def _transform(t: SE3) -> rr.Transform3D:
+    return rr.Transform3D(translation=np.asarray(t.translation, dtype=float), mat3x3=np.asarray(t.rotation))
+
+
+def _mesh(model: Polyhedron, color: tuple[int, ...]) -> rr.Mesh3D:
+    """Flat-shaded mesh in the model frame (vertices repeated per triangle so each face keeps its normal)."""
+    tris = np.asarray(model.triangles)
+    pos = np.asarray(model.vertices, dtype=float)[tris].reshape(-1, 3)
+    nrm = np.repeat(np.asarray(model.face_normals, dtype=float)[np.asarray(model.triangle_faces)], 3, axis=0)
+    return rr.Mesh3D(
+        vertex_positions=pos, triangle_indices=np.arange(len(pos)).reshape(-1, 3), vertex_normals=nrm,
+        albedo_factor=color,
+    )  # fmt: skip
+
+
+def _wireframe(model: Polyhedron, color: tuple[int, ...], radius: float) -> rr.LineStrips3D:
+    v = np.asarray(model.vertices, dtype=float)
+    return rr.LineStrips3D([v[list(e)] for e in np.asarray(model.edges)], colors=[color], radii=radius)
+
+
+def _patch(face: DataFace) -> tuple[np.ndarray, np.ndarray]:
+    """A square in the face's plane around its touched points (half-size: their spread + PATCH_RADIUS)."""
+    n = face.normal
+    a = np.cross(n, [1.0, 0.0, 0.0])
+    if np.linalg.norm(a) < 0.1:
+        a = np.cross(n, [0.0, 1.0, 0.0])
+    a /= np.linalg.norm(a)
+    b = np.cross(n, a)
+    c = face.points.mean(axis=0)
+    c = c - (c @ n - face.offset) * n
+    rel = face.points - c
+    ha = float(np.abs(rel @ a).max()) + PATCH_RADIUS
+    hb = float(np.abs(rel @ b).max()) + PATCH_RADIUS
+    v = np.array([c - ha * a - hb * b, c + ha * a - hb * b, c + ha * a + hb * b, c - ha * a + hb * b])
+    return v, np.array([[0, 1, 2], [0, 2, 3]])
+
+
+def _edge_crossing(start: np.ndarray, direction: np.ndarray, edge: DataEdge) -> np.ndarray | None:
+    """Where the ray ``start + t direction`` passes closest to the edge's line (the point on the line)."""
+    d = np.asarray(direction, dtype=float)
+    b = edge.direction
+    w = start - edge.point
+    m = np.array([[d @ d, -(d @ b)], [d @ b, -(b @ b)]])
+    if abs(np.linalg.det(m)) < 1e-12:
+        return None
+    _, u = np.linalg.solve(m, [-(w @ d), -(w @ b)])
+    return edge.point + u * b
+
+
+def _waypoints(prev: np.ndarray | None, result: MoveResult, new: np.ndarray | None) -> np.ndarray:
+    """The sensed points of a move in the order they were met, from the previous sensor position to the new
+    one: the geometric executor's path (it has no fingertip trajectory)."""
+    pts: list[np.ndarray] = [prev] if prev is not None else []
+    move = result.move
+    for c in result.components:
+        if isinstance(c, DataFace):
+            pts.extend(c.points)
+        elif isinstance(c, DataVertex):
+            pts.append(c.position)
+        elif isinstance(c, DataEdge):
+            if getattr(move, "kind", None) == "edge":
+                continue  # the path runs along the edge to the vertex (or its end), added below
+            start = pts[-1] if pts else None
+            hit = None
+            if start is not None and getattr(move, "kind", None) == "face":
+                hit = _edge_crossing(start, move.direction, c)
+            elif c.side_points:
+                q = c.side_points[0][1]
+                pts.append(q)
+                hit = c.point + ((q - c.point) @ c.direction) * c.direction
+            if hit is not None:
+                pts.append(hit)
+    if getattr(move, "kind", None) == "edge" and not any(isinstance(c, DataVertex) for c in result.components):
+        e = next((c for c in result.components if isinstance(c, DataEdge)), None)
+        if e is not None and prev is not None:
+            ends = [e.point, e.end_point]
+            pts.append(max(ends, key=lambda q: float(np.linalg.norm(q - prev))))
+    if new is not None:
+        pts.append(new)
+    out: list[np.ndarray] = []
+    for p in pts:
+        p = np.asarray(p, dtype=float)
+        if not out or np.linalg.norm(p - out[-1]) > 1e-9:
+            out.append(p)
+    return np.array(out).reshape(-1, 3)
+
+
+def _contacts(components: tuple[DataComponent, ...]) -> tuple[np.ndarray, np.ndarray]:
+    """Contact points and normals of a move from its components (geometric executor): face points with the
+    face normal."""
+    pts, nrm = [], []
+    for c in components:
+        if isinstance(c, DataFace):
+            pts.extend(c.points)
+            nrm.extend([c.normal] * len(c.points))
+    if not pts:
+        return np.zeros((0, 3)), np.zeros((0, 3))
+    return np.array(pts), np.array(nrm)
+
+
+def _subsample(a: np.ndarray, k: int) -> np.ndarray:
+    """At most ``k`` rows of ``a``, evenly spaced, first and last kept."""
+    if len(a) <= k:
+        return a
+    return a[np.unique(np.linspace(0, len(a) - 1, k).round().astype(int))]
+
+
+def _trace_of(result: MoveResult) -> Any:
+    """The contact trace in ``result.info["trace"]`` when it looks like one, else None."""
+    info = getattr(result, "info", None)
+    tr = info.get("trace") if isinstance(info, dict) else None
+    needed = ("time", "tip_in_world", "point_in_world", "normal_in_world", "force")
+    if tr is None or not all(hasattr(tr, a) for a in needed):
+        return None
+    return tr
+
+
+def _score_color(r: float) -> tuple[int, int, int]:
+    """Dark blue (worst) to yellow (best)."""
+    r = float(min(max(r, 0.0), 1.0))
+    lo, hi = np.array([40, 30, 120]), np.array([250, 230, 40])
+    return tuple(int(x) for x in lo + r * (hi - lo))
+
+
+def _move_name(move: Move) -> str:
+    kind = getattr(move, "kind", "?")
+    if kind == "face":
+        d = np.asarray(move.direction, dtype=float)
+        return f"face ({d[0]:+.2f},{d[1]:+.2f},{d[2]:+.2f})"
+    if kind == "edge":
+        return f"edge {'+' if move.sense > 0 else '-'}"
+    if kind == "vertex":
+        return f"vertex across f{move.across_face}"
+    return str(move)
+
+
+# ---------------------------------------------------------------------------------------------- reading back
+
+
+@dataclass
+class EntityData:
+    """One entity of a recording read back."""
+
+    path: str
+    """Entity path, e.g. ``/plots/interpretations``."""
+    static: dict[str, list]
+    """Component column (``Archetype:field``) -> its static value (a list of instances)."""
+    timelines: dict[str, list]
+    """Timeline name -> one value per temporal row, in logging order (sequence: int; duration: seconds; None
+    where the row has no value on that timeline)."""
+    components: dict[str, list]
+    """Component column -> one value per temporal row (a list of instances, or None where not logged)."""
+
+    @property
+    def rows(self) -> int:
+        """Number of temporal rows."""
+        return max((len(v) for v in self.timelines.values()), default=0)
+
+    def series(self, component: str, timeline: str = "move") -> tuple[list, list]:
+        """``(times, values)`` of the temporal rows that hold ``component``, in logging order."""
+        values = self.components.get(component, [])
+        times = self.timelines.get(timeline, [None] * len(values))
+        keep = [i for i, v in enumerate(values) if v is not None]
+        return [times[i] for i in keep], [values[i] for i in keep]
+
+
+def load_recording(path: str | os.PathLike) -> dict[str, EntityData]:
+    """Every entity of the (first) recording in an ``.rrd`` file, read with rerun's own
+    :class:`rerun.chunk.RrdReader`; keys are entity paths without the leading slash."""
+    import pyarrow as pa
+    from rerun.chunk import RrdReader
+
+    p = Path(path)
+    if not p.is_file():
+        raise RecordingError(f"{p}: no such recording")
+    try:
+        chunks = RrdReader(p).stream().to_chunks()
+    except Exception as exc:  # noqa: BLE001 -- rerun raises plain exceptions on a bad file
+        raise RecordingError(f"{p}: not a readable rerun recording ({exc})") from exc
+    temporal: dict[str, list[tuple[bytes, dict]]] = {}
+    static: dict[str, dict[str, list]] = {}
+    for ch in chunks:
+        batch = ch.to_record_batch()
+        row_ids: list[bytes] = [b""] * ch.num_rows
+        cols: dict[tuple[str, str], list] = {}
+        for fld, col in zip(batch.schema, batch.columns, strict=True):
+            kind = (fld.metadata or {}).get(b"rerun:kind", b"").decode()
+            if kind == "index" and pa.types.is_duration(fld.type):  # to seconds (as_py would drop nanoseconds)
+                scale = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}[fld.type.unit]
+                cols[("t", fld.name)] = [v * scale if v is not None else None for v in col.cast(pa.int64()).to_pylist()]
+                continue
+            values = col.to_pylist()
+            if kind == "control":
+                row_ids = [bytes(x) if x is not None else b"" for x in values]
+            elif kind == "index":
+                cols[("t", fld.name)] = values
+            else:
+                cols[("c", fld.name)] = values
+        ep = ch.entity_path.lstrip("/")
+        if ch.is_static:
+            for (_, name), values in cols.items():
+                if values and values[-1] is not None:
+                    static.setdefault(ep, {})[name] = values[-1]
+            continue
+        for r in range(ch.num_rows):
+            temporal.setdefault(ep, []).append((row_ids[r], {k: v[r] for k, v in cols.items()}))
+    out: dict[str, EntityData] = {}
+    for ep in sorted(set(temporal) | set(static)):
+        rows = sorted(temporal.get(ep, []), key=lambda x: x[0])  # row ids (TUIDs) sort in logging order
+        keys = sorted({k for _, d in rows for k in d})
+        out[ep] = EntityData(
+            path="/" + ep,
+            static=static.get(ep, {}),
+            timelines={k[1]: [d.get(k) for _, d in rows] for k in keys if k[0] == "t"},
+            components={k[1]: [d.get(k) for _, d in rows] for k in keys if k[0] == "c"},
+        )
+    return out
+
+
+__all__ = ["EntityData", "EpisodeRecorder", "RecordingError", "default_blueprint", "load_recording"]

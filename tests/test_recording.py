@@ -1,0 +1,216 @@
+"""Rerun recordings: an episode written to .rrd and read back with rerun's own reader; failures leave no file."""
+
+from __future__ import annotations
+
+import re
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from haptic.bench.runner import EpisodeSpec
+from haptic.episode import EpisodeObserver, EpisodeRecord, run_episode
+from haptic.recording import EpisodeRecorder, RecordingError, load_recording
+
+SPEC = EpisodeSpec(model="WEDGE01", seed=3, policy="planner")
+
+
+def _count(values: list | None) -> int:
+    return len(values) if values is not None else 0
+
+
+@pytest.fixture(scope="module")
+def recorded(tmp_path_factory) -> tuple[Path, EpisodeRecord]:
+    out = tmp_path_factory.mktemp("rec") / "episode.rrd"
+    recorder = EpisodeRecorder(out)
+    record = run_episode(SPEC, observer=recorder.observer())
+    assert recorder.close() == out
+    return out, record
+
+
+def test_recording_reads_back_with_rerun(recorded):
+    from rerun.chunk import RrdReader
+
+    path, record = recorded
+    assert record.moves >= 3 and len(record.interpretations) >= 4
+    reader = RrdReader(path)
+    assert len(reader.recordings()) == 1
+    assert len(reader.blueprints()) == 1, "the default blueprint is in the file"
+    assert [p.name for p in path.parent.iterdir()] == ["episode.rrd"], "no temporary file left behind"
+
+    ents = load_recording(path)
+    n = len(record.interpretations)  # one per successful move, the start included
+
+    # the interpretation-count series: the record's list, one value per move
+    moves, counts = ents["plots/interpretations"].series("Scalars:scalars")
+    assert [c[0] for c in counts] == [float(x) for x in record.interpretations]
+    assert moves[0] == 0 and moves == sorted(moves) and len(set(moves)) == n
+    assert moves[-1] <= record.moves
+    _, classes = ents["plots/pose_classes"].series("Scalars:scalars")
+    assert classes and classes[-1] == [1.0]  # recognised: one pose class
+
+    # the trace path: one strip per move, accumulated, each a real polyline
+    _, strips = ents["world/trace/path"].series("LineStrips3D:strips")
+    assert len(strips) == n
+    assert [len(s) for s in strips] == list(range(1, n + 1))
+    assert all(len(strip) >= 2 for strip in strips[-1])
+    assert np.isfinite(np.array([p for strip in strips[-1] for p in strip])).all()
+
+    # the components: the latest snapshot holds as many as the record counts
+    _, normals = ents["world/data/faces/normals"].series("Arrows3D:vectors")
+    _, patches = ents["world/data/faces/patches"].series("Mesh3D:triangle_indices")
+    _, edges = ents["world/data/edges"].series("LineStrips3D:strips")
+    _, vertices = ents["world/data/vertices"].series("Points3D:positions")
+    assert (len(normals[-1]), len(edges[-1]), len(vertices[-1])) == (record.faces, record.edges, record.vertices)
+    assert len(patches[-1]) == 2 * record.faces
+    assert all(len(seg) == 2 for seg in edges[-1])
+    assert np.allclose(np.linalg.norm(np.array(normals[-1]), axis=1), 0.012, atol=1e-5)
+
+    # the ground-truth layer, static, and the decisions
+    truth = ents["world/truth/object"]
+    assert truth.rows == 0 and _count(truth.static.get("Mesh3D:vertex_positions")) % 3 == 0
+    assert "Transform3D:translation" in ents["world/truth"].static
+    _, bars = ents["plots/candidates"].series("BarChart:values")
+    assert len(bars) == len(record.decision_times_s)
+    assert ents["log/episode"].series("TextLog:text")[1][0][0].startswith(record.outcome)
+
+
+def test_failed_episode_leaves_no_file(tmp_path):
+    out = tmp_path / "sub" / "failed.rrd"
+    recorder = EpisodeRecorder(out)
+    inner = recorder.observer()
+
+    def on_move(i, result, n, rec):
+        inner.on_move(i, result, n, rec)
+        if i == 2:
+            raise RuntimeError("executor crashed")
+
+    observer = EpisodeObserver(inner.on_start, on_move, inner.on_decision, inner.on_end)
+    with pytest.raises(RuntimeError, match="crashed"):
+        try:
+            run_episode(SPEC, observer=observer)
+        finally:
+            assert recorder.close() is None
+    assert not out.exists()
+    assert list(out.parent.iterdir()) == []
+
+
+def test_context_manager_discards_on_error_and_keeps_on_success(tmp_path):
+    out = tmp_path / "ctx.rrd"
+    with pytest.raises(KeyError), EpisodeRecorder(out) as recorder:
+        recorder.on_move  # noqa: B018
+        raise KeyError("boom")
+    assert not out.exists() and list(tmp_path.iterdir()) == []
+    with EpisodeRecorder(out) as recorder:
+        run_episode(SPEC, observer=recorder.observer())
+    assert out.is_file() and load_recording(out)["plots/interpretations"].rows > 0
+
+
+def test_physics_trace_and_hand_links_are_recorded(tmp_path):
+    """A physics-style move result: the contact trace on the sim_time timeline, hand links, force."""
+    from haptic.executor.primitives import ContactTrace
+    from haptic.geometry import SE3, load_library
+    from haptic.matching.components import DataFace
+    from haptic.planning.moves import FaceMove, MoveResult, SensorState
+
+    n = 50
+    t = 1.0 + 0.002 * np.arange(n)
+    tip = np.c_[np.linspace(0, 0.03, n), np.zeros(n), np.full(n, 0.05)]
+    contact = np.arange(n) >= 10
+    pts = np.where(contact[:, None], tip - [0, 0, 0.008], np.nan)
+    nrm = np.where(contact[:, None], [0.0, 0.0, 1.0], np.nan)
+    trace = ContactTrace(t, tip, np.repeat(np.eye(3)[None], n, 0), pts, nrm, np.where(contact, 1.0, 0.0),
+                         np.zeros(n, dtype=int))  # fmt: skip
+    face = DataFace(id=0, normal=[0, 0, 1], points=pts[contact][::10], normal_bound=0.01, position_bound=1e-3)
+    links = {"palm": tip + [0, 0, 0.1], "index_tip": np.tile(np.eye(4), (n, 1, 1)), "bad": np.zeros((n, 2))}
+    result = MoveResult(
+        move=FaceMove(np.zeros(3)), status="ok", components=(face,), cost=1.0,
+        state=SensorState(position=pts[-1], face=0), info={"trace": trace, "hand_links": links, "sim_time": 0.1},
+    )  # fmt: skip
+    out = tmp_path / "physics.rrd"
+    recorder = EpisodeRecorder(out)
+    recorder.on_start(load_library()["WEDGE01"], SE3.identity())
+    with pytest.warns(UserWarning, match="bad"):
+        recorder.on_move(0, result, 12, None)
+    later = ContactTrace(*(a[:20] for a in trace._arrays()))
+    later = ContactTrace(later.time + 1.0, *later._arrays()[1:])
+    failed = MoveResult(move=FaceMove(np.array([1.0, 0, 0])), status="timeout", cost=0.5,
+                        state=result.state, info={"trace": later, "reason": "no edge"})  # fmt: skip
+    recorder.on_failed_move(1, failed)
+    recorder.close(keep=True)
+
+    ents = load_recording(out)
+    tip_e = ents["world/hand/fingertip"]
+    assert tip_e.timelines["sim_time"][:n] == pytest.approx(list(t))
+    assert ents["plots/force"].series("Scalars:scalars", "sim_time")[0][:n] == pytest.approx(list(t))
+    _, cps = ents["world/hand/contact/points"].series("Points3D:positions", "sim_time")
+    assert sum(len(p) for p in cps[:n]) == int(contact.sum())
+    _, link_pts = ents["world/hand/links"].series("Points3D:positions", "sim_time")
+    assert len(link_pts) == n and all(len(p) == 2 for p in link_pts)
+    assert ents["world/hand/links"].static["Points3D:labels"] == ["palm", "index_tip"]
+    _, strips = ents["world/trace/path"].series("LineStrips3D:strips")
+    assert len(strips[-1][0]) == n  # the fingertip path itself, not waypoints
+    assert ents["plots/interpretations"].timelines["sim_time"][-1] == pytest.approx(t[-1])
+    # the failed move: its own strip (not in the path), its ticks, a warning; the path cost includes it
+    _, failed_strips = ents["world/trace/failed"].series("LineStrips3D:strips")
+    assert len(failed_strips) == 1 and len(failed_strips[0][0]) == 20
+    assert ents["world/hand/fingertip"].rows == n + 20
+    _, texts = ents["log/moves"].series("TextLog:text")
+    assert "failed: timeout (no edge)" in texts[-1][0]
+    assert ents["plots/path_cost"].series("Scalars:scalars")[1][-1] == [1.5]
+
+
+def test_only_the_recording_module_imports_rerun():
+    package = Path(__file__).resolve().parents[1] / "haptic"
+    pattern = re.compile(r"^\s*(import|from)\s+rerun(_bindings)?\b", re.MULTILINE)
+    importers = sorted(str(p.relative_to(package)) for p in package.rglob("*.py") if pattern.search(p.read_text()))
+    assert importers == ["recording.py"]
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="display detection is for X11/Wayland")
+def test_spawn_without_display_fails_in_one_line(tmp_path, monkeypatch):
+    for var in ("DISPLAY", "WAYLAND_DISPLAY", "WAYLAND_SOCKET"):
+        monkeypatch.delenv(var, raising=False)
+    out = tmp_path / "x.rrd"
+    with pytest.raises(RecordingError, match="no display") as info:
+        EpisodeRecorder(out, spawn=True)
+    assert "\n" not in str(info.value)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_spawn_without_viewer_executable(tmp_path, monkeypatch):
+    import haptic.recording as recording
+
+    monkeypatch.setenv("DISPLAY", ":99")
+    monkeypatch.setattr(recording.shutil, "which", lambda *a, **k: None)
+    with pytest.raises(RecordingError, match="no rerun viewer executable"):
+        EpisodeRecorder(tmp_path / "x.rrd", spawn=True)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_bad_targets(tmp_path):
+    with pytest.raises(RecordingError, match="is a directory"):
+        EpisodeRecorder(tmp_path)
+    with pytest.raises(RecordingError, match="a file .* or a viewer"):
+        EpisodeRecorder(None)
+    with pytest.raises(RecordingError, match="no such recording"):
+        load_recording(tmp_path / "missing.rrd")
+    (tmp_path / "junk.rrd").write_bytes(b"not a recording")
+    with pytest.raises(RecordingError, match="not a readable"):
+        load_recording(tmp_path / "junk.rrd")
+
+
+def test_explore_cli_records(tmp_path, capsys, monkeypatch):
+    from haptic.cli import main
+
+    out = tmp_path / "cli.rrd"
+    assert main(["explore", "--object", "WEDGE01", "--seed", "3", "--record", str(out)]) == 0
+    assert f"recording   {out}" in capsys.readouterr().out
+    assert load_recording(out)["world/trace/path"].rows >= 4
+    for var in ("DISPLAY", "WAYLAND_DISPLAY", "WAYLAND_SOCKET"):
+        monkeypatch.delenv(var, raising=False)
+    monkeypatch.setattr(sys, "platform", "linux")
+    assert main(["explore", "--object", "WEDGE01", "--spawn"]) == 1
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "--spawn" in err
