@@ -6,7 +6,9 @@ from the true edge segment and its direction, a vertex by position. Errors: face
 [deg], edge position [mm] (largest distance of the interval's ends from the true edge line), vertex position
 [mm]. A component farther than the tolerances from every true component of its kind is *spurious*. A move whose
 reported edge (vertex) is not the first true edge (vertex) on the ideal path from where the move started -- it
-crossed a true edge without reporting it -- counts one *missed* component.
+crossed a true edge without reporting it --, an edge move whose vertex is not an end of the true edge it
+followed, and a vertex move whose new edge does not leave the circled vertex on the face circled across each
+count one *missed* component.
 
 The executor and the segmenter never import this module.
 """
@@ -200,6 +202,27 @@ def _missed(results, model: Polyhedron, rot: np.ndarray, trans: np.ndarray, by_i
                         ok = e_score.true_id == hit.edge
                         missed += 0 if ok else 1
                         checks.append(("face", r.components[0].id, hit.edge, e_score.true_id, ok))
+        if r.ok and r.move.kind == "edge" and prev_state is not None and prev_state.edge is not None:
+            # the vertex reached must be an end of the true edge followed (else the trace ran past one)
+            e_score = by_id.get(prev_state.edge)
+            v = next((c for c in r.components if c.kind == "vertex"), None)
+            v_score = by_id.get(v.id) if v is not None else None
+            if e_score and e_score.true_id is not None and v_score and v_score.true_id is not None:
+                ok = v_score.true_id in (int(model.edges[e_score.true_id, 0]), int(model.edges[e_score.true_id, 1]))
+                missed += 0 if ok else 1
+                checks.append(("edge", v.id, e_score.true_id, v_score.true_id, ok))
+        if r.ok and r.move.kind == "vertex" and prev_state is not None and prev_state.vertex is not None:
+            # the new edge must leave the vertex circled and bound the face circled across
+            v_score = by_id.get(prev_state.vertex)
+            f_score = by_id.get(r.move.across_face)
+            e_score = by_id.get(r.components[0].id)
+            if v_score and f_score and e_score and None not in (v_score.true_id, f_score.true_id, e_score.true_id):
+                e = e_score.true_id
+                ok = v_score.true_id in (int(model.edges[e, 0]), int(model.edges[e, 1])) and (
+                    f_score.true_id in model.edge_faces(e)
+                )
+                missed += 0 if ok else 1
+                checks.append(("vertex", r.components[0].id, v_score.true_id, e, ok))
         if r.ok:
             prev_state = r.state
     return missed, {"checks": checks}

@@ -115,6 +115,7 @@ class PhysicsExecutor:
         self._faces: dict[int, _FaceData] = {}
         self._on_face: int | None = None  # data face the pad is known to rest on
         self._finger = finger
+        self._why = ""  # detail of the last repositioning failure
 
     @property
     def components(self) -> list[DataComponent]:
@@ -272,7 +273,7 @@ class PhysicsExecutor:
                     break
             if all(r.ok and r.event == "done" for r in legs) and len(legs) == 2:
                 trace = ContactTrace.concatenate([r.trace for r in legs])
-                fit = self.segmenter.fit_face_trace(trace, legs[-1].info["face_normal"])
+                fit = self.segmenter.fit_face_trace(trace, legs[-1].info["face_normal"], two_d=True)
                 return fit, trace
             if legs[-1].status == "unstable":
                 return None, ContactTrace.concatenate([])
@@ -313,11 +314,13 @@ class PhysicsExecutor:
                 and angle(t.normal, n) < math.radians(5.0)):  # fmt: skip
             return "ok"
         target = self._faces[fid].anchor if near is None else near
-        r = t.lift_and_approach(target, n)
+        r = t.lift_and_approach(target, n, floor_z=TABLE_TOP_Z + t.pad_radius + self.settings.table_margin)
         pieces.append(r)
         if not r.ok:
+            self._why = f"{r.status}/{r.event}"
             return r.status
         if angle(r.info["normal"], n) > math.radians(6.0):
+            self._why = f"touched a normal {math.degrees(angle(r.info['normal'], n)):.0f}° off the face"
             return "unreachable"
         self._on_face = fid
         return "ok"
@@ -360,7 +363,7 @@ class PhysicsExecutor:
             return self._invalid(move, "direction is not in the plane of the current face")
         status = self._ensure_on_face(st.face, pieces)
         if status != "ok":
-            return self._fail(move, status, "could not return to the current face")
+            return self._fail(move, status, f"could not return to the current face: {self._why}")
         r = t.trace_face(inplane, n_a, self.settings.max_face_trace)
         pieces.append(r)
         if not r.ok:
@@ -368,7 +371,6 @@ class PhysicsExecutor:
         if r.event == "done":
             return self._fail(move, "unreachable", "no edge within the longest trace")
         kind = r.info["kind"]
-        side_a = self._last_on(r.trace, n_a)
         corner = self._contact_point()
         status, reason, roll, stroke, fit_b = self._cross_and_acquire(kind, r.info["face_normal"], r.info["direction"],
                                                                       pieces)  # fmt: skip
@@ -378,8 +380,7 @@ class PhysicsExecutor:
         roll_all = ContactTrace.concatenate([r.trace.select(r.trace.phase == PHASES.index("face")).tail(8), roll])
         line = seg.edge_line(fit_a, fit_b, kind == "convex", roll_all, corner)
         new_face = seg.next_id + 1
-        side_b = fit_b.points[len(fit_b.points) // 2]
-        edge = seg.add_edge(line, (st.face, new_face), kind == "convex", [(st.face, side_a), (new_face, side_b)],
+        edge = seg.add_edge(line, (st.face, new_face), kind == "convex", (fit_a.normal, fit_b.normal),
                             adjacent=(st.face,))  # fmt: skip
         face = seg.add_face(fit_b, adjacent=(edge.id,))
         self._store_face(face.id, stroke, fit_b)
@@ -425,7 +426,7 @@ class PhysicsExecutor:
             here = rec.at(rec.param(self._contact_point()))
             status = self._ensure_on_face(fid, pieces, near=here + 0.004 * rec.inward[fid])
             if status != "ok":
-                return self._fail(move, status, "could not return next to the edge")
+                return self._fail(move, status, f"could not return next to the edge: {self._why}")
         acq = t.follow_edge(u, n_a, n_b, toward_a, 0.0, acquire_only=True)
         pieces.append(acq)
         if not acq.ok:
@@ -516,14 +517,13 @@ class PhysicsExecutor:
         p0 = vtx + rho * (-math.cos(beta) * u + math.sin(beta) * w_f)
         status = self._ensure_on_face(f, pieces, near=p0)
         if status != "ok":
-            return self._fail(move, status, "could not reach the face next to the vertex")
+            return self._fail(move, status, f"could not reach the face next to the vertex: {self._why}")
         tangent = math.sin(beta) * u + math.cos(beta) * w_f
         r = t.circle_vertex(vtx, n_f, tangent, rho)
         pieces.append(r)
         if not r.ok:
             return self._fail(move, r, f"circling the vertex: {r.event}")
         kind = r.info["kind"]
-        side_f = self._last_on(r.trace, n_f)
         corner = self._contact_point()
         status, reason, roll, stroke, fit_g = self._cross_and_acquire(
             kind, r.info["face_normal"], r.info["direction"], pieces, away_from=vtx
@@ -534,9 +534,8 @@ class PhysicsExecutor:
         roll_all = ContactTrace.concatenate([r.trace.select(r.trace.phase == PHASES.index("circle")).tail(8), roll])
         line = seg.edge_line(fit_f, fit_g, kind == "convex", roll_all, corner)
         new_face = seg.next_id + 1
-        side_g = fit_g.points[len(fit_g.points) // 2]
         s_vtx = float((vtx - line.point) @ line.direction)
-        edge = seg.add_edge(line, (f, new_face), kind == "convex", [(f, side_f), (new_face, side_g)],
+        edge = seg.add_edge(line, (f, new_face), kind == "convex", (fit_f.normal, fit_g.normal),
                             adjacent=(st.vertex, f), vertex=(st.vertex, s_vtx))  # fmt: skip
         face = seg.add_face(fit_g, adjacent=(edge.id,))
         self._store_face(face.id, stroke, fit_g)

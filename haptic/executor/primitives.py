@@ -85,8 +85,15 @@ class TouchConfig:
     """Length of the stroke along the edge on a new face (the second leg of the L for its normal) [m]."""
     ridge_gain: float = 12.0
     """Sideways servo of ridge following: pad speed per radian of normal error, per metre of pad radius [1/s]."""
-    settle_time: float = 0.12
-    """Hold after a guarded contact before moving [s]."""
+    settle_time: float = 0.15
+    """Shortest hold after a guarded contact before moving [s] ..."""
+    settle_max: float = 0.6
+    """... longest: the hold ends once the force has stayed within ``settle_band`` of the target for
+    ``settle_time`` (the impact transient of the approach takes ~0.3 s to die out) [s]."""
+    settle_band: float = 0.15
+    """Relative force band of a settled contact [-]."""
+    ramp_time: float = 0.25
+    """Tangential speeds ramp up over this time at the start of a slide (a step start loses force) [s]."""
     lift: float = 0.008
     """Clearance of a repositioning move above the surface [m]."""
     hand_rotation: np.ndarray = field(default_factory=lambda: DOWN.copy())
@@ -275,6 +282,25 @@ class Toucher:
         self.robot.set_hybrid(cfg.force, velocity, normal_hint=hint, rotation_in_world=cfg.hand_rotation)
         self.hybrid = True
 
+    def _settle(self, phase: str = "settle") -> bool:
+        """Press in place until the force has stayed within the band for ``settle_time`` (at most
+        ``settle_max``). False when the simulation became unhealthy."""
+        cfg = self.config
+        need = max(1, int(cfg.settle_time / self.dt))
+        good = 0
+        for _ in range(max(need, int(cfg.settle_max / self.dt))):
+            self.tick(phase)
+            if self._unhealthy:
+                return False
+            good = good + 1 if abs(self.contact[0] - cfg.force) < cfg.settle_band * cfg.force else 0
+            if good >= need:
+                break
+        return True
+
+    def ramp(self, k: int) -> float:
+        """Speed factor (0, 1] of tick ``k`` of a slide."""
+        return min(1.0, (k + 1) * self.dt / self.config.ramp_time)
+
     # -- free space ----------------------------------------------------------------------------------------------
     def move_free(self, point: np.ndarray, timeout: float = 4.0, tol: float = 7e-4) -> PrimitiveResult:
         """Move the pad centre to ``point`` [m] in free space along a straight line (position control)."""
@@ -335,38 +361,55 @@ class Toucher:
             self.robot.move_fingertip(self.tip.copy(), cfg.hand_rotation)
             return self._result("ok", "contact", 0.0, normal=self.normal.copy(), point=self.contact[2].copy())
         self._press(np.zeros(3), hint=-d)
-        for _ in range(int(cfg.settle_time / self.dt)):
-            self.tick("settle")
-            if self._unhealthy:
-                return self._result("unstable", "nan", 0.0)
+        if not self._settle():
+            return self._result("unstable", "nan", 0.0)
         if self.contact[1] is None:
             return self._result("no-contact", "lost", 0.0)
         return self._result("ok", "contact", 0.0, normal=self.normal.copy(), point=self.contact[2].copy())
 
-    def lift_and_approach(self, point_on_surface: np.ndarray, normal: np.ndarray) -> PrimitiveResult:
-        """Reposition: lift off along the sensed normal, move above ``point_on_surface`` along ``normal`` and
-        touch it again with a guarded approach."""
+    def lift_and_approach(
+        self, point_on_surface: np.ndarray, normal: np.ndarray, floor_z: float | None = None
+    ) -> PrimitiveResult:
+        """Reposition without going through the object: lift off along the current contact normal, pass a
+        waypoint that is at least the clearance outside both the current face's plane and the target face's
+        plane, stop above ``point_on_surface`` along its face ``normal`` and touch it with a guarded approach.
+
+        On a convex solid a path whose legs each stay outside one face plane by the clearance cannot meet the
+        solid (each leg's ends are outside that plane). ``floor_z``: lowest height of the pad centre (the table
+        plus the pad radius and a margin) [m]."""
         cfg = self.config
-        up = self.normal if self.normal is not None else np.array([0.0, 0.0, 1.0])
+        n_t = unit(np.asarray(normal, dtype=float))
+        q_t = np.asarray(point_on_surface, dtype=float)
+        clear = cfg.lift + self.pad_radius
+        if self.normal is not None and self.contact[2] is not None:
+            n_c, q_c = self.normal.copy(), self.contact[2].copy()
+        elif self.normal is not None:
+            n_c, q_c = self.normal.copy(), self.tip - self.pad_radius * self.normal
+        else:
+            n_c, q_c = np.array([0.0, 0.0, 1.0]), self.tip - self.pad_radius * np.array([0.0, 0.0, 1.0])
+        lifted = q_c + clear * n_c
+        above = q_t + clear * n_t
+        mid = 0.5 * (lifted + above)
+        bis = n_c + n_t
+        bis = unit(bis) if bis @ bis > 1e-6 else np.array([0.0, 0.0, 1.0])
+        deficit = max(clear - float((mid - q_c) @ n_c), clear - float((mid - q_t) @ n_t), 0.0)
+        waypoint = mid + deficit / max(float(bis @ n_c), 0.2) * bis
+        points = [lifted, waypoint, above]
+        if floor_z is not None:
+            for w in points:
+                w[2] = max(w[2], floor_z)
         pieces = []
-        lifted = self.tip + (cfg.lift + 0.004) * up
-        lifted[2] = max(lifted[2], self.tip[2])
-        res = self.move_free(lifted, timeout=2.0, tol=2e-3)
+        res = self.move_free(points[0], timeout=2.0, tol=2e-3)
         pieces.append(res)
+        for w, tol in ((points[1], 3e-3), (points[2], 1e-3)):
+            if not res.ok:
+                break
+            if float(np.linalg.norm(w - self.tip)) > 1e-3:
+                res = self.move_free(w, timeout=3.0, tol=tol)
+                pieces.append(res)
         if res.ok:
-            clear = cfg.lift + self.pad_radius
-            above = point_on_surface + clear * normal
-            mid = np.maximum(lifted, above) if normal[2] > 0.3 else None
-            if mid is not None:
-                mid = np.array([above[0], above[1], max(lifted[2], above[2])])
-                res = self.move_free(mid, timeout=3.0, tol=2e-3)
-                pieces.append(res)
-            if res.ok:
-                res = self.move_free(above, timeout=3.0, tol=1.5e-3)
-                pieces.append(res)
-            if res.ok:
-                res = self.approach(-normal, 2 * cfg.lift)
-                pieces.append(res)
+            res = self.approach(-n_t, 2 * cfg.lift + 0.004)
+            pieces.append(res)
         return PrimitiveResult(res.status, res.event, ContactTrace.concatenate([p.trace for p in pieces]),
                                sum(p.distance for p in pieces), res.info)  # fmt: skip
 
@@ -392,7 +435,7 @@ class Toucher:
         n_run = n_f
         timeout = max_distance / cfg.face_speed * 2.0 + 2.0
         for k in range(int(timeout / self.dt)):
-            self._press(cfg.face_speed * d)
+            self._press(self.ramp(k) * cfg.face_speed * d)
             self.tick(phase)
             if self._unhealthy:
                 return self._result("unstable", "nan", 0.0)
@@ -411,7 +454,7 @@ class Toucher:
                         return self._result("ok", f"{kind}-edge", 0.0, face_normal=n_run, direction=d, kind=kind)
                 else:
                     over = 0
-                    if a < math.radians(3.0):
+                    if angle(n, n_f) < math.radians(3.0):  # the face's samples, never a slow drift
                         n_sum += self.contact[1]
                         if k > 10:
                             n_run = unit(n_sum)
@@ -529,16 +572,21 @@ class Toucher:
         window = max(2, int(cfg.stall_time / self.dt))
         timeout = (max_distance / cfg.edge_speed if not acquire_only else 0.0) * 2.0 + 3.0
         err = 0.0
+        # rolling onto the bisector takes pad radius × angle at the sideways speed limit; allow twice that
+        n0 = self.normal if self.normal is not None else n_b
+        roll_angle = abs(target - math.atan2(float(n0 @ m), float(n0 @ nb_p)))
+        acquire_time = 2.0 * self.pad_radius * roll_angle / 0.012 + 0.6
+        timeout += acquire_time
         for _ in range(int(timeout / self.dt)):
             n = self.normal if self.normal is not None else n_b
             alpha = math.atan2(float(n @ m), float(n @ nb_p))
             err = target - alpha
             v_side = cfg.ridge_gain * self.pad_radius * err
-            lim = 0.025
+            lim = 0.012
             v_side = max(-lim, min(lim, v_side))
             s_dir = unit(side - float(side @ n) * n)
             ridge_ok = abs(err) < math.radians(8.0)
-            v = v_side * s_dir + (speed * u if (ridge_ok or on_ridge > 0) else 0.0 * u)
+            v = v_side * s_dir + (self.ramp(on_ridge) * speed * u if (ridge_ok or on_ridge > 0) else 0.0 * u)
             self._press(v)
             self.tick("ridge")
             if self._unhealthy:
@@ -550,7 +598,7 @@ class Toucher:
             travelled = float((self.tip - start) @ u)
             progress.append(travelled)
             if on_ridge == 0:
-                if len(progress) > 4 * window:
+                if len(progress) * self.dt > acquire_time:
                     return self._result("timeout", "limit", 0.0, error=err)
                 continue
             if self.weak_ticks * self.dt >= cfg.loss_time:
@@ -563,6 +611,8 @@ class Toucher:
                         return self._result("ok", "vertex", 0.0, event_sign=1 if c > 0 else -1)
                 else:
                     over = 0
+            if acquire_only:
+                continue
             if travelled > max_distance:
                 return self._result("unreachable", "limit", 0.0)
             if len(progress) > window + 20 and progress[-1] - progress[-1 - window] < (
@@ -636,7 +686,7 @@ class Toucher:
                                             arc=swept)  # fmt: skip
                 else:
                     over = 0
-                    if a < math.radians(3.0):
+                    if angle(n, n_f) < math.radians(3.0):  # the face's samples, never a slow drift
                         n_sum += self.contact[1]
                         if k > 10:
                             n_run = unit(n_sum)

@@ -52,6 +52,17 @@ class SegmentBounds:
     """Fewest contact rows a face is fitted from."""
     face_cone: float = math.radians(4.0)
     """A row belongs to a face when its sensed normal is within this of the face normal [rad]."""
+    side_reach: float = 4e-3
+    """Side points of an edge lie this far in on each face from the explored interval [m]."""
+    min_face_extent: float = 3e-3
+    """The pad centres of a face's rows must span at least this along their principal axis [m]: on a face the
+    pad slides with a constant normal, on a vertex or a ridge it cannot (the normal turns by Δ/r) [m]."""
+    min_face_width: float = 1.5e-3
+    """... and this across it, when a 2-D stroke is required (the start's L) [m]."""
+    max_face_curvature: float = math.radians(1.0) / 1e-3
+    """On a face the sensed normal does not turn as the pad slides; rolling on an edge or a vertex it turns by
+    1/r (r = 12 mm pad: 4.8°/mm). Rows whose normal turns faster than this with the pad's position are not a
+    face [rad/m]."""
 
     @classmethod
     def from_noise(cls, force_std: float, normal_std: float, point_std: float, **kw) -> SegmentBounds:
@@ -133,6 +144,26 @@ def fit_face(points: np.ndarray, normals: np.ndarray, bounds: SegmentBounds) -> 
     s_off = max(resid, bounds.point_sigma) / math.sqrt(len(d))
     projected = points - (d - offset)[:, None] * normal
     return FaceFit(normal, offset, projected, s_n, s_off, nn)
+
+
+def normal_turn_rate(coords: np.ndarray, normals: np.ndarray) -> float:
+    """How fast the normals turn with the pad's position: the largest singular value of the least-squares
+    slope of the normals' tangent components over ``coords`` (k, m) (pad centres in m in-plane axes) [rad/m].
+    Zero on a face; 1/r while rolling on an edge or a vertex."""
+    n0 = unit(normals.sum(axis=0))
+    a = perpendicular_unit(n0)
+    b = np.cross(n0, a)
+    y = np.column_stack([normals @ a, normals @ b])
+    x = np.column_stack([coords - coords.mean(axis=0), np.ones(len(coords))])
+    sol, *_ = np.linalg.lstsq(x, y - y.mean(axis=0), rcond=None)
+    return float(np.linalg.svd(sol[:-1], compute_uv=False)[0])
+
+
+def perpendicular_unit(v: np.ndarray) -> np.ndarray:
+    a = np.cross(v, [1.0, 0.0, 0.0])
+    if a @ a < 0.01:
+        a = np.cross(v, [0.0, 1.0, 0.0])
+    return unit(a)
 
 
 def angle_between(a: np.ndarray, b: np.ndarray) -> float:
@@ -250,10 +281,23 @@ class Segmenter:
         return self._next
 
     # -- faces ---------------------------------------------------------------------------------------------
-    def fit_face_trace(self, trace: ContactTrace, normal_guess: np.ndarray) -> FaceFit | None:
-        """The plane of the rows of ``trace`` that agree with ``normal_guess``; None with fewer than 5 rows."""
+    def fit_face_trace(self, trace: ContactTrace, normal_guess: np.ndarray, two_d: bool = False) -> FaceFit | None:
+        """The plane of the rows of ``trace`` that agree with ``normal_guess``; None with fewer than
+        ``min_face_rows`` rows, when the normals spread more than noise allows, or when the pad centres of the
+        rows do not span ``min_face_extent`` (and ``min_face_width`` across, with ``two_d``): the pad touched a
+        vertex or an edge, not a face."""
         mask = face_rows(trace, unit(np.asarray(normal_guess, float)), self.bounds.face_cone)
         if mask.sum() < self.bounds.min_face_rows:
+            return None
+        tips = trace.tip_in_world[mask]
+        q = tips - tips.mean(axis=0)
+        _, _, vt = np.linalg.svd(q, full_matrices=False)
+        ext = np.ptp(q @ vt[:2].T, axis=0)
+        if ext[0] < self.bounds.min_face_extent or (two_d and ext[1] < self.bounds.min_face_width):
+            return None
+        if normal_turn_rate(q @ vt[: 2 if ext[1] > 1e-3 else 1].T, trace.normal_in_world[mask]) > (
+            self.bounds.max_face_curvature
+        ):
             return None
         normals = trace.normal_in_world[mask]
         mean = unit(normals.sum(axis=0))
@@ -310,23 +354,31 @@ class Segmenter:
         line: LineFit,
         faces: tuple[int, int],
         convex: bool,
-        side_points: list[tuple[int, np.ndarray]],
+        normals: tuple[np.ndarray, np.ndarray],
         adjacent: tuple[int, ...],
         vertex: tuple[int, float] | None = None,
     ) -> DataEdge:
-        """Report a new edge (``faces[1]`` may be the id the next face will get). ``vertex``: a known data
-        vertex on this edge and its parameter."""
+        """Report a new edge between ``faces`` of outward ``normals`` (``faces[1]`` may be the id the next face
+        will get). ``vertex``: a known data vertex on this edge and its parameter.
+
+        Which side of the edge each face lies on follows from the normals and the convexity (a convex edge's
+        face a extends away from ``n_b``, a concave edge's towards it), not from contact points next to the
+        edge, whose offset across the edge is often below the noise; the side points reported are on each face
+        ``side_reach`` in from the middle of the explored interval."""
         eid = self._id()
         rec = EdgeRecord(
             point=line.point, direction=line.direction, direction_sigma=line.direction_sigma,
             position_sigma=line.position_sigma, interval=line.s_range, faces=faces, convex=convex,
-            side_points=list(side_points), adjacent=adjacent,
+            adjacent=adjacent,
         )  # fmt: skip
         if vertex is not None:
             rec.vertices[vertex[0]] = vertex[1]
-        for fid, q in side_points:
-            w = q - rec.at(rec.param(q))
-            rec.inward[fid] = unit(w)
+        mid = rec.at(0.5 * (rec.interval[0] + rec.interval[1]))
+        for fid, n_f, n_o in ((faces[0], normals[0], normals[1]), (faces[1], normals[1], normals[0])):
+            w = unit(n_o - float(n_o @ n_f) * n_f)
+            w = unit(w - float(w @ rec.direction) * rec.direction)
+            rec.inward[fid] = -w if convex else w
+            rec.side_points.append((fid, mid + self.bounds.side_reach * rec.inward[fid]))
         self.edges[eid] = rec
         return self._emit_edge(eid)
 

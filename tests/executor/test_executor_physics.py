@@ -121,3 +121,51 @@ def test_no_peeking_output_does_not_depend_on_the_ground_truth_record():
     for ca, cb in zip(ex_a.components, ex_b.components, strict=True):
         np.testing.assert_array_equal(ca.normal, cb.normal)
         np.testing.assert_array_equal(ca.points, cb.points)
+
+
+@pytest.fixture(scope="module", params=[("BOX01", 3), ("WEDGE01", 5)], ids=["BOX01", "WEDGE01"])
+def sequence_run(request):
+    """The fixed sequence start, face, edge, vertex (an edge move tries both senses, a vertex move both faces)."""
+    name, seed = request.param
+    poly, sim = _setup(name, seed)
+    ex, results = _start_and_face_move(sim, seed)
+    for sense in (1, -1):
+        results.append(ex.execute(EdgeMove(sense)))
+        if results[-1].ok:
+            break
+    for face in ex.state.edge_faces if ex.state.vertex is not None else ():
+        results.append(ex.execute(VertexMove(face)))
+        if results[-1].ok:
+            break
+    return poly, sim, ex, results
+
+
+def test_edge_and_vertex_moves_report_like_the_geometric_executor(sequence_run):
+    poly, sim, ex, results = sequence_run
+    edge_move = next(r for r in results if r.move.kind == "edge" and r.ok)
+    vertex_move = next(r for r in results if r.move.kind == "vertex" and r.ok)
+    edge, vertex = edge_move.components
+    assert (edge.kind, vertex.kind) == ("edge", "vertex") and vertex.adjacent == (edge.id,)
+    assert vertex.id in (edge.start_vertex, edge.end_vertex)
+    assert edge_move.state.vertex == vertex.id and edge_move.state.edge == edge.id
+    new_edge, new_face = vertex_move.components
+    assert new_edge.adjacent == (vertex.id, vertex_move.move.across_face) and new_face.adjacent == (new_edge.id,)
+    assert vertex_move.state.vertex == vertex.id and vertex_move.state.edge == new_edge.id
+    assert edge_move.cost == pytest.approx(ex.costs.edge_move(edge_move.distance))
+    assert vertex_move.cost == pytest.approx(ex.costs.vertex_move(vertex_move.distance))
+    score = score_components(ex.components, poly, sim.ground_truth().world_from_object, results)
+    assert score.spurious == 0 and score.missed == 0
+    assert score.errors("vertex", "position").max() < 1.0
+    assert score.errors("edge", "position").max() < 1.0
+    assert score.errors("edge", "angle").max() < 1.0
+    assert score.errors("face", "angle").max() < 0.5
+
+
+def test_matcher_keeps_the_true_model_through_the_sequence(sequence_run):
+    from haptic.matching.tree import InterpretationTree
+
+    poly, _, ex, _ = sequence_run
+    tree = InterpretationTree(load_library())
+    for c in ex.components:
+        tree.add(c)
+        assert poly.name in tree.models_alive(), f"{poly.name} pruned by component {c}"

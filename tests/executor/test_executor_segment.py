@@ -1,0 +1,63 @@
+"""Segmentation by property: a face is a face only if the pad slid on it; edges know their sides."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from haptic.executor.primitives import ContactTrace
+from haptic.executor.segment import LineFit, SegmentBounds, Segmenter, normal_turn_rate
+
+R_PAD = 0.012
+
+
+def _trace(tips: np.ndarray, normals: np.ndarray, points: np.ndarray) -> ContactTrace:
+    n = len(tips)
+    return ContactTrace(np.arange(n) * 0.005, tips, np.repeat(np.eye(3)[None], n, axis=0), points, normals,
+                        np.ones(n), np.full(n, 3))  # fmt: skip
+
+
+def _l_stroke(n: int = 120) -> np.ndarray:
+    s = np.linspace(0.0, 1.0, n)
+    leg = np.where(s < 0.5, s * 2, 1.0)
+    side = np.where(s < 0.5, 0.0, (s - 0.5) * 2)
+    return np.column_stack([0.005 * leg, 0.005 * side, np.zeros(n)])
+
+
+def test_a_plane_touched_along_an_l_is_a_face():
+    rng = np.random.default_rng(0)
+    rot = np.linalg.qr(rng.normal(size=(3, 3)))[0]
+    xy = _l_stroke() @ rot.T
+    normal = rot[:, 2]
+    noisy = normal + np.radians(1.0) * rng.normal(size=(len(xy), 3))
+    noisy /= np.linalg.norm(noisy, axis=1)[:, None]
+    points = xy + 2e-4 * rng.normal(size=xy.shape)
+    fit = Segmenter().fit_face_trace(_trace(xy + R_PAD * normal, noisy, points), normal, two_d=True)
+    assert fit is not None
+    assert math.degrees(math.acos(min(1.0, fit.normal @ normal))) < 0.5
+
+
+def test_rolling_on_a_vertex_or_a_ridge_is_not_a_face():
+    rng = np.random.default_rng(1)
+    tips = _l_stroke() + np.array([0.0, 0.0, R_PAD])
+    # vertex at the origin: the normal points from it to the pad centre, the contact point stays put
+    normals = tips / np.linalg.norm(tips, axis=1)[:, None]
+    points = 2e-4 * rng.normal(size=tips.shape)
+    seg = Segmenter()
+    assert seg.fit_face_trace(_trace(tips, normals, points), np.array([0.0, 0.0, 1.0])) is None
+    assert normal_turn_rate(tips[:, :2], normals) > 0.5 / R_PAD  # turns with 1/r
+
+
+def test_edge_sides_follow_from_normals_and_convexity():
+    seg = Segmenter(SegmentBounds())
+    line = LineFit(np.zeros(3), np.array([0.0, 1.0, 0.0]), 1e-3, 1e-4, (0.0, 0.01))
+    top, side = np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0])
+    convex = seg.add_edge(line, (0, 1), True, (top, side), adjacent=(0,))
+    sides = dict(convex.side_points)
+    assert sides[0][0] < -1e-3 and abs(sides[0][2]) < 1e-9  # the top extends away from the side face
+    assert sides[1][2] < -1e-3 and abs(sides[1][0]) < 1e-9  # the side face extends downwards
+    # a notch floor (up) meeting a wall facing -x: the floor extends towards -x, the wall upwards
+    concave = seg.add_edge(line, (2, 3), False, (top, -side), adjacent=(2,))
+    sides = dict(concave.side_points)
+    assert sides[2][0] < -1e-3 and sides[3][2] > 1e-3
