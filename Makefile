@@ -5,7 +5,7 @@ BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed-stamp
 export MUJOCO_GL ?= disable
 
-.PHONY: demo test bench lint models clean
+.PHONY: demo test bench bench-ci lint models clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -15,9 +15,19 @@ $(STAMP): pyproject.toml
 
 demo: $(STAMP)
 	$(BIN)/haptic models list
+	@echo
+	$(BIN)/haptic explore --object BOX01N --seed 1 --policy planner --record out/demo.rrd --json out/demo.json
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -n 2 -p no:cacheprovider
+
+bench: $(STAMP)
+	$(BIN)/haptic bench --episodes 200 --policy planner,greedy,random --seed 1 --workers 2 --out out/bench/seed.jsonl
+	$(BIN)/haptic bench --models assets/libraries/lookalike --episodes 200 --policy planner,greedy,random --seed 1 \
+		--workers 2 --out out/bench/lookalike.jsonl
+
+bench-ci: $(STAMP)
+	$(BIN)/haptic bench --episodes 40 --policy planner,random --seed 1 --workers 2 --no-plot --out out/ci/seed.jsonl
 
 lint: $(STAMP)
 	$(BIN)/ruff check haptic tests scripts

@@ -92,6 +92,7 @@ def hypotheses_from(tree: InterpretationTree, rec: Recognition) -> list[Hypothes
                 edges=it.edges,
                 vertices=it.vertices,
                 size=len(c.leaves),
+                leaves=tuple(c.leaves),
             )
         )
     return out
@@ -215,7 +216,7 @@ def run_loop(
             if move is None:
                 t_dec = time.perf_counter()
                 hyps = hypotheses_from(tree, rec) if rec is not None and rec.classes else []
-                ctx = Context(hyps, state, components, noise, config)
+                ctx = Context(hyps, state, components, noise, config, tree=tree)
                 chooser = policy if len(hyps) >= 2 else fallback
                 try:
                     decision = chooser.choose(ctx, rng)

@@ -3,8 +3,8 @@
 - ``planner``: the candidate of highest efficiency (expected pose classes eliminated per expected cost).
 - ``greedy``: the candidate of most expected eliminations, whatever it costs.
 - ``random``: a random admissible move (a random move type, then a random move of that type).
-- ``optimal``: exhaustive search over move sequences (discretised directions, limited depth) for the least
-  expected path cost to recognition; see :mod:`haptic.planning.search`.
+
+The best possible cost of an episode is measured from outside, in hindsight: :mod:`haptic.bench.oracle`.
 
 Every policy sees only data-side information (hypotheses derived from the data, the sensor state, the data
 components) and draws any random choice from the generator it is given.
@@ -38,6 +38,9 @@ class Context:
     """Sensor-noise model (for outcome bounds)."""
     config: PlannerConfig = field(default_factory=PlannerConfig)
     """Candidate generation and cost options."""
+    tree: object | None = None
+    """The matcher's interpretation tree (an ``InterpretationTree``), when a policy or a check wants to ask
+    the matcher itself which hypotheses a predicted outcome would eliminate."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -62,10 +65,13 @@ class Decision:
 
 
 def _score_all(ctx: Context) -> list[tuple[Prediction, float, float, float]]:
+    """Efficiency, expected eliminations and expected cost of every fresh, reliable candidate move; the
+    eliminations come from comparing predicted outcome attributes (§4.1)."""
     weights = class_weights([h.model for h in ctx.hypotheses])
+    preds = [predict(ctx.hypotheses, m, ctx.state, ctx.components, ctx.noise, ctx.config) for m in _fresh_moves(ctx)]
+    preds = [p for p in preds if p.reliable(ctx.config)] or preds
     out = []
-    for move in _fresh_moves(ctx):
-        pred = predict(ctx.hypotheses, move, ctx.state, ctx.components, ctx.noise, ctx.config)
+    for pred in preds:
         eff, _ = move_efficiency(pred.outcomes, pred.bounds, pred.costs, weights)
         elim = expected_eliminations(pred.outcomes, pred.bounds, weights)
         out.append((pred, eff, elim, float(pred.costs @ weights)))
@@ -181,16 +187,11 @@ POLICIES: dict[str, type[Policy]] = {
 
 
 def make_policy(name: str, **options) -> Policy:
-    """A policy by name: planner, greedy, random, optimal."""
-    if name == "optimal":
-        from haptic.planning.search import OptimalPolicy
-
-        return OptimalPolicy(**options)
+    """A policy by name: planner, greedy, random."""
     try:
         return POLICIES[name](**options)
     except KeyError:
-        valid = ", ".join([*POLICIES, "optimal"])
-        raise PlanningError(f"unknown policy {name!r}; valid: {valid}") from None
+        raise PlanningError(f"unknown policy {name!r}; valid: {', '.join(POLICIES)}") from None
 
 
-POLICY_NAMES = (*POLICIES, "optimal")
+POLICY_NAMES = tuple(POLICIES)

@@ -30,6 +30,12 @@ class PlannerConfig:
     """Radius of the circular path of a vertex move [m]."""
     costs: CostModel = field(default_factory=CostModel)
     """Cost constants (§3.1)."""
+    min_face_travel: float = 0.006
+    """Face moves predicted (median over hypotheses) to meet an edge sooner than this are not offered: a
+    finger that starts that close to an edge cannot settle on the face first [m]."""
+    min_vertex_clearance: float = 0.004
+    """Face moves predicted to meet their edge closer than this to a vertex are not offered: a fingertip
+    crossing there touches two edges at once [m]."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -50,6 +56,8 @@ class Hypothesis:
     """Data vertex id → model vertex id."""
     size: int = 1
     """Interpretations in this pose class."""
+    leaves: tuple[int, ...] = ()
+    """The matcher's leaf indices of this pose class's interpretations (when known)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -64,6 +72,18 @@ class Prediction:
     """Error bound of each attribute, shape (A,)."""
     costs: np.ndarray
     """Predicted cost per hypothesis, shape (N,) [units]."""
+    clearance: np.ndarray
+    """For face moves, the predicted distance of the edge crossing from the nearest vertex, per hypothesis
+    (NaN otherwise), shape (N,) [m]."""
+
+    def reliable(self, config: PlannerConfig) -> bool:
+        """False for a face move predicted to be too short, or to cross its edge too near a vertex."""
+        if self.move.kind != "face" or np.isnan(self.outcomes[:, 0]).all():
+            return True
+        return bool(
+            np.nanmedian(self.outcomes[:, 0]) >= config.min_face_travel
+            and np.nanmedian(self.clearance) >= config.min_vertex_clearance
+        )
 
 
 def outcome_bounds(noise: SensorNoise) -> dict[str, np.ndarray]:
@@ -152,23 +172,30 @@ def predict_one(
     h: Hypothesis, move: Move, state: SensorState, components: Mapping[int, DataComponent], config: PlannerConfig
 ) -> tuple[np.ndarray, float]:
     """One hypothesis's predicted outcome attributes and cost for a move (NaN attributes when it can't say)."""
+    out, cost, _ = _predict_one(h, move, state, components, config)
+    return out, cost
+
+
+def _predict_one(
+    h: Hypothesis, move: Move, state: SensorState, components: Mapping[int, DataComponent], config: PlannerConfig
+) -> tuple[np.ndarray, float, float]:
     nan_face, nan_edge, nan_vertex = np.full(3, np.nan), np.full(1, np.nan), np.full(2, np.nan)
     costs = config.costs
     if h.world_from_model is None:
-        return {"face": nan_face, "edge": nan_edge, "vertex": nan_vertex}[move.kind], np.nan
+        return {"face": nan_face, "edge": nan_edge, "vertex": nan_vertex}[move.kind], np.nan, np.nan
     model_from_world = h.world_from_model.inverse()
     p_m = model_from_world.apply(state.position)
     poly = h.poly
     if isinstance(move, FaceMove):
         f_m = h.faces.get(state.face)
         if f_m is None:
-            return nan_face, np.nan
+            return nan_face, np.nan, np.nan
         n = poly.face_normals[f_m]
         p_m = p_m - (p_m @ n - poly.face_offsets[f_m]) * n
         d_m = model_from_world.rotate(move.direction)
         hit = trace_face(poly, f_m, p_m, d_m)
         if hit is None:
-            return nan_face, np.nan
+            return nan_face, np.nan, np.nan
         out = np.array(
             [
                 hit.distance,
@@ -176,28 +203,30 @@ def predict_one(
                 _signed_dihedral(poly, f_m, hit.next_face, hit.edge),
             ]
         )
-        return out, costs.face_move(hit.distance)
+        s_hit = float((hit.point - poly.edge_points[hit.edge]) @ poly.edge_directions[hit.edge])
+        clearance = min(s_hit, float(poly.edge_lengths[hit.edge]) - s_hit)
+        return out, costs.face_move(hit.distance), clearance
     if isinstance(move, EdgeMove):
         e_m = h.edges.get(state.edge) if state.edge is not None else None
         if e_m is None:
-            return nan_edge, np.nan
+            return nan_edge, np.nan, np.nan
         b_world = h.world_from_model.rotate(poly.edge_directions[e_m])
         data_edge = components[state.edge]
         sense_m = move.sense if b_world @ data_edge.direction > 0 else -move.sense
         hit = trace_edge(poly, e_m, p_m, sense_m)
-        return np.array([hit.distance]), costs.edge_move(hit.distance)
+        return np.array([hit.distance]), costs.edge_move(hit.distance), np.nan
     if isinstance(move, VertexMove):
         e_m = h.edges.get(state.edge) if state.edge is not None else None
         v_m = h.vertices.get(state.vertex) if state.vertex is not None else None
         a_m = h.faces.get(move.across_face)
         if e_m is None or v_m is None or a_m is None:
-            return nan_vertex, np.nan
+            return nan_vertex, np.nan, np.nan
         try:
             hit = circle_vertex(poly, v_m, e_m, a_m, config.vertex_radius)
         except ValueError:
-            return nan_vertex, np.nan
+            return nan_vertex, np.nan, np.nan
         out = np.array([hit.angle, _signed_dihedral(poly, a_m, hit.next_face, hit.edge)])
-        return out, costs.vertex_move(hit.arc_length)
+        return out, costs.vertex_move(hit.arc_length), np.nan
     raise TypeError(f"unknown move {move!r}")
 
 
@@ -210,14 +239,15 @@ def predict(
     config: PlannerConfig,
 ) -> Prediction:
     """Every hypothesis's predicted outcome and cost for one candidate move."""
-    rows, costs = [], []
+    rows, costs, clear = [], [], []
     for h in hypotheses:
-        o, c = predict_one(h, move, state, components, config)
+        o, c, cl = _predict_one(h, move, state, components, config)
         rows.append(o)
         costs.append(c)
+        clear.append(cl)
     costs_arr = np.array(costs, dtype=float)
     if np.isnan(costs_arr).all():
         costs_arr[:] = 1.0
     else:
         costs_arr = np.where(np.isnan(costs_arr), np.nanmean(costs_arr), costs_arr)
-    return Prediction(move, np.array(rows), outcome_bounds(noise)[move.kind], costs_arr)
+    return Prediction(move, np.array(rows), outcome_bounds(noise)[move.kind], costs_arr, np.array(clear, dtype=float))

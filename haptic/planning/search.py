@@ -2,8 +2,8 @@
 the data it would produce and the sensor state it would end in; from there the next moves are predicted.
 
 Used by the planner when no single move is expected to eliminate anything (the discriminating features are
-more than one move away), and by the ``optimal`` policy: an exhaustive search over move sequences
-(directions discretised, depth limited) for the least expected path cost to recognition.
+more than one move away), and to check predictions against the matcher itself
+(:func:`matcher_eliminations`).
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ from haptic.geometry.tracing import circle_vertex, trace_edge, trace_face
 from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex, SensorNoise
 from haptic.planning.efficiency import class_weights, outcome_groups
 from haptic.planning.moves import EdgeMove, FaceMove, Move, SensorState, VertexMove
-from haptic.planning.policies import Context, Decision, Policy, Scored
+from haptic.planning.policies import Context
 from haptic.planning.predict import Hypothesis, PlannerConfig, candidate_moves, predict
 
 STEP_ONTO = 0.003
@@ -43,7 +43,12 @@ class Branch:
 
 
 def simulate(
-    h: Hypothesis, move: Move, state: SensorState, components: Mapping[int, DataComponent], config: PlannerConfig
+    h: Hypothesis,
+    move: Move,
+    state: SensorState,
+    components: Mapping[int, DataComponent],
+    config: PlannerConfig,
+    noise: SensorNoise | None = None,
 ) -> tuple[Hypothesis, SensorState, dict[int, DataComponent]] | None:
     """The move carried out exactly in hypothesis ``h``'s world: its extended correspondence, the new sensor
     state and the new (noiseless) data components; None when ``h`` cannot say (no pose, meets a vertex) or
@@ -57,8 +62,14 @@ def simulate(
     new: dict[int, DataComponent] = {}
     faces, edges, vertices = dict(h.faces), dict(h.edges), dict(h.vertices)
 
+    k = noise.k if noise is not None else 0.0
+    nb = k * noise.normal_sigma if noise is not None else 0.0
+    db = k * noise.direction_sigma if noise is not None else 0.0
+    pb = k * noise.position_sigma if noise is not None else 0.0
+    lb = k * noise.length_sigma if noise is not None else 0.0
+
     def face_comp(fid: int, g: int, point_m: np.ndarray, adjacent) -> DataFace:
-        return DataFace(fid, t.rotate(poly.face_normals[g]), t.apply(point_m)[None, :], 0.0, 0.0, adjacent)
+        return DataFace(fid, t.rotate(poly.face_normals[g]), t.apply(point_m)[None, :], nb, pb, adjacent)
 
     if isinstance(move, FaceMove | VertexMove):
         if isinstance(move, FaceMove):
@@ -66,7 +77,8 @@ def simulate(
             if f_m is None:
                 return None
             d_m = t.inverse().rotate(move.direction)
-            hit = trace_face(poly, f_m, p_m, d_m)
+            n_f = poly.face_normals[f_m]
+            hit = trace_face(poly, f_m, p_m - (p_m @ n_f - poly.face_offsets[f_m]) * n_f, d_m)
             if hit is None:
                 return None
             e_m, g_m, at_m, from_face = hit.edge, hit.next_face, hit.point, state.face
@@ -89,13 +101,19 @@ def simulate(
         hi = min(float(poly.edge_lengths[e_m]), s + EDGE_PROBE / 2)
         eid, fid = nxt, nxt + 1
         adj = (from_face,) if isinstance(move, FaceMove) else (state.vertex, from_face)
-        new[eid] = DataEdge(
-            eid, t.rotate(b_m), t.apply(poly.edge_points[e_m] + lo * b_m), hi - lo, 0.0, 0.0, 0.0, adjacent=adj
-        )
         inward = np.cross(poly.face_normals[g_m], b_m)
         if poly.edge_left_face[e_m] != g_m:
             inward = -inward
         onto = at_m + STEP_ONTO * inward
+        f_from = h.faces[from_face]
+        back = np.cross(poly.face_normals[f_from], b_m)
+        if poly.edge_left_face[e_m] != f_from:
+            back = -back
+        sides = ((from_face, t.apply(at_m + STEP_ONTO * back)), (fid, t.apply(onto)))
+        new[eid] = DataEdge(
+            eid, t.rotate(b_m), t.apply(poly.edge_points[e_m] + lo * b_m), hi - lo, db, pb, lb,
+            adjacent=adj, side_points=sides,
+        )  # fmt: skip
         new[fid] = face_comp(fid, g_m, onto, (eid,))
         edges[eid], faces[fid] = e_m, g_m
         vertex = state.vertex if isinstance(move, VertexMove) else None
@@ -116,7 +134,7 @@ def simulate(
             end = p + length * b
             ext = replace(data_edge, point=v_w, length=max(0.0, float((end - v_w) @ b)), start_vertex=vid)
         new[ext.id] = ext
-        new[vid] = DataVertex(vid, v_w, 0.0, (ext.id,))
+        new[vid] = DataVertex(vid, v_w, pb, (ext.id,))
         vertices[vid] = eh.vertex
         new_state = SensorState(v_w, state.face, state.edge, vid, state.edge_faces)
     else:
@@ -137,9 +155,11 @@ def branches(
 ) -> list[Branch]:
     """Split the hypotheses by what ``move`` would show, and simulate each group onward."""
     pred = predict(hyps, move, state, components, noise, config)
+    if not pred.reliable(config):
+        return []
     out = []
     for g in outcome_groups(pred.outcomes, pred.bounds):
-        sims = [(i, simulate(hyps[i], move, state, components, config)) for i in g]
+        sims = [(i, simulate(hyps[i], move, state, components, config, noise)) for i in g]
         sims = [(i, s) for i, s in sims if s is not None]
         if not sims:
             continue
@@ -150,77 +170,6 @@ def branches(
             Branch(tuple(s[0] for _, s in sims), w, st, comps, float(pred.costs[idx] @ (w / w.sum())))
         )
     return out
-
-
-def expected_cost_to_go(
-    hyps: Sequence[Hypothesis],
-    weights: np.ndarray,
-    state: SensorState,
-    components: Mapping[int, DataComponent],
-    noise: SensorNoise,
-    config: PlannerConfig,
-    depth: int,
-    leaf_cost: float,
-) -> tuple[float, Move | None]:
-    """Least expected cost until one hypothesis remains, searching ``depth`` moves ahead.
-
-    A node with one hypothesis costs 0; a node still unresolved at depth 0 costs ``leaf_cost`` per halving
-    still needed (``leaf_cost · log2 n``), an optimistic estimate of the rest.
-    """
-    n = len(hyps)
-    if n <= 1:
-        return 0.0, None
-    if depth == 0:
-        return leaf_cost * float(np.log2(n)), None
-    best, best_move = np.inf, None
-    total = float(weights.sum())
-    for move in candidate_moves(state, components, config):
-        bs = branches(hyps, weights, move, state, components, noise, config)
-        covered = sum(float(br.weights.sum()) for br in bs) / total
-        if covered < 1e-9:
-            continue  # no hypothesis can carry the move out (or it only circles back)
-        # hypotheses that cannot simulate the move learn nothing from it: they stay where they were
-        value = (1.0 - covered) * (max((br.cost for br in bs), default=0.0) + leaf_cost * float(np.log2(n)))
-        for br in sorted(bs, key=lambda b: -float(b.weights.sum())):
-            p = float(br.weights.sum()) / total
-            rest, _ = expected_cost_to_go(
-                br.hypotheses, br.weights, br.state, br.components, noise, config, depth - 1, leaf_cost
-            )
-            value += p * (br.cost + rest)
-            if value >= best:
-                break
-        if value < best:
-            best, best_move = value, move
-    return best, best_move
-
-
-class OptimalPolicy(Policy):
-    """Exhaustive depth-limited search for the least expected path cost to recognition.
-
-    ``depth`` moves are searched exhaustively over the discretised candidates (``n_directions`` face-move
-    directions); beyond it, an optimistic ``leaf_cost · log2 n`` stands for the rest. Re-planned after every
-    move (receding horizon). Feasible for small libraries: the work grows as (candidates)^depth.
-    """
-
-    name = "optimal"
-
-    def __init__(self, depth: int = 3, n_directions: int = 6, leaf_cost: float | None = None) -> None:
-        self.depth = depth
-        self.n_directions = n_directions
-        self.leaf_cost = leaf_cost
-
-    def choose(self, ctx: Context, rng: np.random.Generator) -> Decision:
-        config = replace(ctx.config, n_directions=self.n_directions)
-        weights = class_weights([h.model for h in ctx.hypotheses])
-        leaf = self.leaf_cost if self.leaf_cost is not None else config.costs.face_move(0.03)
-        value, move = expected_cost_to_go(
-            ctx.hypotheses, weights, ctx.state, ctx.components, ctx.noise, config, self.depth, leaf
-        )
-        if move is None:
-            from haptic.planning.policies import PlannerPolicy
-
-            return PlannerPolicy().choose(ctx, rng)
-        return Decision(move, (Scored(move, -value, value, float("nan")),))
 
 
 def lookahead_choice(ctx: Context, depth: int = 2) -> Move | None:
@@ -256,3 +205,36 @@ def _lookahead_score(ctx, hyps, weights, move, state, components, depth, spent) 
                 )
         score += p * max(here, further)
     return score
+
+
+def matcher_eliminations(ctx: Context, move: Move) -> tuple[np.ndarray, np.ndarray] | None:
+    """``D[i, j]``: would the data that ``move`` yields if hypothesis ``i`` is true eliminate hypothesis ``j``,
+    by the matcher itself (the move simulated in ``i``'s world, its components added to a copy of the tree)?
+    Also each hypothesis's simulated cost. None without a tree in the context.
+    """
+    tree = ctx.tree
+    if tree is None:
+        return None
+    n = len(ctx.hypotheses)
+    leaf_class = np.full(tree.count, -1)
+    for j, h in enumerate(ctx.hypotheses):
+        leaf_class[list(h.leaves)] = j
+    old = tree.assignments
+    parent_of = {row.tobytes(): i for i, row in enumerate(old)}
+    d = np.zeros((n, n), dtype=bool)
+    pred = predict(ctx.hypotheses, move, ctx.state, ctx.components, ctx.noise, ctx.config)
+    for i, h in enumerate(ctx.hypotheses):
+        sim = simulate(h, move, ctx.state, ctx.components, ctx.config, ctx.noise)
+        if sim is None:
+            continue
+        _, _, merged = sim
+        t2 = tree.copy()
+        for cid in sorted(set(merged) - set(ctx.components)) + sorted(
+            c for c in merged if c in ctx.components and merged[c] is not ctx.components[c]
+        ):
+            t2.add(merged[cid])
+        rows = t2.assignments[:, : old.shape[1]]
+        alive = {leaf_class[parent_of[r.tobytes()]] for r in rows if r.tobytes() in parent_of}
+        d[i] = [j not in alive for j in range(n)]
+        d[i, i] = False
+    return d, pred.costs

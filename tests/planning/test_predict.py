@@ -46,3 +46,36 @@ def test_true_hypothesis_predicts_the_executed_distance():
                     comps[c.id] = c
                 state = res.state
     assert checked >= 40
+
+
+def test_predicted_eliminations_agree_with_the_matcher():
+    """The planner's attribute predictions (seed §4.1) against the matcher given each hypothesis's simulated
+    data: over real decision points, the two agree on nearly every (true, eliminated) pair."""
+    from haptic.bench.runner import EpisodeSpec
+    from haptic.episode import run_episode
+    from haptic.planning import policies as P
+    from haptic.planning.efficiency import distinguishable
+    from haptic.planning.predict import predict
+    from haptic.planning.search import matcher_eliminations
+
+    agree = total = 0
+    original = P.PlannerPolicy.choose
+
+    def checking(self, ctx, rng):
+        nonlocal agree, total
+        for move in P._fresh_moves(ctx)[:6]:
+            d_matcher, _ = matcher_eliminations(ctx, move)
+            pred = predict(ctx.hypotheses, move, ctx.state, ctx.components, ctx.noise, ctx.config)
+            d_attr = distinguishable(pred.outcomes, pred.bounds)
+            agree += int((d_matcher == d_attr).sum())
+            total += d_attr.size
+        return original(self, ctx, rng)
+
+    P.PlannerPolicy.choose = checking
+    try:
+        for name, seed in (("BOX01", 1), ("WEDGE01", 2), ("BOX01N", 3)):
+            run_episode(EpisodeSpec(model=name, seed=seed, policy="planner"), library=LIB)
+    finally:
+        P.PlannerPolicy.choose = original
+    assert total > 500
+    assert agree / total > 0.95
