@@ -26,7 +26,7 @@ from haptic.planning.predict import Hypothesis, PlannerConfig, candidate_moves
 
 MAX_POSED = 400
 """Largest number of interpretations whose poses are computed to group them into pose classes."""
-MAX_FAILED_MOVES = 3
+MAX_FAILED_MOVES = 4
 """Consecutive failed moves after which the episode ends as "failed"."""
 CORRECT_POSE_MM, CORRECT_POSE_DEG = 5.0, 5.0
 """A recognition is correct when the model is right and the pose within these of the truth."""
@@ -108,10 +108,17 @@ def pose_error(model: Polyhedron, truth: SE3, estimate: SE3) -> tuple[float, flo
     return dist, float(np.degrees(ang))
 
 
-def _fixed_move(kind: str, state, components, config: PlannerConfig, rng: np.random.Generator) -> Move | None:
+def _fixed_move(
+    kind: str, state, components, config: PlannerConfig, rng: np.random.Generator, avoid: tuple = ()
+) -> Move | None:
     """The seed's initial sequence (§4.1): a face move, an edge move, a vertex move, each in a random
-    admissible direction."""
-    moves = [m for m in candidate_moves(state, components, config) if m.kind == kind]
+    admissible direction (not one that already failed from here)."""
+    from haptic.planning.policies import same_move
+
+    moves = [
+        m for m in candidate_moves(state, components, config)
+        if m.kind == kind and not any(same_move(m, bad) for bad in avoid)
+    ]
     if not moves:
         return None
     return moves[int(rng.integers(len(moves)))]
@@ -177,6 +184,7 @@ def run_loop(
     decision_times: list[float] = []
     cost = 0.0
     failed_in_a_row = failed_total = 0
+    failed_here: list[Move] = []
     rec: Recognition | None = None
     outcome, detail = EXPLORING, ""
     fallback = RandomPolicy()
@@ -212,11 +220,11 @@ def run_loop(
                 break
             move = None
             if fixed:
-                move = _fixed_move(fixed.pop(0), state, components, config, rng)
+                move = _fixed_move(fixed.pop(0), state, components, config, rng, tuple(failed_here))
             if move is None:
                 t_dec = time.perf_counter()
                 hyps = hypotheses_from(tree, rec) if rec is not None and rec.classes else []
-                ctx = Context(hyps, state, components, noise, config, tree=tree)
+                ctx = Context(hyps, state, components, noise, config, avoid=tuple(failed_here), tree=tree)
                 chooser = policy if len(hyps) >= 2 else fallback
                 try:
                     decision = chooser.choose(ctx, rng)
@@ -232,6 +240,7 @@ def run_loop(
             if not result.ok:
                 failed_total += 1
                 failed_in_a_row += 1
+                failed_here.append(move)
                 cost += result.cost
                 if obs.on_failed_move:
                     obs.on_failed_move(n_moves, result)
@@ -242,6 +251,7 @@ def run_loop(
                     break
                 continue
             failed_in_a_row = 0
+            failed_here.clear()
             absorb(result)
             state = result.state
             if obs.on_move:

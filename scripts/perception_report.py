@@ -7,14 +7,17 @@ Each run: start, then the fixed sequence face, edge, vertex, edge, face, edge, v
 a seeded generator; a failed move is retried with another choice, up to 4 times; an edge move in the sense of
 a vertex already reached is not asked). On objects with concave edges a *concave probe* follows: face moves
 whose directions are chosen with the ground truth (an oracle standing in for the planner -- the executor is
-as blind as ever) towards the nearest concave edge, until one is reported or 6 moves are spent.
+as blind as ever) towards the nearest concave edge of the current face -- or, from a face without one, towards
+the middle of the edge to a face that has one --, until one is reported or 6 moves are spent.
 
 The components are scored against ground truth by ``haptic.executor.evaluate`` (outside the executor); every
 component of every run is also fed, unchanged, to the interpretation-tree matcher, and the run counts as
 accepted when the true model survives every one of them.
 
-Move counts: ``ok/asked``; ``table`` counts failures because the move needed the object's face on the table
-(an edge on the table, the finger meeting the table), which no hand can touch.
+Move counts: ``ok/asked``; ``table`` counts failures because the move needed the part of the object next to
+the table (an edge on the table, the finger meeting the table, a vertex circle that would put the pad on the
+table), which the pad cannot touch; a vertex move across a face that failed so is not asked again from the
+same state. The totals also give the success rate of the moves that did not fail for the table.
 """
 
 from __future__ import annotations
@@ -64,6 +67,7 @@ def explore(poly, seed: int, plan=PLAN, retries: int = 4):
     if not results[0].ok:
         return sim, ex, results
     for kind in plan:
+        table_faces: set[int] = set()  # faces a vertex move from this state cannot circle (the table)
         for attempt in range(retries):
             st = ex.state
             if kind == "face":
@@ -74,13 +78,16 @@ def explore(poly, seed: int, plan=PLAN, retries: int = 4):
                     break
                 move = EdgeMove(sense)
             else:
-                if st.vertex is None:
+                faces = [f for f in st.edge_faces if f not in table_faces] if st.vertex is not None else []
+                if not faces:
                     break
-                move = VertexMove(st.edge_faces[(attempt + int(rng.integers(2))) % 2])
+                move = VertexMove(faces[(attempt + int(rng.integers(2))) % len(faces)])
             r = ex.execute(move)
             results.append(r)
             if r.ok:
                 break
+            if kind == "vertex" and _is_table(r):
+                table_faces.add(move.across_face)
     return sim, ex, results
 
 
@@ -100,12 +107,23 @@ def concave_probe(sim: Simulation, ex: PhysicsExecutor, poly, results: list, max
         ab = b_w - a_w
         s = np.clip(np.einsum("ij,ij->i", x - a_w, ab) / np.einsum("ij,ij->i", ab, ab), 0.0, 1.0)
         near = a_w + s[:, None] * ab
-        # prefer concave edges of the current face (true face by the evaluator), else the nearest
+        # aim at the nearest concave edge of the current face (true face by the evaluator); on a face without
+        # one, at the middle of its nearest edge towards a face that has one (crossing there), else at the
+        # nearest concave edge
         true_face = score_face(face, poly, rot, trans, _tol()).true_id
         own = [i for i, e in enumerate(concave) if true_face in poly.edge_faces(int(e))]
-        pick = own if own else list(range(len(concave)))
-        k = min(pick, key=lambda i: float(np.linalg.norm(near[i] - x)))
-        d = near[k] - x
+        bordering = {f for e in concave for f in poly.edge_faces(int(e))}
+        edges_here = poly.face_edges[true_face] if true_face is not None else ()
+        gates = [int(e) for e in edges_here if set(poly.edge_faces(int(e))) & bordering]
+        if own or not gates:
+            pick = own if own else list(range(len(concave)))
+            k = min(pick, key=lambda i: float(np.linalg.norm(near[i] - x)))
+            target = near[k]
+        else:
+            mids = [0.5 * (poly.vertices[poly.edges[e, 0]] + poly.vertices[poly.edges[e, 1]]) @ rot.T + trans
+                    for e in gates]  # fmt: skip
+            target = min(mids, key=lambda m: float(np.linalg.norm(m - x)))
+        d = target - x
         d = d - (d @ face.normal) * face.normal
         if np.linalg.norm(d) < 1e-4:
             break
@@ -161,6 +179,7 @@ def main(argv=None) -> int:
                 c[f"{r.move.kind}_asked"] += 1
                 c[f"{r.move.kind}_ok"] += r.ok
                 c["table"] += (not r.ok) and _is_table(r)
+                c[f"{r.move.kind}_table"] += (not r.ok) and _is_table(r)
             c["start_ok"] += results[0].ok
             gt = sim.ground_truth()
             score = score_components(ex.components, poly, gt.world_from_object, results)
@@ -187,8 +206,10 @@ def main(argv=None) -> int:
               f"{cell(dirs):>13} {cell(epos):>13} {cell(verts):>13} {c['spurious']:4d} {c['missed']:4d} "
               f"{c['concave']:7d} {c['accepted']:3d}/{args.poses:<3d}")  # fmt: skip
     for kind in ("face", "edge", "vertex"):
-        asked, ok = totals[kind + "_asked"], totals[kind + "_ok"]
-        print(f"{kind} moves: {ok}/{asked} ok ({100 * ok / max(asked, 1):.0f} %)", end="; ")
+        asked, ok, tab = totals[kind + "_asked"], totals[kind + "_ok"], totals[kind + "_table"]
+        feasible = asked - tab
+        print(f"{kind} moves: {ok}/{asked} ok ({100 * ok / max(asked, 1):.0f} %; {100 * ok / max(feasible, 1):.0f} % "
+              f"of the {feasible} not failing for the table)", end="; ")
     print(f"failures needing the table side: {totals['table']}")
     if all_rates:
         sim_t = sum(s for s, _ in all_rates)

@@ -6,7 +6,8 @@ from the true edge segment and its direction, a vertex by position. Errors: face
 [deg], edge position [mm] (largest distance of the interval's ends from the true edge line), vertex position
 [mm]. A component farther than the tolerances from every true component of its kind is *spurious*. A move whose
 reported edge (vertex) is not the first true edge (vertex) on the ideal path from where the move started -- it
-crossed a true edge without reporting it --, an edge move whose vertex is not an end of the true edge it
+crossed a true edge without reporting it; a path meeting the boundary within the position tolerance of a vertex
+is not checked --, an edge move whose vertex is not an end of the true edge it
 followed, and a vertex move whose new edge does not leave the circled vertex on the face circled across each
 count one *missed* component.
 
@@ -171,11 +172,13 @@ def score_components(
     concave = sum(1 for s in scores if s.kind == "edge" and s.true_id is not None and convexity[s.true_id] < 0)
     missed, details = 0, {}
     if results:
-        missed, details = _missed(results, model, rot, trans, by_id)
+        missed, details = _missed(results, model, rot, trans, by_id, tol)
     return PerceptionScore(tuple(scores), sum(1 for s in scores if s.true_id is None), missed, concave, details)
 
 
-def _missed(results, model: Polyhedron, rot: np.ndarray, trans: np.ndarray, by_id: dict) -> tuple[int, dict]:
+def _missed(
+    results, model: Polyhedron, rot: np.ndarray, trans: np.ndarray, by_id: dict, tol: EvaluationTolerances
+) -> tuple[int, dict]:
     missed = 0
     checks = []
     prev_state = None
@@ -195,7 +198,9 @@ def _missed(results, model: Polyhedron, rot: np.ndarray, trans: np.ndarray, by_i
                     d_m = d_m - (d_m @ n) * n
                     start_m = start_m - (start_m @ n - model.face_offsets[f_score.true_id]) * n
                     try:
-                        hit = tracing.trace_face(model, f_score.true_id, start_m, d_m)
+                        # a path meeting the boundary within the position tolerance of a vertex has no
+                        # single first edge (the pad is 12 mm wide): not checked
+                        hit = tracing.trace_face(model, f_score.true_id, start_m, d_m, vertex_margin=tol.position)
                     except (ValueError, IndexError):
                         hit = None
                     if hit is not None:

@@ -70,6 +70,11 @@ class PhysicsSettings:
     """After an edge move the pad rests on the current face this far back along the edge and in from it [m]."""
     table_margin: float = 0.003
     """A contact below the table top plus this, with an upward normal, is the table [m]."""
+    pad_clearance: float = 0.002
+    """A touch (a repositioning target, a point of a vertex circle) is out of reach when the pad's lowest
+    point would come closer than this to the table top; a slide heading down stops there [m]."""
+    edge_reentry: float = 0.004
+    """An edge move that must first return next to its edge touches the face this far in from the edge [m]."""
 
 
 @dataclass
@@ -107,6 +112,7 @@ class PhysicsExecutor:
             )
         self.settings = s
         self.toucher = Toucher(robot, s.touch, finger)
+        self.toucher.floor_z = TABLE_TOP_Z + s.pad_clearance
         self.segmenter = Segmenter(self.bounds)
         self.state: SensorState | None = None
         """Sensor state after the last move (None before :meth:`start`)."""
@@ -179,6 +185,12 @@ class PhysicsExecutor:
 
     def _is_table(self, normal: np.ndarray, point: np.ndarray | None) -> bool:
         return point is not None and normal[2] > 0.99 and point[2] < TABLE_TOP_Z + self.settings.table_margin
+
+    def _pad_clearance(self, point: np.ndarray, normal: np.ndarray) -> float:
+        """Height above the table top of the pad's lowest point when it touches ``point`` of a face of
+        ``normal`` (fingers pointing down; the workspace prior is the table's height) [m]."""
+        r = self.toucher.pad_radius
+        return float(point[2] + r * normal[2] - r - TABLE_TOP_Z)
 
     def _contact_point(self) -> np.ndarray:
         t = self.toucher
@@ -314,6 +326,9 @@ class PhysicsExecutor:
                 and angle(t.normal, n) < math.radians(5.0)):  # fmt: skip
             return "ok"
         target = self._faces[fid].anchor if near is None else near
+        if self._pad_clearance(target, n) < self.settings.pad_clearance:
+            self._why = "the touch would put the pad on the table"
+            return "unreachable"
         r = t.lift_and_approach(target, n, floor_z=TABLE_TOP_Z + t.pad_radius + self.settings.table_margin)
         pieces.append(r)
         if not r.ok:
@@ -367,6 +382,8 @@ class PhysicsExecutor:
         r = t.trace_face(inplane, n_a, self.settings.max_face_trace)
         pieces.append(r)
         if not r.ok:
+            if r.event == "table":
+                return self._fail(move, r, "the finger would meet the table before an edge")
             return self._fail(move, r, f"trace across the face: {r.event}")
         if r.event == "done":
             return self._fail(move, "unreachable", "no edge within the longest trace")
@@ -423,8 +440,10 @@ class PhysicsExecutor:
         )
         if self._on_face not in rec.faces or self._line_distance(rec, t.tip) > 0.03 or not on_clean:
             fid = st.face if st.face in rec.faces else rec.faces[1]
-            here = rec.at(rec.param(self._contact_point()))
-            status = self._ensure_on_face(fid, pieces, near=here + 0.004 * rec.inward[fid])
+            near = self._reentry_point(rec, fid, u)
+            if near is None:
+                return self._fail(move, "unreachable", "the edge next to the table is out of the pad's reach")
+            status = self._ensure_on_face(fid, pieces, near=near)
             if status != "ok":
                 return self._fail(move, status, f"could not return next to the edge: {self._why}")
         acq = t.follow_edge(u, n_a, n_b, toward_a, 0.0, acquire_only=True)
@@ -450,7 +469,7 @@ class PhysicsExecutor:
         seg.refine_edge(st.edge, rows.point_in_world[ridge] if ridge.sum() >= 10 else None,
                         (self._face_fit(rec.faces[0]), self._face_fit(rec.faces[1])))  # fmt: skip
         s_v, s_from = rec.param(w_v), rec.param(w_from)
-        edge, vertex = seg.extend_edge(st.edge, s_from, s_v, s_sigma)
+        edge, vertex = seg.extend_edge(st.edge, s_from, s_v, s_sigma, 1 if float(u @ rec.direction) > 0 else -1)
         # rest on the current face next to the vertex (the state the next move starts from)
         fid = st.face if st.face in rec.faces else rec.faces[1]
         rest = vertex.position - s.vertex_standoff * u + s.vertex_standoff * rec.inward[fid]
@@ -461,6 +480,23 @@ class PhysicsExecutor:
         return MoveResult(move=move, status="ok", components=(edge, vertex), distance=r.distance,
                           cost=self.costs.edge_move(r.distance), state=self.state,
                           info={"vertex_event": r.info.get("event_sign", 1)})  # fmt: skip
+
+    def _reentry_point(self, rec, fid: int, u: np.ndarray) -> np.ndarray | None:
+        """Where an edge move touches face ``fid`` again next to edge ``rec`` before following it along
+        ``u``: beside the last contact, or -- when that is within the pad's reach of the table -- the
+        nearest point further along ``u`` (inside the explored interval) that is not. None: no such point."""
+        n = self.segmenter.faces[fid].component.normal
+        s0 = rec.param(self._contact_point())
+        lo, hi = rec.interval
+        sense = 1.0 if float(u @ rec.direction) > 0 else -1.0
+        for shift in np.arange(0.0, 0.0301, 0.002):
+            s_k = s0 + sense * shift
+            if shift > 0 and not (lo - 1e-3 <= s_k <= hi + 1e-3):
+                break
+            p = rec.at(s_k) + self.settings.edge_reentry * rec.inward[fid]
+            if self._pad_clearance(p, n) >= self.settings.pad_clearance + 0.001:
+                return p
+        return None
 
     @staticmethod
     def _line_distance(rec, w: np.ndarray) -> float:
@@ -515,13 +551,19 @@ class PhysicsExecutor:
         n_f = seg.faces[f].component.normal
         rho, beta = s.vertex_radius, s.vertex_start_angle
         p0 = vtx + rho * (-math.cos(beta) * u + math.sin(beta) * w_f)
+        sweep = self._circle_sweep_off_table(vtx, n_f, u, w_f)
+        if sweep <= 0.0:
+            return self._fail(move, "unreachable", "the vertex is next to the table: the circle around it would "
+                                                   "put the pad on the table")  # fmt: skip
         status = self._ensure_on_face(f, pieces, near=p0)
         if status != "ok":
             return self._fail(move, status, f"could not reach the face next to the vertex: {self._why}")
         tangent = math.sin(beta) * u + math.cos(beta) * w_f
-        r = t.circle_vertex(vtx, n_f, tangent, rho)
+        r = t.circle_vertex(vtx, n_f, tangent, rho, max_sweep=sweep)
         pieces.append(r)
         if not r.ok:
+            if r.event == "table":
+                return self._fail(move, r, "circling the vertex: no edge before the circle would meet the table")
             return self._fail(move, r, f"circling the vertex: {r.event}")
         kind = r.info["kind"]
         corner = self._contact_point()
@@ -545,6 +587,17 @@ class PhysicsExecutor:
         return MoveResult(move=move, status="ok", components=(edge, face), distance=r.distance,
                           cost=self.costs.vertex_move(r.distance), state=self.state, info={"kind": kind})  # fmt: skip
 
+    def _circle_sweep_off_table(self, vtx: np.ndarray, n_f: np.ndarray, u: np.ndarray, w_f: np.ndarray) -> float:
+        """Angle [rad] the vertex circle can sweep from its start before the pad would come onto the table
+        (2π: never; 0: not even its start is reachable)."""
+        s = self.settings
+        rho, beta = s.vertex_radius, s.vertex_start_angle
+        for th in np.arange(beta, 2.0 * math.pi - beta + 1e-9, math.radians(2.0)):
+            p = vtx + rho * (-math.cos(th) * u + math.sin(th) * w_f)
+            if self._pad_clearance(p, n_f) < s.pad_clearance:
+                return float(th - beta)
+        return 2.0 * math.pi
+
     # ------------------------------------------------------------------------------------------ helpers
     def admissible_moves(self, rng: np.random.Generator, n_directions: int = 8) -> list[Move]:
         """Candidate moves from the current state (as the geometric executor's): face moves in random
@@ -561,8 +614,21 @@ class PhysicsExecutor:
         if st.edge is not None:
             moves.extend([EdgeMove(1), EdgeMove(-1)])
         if st.vertex is not None:
-            moves.extend(VertexMove(f) for f in st.edge_faces)
+            moves.extend(VertexMove(f) for f in st.edge_faces if self._vertex_move_off_table(f))
         return moves
+
+    def _vertex_move_off_table(self, f: int) -> bool:
+        """Whether the circle of a vertex move across face ``f`` can start off the table (else the move
+        fails at once with status ``unreachable``)."""
+        st, seg = self.state, self.segmenter
+        rec = seg.edges.get(st.edge) if st.edge is not None else None
+        if rec is None or f not in rec.inward or st.vertex not in rec.vertices:
+            return True
+        s_v = rec.vertices[st.vertex]
+        lo, hi = rec.interval
+        u = rec.direction if s_v >= 0.5 * (lo + hi) else -rec.direction
+        vtx = seg.vertices[st.vertex].position
+        return self._circle_sweep_off_table(vtx, seg.faces[f].component.normal, u, rec.inward[f]) > 0.0
 
 
 __all__ = ["PhysicsExecutor", "PhysicsSettings"]

@@ -4,9 +4,9 @@ Each primitive is a small state machine run one control tick at a time through a
 :class:`~haptic.sim.robot.RobotInterface` -- the only handle it has: commands to the controller, the joint
 encoders' forward kinematics, and the fingertip's sensed contact (force, normal, point, noise applied). It
 ends with an *event* (why it stopped: ``"contact"``, ``"convex-edge"``, ``"concave-edge"``, ``"vertex"``,
-``"done"``) or a failure status (``"no-contact"``, ``"unreachable"``, ``"timeout"``, ``"unstable"``), and
-returns the contact trace it recorded (time, fingertip pose, contact point, normal, force, phase) and the
-distance the fingertip travelled.
+``"done"``; ``"table"`` when a slide would take the pad onto the table) or a failure status
+(``"no-contact"``, ``"unreachable"``, ``"timeout"``, ``"unstable"``), and returns the contact trace it
+recorded (time, fingertip pose, contact point, normal, force, phase) and the distance the fingertip travelled.
 
 Detection follows ``PHYSICS_NOTES.md``: contact when the sensed force exceeds max(0.1 F, 5 σF) for 3 samples
 with a valid normal (pitfall 5); an edge when the filtered normal leaves the running face normal by more
@@ -223,6 +223,10 @@ class Toucher:
         self.rotation = rot
         self.contact: tuple[float, np.ndarray | None, np.ndarray | None] = (0.0, None, None)
         self._unhealthy = False
+        self.floor_z: float | None = None
+        """Lowest height [m] the pad's lowest point may reach while sliding (the table top plus a margin, a
+        workspace prior set by the executor); a slide heading down stops there with event ``"table"``. None:
+        no floor."""
 
     # -- the tick ---------------------------------------------------------------------------------------------
     def tick(self, phase: str) -> None:
@@ -296,6 +300,12 @@ class Toucher:
             if good >= need:
                 break
         return True
+
+    def below_floor(self, heading: np.ndarray | None = None) -> bool:
+        """The pad's lowest point is below :attr:`floor_z` (and ``heading``, when given, points down)."""
+        if self.floor_z is None or (heading is not None and float(heading[2]) >= 0.0):
+            return False
+        return float(self.tip[2]) - self.pad_radius < self.floor_z
 
     def ramp(self, k: int) -> float:
         """Speed factor (0, 1] of tick ``k`` of a slide."""
@@ -441,6 +451,8 @@ class Toucher:
                 return self._result("unstable", "nan", 0.0)
             travelled = float((self.tip - start) @ d)
             progress.append(travelled)
+            if self.below_floor(d):
+                return self._result("unreachable", "table", 0.0, face_normal=n_run, direction=d)
             if self.weak_ticks * self.dt >= cfg.loss_time:
                 return self._result("ok", "convex-edge", 0.0, face_normal=unit(n_sum) if n_sum.any() else n_run,
                                     direction=d, kind="convex", lost=True)  # fmt: skip
@@ -632,11 +644,19 @@ class Toucher:
 
     # -- around a vertex ---------------------------------------------------------------------------------------
     def circle_vertex(
-        self, vertex: np.ndarray, normal: np.ndarray, start_direction: np.ndarray, radius: float
+        self,
+        vertex: np.ndarray,
+        normal: np.ndarray,
+        start_direction: np.ndarray,
+        radius: float,
+        max_sweep: float = 1.9 * math.pi,
     ) -> PrimitiveResult:
         """Slide on the face of ``normal`` along a circle of ``radius`` about ``vertex``, leaving along
         ``start_direction`` (the in-plane tangent at the start), until the next edge (convex or concave).
-        ``info``: like :meth:`trace_face`, plus ``arc`` (the angle swept [rad])."""
+        ``max_sweep``: the circle gives up (``unreachable``, event ``"table"``) after sweeping this angle
+        [rad] -- the executor sets it where the circle would bring the pad onto the table; the pad's reaching
+        :attr:`floor_z` ends it the same way. ``info``: like :meth:`trace_face`, plus ``arc`` (the angle
+        swept [rad])."""
         cfg = self.config
         n_f = unit(np.asarray(normal, dtype=float))
         vtx = np.asarray(vertex, dtype=float)
@@ -672,6 +692,8 @@ class Toucher:
             progress_t.append(path)
             swept += angle(prev, rh)
             prev = rh
+            if (swept > max_sweep and max_sweep < 1.9 * math.pi) or self.below_floor(t):
+                return self._result("unreachable", "table", 0.0, arc=swept)
             if self.weak_ticks * self.dt >= cfg.loss_time:
                 return self._result("ok", "convex-edge", 0.0, face_normal=n_run, direction=t, kind="convex",
                                     arc=swept, lost=True)  # fmt: skip
@@ -690,7 +712,7 @@ class Toucher:
                         n_sum += self.contact[1]
                         if k > 10:
                             n_run = unit(n_sum)
-            if swept > 1.9 * math.pi:
+            if swept > min(max_sweep, 1.9 * math.pi):
                 return self._result("timeout", "limit", 0.0, arc=swept)
             if len(progress_t) > window and path - progress_t[-1 - window] < (
                 cfg.stall_fraction * cfg.face_speed * cfg.stall_time

@@ -423,22 +423,29 @@ class Segmenter:
         rec.interval = (min(ends), max(ends))
         rec.vertices = {v: rec.param(w) for v, w in old_v.items()}
 
-    def extend_edge(self, eid: int, s_from: float, s_vertex: float, vertex_sigma: float) -> tuple[DataEdge, DataVertex]:
-        """An edge move reached a vertex at parameter ``s_vertex`` having started at ``s_from``: re-report the
-        edge with its interval extended to the vertex, and report the vertex (adjacent to the edge)."""
+    def extend_edge(
+        self, eid: int, s_from: float, s_vertex: float, vertex_sigma: float, sense: int
+    ) -> tuple[DataEdge, DataVertex]:
+        """An edge move in ``sense`` (+1 along the data edge's direction, −1 against it) reached a vertex at
+        parameter ``s_vertex`` having started at ``s_from``: re-report the edge with its interval extended to
+        the vertex, and report the vertex (adjacent to the edge).
+
+        The vertex is the end of the interval the move ran toward, whatever the measured parameters say: a
+        contact point measured a fraction of a millimetre past the corner must not turn the vertex into the
+        other end of the edge (``start_vertex``/``end_vertex`` state which way the edge runs from it)."""
         rec = self.edges[eid]
         b = self.bounds
         vid = self._id()
         lo, hi = rec.interval
-        if s_vertex >= s_from:
+        if sense > 0:
             hi_new = s_vertex
-            lo_new = min(lo, s_from)
+            lo_new = min(lo, s_from, s_vertex)
             for v, s in list(rec.vertices.items()):
                 if s > hi_new:
                     del rec.vertices[v]
         else:
             lo_new = s_vertex
-            hi_new = max(hi, s_from)
+            hi_new = max(hi, s_from, s_vertex)
             for v, s in list(rec.vertices.items()):
                 if s < lo_new:
                     del rec.vertices[v]

@@ -12,6 +12,8 @@ hold it.
 
 from __future__ import annotations
 
+import json
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -72,9 +74,16 @@ class DataEdge:
     length_bound: float
     """Error bound on each end of the explored interval, along the line [m]."""
     start_vertex: int | None = None
-    """Id of the data vertex at ``p`` when the interval starts at a known vertex, else None."""
+    """Id of the data vertex at ``p`` when the interval starts at a known vertex, else None.
+
+    A topological claim, not only a position: the true edge runs from that vertex along ``+b`` (the vertex is
+    the end of the true edge at the interval's start), so the matcher pairs it with the end of the model edge
+    that ``b`` points away from, and it is not covered by ``length_bound``. An executor that reaches a vertex
+    moving along ``+b`` reports it as ``end_vertex`` (with the interval clipped there), moving along ``−b`` as
+    ``start_vertex`` -- whatever the sign of a short interval measured near the vertex."""
     end_vertex: int | None = None
-    """Id of the data vertex at ``p + l b`` when the interval ends at a known vertex, else None."""
+    """Id of the data vertex at ``p + l b`` when the interval ends at a known vertex (the true edge ends there,
+    seen along ``+b``), else None."""
     adjacent: tuple[int, ...] = ()
     """Ids of earlier components known to be adjacent (its faces, its vertices)."""
     side_points: tuple[tuple[int, np.ndarray], ...] = ()
@@ -152,4 +161,66 @@ class SensorNoise:
         )
 
 
-__all__ = ["DataComponent", "DataEdge", "DataFace", "DataVertex", "SensorNoise"]
+# ------------------------------------------------------------------------------------------- serialisation
+
+
+def component_to_dict(c: DataComponent) -> dict:
+    """A JSON-friendly dict of one data component (floats at full precision; ``kind`` names its class)."""
+    if isinstance(c, DataFace):
+        return {
+            "kind": "face", "id": c.id, "normal": c.normal.tolist(), "points": c.points.tolist(),
+            "normal_bound": c.normal_bound, "position_bound": c.position_bound, "adjacent": list(c.adjacent),
+        }  # fmt: skip
+    if isinstance(c, DataEdge):
+        return {
+            "kind": "edge", "id": c.id, "direction": c.direction.tolist(), "point": c.point.tolist(),
+            "length": c.length, "direction_bound": c.direction_bound, "position_bound": c.position_bound,
+            "length_bound": c.length_bound, "start_vertex": c.start_vertex, "end_vertex": c.end_vertex,
+            "adjacent": list(c.adjacent), "side_points": [[f, q.tolist()] for f, q in c.side_points],
+        }  # fmt: skip
+    if isinstance(c, DataVertex):
+        return {
+            "kind": "vertex", "id": c.id, "position": c.position.tolist(), "position_bound": c.position_bound,
+            "adjacent": list(c.adjacent),
+        }  # fmt: skip
+    raise TypeError(f"not a data component: {type(c).__name__}")
+
+
+def component_from_dict(d: Mapping) -> DataComponent:
+    """The inverse of :func:`component_to_dict`."""
+    d = dict(d)
+    kind = d.pop("kind")
+    if kind == "face":
+        return DataFace(**d)
+    if kind == "edge":
+        d["side_points"] = tuple((int(f), q) for f, q in d.get("side_points", ()))
+        return DataEdge(**d)
+    if kind == "vertex":
+        return DataVertex(**d)
+    raise ValueError(f"unknown data component kind {kind!r} (expected face, edge or vertex)")
+
+
+def to_json(components: Iterable[DataComponent], indent: int | None = None, **extra) -> str:
+    """A sequence of data reports (re-reported edges included, in order) as JSON:
+    ``{"components": [...], **extra}`` (``extra``: JSON-friendly metadata, e.g. the model and true pose)."""
+    return json.dumps({**extra, "components": [component_to_dict(c) for c in components]}, indent=indent)
+
+
+def from_json(text: str) -> list[DataComponent]:
+    """The data reports of :func:`to_json` (also accepts a bare JSON list of component dicts)."""
+    obj = json.loads(text)
+    items = obj["components"] if isinstance(obj, Mapping) else obj
+    return [component_from_dict(d) for d in items]
+
+
+__all__ = [
+    "DataComponent",
+    "DataEdge",
+    "DataFace",
+    "DataVertex",
+    "SensorNoise",
+    "component_from_dict",
+    "component_to_dict",
+    "from_json",
+    "to_json",
+]

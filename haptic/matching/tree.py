@@ -248,9 +248,12 @@ class InterpretationTree:
             self._model = models[ok]
             self._assign, self._sense = assign[ok], sense[ok]
         else:
+            previous = self._data.items[component.id]
             self._data.put(component, kind)
             parents = np.arange(self.count)
-            ok, assign, sense = self._evaluate(component, kind, parents, self._assign[:, component.id], new=False)
+            ok, assign, sense = self._evaluate(
+                component, kind, parents, self._assign[:, component.id], new=False, previous=previous
+            )
             self._model, self._assign, self._sense = self._model[ok], assign[ok], sense[ok]
         self.counts.append(self.count)
         if len(self._pose_cache) > 4096:
@@ -277,7 +280,9 @@ class InterpretationTree:
         saved = self._data.items[component.id]
         self._data.put(component, kind)
         try:
-            ok, _, _ = self._evaluate(component, kind, np.arange(self.count), self._assign[:, component.id], new=False)
+            ok, _, _ = self._evaluate(
+                component, kind, np.arange(self.count), self._assign[:, component.id], new=False, previous=saved
+            )
         finally:
             self._data.put(saved, kind)
         return ok
@@ -337,8 +342,9 @@ class InterpretationTree:
             parents, cands = parents[keep], cands[keep]
         return parents, cands
 
-    def _evaluate(self, comp, kind: int, parents, cands, new: bool):
-        """Seed §2.3 steps 2–3 for ``comp`` paired with ``cands`` under ``parents``.
+    def _evaluate(self, comp, kind: int, parents, cands, new: bool, previous: DataEdge | None = None):
+        """Seed §2.3 steps 2–3 for ``comp`` paired with ``cands`` under ``parents``; ``previous``: the earlier
+        report of a re-reported edge.
 
         Returns ``(ok, assign, sense)`` with the children's full assignment and sense matrices.
         """
@@ -351,7 +357,12 @@ class InterpretationTree:
             adjacent = set(comp.adjacent)
         else:
             assign, sense = self._assign[parents].copy(), self._sense[parents].copy()
-            sense[:, k] = 0
+            # A pairing's sense is a fact about the leaf, found from a face side when it was decided; it carries
+            # over to the new report (flipped if the direction was reversed), and the faces re-check it. (The
+            # side of a face from the new report may be undecidable: a longer interval puts p farther from the
+            # side point, and the margin grows with that lever arm.)
+            c = float(comp.direction @ previous.direction) if isinstance(previous, DataEdge) else 0.0
+            sense[:, k] = sense[:, k] * (1 if c > 0.5 else -1 if c < -0.5 else 0)
             adjacent = set(self._data.adj[k]) | set(comp.adjacent)
         ok = np.ones(len(cands), dtype=bool)
         if len(cands) == 0:
@@ -435,8 +446,8 @@ class InterpretationTree:
             C.edge_length_epsilon(comp.length_bound, comp.position_bound, comp.direction_bound),
         )
         width = assign.shape[1]
-        # sense from the adjacent faces (each must agree)
-        s_k = np.zeros(len(cands), dtype=np.int8)
+        # sense from the adjacent faces (each must agree), starting from a re-reported edge's known sense
+        s_k = sense[:, k].astype(np.int8)
         for f in sorted(adjacent):
             if f == k or f >= len(data.kinds) or data.kinds[f] != FACE:
                 continue

@@ -38,6 +38,8 @@ class Context:
     """Sensor-noise model (for outcome bounds)."""
     config: PlannerConfig = field(default_factory=PlannerConfig)
     """Candidate generation and cost options."""
+    avoid: tuple[Move, ...] = ()
+    """Moves that failed from the current state (they are not offered again until a move succeeds)."""
     tree: object | None = None
     """The matcher's interpretation tree (an ``InterpretationTree``), when a policy or a check wants to ask
     the matcher itself which hypotheses a predicted outcome would eliminate."""
@@ -84,12 +86,25 @@ def _fresh_moves(ctx: Context) -> list[Move]:
 
     out = []
     for move in candidate_moves(ctx.state, ctx.components, ctx.config):
+        if any(same_move(move, bad) for bad in ctx.avoid):
+            continue
         if move.kind == "vertex" and ctx.hypotheses and all(
             simulate(h, move, ctx.state, ctx.components, ctx.config) is None for h in ctx.hypotheses
         ):
             continue
         out.append(move)
     return out
+
+
+def same_move(a: Move, b: Move) -> bool:
+    """Two moves are the same when of one kind with the same parameter (face directions within ~8°)."""
+    if a.kind != b.kind:
+        return False
+    if a.kind == "face":
+        return float(np.dot(a.direction, b.direction)) > 0.99
+    if a.kind == "edge":
+        return a.sense == b.sense
+    return a.across_face == b.across_face
 
 
 class Policy:
@@ -151,7 +166,10 @@ class RandomPolicy(Policy):
     name = "random"
 
     def choose(self, ctx: Context, rng: np.random.Generator) -> Decision:
-        moves = candidate_moves(ctx.state, ctx.components, ctx.config)
+        moves = [
+            m for m in candidate_moves(ctx.state, ctx.components, ctx.config)
+            if not any(same_move(m, bad) for bad in ctx.avoid)
+        ]
         if not moves:
             raise PlanningError("no admissible move from the current sensor state")
         kinds = sorted({m.kind for m in moves})
