@@ -1,0 +1,41 @@
+"""``haptic bench``: results file, summary, plot; one-line errors."""
+
+import json
+
+from haptic.bench.results import read_results
+from haptic.cli import main
+
+
+def test_bench_writes_results_summary_and_plot(tmp_path, capsys):
+    out = tmp_path / "r" / "results.jsonl"
+    assert main(["bench", "--episodes", "3", "--policy", "planner,random", "--seed", "2", "--out", str(out)]) == 0
+    records = read_results(out)
+    assert len(records) == 6
+    assert {r["policy"] for r in records} == {"planner", "random"}
+    # both policies ran on the same (model, seed) draws
+    draws = {p: sorted((r["model"], r["seed"]) for r in records if r["policy"] == p) for p in ("planner", "random")}
+    assert draws["planner"] == draws["random"]
+    assert out.with_suffix(".md").read_text().startswith("| library |")
+    assert out.with_suffix(".png").read_bytes()[:4] == b"\x89PNG"
+    printed = capsys.readouterr().out
+    assert "| planner |" in printed and "episodes/min" in printed
+    json.dumps(records)
+
+
+def test_bench_is_deterministic(tmp_path):
+    a, b = tmp_path / "a.jsonl", tmp_path / "b.jsonl"
+    for p in (a, b):
+        assert main(["bench", "--episodes", "2", "--policy", "planner", "--seed", "5", "--out", str(p), "--no-plot"]) == 0
+    strip = [{k: v for k, v in r.items() if k not in ("wall_time_s", "decision_times_s")} for r in read_results(a)]
+    again = [{k: v for k, v in r.items() if k not in ("wall_time_s", "decision_times_s")} for r in read_results(b)]
+    assert strip == again
+
+
+def test_bench_errors_are_one_line(tmp_path, capsys):
+    assert main(["bench", "--episodes", "1", "--policy", "planner,oracle", "--out", str(tmp_path / "x.jsonl")]) == 1
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "oracle" in err and "planner" in err
+    assert main(["bench", "--episodes", "1", "--out", str(tmp_path)]) == 1
+    assert "is a directory" in capsys.readouterr().err
+    assert main(["bench", "--episodes", "0"]) == 1
+    assert "--episodes" in capsys.readouterr().err
