@@ -25,7 +25,8 @@ def test_bench_writes_results_summary_and_plot(tmp_path, capsys):
 def test_bench_is_deterministic(tmp_path):
     a, b = tmp_path / "a.jsonl", tmp_path / "b.jsonl"
     for p in (a, b):
-        assert main(["bench", "--episodes", "2", "--policy", "planner", "--seed", "5", "--out", str(p), "--no-plot"]) == 0
+        args = ["bench", "--episodes", "2", "--policy", "planner", "--seed", "5", "--out", str(p), "--no-plot"]
+        assert main(args) == 0
     strip = [{k: v for k, v in r.items() if k not in ("wall_time_s", "decision_times_s")} for r in read_results(a)]
     again = [{k: v for k, v in r.items() if k not in ("wall_time_s", "decision_times_s")} for r in read_results(b)]
     assert strip == again
