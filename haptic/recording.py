@@ -58,6 +58,7 @@ import rerun.blueprint as rrb
 
 from haptic.errors import RecordingError
 from haptic.geometry import SE3, Polyhedron
+from haptic.geometry.se3 import plane_basis
 from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex
 
 if TYPE_CHECKING:
@@ -675,11 +676,7 @@ def _wireframe(model: Polyhedron, color: tuple[int, ...], radius: float) -> rr.L
 def _patch(face: DataFace) -> tuple[np.ndarray, np.ndarray]:
     """A square in the face's plane around its touched points (half-size: their spread + PATCH_RADIUS)."""
     n = face.normal
-    a = np.cross(n, [1.0, 0.0, 0.0])
-    if np.linalg.norm(a) < 0.1:
-        a = np.cross(n, [0.0, 1.0, 0.0])
-    a /= np.linalg.norm(a)
-    b = np.cross(n, a)
+    a, b = plane_basis(n)
     c = face.points.mean(axis=0)
     c = c - (c @ n - face.offset) * n
     rel = face.points - c

@@ -20,7 +20,7 @@ import numpy as np
 
 from haptic.geometry import tracing
 from haptic.geometry.polyhedron import Polyhedron
-from haptic.geometry.se3 import SE3
+from haptic.geometry.se3 import SE3, plane_basis
 from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex, SensorNoise
 from haptic.planning.moves import CostModel, EdgeMove, FaceMove, Move, MoveResult, SensorState, VertexMove
 
@@ -395,12 +395,7 @@ class GeometricExecutor:
         if st is None:
             return []
         face = next(c for c in reversed(self.components) if c.id == st.face)
-        n = face.normal
-        a = np.cross(n, [1.0, 0.0, 0.0])
-        if np.linalg.norm(a) < 0.1:
-            a = np.cross(n, [0.0, 1.0, 0.0])
-        a /= np.linalg.norm(a)
-        b = np.cross(n, a)
+        a, b = plane_basis(face.normal)
         moves: list[Move] = []
         for ang in rng.uniform(0, 2 * np.pi, n_directions):
             moves.append(FaceMove(np.cos(ang) * a + np.sin(ang) * b))

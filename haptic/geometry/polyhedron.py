@@ -440,12 +440,9 @@ class Polyhedron:
 
 def triangulate_polygon(vertices: np.ndarray, loop: tuple[int, ...], normal: np.ndarray) -> list[tuple[int, int, int]]:
     """Ear-clip a simple planar polygon (CCW about ``normal``) into triangles of vertex ids."""
-    n = normal / np.linalg.norm(normal)
-    u = np.cross(n, [1.0, 0.0, 0.0])
-    if np.linalg.norm(u) < 0.1:
-        u = np.cross(n, [0.0, 1.0, 0.0])
-    u /= np.linalg.norm(u)
-    w = np.cross(n, u)
+    from haptic.geometry.se3 import plane_basis
+
+    u, w = plane_basis(normal)
     pts = {i: np.array([vertices[i] @ u, vertices[i] @ w]) for i in loop}
     idx = list(loop)
     out: list[tuple[int, int, int]] = []

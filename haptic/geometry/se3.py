@@ -107,3 +107,13 @@ def frame_from_edge(direction: np.ndarray, face_normal: np.ndarray) -> np.ndarra
     n = face_normal - (face_normal @ b) * b
     n /= np.linalg.norm(n)
     return np.column_stack([b, n, np.cross(b, n)])
+
+
+def plane_basis(normal: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Two unit vectors ``(u, w)`` spanning the plane normal to ``normal``, with ``u × w = n``."""
+    n = np.asarray(normal, dtype=float) / np.linalg.norm(normal)
+    u = np.cross(n, [1.0, 0.0, 0.0])
+    if np.linalg.norm(u) < 0.1:
+        u = np.cross(n, [0.0, 1.0, 0.0])
+    u /= np.linalg.norm(u)
+    return u, np.cross(n, u)

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from haptic.geometry.polyhedron import Polyhedron
+from haptic.geometry.se3 import plane_basis
 
 
 @dataclass(frozen=True, eq=False)
@@ -51,13 +52,6 @@ class VertexHit:
     """Length of the circular path, ``radius · angle`` [m]."""
 
 
-def _face_frame(poly: Polyhedron, face: int) -> tuple[np.ndarray, np.ndarray]:
-    n = poly.face_normals[face]
-    u = np.cross(n, [1.0, 0.0, 0.0])
-    if np.linalg.norm(u) < 0.1:
-        u = np.cross(n, [0.0, 1.0, 0.0])
-    u /= np.linalg.norm(u)
-    return u, np.cross(n, u)
 
 
 def trace_face(
@@ -158,7 +152,7 @@ def random_face_point(poly: Polyhedron, face: int, rng: np.random.Generator, mar
     """A random point inside ``face`` at least ``margin`` from its boundary (rejection sampling)."""
     loop = poly.faces[face]
     pts = poly.vertices[list(loop)]
-    u, w = _face_frame(poly, face)
+    u, w = plane_basis(poly.face_normals[face])
     uv = np.column_stack([pts @ u, pts @ w])
     lo, hi = uv.min(axis=0), uv.max(axis=0)
     origin = poly.face_normals[face] * poly.face_offsets[face]
