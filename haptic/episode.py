@@ -22,7 +22,15 @@ from haptic.matching.recognition import AMBIGUOUS, EXPLORING, NO_MATCH, RECOGNIZ
 from haptic.matching.tree import InterpretationTree
 from haptic.planning.moves import CostModel, Move, MoveResult
 from haptic.planning.policies import Context, Decision, Policy, RandomPolicy, make_policy
-from haptic.planning.predict import Hypothesis, PlannerConfig, candidate_moves
+from haptic.planning.predict import (
+    Hypothesis,
+    PlannerConfig,
+    candidate_moves,
+    pose_fixed_by,
+    rests_on_table,
+    table_safe_moves,
+    vertex_sweep_off_table,
+)
 
 MAX_POSED = 400
 """Largest number of interpretations whose poses are computed to group them into pose classes."""
@@ -108,11 +116,41 @@ def pose_error(model: Polyhedron, truth: SE3, estimate: SE3) -> tuple[float, flo
     return dist, float(np.degrees(ang))
 
 
+def _on_the_table(
+    rec: Recognition, tree: InterpretationTree, components, config: PlannerConfig
+) -> Recognition:
+    """The matcher's verdict with the workspace prior that the object rests on the table (``config.table_z``):
+    once the data fix the poses, pose classes that would put the model through the table or float it above
+    it are set aside, and the verdict is taken again over the rest. Left unchanged when that would leave no
+    class (the prior is then doubted, not the data)."""
+    from haptic.matching.recognition import PoseTolerance, same_solid
+
+    if not rec.classes or not pose_fixed_by(components):
+        return rec
+    keep = tuple(c for c in rec.classes if rests_on_table(c.model, c.world_from_model, config))
+    if not keep or len(keep) == len(rec.classes):
+        return rec
+    models = tuple(sorted({c.name for c in keep}))
+    if len(keep) == 1:
+        return Recognition(RECOGNIZED, keep[0].name, keep[0].world_from_model, keep, rec.count, models)
+    tol = PoseTolerance.from_data(tree.data)
+    status = AMBIGUOUS if all(same_solid(keep[0], c, tol) for c in keep[1:]) else EXPLORING
+    return Recognition(status, None, None, keep, rec.count, models)
+
+
 def _fixed_move(
-    kind: str, state, components, config: PlannerConfig, rng: np.random.Generator, avoid: tuple = ()
+    kind: str,
+    state,
+    components,
+    config: PlannerConfig,
+    rng: np.random.Generator,
+    avoid: tuple = (),
+    hypotheses: tuple = (),
 ) -> Move | None:
     """The seed's initial sequence (§4.1): a face move, an edge move, a vertex move, each in a random
-    admissible direction (not one that already failed from here)."""
+    admissible direction (not one that already failed from here). With a table (``config.table_z``), away
+    from it: not a move the data or the hypotheses predict to run into it, and among the rest those heading
+    up rather than down (face and edge moves) or whose vertex circle stays clear of it."""
     from haptic.planning.policies import same_move
 
     moves = [
@@ -121,7 +159,28 @@ def _fixed_move(
     ]
     if not moves:
         return None
+    if config.table_z is not None:
+        moves = _away_from_table(table_safe_moves(moves, hypotheses, state, components, config), state,
+                                 components, config)  # fmt: skip
     return moves[int(rng.integers(len(moves)))]
+
+
+def _away_from_table(moves: list[Move], state, components, config: PlannerConfig) -> list[Move]:
+    """The moves of ``moves`` that head away from the table: face moves and edge moves not heading down by
+    more than ~12°; vertex moves whose circle can sweep half a turn off the table (else the widest sweep)."""
+    if not moves:
+        return moves
+    if moves[0].kind == "vertex":
+        sweep = np.array([vertex_sweep_off_table(state, components, m.across_face, config) for m in moves])
+        keep = sweep >= np.pi if (sweep >= np.pi).any() else sweep >= sweep.max() - 1e-9
+        return [m for m, k in zip(moves, keep, strict=True) if k]
+    if moves[0].kind == "face":
+        up = np.array([float(m.direction[2]) for m in moves])
+    else:
+        b = components[state.edge].direction
+        up = np.array([m.sense * float(b[2]) for m in moves])
+    keep = up >= -0.2 if (up >= -0.2).any() else up >= up.max() - 1e-9
+    return [m for m, k in zip(moves, keep, strict=True) if k]
 
 
 def make_geometric_executor(model: Polyhedron, world_from_model: SE3, noise: SensorNoise, rng, costs: CostModel):
@@ -196,6 +255,8 @@ def run_loop(
             tree.add(c)
         cost += result.cost
         rec = recognize(tree, max_interpretations=MAX_POSED)
+        if config.table_z is not None:
+            rec = _on_the_table(rec, tree, components, config)
         counts.append(tree.count)
         n_classes.append(len(rec.classes) if rec.classes else tree.count)
         cum_cost.append(cost)
@@ -220,7 +281,11 @@ def run_loop(
                 break
             move = None
             if fixed:
-                move = _fixed_move(fixed.pop(0), state, components, config, rng, tuple(failed_here))
+                hyps = (
+                    tuple(hypotheses_from(tree, rec))
+                    if config.table_z is not None and rec is not None and rec.classes else ()
+                )  # fmt: skip
+                move = _fixed_move(fixed.pop(0), state, components, config, rng, tuple(failed_here), hyps)
             if move is None:
                 t_dec = time.perf_counter()
                 hyps = hypotheses_from(tree, rec) if rec is not None and rec.classes else []

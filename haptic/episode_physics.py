@@ -7,6 +7,8 @@ and to score perception and recognition afterwards.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from haptic.bench.runner import EpisodeSpec
@@ -15,6 +17,10 @@ from haptic.geometry import SE3, Polyhedron, load_library, resolve_model
 from haptic.matching.components import SensorNoise
 from haptic.planning.policies import Policy, make_policy
 from haptic.planning.predict import PlannerConfig
+
+STEEP_DESCENT_RISK = 0.5
+"""Failure risk the planner charges a face move heading steeply down on the simulated hand (measured: such
+moves often lose the surface rolling over the edge they meet)."""
 
 
 def run_physics_episode(
@@ -29,11 +35,13 @@ def run_physics_episode(
     from haptic.executor.physics import PhysicsExecutor
     from haptic.sim import RobotInterface, Simulation, compose_scene, random_object_pose
     from haptic.sim import SensorNoise as SimNoise
-    from haptic.sim.scene import scene_object_from_polyhedron
+    from haptic.sim.scene import TABLE_TOP_Z, scene_object_from_polyhedron
 
     library = library if library is not None else load_library(spec.models)
     true_model = resolve_model(spec.model, library)
     config = config or PlannerConfig()
+    if config.table_z is None:  # the robot knows its workspace: where the table top is (never the object)
+        config = replace(config, table_z=TABLE_TOP_Z, steep_descent_risk=STEEP_DESCENT_RISK)
     root = np.random.SeedSequence(spec.seed)
     pose_rng, exec_rng, policy_rng, sim_seq = (np.random.default_rng(s) for s in root.spawn(4))
     obj = scene_object_from_polyhedron(true_model)

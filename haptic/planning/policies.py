@@ -21,7 +21,15 @@ from haptic.errors import PlanningError
 from haptic.matching.components import DataComponent, SensorNoise
 from haptic.planning.efficiency import class_weights, expected_eliminations, move_efficiency
 from haptic.planning.moves import Move, SensorState
-from haptic.planning.predict import Hypothesis, PlannerConfig, Prediction, candidate_moves, predict
+from haptic.planning.predict import (
+    Hypothesis,
+    PlannerConfig,
+    Prediction,
+    candidate_moves,
+    descent_risk,
+    predict,
+    table_safe_moves,
+)
 
 
 @dataclass(frozen=True, eq=False)
@@ -68,15 +76,18 @@ class Decision:
 
 def _score_all(ctx: Context) -> list[tuple[Prediction, float, float, float]]:
     """Efficiency, expected eliminations and expected cost of every fresh, reliable candidate move; the
-    eliminations come from comparing predicted outcome attributes (§4.1)."""
+    eliminations come from comparing predicted outcome attributes (§4.1). With a table (``config.table_z``),
+    moves the hypotheses predict to run into it are left out and the rest discounted by that risk."""
     weights = class_weights([h.model for h in ctx.hypotheses])
     preds = [predict(ctx.hypotheses, m, ctx.state, ctx.components, ctx.noise, ctx.config) for m in _fresh_moves(ctx)]
     preds = [p for p in preds if p.reliable(ctx.config)] or preds
+    preds = [p for p in preds if p.table_risk < ctx.config.table_risk] or preds
     out = []
     for pred in preds:
         eff, _ = move_efficiency(pred.outcomes, pred.bounds, pred.costs, weights)
         elim = expected_eliminations(pred.outcomes, pred.bounds, weights)
-        out.append((pred, eff, elim, float(pred.costs @ weights)))
+        ok = (1.0 - pred.table_risk) * (1.0 - descent_risk(pred.move, ctx.config))
+        out.append((pred, eff * ok, elim * ok, float(pred.costs @ weights)))
     return out
 
 
@@ -170,6 +181,7 @@ class RandomPolicy(Policy):
             m for m in candidate_moves(ctx.state, ctx.components, ctx.config)
             if not any(same_move(m, bad) for bad in ctx.avoid)
         ]
+        moves = table_safe_moves(moves, ctx.hypotheses, ctx.state, ctx.components, ctx.config)
         if not moves:
             raise PlanningError("no admissible move from the current sensor state")
         kinds = sorted({m.kind for m in moves})

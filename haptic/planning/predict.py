@@ -36,6 +36,25 @@ class PlannerConfig:
     min_vertex_clearance: float = 0.004
     """Face moves predicted to meet their edge closer than this to a vertex are not offered: a fingertip
     crossing there touches two edges at once [m]."""
+    table_z: float | None = None
+    """Height of the table top in the world frame, a workspace prior the robot knows (set for the physics
+    executor's scene, never from the object) [m]. None: no table (the geometric executor), no table checks."""
+    pad_radius: float = 0.012
+    """Radius of the fingertip pad (the robot's own geometry), for the table checks [m]."""
+    table_clearance: float = 0.004
+    """A pad position whose lowest point would come closer than this to the table top counts as on the table:
+    the executor's own limit (2 mm) plus a margin for the hypotheses' pose error [m]."""
+    steep_descent: float = 0.5
+    """A face move whose direction points down more steeply than this (the sine of its descent) is "steep"."""
+    steep_descent_risk: float = 0.0
+    """Failure risk charged to steep face moves (their efficiency is discounted by it): the physics hand,
+    fingers pointing down, often loses the surface rolling down over the edge such a trace meets. 0: none."""
+    table_rest_tol: float = 0.003
+    """With a table, a pose class whose model would reach more than this below the table top, or whose lowest
+    point would float more than this above it, is not a pose the object can rest in [m]."""
+    table_risk: float = 0.5
+    """Candidate moves that at least this fraction of the hypotheses predict to bring the pad onto the table
+    are not offered (the executor would refuse or abort them); the rest are discounted by their risk."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -75,6 +94,17 @@ class Prediction:
     clearance: np.ndarray
     """For face moves, the predicted distance of the edge crossing from the nearest vertex, per hypothesis
     (NaN otherwise), shape (N,) [m]."""
+    table: np.ndarray | None = None
+    """Per hypothesis: 1 when the move is predicted to bring the pad onto the table, 0 when not, NaN when the
+    hypothesis cannot say; None without a table (``PlannerConfig.table_z``)."""
+
+    @property
+    def table_risk(self) -> float:
+        """Fraction of the hypotheses that can say which predict the move to run into the table (0 without
+        a table or a prediction)."""
+        if self.table is None or np.isnan(self.table).all():
+            return 0.0
+        return float(np.nanmean(self.table))
 
     def reliable(self, config: PlannerConfig) -> bool:
         """False for a face move predicted to be too short, or to cross its edge too near a vertex."""
@@ -141,7 +171,11 @@ def face_directions(
         b = edge.direction - (edge.direction @ normal) * normal
         b /= np.linalg.norm(b)
         inward = np.cross(normal, b)
-        if (face.points.mean(axis=0) - state.position) @ inward < 0:
+        side = dict(edge.side_points).get(state.face)
+        if side is not None:  # a point on the face beside the edge: the face's side of the edge line
+            if (side - edge.point) @ inward < 0:
+                inward = -inward
+        elif (face.points.mean(axis=0) - state.position) @ inward < 0:
             inward = -inward
         angles = (np.arange(n) + 0.5) * np.pi / n
         return [np.cos(a) * b + np.sin(a) * inward for a in angles]
@@ -245,9 +279,224 @@ def predict(
         rows.append(o)
         costs.append(c)
         clear.append(cl)
+    table = None
+    if config.table_z is not None:
+        if data_table_conflict(move, state, components, config):
+            table = np.ones(len(hypotheses))
+        else:
+            table = np.array([table_conflict(h, move, state, components, config) for h in hypotheses], dtype=float)
     costs_arr = np.array(costs, dtype=float)
     if np.isnan(costs_arr).all():
         costs_arr[:] = 1.0
     else:
         costs_arr = np.where(np.isnan(costs_arr), np.nanmean(costs_arr), costs_arr)
-    return Prediction(move, np.array(rows), outcome_bounds(noise)[move.kind], costs_arr, np.array(clear, dtype=float))
+    return Prediction(
+        move, np.array(rows), outcome_bounds(noise)[move.kind], costs_arr, np.array(clear, dtype=float), table
+    )
+
+
+# ------------------------------------------------------------------------------------------- the table
+
+TABLE_STEP_ONTO = 0.003
+"""How far onto the next face a face or vertex move strokes for its normal (for the table check) [m]."""
+
+
+def pad_clearance(point: np.ndarray, normal: np.ndarray, config: PlannerConfig) -> float:
+    """Height above the table top of the pad's lowest point when it touches ``point`` of a surface of outward
+    ``normal`` (the fingers point down) [m]; +inf without a table."""
+    if config.table_z is None:
+        return float("inf")
+    r = config.pad_radius
+    return float(point[2] + r * normal[2] - r - config.table_z)
+
+
+def _inward(poly: Polyhedron, edge: int, face: int) -> np.ndarray:
+    """Unit vector in ``face``'s plane, perpendicular to ``edge``, pointing into the face (model frame)."""
+    w = np.cross(poly.face_normals[face], poly.edge_directions[edge])
+    return w if poly.edge_left_face[edge] == face else -w
+
+
+def circle_points(
+    vertex: np.ndarray, u: np.ndarray, w: np.ndarray, radius: float, start: float, stop: float, step: float
+) -> np.ndarray:
+    """Points of the circle of a vertex move: ``vertex + radius (−cos θ u + sin θ w)`` for θ from ``start`` to
+    ``stop`` (``u`` along the current edge toward the vertex, ``w`` into the crossed face), shape (K, 3)."""
+    th = np.arange(start, stop + 1e-9, step) if stop > start else np.array([start])
+    return vertex + radius * (-np.cos(th)[:, None] * u + np.sin(th)[:, None] * w)
+
+
+VERTEX_START_ANGLE = np.deg2rad(25.0)
+"""The physics executor's vertex circle starts this far from the current edge [rad]."""
+
+
+def table_conflict(
+    h: Hypothesis, move: Move, state: SensorState, components: Mapping[int, DataComponent], config: PlannerConfig
+) -> float:
+    """Whether hypothesis ``h`` predicts ``move`` to bring the pad onto the table (1.0), not (0.0), or cannot
+    say (NaN): a face move sliding down to an edge within the pad's reach of the table or stepping onto a face
+    the table hides; a vertex move whose circle, before it meets the next edge, would put the pad on the table,
+    or whose next face the table hides. Edge moves are never refused (one running down to the table ends at
+    the vertex the table blocks, which the executor finds). A workspace prior (``config.table_z``) with the
+    hypothesis's own pose; 0.0 without a table."""
+    if config.table_z is None:
+        return 0.0
+    t = h.world_from_model
+    if t is None:
+        return np.nan
+    poly, lim = h.poly, config.table_clearance
+    p_m = t.inverse().apply(state.position)
+
+    def onto_hidden(e_m: int, g_m: int, at_m: np.ndarray) -> bool:
+        q = t.apply(at_m + TABLE_STEP_ONTO * _inward(poly, e_m, g_m))
+        return pad_clearance(q, t.rotate(poly.face_normals[g_m]), config) < lim
+
+    if isinstance(move, FaceMove):
+        f_m = h.faces.get(state.face)
+        if f_m is None:
+            return np.nan
+        n = poly.face_normals[f_m]
+        hit = trace_face(poly, f_m, p_m - (p_m @ n - poly.face_offsets[f_m]) * n, t.inverse().rotate(move.direction))
+        if hit is None:
+            return np.nan
+        n_w = t.rotate(n)
+        down = float(np.asarray(move.direction) @ [0.0, 0.0, 1.0]) < 0.0
+        if down and pad_clearance(t.apply(hit.point), n_w, config) < lim:
+            return 1.0
+        return float(onto_hidden(hit.edge, hit.next_face, hit.point))
+    if isinstance(move, EdgeMove):
+        # an edge running down to the table ends at a vertex on it, where the table blocks the finger: the
+        # executor finds that vertex (the only way to measure such an edge), so an edge move is never refused
+        return 0.0
+    if isinstance(move, VertexMove):
+        e_m = h.edges.get(state.edge) if state.edge is not None else None
+        v_m = h.vertices.get(state.vertex) if state.vertex is not None else None
+        a_m = h.faces.get(move.across_face)
+        if e_m is None or v_m is None or a_m is None:
+            return np.nan
+        try:
+            hit = circle_vertex(poly, v_m, e_m, a_m, config.vertex_radius)
+        except ValueError:
+            return np.nan
+        u = poly.edge_directions[e_m] * (1.0 if poly.edges[e_m, 1] == v_m else -1.0)
+        pts = circle_points(poly.vertices[v_m], u, _inward(poly, e_m, a_m), config.vertex_radius,
+                            VERTEX_START_ANGLE, hit.angle, np.deg2rad(3.0))  # fmt: skip
+        n_w = t.rotate(poly.face_normals[a_m])
+        if min(pad_clearance(q, n_w, config) for q in t.apply(pts)) < lim:
+            return 1.0
+        away = poly.edge_directions[hit.edge] * (1.0 if poly.edges[hit.edge, 0] == v_m else -1.0)
+        return float(onto_hidden(hit.edge, hit.next_face, poly.vertices[v_m] + config.vertex_radius * away))
+    raise TypeError(f"unknown move {move!r}")
+
+
+def _vertex_frame(
+    state: SensorState, components: Mapping[int, DataComponent], face: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
+    """From the data: the current vertex, the unit vector along the current edge toward it, the unit vector
+    into data face ``face`` perpendicular to the edge, and that face's normal. None when the data lack one."""
+    edge = components.get(state.edge) if state.edge is not None else None
+    vertex = components.get(state.vertex) if state.vertex is not None else None
+    f = components.get(face)
+    if not isinstance(edge, DataEdge) or vertex is None or not isinstance(f, DataFace):
+        return None
+    b, n = edge.direction, f.normal
+    mid = edge.point + 0.5 * edge.length * b
+    u = b if (vertex.position - mid) @ b >= 0 else -b
+    w = np.cross(n, b)
+    w /= max(float(np.linalg.norm(w)), 1e-12)
+    side = dict(edge.side_points).get(face) if edge.side_points else None
+    ref = side if side is not None else f.points.mean(axis=0)
+    if (ref - edge.point) @ w < 0:
+        w = -w
+    return vertex.position, u, w, n
+
+
+def vertex_sweep_off_table(
+    state: SensorState, components: Mapping[int, DataComponent], face: int, config: PlannerConfig
+) -> float:
+    """From the data alone: the angle the circle of a vertex move across data face ``face`` can sweep from its
+    start before the pad would come onto the table (2π: never; 0: its start is out of reach) [rad]."""
+    if config.table_z is None:
+        return 2 * np.pi
+    frame = _vertex_frame(state, components, face)
+    if frame is None:
+        return 2 * np.pi
+    vtx, u, w, n = frame
+    step = np.deg2rad(2.0)
+    pts = circle_points(vtx, u, w, config.vertex_radius, VERTEX_START_ANGLE, 2 * np.pi - VERTEX_START_ANGLE, step)
+    low = [i for i, q in enumerate(pts) if pad_clearance(q, n, config) < config.table_clearance]
+    return float(low[0] * step) if low else 2 * np.pi
+
+
+def data_table_conflict(
+    move: Move, state: SensorState, components: Mapping[int, DataComponent], config: PlannerConfig
+) -> bool:
+    """What the data alone say about the table, whatever the model: a face move heading down from a point
+    already within the pad's reach of the table, or a vertex move whose circle cannot even start off it."""
+    if config.table_z is None:
+        return False
+    if isinstance(move, FaceMove):
+        face = components.get(state.face)
+        if not isinstance(face, DataFace) or float(np.asarray(move.direction)[2]) >= 0.0:
+            return False
+        return pad_clearance(state.position, face.normal, config) < config.table_clearance
+    if isinstance(move, VertexMove):
+        return vertex_sweep_off_table(state, components, move.across_face, config) <= 0.0
+    return False
+
+
+def move_table_risk(
+    move: Move,
+    hypotheses: Sequence[Hypothesis],
+    state: SensorState,
+    components: Mapping[int, DataComponent],
+    config: PlannerConfig,
+) -> float:
+    """Fraction of the hypotheses (that can say) predicting ``move`` to run into the table; 1 when the data
+    alone say so; 0 without a table or a prediction."""
+    if config.table_z is None:
+        return 0.0
+    if data_table_conflict(move, state, components, config):
+        return 1.0
+    vals = np.array([table_conflict(h, move, state, components, config) for h in hypotheses], dtype=float)
+    return 0.0 if not len(vals) or np.isnan(vals).all() else float(np.nanmean(vals))
+
+
+def table_safe_moves(
+    moves: Sequence[Move],
+    hypotheses: Sequence[Hypothesis],
+    state: SensorState,
+    components: Mapping[int, DataComponent],
+    config: PlannerConfig,
+) -> list[Move]:
+    """``moves`` less those predicted to run into the table (risk ≥ ``config.table_risk``); all of them when
+    that leaves none (the executor then says so). Unchanged without a table."""
+    if config.table_z is None:
+        return list(moves)
+    safe = [m for m in moves if move_table_risk(m, hypotheses, state, components, config) < config.table_risk]
+    return safe or list(moves)
+
+
+def descent_risk(move: Move, config: PlannerConfig) -> float:
+    """``config.steep_descent_risk`` for a face move heading down more steeply than ``config.steep_descent``,
+    else 0."""
+    if move.kind != "face" or config.steep_descent_risk <= 0.0:
+        return 0.0
+    return config.steep_descent_risk if float(np.asarray(move.direction)[2]) < -config.steep_descent else 0.0
+
+
+def rests_on_table(poly: Polyhedron, world_from_model: SE3, config: PlannerConfig) -> bool:
+    """Whether ``poly`` at ``world_from_model`` rests on the table: its lowest vertex at the table top within
+    ``config.table_rest_tol`` (neither through it nor floating). True without a table."""
+    if config.table_z is None:
+        return True
+    low = float(world_from_model.apply(poly.vertices)[:, 2].min()) - config.table_z
+    return abs(low) <= config.table_rest_tol
+
+
+def pose_fixed_by(components: Mapping[int, DataComponent]) -> bool:
+    """Whether the data fix every interpretation's translation: a data vertex, or faces whose normals span
+    space. (Until then a pose class's pose is one of many and says nothing about where the table is.)"""
+    if any(c.kind == "vertex" for c in components.values()):
+        return True
+    normals = np.array([c.normal for c in components.values() if isinstance(c, DataFace)])
+    return len(normals) >= 3 and float(np.linalg.svd(normals, compute_uv=False)[2]) > 0.3

@@ -17,7 +17,7 @@ from haptic.geometry.tracing import circle_vertex, trace_edge, trace_face
 from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex, SensorNoise
 from haptic.planning.efficiency import class_weights, outcome_groups
 from haptic.planning.moves import EdgeMove, FaceMove, Move, SensorState, VertexMove
-from haptic.planning.policies import Context
+from haptic.planning.policies import Context, same_move
 from haptic.planning.predict import Hypothesis, PlannerConfig, candidate_moves, predict
 
 STEP_ONTO = 0.003
@@ -155,7 +155,7 @@ def branches(
 ) -> list[Branch]:
     """Split the hypotheses by what ``move`` would show, and simulate each group onward."""
     pred = predict(hyps, move, state, components, noise, config)
-    if not pred.reliable(config):
+    if not pred.reliable(config) or pred.table_risk >= config.table_risk:
         return []
     out = []
     for g in outcome_groups(pred.outcomes, pred.bounds):
@@ -178,6 +178,8 @@ def lookahead_choice(ctx: Context, depth: int = 2) -> Move | None:
     weights = class_weights([h.model for h in ctx.hypotheses])
     best, best_move = 0.0, None
     for move in candidate_moves(ctx.state, ctx.components, ctx.config):
+        if any(same_move(move, bad) for bad in ctx.avoid):
+            continue
         score = _lookahead_score(ctx, list(ctx.hypotheses), weights, move, ctx.state, ctx.components, depth, 0.0)
         if score > best:
             best, best_move = score, move

@@ -1,0 +1,60 @@
+"""The table as a workspace prior: moves the hypotheses predict to run into it are not offered, and pose classes
+that would not rest on it are set aside -- only when a table is configured (the geometric setting has none)."""
+
+from dataclasses import replace
+
+import numpy as np
+
+from haptic.executor.geometric import GeometricExecutor
+from haptic.geometry import SE3, load_library
+from haptic.matching.components import SensorNoise
+from haptic.planning.moves import CostModel, FaceMove
+from haptic.planning.predict import (
+    Hypothesis,
+    PlannerConfig,
+    rests_on_table,
+    table_conflict,
+    table_safe_moves,
+)
+
+LIB = load_library()
+TABLE_Z = 0.35
+
+
+def _on_a_side_face():
+    """BOX01 resting on the table (its bottom at ``TABLE_Z``), the sensor on a vertical face, and the true
+    hypothesis."""
+    box = LIB["BOX01"]
+    pose = SE3(np.eye(3), np.array([0.5, 0.0, TABLE_Z]))  # model z = 0 is the bottom face
+    for seed in range(50):
+        ex = GeometricExecutor(box, pose, noise=SensorNoise().scaled(0.0), rng=np.random.default_rng(seed),
+                               costs=CostModel())  # fmt: skip
+        res = ex.start()
+        face = res.components[0]
+        if abs(face.normal[2]) < 1e-6:
+            truth = {d: m for d, (k, m) in ex.truth.items() if k == "face"}
+            h = Hypothesis(box.name, box, pose, truth, {}, {})
+            return h, res.state, {c.id: c for c in res.components}
+    raise AssertionError("no start on a side face")
+
+
+def test_a_face_move_down_to_the_table_is_predicted_and_not_offered():
+    h, state, comps = _on_a_side_face()
+    config = PlannerConfig(table_z=TABLE_Z)
+    down, up = FaceMove(np.array([0.0, 0.0, -1.0])), FaceMove(np.array([0.0, 0.0, 1.0]))
+    assert table_conflict(h, down, state, comps, config) == 1.0
+    assert table_conflict(h, up, state, comps, config) == 0.0
+    assert table_safe_moves([down, up], [h], state, comps, config) == [up]
+    # without a table (the geometric setting) nothing is predicted or filtered
+    assert table_conflict(h, down, state, comps, PlannerConfig()) == 0.0
+    assert table_safe_moves([down, up], [h], state, comps, PlannerConfig()) == [down, up]
+
+
+def test_a_pose_through_or_above_the_table_does_not_rest_on_it():
+    box = LIB["BOX01"]
+    config = PlannerConfig(table_z=TABLE_Z)
+    on = SE3(np.eye(3), np.array([0.5, 0.0, TABLE_Z]))
+    assert rests_on_table(box, on, config)
+    assert not rests_on_table(box, SE3(np.eye(3), on.translation - [0, 0, 0.02]), config)
+    assert not rests_on_table(box, SE3(np.eye(3), on.translation + [0, 0, 0.02]), config)
+    assert rests_on_table(box, SE3(np.eye(3), on.translation - [0, 0, 0.02]), replace(config, table_z=None))
