@@ -16,7 +16,7 @@ $(STAMP): pyproject.toml
 demo: $(STAMP)
 	$(BIN)/haptic models list
 	@echo
-	$(BIN)/haptic explore --object BOX01N --seed 1 --policy planner --record out/demo.rrd --json out/demo.json
+	$(BIN)/haptic explore --object WEDGE01 --executor physics --seed 1 --record out/demo.rrd --json out/demo.json
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -n 2 -p no:cacheprovider
