@@ -35,7 +35,8 @@ def summary_lines(rec: dict) -> list[str]:
         f"object      {rec['model']}  (executor {rec['executor']}, policy {rec['policy']}, seed {rec['seed']})",
         f"outcome     {rec['outcome']}" + (f": {rec['recognized']}" if rec["recognized"] else "")
         + ("  [correct]" if rec["correct"] else "  [wrong]" if rec["outcome"] == "recognized" else ""),
-        f"moves       {rec['moves']} ({', '.join(rec['move_kinds'][1:]) or 'none'})",
+        f"moves       {rec['moves']} ({', '.join(rec['move_kinds'][1:]) or 'none'}"
+        + (f"; {rec['failed_moves']} failed)" if rec.get("failed_moves") else ")"),
         f"path cost   {rec['path_cost']:.1f} units",
         f"data        {rec['faces']} faces, {rec['edges']} edges, {rec['vertices']} vertices",
         "interpret.  " + " -> ".join(str(c) for c in rec["interpretations"]),
