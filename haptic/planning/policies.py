@@ -127,48 +127,52 @@ class Policy:
         raise NotImplementedError
 
 
-class PlannerPolicy(Policy):
-    """Highest efficiency. When no single move is expected to eliminate anything (what separates the
-    hypotheses is further away), the first move of the most efficient sequence of ``lookahead`` moves; failing
-    that, the cheapest move that reaches a new edge and face. Ties are broken at random."""
+class _ScoringPolicy(Policy):
+    """The best-scoring candidate; when no candidate scores above zero (what separates the hypotheses is
+    further away), the first move of the most efficient sequence of ``lookahead`` moves, failing that the
+    cheapest move that reaches a new edge and face."""
+
+    def __init__(self, lookahead: int = 3) -> None:
+        self.lookahead = lookahead
+
+    def score(self, efficiency: float, eliminated: float) -> float:  # pragma: no cover - interface
+        raise NotImplementedError
+
+    def tie_break(self, cands: Sequence[Scored], best: np.ndarray, rng: np.random.Generator) -> Move:
+        return cands[int(rng.choice(best))].move
+
+    def choose(self, ctx: Context, rng: np.random.Generator) -> Decision:
+        scored = _score_all(ctx)
+        if not scored:
+            raise PlanningError("no admissible move from the current sensor state")
+        cands = tuple(Scored(p.move, self.score(eff, elim), cost, elim) for p, eff, elim, cost in scored)
+        scores = np.array([c.score for c in cands])
+        if scores.max() <= 0:
+            return Decision(_further(ctx, cands, rng, self.lookahead), cands)
+        best = np.flatnonzero(scores >= scores.max() * (1 - 1e-9))
+        return Decision(self.tie_break(cands, best, rng), cands)
+
+
+class PlannerPolicy(_ScoringPolicy):
+    """Highest efficiency (expected pose classes eliminated per expected cost, §4.1); ties at random."""
 
     name = "planner"
 
-    def __init__(self, lookahead: int = 3) -> None:
-        self.lookahead = lookahead
-
-    def choose(self, ctx: Context, rng: np.random.Generator) -> Decision:
-        scored = _score_all(ctx)
-        if not scored:
-            raise PlanningError("no admissible move from the current sensor state")
-        cands = tuple(Scored(p.move, eff, cost, elim) for p, eff, elim, cost in scored)
-        effs = np.array([c.score for c in cands])
-        if effs.max() <= 0:
-            return Decision(_further(ctx, cands, rng, self.lookahead), cands)
-        best = np.flatnonzero(effs >= effs.max() * (1 - 1e-9))
-        return Decision(cands[int(rng.choice(best))].move, cands)
+    def score(self, efficiency: float, eliminated: float) -> float:
+        return efficiency
 
 
-class GreedyPolicy(Policy):
-    """Most expected eliminations, ignoring cost (ties: the cheaper); with nothing to gain from one move, the
-    same look-ahead as the planner."""
+class GreedyPolicy(_ScoringPolicy):
+    """Most expected eliminations, ignoring cost; ties go to the cheaper move."""
 
     name = "greedy"
 
-    def __init__(self, lookahead: int = 3) -> None:
-        self.lookahead = lookahead
+    def score(self, efficiency: float, eliminated: float) -> float:
+        return eliminated
 
-    def choose(self, ctx: Context, rng: np.random.Generator) -> Decision:
-        scored = _score_all(ctx)
-        if not scored:
-            raise PlanningError("no admissible move from the current sensor state")
-        cands = tuple(Scored(p.move, elim, cost, elim) for p, _eff, elim, cost in scored)
-        elims = np.array([c.score for c in cands])
-        if elims.max() <= 0:
-            return Decision(_further(ctx, cands, rng, self.lookahead), cands)
-        best = np.flatnonzero(elims >= elims.max() * (1 - 1e-9))
+    def tie_break(self, cands: Sequence[Scored], best: np.ndarray, rng: np.random.Generator) -> Move:
         costs = np.array([cands[i].expected_cost for i in best])
-        return Decision(cands[int(best[int(np.argmin(costs))])].move, cands)
+        return cands[int(best[int(np.argmin(costs))])].move
 
 
 class RandomPolicy(Policy):
