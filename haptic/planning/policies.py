@@ -3,6 +3,8 @@
 - ``planner``: the candidate of highest efficiency (expected pose classes eliminated per expected cost).
 - ``greedy``: the candidate of most expected eliminations, whatever it costs.
 - ``random``: a random admissible move (a random move type, then a random move of that type).
+- ``optimal``: the least expected path cost to recognition by exhaustive search over move sequences, for
+  small libraries (:mod:`haptic.planning.optimal`).
 
 The best possible cost of an episode is measured from outside, in hindsight: :mod:`haptic.bench.oracle`.
 
@@ -12,7 +14,7 @@ components) and draws any random choice from the generator it is given.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -213,15 +215,22 @@ def _cheapest_exploring(cands: Sequence[Scored], rng: np.random.Generator) -> Mo
     return pool[int(rng.choice(best))].move
 
 
-POLICIES: dict[str, type[Policy]] = {
+def _optimal(**options) -> Policy:
+    from haptic.planning.optimal import OptimalPolicy
+
+    return OptimalPolicy(**options)
+
+
+POLICIES: dict[str, Callable[..., Policy]] = {
     "planner": PlannerPolicy,
     "greedy": GreedyPolicy,
     "random": RandomPolicy,
+    "optimal": _optimal,
 }
 
 
 def make_policy(name: str, **options) -> Policy:
-    """A policy by name: planner, greedy, random."""
+    """A policy by name: planner, greedy, random, optimal."""
     try:
         return POLICIES[name](**options)
     except KeyError:

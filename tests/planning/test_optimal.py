@@ -1,0 +1,72 @@
+"""The optimal policy: least expected cost to recognition by exhaustive search, with planner roll-outs."""
+
+import numpy as np
+import pytest
+
+from haptic.bench.runner import EpisodeSpec, plan_sweep
+from haptic.episode import run_episode
+from haptic.errors import HapticError
+from haptic.geometry import load_library
+from haptic.planning.efficiency import class_weights
+from haptic.planning.optimal import OptimalPolicy, _Search
+from haptic.planning.policies import PlannerPolicy, make_policy
+
+SMALL = ["BOX01", "WEDGE01", "BOX01N", "BOX01P", "PYR01", "TETRA01L", "TETRA01R"]
+LIB = {k: v for k, v in load_library().items() if k in SMALL}
+
+
+class Recording(PlannerPolicy):
+    """The planner, keeping every context it was asked to decide from."""
+
+    def __init__(self):
+        super().__init__()
+        self.contexts = []
+
+    def choose(self, ctx, rng):
+        self.contexts.append(ctx)
+        return super().choose(ctx, rng)
+
+
+def _contexts(n_episodes=6):
+    out = []
+    for spec in plan_sweep(SMALL, n_episodes, seed=3, policies=["planner"]):
+        pol = Recording()
+        run_episode(spec, library=LIB, policy=pol)
+        out += [c for c in pol.contexts if 2 <= len(c.hypotheses) <= 30]
+    return out
+
+
+def test_search_never_expects_more_than_following_the_planner():
+    contexts = _contexts()
+    assert contexts, "no decision with several pose classes"
+    for ctx in contexts[:8]:
+        hyps = list(ctx.hypotheses)
+        w = class_weights([h.model for h in hyps])
+        search = _Search(ctx, rollout_moves=6, unresolved_cost=20.0)
+        planned = search.rollout(hyps, w, ctx.state, ctx.components, 6)
+        best = search.value(hyps, w, ctx.state, ctx.components, depth=2)
+        assert best <= planned + 1e-9
+        assert best > 0
+
+
+def test_optimal_recognizes_and_is_no_costlier_than_the_planner_on_small_library():
+    specs = plan_sweep(SMALL, 6, seed=7, policies=["planner", "optimal"])
+    cost = {"planner": [], "optimal": []}
+    for s in specs:
+        r = run_episode(s, library=LIB)
+        assert r.outcome == "recognized" and r.correct, (s, r.outcome)
+        cost[s.policy].append(r.path_cost)
+    assert np.mean(cost["optimal"]) <= np.mean(cost["planner"])
+    assert np.mean(cost["planner"]) <= 1.15 * np.mean(cost["optimal"])
+
+
+def test_optimal_is_deterministic_and_named():
+    spec = EpisodeSpec(model="WEDGE01", seed=4, policy="optimal")
+    a, b = (run_episode(spec, library=LIB).to_json() for _ in range(2))
+    for r in (a, b):
+        r.pop("wall_time_s")
+        r.pop("decision_times_s")
+    assert a == b and a["policy"] == "optimal"
+    assert isinstance(make_policy("optimal", depth=1), OptimalPolicy)
+    with pytest.raises(HapticError, match="depth"):
+        make_policy("optimal", depth=0)
