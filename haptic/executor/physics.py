@@ -351,7 +351,8 @@ class PhysicsExecutor:
         r = t.cross_edge(kind, n_a, direction)
         pieces.append(r)
         if not r.ok:
-            return r.status, f"crossing the {kind} edge: {r.event}", None, None, None
+            why = "the next face leans under, out of the pad's reach" if r.event == "undercut" else r.event
+            return r.status, f"crossing the {kind} edge: {why}", None, None, None
         n_b = r.info["normal"]
         if self._is_table(n_b, t.contact[2]):
             return "unreachable", "the edge lies on the table", None, None, None
@@ -395,6 +396,9 @@ class PhysicsExecutor:
             return self._fail(move, status, reason)
         fit_a = self._face_fit(st.face, r.trace)
         roll_all = ContactTrace.concatenate([r.trace.select(r.trace.phase == PHASES.index("face")).tail(8), roll])
+        why = seg.edge_inconsistency(fit_a, fit_b, kind == "convex", roll_all)
+        if why is not None:
+            return self._fail(move, "unreachable", f"no edge between the faces: {why}")
         line = seg.edge_line(fit_a, fit_b, kind == "convex", roll_all, corner)
         new_face = seg.next_id + 1
         edge = seg.add_edge(line, (st.face, new_face), kind == "convex", (fit_a.normal, fit_b.normal),
@@ -574,6 +578,9 @@ class PhysicsExecutor:
             return self._fail(move, status, reason)
         fit_f = self._face_fit(f, r.trace)
         roll_all = ContactTrace.concatenate([r.trace.select(r.trace.phase == PHASES.index("circle")).tail(8), roll])
+        why = seg.edge_inconsistency(fit_f, fit_g, kind == "convex", roll_all)
+        if why is not None:
+            return self._fail(move, "unreachable", f"no edge between the faces: {why}")
         line = seg.edge_line(fit_f, fit_g, kind == "convex", roll_all, corner)
         new_face = seg.next_id + 1
         s_vtx = float((vtx - line.point) @ line.direction)

@@ -77,6 +77,10 @@ class TouchConfig:
     """A roll is over when the normal turned less than ``roll_settled`` over this much travel [m] ..."""
     roll_settled: float = math.radians(1.5)
     """... [rad]."""
+    max_undercut: float = math.radians(30.0)
+    """The pad reaches a surface whose normal leans at most this far back against the finger's axis (past
+    perpendicular to it); beyond, the finger's phalanx meets the object first and the pad loses contact. A
+    roll over a convex edge stops there (event ``"undercut"``) [rad]."""
     roll_max: float = 0.04
     """Longest pad travel while rolling over or climbing onto an edge [m]."""
     step_in: float = 0.0015
@@ -96,6 +100,9 @@ class TouchConfig:
     """Tangential speeds ramp up over this time at the start of a slide (a step start loses force) [s]."""
     lift: float = 0.008
     """Clearance of a repositioning move above the surface [m]."""
+    overpass: float = 0.02
+    """A repositioning move whose straight legs are blocked (a non-convex solid) goes round over the top, this
+    far above the higher of its start and its target [m]."""
     hand_rotation: np.ndarray = field(default_factory=lambda: DOWN.copy())
     """Hand rotation held while exploring (3, 3)."""
 
@@ -417,11 +424,28 @@ class Toucher:
             if float(np.linalg.norm(w - self.tip)) > 1e-3:
                 res = self.move_free(w, timeout=3.0, tol=tol)
                 pieces.append(res)
+        if res.status == "timeout":
+            # blocked: the straight legs cut a corner of a non-convex solid. Go round over the top instead:
+            # straight up, across above the target, down to it (objects rest on the table; nothing is above)
+            res = self._over_the_top(above, cfg.overpass, pieces)
         if res.ok:
             res = self.approach(-n_t, 2 * cfg.lift + 0.004)
             pieces.append(res)
         return PrimitiveResult(res.status, res.event, ContactTrace.concatenate([p.trace for p in pieces]),
                                sum(p.distance for p in pieces), res.info)  # fmt: skip
+
+    def _over_the_top(self, above: np.ndarray, rise: float, pieces: list[PrimitiveResult]) -> PrimitiveResult:
+        """Free moves from the pad's position straight up to ``rise`` above the higher of it and ``above``,
+        across, and down to ``above``. The last result (status ``timeout`` when still blocked)."""
+        z = max(float(self.tip[2]), float(above[2])) + rise
+        res = self._result("ok", "done", 0.0)
+        for w, tol in ((np.array([self.tip[0], self.tip[1], z]), 3e-3), (np.array([above[0], above[1], z]), 3e-3),
+                       (above, 1e-3)):  # fmt: skip
+            res = self.move_free(w, timeout=3.0, tol=tol)
+            pieces.append(res)
+            if not res.ok:
+                break
+        return res
 
     # -- on a face -------------------------------------------------------------------------------------------
     def trace_face(
@@ -489,6 +513,7 @@ class Toucher:
         if e @ e < 0.5:
             e = unit(np.cross(n_a, d))
         sign = -1.0 if kind == "convex" else 1.0
+        back = -(np.asarray(cfg.hand_rotation, dtype=float) @ np.array([0.0, 0.0, 1.0]))  # up the finger
         hist: list[tuple[float, np.ndarray]] = []
         travelled = 0.0
         last = self.tip.copy()
@@ -517,6 +542,10 @@ class Toucher:
                 continue
             lost = 0
             hist.append((travelled, self.normal.copy()))
+            if kind == "convex" and float(self.normal @ back) < -math.sin(cfg.max_undercut):
+                self._press(np.zeros(3))
+                self.tick("roll")
+                return self._result("unreachable", "undercut", 0.0)
             if angle(self.normal, n_a) > cfg.edge_angle:
                 # settled: the normal turned less than roll_settled over the last roll_window of travel
                 old = [nn for s, nn in hist if s <= travelled - cfg.roll_window]

@@ -63,6 +63,15 @@ class SegmentBounds:
     """On a face the sensed normal does not turn as the pad slides; rolling on an edge or a vertex it turns by
     1/r (r = 12 mm pad: 4.8°/mm). Rows whose normal turns faster than this with the pad's position are not a
     face [rad/m]."""
+    min_edge_angle: float = math.radians(10.0)
+    """The two faces of an edge differ in normal by at least this; closer, the "edge" is noise on one face [rad]."""
+    max_roll_skew: float = math.radians(20.0)
+    """Rolling over (or climbing out of) an edge the sensed normal turns about the edge, so it stays
+    perpendicular to ``n_a × n_b``; a roll whose normals lean further along it (median) went round another
+    edge or vertex, and the next face was met elsewhere [rad]."""
+    max_roll_offset: float = 2e-3
+    """The contact points of a roll over a convex edge lie on the edge, hence on both faces' planes; a roll
+    farther than this (median) from either plane was not over the edge between them [m]."""
 
     @classmethod
     def from_noise(cls, force_std: float, normal_std: float, point_std: float, **kw) -> SegmentBounds:
@@ -348,6 +357,34 @@ class Segmenter:
         else:
             rng = (0.0, 0.0)
         return LineFit(p, b_dir, s_b, s_p, rng)
+
+    def edge_inconsistency(self, fit_a: FaceFit, fit_b: FaceFit, convex: bool, roll: ContactTrace) -> str | None:
+        """Why the roll from face a onto face b cannot have been over the edge between them (None: it can):
+        the faces' normals are too close for an edge, the rolling normals did not turn about ``n_a × n_b``,
+        or (convex) the rolling contacts lie off either face's plane. Such a move met the next face after
+        going round some other edge or vertex: reporting an edge between a and b would be spurious."""
+        b = self.bounds
+        if angle_between(fit_a.normal, fit_b.normal) < b.min_edge_angle:
+            return "the two faces' normals are too close for an edge"
+        ok = roll.in_contact
+        if not ok.any():
+            return None
+        n = roll.normal_in_world[ok]
+        pts = roll.point_in_world[ok]
+        c = math.cos(math.radians(3.0))
+        between = (n @ fit_a.normal < c) & (n @ fit_b.normal < c)
+        if between.sum() < 3:
+            return None
+        e = unit(np.cross(fit_a.normal, fit_b.normal))
+        if float(np.median(np.abs(n[between] @ e))) > math.sin(b.max_roll_skew):
+            return "the roll turned about another axis than the edge between the faces"
+        if convex:
+            q = pts[between]
+            off = max(float(np.median(np.abs(q @ fit_a.normal - fit_a.offset))),
+                      float(np.median(np.abs(q @ fit_b.normal - fit_b.offset))))  # fmt: skip
+            if off > b.max_roll_offset:
+                return f"the roll lies {off * 1e3:.1f} mm off the faces' planes"
+        return None
 
     def add_edge(
         self,

@@ -6,8 +6,8 @@ import math
 
 import numpy as np
 
-from haptic.executor.primitives import ContactTrace
-from haptic.executor.segment import LineFit, SegmentBounds, Segmenter, normal_turn_rate
+from haptic.executor.primitives import ContactTrace, unit
+from haptic.executor.segment import FaceFit, LineFit, SegmentBounds, Segmenter, fit_face, normal_turn_rate
 
 R_PAD = 0.012
 
@@ -61,3 +61,43 @@ def test_edge_sides_follow_from_normals_and_convexity():
     concave = seg.add_edge(line, (2, 3), False, (top, -side), adjacent=(2,))
     sides = dict(concave.side_points)
     assert sides[2][0] < -1e-3 and sides[3][2] > 1e-3
+
+
+def _roll(axis: np.ndarray, n_from: np.ndarray, n_to: np.ndarray, at: np.ndarray, k: int = 40) -> ContactTrace:
+    """Rows of a pad rolling about ``axis`` through ``at`` (the contact point stays put) from ``n_from`` to
+    ``n_to``."""
+    th = np.linspace(0.0, math.acos(float(n_from @ n_to)), k)
+    w = np.cross(axis, n_from)
+    normals = np.cos(th)[:, None] * n_from + np.sin(th)[:, None] * w
+    points = np.repeat(at[None], k, axis=0)
+    return _trace(points + R_PAD * normals, normals, points)
+
+
+def _plane(normal: np.ndarray, through: np.ndarray) -> FaceFit:
+    pts = through + 0.005 * np.random.default_rng(0).normal(size=(30, 3))
+    pts -= np.outer((pts - through) @ normal, normal)
+    return fit_face(pts, np.repeat(normal[None], 30, axis=0), SegmentBounds())
+
+
+def test_a_roll_over_the_edge_between_the_faces_is_consistent():
+    top, side = np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0])
+    edge_pt = np.array([0.0, 0.01, 0.0])
+    fa, fb = _plane(top, np.array([-0.01, 0.0, 0.0])), _plane(side, np.array([0.0, 0.0, -0.01]))
+    roll = _roll(np.array([0.0, 1.0, 0.0]), top, side, edge_pt)
+    assert Segmenter().edge_inconsistency(fa, fb, True, roll) is None
+
+
+def test_a_roll_round_another_edge_is_no_edge_between_the_faces():
+    # slid on a wall (normal +x), rolled round a vertical edge onto a wall facing +y, then dropped onto a
+    # step (normal +z) 10 mm below: the faces are real, an edge between the wall and the step is not
+    seg = Segmenter()
+    wall, step = np.array([1.0, 0.0, 0.0]), np.array([0.0, 0.0, 1.0])
+    fa, fb = _plane(wall, np.zeros(3)), _plane(step, np.array([-0.01, 0.0, -0.01]))
+    roll = _roll(np.array([0.0, 0.0, 1.0]), wall, np.array([0.0, 1.0, 0.0]), np.zeros(3))
+    assert "another axis" in seg.edge_inconsistency(fa, fb, True, roll)
+    # the right axis, but the contacts 10 mm off the step's plane
+    roll = _roll(np.array([0.0, -1.0, 0.0]), wall, step, np.zeros(3))
+    assert "off the faces' planes" in seg.edge_inconsistency(fa, fb, True, roll)
+    # two faces too alike for an edge
+    fc = _plane(unit(wall + np.array([0.0, 0.0, 0.05])), np.zeros(3))
+    assert "too close" in seg.edge_inconsistency(fa, fc, True, roll)
