@@ -27,7 +27,10 @@ Entities (world frame, metres, Z up):
 - ``world/hand/pad``: fingertip pad pose per control tick (``sim_time``; physics only)
 - ``world/hand/fingertip``: pad centre per control tick (physics only)
 - ``world/hand/contact/points``, ``/normals``: sensed contact per control tick (physics only)
-- ``world/hand/links``: hand link origins per control tick, labelled (``info["hand_links"]``)
+- ``world/hand/links``: hand link origins, labelled (``info["hand_links"]``; on ``sim_time`` at the
+  ``info["hand_links_time"]`` samples when given, else one row per trace tick)
+- ``world/hand/skeleton``: the links joined as line strips (``info["hand_link_chains"]``: polylines of link
+  names, e.g. the palm out along each finger), at the same times
 - ``plots/interpretations``: surviving interpretations after each move
 - ``plots/pose_classes``: pose classes after each move (when known)
 - ``plots/path_cost``: cumulative path cost [units]
@@ -175,6 +178,7 @@ class _State:
     decided: set[int] = field(default_factory=set)
     state: SensorState | None = None
     link_labels_logged: bool = False
+    skeleton_style_logged: bool = False
     pad_axes_logged: bool = False
     decision_shown: bool = False
 
@@ -364,9 +368,7 @@ class EpisodeRecorder:
             "world/contacts/normals",
             rr.Arrows3D(origins=pts, vectors=nrm * CONTACT_NORMAL_LENGTH, colors=[CONTACT_COLOR], radii=0.0002),
         )
-        links = result.info.get("hand_links") if isinstance(result.info, dict) else None
-        if links:
-            self._log_links(links, trace)
+        self._log_hand(result, trace)
 
         self._log_components()
 
@@ -409,6 +411,8 @@ class EpisodeRecorder:
         self._set_time(i)
         if trace is not None and len(trace.time):
             self._log_trace(trace)
+        self._log_hand(result, trace)
+        if trace is not None and len(trace.time):
             path = _subsample(np.asarray(trace.tip_in_world, dtype=float), TRACE_MAX_POINTS)
             if len(path) >= 2:
                 s.failed_strips.append(path)
@@ -580,10 +584,18 @@ class EpisodeRecorder:
             columns=rr.Arrows3D.columns(origins=pts[ok], vectors=nrm[ok] * CONTACT_NORMAL_LENGTH).partition(lengths),
         )  # fmt: skip
 
-    def _log_links(self, links: dict, trace: Any) -> None:
+    def _log_hand(self, result: MoveResult, trace: Any) -> None:
+        info = result.info if isinstance(result.info, dict) else {}
+        links = info.get("hand_links")
+        if links:
+            self._log_links(links, trace, info.get("hand_links_time"), info.get("hand_link_chains"))
+
+    def _log_links(self, links: dict, trace: Any, times: Any = None, chains: Any = None) -> None:
         """``info["hand_links"]``: link name -> (n, 3) positions, (n, 4, 4) poses or (n, 7) position +
-        quaternion (w, x, y, z), world frame; n rows aligned with the trace's ticks (or 1: the pose at the
-        end of the move). Malformed entries are skipped with a warning."""
+        quaternion (w, x, y, z), world frame; n rows at the sim times ``times`` (n,) [s] when given, else
+        aligned with the trace's ticks (or 1: the pose at the end of the move). ``chains``: polylines of link
+        names, drawn as line strips in ``world/hand/skeleton``. Malformed entries are skipped with a
+        warning."""
         rec, s = self.stream, self._s
         names, positions = [], []
         for name, value in links.items():
@@ -610,14 +622,33 @@ class EpisodeRecorder:
             rec.log("world/hand/links", rr.Points3D.from_fields(labels=names, radii=0.003, show_labels=False),
                     static=True)  # fmt: skip
             s.link_labels_logged = True
-        if trace is not None and len(trace.time) == n and n > 1:
+        t = np.asarray(times, dtype=float).reshape(-1) if times is not None else None
+        if t is not None and len(t) != n:
+            warnings.warn(f"hand_links_time: {len(t)} times for {n} rows; ignored", stacklevel=2)
+            t = None
+        if t is None and trace is not None and len(trace.time) == n and n > 1:
+            t = np.asarray(trace.time, dtype=float)
+        strips = _chain_index(names, chains)
+        if t is not None and n:
+            index = [rr.TimeColumn("sim_time", duration=t)]
             rec.send_columns(
-                "world/hand/links",
-                indexes=[rr.TimeColumn("sim_time", duration=np.asarray(trace.time, dtype=float))],
+                "world/hand/links", indexes=index,
                 columns=rr.Points3D.columns(positions=stacked.reshape(-1, 3)).partition([k] * n),
-            )
+            )  # fmt: skip
+            if strips:
+                flat = [stacked[i, c] for i in range(n) for c in strips]
+                rec.send_columns(
+                    "world/hand/skeleton", indexes=index,
+                    columns=rr.LineStrips3D.columns(strips=flat).partition([len(strips)] * n),
+                )  # fmt: skip
         else:
             rec.log("world/hand/links", rr.Points3D(stacked[-1]))
+            if strips:
+                rec.log("world/hand/skeleton", rr.LineStrips3D([stacked[-1, c] for c in strips]))
+        if strips and not s.skeleton_style_logged:
+            rec.log("world/hand/skeleton", rr.LineStrips3D.from_fields(radii=0.002, colors=[(200, 200, 210)]),
+                    static=True)  # fmt: skip
+            s.skeleton_style_logged = True
 
     def _move_direction(self, move: Move) -> np.ndarray | None:
         """A unit world direction for drawing a move from the sensor's position (None when unknown)."""
@@ -771,6 +802,20 @@ def _score_color(r: float) -> tuple[int, int, int]:
     r = float(min(max(r, 0.0), 1.0))
     lo, hi = np.array([40, 30, 120]), np.array([250, 230, 40])
     return tuple(int(x) for x in lo + r * (hi - lo))
+
+
+def _chain_index(names: list[str], chains: Any) -> list[np.ndarray]:
+    """Row indices of each polyline of link names (chains naming an unknown link, or with fewer than two
+    links, are left out)."""
+    if not chains:
+        return []
+    where = {name: j for j, name in enumerate(names)}
+    out = []
+    for chain in chains:
+        idx = [where.get(str(name)) for name in chain]
+        if len(idx) >= 2 and None not in idx:
+            out.append(np.array(idx))
+    return out
 
 
 def _move_name(move: Move) -> str:

@@ -40,3 +40,27 @@ def test_bench_errors_are_one_line(tmp_path, capsys):
     assert "is a directory" in capsys.readouterr().err
     assert main(["bench", "--episodes", "0"]) == 1
     assert "--episodes" in capsys.readouterr().err
+
+
+def test_bench_physics_executor_on_a_small_library(tmp_path, capsys):
+    """``--executor physics`` end to end on a two-model library: the MuJoCo hand runs every episode."""
+    import shutil
+
+    from haptic.geometry.io import DEFAULT_LIBRARY
+
+    lib = tmp_path / "small"
+    lib.mkdir()
+    for name in ("PYR01", "WEDGE01"):
+        shutil.copy(DEFAULT_LIBRARY / f"{name}.json", lib)
+    out = tmp_path / "p" / "results.jsonl"
+    args = ["bench", "--executor", "physics", "--models", str(lib), "--episodes", "2", "--policy", "planner",
+            "--seed", "1", "--no-plot", "--out", str(out)]  # fmt: skip
+    assert main(args) == 0
+    records = read_results(out)
+    assert len(records) == 2
+    assert all(r["executor"] == "physics" and r["library"] == "small" for r in records)
+    assert all(r["model"] in ("PYR01", "WEDGE01") and r["sim_time_s"] > 1.0 for r in records)
+    assert all(r["outcome"] in ("recognized", "ambiguous", "no-match", "budget", "failed") for r in records)
+    assert any(r["outcome"] == "recognized" for r in records)
+    printed = capsys.readouterr().out
+    assert "| small | physics | 1.0 | planner | 2 |" in printed and "episodes/min" in printed

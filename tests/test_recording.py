@@ -161,6 +161,58 @@ def test_physics_trace_and_hand_links_are_recorded(tmp_path):
     assert ents["plots/path_cost"].series("Scalars:scalars")[1][-1] == [1.5]
 
 
+def test_physics_episode_records_the_hand_links(tmp_path):
+    """A physics episode: the executor samples the hand's links (robot forward kinematics) during every move;
+    the recording shows them on the sim_time timeline, with the skeleton as line strips."""
+    from haptic.sim import RobotInterface
+
+    out = tmp_path / "physics.rrd"
+    with EpisodeRecorder(out) as recorder:
+        record = run_episode(EpisodeSpec(model="PYR01", seed=1, executor="physics"), observer=recorder.observer())
+    assert record.moves >= 1
+    ents = load_recording(out)
+    links = ents["world/hand/links"]
+    assert links.static["Points3D:labels"] == list(RobotInterface.link_names)
+    times, rows = links.series("Points3D:positions", "sim_time")
+    assert len(times) >= 20 and all(t is not None for t in times)
+    assert len(set(times)) == len(times) and times == sorted(times)
+    assert times[-1] == pytest.approx(record.sim_time_s, abs=1e-6)
+    pts = np.array(rows)
+    assert pts.shape == (len(times), len(RobotInterface.link_names), 3) and np.isfinite(pts).all()
+    assert np.ptp(pts[:, RobotInterface.link_names.index("palm")], axis=0).max() > 0.02, "the hand moves"
+    # the index pad agrees with the fingertip trace at the ticks both were sampled
+    tip_t, tip_p = ents["world/hand/fingertip"].series("Points3D:positions", "sim_time")
+    tips = {round(t, 6): p[0] for t, p in zip(tip_t, tip_p, strict=True)}
+    k = RobotInterface.link_names.index("index_tip")
+    common = [(tips[round(t, 6)], row[k]) for t, row in zip(times, rows, strict=True) if round(t, 6) in tips]
+    assert len(common) >= 10
+    expected, got = np.array(common).transpose(1, 0, 2)
+    assert np.allclose(got, expected, atol=1e-6)
+    # the skeleton: one strip per chain at every sampled time
+    s_times, strips = ents["world/hand/skeleton"].series("LineStrips3D:strips", "sim_time")
+    assert s_times == times
+    assert all(len(row) == len(RobotInterface.link_chains) for row in strips)
+    assert [len(c) for c in strips[-1]] == [len(c) for c in RobotInterface.link_chains]
+
+
+def test_hand_links_time_must_match_the_rows(tmp_path):
+    from haptic.planning.moves import FaceMove, MoveResult
+
+    links = {"palm": np.zeros((4, 3)), "index_tip": np.ones((4, 3))}
+    result = MoveResult(move=FaceMove(np.zeros(3)), status="timeout",
+                        info={"hand_links": links, "hand_links_time": [0.1, 0.2],
+                              "hand_link_chains": (("palm", "index_tip"), ("palm", "nowhere"))})  # fmt: skip
+    out = tmp_path / "x.rrd"
+    recorder = EpisodeRecorder(out)
+    with pytest.warns(UserWarning, match="hand_links_time"):
+        recorder.on_failed_move(1, result)
+    recorder.close(keep=True)
+    ents = load_recording(out)
+    assert ents["world/hand/links"].series("Points3D:positions")[1] == [[[0.0, 0.0, 0.0], [1.0, 1.0, 1.0]]]
+    _, strips = ents["world/hand/skeleton"].series("LineStrips3D:strips")
+    assert strips == [[[[0.0, 0.0, 0.0], [1.0, 1.0, 1.0]]]]  # the last pose; the chain naming no link is left out
+
+
 def test_only_the_recording_module_imports_rerun():
     package = Path(__file__).resolve().parents[1] / "haptic"
     pattern = re.compile(r"^\s*(import|from)\s+rerun(_bindings)?\b", re.MULTILINE)

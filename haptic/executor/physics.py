@@ -122,6 +122,7 @@ class PhysicsExecutor:
         self._on_face: int | None = None  # data face the pad is known to rest on
         self._finger = finger
         self._why = ""  # detail of the last repositioning failure
+        self._links_until: float | None = None  # sim time of the last hand-link sample reported
 
     @property
     def components(self) -> list[DataComponent]:
@@ -132,6 +133,9 @@ class PhysicsExecutor:
     def _run(self, move: Move, body) -> MoveResult:
         t0, w0 = self.robot.time, time.perf_counter()
         pieces: list[PrimitiveResult] = []
+        self.toucher.take_links()  # drop samples taken outside a move
+        if self.robot.time != self._links_until:  # the pose at the start, unless the last move reported it
+            self.toucher.sample_links()
         try:
             res = body(pieces)
         except (HapticError, FloatingPointError, ValueError, np.linalg.LinAlgError) as exc:
@@ -144,9 +148,24 @@ class PhysicsExecutor:
         trace = ContactTrace.concatenate([p.trace for p in pieces])
         self.traces.append(trace)
         info = dict(res.info)
-        info.update(trace=trace, sim_time=self.robot.time - t0, wall_time=time.perf_counter() - w0)
+        info.update(trace=trace, **self._hand_links())
+        info.update(sim_time=self.robot.time - t0, wall_time=time.perf_counter() - w0)
         return MoveResult(move=res.move, status=res.status, components=res.components, distance=res.distance,
                           cost=res.cost, state=res.state, info=info)  # fmt: skip
+
+    def _hand_links(self) -> dict:
+        """The hand's link positions sampled during the move (the robot's own forward kinematics), for
+        recordings: ``hand_links`` (name -> (n, 3) [m]), ``hand_links_time`` (n,) [s] and
+        ``hand_link_chains`` (the skeleton's polylines of link names)."""
+        self.toucher.sample_links()  # the pose at the end of the move
+        times, pos = self.toucher.take_links()
+        self._links_until = float(times[-1]) if len(times) else self._links_until
+        names = self.robot.link_names
+        return {
+            "hand_links": {name: pos[:, j] for j, name in enumerate(names)},
+            "hand_links_time": times,
+            "hand_link_chains": self.robot.link_chains,
+        }
 
     def _fail(self, move: Move, res: PrimitiveResult | str, reason: str) -> MoveResult:
         status = res if isinstance(res, str) else res.status

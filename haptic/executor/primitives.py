@@ -105,6 +105,9 @@ class TouchConfig:
     far above the higher of its start and its target [m]."""
     hand_rotation: np.ndarray = field(default_factory=lambda: DOWN.copy())
     """Hand rotation held while exploring (3, 3)."""
+    link_every: int = 10
+    """The hand's link positions (forward kinematics, for recordings) are sampled every this many ticks
+    (0: never) [ticks]."""
 
     @property
     def contact_threshold(self) -> float:
@@ -225,6 +228,8 @@ class Toucher:
         self.hybrid = False
         self.pad_radius = 0.012  # refined from the sensed contact (|tip − contact point|)
         self._rows: list[tuple] = []
+        self._ticks = 0
+        self._links: list[tuple[float, np.ndarray]] = []  # (time, link positions) samples
         tip, rot = robot.fingertip_pose()
         self.tip = tip
         self.rotation = rot
@@ -265,6 +270,25 @@ class Toucher:
             self._unhealthy = True
         elif len(self._rows) % 20 == 0 and not r.is_stable():
             self._unhealthy = True
+        self._ticks += 1
+        every = self.config.link_every
+        if every > 0 and self._ticks % every == 0:
+            self._links.append((r.time, r.link_array()))
+
+    def sample_links(self) -> None:
+        """Sample the hand's link positions now (once per simulation time)."""
+        t = self.robot.time
+        if not self._links or self._links[-1][0] != t:
+            self._links.append((t, self.robot.link_array()))
+
+    def take_links(self) -> tuple[np.ndarray, np.ndarray]:
+        """The link samples since the last call: times (n,) [s] and positions (n, len(robot.link_names), 3)
+        [m], world frame."""
+        samples, self._links = self._links, []
+        if not samples:
+            return np.zeros(0), np.zeros((0, len(self.robot.link_names), 3))
+        t, p = zip(*samples, strict=True)
+        return np.array(t), np.stack(p)
 
     @property
     def touching(self) -> bool:

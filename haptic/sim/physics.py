@@ -128,6 +128,31 @@ class GroundTruth:
     """Object pose (4, 4) [m]."""
 
 
+HAND_LINK_PARTS = ("base", "proximal", "medial", "distal")
+"""The link bodies of each finger, from the palm out."""
+
+
+def hand_link_bodies() -> tuple[tuple[str, str], ...]:
+    """(link name, MuJoCo body name) of the robot links :meth:`Simulation.link_positions` reports (robot
+    bodies only): the elbow and the wrist of the arm (the forearm between them), the palm, then each finger's
+    link bodies."""
+    out = [("elbow", ARM_PREFIX + "link3"), ("wrist", ARM_PREFIX + "link6"), ("palm", HAND_PREFIX + "palm")]
+    for f in FINGERS:
+        out.extend((f"{f}_{part}", f"{HAND_PREFIX}{FINGER_PREFIX[f]}_{part}") for part in HAND_LINK_PARTS)
+    return tuple(out)
+
+
+LINK_NAMES: tuple[str, ...] = tuple(n for n, _ in hand_link_bodies()) + tuple(f"{f}_tip" for f in FINGERS)
+"""Names of the rows of :meth:`Simulation.link_positions`: the link bodies' origins, then each fingertip's pad
+centre."""
+
+LINK_CHAINS: tuple[tuple[str, ...], ...] = (("elbow", "wrist", "palm"),) + tuple(
+    ("palm", *(f"{f}_{part}" for part in HAND_LINK_PARTS), f"{f}_tip") for f in FINGERS
+)
+"""The hand's skeleton as polylines of :data:`LINK_NAMES`: the forearm (elbow to wrist) on to the palm, and the
+palm out along each finger to its pad."""
+
+
 def finger_index(name: str) -> int:
     """Index of a finger name in ``FINGERS``; :class:`SceneError` lists the valid names."""
     try:
@@ -195,6 +220,8 @@ class Simulation:
         touch = [oid(mujoco.mjtObj.mjOBJ_SENSOR, p + "_touch") for p in pre]
         self.touch_adr = np.array([m.sensor_adr[s] for s in touch])
         self.flange_site = oid(mujoco.mjtObj.mjOBJ_SITE, ARM_PREFIX + "flange")
+        self.link_body = np.array([oid(mujoco.mjtObj.mjOBJ_BODY, b) for _, b in hand_link_bodies()])
+        """Body ids of the robot links of :data:`LINK_NAMES` (robot bodies only, never the object)."""
         self._geom_finger = np.full(m.ngeom, -1, dtype=int)
         self._geom_finger[self.pad_geom] = np.arange(len(FINGERS))
         self._geom_finger_list: list[int] = self._geom_finger.tolist()
@@ -318,6 +345,12 @@ class Simulation:
     def fingertip_positions(self) -> np.ndarray:
         """Fingertip pad centres (4, 3) in the world [m] (forward kinematics)."""
         return self.data.site_xpos[self.tip_site].copy()
+
+    def link_positions(self) -> np.ndarray:
+        """Origins of the robot's links then the fingertip pad centres (len(LINK_NAMES), 3) in the world [m]
+        (forward kinematics of the robot's own bodies; the rows follow :data:`LINK_NAMES`)."""
+        d = self.data
+        return np.concatenate((d.xpos[self.link_body], d.site_xpos[self.tip_site]))
 
     def read_sensors(self) -> SensorReading:
         """Everything the robot senses now, as a plain snapshot (noise applied)."""

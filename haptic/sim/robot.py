@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from haptic.sim.control import Controller, HybridStatus, IKResult, solve_fingertip_ik
-from haptic.sim.physics import ContactSummary, SensorReading, Simulation
+from haptic.sim.physics import LINK_CHAINS, LINK_NAMES, ContactSummary, SensorReading, Simulation
 from haptic.sim.scene import FINGERS
 
 
@@ -28,6 +28,11 @@ class RobotInterface:
 
     fingers = FINGERS
     """Finger names, in the order of every per-finger array."""
+    link_names = LINK_NAMES
+    """Names of the rows of :meth:`link_array` (the hand's links, then the fingertip pads)."""
+    link_chains = LINK_CHAINS
+    """The hand's skeleton as polylines of :attr:`link_names` (the wrist to the palm, the palm along each
+    finger)."""
 
     # -- sensing ----------------------------------------------------------------------------------------------
     def read(self) -> SensorReading:
@@ -80,6 +85,15 @@ class RobotInterface:
     def is_stable(self) -> bool:
         """False when the simulation state is not finite or MuJoCo has raised a warning (instability)."""
         return self._sim.state_is_finite() and not self._sim.warnings()
+
+    def link_array(self) -> np.ndarray:
+        """World positions (len(link_names), 3) [m] of the robot's own links (elbow, wrist, palm, each
+        finger's link bodies, the fingertip pads) by forward kinematics; nothing of the object."""
+        return self._sim.link_positions()
+
+    def link_positions(self) -> dict[str, np.ndarray]:
+        """:meth:`link_array` by link name: name -> (3,) world position [m]."""
+        return dict(zip(self.link_names, self.link_array(), strict=True))
 
     def fingertip_pose(self) -> tuple[np.ndarray, np.ndarray]:
         """Active fingertip position (3,) [m] and hand rotation (3, 3), from the joint encoders."""

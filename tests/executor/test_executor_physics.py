@@ -93,6 +93,23 @@ def test_invalid_moves_are_statuses_not_exceptions(box_run):
     assert ex.state is state
 
 
+def test_moves_report_the_hand_links_from_the_robot_bodies_only(box_run):
+    """``info["hand_links"]``: the robot's own links (forward kinematics of robot bodies, never the object),
+    sampled through every move on one continuous sim-time axis."""
+    _, sim, _, results = box_run
+    m = sim.model
+    robot_root = m.body_rootid[sim.link_body[0]]
+    assert all(m.body_rootid[b] == robot_root != m.body_rootid[m.body("object").id] for b in sim.link_body)
+    last = -1.0
+    for r in results:
+        t, links = r.info["hand_links_time"], r.info["hand_links"]
+        assert list(links) == list(RobotInterface.link_names)
+        assert len(t) >= 2 and np.all(np.diff(t) > 0) and t[0] > last
+        last = t[-1]
+        assert all(v.shape == (len(t), 3) and np.isfinite(v).all() for v in links.values())
+    assert last == pytest.approx(sim.time)
+
+
 def test_no_peeking_constructor_refuses_the_simulation():
     _, sim = _setup("BOX01", 3)
     with pytest.raises(TypeError, match="RobotInterface"):
