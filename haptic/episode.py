@@ -121,21 +121,33 @@ def _on_the_table(
 ) -> Recognition:
     """The matcher's verdict with the workspace prior that the object rests on the table (``config.table_z``):
     once the data fix the poses, pose classes that would put the model through the table or float it above
-    it are set aside, and the verdict is taken again over the rest. Left unchanged when that would leave no
-    class (the prior is then doubted, not the data)."""
+    it are set aside, and the verdict is taken again over the rest (left as it is when that would leave no
+    class: the prior is then doubted, not the data). A few classes left that differ only where the fingertip
+    cannot reach (:func:`~haptic.planning.reach.indistinguishable`: their difference faces the table) are
+    ambiguous."""
     from haptic.matching.recognition import PoseTolerance, same_solid
+    from haptic.planning.reach import indistinguishable
 
     if not rec.classes or not pose_fixed_by(components):
         return rec
-    keep = tuple(c for c in rec.classes if rests_on_table(c.model, c.world_from_model, config))
-    if not keep or len(keep) == len(rec.classes):
+    keep = tuple(c for c in rec.classes if rests_on_table(c.model, c.world_from_model, config)) or rec.classes
+    if len(keep) == len(rec.classes) and rec.status != EXPLORING:
         return rec
     models = tuple(sorted({c.name for c in keep}))
     if len(keep) == 1:
         return Recognition(RECOGNIZED, keep[0].name, keep[0].world_from_model, keep, rec.count, models)
     tol = PoseTolerance.from_data(tree.data)
     status = AMBIGUOUS if all(same_solid(keep[0], c, tol) for c in keep[1:]) else EXPLORING
+    if status == EXPLORING and len(keep) <= MAX_HIDDEN_CHECK and all(
+        indistinguishable(keep[0].model, keep[0].world_from_model, c.model, c.world_from_model, config)
+        for c in keep[1:]
+    ):
+        status = AMBIGUOUS
     return Recognition(status, None, None, keep, rec.count, models)
+
+
+MAX_HIDDEN_CHECK = 4
+"""Pose classes up to which an episode on the table checks whether what tells them apart is out of reach."""
 
 
 def _fixed_move(

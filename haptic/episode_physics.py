@@ -33,6 +33,7 @@ def run_physics_episode(
     """One episode on the simulated hand (the object rests on the table at a seeded random pose)."""
     from haptic.executor.evaluate import score_components
     from haptic.executor.physics import PhysicsExecutor
+    from haptic.executor.primitives import TouchConfig
     from haptic.sim import RobotInterface, Simulation, compose_scene, random_object_pose
     from haptic.sim import SensorNoise as SimNoise
     from haptic.sim.scene import TABLE_TOP_Z, scene_object_from_polyhedron
@@ -41,7 +42,10 @@ def run_physics_episode(
     true_model = resolve_model(spec.model, library)
     config = config or PlannerConfig()
     if config.table_z is None:  # the robot knows its workspace: where the table top is (never the object)
-        config = replace(config, table_z=TABLE_TOP_Z, steep_descent_risk=STEEP_DESCENT_RISK)
+        config = replace(
+            config, table_z=TABLE_TOP_Z, steep_descent_risk=STEEP_DESCENT_RISK,
+            max_undercut=TouchConfig().max_undercut,
+        )
     root = np.random.SeedSequence(spec.seed)
     pose_rng, exec_rng, policy_rng, sim_seq = (np.random.default_rng(s) for s in root.spawn(4))
     obj = scene_object_from_polyhedron(true_model)

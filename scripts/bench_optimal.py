@@ -96,7 +96,9 @@ def main(argv: list[str] | None = None) -> int:
         rs = [by[(p, k)] for k in ks]
         c = np.array([r["cost"] for r in rs])
         m = np.array([r["moves"] for r in rs])
-        vs_opt = f"{mean_cost(p, seeds) / mean_cost('optimal', seeds):.3f}" if "optimal" in policies and p != "hindsight" else "-"
+        vs_opt = "-"
+        if "optimal" in policies and p != "hindsight":
+            vs_opt = f"{mean_cost(p, seeds) / mean_cost('optimal', seeds):.3f}"
         vs_hind = f"{mean_cost(p, hind_ok) / mean_cost('hindsight', hind_ok):.3f}"
         wall_ep = "-" if p == "hindsight" else f"{np.mean([r['wall_s'] for r in rs]):.2f}"
         correct = "-" if p == "hindsight" else f"{sum(r['correct'] for r in rs)}/{len(rs)}"

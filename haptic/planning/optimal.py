@@ -72,10 +72,10 @@ class OptimalPolicy(Policy):
         weights = class_weights([h.model for h in hyps])
         search = _Search(ctx, self.rollout_moves, self.unresolved_cost)
         scored = []
-        for pred, _eff, elim, cost in _score_all(ctx):
+        for pred, _eff, elim, cost, risk in _score_all(ctx):
             q = search.q(hyps, weights, pred.move, ctx.state, ctx.components, self.depth)
             if q is not None:
-                scored.append(Scored(pred.move, -q, cost, elim))
+                scored.append(Scored(pred.move, -q, cost, elim, risk))
         if not scored:
             return self._planner.choose(ctx, rng)
         scores = np.array([s.score for s in scored])
@@ -99,7 +99,7 @@ class _Search:
     def _moves(self, hyps, state, components) -> list[tuple[Move, float, float]]:
         """Candidate moves from a node with the planner's score (efficiency) and expected cost."""
         sub = Context(hyps, state, components, self.ctx.noise, self.ctx.config)
-        return [(p.move, eff, cost) for p, eff, _elim, cost in _score_all(sub)]
+        return [(p.move, eff, cost) for p, eff, _elim, cost, _risk in _score_all(sub)]
 
     def q(
         self,

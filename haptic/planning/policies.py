@@ -66,6 +66,8 @@ class Scored:
     """Weighted mean predicted cost [units]."""
     expected_eliminated: float
     """Weighted mean pose classes eliminated."""
+    risk: float = 0.0
+    """Predicted chance that the executor cannot carry the move out (the table, a steep descent)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -76,8 +78,8 @@ class Decision:
     candidates: tuple[Scored, ...] = ()
 
 
-def _score_all(ctx: Context) -> list[tuple[Prediction, float, float, float]]:
-    """Efficiency, expected eliminations and expected cost of every fresh, reliable candidate move; the
+def _score_all(ctx: Context) -> list[tuple[Prediction, float, float, float, float]]:
+    """Efficiency, expected eliminations, expected cost and risk of every fresh, reliable candidate move; the
     eliminations come from comparing predicted outcome attributes (§4.1). With a table (``config.table_z``),
     moves the hypotheses predict to run into it are left out and the rest discounted by that risk."""
     weights = class_weights([h.model for h in ctx.hypotheses])
@@ -89,7 +91,7 @@ def _score_all(ctx: Context) -> list[tuple[Prediction, float, float, float]]:
         eff, _ = move_efficiency(pred.outcomes, pred.bounds, pred.costs, weights)
         elim = expected_eliminations(pred.outcomes, pred.bounds, weights)
         ok = (1.0 - pred.table_risk) * (1.0 - descent_risk(pred.move, ctx.config))
-        out.append((pred, eff * ok, elim * ok, float(pred.costs @ weights)))
+        out.append((pred, eff * ok, elim * ok, float(pred.costs @ weights), 1.0 - ok))
     return out
 
 
@@ -147,7 +149,9 @@ class _ScoringPolicy(Policy):
         scored = _score_all(ctx)
         if not scored:
             raise PlanningError("no admissible move from the current sensor state")
-        cands = tuple(Scored(p.move, self.score(eff, elim), cost, elim) for p, eff, elim, cost in scored)
+        cands = tuple(
+            Scored(p.move, self.score(eff, elim), cost, elim, risk) for p, eff, elim, cost, risk in scored
+        )
         scores = np.array([c.score for c in cands])
         if scores.max() <= 0:
             return Decision(_further(ctx, cands, rng, self.lookahead), cands)
@@ -207,8 +211,11 @@ def _further(ctx: Context, cands: Sequence[Scored], rng: np.random.Generator, de
 
 
 def _cheapest_exploring(cands: Sequence[Scored], rng: np.random.Generator) -> Move:
-    """With nothing to gain now, move on to new components: face and vertex moves reach a new edge and face."""
+    """With nothing to gain now, move on to new components: face and vertex moves reach a new edge and face;
+    of those, the least risky, then the cheapest."""
     pool = [c for c in cands if c.move.kind in ("face", "vertex")] or list(cands)
+    least = min(c.risk for c in pool)
+    pool = [c for c in pool if c.risk <= least + 1e-9]
     costs = np.array([c.expected_cost for c in pool])
     costs = np.where(np.isfinite(costs), costs, np.inf)
     best = np.flatnonzero(costs <= costs.min() * (1 + 1e-9)) if np.isfinite(costs).any() else np.arange(len(pool))

@@ -52,6 +52,11 @@ class PlannerConfig:
     table_rest_tol: float = 0.003
     """With a table, a pose class whose model would reach more than this below the table top, or whose lowest
     point would float more than this above it, is not a pose the object can rest in [m]."""
+    max_undercut: float | None = None
+    """With a table, how far a face's outward normal may lean back under, past horizontal, for the pad of the
+    downward-pointing fingers to roll onto it over a convex edge (the robot's own reach, set for the physics
+    executor); a move predicted to roll onto a face leaning further counts as refused like one running into
+    the table [rad]. None: no limit."""
     table_risk: float = 0.5
     """Candidate moves that at least this fraction of the hypotheses predict to bring the pad onto the table
     are not offered (the executor would refuse or abort them); the rest are discounted by their risk."""
@@ -337,7 +342,8 @@ def table_conflict(
     the table hides; a vertex move whose circle, before it meets the next edge, would put the pad on the table,
     or whose next face the table hides. Edge moves are never refused (one running down to the table ends at
     the vertex the table blocks, which the executor finds). A workspace prior (``config.table_z``) with the
-    hypothesis's own pose; 0.0 without a table."""
+    hypothesis's own pose; 0.0 without a table. With ``config.max_undercut``, stepping over a convex edge onto
+    a face that leans under further than the pad reaches counts too."""
     if config.table_z is None:
         return 0.0
     t = h.world_from_model
@@ -348,7 +354,11 @@ def table_conflict(
 
     def onto_hidden(e_m: int, g_m: int, at_m: np.ndarray) -> bool:
         q = t.apply(at_m + TABLE_STEP_ONTO * _inward(poly, e_m, g_m))
-        return pad_clearance(q, t.rotate(poly.face_normals[g_m]), config) < lim
+        n_g = t.rotate(poly.face_normals[g_m])
+        if config.max_undercut is not None and poly.edge_convexity[e_m] > 0:
+            if float(n_g[2]) < -np.sin(config.max_undercut):
+                return True  # the next face leans under, out of the pad's reach
+        return pad_clearance(q, n_g, config) < lim
 
     if isinstance(move, FaceMove):
         f_m = h.faces.get(state.face)

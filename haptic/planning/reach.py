@@ -1,0 +1,134 @@
+"""What a fingertip can touch of an object resting on the table, and whether two hypotheses differ there.
+
+The fingers point down and end in a pad of radius ``config.pad_radius``. A surface point ``p`` of outward
+normal ``n`` is *reachable* when the pad touching it, centred at ``c = p + r n``,
+
+- stays clear of the table with room to trace (its lowest point ``config.table_clearance`` plus
+  :data:`TRACE_ROOM` above the top),
+- does not dig into the object elsewhere (``c`` is at least ``r`` from the whole surface, within a margin),
+- can be lowered there from above (the vertical line over ``c`` stays outside the object), and
+- meets a face it can press on (the normal leans under by no more than ``config.max_undercut``).
+
+Two hypotheses (model and pose) that agree on every reachable point -- each one's reachable surface lies on
+the other's surface, within ``tol`` -- cannot be told apart by any move: their difference faces the table.
+The episode then ends as ambiguous instead of exploring without end.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from haptic.geometry import SE3, Polyhedron
+from haptic.planning.predict import PlannerConfig
+
+SPACING = 0.004
+"""Spacing of the sample points over the faces [m]."""
+LIFT = 0.08
+"""Height over the pad through which the finger must be free [m]."""
+MARGIN = 0.0005
+"""Slack of the pad-clearance test against the object [m]."""
+TRACE_ROOM = 0.006
+"""Room a trace needs: a point the pad could touch only within this of its limit above the table counts as
+out of reach (a face move there would be refused as too close to the table) [m]."""
+
+
+def surface_samples(poly: Polyhedron, spacing: float = SPACING) -> tuple[np.ndarray, np.ndarray]:
+    """Points over every face (a barycentric grid per triangle, corners and edges included) and their faces'
+    outward normals, model frame: shapes (P, 3), (P, 3)."""
+    pts, nrm = [], []
+    for (i, j, k), f in zip(poly.triangles, poly.triangle_faces, strict=True):
+        a, b, c = poly.vertices[i], poly.vertices[j], poly.vertices[k]
+        n = max(1, int(np.ceil(max(np.linalg.norm(b - a), np.linalg.norm(c - a), np.linalg.norm(c - b)) / spacing)))
+        u, v = np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij")
+        keep = u + v <= n
+        u, v = u[keep] / n, v[keep] / n
+        pts.append(a + u[:, None] * (b - a) + v[:, None] * (c - a))
+        nrm.append(np.broadcast_to(poly.face_normals[f], (len(u), 3)))
+    return np.concatenate(pts), np.concatenate(nrm)
+
+
+def surface_distance(poly: Polyhedron, points: np.ndarray) -> np.ndarray:
+    """Unsigned distance from each point (model frame) to the surface, shape (P,)."""
+    p = np.atleast_2d(np.asarray(points, dtype=float))
+    tri = poly.vertices[poly.triangles]  # (T, 3, 3)
+    best = np.full(len(p), np.inf)
+    for start in range(0, len(p), 2048):
+        q = p[start : start + 2048]
+        d = _point_triangle_distance(q, tri)
+        best[start : start + 2048] = d.min(axis=1)
+    return best
+
+
+def _point_triangle_distance(p: np.ndarray, tri: np.ndarray) -> np.ndarray:
+    """Distances (P, T) from points to triangles (closest point by barycentric clamping over the regions)."""
+    a, b, c = tri[None, :, 0], tri[None, :, 1], tri[None, :, 2]
+    q = p[:, None, :]
+    ab, ac = b - a, c - a
+    n = np.cross(ab, ac)
+    nn = np.einsum("ptk,ptk->pt", n, n) + 1e-30
+    # projection onto the plane and its barycentric coordinates
+    w = q - a
+    dist_plane = np.einsum("ptk,ptk->pt", w, n) / np.sqrt(nn)
+    proj = q - (np.einsum("ptk,ptk->pt", w, n) / nn)[..., None] * n
+    v0, v1, v2 = ab, ac, proj - a
+    d00 = np.einsum("ptk,ptk->pt", v0, v0)
+    d01 = np.einsum("ptk,ptk->pt", v0, v1)
+    d11 = np.einsum("ptk,ptk->pt", v1, v1)
+    d20 = np.einsum("ptk,ptk->pt", v2, v0)
+    d21 = np.einsum("ptk,ptk->pt", v2, v1)
+    den = d00 * d11 - d01 * d01 + 1e-30
+    s = (d11 * d20 - d01 * d21) / den
+    t = (d00 * d21 - d01 * d20) / den
+    inside = (s >= 0) & (t >= 0) & (s + t <= 1)
+    d_in = np.abs(dist_plane)
+
+    def seg(x, y):
+        xy = y - x
+        h = np.clip(np.einsum("ptk,ptk->pt", q - x, xy) / (np.einsum("ptk,ptk->pt", xy, xy) + 1e-30), 0.0, 1.0)
+        return np.linalg.norm(q - (x + h[..., None] * xy), axis=2)
+
+    d_edge = np.minimum(np.minimum(seg(a, b), seg(b, c)), seg(c, a))
+    return np.where(inside, d_in, d_edge)
+
+
+def reachable(
+    poly: Polyhedron, world_from_model: SE3, config: PlannerConfig, spacing: float = SPACING
+) -> tuple[np.ndarray, np.ndarray]:
+    """The reachable sample points of ``poly`` at ``world_from_model``, world frame, and their normals."""
+    pts_m, nrm_m = surface_samples(poly, spacing)
+    pts, nrm = world_from_model.apply(pts_m), world_from_model.rotate(nrm_m)
+    r = config.pad_radius
+    ok = np.ones(len(pts), dtype=bool)
+    centre = pts + r * nrm
+    if config.table_z is not None:
+        ok &= centre[:, 2] - r - config.table_z >= config.table_clearance + TRACE_ROOM
+    if config.max_undercut is not None:
+        ok &= nrm[:, 2] >= -np.sin(config.max_undercut)
+    idx = np.flatnonzero(ok)
+    if len(idx):
+        model_from_world = world_from_model.inverse()
+        c_m = model_from_world.apply(centre[idx])
+        clear = surface_distance(poly, c_m) >= r - MARGIN
+        up = model_from_world.rotate(np.array([0.0, 0.0, 1.0]))
+        for h in np.linspace(r, LIFT, 6):
+            above = c_m + h * up
+            clear &= ~poly.contains(above)
+        ok[idx] = clear
+    return pts[ok], nrm[ok]
+
+
+def indistinguishable(
+    a: Polyhedron, a_pose: SE3, b: Polyhedron, b_pose: SE3, config: PlannerConfig, tol: float = 0.0015
+) -> bool:
+    """Whether every reachable point of each hypothesis lies on the other's surface within ``tol``, with the
+    (their difference is out of reach). A coarse pass first, since most pairs differ
+    grossly."""
+    for spacing in (3 * SPACING, SPACING):
+        for (p, pp), (q, qp) in (((a, a_pose), (b, b_pose)), ((b, b_pose), (a, a_pose))):
+            pts, _ = reachable(p, pp, config, spacing)
+            if len(pts) == 0:
+                return False
+            d = surface_distance(q, qp.inverse().apply(pts))
+            if float(d.max()) > tol:
+                return False
+    return True
