@@ -1,5 +1,5 @@
-"""Physics episodes on every seed object at a few random resting poses, headless: outcome, moves, path cost,
-wall and simulated time, pose error and perception errors per episode, then a summary per object.
+"""Physics episodes on every object of the seed library at a few random resting poses, headless: outcome,
+moves, path cost, wall and simulated time, pose error and perception errors per episode, then a summary per object.
 
     .venv/bin/python scripts/physics_episodes.py [--poses 3] [--first-seed 1] [--objects BOX01,WEDGE01]
                                                  [--policy planner] [--jobs 2] [--json episodes.json]
@@ -16,6 +16,7 @@ import json
 import math
 import sys
 import time
+from collections import Counter
 from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
@@ -23,8 +24,10 @@ import numpy as np
 from haptic.bench.runner import EpisodeSpec
 from haptic.episode import run_episode
 from haptic.errors import HapticError
+from haptic.geometry.io import atomic_write
 
-SEED_OBJECTS = ("BOX01", "WEDGE01", "BOX01N", "BOX01P", "PYR01", "TETRA01L", "TETRA01R")
+SEED_OBJECTS = ("BOX01", "WEDGE01", "BOX01N", "BOX01P", "PYR01", "TETRA01L", "TETRA01R", "HEXPRISM01", "LBLOCK01",
+                "FRAME01")
 
 
 def one(model: str, seed: int, policy: str) -> dict:
@@ -68,19 +71,19 @@ def main(argv: list[str] | None = None) -> int:
     else:
         records = [one(*j) for j in jobs]
 
-    print(f"{'object':<9} {'seed':>4} {'outcome':<10} {'ok':<3} {'moves':>5} {'fail':>4} {'cost':>6} "
+    print(f"{'object':<10} {'seed':>4} {'outcome':<10} {'ok':<3} {'moves':>5} {'fail':>4} {'cost':>6} "
           f"{'wall s':>6} {'sim s':>6} {'err mm':>6} {'err °':>5}  perception (medians)")  # fmt: skip
     for r in records:
-        print(f"{r['model']:<9} {r['seed']:>4} {r['outcome']:<10} {'yes' if r['correct'] else 'no':<3} "
+        print(f"{r['model']:<10} {r['seed']:>4} {r['outcome']:<10} {'yes' if r['correct'] else 'no':<3} "
               f"{r.get('moves', 0):>5} {r.get('failed_moves', 0):>4} {_f(r.get('path_cost')):>6} "
               f"{_f(r.get('wall_time_s')):>6} {_f(r.get('sim_time_s')):>6} {_f(r.get('pose_error_mm'), '.2f'):>6} "
               f"{_f(r.get('pose_error_deg'), '.2f'):>5}  {_perception(r)}")  # fmt: skip
         if r["outcome"] not in ("recognized",) and r.get("detail"):
-            print(f"{'':<15}{r['detail']}")
+            print(f"{'':<16}{r['detail']}")
 
     print()
-    print(f"{'object':<9} {'correct':>7} {'wrong':>5} {'moves':>6} {'cost':>6} {'wall s':>6} {'sim s':>6} {'err mm':>6}"
-          "  (medians over the correctly recognised episodes)")  # fmt: skip
+    print(f"{'object':<10} {'correct':>7} {'wrong':>5} {'moves':>6} {'cost':>6} {'wall s':>6} {'sim s':>6} "
+          f"{'err mm':>6}  (medians over the correctly recognised episodes)")  # fmt: skip
     wrong_total = 0
     for o in objects:
         rs = [r for r in records if r["model"] == o]
@@ -92,17 +95,18 @@ def main(argv: list[str] | None = None) -> int:
             v = [r[k] for r in good if r.get(k) is not None]
             return float(np.median(v)) if v else None
 
-        print(f"{o:<9} {len(good):>3}/{len(rs):<3} {len(wrong):>5} {_f(med('moves')):>6} "
+        print(f"{o:<10} {len(good):>3}/{len(rs):<3} {len(wrong):>5} {_f(med('moves')):>6} "
               f"{_f(med('path_cost')):>6} {_f(med('wall_time_s')):>6} {_f(med('sim_time_s')):>6} "
               f"{_f(med('pose_error_mm'), '.2f'):>6}")  # fmt: skip
     good = [r for r in records if r["correct"]]
     walls = [r["wall_time_s"] for r in good]
     print()
-    print(f"correct {len(good)}/{len(records)}, wrong recognitions {wrong_total}; median wall time to recognition "
+    outcomes = Counter(r["outcome"] for r in records)
+    print(f"correct {len(good)}/{len(records)}, wrong recognitions {wrong_total}; outcomes: "
+          f"{', '.join(f'{k} {v}' for k, v in sorted(outcomes.items()))}; median wall time to recognition "
           f"{_f(float(np.median(walls)) if walls else None)} s; total {time.perf_counter() - t0:.0f} s")  # fmt: skip
     if args.json:
-        with open(args.json, "w") as fh:
-            json.dump(records, fh, indent=1)
+        atomic_write(args.json, json.dumps(records, indent=1))
         print(f"wrote {args.json}")
     return 0
 

@@ -56,6 +56,11 @@ class PhysicsSettings:
     """Start: the grid extends this far beyond the object region [m]."""
     max_landings: int = 40
     """Start: landing attempts before giving up."""
+    approach_raise: float = 0.03
+    """Start: when the object reaches up to the approach height (the move across above it is blocked, or the
+    descent touches at once), the approach height is raised by this and the landing tried again [m]."""
+    max_approach_height: float = 0.20
+    """Start: ... up to this height of the pad centre above the table (the hand's reach over the region) [m]."""
     normal_stroke: float = 0.004
     """Start: length of each leg of the L stroke for the first face's normal [m]."""
     max_face_trace: float = 0.25
@@ -237,6 +242,7 @@ class PhysicsExecutor:
     def _start(self, move: Move, pieces: list[PrimitiveResult]) -> MoveResult:
         s, t = self.settings, self.toucher
         z_top = TABLE_TOP_Z + s.approach_height
+        z_max = TABLE_TOP_Z + max(s.max_approach_height, s.approach_height)
         last = "no-contact"
         landings = self._landing_points()
         i = -1
@@ -250,6 +256,11 @@ class PhysicsExecutor:
                 pieces.append(t.move_free(up, timeout=3.0, tol=3e-3))
             r = t.move_free(above, timeout=4.0, tol=3e-3)
             pieces.append(r)
+            if r.status == "timeout" and z_top < z_max - 1e-6:
+                # blocked on the way across: the object stands taller than the approach height. Go higher
+                z_top = min(z_top + s.approach_raise, z_max)
+                i -= 1
+                continue
             if not r.ok:
                 last = r.status
                 if r.status == "unstable":
@@ -257,9 +268,14 @@ class PhysicsExecutor:
                 continue
             # fast guarded descent to just above the table, then back off and touch again slowly
             r = t.approach(
-                np.array([0.0, 0.0, -1.0]), s.approach_height - s.search_floor, speed=s.search_speed, settle=False
+                np.array([0.0, 0.0, -1.0]), z_top - TABLE_TOP_Z - s.search_floor, speed=s.search_speed, settle=False
             )
             pieces.append(r)
+            if r.ok and r.info["point"][2] > z_top - 0.006 - t.pad_radius and z_top < z_max - 1e-6:
+                # touched at once (the side of something reaching up to the approach height): go higher
+                z_top = min(z_top + s.approach_raise, z_max)
+                i -= 1
+                continue
             if r.ok:
                 back = t.tip + np.array([0.0, 0.0, 0.005])
                 pieces.append(t.move_free(back, timeout=1.0, tol=1e-3))

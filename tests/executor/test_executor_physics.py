@@ -186,3 +186,18 @@ def test_matcher_keeps_the_true_model_through_the_sequence(sequence_run):
     for c in ex.components:
         tree.add(c)
         assert poly.name in tree.models_alive(), f"{poly.name} pruned by component {c}"
+
+
+def test_start_finds_an_object_taller_than_the_approach_height():
+    """FRAME01 standing on an outer wall is 120 mm tall, above the default approach height: the start raises
+    its approach height when blocked and lands on the top instead of timing out."""
+    from haptic.executor.physics import PhysicsSettings
+    from haptic.sim.scene import TABLE_TOP_Z
+
+    poly, sim = _setup("FRAME01", 3)  # upright, its top 120 mm above the table
+    assert PhysicsSettings().approach_height < 0.12
+    ex = PhysicsExecutor(RobotInterface(sim), rng=np.random.default_rng(3))
+    r = ex.start()
+    assert r.ok, r.info
+    assert r.info["sim_time"] < 60.0
+    assert r.state.position[2] > TABLE_TOP_Z + PhysicsSettings().approach_height, r.state.position  # on the top
