@@ -31,7 +31,7 @@ from haptic.executor.primitives import (
     angle,
     perpendicular,
 )
-from haptic.executor.segment import FaceFit, SegmentBounds, Segmenter, fit_face
+from haptic.executor.segment import FaceFit, LineFit, SegmentBounds, Segmenter, fit_face
 from haptic.matching.components import DataComponent
 from haptic.planning.moves import CostModel, EdgeMove, FaceMove, Move, MoveResult, SensorState, VertexMove
 from haptic.sim.robot import RobotInterface
@@ -172,6 +172,19 @@ class PhysicsExecutor:
             "hand_link_chains": self.robot.link_chains,
         }
 
+    def _edge_between(self, face: int, trace: ContactTrace, phase: str, roll: ContactTrace, fit_b: FaceFit,
+                      kind: str, corner: np.ndarray) -> tuple[FaceFit, LineFit | None, str]:  # fmt: skip
+        """The fit of data face ``face`` from the ``phase`` rows of ``trace``, and the line of the edge the pad
+        rolled over (the last rows on the face, then ``roll``) onto the face of ``fit_b``; no line, and why,
+        when the roll cannot have been over an edge between the two faces."""
+        seg = self.segmenter
+        fit_a = self._face_fit(face, trace)
+        roll_all = ContactTrace.concatenate([trace.select(trace.phase == PHASES.index(phase)).tail(8), roll])
+        why = seg.edge_inconsistency(fit_a, fit_b, kind == "convex", roll_all)
+        if why is not None:
+            return fit_a, None, f"no edge between the faces: {why}"
+        return fit_a, seg.edge_line(fit_a, fit_b, kind == "convex", roll_all, corner), ""
+
     def _fail(self, move: Move, res: PrimitiveResult | str, reason: str) -> MoveResult:
         status = res if isinstance(res, str) else res.status
         if status == "ok":
@@ -256,10 +269,10 @@ class PhysicsExecutor:
                 pieces.append(t.move_free(up, timeout=3.0, tol=3e-3))
             r = t.move_free(above, timeout=4.0, tol=3e-3)
             pieces.append(r)
-            if r.status == "timeout" and z_top < z_max - 1e-6:
+            can_raise = z_top < z_max - 1e-6
+            if r.status == "timeout" and can_raise:
                 # blocked on the way across: the object stands taller than the approach height. Go higher
-                z_top = min(z_top + s.approach_raise, z_max)
-                i -= 1
+                z_top, i = min(z_top + s.approach_raise, z_max), i - 1
                 continue
             if not r.ok:
                 last = r.status
@@ -271,10 +284,9 @@ class PhysicsExecutor:
                 np.array([0.0, 0.0, -1.0]), z_top - TABLE_TOP_Z - s.search_floor, speed=s.search_speed, settle=False
             )
             pieces.append(r)
-            if r.ok and r.info["point"][2] > z_top - 0.006 - t.pad_radius and z_top < z_max - 1e-6:
+            if r.ok and r.info["point"][2] > z_top - 0.006 - t.pad_radius and can_raise:
                 # touched at once (the side of something reaching up to the approach height): go higher
-                z_top = min(z_top + s.approach_raise, z_max)
-                i -= 1
+                z_top, i = min(z_top + s.approach_raise, z_max), i - 1
                 continue
             if r.ok:
                 back = t.tip + np.array([0.0, 0.0, 0.005])
@@ -429,12 +441,9 @@ class PhysicsExecutor:
                                                                       pieces)  # fmt: skip
         if status != "ok":
             return self._fail(move, status, reason)
-        fit_a = self._face_fit(st.face, r.trace)
-        roll_all = ContactTrace.concatenate([r.trace.select(r.trace.phase == PHASES.index("face")).tail(8), roll])
-        why = seg.edge_inconsistency(fit_a, fit_b, kind == "convex", roll_all)
-        if why is not None:
-            return self._fail(move, "unreachable", f"no edge between the faces: {why}")
-        line = seg.edge_line(fit_a, fit_b, kind == "convex", roll_all, corner)
+        fit_a, line, why = self._edge_between(st.face, r.trace, "face", roll, fit_b, kind, corner)
+        if line is None:
+            return self._fail(move, "unreachable", why)
         new_face = seg.next_id + 1
         edge = seg.add_edge(line, (st.face, new_face), kind == "convex", (fit_a.normal, fit_b.normal),
                             adjacent=(st.face,))  # fmt: skip
@@ -611,12 +620,9 @@ class PhysicsExecutor:
         )
         if status != "ok":
             return self._fail(move, status, reason)
-        fit_f = self._face_fit(f, r.trace)
-        roll_all = ContactTrace.concatenate([r.trace.select(r.trace.phase == PHASES.index("circle")).tail(8), roll])
-        why = seg.edge_inconsistency(fit_f, fit_g, kind == "convex", roll_all)
-        if why is not None:
-            return self._fail(move, "unreachable", f"no edge between the faces: {why}")
-        line = seg.edge_line(fit_f, fit_g, kind == "convex", roll_all, corner)
+        fit_f, line, why = self._edge_between(f, r.trace, "circle", roll, fit_g, kind, corner)
+        if line is None:
+            return self._fail(move, "unreachable", why)
         new_face = seg.next_id + 1
         s_vtx = float((vtx - line.point) @ line.direction)
         edge = seg.add_edge(line, (f, new_face), kind == "convex", (fit_f.normal, fit_g.normal),

@@ -25,7 +25,7 @@ efficiencies, not expected costs).
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
 
@@ -115,13 +115,7 @@ class _Search:
         brs = self._branches(hyps, weights, move, state, components)
         if not brs:
             return None
-        total = sum(float(b.weights.sum()) for b in brs)
-        value = 0.0
-        for b in brs:
-            p = float(b.weights.sum()) / total
-            rest = self.value(list(b.hypotheses), b.weights, b.state, b.components, depth - 1)
-            value += p * (b.cost + rest)
-        return value
+        return _expected(brs, lambda b: self.value(list(b.hypotheses), b.weights, b.state, b.components, depth - 1))
 
     def value(self, hyps, weights, state, components, depth: int) -> float:
         """Least expected cost to recognition from a node."""
@@ -159,10 +153,13 @@ class _Search:
         brs = self._branches(hyps, weights, move, state, components)
         if not brs:
             return self.unresolved_cost
-        total = sum(float(b.weights.sum()) for b in brs)
-        value = 0.0
-        for b in brs:
-            p = float(b.weights.sum()) / total
-            rest = self.rollout(list(b.hypotheses), b.weights, b.state, b.components, moves_left - 1)
-            value += p * (b.cost + rest)
-        return value
+        return _expected(
+            brs, lambda b: self.rollout(list(b.hypotheses), b.weights, b.state, b.components, moves_left - 1)
+        )
+
+
+def _expected(brs: Sequence[Branch], rest: Callable[[Branch], float]) -> float:
+    """Expected cost over the branches of a move: each branch's share of the weight times its cost of the
+    move plus ``rest(branch)``, the cost still to come from it."""
+    total = sum(float(b.weights.sum()) for b in brs)
+    return sum(float(b.weights.sum()) / total * (b.cost + rest(b)) for b in brs)

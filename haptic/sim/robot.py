@@ -91,10 +91,6 @@ class RobotInterface:
         finger's link bodies, the fingertip pads) by forward kinematics; nothing of the object."""
         return self._sim.link_positions()
 
-    def link_positions(self) -> dict[str, np.ndarray]:
-        """:meth:`link_array` by link name: name -> (3,) world position [m]."""
-        return dict(zip(self.link_names, self.link_array(), strict=True))
-
     def fingertip_pose(self) -> tuple[np.ndarray, np.ndarray]:
         """Active fingertip position (3,) [m] and hand rotation (3, 3), from the joint encoders."""
         return self._ctl.fingertip_pose()[0], self._ctl.hand_rotation()
