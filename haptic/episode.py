@@ -116,13 +116,48 @@ def pose_error(model: Polyhedron, truth: SE3, estimate: SE3) -> tuple[float, flo
     return dist, float(np.degrees(ang))
 
 
+TOUCH_TOL = 0.0025
+"""A touched point farther than this from a pose class's surface, at the class's pose, contradicts it [m]."""
+TOUCH_OUTLIERS = 3
+"""Contradicting points it takes to set a pose class aside (a stray reading is not enough)."""
+TOUCH_SPACING = 0.002
+"""Touched points are thinned to about one per this much of the trace [m]."""
+
+
+def touched_points(result: MoveResult, config: PlannerConfig) -> np.ndarray:
+    """The contact points of a move's trace (the physics executor's sensing, in ``result.info["trace"]``),
+    touches of the table left out, thinned along the trace; (0, 3) when the executor keeps no trace."""
+    trace = result.info.get("trace") if isinstance(result.info, dict) else None
+    if trace is None or not len(trace):
+        return np.zeros((0, 3))
+    ok = trace.in_contact
+    p, n = trace.point_in_world[ok], trace.normal_in_world[ok]
+    if config.table_z is not None:
+        p = p[~((n[:, 2] > 0.95) & (p[:, 2] < config.table_z + 0.003))]
+    kept: list[np.ndarray] = []
+    for q in p:
+        if not kept or float(np.linalg.norm(q - kept[-1])) >= TOUCH_SPACING:
+            kept.append(q)
+    return np.array(kept).reshape(-1, 3)
+
+
+def _fits_touches(c, touched: np.ndarray) -> bool:
+    """Whether pose class ``c`` has every touched point on its surface (but a few strays)."""
+    from haptic.planning.reach import surface_distance
+
+    d = surface_distance(c.model, c.world_from_model.inverse().apply(touched))
+    return int((d > TOUCH_TOL).sum()) < TOUCH_OUTLIERS
+
+
 def _on_the_table(
-    rec: Recognition, tree: InterpretationTree, components, config: PlannerConfig
+    rec: Recognition, tree: InterpretationTree, components, config: PlannerConfig, touched: np.ndarray | None = None
 ) -> Recognition:
     """The matcher's verdict with the workspace prior that the object rests on the table (``config.table_z``):
     once the data fix the poses, pose classes that would put the model through the table or float it above
     it are set aside, and the verdict is taken again over the rest (left as it is when that would leave no
-    class: the prior is then doubted, not the data). A few classes left that differ only where the fingertip
+    class: the prior is then doubted, not the data). With ``touched`` points (every contact sensed so far),
+    classes that leave some of them off their surface are set aside too. A few classes left that differ only
+    where the fingertip
     cannot reach (:func:`~haptic.planning.reach.indistinguishable`: their difference faces the table) are
     ambiguous."""
     from haptic.matching.recognition import PoseTolerance, same_solid
@@ -131,6 +166,8 @@ def _on_the_table(
     if not rec.classes or not pose_fixed_by(components):
         return rec
     keep = tuple(c for c in rec.classes if rests_on_table(c.model, c.world_from_model, config)) or rec.classes
+    if touched is not None and len(touched) and len(keep) <= MAX_TOUCH_CHECK:
+        keep = tuple(c for c in keep if _fits_touches(c, touched)) or keep
     if len(keep) == len(rec.classes) and rec.status != EXPLORING:
         return rec
     models = tuple(sorted({c.name for c in keep}))
@@ -148,6 +185,8 @@ def _on_the_table(
 
 MAX_HIDDEN_CHECK = 4
 """Pose classes up to which an episode on the table checks whether what tells them apart is out of reach."""
+MAX_TOUCH_CHECK = 24
+"""Pose classes up to which the touched points are checked against each class's surface."""
 
 
 def _fixed_move(
@@ -260,15 +299,24 @@ def run_loop(
     outcome, detail = EXPLORING, ""
     fallback = RandomPolicy()
 
+    touched: list[np.ndarray] = []
+
+    def assess() -> Recognition:
+        """The verdict on the data so far (with the table and the touched points, when known)."""
+        r = recognize(tree, max_interpretations=MAX_POSED)
+        if config.table_z is None:
+            return r
+        return _on_the_table(r, tree, components, config, np.concatenate(touched) if touched else None)
+
     def absorb(result: MoveResult) -> None:
         nonlocal cost, rec
         for c in result.components:
             components[c.id] = c
             tree.add(c)
+        if config.touch_evidence:
+            touched.append(touched_points(result, config))
         cost += result.cost
-        rec = recognize(tree, max_interpretations=MAX_POSED)
-        if config.table_z is not None:
-            rec = _on_the_table(rec, tree, components, config)
+        rec = assess()
         counts.append(tree.count)
         n_classes.append(len(rec.classes) if rec.classes else tree.count)
         cum_cost.append(cost)
@@ -323,6 +371,12 @@ def run_loop(
                     obs.on_failed_move(n_moves, result)
                 if result.state is not None:
                     state = result.state
+                if config.touch_evidence and rec is not None:
+                    touched.append(touched_points(result, config))
+                    before = len(rec.classes)
+                    rec = assess()
+                    if len(rec.classes) < before:  # the failed move's touches told something
+                        failed_in_a_row = 0
                 if failed_in_a_row >= MAX_FAILED_MOVES:
                     outcome, detail = "failed", f"{failed_in_a_row} failed moves in a row (last: {result.status})"
                     break

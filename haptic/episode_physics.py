@@ -44,7 +44,7 @@ def run_physics_episode(
     if config.table_z is None:  # the robot knows its workspace: where the table top is (never the object)
         config = replace(
             config, table_z=TABLE_TOP_Z, steep_descent_risk=STEEP_DESCENT_RISK,
-            max_undercut=TouchConfig().max_undercut,
+            max_undercut=TouchConfig().max_undercut, touch_evidence=True,
         )
     root = np.random.SeedSequence(spec.seed)
     pose_rng, exec_rng, policy_rng, sim_seq = (np.random.default_rng(s) for s in root.spawn(4))

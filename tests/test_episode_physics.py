@@ -17,3 +17,18 @@ def test_a_physics_episode_recognises_the_pyramid():
     for key in ("face_normal_deg", "edge_direction_deg", "edge_position_mm", "vertex_position_mm"):
         assert math.isfinite(p[key]["median"]) and p[key]["median"] < 1.0, (key, p[key])
     assert p["spurious"] == 0
+
+
+def test_touches_past_an_unreachable_edge_tell_the_box_family_apart():
+    # BOX01P resting tilted: the moves that separate it from BOX01 and BOX01N all end stepping onto a face
+    # leaning under the pad; their touches on the way still rule the look-alikes out
+    rec = run_episode(EpisodeSpec(model="BOX01P", seed=2, executor="physics"))
+    assert rec.outcome == "recognized" and rec.correct, rec.detail
+    assert rec.failed_moves >= 1
+
+
+def test_a_slot_against_the_table_ends_as_ambiguous():
+    # BOX01N resting with its slot against the table: no move can reach what tells it from BOX01
+    rec = run_episode(EpisodeSpec(model="BOX01N", seed=3, executor="physics"))
+    assert rec.outcome == "ambiguous", rec.outcome
+    assert rec.recognized is None and not rec.correct

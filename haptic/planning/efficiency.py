@@ -48,20 +48,32 @@ def move_efficiency(
     Per hypothesis ``i``: (number of hypotheses eliminated if ``i`` is true) / (cost if ``i`` is true).
     The move's efficiency is the weighted mean over hypotheses (the plain mean when ``weights`` is None).
     """
-    d = distinguishable(outcomes, np.asarray(bounds, dtype=float))
-    eliminated = d.sum(axis=1).astype(float)
-    c = np.asarray(costs, dtype=float)
-    per = eliminated / np.maximum(c, 1e-12)
-    w = np.full(len(per), 1.0 / len(per)) if weights is None else np.asarray(weights, dtype=float) / np.sum(weights)
-    return float(per @ w), per
+    return efficiency_of(distinguishable(outcomes, np.asarray(bounds, dtype=float)), costs, weights)
+
+
+def efficiency_of(
+    eliminates: np.ndarray, costs: np.ndarray | Sequence[float], weights: np.ndarray | Sequence[float] | None = None
+) -> tuple[float, np.ndarray]:
+    """:func:`move_efficiency` from ``eliminates[i, j]``: whether hypothesis ``j`` is eliminated if ``i`` is
+    true."""
+    eliminated = np.asarray(eliminates).sum(axis=1).astype(float)
+    per = eliminated / np.maximum(np.asarray(costs, dtype=float), 1e-12)
+    return float(per @ _normalised(weights, len(per))), per
 
 
 def expected_eliminations(outcomes: np.ndarray, bounds, weights=None) -> float:
     """Expected number of hypotheses eliminated, ignoring cost (the greedy policy's score)."""
-    d = distinguishable(outcomes, np.asarray(bounds, dtype=float))
-    n = len(d)
-    w = np.full(n, 1.0 / n) if weights is None else np.asarray(weights, dtype=float) / np.sum(weights)
-    return float(d.sum(axis=1) @ w)
+    return expected_eliminated(distinguishable(outcomes, np.asarray(bounds, dtype=float)), weights)
+
+
+def expected_eliminated(eliminates: np.ndarray, weights=None) -> float:
+    """:func:`expected_eliminations` from ``eliminates[i, j]`` (see :func:`efficiency_of`)."""
+    d = np.asarray(eliminates)
+    return float(d.sum(axis=1) @ _normalised(weights, len(d)))
+
+
+def _normalised(weights, n: int) -> np.ndarray:
+    return np.full(n, 1.0 / n) if weights is None else np.asarray(weights, dtype=float) / np.sum(weights)
 
 
 def outcome_groups(outcomes: np.ndarray, bounds) -> list[np.ndarray]:

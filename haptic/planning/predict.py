@@ -57,6 +57,10 @@ class PlannerConfig:
     downward-pointing fingers to roll onto it over a convex edge (the robot's own reach, set for the physics
     executor); a move predicted to roll onto a face leaning further counts as refused like one running into
     the table [rad]. None: no limit."""
+    touch_evidence: bool = False
+    """Every touched point is checked against each pose class's surface (the episode does so with the
+    physics executor's traces), so a face move that cannot step onto its next face still tells how far its
+    face reaches; scored so."""
     table_risk: float = 0.5
     """Candidate moves that at least this fraction of the hypotheses predict to bring the pad onto the table
     are not offered (the executor would refuse or abort them); the rest are discounted by their risk."""
@@ -102,6 +106,17 @@ class Prediction:
     table: np.ndarray | None = None
     """Per hypothesis: 1 when the move is predicted to bring the pad onto the table, 0 when not, NaN when the
     hypothesis cannot say; None without a table (``PlannerConfig.table_z``)."""
+    slide: np.ndarray | None = None
+    """For face moves with a table, per hypothesis: 1 when the trace across the face itself runs into the
+    table (0 when only the step onto the next face is out of reach; NaN: cannot say)."""
+
+    @property
+    def fails_past_edge(self) -> np.ndarray | None:
+        """Per hypothesis: the face move traces its face to the edge but cannot step onto the next face (the
+        touched points still tell how far the face reaches); None when not a face move with a table."""
+        if self.slide is None or self.table is None:
+            return None
+        return (self.table == 1) & (self.slide == 0)
 
     @property
     def table_risk(self) -> float:
@@ -284,19 +299,22 @@ def predict(
         rows.append(o)
         costs.append(c)
         clear.append(cl)
-    table = None
+    table = slide = None
     if config.table_z is not None:
         if data_table_conflict(move, state, components, config):
             table = np.ones(len(hypotheses))
         else:
-            table = np.array([table_conflict(h, move, state, components, config) for h in hypotheses], dtype=float)
+            both = np.array([_table_conflict(h, move, state, components, config) for h in hypotheses], dtype=float)
+            table = both[:, 0]
+            slide = both[:, 1] if isinstance(move, FaceMove) else None
     costs_arr = np.array(costs, dtype=float)
     if np.isnan(costs_arr).all():
         costs_arr[:] = 1.0
     else:
         costs_arr = np.where(np.isnan(costs_arr), np.nanmean(costs_arr), costs_arr)
     return Prediction(
-        move, np.array(rows), outcome_bounds(noise)[move.kind], costs_arr, np.array(clear, dtype=float), table
+        move, np.array(rows), outcome_bounds(noise)[move.kind], costs_arr, np.array(clear, dtype=float), table,
+        slide,
     )
 
 
@@ -344,11 +362,19 @@ def table_conflict(
     the vertex the table blocks, which the executor finds). A workspace prior (``config.table_z``) with the
     hypothesis's own pose; 0.0 without a table. With ``config.max_undercut``, stepping over a convex edge onto
     a face that leans under further than the pad reaches counts too."""
+    return _table_conflict(h, move, state, components, config)[0]
+
+
+def _table_conflict(
+    h: Hypothesis, move: Move, state: SensorState, components: Mapping[int, DataComponent], config: PlannerConfig
+) -> tuple[float, float]:
+    """:func:`table_conflict`, and for a face move whether the trace across the face itself runs into the
+    table (the step onto the next face aside; NaN for other moves)."""
     if config.table_z is None:
-        return 0.0
+        return 0.0, np.nan
     t = h.world_from_model
     if t is None:
-        return np.nan
+        return np.nan, np.nan
     poly, lim = h.poly, config.table_clearance
     p_m = t.inverse().apply(state.position)
 
@@ -363,38 +389,38 @@ def table_conflict(
     if isinstance(move, FaceMove):
         f_m = h.faces.get(state.face)
         if f_m is None:
-            return np.nan
+            return np.nan, np.nan
         n = poly.face_normals[f_m]
         hit = trace_face(poly, f_m, p_m - (p_m @ n - poly.face_offsets[f_m]) * n, t.inverse().rotate(move.direction))
         if hit is None:
-            return np.nan
+            return np.nan, np.nan
         n_w = t.rotate(n)
         down = float(np.asarray(move.direction) @ [0.0, 0.0, 1.0]) < 0.0
         if down and pad_clearance(t.apply(hit.point), n_w, config) < lim:
-            return 1.0
-        return float(onto_hidden(hit.edge, hit.next_face, hit.point))
+            return 1.0, 1.0
+        return float(onto_hidden(hit.edge, hit.next_face, hit.point)), 0.0
     if isinstance(move, EdgeMove):
         # an edge running down to the table ends at a vertex on it, where the table blocks the finger: the
         # executor finds that vertex (the only way to measure such an edge), so an edge move is never refused
-        return 0.0
+        return 0.0, np.nan
     if isinstance(move, VertexMove):
         e_m = h.edges.get(state.edge) if state.edge is not None else None
         v_m = h.vertices.get(state.vertex) if state.vertex is not None else None
         a_m = h.faces.get(move.across_face)
         if e_m is None or v_m is None or a_m is None:
-            return np.nan
+            return np.nan, np.nan
         try:
             hit = circle_vertex(poly, v_m, e_m, a_m, config.vertex_radius)
         except ValueError:
-            return np.nan
+            return np.nan, np.nan
         u = poly.edge_directions[e_m] * (1.0 if poly.edges[e_m, 1] == v_m else -1.0)
         pts = circle_points(poly.vertices[v_m], u, _inward(poly, e_m, a_m), config.vertex_radius,
                             VERTEX_START_ANGLE, hit.angle, np.deg2rad(3.0))  # fmt: skip
         n_w = t.rotate(poly.face_normals[a_m])
         if min(pad_clearance(q, n_w, config) for q in t.apply(pts)) < lim:
-            return 1.0
+            return 1.0, np.nan
         away = poly.edge_directions[hit.edge] * (1.0 if poly.edges[hit.edge, 0] == v_m else -1.0)
-        return float(onto_hidden(hit.edge, hit.next_face, poly.vertices[v_m] + config.vertex_radius * away))
+        return float(onto_hidden(hit.edge, hit.next_face, poly.vertices[v_m] + config.vertex_radius * away)), np.nan
     raise TypeError(f"unknown move {move!r}")
 
 

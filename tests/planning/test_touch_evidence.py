@@ -1,0 +1,49 @@
+"""Touched points as evidence: a face move that cannot step onto its next face still tells how far the face
+reaches, and the episode sets aside pose classes that leave touched points off their surface."""
+
+import numpy as np
+
+from haptic.episode import _fits_touches
+from haptic.geometry import SE3, load_library
+from haptic.matching.recognition import PoseClass
+from haptic.planning.moves import FaceMove
+from haptic.planning.policies import _eliminates, _refusal
+from haptic.planning.predict import PlannerConfig, Prediction
+
+LIB = load_library()
+
+
+def _prediction(reach, table, slide):
+    n = len(reach)
+    outcomes = np.column_stack([reach, np.zeros(n), np.zeros(n)])
+    return Prediction(FaceMove(np.array([1.0, 0.0, 0.0])), outcomes, np.array([0.002, 0.02, 0.02]),
+                      np.ones(n), np.full(n, 0.02), np.asarray(table, float), np.asarray(slide, float))
+
+
+def test_a_trace_failing_past_its_edge_rules_out_only_shorter_faces():
+    # hypotheses 0 and 2 predict the face to reach 68 and 92 mm and the next face out of reach; 1 reaches 57
+    pred = _prediction([0.068, 0.057, 0.092], table=[1, 0, 1], slide=[0, 0, 0])
+    on, off = PlannerConfig(table_z=0.0, touch_evidence=True), PlannerConfig(table_z=0.0)
+    d = _eliminates(pred, on)
+    assert d[0].tolist() == [False, True, False]  # 0's trace passes 1's edge, stops before 2's
+    assert d[2].tolist() == [True, True, False]
+    assert d[1].tolist() == [True, False, True]  # 1's move succeeds: every attribute counts
+    assert _refusal(pred, on) == 0.0
+    assert np.isclose(_refusal(pred, off), 2 / 3)
+    assert _eliminates(pred, off).tolist() == [[False, True, True], [True, False, True], [True, True, False]]
+
+
+def test_a_trace_into_the_table_still_counts_as_refused():
+    pred = _prediction([0.068, 0.057, 0.092], table=[1, 1, 1], slide=[1, 0, 0])
+    assert np.isclose(_refusal(pred, PlannerConfig(table_z=0.0, touch_evidence=True)), 1 / 3)
+
+
+def test_touches_off_a_class_surface_set_it_aside():
+    box, slotted = LIB["BOX01"], LIB["BOX01N"]
+    pose = SE3(np.eye(3), np.array([0.1, 0.2, 0.0]))
+    # points along the top face's middle, across where BOX01N has its slot (x 35-65 mm, 20 deep)
+    xs = np.linspace(0.01, 0.09, 41)
+    touched = pose.apply(np.column_stack([xs, np.full_like(xs, 0.04), np.full_like(xs, 0.06)]))
+    noisy = touched + np.random.default_rng(0).normal(0.0, 0.0002, touched.shape)
+    assert _fits_touches(PoseClass(box, (0,), pose), noisy)
+    assert not _fits_touches(PoseClass(slotted, (0,), pose), noisy)
