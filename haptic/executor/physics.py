@@ -54,8 +54,11 @@ class PhysicsSettings:
     """Start: spacing of the landing grid over the object region [m]."""
     search_margin: float = 0.04
     """Start: the grid extends this far beyond the object region [m]."""
-    max_landings: int = 40
-    """Start: landing attempts before giving up."""
+    max_landings: int | None = None
+    """Start: landing attempts before giving up (None: every point of the landing grid -- the object may rest
+    anywhere over the region, out to its corners -- plus ``edge_retries`` landings close to an edge touched)."""
+    edge_retries: int = 20
+    """Start: landings beyond the grid for trying again close by after touching the object near an edge."""
     approach_raise: float = 0.03
     """Start: when the object reaches up to the approach height (the move across above it is blocked, or the
     descent touches at once), the approach height is raised by this and the landing tried again [m]."""
@@ -258,8 +261,9 @@ class PhysicsExecutor:
         z_max = TABLE_TOP_Z + max(s.max_approach_height, s.approach_height)
         last = "no-contact"
         landings = self._landing_points()
+        budget = s.max_landings if s.max_landings is not None else len(landings) + s.edge_retries
         i = -1
-        while i + 1 < min(len(landings), s.max_landings):
+        while i + 1 < min(len(landings), budget):
             i += 1
             xy = landings[i]
             above = np.array([xy[0], xy[1], z_top])

@@ -99,7 +99,9 @@ class TouchConfig:
     ramp_time: float = 0.25
     """Tangential speeds ramp up over this time at the start of a slide (a step start loses force) [s]."""
     lift: float = 0.008
-    """Clearance of a repositioning move above the surface [m]."""
+    """Clearance of a repositioning move above the surface [m] ..."""
+    narrow_lift: float = 0.002
+    """... and of its second try when the first was blocked (a slot narrower than 2 × pad radius + lift) [m]."""
     overpass: float = 0.02
     """A repositioning move whose straight legs are blocked (a non-convex solid) goes round over the top, this
     far above the higher of its start and its target [m]."""
@@ -417,11 +419,28 @@ class Toucher:
 
         On a convex solid a path whose legs each stay outside one face plane by the clearance cannot meet the
         solid (each leg's ends are outside that plane). ``floor_z``: lowest height of the pad centre (the table
-        plus the pad radius and a margin) [m]."""
+        plus the pad radius and a margin) [m].
+
+        In a gap narrower than twice the pad radius plus the lift (a slot of a non-convex solid) the points a
+        lift away from the walls lie inside the opposite wall: the moves there are blocked, or the approach
+        touches the opposite wall (a normal facing away from ``normal``). The reposition is then tried once
+        more with the lift cut to ``narrow_lift``."""
+        res = self._lift_and_approach(point_on_surface, normal, floor_z, self.config.lift)
+        n_t = unit(np.asarray(normal, dtype=float))
+        wrong = res.ok and angle(res.info["normal"], n_t) > math.radians(60.0)
+        if res.status == "timeout" or wrong:
+            again = self._lift_and_approach(point_on_surface, normal, floor_z, self.config.narrow_lift)
+            res = PrimitiveResult(again.status, again.event, ContactTrace.concatenate([res.trace, again.trace]),
+                                  res.distance + again.distance, again.info)  # fmt: skip
+        return res
+
+    def _lift_and_approach(
+        self, point_on_surface: np.ndarray, normal: np.ndarray, floor_z: float | None, lift: float
+    ) -> PrimitiveResult:
         cfg = self.config
         n_t = unit(np.asarray(normal, dtype=float))
         q_t = np.asarray(point_on_surface, dtype=float)
-        clear = cfg.lift + self.pad_radius
+        clear = lift + self.pad_radius
         if self.normal is not None and self.contact[2] is not None:
             n_c, q_c = self.normal.copy(), self.contact[2].copy()
         elif self.normal is not None:
@@ -453,7 +472,7 @@ class Toucher:
             # straight up, across above the target, down to it (objects rest on the table; nothing is above)
             res = self._over_the_top(above, cfg.overpass, pieces)
         if res.ok:
-            res = self.approach(-n_t, 2 * cfg.lift + 0.004)
+            res = self.approach(-n_t, 2 * lift + 0.004)
             pieces.append(res)
         return PrimitiveResult(res.status, res.event, ContactTrace.concatenate([p.trace for p in pieces]),
                                sum(p.distance for p in pieces), res.info)  # fmt: skip

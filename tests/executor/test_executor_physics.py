@@ -201,3 +201,21 @@ def test_start_finds_an_object_taller_than_the_approach_height():
     assert r.ok, r.info
     assert r.info["sim_time"] < 60.0
     assert r.state.position[2] > TABLE_TOP_Z + PhysicsSettings().approach_height, r.state.position  # on the top
+
+
+@pytest.mark.parametrize("corner", [(0, 0), (1, 1)])
+def test_start_finds_an_object_at_a_corner_of_the_region(corner):
+    """An object resting at a corner of the object region lies beyond the landings nearest the region's centre:
+    the start keeps landing over the whole grid (region + margin) until it touches it."""
+    from haptic.sim.scene import OBJECT_REGION
+
+    poly = load_library()["TETRA01L"]
+    obj = scene_object_from_polyhedron(poly)
+    pose = random_object_pose(obj, np.random.default_rng(5))
+    v = obj.vertices @ pose[:3, :3].T + pose[:3, 3]
+    (x0, x1), (y0, y1) = OBJECT_REGION
+    target = np.array([(x0, x1)[corner[0]], (y0, y1)[corner[1]]])
+    pose[:2, 3] += target - 0.5 * (v.min(axis=0) + v.max(axis=0))[:2]  # bounding-box centre on the corner
+    sim = Simulation(compose_scene(obj, pose), noise=SensorNoise.from_notes(), seed=5)
+    r = PhysicsExecutor(RobotInterface(sim), rng=np.random.default_rng(5)).start()
+    assert r.ok, r.info.get("reason")

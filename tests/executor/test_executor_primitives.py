@@ -59,3 +59,33 @@ def test_approach_into_free_space_reports_no_contact():
     assert t.move_free(np.array([CENTRE[0] - 0.1, 0.1, TABLE_TOP_Z + 0.08])).ok
     r = t.approach(np.array([0.0, 0.0, -1.0]), 0.03)
     assert r.status == "no-contact"
+
+
+def test_lift_and_approach_inside_a_narrow_slot():
+    """BOX01N's slot is 30 mm wide: a reposition onto one wall from the slot's floor with the usual lift (pad
+    centre 20 mm off the wall, 10 mm from the other wall: inside it) is blocked; the retry with the narrow lift
+    reaches the wall."""
+    from haptic.executor.primitives import Toucher
+    from haptic.geometry import load_library
+    from haptic.sim import RobotInterface, SensorNoise, Simulation, compose_scene, random_object_pose
+    from haptic.sim.scene import scene_object_from_polyhedron
+
+    poly = load_library()["BOX01N"]
+    obj = scene_object_from_polyhedron(poly)
+    pose = random_object_pose(obj, np.random.default_rng(2017))  # upright: the slot opens upwards
+    sim = Simulation(compose_scene(obj, pose), noise=SensorNoise.from_notes(), seed=2017)
+    gt = sim.ground_truth().world_from_object  # the test's setup only; the toucher never sees it
+    rot, trans = gt[:3, :3], gt[:3, 3]
+    assert (rot @ [0.0, 0.0, 1.0])[2] > 0.99
+
+    def world(p_mm):
+        return rot @ (np.asarray(p_mm) / 1000.0) + trans
+
+    t = Toucher(RobotInterface(sim))
+    assert t.move_free(world([50.0, 40.0, 95.0])).ok
+    r = t.approach(np.array([0.0, 0.0, -1.0]), 0.06)
+    assert r.ok and r.info["normal"][2] > 0.95  # on the slot's floor
+    wall_normal = rot @ np.array([-1.0, 0.0, 0.0])
+    r = t.lift_and_approach(world([65.0, 40.0, 54.0]), wall_normal)
+    assert r.ok, (r.status, r.event)
+    assert float(r.info["normal"] @ wall_normal) > np.cos(np.radians(8.0))
