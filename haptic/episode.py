@@ -116,24 +116,30 @@ def pose_error(model: Polyhedron, truth: SE3, estimate: SE3) -> tuple[float, flo
     return dist, float(np.degrees(ang))
 
 
-TOUCH_TOL = 0.0025
+TOUCH_TOL = 0.005
 """A touched point farther than this from a pose class's surface, at the class's pose, contradicts it [m]."""
-TOUCH_OUTLIERS = 3
+TOUCH_OUTLIERS = 5
 """Contradicting points it takes to set a pose class aside (a stray reading is not enough)."""
 TOUCH_SPACING = 0.002
 """Touched points are thinned to about one per this much of the trace [m]."""
+TOUCH_PHASES = ("face", "circle")
+"""Trace phases whose contacts count: the pad sliding on one face (rolling over an edge, or resting on an edge
+or a vertex, it may touch two faces at once, and the sensed point is their mean)."""
 
 
 def touched_points(result: MoveResult, config: PlannerConfig) -> np.ndarray:
-    """The contact points of a move's trace (the physics executor's sensing, in ``result.info["trace"]``),
-    touches of the table left out, thinned along the trace; (0, 3) when the executor keeps no trace."""
+    """The contact points of a move's trace (the physics executor's sensing, in ``result.info["trace"]``) while
+    sliding on a face, thinned along the trace, none within the pad's radius of the table (where the pad may
+    touch the table and the object at once); (0, 3) when the executor keeps no trace."""
+    from haptic.executor.primitives import PHASES
+
     trace = result.info.get("trace") if isinstance(result.info, dict) else None
     if trace is None or not len(trace):
         return np.zeros((0, 3))
-    ok = trace.in_contact
-    p, n = trace.point_in_world[ok], trace.normal_in_world[ok]
+    ok = trace.in_contact & np.isin(trace.phase, [PHASES.index(ph) for ph in TOUCH_PHASES])
+    p = trace.point_in_world[ok]
     if config.table_z is not None:
-        p = p[~((n[:, 2] > 0.95) & (p[:, 2] < config.table_z + 0.003))]
+        p = p[p[:, 2] > config.table_z + config.pad_radius]
     kept: list[np.ndarray] = []
     for q in p:
         if not kept or float(np.linalg.norm(q - kept[-1])) >= TOUCH_SPACING:

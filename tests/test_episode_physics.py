@@ -3,6 +3,8 @@ perception errors scored from outside the executor."""
 
 import math
 
+import numpy as np
+
 from haptic.bench.runner import EpisodeSpec
 from haptic.episode import run_episode
 
@@ -32,3 +34,24 @@ def test_a_slot_against_the_table_ends_as_ambiguous():
     rec = run_episode(EpisodeSpec(model="BOX01N", seed=3, executor="physics"))
     assert rec.outcome == "ambiguous", rec.outcome
     assert rec.recognized is None and not rec.correct
+
+
+def test_touched_points_lie_on_the_true_surface():
+    # the evidence the episode checks pose classes against: every touched point on the object itself
+    from haptic.episode import TOUCH_TOL, EpisodeObserver, touched_points
+    from haptic.planning.predict import PlannerConfig
+    from haptic.planning.reach import surface_distance
+    from haptic.sim.scene import TABLE_TOP_Z
+
+    seen, truth = [], {}
+    cfg = PlannerConfig(table_z=TABLE_TOP_Z)
+    obs = EpisodeObserver(
+        on_start=lambda model, pose: truth.update(model=model, pose=pose),
+        on_move=lambda n, r, count, rec: seen.append(touched_points(r, cfg)),
+        on_failed_move=lambda n, r: seen.append(touched_points(r, cfg)),
+    )
+    run_episode(EpisodeSpec(model="BOX01N", seed=1, executor="physics", max_moves=12), observer=obs)
+    pts = np.concatenate(seen)
+    assert len(pts) > 100
+    d = surface_distance(truth["model"], truth["pose"].inverse().apply(pts))
+    assert d.max() < TOUCH_TOL, d.max()

@@ -85,45 +85,49 @@ def _score_all(ctx: Context) -> list[tuple[Prediction, float, float, float, floa
     weights = class_weights([h.model for h in ctx.hypotheses])
     preds = [predict(ctx.hypotheses, m, ctx.state, ctx.components, ctx.noise, ctx.config) for m in _fresh_moves(ctx)]
     preds = [p for p in preds if p.reliable(ctx.config)] or preds
-    preds = [p for p in preds if _refusal(p, ctx.config) < ctx.config.table_risk] or preds
+    refused = [(p, _refusal(p, ctx.config)) for p in preds]
+    refused = [(p, r) for p, r in refused if r < ctx.config.table_risk] or refused
     out = []
-    for pred in preds:
+    for pred, refusal in refused:
         d = _eliminates(pred, ctx.config)
         eff, _ = efficiency_of(d, pred.costs, weights)
         elim = expected_eliminated(d, weights)
-        ok = (1.0 - _refusal(pred, ctx.config)) * (1.0 - descent_risk(pred.move, ctx.config))
+        ok = (1.0 - refusal) * (1.0 - descent_risk(pred.move, ctx.config))
         out.append((pred, eff * ok, elim * ok, float(pred.costs @ weights), 1.0 - ok))
     return out
 
 
-def _past_edge(pred: Prediction, config: PlannerConfig) -> np.ndarray | None:
-    """Hypotheses in which the face move fails only past its edge, when touched points count as evidence."""
-    past = pred.fails_past_edge if config.touch_evidence else None
-    return past if past is not None and past.any() else None
+def _failing(pred: Prediction, config: PlannerConfig) -> np.ndarray | None:
+    """Hypotheses in which the face move fails for the table (or a face out of reach) after touching its
+    face some way, when touched points count as evidence; None when there are none."""
+    if not config.touch_evidence or pred.reach is None or pred.table is None:
+        return None
+    fails = pred.table == 1
+    return fails if fails.any() else None
 
 
 def _refusal(pred: Prediction, config: PlannerConfig) -> float:
     """Predicted chance that the move is refused or aborted for the table before it tells anything: with
-    touched points as evidence, a face move that fails only past its edge has told how far its face reaches."""
-    past = _past_edge(pred, config)
-    if past is None:
+    touched points as evidence, a face move failing after a trace of at least ``config.min_face_travel`` has
+    told how far its face reaches."""
+    fails = _failing(pred, config)
+    if fails is None:
         return pred.table_risk
-    t = np.where(past, 0.0, pred.table)
+    t = np.where(fails & (pred.reach >= config.min_face_travel), 0.0, pred.table)
     return 0.0 if np.isnan(t).all() else float(np.nanmean(t))
 
 
 def _eliminates(pred: Prediction, config: PlannerConfig) -> np.ndarray:
     """``D[i, j]``: hypothesis ``j`` eliminated if ``i`` is true. By the predicted attributes (§4.1); where the
-    face move fails past its edge in ``i``'s world, only the hypotheses whose face ends sooner than ``i``'s
-    (the trace touches points beyond their edge)."""
+    face move fails in ``i``'s world, only the hypotheses whose face ends sooner than ``i``'s trace (it touches
+    points beyond their edge)."""
     d = distinguishable(pred.outcomes, pred.bounds)
-    past = _past_edge(pred, config)
-    if past is None:
+    fails = _failing(pred, config)
+    if fails is None:
         return d
-    reach = pred.outcomes[:, 0]
     with np.errstate(invalid="ignore"):
-        beyond = reach[:, None] - reach[None, :] > pred.bounds[0]
-    return np.where(past[:, None], beyond, d)
+        beyond = pred.reach[:, None] - pred.outcomes[None, :, 0] > pred.bounds[0]
+    return np.where(fails[:, None], beyond, d)
 
 
 def _fresh_moves(ctx: Context) -> list[Move]:

@@ -106,17 +106,10 @@ class Prediction:
     table: np.ndarray | None = None
     """Per hypothesis: 1 when the move is predicted to bring the pad onto the table, 0 when not, NaN when the
     hypothesis cannot say; None without a table (``PlannerConfig.table_z``)."""
-    slide: np.ndarray | None = None
-    """For face moves with a table, per hypothesis: 1 when the trace across the face itself runs into the
-    table (0 when only the step onto the next face is out of reach; NaN: cannot say)."""
-
-    @property
-    def fails_past_edge(self) -> np.ndarray | None:
-        """Per hypothesis: the face move traces its face to the edge but cannot step onto the next face (the
-        touched points still tell how far the face reaches); None when not a face move with a table."""
-        if self.slide is None or self.table is None:
-            return None
-        return (self.table == 1) & (self.slide == 0)
+    reach: np.ndarray | None = None
+    """For face moves with a table, per hypothesis: how far along the face the trace touches it, to the edge
+    or to where the pad would come too close to the table and stop, whether or not the move then succeeds
+    (NaN: cannot say) [m]."""
 
     @property
     def table_risk(self) -> float:
@@ -299,14 +292,14 @@ def predict(
         rows.append(o)
         costs.append(c)
         clear.append(cl)
-    table = slide = None
+    table = reach = None
     if config.table_z is not None:
         if data_table_conflict(move, state, components, config):
             table = np.ones(len(hypotheses))
         else:
             both = np.array([_table_conflict(h, move, state, components, config) for h in hypotheses], dtype=float)
             table = both[:, 0]
-            slide = both[:, 1] if isinstance(move, FaceMove) else None
+            reach = both[:, 1] if isinstance(move, FaceMove) else None
     costs_arr = np.array(costs, dtype=float)
     if np.isnan(costs_arr).all():
         costs_arr[:] = 1.0
@@ -314,7 +307,7 @@ def predict(
         costs_arr = np.where(np.isnan(costs_arr), np.nanmean(costs_arr), costs_arr)
     return Prediction(
         move, np.array(rows), outcome_bounds(noise)[move.kind], costs_arr, np.array(clear, dtype=float), table,
-        slide,
+        reach,
     )
 
 
@@ -368,8 +361,8 @@ def table_conflict(
 def _table_conflict(
     h: Hypothesis, move: Move, state: SensorState, components: Mapping[int, DataComponent], config: PlannerConfig
 ) -> tuple[float, float]:
-    """:func:`table_conflict`, and for a face move whether the trace across the face itself runs into the
-    table (the step onto the next face aside; NaN for other moves)."""
+    """:func:`table_conflict`, and for a face move how far its trace touches the face (:attr:`Prediction.reach`;
+    NaN for other moves)."""
     if config.table_z is None:
         return 0.0, np.nan
     t = h.world_from_model
@@ -395,10 +388,12 @@ def _table_conflict(
         if hit is None:
             return np.nan, np.nan
         n_w = t.rotate(n)
-        down = float(np.asarray(move.direction) @ [0.0, 0.0, 1.0]) < 0.0
-        if down and pad_clearance(t.apply(hit.point), n_w, config) < lim:
-            return 1.0, 1.0
-        return float(onto_hidden(hit.edge, hit.next_face, hit.point)), 0.0
+        d_z = float(np.asarray(move.direction)[2])
+        if d_z < 0.0 and pad_clearance(t.apply(hit.point), n_w, config) < lim:
+            # the slide stops where the pad comes too close to the table
+            start = pad_clearance(t.apply(p_m - (p_m @ n - poly.face_offsets[f_m]) * n), n_w, config)
+            return 1.0, float(np.clip((start - lim) / -d_z, 0.0, hit.distance))
+        return float(onto_hidden(hit.edge, hit.next_face, hit.point)), float(hit.distance)
     if isinstance(move, EdgeMove):
         # an edge running down to the table ends at a vertex on it, where the table blocks the finger: the
         # executor finds that vertex (the only way to measure such an edge), so an edge move is never refused

@@ -13,16 +13,16 @@ from haptic.planning.predict import PlannerConfig, Prediction
 LIB = load_library()
 
 
-def _prediction(reach, table, slide):
-    n = len(reach)
-    outcomes = np.column_stack([reach, np.zeros(n), np.zeros(n)])
+def _prediction(edge, table, reach):
+    n = len(edge)
+    outcomes = np.column_stack([edge, np.zeros(n), np.zeros(n)])
     return Prediction(FaceMove(np.array([1.0, 0.0, 0.0])), outcomes, np.array([0.002, 0.02, 0.02]),
-                      np.ones(n), np.full(n, 0.02), np.asarray(table, float), np.asarray(slide, float))
+                      np.ones(n), np.full(n, 0.02), np.asarray(table, float), np.asarray(reach, float))
 
 
 def test_a_trace_failing_past_its_edge_rules_out_only_shorter_faces():
     # hypotheses 0 and 2 predict the face to reach 68 and 92 mm and the next face out of reach; 1 reaches 57
-    pred = _prediction([0.068, 0.057, 0.092], table=[1, 0, 1], slide=[0, 0, 0])
+    pred = _prediction([0.068, 0.057, 0.092], table=[1, 0, 1], reach=[0.068, 0.057, 0.092])
     on, off = PlannerConfig(table_z=0.0, touch_evidence=True), PlannerConfig(table_z=0.0)
     d = _eliminates(pred, on)
     assert d[0].tolist() == [False, True, False]  # 0's trace passes 1's edge, stops before 2's
@@ -33,9 +33,14 @@ def test_a_trace_failing_past_its_edge_rules_out_only_shorter_faces():
     assert _eliminates(pred, off).tolist() == [[False, True, True], [True, False, True], [True, True, False]]
 
 
-def test_a_trace_into_the_table_still_counts_as_refused():
-    pred = _prediction([0.068, 0.057, 0.092], table=[1, 1, 1], slide=[1, 0, 0])
-    assert np.isclose(_refusal(pred, PlannerConfig(table_z=0.0, touch_evidence=True)), 1 / 3)
+def test_a_trace_stopped_by_the_table_tells_as_far_as_it_went():
+    # in hypothesis 2 the slide runs down to the table after 40 mm: far enough to pass 1's edge only
+    pred = _prediction([0.068, 0.030, 0.092], table=[0, 0, 1], reach=[0.068, 0.030, 0.040])
+    on = PlannerConfig(table_z=0.0, touch_evidence=True)
+    assert _eliminates(pred, on)[2].tolist() == [False, True, False]
+    assert _refusal(pred, on) == 0.0
+    short = _prediction([0.068, 0.030, 0.092], table=[0, 0, 1], reach=[0.068, 0.030, 0.003])
+    assert np.isclose(_refusal(short, on), 1 / 3)  # stopped at once: it tells nothing
 
 
 def test_touches_off_a_class_surface_set_it_aside():
