@@ -31,7 +31,7 @@ from haptic.executor.primitives import (
     angle,
     perpendicular,
 )
-from haptic.executor.segment import FaceFit, LineFit, SegmentBounds, Segmenter, fit_face
+from haptic.executor.segment import FaceFit, LineFit, SegmentBounds, Segmenter, fit_face, normal_turn_rate
 from haptic.matching.components import DataComponent
 from haptic.planning.moves import CostModel, EdgeMove, FaceMove, Move, MoveResult, SensorState, VertexMove
 from haptic.sim.robot import RobotInterface
@@ -336,6 +336,8 @@ class PhysicsExecutor:
                     break
             if all(r.ok and r.event == "done" for r in legs) and len(legs) == 2:
                 trace = ContactTrace.concatenate([r.trace for r in legs])
+                if not self._on_one_face(trace):
+                    return None, trace  # the pad rolled on an edge or a vertex: land again elsewhere
                 fit = self.segmenter.fit_face_trace(trace, legs[-1].info["face_normal"], two_d=True)
                 return fit, trace
             if legs[-1].status == "unstable":
@@ -352,6 +354,20 @@ class PhysicsExecutor:
                 return None, ContactTrace.concatenate([])
             n0 = t.normal.copy()
         return None, ContactTrace.concatenate([])
+
+    def _on_one_face(self, trace: ContactTrace) -> bool:
+        """Whether every contact row of the start's L stroke lies on one face. On a face the sensed normal does
+        not turn as the pad slides; landed on (or next to) an edge or a vertex, the pad rolls on it and the
+        normal turns by 1/r along the stroke -- slowly enough for the edge detector not to fire, and the rows
+        within the face cone of the turning normals then fit a wrong plane. Every contact row counts here, not
+        only those in the cone."""
+        ok = trace.in_contact
+        if ok.sum() < self.bounds.min_face_rows:
+            return False
+        tips = trace.tip_in_world[ok]
+        q = tips - tips.mean(axis=0)
+        _, _, vt = np.linalg.svd(q, full_matrices=False)
+        return normal_turn_rate(q @ vt[:2].T, trace.normal_in_world[ok]) <= self.bounds.max_face_curvature
 
     # ------------------------------------------------------------------------------------------ moves
     def execute(self, move: Move) -> MoveResult:
@@ -413,7 +429,7 @@ class PhysicsExecutor:
         st = t.stroke(n_b, r.info["away"], along)
         pieces.append(st)
         if not st.ok:
-            return st.status, "stroke on the next face failed", None, None, None
+            return st.status, f"stroke on the next face failed: {st.event}", None, None, None
         fit = self.segmenter.fit_face_trace(st.trace, st.info["normal"])
         if fit is None:
             return "unreachable", "too few contacts on the next face", None, None, None

@@ -605,14 +605,19 @@ class Toucher:
 
     def stroke(self, normal: np.ndarray, away: np.ndarray, along: np.ndarray) -> PrimitiveResult:
         """A short L on a face for its normal: ``step_in`` along ``away``, then ``stroke`` along ``along`` (the
-        other way if an edge comes first). ``info["normal"]``: mean sensed normal on the face."""
+        other way if an edge comes first). ``info["normal"]``: mean sensed normal on the face.
+
+        A leg heading down that would bring the pad onto the table (event ``"table"``: a face leaning under,
+        next to the table) ends there without failing the stroke: the step in is skipped, the stroke turns
+        back the other way; the rows recorded still tell the face (the caller's fit judges whether they are
+        enough)."""
         cfg = self.config
         n_f = unit(np.asarray(normal, dtype=float))
         pieces = [self.trace_face(away, n_f, cfg.step_in, phase="stroke")]
-        if pieces[-1].status != "ok":
+        if not pieces[-1].ok and pieces[-1].event != "table":
             return pieces[-1]
         pieces.append(self.trace_face(along, n_f, cfg.stroke, phase="stroke"))
-        if pieces[-1].ok and pieces[-1].event != "done":
+        if (pieces[-1].ok and pieces[-1].event != "done") or pieces[-1].event == "table":
             back = self.trace_face(-along, n_f, cfg.stroke * 2.0, phase="stroke")
             pieces.append(back)
         trace = ContactTrace.concatenate([p.trace for p in pieces])
@@ -620,8 +625,10 @@ class Toucher:
         nn = trace.normal_in_world[ok_rows]
         keep = nn @ n_f > math.cos(math.radians(4.0))
         n_mean = unit(nn[keep].sum(axis=0)) if keep.any() else n_f
-        status = "ok" if all(p.status == "ok" for p in pieces) else pieces[-1].status
-        return PrimitiveResult(status, "done", trace, sum(p.distance for p in pieces), {"normal": n_mean})
+        failed = [p for p in pieces if not p.ok and p.event != "table"]
+        status = failed[-1].status if failed else "ok"
+        event = failed[-1].event if failed else "done"
+        return PrimitiveResult(status, event, trace, sum(p.distance for p in pieces), {"normal": n_mean})
 
     # -- along an edge -----------------------------------------------------------------------------------------
     def follow_edge(
@@ -652,6 +659,10 @@ class Toucher:
         speed = 0.0 if acquire_only else cfg.edge_speed
         over = 0
         on_ridge = 0
+        # a normal leaning back against ``along`` is a wall ahead only once the pad has been on the edge's
+        # line: starting beyond the end of the edge behind it (rolling on the vertex there), the normal leans
+        # back until the pad has moved onto the ridge
+        on_line = False
         progress: list[float] = []
         window = max(2, int(cfg.stall_time / self.dt))
         timeout = (max_distance / cfg.edge_speed if not acquire_only else 0.0) * 2.0 + 3.0
@@ -689,12 +700,13 @@ class Toucher:
                 return self._result("ok", "vertex", 0.0, event_sign=1, lost=True)
             if self.normal is not None:
                 c = float(self.normal @ u)
-                if abs(c) > cfg.vertex_sin:
+                if abs(c) > cfg.vertex_sin and (c > 0 or on_line):
                     over += 1
                     if over >= cfg.debounce:
                         return self._result("ok", "vertex", 0.0, event_sign=1 if c > 0 else -1)
                 else:
                     over = 0
+                    on_line = on_line or abs(c) <= cfg.vertex_sin
             if acquire_only:
                 continue
             if travelled > max_distance:
