@@ -23,6 +23,7 @@ import numpy as np
 
 from haptic.geometry import tracing
 from haptic.geometry.polyhedron import Polyhedron
+from haptic.geometry.se3 import plane_basis
 from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex
 
 
@@ -110,12 +111,25 @@ def _segment_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
     return float(np.linalg.norm(p - (a + s * ab)))
 
 
+def _outside_distance(model: Polyhedron, face: int, points_m: np.ndarray) -> float:
+    """Mean in-plane distance of ``points_m`` (model frame) outside the polygon of ``face`` (0 inside)."""
+    u, w = plane_basis(model.face_normals[face])
+    loop = model.vertices[list(model.faces[face])]
+    uv = np.column_stack([loop @ u, loop @ w])
+    q = np.column_stack([points_m @ u, points_m @ w])
+    return float(np.mean([0.0 if tracing._inside_polygon(x, uv) else tracing._boundary_distance(x, uv) for x in q]))
+
+
 def score_face(c: DataFace, model: Polyhedron, rot: np.ndarray, trans: np.ndarray, tol: EvaluationTolerances):
     normals = model.face_normals @ rot.T
     offsets = model.face_offsets + normals @ trans
     ang = np.degrees(np.arccos(np.clip(normals @ c.normal, -1, 1)))
     dist = np.abs(c.points @ normals.T - offsets).mean(axis=0)
-    cost = ang / math.degrees(tol.normal) + dist / tol.plane
+    # coplanar faces (BOX01N/P's two top faces) have the same normal and plane: tell them apart by whether the
+    # points lie inside the face polygon, else the lower index would always win
+    points_m = (np.asarray(c.points, dtype=float) - trans) @ rot
+    outside = np.array([_outside_distance(model, f, points_m) for f in range(model.n_faces)])
+    cost = ang / math.degrees(tol.normal) + dist / tol.plane + outside / tol.plane
     k = int(np.argmin(cost))
     ok = ang[k] <= math.degrees(tol.normal) and dist[k] <= tol.plane
     return ComponentScore(c.id, "face", k if ok else None, float(ang[k]), float(dist[k] * 1e3))
