@@ -116,53 +116,65 @@ def pose_error(model: Polyhedron, truth: SE3, estimate: SE3) -> tuple[float, flo
     return dist, float(np.degrees(ang))
 
 
-TOUCH_TOL = 0.005
-"""A touched point farther than this from a pose class's surface, at the class's pose, contradicts it [m]."""
-TOUCH_OUTLIERS = 5
-"""Contradicting points it takes to set a pose class aside (a stray reading is not enough)."""
-TOUCH_SPACING = 0.002
-"""Touched points are thinned to about one per this much of the trace [m]."""
 TOUCH_PHASES = ("face", "circle")
 """Trace phases whose contacts count: the pad sliding on one face (rolling over an edge, or resting on an edge
 or a vertex, it may touch two faces at once, and the sensed point is their mean)."""
+TOUCH_CONE = np.deg2rad(8.0)
+"""Within a phase, rows whose sensed normal is farther than this from the phase's median normal are not on
+the face slid on (the pad in a corner, or turning at an edge) and do not count [rad]."""
 
 
-def touched_points(result: MoveResult, config: PlannerConfig) -> np.ndarray:
-    """The contact points of a move's trace (the physics executor's sensing, in ``result.info["trace"]``) while
-    sliding on a face, thinned along the trace, none within the pad's radius of the table (where the pad may
-    touch the table and the object at once); (0, 3) when the executor keeps no trace."""
+def touched_points(result: MoveResult, config: PlannerConfig) -> tuple[np.ndarray, np.ndarray]:
+    """The contact points and sensed normals of a move's trace (the physics executor's sensing, in
+    ``result.info["trace"]``) while sliding on a face, thinned to one per ``config.touch_spacing`` of the
+    trace, none within the pad's radius of the table (where the pad may touch the table and the object at
+    once); shapes (P, 3), (P, 3), with P = 0 when the executor keeps no trace."""
     from haptic.executor.primitives import PHASES
 
+    none = (np.zeros((0, 3)), np.zeros((0, 3)))
     trace = result.info.get("trace") if isinstance(result.info, dict) else None
     if trace is None or not len(trace):
-        return np.zeros((0, 3))
-    ok = trace.in_contact & np.isin(trace.phase, [PHASES.index(ph) for ph in TOUCH_PHASES])
-    p = trace.point_in_world[ok]
-    if config.table_z is not None:
-        p = p[p[:, 2] > config.table_z + config.pad_radius]
-    kept: list[np.ndarray] = []
-    for q in p:
-        if not kept or float(np.linalg.norm(q - kept[-1])) >= TOUCH_SPACING:
-            kept.append(q)
-    return np.array(kept).reshape(-1, 3)
+        return none
+    pts, nrm = [], []
+    for ph in TOUCH_PHASES:
+        ok = trace.in_contact & (trace.phase == PHASES.index(ph))
+        p, n = trace.point_in_world[ok], trace.normal_in_world[ok]
+        if config.table_z is not None:
+            high = p[:, 2] > config.table_z + config.pad_radius
+            p, n = p[high], n[high]
+        if not len(p):
+            continue
+        med = np.median(n, axis=0)
+        on = n @ (med / np.linalg.norm(med)) > np.cos(TOUCH_CONE)
+        last = None
+        for q, m in zip(p[on], n[on], strict=True):
+            if last is None or float(np.linalg.norm(q - last)) >= config.touch_spacing:
+                pts.append(q)
+                nrm.append(m)
+                last = q
+    return (np.array(pts), np.array(nrm)) if pts else none
 
 
-def _fits_touches(c, touched: np.ndarray) -> bool:
-    """Whether pose class ``c`` has every touched point on its surface (but a few strays)."""
-    from haptic.planning.reach import surface_distance
+def _fits_touches(c, touched: tuple[np.ndarray, np.ndarray], config: PlannerConfig) -> bool:
+    """Whether pose class ``c`` has every touched point on a face of its sensed normal (but a few strays)."""
+    from haptic.planning.reach import touch_distance
 
-    d = surface_distance(c.model, c.world_from_model.inverse().apply(touched))
-    return int((d > TOUCH_TOL).sum()) < TOUCH_OUTLIERS
+    d = touch_distance(c.model, c.world_from_model, *touched)
+    return int((d > config.touch_tol).sum()) < config.touch_outliers
 
 
 def _on_the_table(
-    rec: Recognition, tree: InterpretationTree, components, config: PlannerConfig, touched: np.ndarray | None = None
+    rec: Recognition,
+    tree: InterpretationTree,
+    components,
+    config: PlannerConfig,
+    touched: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> Recognition:
     """The matcher's verdict with the workspace prior that the object rests on the table (``config.table_z``):
     once the data fix the poses, pose classes that would put the model through the table or float it above
     it are set aside, and the verdict is taken again over the rest (left as it is when that would leave no
     class: the prior is then doubted, not the data). With ``touched`` points (every contact sensed so far),
-    classes that leave some of them off their surface are set aside too. A few classes left that differ only
+    classes that leave some of them off their faces are set aside too. A few classes left that differ only
     where the fingertip
     cannot reach (:func:`~haptic.planning.reach.indistinguishable`: their difference faces the table) are
     ambiguous."""
@@ -172,8 +184,8 @@ def _on_the_table(
     if not rec.classes or not pose_fixed_by(components):
         return rec
     keep = tuple(c for c in rec.classes if rests_on_table(c.model, c.world_from_model, config)) or rec.classes
-    if touched is not None and len(touched) and len(keep) <= MAX_TOUCH_CHECK:
-        keep = tuple(c for c in keep if _fits_touches(c, touched)) or keep
+    if touched is not None and len(touched[0]) and len(keep) <= MAX_TOUCH_CHECK:
+        keep = tuple(c for c in keep if _fits_touches(c, touched, config)) or keep
     if len(keep) == len(rec.classes) and rec.status != EXPLORING:
         return rec
     models = tuple(sorted({c.name for c in keep}))
@@ -305,14 +317,17 @@ def run_loop(
     outcome, detail = EXPLORING, ""
     fallback = RandomPolicy()
 
-    touched: list[np.ndarray] = []
+    touched: list[tuple[np.ndarray, np.ndarray]] = []
 
     def assess() -> Recognition:
         """The verdict on the data so far (with the table and the touched points, when known)."""
         r = recognize(tree, max_interpretations=MAX_POSED)
         if config.table_z is None:
             return r
-        return _on_the_table(r, tree, components, config, np.concatenate(touched) if touched else None)
+        if not touched:
+            return _on_the_table(r, tree, components, config)
+        both = (np.concatenate([p for p, _ in touched]), np.concatenate([n for _, n in touched]))
+        return _on_the_table(r, tree, components, config, both)
 
     def absorb(result: MoveResult) -> None:
         nonlocal cost, rec

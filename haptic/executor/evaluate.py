@@ -5,11 +5,11 @@ true component of its kind: a face by normal and plane distance, an edge by the 
 from the true edge segment and its direction, a vertex by position. Errors: face normal [deg], edge direction
 [deg], edge position [mm] (largest distance of the interval's ends from the true edge line), vertex position
 [mm]. A component farther than the tolerances from every true component of its kind is *spurious*. A move whose
-reported edge (vertex) is not the first true edge (vertex) on the ideal path from where the move started -- it
-crossed a true edge without reporting it; a path meeting the boundary within the position tolerance of a vertex
-is not checked --, an edge move whose vertex is not an end of the true edge it
-followed, and a vertex move whose new edge does not leave the circled vertex on the face circled across each
-count one *missed* component.
+reported edge (vertex) is not the first true edge (vertex) the pad must feel on the ideal path from where the
+move started (:func:`first_felt_edge`) -- it crossed a true edge without reporting it; a path meeting the
+boundary within the position tolerance of a vertex is not checked --, an edge move whose vertex is not an end
+of the true edge it followed, and a vertex move whose new edge does not leave the circled vertex on the face
+circled across each count one *missed* component.
 
 The executor and the segmenter never import this module.
 """
@@ -190,6 +190,48 @@ def score_components(
     return PerceptionScore(tuple(scores), sum(1 for s in scores if s.true_id is None), missed, concave, details)
 
 
+PAD_RADIUS = 0.012
+"""Radius of the fingertip pad [m] (the hand's geometry, for what its path can feel)."""
+MIN_TILT = math.radians(10.0)
+"""The least angle between the two faces of an edge of the library: a pad tilted less than this over the
+rim of a face cannot be told from one on a real edge that shallow."""
+
+
+def first_felt_edge(model: Polyhedron, face: int, start_m: np.ndarray, d_m: np.ndarray, tol: EvaluationTolerances):
+    """The first edge a pad sliding from ``start_m`` along ``d_m`` on ``face`` (model frame) must feel: the
+    first boundary crossing of the straight path after which the path goes farther off the face's polygon
+    than ``PAD_RADIUS · sin(MIN_TILT)`` (≈ 2.1 mm) before coming back onto it. Across a shorter excursion
+    -- clipping a reflex corner of a non-convex face -- the pad, resting on the face around it, tilts less
+    than an edge would turn it. None when there is no such edge, or when the path meets the boundary within
+    the position tolerance of a vertex (no single first edge: the pad is 24 mm wide)."""
+    u, w = plane_basis(model.face_normals[face])
+    loop = model.vertices[list(model.faces[face])]
+    uv = np.column_stack([loop @ u, loop @ w])
+    depth = PAD_RADIUS * math.sin(MIN_TILT)
+    step = 2e-4
+    p = np.asarray(start_m, dtype=float)
+    for _ in range(model.n_edges):
+        try:
+            hit = tracing.trace_face(model, face, p, d_m, vertex_margin=tol.position)
+        except (ValueError, IndexError):
+            return None
+        if hit is None:
+            return None
+        d = hit.point - p
+        d /= np.linalg.norm(d)
+        for s in np.arange(step, float(np.linalg.norm(model.extents)) + step, step):
+            q = hit.point + s * d
+            x = np.array([q @ u, q @ w])
+            if tracing._inside_polygon(x, uv):
+                p = q
+                break  # back on the face: a corner the pad bridges; trace on from here
+            if tracing._boundary_distance(x, uv) > depth:
+                return hit
+        else:
+            return hit
+    return None
+
+
 def _missed(
     results, model: Polyhedron, rot: np.ndarray, trans: np.ndarray, by_id: dict, tol: EvaluationTolerances
 ) -> tuple[int, dict]:
@@ -211,12 +253,7 @@ def _missed(
                     n = model.face_normals[f_score.true_id]
                     d_m = d_m - (d_m @ n) * n
                     start_m = start_m - (start_m @ n - model.face_offsets[f_score.true_id]) * n
-                    try:
-                        # a path meeting the boundary within the position tolerance of a vertex has no
-                        # single first edge (the pad is 12 mm wide): not checked
-                        hit = tracing.trace_face(model, f_score.true_id, start_m, d_m, vertex_margin=tol.position)
-                    except (ValueError, IndexError):
-                        hit = None
+                    hit = first_felt_edge(model, f_score.true_id, start_m, d_m, tol)
                     if hit is not None:
                         ok = e_score.true_id == hit.edge
                         missed += 0 if ok else 1

@@ -418,8 +418,10 @@ class PhysicsExecutor:
         r = t.cross_edge(kind, n_a, direction)
         pieces.append(r)
         if not r.ok:
-            why = "the next face leans under, out of the pad's reach" if r.event == "undercut" else r.event
-            return r.status, f"crossing the {kind} edge: {why}", None, None, None
+            if r.event == "undercut":
+                return "undercut", f"crossing the {kind} edge: the next face leans under, out of the pad's reach", \
+                    r.trace, None, None
+            return r.status, f"crossing the {kind} edge: {r.event}", None, None, None
         n_b = r.info["normal"]
         if self._is_table(n_b, t.contact[2]):
             return "unreachable", "the edge lies on the table", None, None, None
@@ -459,6 +461,8 @@ class PhysicsExecutor:
         corner = self._contact_point()
         status, reason, roll, stroke, fit_b = self._cross_and_acquire(kind, r.info["face_normal"], r.info["direction"],
                                                                       pieces)  # fmt: skip
+        if status == "undercut":
+            return self._edge_only(move, r, roll, reason)
         if status != "ok":
             return self._fail(move, status, reason)
         fit_a, line, why = self._edge_between(st.face, r.trace, "face", roll, fit_b, kind, corner)
@@ -474,6 +478,23 @@ class PhysicsExecutor:
                                  edge_faces=(st.face, face.id))  # fmt: skip
         return MoveResult(move=move, status="ok", components=(edge, face), distance=r.distance,
                           cost=self.costs.face_move(r.distance), state=self.state, info={"kind": kind})  # fmt: skip
+
+    def _edge_only(self, move: FaceMove, r: PrimitiveResult, roll: ContactTrace, reason: str) -> MoveResult:
+        """A face move that rolled over a convex edge onto a face leaning under, out of the pad's reach: the
+        edge alone, from the face and the roll (the sensor stays on the face it traced)."""
+        st, seg = self.state, self.segmenter
+        fit_a = self._face_fit(st.face, r.trace)
+        got = seg.edge_from_roll(fit_a, ContactTrace.concatenate([r.trace.select(r.trace.phase ==
+                                                                                 PHASES.index("face")).tail(8), roll]))
+        if isinstance(got, str):
+            return self._fail(move, "unreachable", f"{reason}; no edge from the roll: {got}")
+        line, n_last = got
+        edge = seg.add_edge(line, (st.face, None), True, (fit_a.normal, n_last), adjacent=(st.face,))
+        self._on_face = None
+        self.state = SensorState(position=line.point + line.direction * 0.5 * sum(line.s_range), face=st.face)
+        return MoveResult(move=move, status="ok", components=(edge,), distance=r.distance,
+                          cost=self.costs.face_move(r.distance), state=self.state,
+                          info={"kind": "convex", "next_face": "out of reach"})  # fmt: skip
 
     @staticmethod
     def _last_on(trace: ContactTrace, normal: np.ndarray) -> np.ndarray:

@@ -31,6 +31,9 @@ DOWN = np.diag([-1.0, 1.0, -1.0])
 """Hand rotation ``world_from_hand`` with the fingers pointing down (the tracing posture)."""
 
 FAILURES = ("no-contact", "unreachable", "timeout", "unstable")
+UNDERCUT_SLACK = math.radians(3.0)
+"""Rolling off a face that itself leans under near the limit, the roll ends for the undercut only once the
+normal leans this much further than the face's (not on a noisy first reading) [rad]."""
 """Failure statuses of a primitive (the move statuses of :class:`~haptic.planning.moves.MoveResult`)."""
 
 PHASES = ("free", "approach", "settle", "face", "roll", "stroke", "ridge", "vertex", "circle")
@@ -585,7 +588,10 @@ class Toucher:
                 continue
             lost = 0
             hist.append((travelled, self.normal.copy()))
-            if kind == "convex" and float(self.normal @ back) < -math.sin(cfg.max_undercut):
+            # leaning under past the limit, and further than face a (from a face near the limit, noise alone
+            # must not end the roll)
+            limit = min(-math.sin(cfg.max_undercut), float(n_a @ back) - math.sin(UNDERCUT_SLACK))
+            if kind == "convex" and float(self.normal @ back) < limit:
                 self._press(np.zeros(3))
                 self.tick("roll")
                 return self._result("unreachable", "undercut", 0.0)

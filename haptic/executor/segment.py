@@ -228,6 +228,11 @@ def line_from_points(
     return LineFit(c, b, s_b, s_pos, (float(s.min()), float(s.max())))
 
 
+ROLL_AXIS_SLACK = math.radians(3.0)
+"""Rolling over an edge whose next face is out of reach, the sensed normals stay this close (beyond the noise)
+to the plane perpendicular to the edge; a roll round a vertex turns them out of any one plane [rad]."""
+
+
 # ----------------------------------------------------------------------------------------------------------- book
 
 
@@ -248,7 +253,7 @@ class EdgeRecord:
     direction_sigma: float
     position_sigma: float
     interval: tuple[float, float]  # explored [s_lo, s_hi] along direction from point
-    faces: tuple[int, int]  # (face traced from, face stepped onto)
+    faces: tuple[int, int | None]  # (face traced from, face stepped onto; None: it was out of reach)
     convex: bool
     inward: dict[int, np.ndarray] = field(default_factory=dict)  # face id -> in-plane unit vector into the face
     side_points: list[tuple[int, np.ndarray]] = field(default_factory=list)
@@ -358,6 +363,41 @@ class Segmenter:
             rng = (0.0, 0.0)
         return LineFit(p, b_dir, s_b, s_p, rng)
 
+    def edge_from_roll(self, fit_a: FaceFit, roll: ContactTrace) -> tuple[LineFit, np.ndarray] | str:
+        """The line of a convex edge from face a and a roll over it alone, when the next face is out of reach
+        (it leans under): the rolling normals turn about the edge, so its direction is the axis
+        perpendicular to ``n_a`` and to every rolling normal (least squares), and the rolling contacts lie on
+        it. Returns the line and the last rolling normal, or why the roll cannot give an edge: too few
+        rolling contacts, a turn under ``min_edge_angle``, contacts off face a's plane, or normals that did
+        not turn about one axis."""
+        b = self.bounds
+        ok = roll.in_contact
+        n, pts = roll.normal_in_world[ok], roll.point_in_world[ok]
+        n_a = fit_a.normal
+        turned = n @ n_a < math.cos(math.radians(3.0))
+        if turned.sum() < 5:
+            return "too few contacts while rolling over the edge"
+        n, pts = n[turned], pts[turned]
+        sin2 = 1.0 - np.clip(n @ n_a, -1.0, 1.0) ** 2
+        if math.asin(math.sqrt(float(sin2.max()))) < b.min_edge_angle:
+            return "the normal turned too little over the edge"
+        off = float(np.median(np.abs(pts @ n_a - fit_a.offset)))
+        if off > b.max_roll_offset:
+            return f"the roll lies {off * 1e3:.1f} mm off the face's plane"
+        # the edge direction e ⊥ n_a: e = cos φ u + sin φ w; each rolling normal gives n·e = 0
+        u = perpendicular_unit(n_a)
+        w = np.cross(n_a, u)
+        m = np.column_stack([n @ u, n @ w])
+        _, _, vt = np.linalg.svd(m, full_matrices=False)
+        e = unit(vt[-1, 0] * u + vt[-1, 1] * w)
+        resid = n @ e
+        # with no second face to check the edge against, every rolling normal must have turned about it
+        if float(np.quantile(np.abs(resid), 0.9)) > math.sin(ROLL_AXIS_SLACK) + b.k * b.normal_sigma:
+            return "the roll turned about more than one axis (round a vertex?)"
+        sigma_n = max(float(np.sqrt(np.mean(resid**2))), b.normal_sigma)
+        s_e = math.hypot(sigma_n / math.sqrt(float(sin2.sum())), fit_a.normal_sigma)
+        return line_from_points(pts, e, s_e, b), n[-1].copy()
+
     def edge_inconsistency(self, fit_a: FaceFit, fit_b: FaceFit, convex: bool, roll: ContactTrace) -> str | None:
         """Why the roll from face a onto face b cannot have been over the edge between them (None: it can):
         the faces' normals are too close for an edge, the rolling normals did not turn about ``n_a × n_b``,
@@ -389,14 +429,15 @@ class Segmenter:
     def add_edge(
         self,
         line: LineFit,
-        faces: tuple[int, int],
+        faces: tuple[int, int | None],
         convex: bool,
         normals: tuple[np.ndarray, np.ndarray],
         adjacent: tuple[int, ...],
         vertex: tuple[int, float] | None = None,
     ) -> DataEdge:
         """Report a new edge between ``faces`` of outward ``normals`` (``faces[1]`` may be the id the next face
-        will get). ``vertex``: a known data vertex on this edge and its parameter.
+        will get, or None when it is out of reach and ``normals[1]`` is the last normal rolled onto).
+        ``vertex``: a known data vertex on this edge and its parameter.
 
         Which side of the edge each face lies on follows from the normals and the convexity (a convex edge's
         face a extends away from ``n_b``, a concave edge's towards it), not from contact points next to the
@@ -412,6 +453,8 @@ class Segmenter:
             rec.vertices[vertex[0]] = vertex[1]
         mid = rec.at(0.5 * (rec.interval[0] + rec.interval[1]))
         for fid, n_f, n_o in ((faces[0], normals[0], normals[1]), (faces[1], normals[1], normals[0])):
+            if fid is None:  # the next face was out of reach
+                continue
             w = unit(n_o - float(n_o @ n_f) * n_f)
             w = unit(w - float(w @ rec.direction) * rec.direction)
             rec.inward[fid] = -w if convex else w

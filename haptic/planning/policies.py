@@ -119,14 +119,18 @@ def _refusal(pred: Prediction, config: PlannerConfig) -> float:
 
 def _eliminates(pred: Prediction, config: PlannerConfig) -> np.ndarray:
     """``D[i, j]``: hypothesis ``j`` eliminated if ``i`` is true. By the predicted attributes (§4.1); where the
-    face move fails in ``i``'s world, only the hypotheses whose face ends sooner than ``i``'s trace (it touches
-    points beyond their edge)."""
+    face move ends at its edge in ``i``'s world, the next face out of reach, by the edge's distance and angle
+    alone; where it fails in ``i``'s world, only the hypotheses whose face ends sooner than ``i``'s trace (it
+    touches points beyond their edge)."""
     d = distinguishable(pred.outcomes, pred.bounds)
+    if pred.edge_only is not None and (pred.edge_only == 1).any():
+        d_edge = distinguishable(pred.outcomes[:, :2], pred.bounds[:2])
+        d = np.where((pred.edge_only == 1)[:, None], d_edge, d)
     fails = _failing(pred, config)
     if fails is None:
         return d
     with np.errstate(invalid="ignore"):
-        beyond = pred.reach[:, None] - pred.outcomes[None, :, 0] > pred.bounds[0]
+        beyond = pred.reach[:, None] - pred.outcomes[None, :, 0] > max(pred.bounds[0], config.touch_margin)
     return np.where(fails[:, None], beyond, d)
 
 

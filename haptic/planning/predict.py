@@ -55,15 +55,29 @@ class PlannerConfig:
     max_undercut: float | None = None
     """With a table, how far a face's outward normal may lean back under, past horizontal, for the pad of the
     downward-pointing fingers to roll onto it over a convex edge (the robot's own reach, set for the physics
-    executor); a move predicted to roll onto a face leaning further counts as refused like one running into
-    the table [rad]. None: no limit."""
+    executor) [rad]. A face move predicted to roll over an edge onto a face leaning further ends there and
+    reports the edge alone (:attr:`Prediction.edge_only`); a vertex move doing so counts as refused like one
+    running into the table. None: no limit."""
     touch_evidence: bool = False
     """Every touched point is checked against each pose class's surface (the episode does so with the
     physics executor's traces), so a face move that cannot step onto its next face still tells how far its
     face reaches; scored so."""
+    touch_tol: float = 0.0025
+    """A touched point farther than this from every face of a pose class whose normal agrees with the sensed
+    one contradicts the class [m]."""
+    touch_outliers: int = 3
+    """Contradicting points it takes to set a pose class aside (a stray reading is not enough)."""
+    touch_spacing: float = 0.001
+    """Touched points are thinned to about one per this much of the trace [m]."""
     table_risk: float = 0.5
     """Candidate moves that at least this fraction of the hypotheses predict to bring the pad onto the table
     are not offered (the executor would refuse or abort them); the rest are discounted by their risk."""
+
+    @property
+    def touch_margin(self) -> float:
+        """How far past a pose class's edge a trace must touch its face for the touched points to set the
+        class aside (``touch_outliers`` points beyond ``touch_tol``) [m]."""
+        return self.touch_tol + self.touch_outliers * self.touch_spacing
 
 
 @dataclass(frozen=True, eq=False)
@@ -110,6 +124,11 @@ class Prediction:
     """For face moves with a table, per hypothesis: how far along the face the trace touches it, to the edge
     or to where the pad would come too close to the table and stop, whether or not the move then succeeds
     (NaN: cannot say) [m]."""
+    edge_only: np.ndarray | None = None
+    """For face moves with ``config.max_undercut``, per hypothesis: 1 when the move is predicted to end at its
+    edge, the next face leaning under out of the pad's reach (the executor then reports the edge alone:
+    its distance and direction are measured, the next face's angle is not), 0 when not, NaN when the
+    hypothesis cannot say."""
 
     @property
     def table_risk(self) -> float:
@@ -292,14 +311,16 @@ def predict(
         rows.append(o)
         costs.append(c)
         clear.append(cl)
-    table = reach = None
+    table = reach = edge_only = None
     if config.table_z is not None:
         if data_table_conflict(move, state, components, config):
             table = np.ones(len(hypotheses))
         else:
-            both = np.array([_table_conflict(h, move, state, components, config) for h in hypotheses], dtype=float)
-            table = both[:, 0]
-            reach = both[:, 1] if isinstance(move, FaceMove) else None
+            got = np.array([_table_conflict(h, move, state, components, config) for h in hypotheses], dtype=float)
+            table = got[:, 0]
+            if isinstance(move, FaceMove):
+                reach = got[:, 1]
+                edge_only = got[:, 2] if config.max_undercut is not None else None
     costs_arr = np.array(costs, dtype=float)
     if np.isnan(costs_arr).all():
         costs_arr[:] = 1.0
@@ -307,12 +328,16 @@ def predict(
         costs_arr = np.where(np.isnan(costs_arr), np.nanmean(costs_arr), costs_arr)
     return Prediction(
         move, np.array(rows), outcome_bounds(noise)[move.kind], costs_arr, np.array(clear, dtype=float), table,
-        reach,
+        reach, edge_only,
     )
 
 
 # ------------------------------------------------------------------------------------------- the table
 
+EDGE_ROLL = np.deg2rad(12.0)
+"""How far the pad's normal must turn over an edge, before it leans under past ``max_undercut``, for the
+executor to measure the edge from the roll alone (its segmenter wants 10°): from a face leaning under
+within this of the limit, a move ending at an edge onto a face out of reach tells nothing [rad]."""
 TABLE_STEP_ONTO = 0.003
 """How far onto the next face a face or vertex move strokes for its normal (for the table check) [m]."""
 
@@ -353,69 +378,78 @@ def table_conflict(
     the table hides; a vertex move whose circle, before it meets the next edge, would put the pad on the table,
     or whose next face the table hides. Edge moves are never refused (one running down to the table ends at
     the vertex the table blocks, which the executor finds). A workspace prior (``config.table_z``) with the
-    hypothesis's own pose; 0.0 without a table. With ``config.max_undercut``, stepping over a convex edge onto
-    a face that leans under further than the pad reaches counts too."""
+    hypothesis's own pose; 0.0 without a table. With ``config.max_undercut``, a vertex move stepping over a
+    convex edge onto a face that leans under further than the pad reaches counts too (a face move doing so
+    ends at the edge instead: :attr:`Prediction.edge_only`)."""
     return _table_conflict(h, move, state, components, config)[0]
 
 
 def _table_conflict(
     h: Hypothesis, move: Move, state: SensorState, components: Mapping[int, DataComponent], config: PlannerConfig
 ) -> tuple[float, float]:
-    """:func:`table_conflict`, and for a face move how far its trace touches the face (:attr:`Prediction.reach`;
-    NaN for other moves)."""
+    """:func:`table_conflict`; for a face move, how far its trace touches the face (:attr:`Prediction.reach`)
+    and whether it ends at its edge, the next face out of reach (:attr:`Prediction.edge_only`); NaN, NaN for
+    other moves."""
     if config.table_z is None:
-        return 0.0, np.nan
+        return 0.0, np.nan, np.nan
     t = h.world_from_model
     if t is None:
-        return np.nan, np.nan
+        return np.nan, np.nan, np.nan
     poly, lim = h.poly, config.table_clearance
     p_m = t.inverse().apply(state.position)
 
+    def leans_under(e_m: int, g_m: int) -> bool:
+        """Whether the pad cannot roll over convex edge ``e_m`` onto ``g_m``: it leans under, out of reach."""
+        if config.max_undercut is None or poly.edge_convexity[e_m] <= 0:
+            return False
+        return float(t.rotate(poly.face_normals[g_m])[2]) < -np.sin(config.max_undercut)
+
     def onto_hidden(e_m: int, g_m: int, at_m: np.ndarray) -> bool:
         q = t.apply(at_m + TABLE_STEP_ONTO * _inward(poly, e_m, g_m))
-        n_g = t.rotate(poly.face_normals[g_m])
-        if config.max_undercut is not None and poly.edge_convexity[e_m] > 0:
-            if float(n_g[2]) < -np.sin(config.max_undercut):
-                return True  # the next face leans under, out of the pad's reach
-        return pad_clearance(q, n_g, config) < lim
+        return leans_under(e_m, g_m) or pad_clearance(q, t.rotate(poly.face_normals[g_m]), config) < lim
 
     if isinstance(move, FaceMove):
         f_m = h.faces.get(state.face)
         if f_m is None:
-            return np.nan, np.nan
+            return np.nan, np.nan, np.nan
         n = poly.face_normals[f_m]
         hit = trace_face(poly, f_m, p_m - (p_m @ n - poly.face_offsets[f_m]) * n, t.inverse().rotate(move.direction))
         if hit is None:
-            return np.nan, np.nan
+            return np.nan, np.nan, np.nan
         n_w = t.rotate(n)
         d_z = float(np.asarray(move.direction)[2])
         if d_z < 0.0 and pad_clearance(t.apply(hit.point), n_w, config) < lim:
             # the slide stops where the pad comes too close to the table
             start = pad_clearance(t.apply(p_m - (p_m @ n - poly.face_offsets[f_m]) * n), n_w, config)
-            return 1.0, float(np.clip((start - lim) / -d_z, 0.0, hit.distance))
-        return float(onto_hidden(hit.edge, hit.next_face, hit.point)), float(hit.distance)
+            return 1.0, float(np.clip((start - lim) / -d_z, 0.0, hit.distance)), 0.0
+        if leans_under(hit.edge, hit.next_face):
+            if float(n_w[2]) < -np.sin(config.max_undercut - EDGE_ROLL):
+                return 1.0, float(hit.distance), 0.0  # no room to roll: the move fails at the edge
+            return 0.0, float(hit.distance), 1.0
+        return float(onto_hidden(hit.edge, hit.next_face, hit.point)), float(hit.distance), 0.0
     if isinstance(move, EdgeMove):
         # an edge running down to the table ends at a vertex on it, where the table blocks the finger: the
         # executor finds that vertex (the only way to measure such an edge), so an edge move is never refused
-        return 0.0, np.nan
+        return 0.0, np.nan, np.nan
     if isinstance(move, VertexMove):
         e_m = h.edges.get(state.edge) if state.edge is not None else None
         v_m = h.vertices.get(state.vertex) if state.vertex is not None else None
         a_m = h.faces.get(move.across_face)
         if e_m is None or v_m is None or a_m is None:
-            return np.nan, np.nan
+            return np.nan, np.nan, np.nan
         try:
             hit = circle_vertex(poly, v_m, e_m, a_m, config.vertex_radius)
         except ValueError:
-            return np.nan, np.nan
+            return np.nan, np.nan, np.nan
         u = poly.edge_directions[e_m] * (1.0 if poly.edges[e_m, 1] == v_m else -1.0)
         pts = circle_points(poly.vertices[v_m], u, _inward(poly, e_m, a_m), config.vertex_radius,
                             VERTEX_START_ANGLE, hit.angle, np.deg2rad(3.0))  # fmt: skip
         n_w = t.rotate(poly.face_normals[a_m])
         if min(pad_clearance(q, n_w, config) for q in t.apply(pts)) < lim:
-            return 1.0, np.nan
+            return 1.0, np.nan, np.nan
         away = poly.edge_directions[hit.edge] * (1.0 if poly.edges[hit.edge, 0] == v_m else -1.0)
-        return float(onto_hidden(hit.edge, hit.next_face, poly.vertices[v_m] + config.vertex_radius * away)), np.nan
+        at = poly.vertices[v_m] + config.vertex_radius * away
+        return float(onto_hidden(hit.edge, hit.next_face, at)), np.nan, np.nan
     raise TypeError(f"unknown move {move!r}")
 
 

@@ -9,9 +9,15 @@ normal ``n`` is *reachable* when the pad touching it, centred at ``c = p + r n``
 - can be lowered there from above (the vertical line over ``c`` stays outside the object), and
 - meets a face it can press on (the normal leans under by no more than ``config.max_undercut``).
 
-Two hypotheses (model and pose) that agree on every reachable point -- each one's reachable surface lies on
-the other's surface, within ``tol`` -- cannot be told apart by any move: their difference faces the table.
-The episode then ends as ambiguous instead of exploring without end.
+A convex edge between a face the pad reaches (with room to roll :data:`~haptic.planning.predict.EDGE_ROLL`
+before the limit) and one leaning under past ``config.max_undercut`` is *observable* where the pad can slide
+to it on the first face and roll over it to that limit clear of the table: a face move there reports the edge
+alone.
+
+Two hypotheses (model and pose) that agree on every reachable point and observable edge -- each one's
+reachable surface lies on the other's surface, and its observable edges on the other's edges, within
+``tol`` -- cannot be told apart by any move: their difference faces the table. The episode then ends as
+ambiguous instead of exploring without end.
 """
 
 from __future__ import annotations
@@ -19,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 
 from haptic.geometry import SE3, Polyhedron
-from haptic.planning.predict import PlannerConfig
+from haptic.planning.predict import EDGE_ROLL, PlannerConfig
 
 SPACING = 0.004
 """Spacing of the sample points over the faces [m]."""
@@ -59,6 +65,27 @@ def surface_distance(poly: Polyhedron, points: np.ndarray) -> np.ndarray:
     return best
 
 
+FACING = np.cos(np.deg2rad(20.0))
+"""A touched point's sensed normal agrees with a face's when their angle is under 20° (a pose class's error
+and the pad's compliance are a few degrees; distinct faces of the library differ by far more)."""
+
+
+def touch_distance(poly: Polyhedron, world_from_model: SE3, points: np.ndarray, normals: np.ndarray) -> np.ndarray:
+    """Distance from each touched point (world frame) to the faces of ``poly`` at ``world_from_model`` whose
+    outward normal agrees with the point's sensed normal (inf when none does), shape (P,). A point the pad
+    touched while sliding on a face lies on a face of that normal: a point on the plane of a face just past
+    its edge, near a face at right angles, is far from the truth however close to the surface."""
+    inv = world_from_model.inverse()
+    p, n = inv.apply(np.atleast_2d(points)), inv.rotate(np.atleast_2d(normals))
+    tri = poly.vertices[poly.triangles]
+    agree = n @ poly.face_normals[poly.triangle_faces].T >= FACING  # (P, T)
+    best = np.full(len(p), np.inf)
+    for start in range(0, len(p), 2048):
+        d = _point_triangle_distance(p[start : start + 2048], tri)
+        best[start : start + 2048] = np.where(agree[start : start + 2048], d, np.inf).min(axis=1)
+    return best
+
+
 def _point_triangle_distance(p: np.ndarray, tri: np.ndarray) -> np.ndarray:
     """Distances (P, T) from points to triangles (closest point by barycentric clamping over the regions)."""
     a, b, c = tri[None, :, 0], tri[None, :, 1], tri[None, :, 2]
@@ -91,17 +118,17 @@ def _point_triangle_distance(p: np.ndarray, tri: np.ndarray) -> np.ndarray:
     return np.where(inside, d_in, d_edge)
 
 
-def reachable(
-    poly: Polyhedron, world_from_model: SE3, config: PlannerConfig, spacing: float = SPACING
-) -> tuple[np.ndarray, np.ndarray]:
-    """The reachable sample points of ``poly`` at ``world_from_model``, world frame, and their normals."""
-    pts_m, nrm_m = surface_samples(poly, spacing)
-    pts, nrm = world_from_model.apply(pts_m), world_from_model.rotate(nrm_m)
+def _touchable(
+    poly: Polyhedron, world_from_model: SE3, pts: np.ndarray, nrm: np.ndarray, config: PlannerConfig, room: float
+) -> np.ndarray:
+    """Which world points ``pts`` of faces of normals ``nrm`` the pad can touch: clear of the table by
+    ``config.table_clearance`` plus ``room``, not leaning under past ``config.max_undercut``, the pad clear
+    of the rest of the object and free to come down from above. Shape (P,) bool."""
     r = config.pad_radius
     ok = np.ones(len(pts), dtype=bool)
     centre = pts + r * nrm
     if config.table_z is not None:
-        ok &= centre[:, 2] - r - config.table_z >= config.table_clearance + TRACE_ROOM
+        ok &= centre[:, 2] - r - config.table_z >= config.table_clearance + room
     if config.max_undercut is not None:
         ok &= nrm[:, 2] >= -np.sin(config.max_undercut)
     idx = np.flatnonzero(ok)
@@ -114,15 +141,72 @@ def reachable(
             above = c_m + h * up
             clear &= ~poly.contains(above)
         ok[idx] = clear
+    return ok
+
+
+def reachable(
+    poly: Polyhedron, world_from_model: SE3, config: PlannerConfig, spacing: float = SPACING
+) -> tuple[np.ndarray, np.ndarray]:
+    """The reachable sample points of ``poly`` at ``world_from_model``, world frame, and their normals."""
+    pts_m, nrm_m = surface_samples(poly, spacing)
+    pts, nrm = world_from_model.apply(pts_m), world_from_model.rotate(nrm_m)
+    ok = _touchable(poly, world_from_model, pts, nrm, config, TRACE_ROOM)
     return pts[ok], nrm[ok]
+
+
+def observable_edges(
+    poly: Polyhedron, world_from_model: SE3, config: PlannerConfig, spacing: float = SPACING
+) -> np.ndarray:
+    """Sample points (world frame, shape (P, 3)) of the convex edges a face move can report alone: from a
+    face the pad touches there, rolling over onto a face that leans under past ``config.max_undercut`` (none
+    without that limit or a table)."""
+    if config.max_undercut is None or config.table_z is None:
+        return np.zeros((0, 3))
+    r, lean = config.pad_radius, np.sin(config.max_undercut)
+    normals = world_from_model.rotate(poly.face_normals)
+    out = []
+    for e in np.flatnonzero(poly.edge_convexity > 0):
+        a_b = (poly.edge_left_face[e], poly.edge_right_face[e])
+        for a, b in (a_b, a_b[::-1]):
+            n_a, n_b = normals[a], normals[b]
+            if n_b[2] >= -lean or n_a[2] < -np.sin(config.max_undercut - EDGE_ROLL):
+                continue
+            p0, p1 = world_from_model.apply(poly.vertices[poly.edges[e]])
+            k = max(2, int(np.ceil(np.linalg.norm(p1 - p0) / spacing)) + 1)
+            pts = p0 + np.linspace(0.0, 1.0, k)[1:-1, None] * (p1 - p0)
+            ok = _touchable(poly, world_from_model, pts, np.broadcast_to(n_a, pts.shape), config, 0.0)
+            # the roll to the limit (the normal turned toward n_b until it leans under by max_undercut) clears
+            # the table
+            m = _limit_normal(n_a, n_b, lean)
+            ok &= pts[:, 2] + r * m[2] - r - config.table_z >= 0.0
+            out.append(pts[ok])
+    return np.concatenate(out) if out else np.zeros((0, 3))
+
+
+def _limit_normal(n_a: np.ndarray, n_b: np.ndarray, lean: float) -> np.ndarray:
+    """The unit normal on the arc from ``n_a`` to ``n_b`` (about their edge) whose z is ``-lean``."""
+    th = np.arccos(np.clip(n_a @ n_b, -1.0, 1.0))
+    ts = np.linspace(0.0, 1.0, 64)
+    arc = (np.sin((1 - ts) * th)[:, None] * n_a + np.sin(ts * th)[:, None] * n_b) / max(np.sin(th), 1e-9)
+    i = int(np.argmax(arc[:, 2] <= -lean))
+    return arc[i]
+
+
+def _edge_distance(poly: Polyhedron, points: np.ndarray) -> np.ndarray:
+    """Distance from each point (model frame) to the nearest edge segment of ``poly``, shape (P,)."""
+    a, b = poly.vertices[poly.edges[:, 0]], poly.vertices[poly.edges[:, 1]]
+    ab = b - a
+    q = points[:, None, :] - a[None]
+    t = np.clip(np.einsum("pek,ek->pe", q, ab) / np.einsum("ek,ek->e", ab, ab), 0.0, 1.0)
+    return np.linalg.norm(q - t[..., None] * ab[None], axis=2).min(axis=1)
 
 
 def indistinguishable(
     a: Polyhedron, a_pose: SE3, b: Polyhedron, b_pose: SE3, config: PlannerConfig, tol: float = 0.0015
 ) -> bool:
-    """Whether every reachable point of each hypothesis lies on the other's surface within ``tol``, with the
-    (their difference is out of reach). A coarse pass first, since most pairs differ
-    grossly."""
+    """Whether every reachable point of each hypothesis lies on the other's surface, and every observable
+    edge point on the other's edges, within ``tol`` (their difference is out of reach). A coarse pass first,
+    since most pairs differ grossly."""
     for spacing in (3 * SPACING, SPACING):
         for (p, pp), (q, qp) in (((a, a_pose), (b, b_pose)), ((b, b_pose), (a, a_pose))):
             pts, _ = reachable(p, pp, config, spacing)
@@ -130,5 +214,8 @@ def indistinguishable(
                 return False
             d = surface_distance(q, qp.inverse().apply(pts))
             if float(d.max()) > tol:
+                return False
+            ridge = observable_edges(p, pp, config, spacing)
+            if len(ridge) and float(_edge_distance(q, qp.inverse().apply(ridge)).max()) > tol:
                 return False
     return True

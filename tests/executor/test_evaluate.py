@@ -19,3 +19,27 @@ def test_score_face_picks_the_coplanar_face_holding_the_points():
         s = score_face(c, poly, rot, trans, EvaluationTolerances())
         assert s.true_id == face
         assert s.angle_deg < 1e-6 and s.position_mm < 1e-6
+
+
+def test_the_first_felt_edge_skips_a_reflex_corner_the_pad_bridges():
+    # BOX01N's front face (y = 0) is a U around the slot (x 35-65 mm, z above 40 mm): a path down at 40°
+    # crossing the slot's wall 3.2 mm above its floor cuts the slot's corner for 5 mm, never more than 1.8 mm
+    # off the face: the pad, resting on the face around the corner, bridges it; the first edge it feels is
+    # the bottom edge
+    from haptic.executor.evaluate import first_felt_edge
+    from haptic.geometry import tracing
+
+    poly, tol = LIB["BOX01N"], EvaluationTolerances()
+    face = 0
+    a = np.radians(40.0)
+    d = np.array([np.cos(a), 0.0, -np.sin(a)])
+    start = np.array([0.035, 0.0, 0.0432]) - 0.015 * d
+    first = tracing.trace_face(poly, face, start, d, vertex_margin=tol.position)
+    hit = first_felt_edge(poly, face, start, d, tol)
+    wall = poly.vertices[poly.edges[first.edge]]
+    assert np.allclose(wall[:, 0], 0.035)  # the straight path's first edge: the slot's wall
+    bottom = poly.vertices[poly.edges[hit.edge]]
+    assert np.allclose(bottom[:, 2], 0.0)  # the first felt: the bottom edge
+    # straight down into the slot's floor edge the path leaves the face for good: felt at once
+    start, down = np.array([0.05, 0.0, 0.02]), np.array([0.0, 0.0, 1.0])
+    assert first_felt_edge(poly, face, start, down, tol).edge == tracing.trace_face(poly, face, start, down).edge

@@ -2,9 +2,9 @@
 
 import numpy as np
 
-from haptic.geometry import SE3, load_library
+from haptic.geometry import SE3, Polyhedron, load_library
 from haptic.planning.predict import PlannerConfig
-from haptic.planning.reach import indistinguishable, reachable
+from haptic.planning.reach import indistinguishable, observable_edges, reachable
 
 LIB = load_library()
 CFG = PlannerConfig(table_z=0.0, max_undercut=np.deg2rad(30.0))
@@ -16,9 +16,30 @@ def resting(poly, rotation):
     return SE3(rotation, np.array([0.2, 0.1, -low]))
 
 
-def test_a_slot_facing_the_table_is_out_of_reach():
-    box, slotted = LIB["BOX01"], LIB["BOX01N"]
+def shallow_slot(depth: float) -> Polyhedron:
+    """BOX01N with its slot ``depth`` deep instead of 20 mm."""
+    slotted = LIB["BOX01N"]
+    v = slotted.vertices.copy()
+    v[np.isclose(v[:, 2], 0.04), 2] = 0.06 - depth
+    return Polyhedron.from_faces(v, [list(f) for f in slotted.faces], name="SHALLOW")
+
+
+def test_a_shallow_slot_facing_the_table_is_out_of_reach():
+    # 5 mm deep against the table: the pad cannot come down the side far enough to roll over the slot's edge
+    box, slotted = LIB["BOX01"], shallow_slot(0.005)
     assert indistinguishable(box, resting(box, UPSIDE_DOWN), slotted, resting(slotted, UPSIDE_DOWN), CFG)
+    assert len(observable_edges(slotted, resting(slotted, UPSIDE_DOWN), CFG)) == 0
+
+
+def test_a_deep_slot_facing_the_table_shows_its_edge_on_the_sides():
+    # 20 mm deep: the pad slides down a side to the slot's edge and rolls over it (the slot's ceiling leans
+    # under out of reach): the edge alone tells BOX01N from BOX01
+    box, slotted = LIB["BOX01"], LIB["BOX01N"]
+    pose = resting(slotted, UPSIDE_DOWN)
+    ridge = observable_edges(slotted, pose, CFG)
+    assert len(ridge) > 10 and np.allclose(ridge[:, 2], 0.02)
+    assert not indistinguishable(box, resting(box, UPSIDE_DOWN), slotted, pose, CFG)
+    assert len(observable_edges(box, resting(box, UPRIGHT), CFG)) == 0  # a box's bottom edges touch the table
 
 
 def test_a_slot_on_top_is_in_reach():

@@ -50,5 +50,21 @@ def test_touches_off_a_class_surface_set_it_aside():
     xs = np.linspace(0.01, 0.09, 41)
     touched = pose.apply(np.column_stack([xs, np.full_like(xs, 0.04), np.full_like(xs, 0.06)]))
     noisy = touched + np.random.default_rng(0).normal(0.0, 0.0002, touched.shape)
-    assert _fits_touches(PoseClass(box, (0,), pose), noisy)
-    assert not _fits_touches(PoseClass(slotted, (0,), pose), noisy)
+    up = np.tile([0.0, 0.0, 1.0], (len(xs), 1))
+    cfg = PlannerConfig()
+    assert _fits_touches(PoseClass(box, (0,), pose), (noisy, up), cfg)
+    assert not _fits_touches(PoseClass(slotted, (0,), pose), (noisy, up), cfg)
+
+
+def test_a_touch_just_past_an_edge_is_off_the_face_however_near_the_surface():
+    # down BOX01's side face to 6 mm below where BOX01N's slot cuts it: within 6 mm of BOX01N's surface (the
+    # slot's ceiling), but on no face of BOX01N facing that way
+    box, slotted = LIB["BOX01"], LIB["BOX01N"]
+    flip = SE3(np.diag([1.0, -1.0, -1.0]), np.array([0.0, 0.0, 0.06]))  # slot against the table, z 0-20 mm
+    zs = np.linspace(0.05, 0.014, 37)
+    side = flip.apply(np.column_stack([np.full_like(zs, 0.05), np.zeros_like(zs), 0.06 - zs]))
+    normal = np.tile(flip.rotate(np.array([0.0, -1.0, 0.0])), (len(zs), 1))
+    cfg = PlannerConfig()
+    assert _fits_touches(PoseClass(box, (0,), flip), (side, normal), cfg)
+    assert not _fits_touches(PoseClass(slotted, (0,), flip), (side, normal), cfg)
+    assert _fits_touches(PoseClass(slotted, (0,), flip), (side[:-3], normal[:-3]), cfg)  # to 3 mm past: one stray
