@@ -30,12 +30,26 @@ from haptic.executor.primitives import (
     Toucher,
     angle,
     perpendicular,
+    unit,
 )
-from haptic.executor.segment import FaceFit, LineFit, SegmentBounds, Segmenter, fit_face, normal_turn_rate
+from haptic.executor.segment import (
+    FaceFit,
+    LineFit,
+    SegmentBounds,
+    Segmenter,
+    fit_face,
+    line_from_points,
+    normal_turn_rate,
+)
 from haptic.matching.components import DataComponent
 from haptic.planning.moves import CostModel, EdgeMove, FaceMove, Move, MoveResult, SensorState, VertexMove
 from haptic.sim.robot import RobotInterface
 from haptic.sim.scene import OBJECT_REGION, TABLE_TOP_Z
+
+RIDGE_PROBE = 0.004
+"""An edge measured from a roll alone is followed this far each way from where the roll ended [m] ..."""
+RIDGE_MIN_SPAN = 0.003
+"""... and its ridge contacts must span at least this along it [m]."""
 
 
 @dataclass(frozen=True)
@@ -462,7 +476,7 @@ class PhysicsExecutor:
         status, reason, roll, stroke, fit_b = self._cross_and_acquire(kind, r.info["face_normal"], r.info["direction"],
                                                                       pieces)  # fmt: skip
         if status == "undercut":
-            return self._edge_only(move, r, roll, reason)
+            return self._edge_only(move, r, roll, reason, pieces)
         if status != "ok":
             return self._fail(move, status, reason)
         fit_a, line, why = self._edge_between(st.face, r.trace, "face", roll, fit_b, kind, corner)
@@ -479,9 +493,13 @@ class PhysicsExecutor:
         return MoveResult(move=move, status="ok", components=(edge, face), distance=r.distance,
                           cost=self.costs.face_move(r.distance), state=self.state, info={"kind": kind})  # fmt: skip
 
-    def _edge_only(self, move: FaceMove, r: PrimitiveResult, roll: ContactTrace, reason: str) -> MoveResult:
+    def _edge_only(
+        self, move: FaceMove, r: PrimitiveResult, roll: ContactTrace, reason: str, pieces: list[PrimitiveResult]
+    ) -> MoveResult:
         """A face move that rolled over a convex edge onto a face leaning under, out of the pad's reach: the
-        edge alone, from the face and the roll (the sensor stays on the face it traced)."""
+        edge alone, from the face and the roll, checked and refined by following it a little each way (a
+        roll round a vertex turns about one axis too, but no edge runs along it); the sensor stays on the face
+        it traced."""
         st, seg = self.state, self.segmenter
         fit_a = self._face_fit(st.face, r.trace)
         got = seg.edge_from_roll(fit_a, ContactTrace.concatenate([r.trace.select(r.trace.phase ==
@@ -489,12 +507,47 @@ class PhysicsExecutor:
         if isinstance(got, str):
             return self._fail(move, "unreachable", f"{reason}; no edge from the roll: {got}")
         line, n_last = got
+        ridge = self._probe_ridge(line.direction, fit_a.normal, n_last, pieces)
+        if isinstance(ridge, str):
+            return self._fail(move, "unreachable", f"{reason}; {ridge}")
+        line = line_from_points(ridge, line.direction, line.direction_sigma, seg.bounds)
         edge = seg.add_edge(line, (st.face, None), True, (fit_a.normal, n_last), adjacent=(st.face,))
         self._on_face = None
         self.state = SensorState(position=line.point + line.direction * 0.5 * sum(line.s_range), face=st.face)
         return MoveResult(move=move, status="ok", components=(edge,), distance=r.distance,
                           cost=self.costs.face_move(r.distance), state=self.state,
                           info={"kind": "convex", "next_face": "out of reach"})  # fmt: skip
+
+    def _probe_ridge(
+        self, e: np.ndarray, n_a: np.ndarray, n_b: np.ndarray, pieces: list[PrimitiveResult]
+    ) -> np.ndarray | str:
+        """From a roll over an edge of direction ``e`` between face ``n_a`` and the normal ``n_b`` the roll
+        ended at, follow the ridge ``RIDGE_PROBE`` along ``e`` and back past the start as far again: the
+        contact points on the ridge, or why there is no edge along ``e`` (they span less than
+        ``RIDGE_MIN_SPAN``)."""
+        t = self.toucher
+        toward_a = unit(np.cross(n_a, e))
+        if float(toward_a @ n_b) > 0:
+            toward_a = -toward_a
+        acq = t.follow_edge(e, n_a, n_b, toward_a, 0.0, acquire_only=True)
+        pieces.append(acq)
+        if not acq.ok:
+            return f"acquiring the ridge: {acq.event}"
+        pts = []
+        for sense, reach in ((1.0, RIDGE_PROBE), (-1.0, 2.0 * RIDGE_PROBE)):
+            f = t.follow_edge(sense * e, n_a, n_b, toward_a, reach)
+            pieces.append(f)
+            rows = f.trace
+            ok = rows.in_contact & (rows.phase == PHASES.index("ridge"))
+            ok &= np.abs(np.where(ok[:, None], rows.normal_in_world, 0.0) @ e) < math.sin(math.radians(4.0))
+            pts.append(rows.point_in_world[ok])
+            if not f.ok and f.event != "limit":
+                return f"following the edge: {f.event}"
+        pts = np.concatenate(pts)
+        span = float(np.ptp(pts @ e)) if len(pts) else 0.0
+        if len(pts) < 10 or span < RIDGE_MIN_SPAN:
+            return f"no edge along the roll's axis (the ridge spans {span * 1e3:.1f} mm: a vertex?)"
+        return pts
 
     @staticmethod
     def _last_on(trace: ContactTrace, normal: np.ndarray) -> np.ndarray:

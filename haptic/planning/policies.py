@@ -22,12 +22,13 @@ import numpy as np
 from haptic.errors import PlanningError
 from haptic.matching.components import DataComponent, SensorNoise
 from haptic.planning.efficiency import class_weights, distinguishable, efficiency_of, expected_eliminated
-from haptic.planning.moves import Move, SensorState
+from haptic.planning.moves import FaceMove, Move, SensorState
 from haptic.planning.predict import (
     Hypothesis,
     PlannerConfig,
     Prediction,
     candidate_moves,
+    crossed_edge,
     descent_risk,
     predict,
     table_safe_moves,
@@ -85,14 +86,14 @@ def _score_all(ctx: Context) -> list[tuple[Prediction, float, float, float, floa
     weights = class_weights([h.model for h in ctx.hypotheses])
     preds = [predict(ctx.hypotheses, m, ctx.state, ctx.components, ctx.noise, ctx.config) for m in _fresh_moves(ctx)]
     preds = [p for p in preds if p.reliable(ctx.config)] or preds
-    refused = [(p, _refusal(p, ctx.config)) for p in preds]
+    refused = [(p, refusal(p, ctx.config)) for p in preds]
     refused = [(p, r) for p, r in refused if r < ctx.config.table_risk] or refused
     out = []
-    for pred, refusal in refused:
-        d = _eliminates(pred, ctx.config)
+    for pred, refused_risk in refused:
+        d = eliminates(pred, ctx.config)
         eff, _ = efficiency_of(d, pred.costs, weights)
         elim = expected_eliminated(d, weights)
-        ok = (1.0 - refusal) * (1.0 - descent_risk(pred.move, ctx.config))
+        ok = (1.0 - refused_risk) * (1.0 - descent_risk(pred.move, ctx.config))
         out.append((pred, eff * ok, elim * ok, float(pred.costs @ weights), 1.0 - ok))
     return out
 
@@ -106,7 +107,7 @@ def _failing(pred: Prediction, config: PlannerConfig) -> np.ndarray | None:
     return fails if fails.any() else None
 
 
-def _refusal(pred: Prediction, config: PlannerConfig) -> float:
+def refusal(pred: Prediction, config: PlannerConfig) -> float:
     """Predicted chance that the move is refused or aborted for the table before it tells anything: with
     touched points as evidence, a face move failing after a trace of at least ``config.min_face_travel`` has
     told how far its face reaches."""
@@ -117,7 +118,7 @@ def _refusal(pred: Prediction, config: PlannerConfig) -> float:
     return 0.0 if np.isnan(t).all() else float(np.nanmean(t))
 
 
-def _eliminates(pred: Prediction, config: PlannerConfig) -> np.ndarray:
+def eliminates(pred: Prediction, config: PlannerConfig) -> np.ndarray:
     """``D[i, j]``: hypothesis ``j`` eliminated if ``i`` is true. By the predicted attributes (§4.1); where the
     face move ends at its edge in ``i``'s world, the next face out of reach, by the edge's distance and angle
     alone; where it fails in ``i``'s world, only the hypotheses whose face ends sooner than ``i``'s trace (it
@@ -135,10 +136,13 @@ def _eliminates(pred: Prediction, config: PlannerConfig) -> np.ndarray:
 
 
 def _fresh_moves(ctx: Context) -> list[Move]:
-    """Candidate moves, less vertex moves that every hypothesis says circle back to an explored edge."""
+    """Candidate moves, less vertex moves that every hypothesis says circle back to an explored edge, and
+    (while others remain) face moves that every hypothesis says cross the edge a face move that failed from
+    here was to cross: the pad did not get over it, and at another angle seldom does."""
     from haptic.planning.search import simulate
 
-    out = []
+    out, again = [], []
+    failed_face = [bad for bad in ctx.avoid if isinstance(bad, FaceMove)]
     for move in candidate_moves(ctx.state, ctx.components, ctx.config):
         if any(same_move(move, bad) for bad in ctx.avoid):
             continue
@@ -146,8 +150,24 @@ def _fresh_moves(ctx: Context) -> list[Move]:
             simulate(h, move, ctx.state, ctx.components, ctx.config) is None for h in ctx.hypotheses
         ):
             continue
+        if isinstance(move, FaceMove) and any(_same_crossing(move, bad, ctx) for bad in failed_face):
+            again.append(move)
+            continue
         out.append(move)
-    return out
+    return out or again
+
+
+def _same_crossing(a: FaceMove, b: FaceMove, ctx: Context) -> bool:
+    """Whether every hypothesis that can say predicts face moves ``a`` and ``b`` to cross the same edge."""
+    said = False
+    for h in ctx.hypotheses:
+        ea, eb = crossed_edge(h, a, ctx.state), crossed_edge(h, b, ctx.state)
+        if ea is None or eb is None:
+            continue
+        if ea != eb:
+            return False
+        said = True
+    return said
 
 
 def same_move(a: Move, b: Move) -> bool:

@@ -296,6 +296,18 @@ def _predict_one(
     raise TypeError(f"unknown move {move!r}")
 
 
+def crossed_edge(h: Hypothesis, move: FaceMove, state: SensorState) -> int | None:
+    """The model edge hypothesis ``h`` predicts face move ``move`` to meet (None when it cannot say)."""
+    f_m = h.faces.get(state.face)
+    if h.world_from_model is None or f_m is None:
+        return None
+    model_from_world = h.world_from_model.inverse()
+    poly, p_m = h.poly, model_from_world.apply(state.position)
+    n = poly.face_normals[f_m]
+    hit = trace_face(poly, f_m, p_m - (p_m @ n - poly.face_offsets[f_m]) * n, model_from_world.rotate(move.direction))
+    return None if hit is None else int(hit.edge)
+
+
 def predict(
     hypotheses: Sequence[Hypothesis],
     move: Move,
@@ -338,6 +350,10 @@ EDGE_ROLL = np.deg2rad(12.0)
 """How far the pad's normal must turn over an edge, before it leans under past ``max_undercut``, for the
 executor to measure the edge from the roll alone (its segmenter wants 10°): from a face leaning under
 within this of the limit, a move ending at an edge onto a face out of reach tells nothing [rad]."""
+EDGE_ONLY_CLEARANCE = 0.008
+"""A face move ends at its edge with the next face out of reach, reporting the edge alone, only where it meets
+the edge at least this far from both its ends: the pad rolls some 40° over it, its centre as far past the
+edge's line as ``pad_radius · sin 40°``, and nearer an end it touches the faces round the vertex [m]."""
 TABLE_STEP_ONTO = 0.003
 """How far onto the next face a face or vertex move strokes for its normal (for the table check) [m]."""
 
@@ -423,8 +439,10 @@ def _table_conflict(
             start = pad_clearance(t.apply(p_m - (p_m @ n - poly.face_offsets[f_m]) * n), n_w, config)
             return 1.0, float(np.clip((start - lim) / -d_z, 0.0, hit.distance)), 0.0
         if leans_under(hit.edge, hit.next_face):
-            if float(n_w[2]) < -np.sin(config.max_undercut - EDGE_ROLL):
-                return 1.0, float(hit.distance), 0.0  # no room to roll: the move fails at the edge
+            s_hit = float((hit.point - poly.edge_points[hit.edge]) @ poly.edge_directions[hit.edge])
+            near_end = min(s_hit, float(poly.edge_lengths[hit.edge]) - s_hit) < EDGE_ONLY_CLEARANCE
+            if near_end or float(n_w[2]) < -np.sin(config.max_undercut - EDGE_ROLL):
+                return 1.0, float(hit.distance), 0.0  # no room to roll over the edge alone: the move fails there
             return 0.0, float(hit.distance), 1.0
         return float(onto_hidden(hit.edge, hit.next_face, hit.point)), float(hit.distance), 0.0
     if isinstance(move, EdgeMove):

@@ -11,8 +11,8 @@ normal ``n`` is *reachable* when the pad touching it, centred at ``c = p + r n``
 
 A convex edge between a face the pad reaches (with room to roll :data:`~haptic.planning.predict.EDGE_ROLL`
 before the limit) and one leaning under past ``config.max_undercut`` is *observable* where the pad can slide
-to it on the first face and roll over it to that limit clear of the table: a face move there reports the edge
-alone.
+to it on the first face and roll over it to that limit clear of the table, away from its ends
+(:data:`~haptic.planning.predict.EDGE_ONLY_CLEARANCE`): a face move there reports the edge alone.
 
 Two hypotheses (model and pose) that agree on every reachable point and observable edge -- each one's
 reachable surface lies on the other's surface, and its observable edges on the other's edges, within
@@ -25,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 
 from haptic.geometry import SE3, Polyhedron
-from haptic.planning.predict import EDGE_ROLL, PlannerConfig
+from haptic.planning.predict import EDGE_ONLY_CLEARANCE, EDGE_ROLL, PlannerConfig
 
 SPACING = 0.004
 """Spacing of the sample points over the faces [m]."""
@@ -172,8 +172,12 @@ def observable_edges(
             if n_b[2] >= -lean or n_a[2] < -np.sin(config.max_undercut - EDGE_ROLL):
                 continue
             p0, p1 = world_from_model.apply(poly.vertices[poly.edges[e]])
-            k = max(2, int(np.ceil(np.linalg.norm(p1 - p0) / spacing)) + 1)
-            pts = p0 + np.linspace(0.0, 1.0, k)[1:-1, None] * (p1 - p0)
+            length = float(np.linalg.norm(p1 - p0))
+            if length <= 2 * EDGE_ONLY_CLEARANCE:
+                continue
+            k = max(2, int(np.ceil((length - 2 * EDGE_ONLY_CLEARANCE) / spacing)) + 1)
+            ts = np.linspace(EDGE_ONLY_CLEARANCE / length, 1.0 - EDGE_ONLY_CLEARANCE / length, k)
+            pts = p0 + ts[:, None] * (p1 - p0)
             ok = _touchable(poly, world_from_model, pts, np.broadcast_to(n_a, pts.shape), config, 0.0)
             # the roll to the limit (the normal turned toward n_b until it leans under by max_undercut) clears
             # the table

@@ -15,10 +15,10 @@ import numpy as np
 
 from haptic.geometry.tracing import circle_vertex, trace_edge, trace_face
 from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex, SensorNoise
-from haptic.planning.efficiency import class_weights, outcome_groups
+from haptic.planning.efficiency import class_weights, expected_eliminated, outcome_groups
 from haptic.planning.moves import EdgeMove, FaceMove, Move, SensorState, VertexMove
-from haptic.planning.policies import Context, same_move
-from haptic.planning.predict import Hypothesis, PlannerConfig, candidate_moves, predict
+from haptic.planning.policies import Context, eliminates, refusal, same_move
+from haptic.planning.predict import Hypothesis, PlannerConfig, candidate_moves, descent_risk, predict
 
 STEP_ONTO = 0.003
 """How far onto the next face a simulated face or vertex move steps for its normal [m]."""
@@ -157,6 +157,8 @@ def branches(
     pred = predict(hyps, move, state, components, noise, config)
     if not pred.reliable(config) or pred.table_risk >= config.table_risk:
         return []
+    if pred.edge_only is not None and (pred.edge_only == 1).any():
+        return []  # not a step on to somewhere else: in some worlds the sensor stays where it is
     out = []
     for g in outcome_groups(pred.outcomes, pred.bounds):
         sims = [(i, simulate(hyps[i], move, state, components, config, noise)) for i in g]
@@ -187,7 +189,11 @@ def lookahead_choice(ctx: Context, depth: int = 2) -> Move | None:
 
 
 def _lookahead_score(ctx, hyps, weights, move, state, components, depth, spent) -> float:
-    """Best expected (pose classes eliminated) / (expected cost) over sequences starting with ``move``."""
+    """Best expected (pose classes eliminated) / (expected cost) over sequences starting with ``move``: the
+    last move scored as the planner scores one (with what the table and touched points tell, when known),
+    the moves before it carried out in each group's world."""
+    if depth == 1:
+        return _last_move_score(ctx, hyps, weights, move, state, components, spent)
     total_w = float(weights.sum())
     n = len(hyps)
     score = 0.0
@@ -207,6 +213,21 @@ def _lookahead_score(ctx, hyps, weights, move, state, components, depth, spent) 
                 )
         score += p * max(here, further)
     return score
+
+
+def _last_move_score(ctx, hyps, weights, move, state, components, spent) -> float:
+    """The expected pose classes ``move`` eliminates, discounted by its risk, per the expected cost of the
+    sequence ending with it."""
+    pred = predict(hyps, move, state, components, ctx.noise, ctx.config)
+    if not pred.reliable(ctx.config):
+        return 0.0
+    refused = refusal(pred, ctx.config)
+    if refused >= ctx.config.table_risk:
+        return 0.0
+    w = np.asarray(weights, dtype=float)
+    elim = expected_eliminated(eliminates(pred, ctx.config), w / w.sum())
+    elim *= (1.0 - refused) * (1.0 - descent_risk(move, ctx.config))
+    return elim / (spent + float(pred.costs @ (w / w.sum()))) if elim > 0 else 0.0
 
 
 def matcher_eliminations(ctx: Context, move: Move) -> tuple[np.ndarray, np.ndarray] | None:

@@ -101,3 +101,49 @@ def test_a_roll_round_another_edge_is_no_edge_between_the_faces():
     # two faces too alike for an edge
     fc = _plane(unit(wall + np.array([0.0, 0.0, 0.05])), np.zeros(3))
     assert "too close" in seg.edge_inconsistency(fa, fc, True, roll)
+
+
+def _noisy_roll(
+    axis: np.ndarray, n_a: np.ndarray, turn_deg: float, pivot: np.ndarray, rng, n: int = 60
+) -> ContactTrace:
+    """Rows of a pad rolling about ``axis`` through ``pivot`` from normal ``n_a`` by ``turn_deg``, with σn 1°."""
+    axis = unit(axis)
+    rows = []
+    for th in np.radians(np.linspace(0.0, turn_deg, n)):
+        k = np.cross(axis, n_a)
+        nrm = unit(n_a * math.cos(th) + k * math.sin(th) + rng.normal(0.0, math.radians(1.0), 3))
+        rows.append(nrm)
+    normals = np.array(rows)
+    points = pivot + rng.normal(0.0, 2e-4, (n, 3))
+    return _trace(points + R_PAD * normals, normals, points)
+
+
+def _face_fit(n_a: np.ndarray) -> FaceFit:
+    pts = np.array([[0.0, 0.0, 0.0], [0.01, 0.0, 0.0], [0.0, 0.01, 0.0]])
+    return FaceFit(n_a, 0.0, pts, math.radians(0.05), 1e-5, 200)
+
+
+def test_an_edge_from_a_roll_alone_turns_the_normals_about_it():
+    # the pad rolls 35° over an edge along y on top of face a (normal +z); no next face is touched
+    rng = np.random.default_rng(3)
+    n_a, axis = np.array([0.0, 0.0, 1.0]), np.array([0.0, 1.0, 0.0])
+    got = Segmenter().edge_from_roll(_face_fit(n_a), _noisy_roll(axis, n_a, 35.0, np.array([0.02, 0.0, 0.0]), rng))
+    assert not isinstance(got, str), got
+    line, n_last = got
+    assert math.degrees(math.acos(abs(float(line.direction @ axis)))) < 1.0
+    assert abs(float(line.direction @ n_a)) < 1e-9  # in face a's plane
+    assert np.linalg.norm(np.cross(line.point - np.array([0.02, 0.0, 0.0]), axis)) < 5e-4
+    assert math.degrees(line.direction_sigma) < 1.0
+    assert float(n_last @ n_a) < math.cos(math.radians(30.0))
+
+
+def test_a_roll_too_short_or_round_a_vertex_gives_no_edge():
+    rng = np.random.default_rng(4)
+    n_a, axis, pivot = np.array([0.0, 0.0, 1.0]), np.array([0.0, 1.0, 0.0]), np.zeros(3)
+    seg = Segmenter()
+    assert isinstance(seg.edge_from_roll(_face_fit(n_a), _noisy_roll(axis, n_a, 6.0, pivot, rng)), str)
+    # round a vertex: the normals turn about y, then about x
+    first = _noisy_roll(axis, n_a, 25.0, pivot, rng, 30)
+    then = _noisy_roll(np.array([1.0, 0.0, 0.0]), first.normal_in_world[-1], 25.0, pivot, rng, 30)
+    both = ContactTrace.concatenate([first, then])
+    assert "axis" in seg.edge_from_roll(_face_fit(n_a), both)

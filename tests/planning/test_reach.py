@@ -37,7 +37,7 @@ def test_a_deep_slot_facing_the_table_shows_its_edge_on_the_sides():
     box, slotted = LIB["BOX01"], LIB["BOX01N"]
     pose = resting(slotted, UPSIDE_DOWN)
     ridge = observable_edges(slotted, pose, CFG)
-    assert len(ridge) > 10 and np.allclose(ridge[:, 2], 0.02)
+    assert len(ridge) >= 8 and np.allclose(ridge[:, 2], 0.02)
     assert not indistinguishable(box, resting(box, UPSIDE_DOWN), slotted, pose, CFG)
     assert len(observable_edges(box, resting(box, UPRIGHT), CFG)) == 0  # a box's bottom edges touch the table
 

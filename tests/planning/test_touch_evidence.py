@@ -7,7 +7,7 @@ from haptic.episode import _fits_touches
 from haptic.geometry import SE3, load_library
 from haptic.matching.recognition import PoseClass
 from haptic.planning.moves import FaceMove
-from haptic.planning.policies import _eliminates, _refusal
+from haptic.planning.policies import eliminates, refusal
 from haptic.planning.predict import PlannerConfig, Prediction
 
 LIB = load_library()
@@ -24,23 +24,23 @@ def test_a_trace_failing_past_its_edge_rules_out_only_shorter_faces():
     # hypotheses 0 and 2 predict the face to reach 68 and 92 mm and the next face out of reach; 1 reaches 57
     pred = _prediction([0.068, 0.057, 0.092], table=[1, 0, 1], reach=[0.068, 0.057, 0.092])
     on, off = PlannerConfig(table_z=0.0, touch_evidence=True), PlannerConfig(table_z=0.0)
-    d = _eliminates(pred, on)
+    d = eliminates(pred, on)
     assert d[0].tolist() == [False, True, False]  # 0's trace passes 1's edge, stops before 2's
     assert d[2].tolist() == [True, True, False]
     assert d[1].tolist() == [True, False, True]  # 1's move succeeds: every attribute counts
-    assert _refusal(pred, on) == 0.0
-    assert np.isclose(_refusal(pred, off), 2 / 3)
-    assert _eliminates(pred, off).tolist() == [[False, True, True], [True, False, True], [True, True, False]]
+    assert refusal(pred, on) == 0.0
+    assert np.isclose(refusal(pred, off), 2 / 3)
+    assert eliminates(pred, off).tolist() == [[False, True, True], [True, False, True], [True, True, False]]
 
 
 def test_a_trace_stopped_by_the_table_tells_as_far_as_it_went():
     # in hypothesis 2 the slide runs down to the table after 40 mm: far enough to pass 1's edge only
     pred = _prediction([0.068, 0.030, 0.092], table=[0, 0, 1], reach=[0.068, 0.030, 0.040])
     on = PlannerConfig(table_z=0.0, touch_evidence=True)
-    assert _eliminates(pred, on)[2].tolist() == [False, True, False]
-    assert _refusal(pred, on) == 0.0
+    assert eliminates(pred, on)[2].tolist() == [False, True, False]
+    assert refusal(pred, on) == 0.0
     short = _prediction([0.068, 0.030, 0.092], table=[0, 0, 1], reach=[0.068, 0.030, 0.003])
-    assert np.isclose(_refusal(short, on), 1 / 3)  # stopped at once: it tells nothing
+    assert np.isclose(refusal(short, on), 1 / 3)  # stopped at once: it tells nothing
 
 
 def test_touches_off_a_class_surface_set_it_aside():

@@ -1,0 +1,59 @@
+"""A face move that rolls over a convex edge onto a face leaning under, out of the pad's reach, reports the
+edge alone: predicted per hypothesis, scored by the edge's distance and angle, and avoided near the edge's
+ends where the pad would roll round the vertex."""
+
+import numpy as np
+
+from haptic.geometry import SE3, load_library
+from haptic.matching.components import DataFace, SensorNoise
+from haptic.planning.moves import FaceMove, SensorState
+from haptic.planning.policies import Context, _fresh_moves, eliminates
+from haptic.planning.predict import Hypothesis, PlannerConfig, predict
+
+LIB = load_library()
+CFG = PlannerConfig(table_z=0.0, max_undercut=np.deg2rad(30.0), touch_evidence=True)
+# upside down, resting on the table: BOX01N's slot (x 35-65 mm) lies against it, 20 mm high; the model's face
+# y = 0 faces world +y at y = 0.1
+FLIP = SE3(np.diag([1.0, -1.0, -1.0]), np.array([0.2, 0.1, 0.06]))
+DOWN = FaceMove(np.array([0.0, 0.0, -1.0]))
+
+
+def _setup(x: float):
+    points = np.array([[x, 0.1, 0.05], [x + 0.01, 0.1, 0.05]])
+    comps = {0: DataFace(0, np.array([0.0, 1.0, 0.0]), points, 0.01, 1e-3)}
+    state = SensorState(position=np.array([x, 0.1, 0.05]), face=0)
+    hyps = []
+    for name in ("BOX01N", "BOX01"):
+        poly = LIB[name]
+        face = int(np.argmax(poly.face_normals @ np.array([0.0, -1.0, 0.0])))
+        hyps.append(Hypothesis(name, poly, FLIP, {0: face}, {}, {}))
+    return hyps, state, comps
+
+
+def test_down_the_side_over_the_slot_ends_at_its_edge():
+    hyps, state, comps = _setup(0.25)  # over the slot's middle
+    pred = predict(hyps, DOWN, state, comps, SensorNoise(), CFG)
+    assert pred.edge_only.tolist() == [1.0, 0.0]  # BOX01N: the slot's edge 30 mm down, its ceiling out of reach
+    assert pred.table.tolist() == [0.0, 1.0]  # BOX01: the slide runs down to the table
+    assert np.isclose(pred.outcomes[0, 0], 0.03)
+    d = eliminates(pred, CFG)
+    assert d[0, 1]  # the edge alone rules BOX01 out
+    # BOX01's trace stops 4 mm past where BOX01N's face ends: too few touches beyond it to rule BOX01N out
+    assert np.isclose(pred.reach[1], 0.034) and not d[1, 0]
+
+
+def test_near_the_slot_s_end_the_roll_would_go_round_the_vertex():
+    hyps, state, comps = _setup(0.238)  # 3 mm from the slot's side
+    pred = predict(hyps, DOWN, state, comps, SensorNoise(), CFG)
+    assert pred.edge_only.tolist() == [0.0, 0.0]
+    assert pred.table.tolist() == [1.0, 1.0]
+
+
+def test_moves_toward_an_edge_that_failed_are_tried_last():
+    hyps, state, comps = _setup(0.25)
+    failed = FaceMove(np.array([0.0, 0.0, 1.0]))  # up to the top edge
+    ctx = Context(hyps, state, comps, SensorNoise(), CFG, avoid=(failed,))
+    fresh = _fresh_moves(ctx)
+    # 10 mm under the top edge, every move heading up (at 45°, 90°, 135°) crosses it: left out while the
+    # five heading sideways or down remain
+    assert len(fresh) == 5 and all(float(m.direction[2]) < 1e-9 for m in fresh)
