@@ -46,6 +46,9 @@ from haptic.planning.moves import CostModel, EdgeMove, FaceMove, Move, MoveResul
 from haptic.sim.robot import RobotInterface
 from haptic.sim.scene import OBJECT_REGION, TABLE_TOP_Z
 
+MAX_STUCK = 4
+"""Start: moves across above the object region, at the highest approach, that may time out in a row before
+the start gives up (the arm is held back: every further landing would be too)."""
 RIDGE_PROBE = 0.004
 """An edge measured from a roll alone is followed this far each way from where the roll ended [m] ..."""
 RIDGE_MIN_SPAN = 0.003
@@ -277,6 +280,7 @@ class PhysicsExecutor:
         landings = self._landing_points()
         budget = s.max_landings if s.max_landings is not None else len(landings) + s.edge_retries
         i = -1
+        stuck = 0  # moves across, at the highest approach, that timed out in a row
         while i + 1 < min(len(landings), budget):
             i += 1
             xy = landings[i]
@@ -292,6 +296,11 @@ class PhysicsExecutor:
                 # blocked on the way across: the object stands taller than the approach height. Go higher
                 z_top, i = min(z_top + s.approach_raise, z_max), i - 1
                 continue
+            stuck = stuck + 1 if r.status == "timeout" else 0
+            if stuck >= MAX_STUCK:
+                return MoveResult(move=move, status="unreachable", state=None,
+                                  info={"reason": f"the hand cannot move across the object region: {stuck} moves "
+                                                  "above it in a row did not get there"})  # fmt: skip
             if not r.ok:
                 last = r.status
                 if r.status == "unstable":

@@ -137,8 +137,8 @@ def eliminates(pred: Prediction, config: PlannerConfig) -> np.ndarray:
 
 def _fresh_moves(ctx: Context) -> list[Move]:
     """Candidate moves, less vertex moves that every hypothesis says circle back to an explored edge, and
-    (while others remain) face moves that every hypothesis says cross the edge a face move that failed from
-    here was to cross: the pad did not get over it, and at another angle seldom does."""
+    (while others remain) face moves that the hypotheses, by at least half their weight, say cross the edge a face
+    move that failed from here was to cross: the pad did not get over it, and at another angle seldom does."""
     from haptic.planning.search import simulate
 
     out, again = [], []
@@ -158,16 +158,19 @@ def _fresh_moves(ctx: Context) -> list[Move]:
 
 
 def _same_crossing(a: FaceMove, b: FaceMove, ctx: Context) -> bool:
-    """Whether every hypothesis that can say predicts face moves ``a`` and ``b`` to cross the same edge."""
-    said = False
-    for h in ctx.hypotheses:
+    """Whether the hypotheses that can say, by at least half their weight, predict face moves ``a`` and ``b``
+    to cross the same edge."""
+    weights = class_weights([h.model for h in ctx.hypotheses])
+    same = differ = 0.0
+    for h, w in zip(ctx.hypotheses, weights, strict=True):
         ea, eb = crossed_edge(h, a, ctx.state), crossed_edge(h, b, ctx.state)
         if ea is None or eb is None:
             continue
-        if ea != eb:
-            return False
-        said = True
-    return said
+        if ea == eb:
+            same += w
+        else:
+            differ += w
+    return same > 0.0 and same >= differ
 
 
 def same_move(a: Move, b: Move) -> bool:
