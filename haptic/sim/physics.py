@@ -37,6 +37,24 @@ WARNINGS = {name: int(w) for name, w in mujoco.mjtWarning.__members__.items() if
 """MuJoCo warning kinds by name (``mjWARN_*``) -> index into ``data.warning``."""
 
 
+PATCH = 0.003
+"""Pad contacts closer than this to one another are one patch of contact [m]."""
+
+
+def merge_patches(points: np.ndarray, normals: np.ndarray, forces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The sensed point and normal of several pad contacts: each patch (contacts within :data:`PATCH` of one
+    another) sensed as its strongest contact, the patches averaged by force (see
+    :meth:`Simulation.sense_contact`)."""
+    n = len(points)
+    keep = [i for i in range(n)
+            if not any(j != i and (forces[j], -j) > (forces[i], -i) and np.linalg.norm(points[j] - points[i]) < PATCH
+                       for j in range(n))]  # fmt: skip
+    fk = forces[keep]
+    w = fk / fk.sum() if fk.sum() > 0 else np.full(len(keep), 1.0 / len(keep))
+    normal = w @ normals[keep]
+    return w @ points[keep], normal / math.sqrt(float(normal @ normal))
+
+
 @dataclass(frozen=True)
 class SensorNoise:
     """Zero-mean Gaussian noise of the robot's sensors (all zero: ideal sensors)."""
@@ -305,11 +323,17 @@ class Simulation:
 
     def contact_summary(self, finger: int) -> ContactSummary:
         """Aggregated sensed contact of one fingertip (noise applied): total normal force, force-weighted
-        mean normal and point."""
+        mean normal and point over the contact patches (see :meth:`sense_contact`)."""
         return ContactSummary(*self.sense_contact(finger))
 
     def sense_contact(self, finger: int) -> tuple[float, np.ndarray | None, np.ndarray | None, int]:
-        """:meth:`contact_summary` as a plain tuple (the controller's fast path)."""
+        """:meth:`contact_summary` as a plain tuple (the controller's fast path).
+
+        Contacts within :data:`PATCH` of one another are one patch of the pad on the surface, sensed as the
+        patch's strongest contact: a non-convex object is simulated as convex pieces, and a pad pressing a
+        face next to the seam of two coplanar pieces also touches the neighbour's edge there, at a normal
+        tilted by several degrees, which a real surface does not have. Separate patches (the pad in a
+        corner, on two faces at once) are averaged, weighted by force."""
         raw = self._pad_contacts(finger)
         if not raw:
             return 0.0, None, None, 0
@@ -318,11 +342,8 @@ class Simulation:
             total = max(float(f @ normal), 0.0)
         else:
             fn = np.array([max(float(f @ n), 0.0) for _, _, n, f in raw])
-            w = fn / fn.sum() if fn.sum() > 0 else np.full(len(raw), 1.0 / len(raw))
-            normal = w @ np.array([n for _, _, n, _ in raw])
-            normal /= math.sqrt(float(normal @ normal))
-            point = w @ np.array([p for _, p, _, _ in raw])
             total = float(fn.sum())
+            point, normal = merge_patches(np.array([p for _, p, _, _ in raw]), np.array([n for _, _, n, _ in raw]), fn)
         nz = self.noise
         if nz.any:
             z = self._rng.standard_normal(7)
