@@ -25,6 +25,7 @@ from haptic.geometry import tracing
 from haptic.geometry.polyhedron import Polyhedron
 from haptic.geometry.se3 import plane_basis
 from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex
+from haptic.planning.reach import point_triangle_distance
 
 
 @dataclass(frozen=True)
@@ -200,10 +201,44 @@ rim of a face cannot be told from one on a real edge that shallow."""
 def first_felt_edge(model: Polyhedron, face: int, start_m: np.ndarray, d_m: np.ndarray, tol: EvaluationTolerances):
     """The first edge a pad sliding from ``start_m`` along ``d_m`` on ``face`` (model frame) must feel: the
     first boundary crossing of the straight path after which the path goes farther off the face's polygon
-    than ``PAD_RADIUS · sin(MIN_TILT)`` (≈ 2.1 mm) before coming back onto it. Across a shorter excursion
-    -- clipping a reflex corner of a non-convex face -- the pad, resting on the face around it, tilts less
-    than an edge would turn it. None when there is no such edge, or when the path meets the boundary within
-    the position tolerance of a vertex (no single first edge: the pad is 24 mm wide)."""
+    than ``PAD_RADIUS · sin(MIN_TILT)`` (≈ 2.1 mm) before coming back onto it -- unless the pad runs into
+    another face before (:func:`_pad_blocked`). Across a shorter excursion -- clipping a reflex corner of a
+    non-convex face -- the pad, resting on the face around it, tilts less than an edge would turn it. None
+    when there is no such edge, or when the path meets the boundary within the position tolerance of a
+    vertex (no single first edge: the pad is 24 mm wide)."""
+    hit = _first_exit_felt(model, face, start_m, d_m, tol)
+    if hit is None:
+        return None
+    return _pad_blocked(model, face, start_m, d_m, hit, tol)
+
+
+def _pad_blocked(model: Polyhedron, face: int, start_m: np.ndarray, d_m: np.ndarray, hit, tol: EvaluationTolerances):
+    """``hit``, or the concave edge to the face the pad (a ball of ``PAD_RADIUS`` on the face) runs into
+    first: a wall 20 mm high above a floor is traced only down to where the pad's underside meets the
+    floor, 12 mm above it. None when the pad would first meet a face that does not share an edge with
+    ``face`` (no single first edge)."""
+    n = model.face_normals[face]
+    d = np.asarray(d_m, dtype=float) - (np.asarray(d_m, dtype=float) @ n) * n
+    d /= np.linalg.norm(d)
+    others = np.flatnonzero(model.triangle_faces != face)
+    tri = model.vertices[model.triangles[others]]
+    ts = np.arange(0.0, hit.distance, 5e-4)
+    centres = np.asarray(start_m, dtype=float) + PAD_RADIUS * n + ts[:, None] * d
+    dist = point_triangle_distance(centres, tri)
+    near = PAD_RADIUS - tol.plane / 6
+    dist[:, dist[0] < near] = np.inf  # faces the pad touches where it starts (it leaves them)
+    touching = dist.min(axis=1) < near
+    if not touching.any():
+        return hit
+    k = int(np.argmax(touching))
+    g = int(model.triangle_faces[others[int(np.argmin(dist[k]))]])
+    shared = [e for e in model.face_edges[face] if g in model.edge_faces(e)]
+    if not shared or model.edge_convexity[shared[0]] > 0:
+        return None
+    return tracing.FaceHit(shared[0], float(ts[k]), centres[k] - PAD_RADIUS * n, g)
+
+
+def _first_exit_felt(model: Polyhedron, face: int, start_m: np.ndarray, d_m: np.ndarray, tol: EvaluationTolerances):
     u, w = plane_basis(model.face_normals[face])
     loop = model.vertices[list(model.faces[face])]
     uv = np.column_stack([loop @ u, loop @ w])

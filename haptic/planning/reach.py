@@ -60,7 +60,7 @@ def surface_distance(poly: Polyhedron, points: np.ndarray) -> np.ndarray:
     best = np.full(len(p), np.inf)
     for start in range(0, len(p), 2048):
         q = p[start : start + 2048]
-        d = _point_triangle_distance(q, tri)
+        d = point_triangle_distance(q, tri)
         best[start : start + 2048] = d.min(axis=1)
     return best
 
@@ -81,12 +81,12 @@ def touch_distance(poly: Polyhedron, world_from_model: SE3, points: np.ndarray, 
     agree = n @ poly.face_normals[poly.triangle_faces].T >= FACING  # (P, T)
     best = np.full(len(p), np.inf)
     for start in range(0, len(p), 2048):
-        d = _point_triangle_distance(p[start : start + 2048], tri)
+        d = point_triangle_distance(p[start : start + 2048], tri)
         best[start : start + 2048] = np.where(agree[start : start + 2048], d, np.inf).min(axis=1)
     return best
 
 
-def _point_triangle_distance(p: np.ndarray, tri: np.ndarray) -> np.ndarray:
+def point_triangle_distance(p: np.ndarray, tri: np.ndarray) -> np.ndarray:
     """Distances (P, T) from points to triangles (closest point by barycentric clamping over the regions)."""
     a, b, c = tri[None, :, 0], tri[None, :, 1], tri[None, :, 2]
     q = p[:, None, :]

@@ -43,3 +43,19 @@ def test_the_first_felt_edge_skips_a_reflex_corner_the_pad_bridges():
     # straight down into the slot's floor edge the path leaves the face for good: felt at once
     start, down = np.array([0.05, 0.0, 0.02]), np.array([0.0, 0.0, 1.0])
     assert first_felt_edge(poly, face, start, down, tol).edge == tracing.trace_face(poly, face, start, down).edge
+
+
+def test_the_pad_tracing_a_low_wall_first_meets_the_floor():
+    # BOX01P's block wall x = 35 mm stands 20 mm over the top face (z 60-80 mm): a path along it sinking
+    # 0.19 per unit would reach the wall's far end at z 64 mm, but the 12 mm pad's underside meets the floor
+    # once the contact comes down to 72 mm: the concave edge at the wall's foot is the first felt
+    from haptic.executor.evaluate import first_felt_edge
+    from haptic.geometry import tracing
+
+    poly, tol = LIB["BOX01P"], EvaluationTolerances()
+    start, d = np.array([0.035, 0.066, 0.077]), np.array([0.0, -0.98, -0.19])
+    straight = tracing.trace_face(poly, 7, start, d, vertex_margin=tol.position)
+    assert np.isclose(straight.point[1], 0.0)  # the straight path leaves the wall at its far end
+    hit = first_felt_edge(poly, 7, start, d, tol)
+    assert np.allclose(poly.vertices[poly.edges[hit.edge]][:, 2], 0.06)  # the wall's foot
+    assert poly.edge_convexity[hit.edge] < 0 and 0.070 < hit.point[2] < 0.073  # contact 12 mm over the floor
