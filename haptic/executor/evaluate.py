@@ -22,10 +22,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from haptic.geometry import tracing
+from haptic.geometry.distance import point_triangle_distance
 from haptic.geometry.polyhedron import Polyhedron
 from haptic.geometry.se3 import plane_basis
 from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex
-from haptic.planning.reach import point_triangle_distance
 
 
 @dataclass(frozen=True)

@@ -527,6 +527,14 @@ class PhysicsExecutor:
                           cost=self.costs.face_move(r.distance), state=self.state,
                           info={"kind": "convex", "next_face": "out of reach"})  # fmt: skip
 
+    @staticmethod
+    def _on_ridge(rows: ContactTrace, u: np.ndarray) -> np.ndarray:
+        """Rows of a ridge-following trace in contact on the ridge itself: the sensed normal within 4° of
+        perpendicular to the edge direction ``u`` (not rolling on a vertex at its end)."""
+        ok = rows.in_contact & (rows.phase == PHASES.index("ridge"))
+        along = np.where(ok[:, None], rows.normal_in_world, 0.0) @ u
+        return ok & (np.abs(along) < math.sin(math.radians(4.0)))
+
     def _probe_ridge(
         self, e: np.ndarray, n_a: np.ndarray, n_b: np.ndarray, pieces: list[PrimitiveResult]
     ) -> np.ndarray | str:
@@ -546,10 +554,7 @@ class PhysicsExecutor:
         for sense, reach in ((1.0, RIDGE_PROBE), (-1.0, 2.0 * RIDGE_PROBE)):
             f = t.follow_edge(sense * e, n_a, n_b, toward_a, reach)
             pieces.append(f)
-            rows = f.trace
-            ok = rows.in_contact & (rows.phase == PHASES.index("ridge"))
-            ok &= np.abs(np.where(ok[:, None], rows.normal_in_world, 0.0) @ e) < math.sin(math.radians(4.0))
-            pts.append(rows.point_in_world[ok])
+            pts.append(f.trace.point_in_world[self._on_ridge(f.trace, e)])
             if not f.ok and f.event != "limit":
                 return f"following the edge: {f.event}"
         pts = np.concatenate(pts)
@@ -613,9 +618,7 @@ class PhysicsExecutor:
         if s_v is None:
             return self._fail(move, "unreachable", "could not locate the vertex")
         # refine the line with the ridge contacts (convex edges), then extend it to the vertex
-        ok = rows.in_contact
-        along = np.where(ok[:, None], rows.normal_in_world, 0.0) @ u
-        ridge = ok & (np.abs(along) < math.sin(math.radians(4.0))) & (rows.phase == PHASES.index("ridge"))
+        ridge = self._on_ridge(rows, u)
         w_v, w_from = rec.at(s_v), rec.at(s_from)
         seg.refine_edge(st.edge, rows.point_in_world[ridge] if ridge.sum() >= 10 else None,
                         (self._face_fit(rec.faces[0]), self._face_fit(rec.faces[1])))  # fmt: skip

@@ -88,14 +88,19 @@ def _score_all(ctx: Context) -> list[tuple[Prediction, float, float, float, floa
     preds = [p for p in preds if p.reliable(ctx.config)] or preds
     refused = [(p, refusal(p, ctx.config)) for p in preds]
     refused = [(p, r) for p, r in refused if r < ctx.config.table_risk] or refused
-    out = []
-    for pred, refused_risk in refused:
-        d = eliminates(pred, ctx.config)
-        eff, _ = efficiency_of(d, pred.costs, weights)
-        elim = expected_eliminated(d, weights)
-        ok = (1.0 - refused_risk) * (1.0 - descent_risk(pred.move, ctx.config))
-        out.append((pred, eff * ok, elim * ok, float(pred.costs @ weights), 1.0 - ok))
-    return out
+    return [(pred, *score_prediction(pred, weights, r, ctx.config)) for pred, r in refused]
+
+
+def score_prediction(
+    pred: Prediction, weights: np.ndarray, refused: float, config: PlannerConfig
+) -> tuple[float, float, float, float]:
+    """Efficiency and expected eliminations of one predicted move, both discounted by its risk (``refused``,
+    :func:`refusal`, and a steep descent), its expected cost and that risk; ``weights`` sum to 1."""
+    d = eliminates(pred, config)
+    eff, _ = efficiency_of(d, pred.costs, weights)
+    elim = expected_eliminated(d, weights)
+    ok = (1.0 - refused) * (1.0 - descent_risk(pred.move, config))
+    return eff * ok, elim * ok, float(pred.costs @ weights), 1.0 - ok
 
 
 def _failing(pred: Prediction, config: PlannerConfig) -> np.ndarray | None:

@@ -15,7 +15,7 @@ import numpy as np
 
 from haptic.geometry.polyhedron import Polyhedron
 from haptic.geometry.se3 import SE3
-from haptic.geometry.tracing import circle_vertex, trace_edge, trace_face
+from haptic.geometry.tracing import FaceHit, circle_vertex, trace_edge, trace_face
 from haptic.matching.components import DataComponent, DataEdge, DataFace, SensorNoise
 from haptic.planning.moves import CostModel, EdgeMove, FaceMove, Move, SensorState, VertexMove
 
@@ -234,6 +234,41 @@ def _line_angle(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.arccos(np.clip(abs(a @ b) / (np.linalg.norm(a) * np.linalg.norm(b)), 0.0, 1.0)))
 
 
+@dataclass(frozen=True, eq=False)
+class FaceTrace:
+    """A face move traced in one hypothesis's world (model frame)."""
+
+    face: int
+    """The model face traced."""
+    start: np.ndarray
+    """The sensor's position projected onto it."""
+    direction: np.ndarray
+    """The move's direction."""
+    hit: FaceHit
+    """Where it meets the face's boundary."""
+
+    def clearance(self, poly: Polyhedron) -> float:
+        """Distance of the crossing point from the nearer end of the edge met [m]."""
+        e = self.hit.edge
+        s_hit = float((self.hit.point - poly.edge_points[e]) @ poly.edge_directions[e])
+        return min(s_hit, float(poly.edge_lengths[e]) - s_hit)
+
+
+def trace_in(h: Hypothesis, move: FaceMove, state: SensorState) -> FaceTrace | None:
+    """Face move ``move`` from ``state`` traced in hypothesis ``h``'s world; None when ``h`` cannot say (no
+    pose, the current face not matched, no single edge met)."""
+    f_m = h.faces.get(state.face)
+    if h.world_from_model is None or f_m is None:
+        return None
+    model_from_world = h.world_from_model.inverse()
+    poly, p_m = h.poly, model_from_world.apply(state.position)
+    n = poly.face_normals[f_m]
+    p_m = p_m - (p_m @ n - poly.face_offsets[f_m]) * n
+    d_m = model_from_world.rotate(move.direction)
+    hit = trace_face(poly, f_m, p_m, d_m)
+    return None if hit is None else FaceTrace(f_m, p_m, d_m, hit)
+
+
 def predict_one(
     h: Hypothesis, move: Move, state: SensorState, components: Mapping[int, DataComponent], config: PlannerConfig
 ) -> tuple[np.ndarray, float]:
@@ -253,25 +288,18 @@ def _predict_one(
     p_m = model_from_world.apply(state.position)
     poly = h.poly
     if isinstance(move, FaceMove):
-        f_m = h.faces.get(state.face)
-        if f_m is None:
+        tr = trace_in(h, move, state)
+        if tr is None:
             return nan_face, np.nan, np.nan
-        n = poly.face_normals[f_m]
-        p_m = p_m - (p_m @ n - poly.face_offsets[f_m]) * n
-        d_m = model_from_world.rotate(move.direction)
-        hit = trace_face(poly, f_m, p_m, d_m)
-        if hit is None:
-            return nan_face, np.nan, np.nan
+        hit = tr.hit
         out = np.array(
             [
                 hit.distance,
-                _line_angle(poly.edge_directions[hit.edge], d_m),
-                _signed_dihedral(poly, f_m, hit.next_face, hit.edge),
+                _line_angle(poly.edge_directions[hit.edge], tr.direction),
+                _signed_dihedral(poly, tr.face, hit.next_face, hit.edge),
             ]
         )
-        s_hit = float((hit.point - poly.edge_points[hit.edge]) @ poly.edge_directions[hit.edge])
-        clearance = min(s_hit, float(poly.edge_lengths[hit.edge]) - s_hit)
-        return out, costs.face_move(hit.distance), clearance
+        return out, costs.face_move(hit.distance), tr.clearance(poly)
     if isinstance(move, EdgeMove):
         e_m = h.edges.get(state.edge) if state.edge is not None else None
         if e_m is None:
@@ -298,14 +326,8 @@ def _predict_one(
 
 def crossed_edge(h: Hypothesis, move: FaceMove, state: SensorState) -> int | None:
     """The model edge hypothesis ``h`` predicts face move ``move`` to meet (None when it cannot say)."""
-    f_m = h.faces.get(state.face)
-    if h.world_from_model is None or f_m is None:
-        return None
-    model_from_world = h.world_from_model.inverse()
-    poly, p_m = h.poly, model_from_world.apply(state.position)
-    n = poly.face_normals[f_m]
-    hit = trace_face(poly, f_m, p_m - (p_m @ n - poly.face_offsets[f_m]) * n, model_from_world.rotate(move.direction))
-    return None if hit is None else int(hit.edge)
+    tr = trace_in(h, move, state)
+    return None if tr is None else int(tr.hit.edge)
 
 
 def predict(
@@ -412,7 +434,6 @@ def _table_conflict(
     if t is None:
         return np.nan, np.nan, np.nan
     poly, lim = h.poly, config.table_clearance
-    p_m = t.inverse().apply(state.position)
 
     def leans_under(e_m: int, g_m: int) -> bool:
         """Whether the pad cannot roll over convex edge ``e_m`` onto ``g_m``: it leans under, out of reach."""
@@ -425,22 +446,18 @@ def _table_conflict(
         return leans_under(e_m, g_m) or pad_clearance(q, t.rotate(poly.face_normals[g_m]), config) < lim
 
     if isinstance(move, FaceMove):
-        f_m = h.faces.get(state.face)
-        if f_m is None:
+        tr = trace_in(h, move, state)
+        if tr is None:
             return np.nan, np.nan, np.nan
-        n = poly.face_normals[f_m]
-        hit = trace_face(poly, f_m, p_m - (p_m @ n - poly.face_offsets[f_m]) * n, t.inverse().rotate(move.direction))
-        if hit is None:
-            return np.nan, np.nan, np.nan
-        n_w = t.rotate(n)
+        hit = tr.hit
+        n_w = t.rotate(poly.face_normals[tr.face])
         d_z = float(np.asarray(move.direction)[2])
         if d_z < 0.0 and pad_clearance(t.apply(hit.point), n_w, config) < lim:
             # the slide stops where the pad comes too close to the table
-            start = pad_clearance(t.apply(p_m - (p_m @ n - poly.face_offsets[f_m]) * n), n_w, config)
+            start = pad_clearance(t.apply(tr.start), n_w, config)
             return 1.0, float(np.clip((start - lim) / -d_z, 0.0, hit.distance)), 0.0
         if leans_under(hit.edge, hit.next_face):
-            s_hit = float((hit.point - poly.edge_points[hit.edge]) @ poly.edge_directions[hit.edge])
-            near_end = min(s_hit, float(poly.edge_lengths[hit.edge]) - s_hit) < EDGE_ONLY_CLEARANCE
+            near_end = tr.clearance(poly) < EDGE_ONLY_CLEARANCE
             if near_end or float(n_w[2]) < -np.sin(config.max_undercut - EDGE_ROLL):
                 return 1.0, float(hit.distance), 0.0  # no room to roll over the edge alone: the move fails there
             return 0.0, float(hit.distance), 1.0

@@ -25,6 +25,7 @@ from __future__ import annotations
 import numpy as np
 
 from haptic.geometry import SE3, Polyhedron
+from haptic.geometry.distance import point_triangle_distance, surface_distance
 from haptic.planning.predict import EDGE_ONLY_CLEARANCE, EDGE_ROLL, PlannerConfig
 
 SPACING = 0.004
@@ -53,18 +54,6 @@ def surface_samples(poly: Polyhedron, spacing: float = SPACING) -> tuple[np.ndar
     return np.concatenate(pts), np.concatenate(nrm)
 
 
-def surface_distance(poly: Polyhedron, points: np.ndarray) -> np.ndarray:
-    """Unsigned distance from each point (model frame) to the surface, shape (P,)."""
-    p = np.atleast_2d(np.asarray(points, dtype=float))
-    tri = poly.vertices[poly.triangles]  # (T, 3, 3)
-    best = np.full(len(p), np.inf)
-    for start in range(0, len(p), 2048):
-        q = p[start : start + 2048]
-        d = point_triangle_distance(q, tri)
-        best[start : start + 2048] = d.min(axis=1)
-    return best
-
-
 FACING = np.cos(np.deg2rad(20.0))
 """A touched point's sensed normal agrees with a face's when their angle is under 20° (a pose class's error
 and the pad's compliance are a few degrees; distinct faces of the library differ by far more)."""
@@ -84,38 +73,6 @@ def touch_distance(poly: Polyhedron, world_from_model: SE3, points: np.ndarray, 
         d = point_triangle_distance(p[start : start + 2048], tri)
         best[start : start + 2048] = np.where(agree[start : start + 2048], d, np.inf).min(axis=1)
     return best
-
-
-def point_triangle_distance(p: np.ndarray, tri: np.ndarray) -> np.ndarray:
-    """Distances (P, T) from points to triangles (closest point by barycentric clamping over the regions)."""
-    a, b, c = tri[None, :, 0], tri[None, :, 1], tri[None, :, 2]
-    q = p[:, None, :]
-    ab, ac = b - a, c - a
-    n = np.cross(ab, ac)
-    nn = np.einsum("ptk,ptk->pt", n, n) + 1e-30
-    # projection onto the plane and its barycentric coordinates
-    w = q - a
-    dist_plane = np.einsum("ptk,ptk->pt", w, n) / np.sqrt(nn)
-    proj = q - (np.einsum("ptk,ptk->pt", w, n) / nn)[..., None] * n
-    v0, v1, v2 = ab, ac, proj - a
-    d00 = np.einsum("ptk,ptk->pt", v0, v0)
-    d01 = np.einsum("ptk,ptk->pt", v0, v1)
-    d11 = np.einsum("ptk,ptk->pt", v1, v1)
-    d20 = np.einsum("ptk,ptk->pt", v2, v0)
-    d21 = np.einsum("ptk,ptk->pt", v2, v1)
-    den = d00 * d11 - d01 * d01 + 1e-30
-    s = (d11 * d20 - d01 * d21) / den
-    t = (d00 * d21 - d01 * d20) / den
-    inside = (s >= 0) & (t >= 0) & (s + t <= 1)
-    d_in = np.abs(dist_plane)
-
-    def seg(x, y):
-        xy = y - x
-        h = np.clip(np.einsum("ptk,ptk->pt", q - x, xy) / (np.einsum("ptk,ptk->pt", xy, xy) + 1e-30), 0.0, 1.0)
-        return np.linalg.norm(q - (x + h[..., None] * xy), axis=2)
-
-    d_edge = np.minimum(np.minimum(seg(a, b), seg(b, c)), seg(c, a))
-    return np.where(inside, d_in, d_edge)
 
 
 def _touchable(

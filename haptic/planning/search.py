@@ -13,12 +13,12 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from haptic.geometry.tracing import circle_vertex, trace_edge, trace_face
+from haptic.geometry.tracing import circle_vertex, trace_edge
 from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex, SensorNoise
-from haptic.planning.efficiency import class_weights, expected_eliminated, outcome_groups
+from haptic.planning.efficiency import class_weights, outcome_groups
 from haptic.planning.moves import EdgeMove, FaceMove, Move, SensorState, VertexMove
-from haptic.planning.policies import Context, eliminates, refusal, same_move
-from haptic.planning.predict import Hypothesis, PlannerConfig, candidate_moves, descent_risk, predict
+from haptic.planning.policies import Context, refusal, same_move, score_prediction
+from haptic.planning.predict import Hypothesis, PlannerConfig, candidate_moves, predict, trace_in
 
 STEP_ONTO = 0.003
 """How far onto the next face a simulated face or vertex move steps for its normal [m]."""
@@ -73,15 +73,10 @@ def simulate(
 
     if isinstance(move, FaceMove | VertexMove):
         if isinstance(move, FaceMove):
-            f_m = h.faces.get(state.face)
-            if f_m is None:
+            tr = trace_in(h, move, state)
+            if tr is None:
                 return None
-            d_m = t.inverse().rotate(move.direction)
-            n_f = poly.face_normals[f_m]
-            hit = trace_face(poly, f_m, p_m - (p_m @ n_f - poly.face_offsets[f_m]) * n_f, d_m)
-            if hit is None:
-                return None
-            e_m, g_m, at_m, from_face = hit.edge, hit.next_face, hit.point, state.face
+            e_m, g_m, at_m, from_face = tr.hit.edge, tr.hit.next_face, tr.hit.point, state.face
         else:
             e0, v_m, a_m = (h.edges.get(state.edge), h.vertices.get(state.vertex), h.faces.get(move.across_face))
             if e0 is None or v_m is None or a_m is None:
@@ -225,9 +220,8 @@ def _last_move_score(ctx, hyps, weights, move, state, components, spent) -> floa
     if refused >= ctx.config.table_risk:
         return 0.0
     w = np.asarray(weights, dtype=float)
-    elim = expected_eliminated(eliminates(pred, ctx.config), w / w.sum())
-    elim *= (1.0 - refused) * (1.0 - descent_risk(move, ctx.config))
-    return elim / (spent + float(pred.costs @ (w / w.sum()))) if elim > 0 else 0.0
+    _, elim, cost, _ = score_prediction(pred, w / w.sum(), refused, ctx.config)
+    return elim / (spent + cost) if elim > 0 else 0.0
 
 
 def matcher_eliminations(ctx: Context, move: Move) -> tuple[np.ndarray, np.ndarray] | None:
