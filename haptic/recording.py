@@ -5,15 +5,30 @@ saved to an ``.rrd`` file (written to a temporary file beside the target and ren
 so a failed episode never leaves a partial recording at the target path) and/or streamed to a spawned viewer.
 
 Timelines: ``move`` (sequence: 0 is the start, then one step per move) and, when the executor reports contact
-traces (the physics executor's ``info["trace"]``), ``sim_time`` (simulated time [s]).
+traces (the physics executor's ``info["trace"]``), ``sim_time`` (simulated time [s]); a physics recording
+opens on ``sim_time``. Everything drawn has a value on both timelines (per control tick on ``sim_time``, the
+state at the end of each move on ``move``).
 
-Entities (world frame, metres, Z up):
+The default blueprint (:func:`default_blueprint`, sent when the first move arrives) frames the work: the
+``object`` view's eye is on the object's region, the ``fingertip`` view follows the active pad close up; the
+plots are the interpretations and pose classes (log10), the normal force and the path cost, each on its own
+axis; the candidate table and the logs beside them.
+
+Entities (world frame, metres, Z up; marks are sized to the object or in screen points, so they read at the
+default framing; labels show on hover):
 
 - ``world/truth``: Transform3D ``world_from_model`` of the true pose (static)
 - ``world/truth/object``: the true model's mesh, model frame (static; the ground-truth layer)
 - ``world/truth/edges``: its edges as line strips (static)
 - ``world/estimate``, ``.../edges``: the recognised model at its estimated pose, once recognised
-- ``world/trace/path``: the sensor's path, one line strip per move, accumulated
+- ``world/robot/<link>``: Transform3D of each robot link (``info["hand_links"]`` poses), per sampled tick
+  (``sim_time``) and at the end of each move (``move``)
+- ``world/robot/<link>/<kind>s``: the link's collision geoms (capsules, spheres, cylinders, boxes, ellipsoids,
+  meshes) in the link frame, static (``info["link_geoms"]``); ``world/table``: the table top
+- ``world/hand/pad``: Transform3D (a translation) to the active fingertip pad's centre (the trace's tip), per
+  tick and at the end of each move: the origin of the ``fingertip`` view, which so follows the pad
+- ``world/trace/path``: the sensor's path, one line strip per move, accumulated, coloured by move kind
+  (:data:`KIND_COLORS`; the legend is the interpretation plot's)
 - ``world/trace/failed``: fingertip paths of failed moves, accumulated (physics)
 - ``world/sensor``: sensor position after the latest move
 - ``world/contacts/points``, ``/normals``: the latest move's contact points and their normals (arrows)
@@ -22,20 +37,20 @@ Entities (world frame, metres, Z up):
 - ``world/data/faces/points``: the points touched on the data faces
 - ``world/data/edges``: one segment per data edge (its explored interval), ``e<id>``
 - ``world/data/vertices``: one point per data vertex, ``v<id>``
-- ``world/decision/candidates``: each candidate move of the latest decision, coloured by score
+- ``world/decision/candidates``: each candidate move of the decision, coloured by score
 - ``world/decision/chosen``: the chosen move
-- ``world/hand/pad``: fingertip pad pose per control tick (``sim_time``; physics only)
 - ``world/hand/fingertip``: pad centre per control tick (physics only)
 - ``world/hand/contact/points``, ``/normals``: sensed contact per control tick (physics only)
-- ``world/hand/links``: hand link origins, labelled (``info["hand_links"]``; on ``sim_time`` at the
-  ``info["hand_links_time"]`` samples when given, else one row per trace tick)
-- ``world/hand/skeleton``: the links joined as line strips (``info["hand_link_chains"]``: polylines of link
-  names, e.g. the palm out along each finger), at the same times
-- ``plots/interpretations``: surviving interpretations after each move
-- ``plots/pose_classes``: pose classes after each move (when known)
+- ``world/hand/links``, ``world/hand/skeleton``: link origins and the links joined as line strips
+  (``info["hand_link_chains"]``), drawn only when a result reports links without their geometry
+- ``plots/interpretations``, ``plots/pose_classes``: log10 of the surviving interpretations and pose classes
+  after each move (-1 stands for none); a failed move repeats the count
+- ``plots/moves/<kind>``: a marker per move on the interpretation plot, coloured by move kind (``start``,
+  ``face``, ``edge``, ``vertex``, ``failed``: a red cross): the legend of the trace's colours
 - ``plots/path_cost``: cumulative path cost [units]
 - ``plots/force``: sensed normal force per control tick [N] (physics only)
-- ``plots/candidates``: bar chart of the latest decision's candidate scores
+- ``decision/scores``: per decision, a table of its candidate moves (kind and direction) with their scores,
+  expected cost and eliminations, best first
 - ``log/moves``, ``log/decisions``, ``log/episode``: text logs
 
 Read a recording back with :func:`load_recording` (rerun's :class:`rerun.chunk.RrdReader`).
@@ -78,53 +93,125 @@ VIEWER_PORT = 9876
 
 PATCH_RADIUS = 0.006
 """Half-size of a data face's patch beyond its touched points [m]."""
-NORMAL_LENGTH = 0.012
-"""Length of a face-normal arrow [m]."""
-CONTACT_NORMAL_LENGTH = 0.006
-"""Length of a contact-normal arrow [m]."""
-CANDIDATE_LENGTH = 0.02
-"""Length of the best candidate move's arrow (the others scale down with their score, to half of it) [m]."""
+NORMAL_SCALE = 0.4
+"""Length of a face-normal arrow, as a fraction of the object's radius."""
+CONTACT_NORMAL_SCALE = 0.25
+"""Length of a contact-normal arrow, as a fraction of the object's radius."""
+CANDIDATE_SCALE = 0.5
+"""Length of the best candidate move's arrow, as a fraction of the object's radius (the others scale down
+with their score, to half of it)."""
+DEFAULT_RADIUS = 0.04
+"""Object radius assumed before the episode's object is known [m]."""
+MOVE_CONTACTS = 60
+"""Most contact points of one move in ``world/contacts/points`` (a physics trace is subsampled to it)."""
+MOVE_NORMALS = 12
+"""Most contact normals of one move drawn in ``world/contacts/normals`` (evenly spaced along the move)."""
+ROBOT_ALPHA = 0.6
+"""Opacity of the robot's geometry (the contact under a pad shows through it)."""
 TRACE_MAX_POINTS = 400
 """Most points of one move's strip in ``world/trace/path`` (a physics trace is subsampled to it)."""
+OBJECT_VIEW_DISTANCE = 3.5
+"""Distance of the ``object`` view's eye from the object's centre, in object radii (at least
+:data:`MIN_VIEW_DISTANCE`)."""
+MIN_VIEW_DISTANCE = 0.12
+"""Closest the ``object`` view's eye starts to the object's centre [m]."""
+FINGERTIP_VIEW_DISTANCE = 0.09
+"""Distance of the ``fingertip`` view's eye from the pad [m]."""
+VIEW_DIRECTION = (0.75, -0.9, 0.75)
+"""Direction (world) from the looked-at point to the eye of both views: from the far side of the table and
+above, so the arm reaches in from behind the object."""
+NO_COUNT = -1.0
+"""What the log10 plots show for zero interpretations or pose classes."""
+MAX_TABLE_ROWS = 12
+"""Most candidate moves listed in a decision's table (best first)."""
+
+# sizes in screen points (rerun draws negative radii as points on screen, whatever the zoom)
+TRACE_RADIUS = rr.components.Radius.ui_points(2.0)
+CONTACT_RADIUS = rr.components.Radius.ui_points(4.0)
+ARROW_RADIUS = rr.components.Radius.ui_points(1.5)
+EDGE_RADIUS = rr.components.Radius.ui_points(3.0)
+VERTEX_RADIUS = rr.components.Radius.ui_points(6.0)
 
 KIND_COLORS: dict[str, tuple[int, int, int]] = {
-    "start": (160, 160, 160),
+    "start": (170, 170, 170),
     "face": (70, 130, 230),
     "edge": (240, 150, 40),
-    "vertex": (180, 80, 200),
+    "vertex": (190, 90, 220),
+    "failed": (230, 50, 50),
 }
-"""Colour of each move kind (path strips, candidate labels)."""
+"""Colour of each move kind (path strips, move markers on the interpretation plot, candidates)."""
 FACE_COLOR = (70, 130, 230, 140)
 EDGE_COLOR = (240, 150, 40)
 VERTEX_COLOR = (220, 40, 60)
 CONTACT_COLOR = (250, 220, 50)
-TRUTH_COLOR = (150, 150, 150, 90)
+TRUTH_COLOR = (235, 225, 190, 120)
 ESTIMATE_COLOR = (60, 200, 90)
+INTERPRETATIONS_COLOR = (225, 225, 225)
+POSE_CLASSES_COLOR = (60, 190, 170)
 
 
 # ---------------------------------------------------------------------------------------------- blueprint
 
 
-def default_blueprint() -> rrb.Blueprint:
-    """The layout a recording opens with: the 3-D scene on the left; the interpretation count, the path cost,
-    the latest decision's candidate scores and the logs on the right; the time panel on the ``move``
-    timeline."""
+@dataclass(frozen=True)
+class Framing:
+    """Where the default blueprint's 3-D views start looking (world frame)."""
+
+    object_eye: tuple[float, float, float] | None = None
+    """Eye of the ``object`` view [m] (None: the viewer's own framing of everything)."""
+    object_target: tuple[float, float, float] | None = None
+    """Point the ``object`` view looks at and orbits: the object's centre [m]."""
+    fingertip_eye: tuple[float, float, float] | None = None
+    """Eye of the ``fingertip`` view relative to the pad [m] (the view's origin is ``world/hand/pad``, which
+    moves with the pad, so the eye follows it)."""
+    timeline: str = "move"
+    """Timeline the recording opens on (``sim_time`` when there are physics traces)."""
+
+
+def default_blueprint(framing: Framing | None = None) -> rrb.Blueprint:
+    """The layout a recording opens with: on the left the ``object`` 3-D view (its eye on the object's region)
+    over the ``fingertip`` view (following the active pad close up) and the latest decision's candidate table;
+    on the right the interpretations and pose classes (log10, with a marker per move coloured by its kind and
+    failed moves crossed), the normal force, the path cost and the logs."""
+    f = framing or Framing()
+    up = (0.0, 0.0, 1.0)
+    obj_eye = (
+        rrb.EyeControls3D(position=f.object_eye, look_target=f.object_target, eye_up=up)
+        if f.object_eye is not None else None
+    )  # fmt: skip
+    tip_eye = (
+        rrb.EyeControls3D(position=f.fingertip_eye, look_target=(0.0, 0.0, 0.0), eye_up=up)
+        if f.fingertip_eye is not None else None
+    )  # fmt: skip
     return rrb.Blueprint(
         rrb.Horizontal(
-            rrb.Spatial3DView(origin="world", name="scene"),
+            rrb.Vertical(
+                rrb.Spatial3DView(origin="world", name="object", eye_controls=obj_eye,
+                                  background=rrb.BackgroundKind.GradientBright),
+                rrb.Horizontal(
+                    rrb.Spatial3DView(origin="world/hand/pad", contents="/world/**", name="fingertip",
+                                      eye_controls=tip_eye, background=rrb.BackgroundKind.GradientBright),
+                    rrb.TextDocumentView(origin="decision", name="candidate moves"),
+                    column_shares=[1, 1],
+                ),
+                row_shares=[3, 2],
+            ),
             rrb.Vertical(
                 rrb.TimeSeriesView(
-                    origin="plots", contents=["plots/interpretations", "plots/pose_classes"], name="interpretations"
-                ),
-                rrb.TimeSeriesView(origin="plots", contents=["plots/path_cost", "plots/force"], name="cost and force"),
-                rrb.BarChartView(origin="plots/candidates", name="candidate scores"),
+                    origin="plots", name="interpretations, pose classes (log10)",
+                    contents=["plots/interpretations", "plots/pose_classes", "plots/moves/**"],
+                    plot_legend=rrb.PlotLegend(corner=rrb.Corner2D.RightTop),
+                ),  # fmt: skip
+                rrb.TimeSeriesView(origin="plots", contents=["plots/force"], name="normal force [N]"),
+                rrb.TimeSeriesView(origin="plots", contents=["plots/path_cost"], name="path cost [units]"),
                 rrb.TextLogView(origin="log", name="log"),
                 row_shares=[3, 2, 2, 2],
             ),
             column_shares=[3, 2],
         ),
-        rrb.TimePanel(timeline="move"),
+        rrb.TimePanel(timeline=f.timeline, state="collapsed"),
         rrb.SelectionPanel(state="collapsed"),
+        rrb.BlueprintPanel(state="collapsed"),
     )
 
 
@@ -179,8 +266,17 @@ class _State:
     state: SensorState | None = None
     link_labels_logged: bool = False
     skeleton_style_logged: bool = False
-    pad_axes_logged: bool = False
+    trace_style_logged: bool = False
     decision_shown: bool = False
+    radius: float = DEFAULT_RADIUS
+    """Object radius [m]: the scale of the marks."""
+    centre: np.ndarray | None = None
+    """Object centre, world [m] (for the ``object`` view's eye)."""
+    blueprint_sent: bool = False
+    geom_links: set[str] | None = None
+    """Links whose geometry is drawn (None: no geometry reported yet)."""
+    counts: tuple[float, float | None] = (math.nan, None)
+    """Latest log10 interpretations and pose classes plotted."""
 
 
 class EpisodeRecorder:
@@ -238,7 +334,7 @@ class EpisodeRecorder:
                     "use --record OUT.rrd and open it with `rerun OUT.rrd`"
                 )
             sinks.append(rr.GrpcSink(f"rerun+http://127.0.0.1:{VIEWER_PORT}/proxy"))
-        self.stream.set_sinks(*sinks, default_blueprint=default_blueprint())
+        self.stream.set_sinks(*sinks)
         if name:
             self.stream.send_recording_name(name)
         self._log_static()
@@ -269,6 +365,7 @@ class EpisodeRecorder:
         self._closed = True
         self._kept = self.completed if keep is None else bool(keep)
         try:
+            self._send_blueprint()
             self.stream.flush(timeout_sec=30.0)
         finally:
             self.stream.disconnect()
@@ -307,12 +404,24 @@ class EpisodeRecorder:
     # ------------------------------------------------------------------------------------------ hooks
 
     def on_start(self, true_model: Polyhedron, world_from_model: SE3) -> None:
-        """The ground-truth layer: the true model in its true pose (static)."""
-        rec = self.stream
+        """The ground-truth layer: the true model in its true pose (static); the scale of the marks and the
+        ``object`` view's target from its size and place."""
+        rec, s = self.stream, self._s
         rec.send_recording_name(f"{true_model.name}")
         rec.log("world/truth", _transform(world_from_model), static=True)
         rec.log("world/truth/object", _mesh(true_model, TRUTH_COLOR), static=True)
-        rec.log("world/truth/edges", _wireframe(true_model, (120, 120, 120), 0.0004), static=True)
+        rec.log("world/truth/edges", _wireframe(true_model, (120, 120, 120), rr.components.Radius.ui_points(1.0)),
+                static=True)  # fmt: skip
+        v = np.asarray(true_model.vertices, dtype=float) @ np.asarray(world_from_model.rotation).T
+        v = v + np.asarray(world_from_model.translation, dtype=float)
+        lo, hi = v.min(axis=0), v.max(axis=0)
+        s.centre = (lo + hi) / 2
+        s.radius = max(float(np.linalg.norm(hi - lo)) / 2, 1e-3)
+        rec.set_time("move", sequence=0)
+        rec.set_time("sim_time", duration=0.0)
+        rec.log("decision/scores", rr.TextDocument("**the start**: the hand comes down onto the object; the planner "
+                                                   "decides from the first contacts on",
+                                                   media_type=rr.MediaType.MARKDOWN))  # fmt: skip
 
     def on_move(
         self, i: int, result: MoveResult, n_interpretations: int, recognition: Recognition | None = None
@@ -322,6 +431,8 @@ class EpisodeRecorder:
         trace = _trace_of(result)
         if trace is not None and len(trace.time):
             s.sim_time = float(trace.time[-1])
+        if not s.blueprint_sent:
+            self._send_blueprint(trace)
         self._set_time(i)
         for c in result.components:
             s.components[c.id] = c
@@ -344,8 +455,8 @@ class EpisodeRecorder:
                 rr.LineStrips3D(
                     s.strips,
                     colors=[KIND_COLORS.get(k, KIND_COLORS["start"]) for k in s.strip_kinds],
-                    radii=0.0006,
-                    labels=[f"{j}: {k}" for j, k in enumerate(s.strip_kinds)],
+                    radii=TRACE_RADIUS,
+                    labels=[f"move {j}: {k}" for j, k in enumerate(s.strip_kinds)],
                     show_labels=False,
                 ),
             )
@@ -353,40 +464,41 @@ class EpisodeRecorder:
             s.state = result.state
         if new is not None:
             s.position = new
-            rec.log("world/sensor", rr.Points3D([new], radii=0.002, colors=[(255, 255, 255)], labels=["sensor"]))
+            rec.log("world/sensor", rr.Points3D([new], radii=VERTEX_RADIUS, colors=[(255, 255, 255)],
+                                                labels=["sensor"], show_labels=False))  # fmt: skip
 
         # contacts of this move
         if trace is not None and len(trace.time):
             ok = np.isfinite(np.asarray(trace.normal_in_world, dtype=float)[:, 0])
-            pts = _subsample(np.asarray(trace.point_in_world, dtype=float)[ok], 60)
-            nrm = _subsample(np.asarray(trace.normal_in_world, dtype=float)[ok], 60)
+            pts = _subsample(np.asarray(trace.point_in_world, dtype=float)[ok], MOVE_CONTACTS)
+            nrm = _subsample(np.asarray(trace.normal_in_world, dtype=float)[ok], MOVE_CONTACTS)
             self._log_trace(trace)
         else:
             pts, nrm = _contacts(result.components)
-        rec.log("world/contacts/points", rr.Points3D(pts, radii=0.0008, colors=[CONTACT_COLOR]))
+        rec.log("world/contacts/points", rr.Points3D(pts, radii=CONTACT_RADIUS, colors=[CONTACT_COLOR]))
+        k = _subsample(np.arange(len(pts)), MOVE_NORMALS)
         rec.log(
             "world/contacts/normals",
-            rr.Arrows3D(origins=pts, vectors=nrm * CONTACT_NORMAL_LENGTH, colors=[CONTACT_COLOR], radii=0.0002),
-        )
+            rr.Arrows3D(origins=pts[k], vectors=nrm[k] * CONTACT_NORMAL_SCALE * s.radius, colors=[CONTACT_COLOR],
+                        radii=ARROW_RADIUS),
+        )  # fmt: skip
         self._log_hand(result, trace)
 
         self._log_components()
 
-        # the counts
+        # the counts, on a log axis, with a marker of the move's kind
         s.cost += float(result.cost)
-        rec.log("plots/interpretations", rr.Scalars(float(n_interpretations)))
-        rec.log("plots/path_cost", rr.Scalars(s.cost))
         n_classes = len(recognition.classes) if recognition is not None and recognition.classes else None
-        if n_classes is not None:
-            rec.log("plots/pose_classes", rr.Scalars(float(n_classes)))
+        self._log_counts(_log_count(n_interpretations), _log_count(n_classes) if n_classes is not None else None,
+                         kind)  # fmt: skip
+        rec.log("plots/path_cost", rr.Scalars(s.cost))
         if recognition is not None and recognition.status == "recognized" and recognition.world_from_model:
             model = next((c.model for c in recognition.classes if c.name == recognition.model), None)
             if model is not None:
                 rec.log("world/estimate", _transform(recognition.world_from_model))
-                rec.log("world/estimate/edges", _wireframe(model, ESTIMATE_COLOR, 0.0005))
-        if i not in s.decided and s.decision_shown:
-            rec.log("world/decision", rr.Clear(recursive=True))
-            s.decision_shown = False
+                rec.log("world/estimate/edges", _wireframe(model, ESTIMATE_COLOR, EDGE_RADIUS))
+        if i not in s.decided:
+            self._no_decision(i, kind)
 
         status = recognition.status if recognition is not None else "-"
         comps = ", ".join(f"{c.kind} {c.id}" for c in result.components) or "none"
@@ -401,13 +513,15 @@ class EpisodeRecorder:
         )
 
     def on_failed_move(self, i: int, result: MoveResult) -> None:
-        """A move that failed (no components): its trace, when there is one, in ``world/trace/failed``, and a
-        warning in ``log/moves``. (Called by the loop when :class:`~haptic.episode.EpisodeObserver` has an
-        ``on_failed_move`` hook.)"""
+        """A move that failed (no components): its trace, when there is one, in ``world/trace/failed``, a cross
+        on the interpretation plot (the counts unchanged) and a warning in ``log/moves``. (Called by the loop
+        when :class:`~haptic.episode.EpisodeObserver` has an ``on_failed_move`` hook.)"""
         rec, s = self.stream, self._s
         trace = _trace_of(result)
         if trace is not None and len(trace.time):
             s.sim_time = float(trace.time[-1])
+        if not s.blueprint_sent:
+            self._send_blueprint(trace)
         self._set_time(i)
         if trace is not None and len(trace.time):
             self._log_trace(trace)
@@ -416,12 +530,17 @@ class EpisodeRecorder:
             path = _subsample(np.asarray(trace.tip_in_world, dtype=float), TRACE_MAX_POINTS)
             if len(path) >= 2:
                 s.failed_strips.append(path)
-                rec.log("world/trace/failed", rr.LineStrips3D(s.failed_strips, colors=[(230, 50, 50)], radii=0.0006))
+                rec.log("world/trace/failed", rr.LineStrips3D(s.failed_strips, colors=[KIND_COLORS["failed"]],
+                                                              radii=TRACE_RADIUS))  # fmt: skip
         if result.state is not None:
             s.state = result.state
             s.position = np.asarray(result.state.position, dtype=float)
         s.cost += float(result.cost)
         rec.log("plots/path_cost", rr.Scalars(s.cost))
+        if math.isfinite(s.counts[0]):
+            self._log_counts(*s.counts, "failed")
+        if i not in s.decided:
+            self._no_decision(i, getattr(result.move, "kind", "?"))
         reason = result.info.get("reason", "") if isinstance(result.info, dict) else ""
         rec.log(
             "log/moves",
@@ -432,7 +551,8 @@ class EpisodeRecorder:
         )
 
     def on_decision(self, i: int, decision: Decision) -> None:
-        """The planner's choice for move ``i``: every candidate with its score, as arrows, bars and text."""
+        """The planner's choice for move ``i``: every candidate with its score, as arrows and as a table (kept
+        per decision on both timelines)."""
         rec, s = self.stream, self._s
         self._set_time(i)
         s.decided.add(i)
@@ -442,20 +562,19 @@ class EpisodeRecorder:
             finite = np.isfinite(scores)
             lo, hi = (float(scores[finite].min()), float(scores[finite].max())) if finite.any() else (0.0, 0.0)
             rel = np.where(finite, (scores - lo) / (hi - lo), 0.0) if hi > lo else np.ones(len(cands))
-            rec.log("plots/candidates", rr.BarChart(np.where(finite, scores, 0.0), color=(70, 130, 230)))
             origins, vectors, colors, labels = [], [], [], []
             for c, r in zip(cands, rel, strict=True):
                 d = self._move_direction(c.move)
                 if d is None:
                     continue
                 origins.append(s.position)
-                vectors.append(d * CANDIDATE_LENGTH * (0.5 + 0.5 * r))
+                vectors.append(d * CANDIDATE_SCALE * s.radius * (0.5 + 0.5 * r))
                 colors.append(_score_color(r))
                 labels.append(f"{_move_name(c.move)} {c.score:.3g}")
             if origins:
                 rec.log(
                     "world/decision/candidates",
-                    rr.Arrows3D(origins=origins, vectors=vectors, colors=colors, labels=labels, radii=0.0004,
+                    rr.Arrows3D(origins=origins, vectors=vectors, colors=colors, labels=labels, radii=ARROW_RADIUS,
                                 show_labels=False),
                 )  # fmt: skip
             lines = [
@@ -469,10 +588,12 @@ class EpisodeRecorder:
         if d is not None and s.position is not None:
             rec.log(
                 "world/decision/chosen",
-                rr.Arrows3D(origins=[s.position], vectors=[d * CANDIDATE_LENGTH * 1.2], colors=[(255, 255, 255)],
-                            radii=0.0008, labels=[_move_name(decision.move)]),
+                rr.Arrows3D(origins=[s.position], vectors=[d * CANDIDATE_SCALE * s.radius * 1.2],
+                            colors=[(255, 255, 255)], radii=rr.components.Radius.ui_points(2.5),
+                            labels=[_move_name(decision.move)], show_labels=False),
             )  # fmt: skip
         s.decision_shown = True
+        rec.log("decision/scores", rr.TextDocument(_decision_table(i, decision), media_type=rr.MediaType.MARKDOWN))
         rec.log(
             "log/decisions",
             rr.TextLog(
@@ -502,22 +623,62 @@ class EpisodeRecorder:
         rec = self.stream
         rec.log("world", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
         series = {
-            "plots/interpretations": ((230, 90, 60), "interpretations"),
-            "plots/pose_classes": ((60, 160, 230), "pose classes"),
+            "plots/interpretations": (INTERPRETATIONS_COLOR, "interpretations (log10)"),
+            "plots/pose_classes": (POSE_CLASSES_COLOR, "pose classes (log10)"),
             "plots/path_cost": ((120, 200, 90), "path cost [units]"),
             "plots/force": ((200, 120, 220), "normal force [N]"),
         }
         for path, (color, label) in series.items():
             rec.log(path, rr.SeriesLines(colors=[color], names=[label], widths=[2.0]), static=True)
+        for kind, color in KIND_COLORS.items():
+            marker, size = ("Cross", 9.0) if kind == "failed" else ("Circle", 5.0)
+            rec.log(f"plots/moves/{kind}", rr.SeriesPoints(colors=[color], names=[f"{kind} move"], markers=[marker],
+                                                           marker_sizes=[size]), static=True)  # fmt: skip
+
+    def _send_blueprint(self, trace: Any = None) -> None:
+        """The default blueprint, once: the ``object`` view's eye on the object's region, the ``fingertip`` view
+        on the pad where the first trace starts, the ``sim_time`` timeline when there is a trace."""
+        s = self._s
+        if s.blueprint_sent:
+            return
+        s.blueprint_sent = True
+        direction = np.asarray(VIEW_DIRECTION, dtype=float)
+        direction /= np.linalg.norm(direction)
+        kw: dict[str, Any] = {}
+        if s.centre is not None:
+            dist = max(OBJECT_VIEW_DISTANCE * s.radius, MIN_VIEW_DISTANCE)
+            kw.update(object_eye=tuple(s.centre + dist * direction), object_target=tuple(s.centre))
+        if trace is not None and len(trace.time):
+            kw.update(fingertip_eye=tuple(FINGERTIP_VIEW_DISTANCE * direction), timeline="sim_time")
+        self.stream.send_blueprint(default_blueprint(Framing(**kw)), make_active=True, make_default=True)
 
     def _set_time(self, i: int) -> None:
         self.stream.set_time("move", sequence=int(i))
         if self._s.sim_time is not None:
             self.stream.set_time("sim_time", duration=self._s.sim_time)
 
+    def _log_counts(self, interpretations: float, classes: float | None, kind: str) -> None:
+        """log10 interpretations (and pose classes) at the current time, and a marker of the move's kind."""
+        rec = self.stream
+        rec.log("plots/interpretations", rr.Scalars(interpretations))
+        if classes is not None:
+            rec.log("plots/pose_classes", rr.Scalars(classes))
+        rec.log(f"plots/moves/{kind if kind in KIND_COLORS else 'start'}", rr.Scalars(interpretations))
+        self._s.counts = (interpretations, classes)
+
+    def _no_decision(self, i: int, kind: str) -> None:
+        """The candidate table at a move the planner did not choose (the start, an opening move)."""
+        s = self._s
+        if s.decision_shown:
+            self.stream.log("world/decision", rr.Clear(recursive=True))
+            s.decision_shown = False
+        what = "the start" if i == 0 else f"an opening {kind} move"
+        self.stream.log("decision/scores", rr.TextDocument(f"**move {i}**: {what}, not a planner decision",
+                                                           media_type=rr.MediaType.MARKDOWN))  # fmt: skip
+
     def _log_components(self) -> None:
         """The data components so far (edges at their latest explored interval)."""
-        rec = self.stream
+        rec, r = self.stream, self._s.radius
         comps = sorted(self._s.components.values(), key=lambda c: c.id)
         faces = [c for c in comps if isinstance(c, DataFace)]
         edges = [c for c in comps if isinstance(c, DataEdge)]
@@ -537,39 +698,37 @@ class EpisodeRecorder:
             centres = np.array([f.points.mean(axis=0) for f in faces])
             rec.log(
                 "world/data/faces/normals",
-                rr.Arrows3D(origins=centres, vectors=np.array([f.normal for f in faces]) * NORMAL_LENGTH,
-                            colors=[FACE_COLOR[:3]], radii=0.0004, labels=[f"f{f.id}" for f in faces]),
+                rr.Arrows3D(origins=centres, vectors=np.array([f.normal for f in faces]) * NORMAL_SCALE * r,
+                            colors=[FACE_COLOR[:3]], radii=ARROW_RADIUS, labels=[f"f{f.id}" for f in faces],
+                            show_labels=False),
             )  # fmt: skip
             rec.log(
                 "world/data/faces/points",
-                rr.Points3D(np.vstack([f.points for f in faces]), radii=0.0006, colors=[FACE_COLOR[:3]]),
-            )
+                rr.Points3D(np.vstack([f.points for f in faces]), radii=rr.components.Radius.ui_points(2.0),
+                            colors=[FACE_COLOR[:3]]),
+            )  # fmt: skip
         if edges:
             rec.log(
                 "world/data/edges",
                 rr.LineStrips3D([np.array([e.point, e.end_point]) for e in edges], colors=[EDGE_COLOR],
-                                radii=0.0008, labels=[f"e{e.id}" for e in edges]),
+                                radii=EDGE_RADIUS, labels=[f"e{e.id}" for e in edges], show_labels=False),
             )  # fmt: skip
         if vertices:
             rec.log(
                 "world/data/vertices",
-                rr.Points3D([v.position for v in vertices], radii=0.0015, colors=[VERTEX_COLOR],
-                            labels=[f"v{v.id}" for v in vertices]),
+                rr.Points3D([v.position for v in vertices], radii=VERTEX_RADIUS, colors=[VERTEX_COLOR],
+                            labels=[f"v{v.id}" for v in vertices], show_labels=False),
             )  # fmt: skip
 
     def _log_trace(self, trace: Any) -> None:
-        """A physics contact trace, one row per control tick on the ``sim_time`` timeline."""
-        rec = self.stream
+        """A physics contact trace, one row per control tick on the ``sim_time`` timeline; the pad's pose and
+        the last tick's contact also at the current ``move``."""
+        rec, r = self.stream, self._s.radius
         t = rr.TimeColumn("sim_time", duration=np.asarray(trace.time, dtype=float))
         tip = np.asarray(trace.tip_in_world, dtype=float)
-        n = len(tip)
         rec.send_columns("world/hand/fingertip", indexes=[t], columns=rr.Points3D.columns(positions=tip))
-        rot = np.asarray(trace.hand_rotation, dtype=float)
-        if rot.shape == (n, 3, 3):
-            if not self._s.pad_axes_logged:
-                rec.log("world/hand/pad", rr.TransformAxes3D(0.01), static=True)
-                self._s.pad_axes_logged = True
-            rec.send_columns("world/hand/pad", indexes=[t], columns=rr.Transform3D.columns(translation=tip, mat3x3=rot))
+        rec.send_columns("world/hand/pad", indexes=[t], columns=rr.Transform3D.columns(translation=tip))
+        rec.log("world/hand/pad", rr.Transform3D(translation=tip[-1]))
         rec.send_columns("plots/force", indexes=[t], columns=rr.Scalars.columns(scalars=np.asarray(trace.force)))
         pts = np.asarray(trace.point_in_world, dtype=float)
         nrm = np.asarray(trace.normal_in_world, dtype=float)
@@ -581,14 +740,68 @@ class EpisodeRecorder:
         )  # fmt: skip
         rec.send_columns(
             "world/hand/contact/normals", indexes=[t],
-            columns=rr.Arrows3D.columns(origins=pts[ok], vectors=nrm[ok] * CONTACT_NORMAL_LENGTH).partition(lengths),
+            columns=rr.Arrows3D.columns(origins=pts[ok], vectors=nrm[ok] * CONTACT_NORMAL_SCALE * r).partition(lengths),
         )  # fmt: skip
+        if not self._s.trace_style_logged:  # sizes and colours of the per-tick marks, once
+            rec.log("world/hand/contact/points", rr.Points3D.from_fields(radii=CONTACT_RADIUS, colors=[(255, 120, 40)]),
+                    static=True)  # fmt: skip
+            rec.log("world/hand/contact/normals", rr.Arrows3D.from_fields(radii=ARROW_RADIUS, colors=[(255, 120, 40)]),
+                    static=True)  # fmt: skip
+            rec.log("world/hand/fingertip", rr.Points3D.from_fields(radii=rr.components.Radius.ui_points(3.0),
+                                                                    colors=[(255, 255, 255)]), static=True)  # fmt: skip
+            self._s.trace_style_logged = True
 
     def _log_hand(self, result: MoveResult, trace: Any) -> None:
         info = result.info if isinstance(result.info, dict) else {}
+        geoms = info.get("link_geoms")
+        if geoms and self._s.geom_links is None:
+            self._log_geoms(geoms)
         links = info.get("hand_links")
-        if links:
+        if not links:
+            return
+        if self._s.geom_links:
+            self._log_link_poses(links, info.get("hand_links_time"))
+        else:
             self._log_links(links, trace, info.get("hand_links_time"), info.get("hand_link_chains"))
+
+    def _log_geoms(self, geoms: Any) -> None:
+        """The robot's collision geometry, static, in its links' frames (``world/robot/<link>/<kind>s``), and the
+        fixed pieces of the workspace (``world/table``). Geoms of unknown kinds are skipped with a warning."""
+        rec = self.stream
+        groups: dict[tuple[str | None, str], list[Any]] = {}
+        for g in geoms:
+            groups.setdefault((getattr(g, "link", None), str(getattr(g, "kind", "?"))), []).append(g)
+        links: set[str] = set()
+        for (link, kind), items in groups.items():
+            base = f"world/robot/{_entity_name(link)}" if link is not None else "world/table"
+            try:
+                archetypes = _geom_archetypes(kind, items, ROBOT_ALPHA if link is not None else 1.0)
+            except ValueError as exc:
+                warnings.warn(f"link_geoms: {exc}; skipped", stacklevel=3)
+                continue
+            for suffix, archetype in archetypes:
+                rec.log(f"{base}/{suffix}", archetype, static=True)
+            if link is not None:
+                links.add(str(link))
+        self._s.geom_links = links
+
+    def _log_link_poses(self, links: dict, times: Any) -> None:
+        """A Transform3D per drawn link: one row per sampled tick on ``sim_time`` and the last pose at the
+        current ``move``. Links without a pose (n, 7) are skipped with a warning."""
+        rec, s = self.stream, self._s
+        t = np.asarray(times, dtype=float).reshape(-1) if times is not None else None
+        for name in sorted(s.geom_links or ()):
+            a = np.asarray(links.get(name, ()), dtype=float)
+            if a.ndim != 2 or a.shape[1] != 7 or not len(a):
+                warnings.warn(f"hand_links[{name!r}]: no (n, 7) poses (got shape {a.shape}); its geometry stays put",
+                              stacklevel=3)  # fmt: skip
+                continue
+            quat = a[:, [4, 5, 6, 3]]  # (w, x, y, z) -> rerun's (x, y, z, w)
+            path = f"world/robot/{_entity_name(name)}"
+            if t is not None and len(t) == len(a):
+                rec.send_columns(path, indexes=[rr.TimeColumn("sim_time", duration=t)],
+                                 columns=rr.Transform3D.columns(translation=a[:, :3], quaternion=quat))  # fmt: skip
+            rec.log(path, rr.Transform3D(translation=a[-1, :3], quaternion=quat[-1]))
 
     def _log_links(self, links: dict, trace: Any, times: Any = None, chains: Any = None) -> None:
         """``info["hand_links"]``: link name -> (n, 3) positions, (n, 4, 4) poses or (n, 7) position +
@@ -818,11 +1031,98 @@ def _chain_index(names: list[str], chains: Any) -> list[np.ndarray]:
     return out
 
 
+def _log_count(n: float) -> float:
+    """What the log10 plots show for ``n`` interpretations or pose classes (:data:`NO_COUNT` for none)."""
+    return math.log10(n) if n >= 1 else NO_COUNT
+
+
+def _entity_name(name: Any) -> str:
+    """A link name as one entity-path part (slashes and spaces replaced)."""
+    return str(name).replace("/", "_").replace(" ", "_") or "_"
+
+
+def _quat_xyzw(wxyz: np.ndarray) -> np.ndarray:
+    return np.asarray(wxyz, dtype=float)[..., [1, 2, 3, 0]]
+
+
+def _rotate(wxyz: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """``v`` (3,) rotated by the unit quaternion (w, x, y, z)."""
+    w, q = float(wxyz[0]), np.asarray(wxyz[1:], dtype=float)
+    return v + 2.0 * np.cross(q, np.cross(q, v) + w * v)
+
+
+def _geom_archetypes(kind: str, geoms: list[Any], alpha: float = 1.0) -> list[tuple[str, Any]]:
+    """Rerun archetypes drawing ``geoms`` (all of one kind, in their link's frame; their opacity times
+    ``alpha``): (entity suffix, archetype) pairs. Raises ValueError for a kind rerun cannot draw here."""
+    pose = np.array([np.asarray(g.pose, dtype=float) for g in geoms]).reshape(len(geoms), 7)
+    size = np.array([np.asarray(g.size, dtype=float) for g in geoms]).reshape(len(geoms), 3)
+    colors = [tuple(int(round(255 * float(c) * (alpha if j == 3 else 1.0))) for j, c in enumerate(g.rgba))
+              for g in geoms]  # fmt: skip
+    pos, quat = pose[:, :3], pose[:, 3:]
+    solid = rr.components.FillMode.Solid
+    if kind == "sphere":
+        return [("spheres", rr.Ellipsoids3D(half_sizes=np.repeat(size[:, :1], 3, axis=1), centers=pos,
+                                            colors=colors, fill_mode=solid))]  # fmt: skip
+    if kind == "ellipsoid":
+        return [("ellipsoids", rr.Ellipsoids3D(half_sizes=size, centers=pos, quaternions=_quat_xyzw(quat),
+                                               colors=colors, fill_mode=solid))]  # fmt: skip
+    if kind == "capsule":  # MuJoCo: centred, along z from -h to +h; rerun: from the origin to (0, 0, length)
+        start = np.array([p - _rotate(q, np.array([0.0, 0.0, h])) for p, q, h in zip(pos, quat, size[:, 1],
+                                                                                      strict=True)])  # fmt: skip
+        return [("capsules", rr.Capsules3D(lengths=2 * size[:, 1], radii=size[:, 0], translations=start,
+                                           quaternions=_quat_xyzw(quat), colors=colors, fill_mode=solid))]  # fmt: skip
+    if kind == "cylinder":
+        cylinders = rr.Cylinders3D(lengths=2 * size[:, 1], radii=size[:, 0], centers=pos,
+                                   quaternions=_quat_xyzw(quat), colors=colors, fill_mode=solid)  # fmt: skip
+        return [("cylinders", cylinders)]
+    if kind == "box":
+        return [("boxes", rr.Boxes3D(half_sizes=size, centers=pos, quaternions=_quat_xyzw(quat), colors=colors,
+                                     fill_mode=solid))]  # fmt: skip
+    if kind == "mesh":
+        out = []
+        for j, (g, p, q, c) in enumerate(zip(geoms, pos, quat, colors, strict=True)):
+            if g.vertices is None or g.triangles is None:
+                raise ValueError(f"mesh geom {g.name!r} has no vertices or triangles")
+            v = np.array([p + _rotate(q, x) for x in np.asarray(g.vertices, dtype=float)])
+            out.append((f"mesh{j}", rr.Mesh3D(vertex_positions=v, triangle_indices=np.asarray(g.triangles),
+                                               albedo_factor=c)))  # fmt: skip
+        return out
+    raise ValueError(f"geom kind {kind!r} (drawn: sphere, ellipsoid, capsule, cylinder, box, mesh)")
+
+
+def _bar(r: float, width: int = 20) -> str:
+    """A text bar of ``r`` in [0, 1], in ASCII (the viewer's fonts lack block characters)."""
+    n = round(max(0.0, min(1.0, r)) * width)
+    return "`" + "=" * n + " " * (width - n) + "`"
+
+
+def _decision_table(i: int, decision: Decision) -> str:
+    """Markdown: the decision's candidate moves, best first, with a bar of their score against the best."""
+    cands = sorted(decision.candidates, key=lambda c: -c.score if math.isfinite(c.score) else math.inf)
+    head = f"**move {i}**: chose **{_move_name(decision.move)}**"
+    if not cands:
+        return head + " (no scored candidates: the fallback policy)"
+    best = max((float(c.score) for c in cands if math.isfinite(c.score)), default=0.0)
+    rows = [head + f" among {len(cands)} candidates", "",
+            "| move | score | | exp. cost | exp. eliminated |", "|---|---|---|--:|--:|"]  # fmt: skip
+    shown = cands[:MAX_TABLE_ROWS]
+    for c in shown:
+        name = f"**{_move_name(c.move)}** (chosen)" if c.move == decision.move else _move_name(c.move)
+        r = float(c.score) / best if best > 0 and math.isfinite(c.score) else 0.0
+        rows.append(f"| {name} | {_bar(r)} | {c.score:.3g} | {c.expected_cost:.2f} | "
+                    f"{c.expected_eliminated:.2f} |")  # fmt: skip
+    if len(cands) > len(shown):
+        rows.append(f"| ... {len(cands) - len(shown)} more | | | | |")
+    return "\n".join(rows)
+
+
 def _move_name(move: Move) -> str:
+    """The move's kind and direction: ``face (+0.92, +0.33, -0.22)`` (a world direction), ``edge +``,
+    ``vertex across f2``."""
     kind = getattr(move, "kind", "?")
     if kind == "face":
         d = np.asarray(move.direction, dtype=float)
-        return f"face ({d[0]:+.2f},{d[1]:+.2f},{d[2]:+.2f})"
+        return f"face ({d[0]:+.2f}, {d[1]:+.2f}, {d[2]:+.2f})"
     if kind == "edge":
         return f"edge {'+' if move.sense > 0 else '-'}"
     if kind == "vertex":
@@ -860,9 +1160,11 @@ class EntityData:
         return [times[i] for i in keep], [values[i] for i in keep]
 
 
-def load_recording(path: str | os.PathLike) -> dict[str, EntityData]:
+def load_recording(path: str | os.PathLike, *, blueprint: bool = False) -> dict[str, EntityData]:
     """Every entity of the (first) recording in an ``.rrd`` file, read with rerun's own
-    :class:`rerun.chunk.RrdReader`; keys are entity paths without the leading slash."""
+    :class:`rerun.chunk.RrdReader`; keys are entity paths without the leading slash. ``blueprint=True``
+    reads the file's (last) blueprint instead: its views (``view/<id>``, with ``ViewBlueprint:*`` and their
+    properties, such as ``view/<id>/EyeControls3D``), containers and panels, on the ``blueprint`` timeline."""
     import pyarrow as pa
     from rerun.chunk import RrdReader
 
@@ -870,7 +1172,16 @@ def load_recording(path: str | os.PathLike) -> dict[str, EntityData]:
     if not p.is_file():
         raise RecordingError(f"{p}: no such recording")
     try:
-        chunks = RrdReader(p).stream().to_chunks()
+        reader = RrdReader(p)
+        if blueprint:
+            stores = reader.blueprints()
+            if not stores:
+                raise RecordingError(f"{p}: the recording holds no blueprint")
+            chunks = reader.stream(store=stores[-1]).to_chunks()
+        else:
+            chunks = reader.stream().to_chunks()
+    except RecordingError:
+        raise
     except Exception as exc:  # noqa: BLE001 -- rerun raises plain exceptions on a bad file
         raise RecordingError(f"{p}: not a readable rerun recording ({exc})") from exc
     temporal: dict[str, list[tuple[bytes, dict]]] = {}
@@ -884,6 +1195,9 @@ def load_recording(path: str | os.PathLike) -> dict[str, EntityData]:
             if kind == "index" and pa.types.is_duration(fld.type):  # to seconds (as_py would drop nanoseconds)
                 scale = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}[fld.type.unit]
                 cols[("t", fld.name)] = [v * scale if v is not None else None for v in col.cast(pa.int64()).to_pylist()]
+                continue
+            if kind == "index" and pa.types.is_timestamp(fld.type):  # nanoseconds since the epoch, as int
+                cols[("t", fld.name)] = col.cast(pa.int64()).to_pylist()
                 continue
             values = col.to_pylist()
             if kind == "control":

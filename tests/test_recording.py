@@ -20,6 +20,38 @@ def _count(values: list | None) -> int:
     return len(values) if values is not None else 0
 
 
+def _views(path: Path) -> dict[str, dict]:
+    """The recording's blueprint views by name: class, origin, contents and the 3-D eye when set."""
+    bp = load_recording(path, blueprint=True)
+    out = {}
+    for key, ent in bp.items():
+        if key.count("/") != 1 or not key.startswith("view/"):
+            continue
+        last = {c: v[-1] for c, v in ent.components.items() if v and v[-1] is not None}
+        view = {"class": last["ViewBlueprint:class_identifier"][0], "origin": last["ViewBlueprint:space_origin"][0]}
+        for sub, prefix in (("ViewContents", "ViewContents:"), ("EyeControls3D", "EyeControls3D:")):
+            for c, v in bp.get(f"{key}/{sub}", ent).components.items():
+                if c.startswith(prefix) and v and v[-1] is not None:
+                    view[c.removeprefix(prefix)] = v[-1] if sub == "ViewContents" else v[-1][0]
+        out[last["ViewBlueprint:display_name"][0]] = view
+    return out
+
+
+def _object_region(record: EpisodeRecord) -> tuple[np.ndarray, float]:
+    """Centre [m] and radius [m] of the true object's world bounding box (from the record's true pose)."""
+    from haptic.geometry import load_library
+    from haptic.geometry.se3 import quat_to_matrix
+
+    v = np.asarray(load_library()[record.model].vertices, dtype=float)
+    v = v @ quat_to_matrix(np.asarray(record.pose["quat_wxyz"])).T + np.asarray(record.pose["translation_m"])
+    lo, hi = v.min(axis=0), v.max(axis=0)
+    return (lo + hi) / 2, float(np.linalg.norm(hi - lo)) / 2
+
+
+def _timeline(path: Path) -> str:
+    return load_recording(path, blueprint=True)["time_panel"].components["TimePanelBlueprint:timeline"][-1][0]
+
+
 @pytest.fixture(scope="module")
 def recorded(tmp_path_factory) -> tuple[Path, EpisodeRecord]:
     out = tmp_path_factory.mktemp("rec") / "episode.rrd"
@@ -42,13 +74,17 @@ def test_recording_reads_back_with_rerun(recorded):
     ents = load_recording(path)
     n = len(record.interpretations)  # one per successful move, the start included
 
-    # the interpretation-count series: the record's list, one value per move
+    # the interpretation-count series, on a log axis: the record's list, one value per move
     moves, counts = ents["plots/interpretations"].series("Scalars:scalars")
-    assert [c[0] for c in counts] == [float(x) for x in record.interpretations]
+    assert [round(10 ** c[0]) for c in counts] == record.interpretations
     assert moves[0] == 0 and moves == sorted(moves) and len(set(moves)) == n
     assert moves[-1] <= record.moves
     _, classes = ents["plots/pose_classes"].series("Scalars:scalars")
-    assert classes and classes[-1] == [1.0]  # recognised: one pose class
+    assert classes and classes[-1] == [0.0]  # recognised: one pose class, log10 1
+    marked = sorted(m for kind in ("start", "face", "edge", "vertex") if f"plots/moves/{kind}" in ents
+                    for m in ents[f"plots/moves/{kind}"].series("Scalars:scalars")[0])  # fmt: skip
+    assert marked == moves, "a marker of its kind on every successful move"
+    assert ents["plots/moves/face"].static["SeriesPoints:names"] == ["face move"]
 
     # the trace path: one strip per move, accumulated, each a real polyline
     _, strips = ents["world/trace/path"].series("LineStrips3D:strips")
@@ -65,15 +101,28 @@ def test_recording_reads_back_with_rerun(recorded):
     assert (len(normals[-1]), len(edges[-1]), len(vertices[-1])) == (record.faces, record.edges, record.vertices)
     assert len(patches[-1]) == 2 * record.faces
     assert all(len(seg) == 2 for seg in edges[-1])
-    assert np.allclose(np.linalg.norm(np.array(normals[-1]), axis=1), 0.012, atol=1e-5)
+    lengths = np.linalg.norm(np.array(normals[-1]), axis=1)  # sized to the object, to be seen at its framing
+    assert np.ptp(lengths) < 1e-6 and 0.005 < lengths[0] < 0.05
 
     # the ground-truth layer, static, and the decisions
     truth = ents["world/truth/object"]
     assert truth.rows == 0 and _count(truth.static.get("Mesh3D:vertex_positions")) % 3 == 0
     assert "Transform3D:translation" in ents["world/truth"].static
-    _, bars = ents["plots/candidates"].series("BarChart:values")
-    assert len(bars) == len(record.decision_times_s)
+    _, tables = ents["decision/scores"].series("TextDocument:text")
+    decided = [t[0] for t in tables if "chose" in t[0]]
+    assert len(decided) == len(record.decision_times_s), "one candidate table per decision, kept"
+    assert all("| move | score |" in t or "fallback" in t for t in decided)
     assert ents["log/episode"].series("TextLog:text")[1][0][0].startswith(record.outcome)
+
+    # the blueprint: the object view's eye on the object, opening on the move timeline (no physics traces)
+    views = _views(path)
+    obj = views["object"]
+    assert obj["class"] == "3D" and obj["origin"] == "world"
+    centre, radius = _object_region(record)
+    assert np.linalg.norm(np.asarray(obj["look_target"]) - centre) < 1e-5
+    assert 2 * radius < np.linalg.norm(np.asarray(obj["position"]) - centre) < 8 * radius
+    assert views["candidate moves"]["class"] == "TextDocument"
+    assert _timeline(path) == "move"
 
 
 def test_failed_episode_leaves_no_file(tmp_path):
@@ -151,7 +200,10 @@ def test_physics_trace_and_hand_links_are_recorded(tmp_path):
     assert ents["world/hand/links"].static["Points3D:labels"] == ["palm", "index_tip"]
     _, strips = ents["world/trace/path"].series("LineStrips3D:strips")
     assert len(strips[-1][0]) == n  # the fingertip path itself, not waypoints
-    assert ents["plots/interpretations"].timelines["sim_time"][-1] == pytest.approx(t[-1])
+    assert ents["plots/interpretations"].timelines["sim_time"][0] == pytest.approx(t[-1])
+    # the pad the fingertip view follows: every tick, and the end of each move on the move timeline
+    pad = ents["world/hand/pad"]
+    assert pad.rows == n + 1 + 20 + 1 and [m for m in pad.timelines["move"] if m is not None] == [0, 1]
     # the failed move: its own strip (not in the path), its ticks, a warning; the path cost includes it
     _, failed_strips = ents["world/trace/failed"].series("LineStrips3D:strips")
     assert len(failed_strips) == 1 and len(failed_strips[0][0]) == 20
@@ -159,40 +211,93 @@ def test_physics_trace_and_hand_links_are_recorded(tmp_path):
     _, texts = ents["log/moves"].series("TextLog:text")
     assert "failed: timeout (no edge)" in texts[-1][0]
     assert ents["plots/path_cost"].series("Scalars:scalars")[1][-1] == [1.5]
+    # the failed move: a cross at the unchanged count; the count line goes on flat through it
+    assert ents["plots/moves/failed"].series("Scalars:scalars") == ([1], [[pytest.approx(np.log10(12))]])
+    assert ents["plots/interpretations"].series("Scalars:scalars")[1] == [[pytest.approx(np.log10(12))]] * 2
 
 
-def test_physics_episode_records_the_hand_links(tmp_path):
-    """A physics episode: the executor samples the hand's links (robot forward kinematics) during every move;
-    the recording shows them on the sim_time timeline, with the skeleton as line strips."""
-    from haptic.sim import RobotInterface
-
-    out = tmp_path / "physics.rrd"
+@pytest.fixture(scope="module")
+def physics_recorded(tmp_path_factory) -> tuple[Path, EpisodeRecord]:
+    out = tmp_path_factory.mktemp("phys") / "physics.rrd"
     with EpisodeRecorder(out) as recorder:
         record = run_episode(EpisodeSpec(model="PYR01", seed=1, executor="physics"), observer=recorder.observer())
+    return out, record
+
+
+def _rotate(q_xyzw: np.ndarray, v: np.ndarray) -> np.ndarray:
+    q, w = np.asarray(q_xyzw[:3]), float(q_xyzw[3])
+    return v + 2.0 * np.cross(q, np.cross(q, v) + w * v)
+
+
+def test_physics_episode_records_the_robot_as_it_is(physics_recorded):
+    """A physics episode: the robot's collision geometry (capsules, spheres, ...) from the MuJoCo model, static
+    in its links' frames, and a pose per link at every sampled tick (sim_time) and at the end of each move
+    (move); the pad the geometry puts at the end is where the fingertip trace ends."""
+    from haptic.sim import RobotInterface, Simulation, compose_scene
+
+    out, record = physics_recorded
     assert record.moves >= 1
     ents = load_recording(out)
-    links = ents["world/hand/links"]
-    assert links.static["Points3D:labels"] == list(RobotInterface.link_names)
-    times, rows = links.series("Points3D:positions", "sim_time")
-    assert len(times) >= 20 and all(t is not None for t in times)
-    assert len(set(times)) == len(times) and times == sorted(times)
-    assert times[-1] == pytest.approx(record.sim_time_s, abs=1e-6)
-    pts = np.array(rows)
-    assert pts.shape == (len(times), len(RobotInterface.link_names), 3) and np.isfinite(pts).all()
-    assert np.ptp(pts[:, RobotInterface.link_names.index("palm")], axis=0).max() > 0.02, "the hand moves"
-    # the index pad agrees with the fingertip trace at the ticks both were sampled
-    tip_t, tip_p = ents["world/hand/fingertip"].series("Points3D:positions", "sim_time")
-    tips = {round(t, 6): p[0] for t, p in zip(tip_t, tip_p, strict=True)}
-    k = RobotInterface.link_names.index("index_tip")
-    common = [(tips[round(t, 6)], row[k]) for t, row in zip(times, rows, strict=True) if round(t, 6) in tips]
-    assert len(common) >= 10
-    expected, got = np.array(common).transpose(1, 0, 2)
-    assert np.allclose(got, expected, atol=1e-6)
-    # the skeleton: one strip per chain at every sampled time
-    s_times, strips = ents["world/hand/skeleton"].series("LineStrips3D:strips", "sim_time")
-    assert s_times == times
-    assert all(len(row) == len(RobotInterface.link_chains) for row in strips)
-    assert [len(c) for c in strips[-1]] == [len(c) for c in RobotInterface.link_chains]
+    geoms = Simulation(compose_scene(None)).link_geoms()
+    links = sorted({g.link for g in geoms if g.link is not None})
+    assert len(links) >= 15 and set(links) <= set(RobotInterface.link_names)
+    kinds = {"capsule": ("capsules", "Capsules3D"), "sphere": ("spheres", "Ellipsoids3D"),
+             "cylinder": ("cylinders", "Cylinders3D"), "box": ("boxes", "Boxes3D")}  # fmt: skip
+    for link in links:
+        for kind in {g.kind for g in geoms if g.link == link}:
+            entity, archetype = kinds[kind]
+            drawn = ents[f"world/robot/{link}/{entity}"]
+            assert drawn.rows == 0, "the geometry is static"
+            want = sorted(g.size[0] for g in geoms if g.link == link and g.kind == kind)
+            radii = drawn.static.get(f"{archetype}:radii") or [h[0] for h in drawn.static[f"{archetype}:half_sizes"]]
+            assert sorted(radii) == pytest.approx(want, rel=1e-6)
+    assert ents["world/table/boxes"].static["Boxes3D:half_sizes"] == [pytest.approx([0.3, 0.4, 0.015])]
+    assert not any(k.startswith("world/hand/skeleton") or k.startswith("world/hand/links") for k in ents)
+
+    # a pose per link per sampled tick on sim_time, and one per move on move
+    palm = ents["world/robot/palm"]
+    times, trans = palm.series("Transform3D:translation", "sim_time")
+    assert len(times) >= 20 and times == sorted(times) and times[-1] == pytest.approx(record.sim_time_s, abs=1e-6)
+    assert np.ptp(np.array(trans), axis=0).max() > 0.02, "the hand moves"
+    per_move = [m for m in palm.timelines["move"] if m is not None]
+    assert sorted(set(per_move)) == list(range(record.moves + 1))
+    # the index pad, placed by its link's last pose, is where the fingertip trace ends
+    distal = ents["world/robot/index_distal"]
+    t, q = distal.series("Transform3D:quaternion", "sim_time")
+    _, p = distal.series("Transform3D:translation", "sim_time")
+    centre = ents["world/robot/index_distal/spheres"].static["Ellipsoids3D:centers"][0]
+    pad = np.asarray(p[-1][0]) + _rotate(np.asarray(q[-1][0]), np.asarray(centre))
+    tip_t, tips = ents["world/hand/fingertip"].series("Points3D:positions", "sim_time")
+    assert np.linalg.norm(pad - np.asarray(tips[-1][0])) < 1e-4
+    assert ents["world/hand/pad"].series("Transform3D:translation", "sim_time")[1][-1][0] == pytest.approx(tips[-1][0])
+
+
+def test_physics_episode_opens_framed_with_readable_plots(physics_recorded):
+    """The default blueprint of a physics recording: the object view's eye on the object's region, the
+    fingertip view moving with the pad, on sim_time; the counts on a log axis with the moves marked by kind,
+    the force on its own plot, a candidate table per decision."""
+    out, record = physics_recorded
+    ents = load_recording(out)
+    views = _views(out)
+    assert _timeline(out) == "sim_time"
+    obj, tip = views["object"], views["fingertip"]
+    assert obj["class"] == tip["class"] == "3D"
+    centre, radius = _object_region(record)
+    assert np.linalg.norm(np.asarray(obj["look_target"]) - centre) < 1e-5
+    assert 2 * radius < np.linalg.norm(np.asarray(obj["position"]) - centre) < 8 * radius, "the object, not the arm"
+    assert tip["origin"] == "world/hand/pad" and tip["query"] == ["/world/**"]
+    assert 0.02 < np.linalg.norm(tip["position"]) < 0.2 and tip["look_target"] == [0.0, 0.0, 0.0]
+    plots = {name: v for name, v in views.items() if v["class"] == "TimeSeries"}
+    force = next(v for name, v in plots.items() if v["query"] == ["plots/force"])
+    assert force and not any("plots/force" in v["query"] and len(v["query"]) > 1 for v in plots.values())
+    counts = next(v for name, v in plots.items() if "log10" in name)
+    assert {"plots/interpretations", "plots/moves/**"} <= set(counts["query"])
+    _, values = ents["plots/interpretations"].series("Scalars:scalars", "sim_time")
+    failed = ents["plots/moves/failed"].rows if "plots/moves/failed" in ents else 0
+    assert failed == record.failed_moves and len(values) == len(record.interpretations) + failed
+    assert ents["plots/force"].rows >= 100
+    _, tables = ents["decision/scores"].series("TextDocument:text", "sim_time")
+    assert sum("chose" in t[0] for t in tables) == len(record.decision_times_s)
 
 
 def test_hand_links_time_must_match_the_rows(tmp_path):

@@ -179,9 +179,10 @@ class PhysicsExecutor:
                           cost=res.cost, state=res.state, info=info)  # fmt: skip
 
     def _hand_links(self) -> dict:
-        """The hand's link positions sampled during the move (the robot's own forward kinematics), for
-        recordings: ``hand_links`` (name -> (n, 3) [m]), ``hand_links_time`` (n,) [s] and
-        ``hand_link_chains`` (the skeleton's polylines of link names)."""
+        """The hand's link poses sampled during the move (the robot's own forward kinematics), for
+        recordings: ``hand_links`` (name -> (n, 7): position [m], quaternion (w, x, y, z)), ``hand_links_time``
+        (n,) [s], ``hand_link_chains`` (the skeleton's polylines of link names) and ``link_geoms`` (the robot's
+        collision geometry per link, and the table top)."""
         self.toucher.sample_links()  # the pose at the end of the move
         times, pos = self.toucher.take_links()
         self._links_until = float(times[-1]) if len(times) else self._links_until
@@ -190,6 +191,7 @@ class PhysicsExecutor:
             "hand_links": {name: pos[:, j] for j, name in enumerate(names)},
             "hand_links_time": times,
             "hand_link_chains": self.robot.link_chains,
+            "link_geoms": self.robot.link_geoms(),
         }
 
     def _edge_between(self, face: int, trace: ContactTrace, phase: str, roll: ContactTrace, fit_b: FaceFit,

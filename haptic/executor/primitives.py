@@ -278,20 +278,20 @@ class Toucher:
         self._ticks += 1
         every = self.config.link_every
         if every > 0 and self._ticks % every == 0:
-            self._links.append((r.time, r.link_array()))
+            self._links.append((r.time, r.link_poses()))
 
     def sample_links(self) -> None:
-        """Sample the hand's link positions now (once per simulation time)."""
+        """Sample the hand's link poses now (once per simulation time)."""
         t = self.robot.time
         if not self._links or self._links[-1][0] != t:
-            self._links.append((t, self.robot.link_array()))
+            self._links.append((t, self.robot.link_poses()))
 
     def take_links(self) -> tuple[np.ndarray, np.ndarray]:
-        """The link samples since the last call: times (n,) [s] and positions (n, len(robot.link_names), 3)
-        [m], world frame."""
+        """The link samples since the last call: times (n,) [s] and poses (n, len(robot.link_names), 7),
+        position [m] then quaternion (w, x, y, z), world frame."""
         samples, self._links = self._links, []
         if not samples:
-            return np.zeros(0), np.zeros((0, len(self.robot.link_names), 3))
+            return np.zeros(0), np.zeros((0, len(self.robot.link_names), 7))
         t, p = zip(*samples, strict=True)
         return np.array(t), np.stack(p)
 

@@ -152,11 +152,14 @@ HAND_LINK_PARTS = ("base", "proximal", "medial", "distal")
 
 def hand_link_bodies() -> tuple[tuple[str, str], ...]:
     """(link name, MuJoCo body name) of the robot links :meth:`Simulation.link_positions` reports (robot
-    bodies only): the elbow and the wrist of the arm (the forearm between them), the palm, then each finger's
-    link bodies."""
+    bodies only): the elbow and the wrist of the arm (the forearm between them), the palm, each finger's link
+    bodies, then the rest of the arm's bodies that carry collision geometry (the base on the stand, the
+    waist, the shoulder, the wrist's pitch link)."""
     out = [("elbow", ARM_PREFIX + "link3"), ("wrist", ARM_PREFIX + "link6"), ("palm", HAND_PREFIX + "palm")]
     for f in FINGERS:
         out.extend((f"{f}_{part}", f"{HAND_PREFIX}{FINGER_PREFIX[f]}_{part}") for part in HAND_LINK_PARTS)
+    out.extend((("base", ARM_PREFIX + "base"), ("waist", ARM_PREFIX + "link1"), ("shoulder", ARM_PREFIX + "link2"),
+                ("wrist_pitch", ARM_PREFIX + "link5")))  # fmt: skip
     return tuple(out)
 
 
@@ -169,6 +172,42 @@ LINK_CHAINS: tuple[tuple[str, ...], ...] = (("elbow", "wrist", "palm"),) + tuple
 )
 """The hand's skeleton as polylines of :data:`LINK_NAMES`: the forearm (elbow to wrist) on to the palm, and the
 palm out along each finger to its pad."""
+
+
+GEOM_KINDS = {
+    int(mujoco.mjtGeom.mjGEOM_SPHERE): "sphere",
+    int(mujoco.mjtGeom.mjGEOM_CAPSULE): "capsule",
+    int(mujoco.mjtGeom.mjGEOM_CYLINDER): "cylinder",
+    int(mujoco.mjtGeom.mjGEOM_BOX): "box",
+    int(mujoco.mjtGeom.mjGEOM_ELLIPSOID): "ellipsoid",
+    int(mujoco.mjtGeom.mjGEOM_MESH): "mesh",
+}
+"""The MuJoCo geom types :class:`LinkGeom` describes, by name."""
+
+
+@dataclass(frozen=True)
+class LinkGeom:
+    """One collision geom of the robot, in the frame of the link it moves with, or a fixed piece of the
+    workspace (the table top) in the world frame: what a recording draws of the robot as it is."""
+
+    link: str | None
+    """Name in :data:`LINK_NAMES` of the link it moves with; None: fixed in the world."""
+    name: str
+    """MuJoCo geom name (may be empty)."""
+    kind: str
+    """``sphere``, ``capsule``, ``cylinder``, ``box``, ``ellipsoid`` or ``mesh``."""
+    size: tuple[float, float, float]
+    """MuJoCo ``geom_size``: radius (sphere); radius, half-length along z (capsule, cylinder); half-sizes
+    (box, ellipsoid) [m]."""
+    pose: np.ndarray
+    """Position (3,) [m] and quaternion (w, x, y, z) of the geom in the link frame (world frame when ``link``
+    is None), as (7,)."""
+    rgba: tuple[float, float, float, float]
+    """Colour in [0, 1]: the geom's own when opaque (the pads), else the link's visual paint."""
+    vertices: np.ndarray | None = None
+    """Mesh vertices (n, 3) in the geom frame [m] (meshes only)."""
+    triangles: np.ndarray | None = None
+    """Mesh triangles (m, 3), indices into ``vertices`` (meshes only)."""
 
 
 def finger_index(name: str) -> int:
@@ -240,6 +279,7 @@ class Simulation:
         self.flange_site = oid(mujoco.mjtObj.mjOBJ_SITE, ARM_PREFIX + "flange")
         self.link_body = np.array([oid(mujoco.mjtObj.mjOBJ_BODY, b) for _, b in hand_link_bodies()])
         """Body ids of the robot links of :data:`LINK_NAMES` (robot bodies only, never the object)."""
+        self._link_geoms: tuple[LinkGeom, ...] | None = None
         self._geom_finger = np.full(m.ngeom, -1, dtype=int)
         self._geom_finger[self.pad_geom] = np.arange(len(FINGERS))
         self._geom_finger_list: list[int] = self._geom_finger.tolist()
@@ -372,6 +412,59 @@ class Simulation:
         (forward kinematics of the robot's own bodies; the rows follow :data:`LINK_NAMES`)."""
         d = self.data
         return np.concatenate((d.xpos[self.link_body], d.site_xpos[self.tip_site]))
+
+    def link_poses(self) -> np.ndarray:
+        """Poses of the rows of :meth:`link_positions`: position [m] then quaternion (w, x, y, z) of each link
+        body's frame (the pad sites' frames for the fingertips), (len(LINK_NAMES), 7), world frame (forward
+        kinematics of the robot's own bodies)."""
+        d = self.data
+        quat = np.empty((len(self.tip_site), 4))
+        for k, s in enumerate(self.tip_site):
+            mujoco.mju_mat2Quat(quat[k], d.site_xmat[s])
+        return np.concatenate(
+            (np.c_[d.xpos[self.link_body], d.xquat[self.link_body]], np.c_[d.site_xpos[self.tip_site], quat])
+        )
+
+    def link_geoms(self) -> tuple[LinkGeom, ...]:
+        """The robot's collision geometry, each geom in its link's frame (links of :data:`LINK_NAMES`, posed by
+        :meth:`link_poses`), and the table top, fixed in the world: the robot and its workspace, never the
+        object. Built once."""
+        if self._link_geoms is None:
+            self._link_geoms = self._make_link_geoms()
+        return self._link_geoms
+
+    def _make_link_geoms(self) -> tuple[LinkGeom, ...]:
+        m, d = self.model, self.data
+        out: list[LinkGeom] = []
+        for name, b in zip(LINK_NAMES, self.link_body, strict=False):
+            geoms = range(m.body_geomadr[b], m.body_geomadr[b] + m.body_geomnum[b])
+            paint = next((tuple(m.geom_rgba[g]) for g in geoms if not (m.geom_contype[g] or m.geom_conaffinity[g])),
+                         None)  # fmt: skip
+            for g in geoms:
+                kind = GEOM_KINDS.get(int(m.geom_type[g]))
+                if kind is None or not (m.geom_contype[g] or m.geom_conaffinity[g]):
+                    continue
+                rgba = tuple(float(x) for x in m.geom_rgba[g])
+                if rgba[3] < 1.0:
+                    rgba = tuple(float(x) for x in paint[:3]) + (1.0,) if paint is not None else rgba[:3] + (1.0,)
+                out.append(LinkGeom(name, m.geom(g).name, kind, tuple(float(x) for x in m.geom_size[g]),
+                                    np.r_[m.geom_pos[g], m.geom_quat[g]], rgba, *self._mesh_of(g)))  # fmt: skip
+        table = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, "table_top")
+        if table >= 0:
+            quat = np.empty(4)
+            mujoco.mju_mat2Quat(quat, d.geom_xmat[table])
+            out.append(LinkGeom(None, "table_top", GEOM_KINDS[int(m.geom_type[table])],
+                                tuple(float(x) for x in m.geom_size[table]), np.r_[d.geom_xpos[table], quat],
+                                tuple(float(x) for x in m.geom_rgba[table])))  # fmt: skip
+        return tuple(out)
+
+    def _mesh_of(self, g: int) -> tuple[np.ndarray | None, np.ndarray | None]:
+        m = self.model
+        if int(m.geom_type[g]) != int(mujoco.mjtGeom.mjGEOM_MESH):
+            return None, None
+        k = m.geom_dataid[g]
+        v0, nv, f0, nf = m.mesh_vertadr[k], m.mesh_vertnum[k], m.mesh_faceadr[k], m.mesh_facenum[k]
+        return m.mesh_vert[v0 : v0 + nv].astype(float), m.mesh_face[f0 : f0 + nf].astype(int)
 
     def read_sensors(self) -> SensorReading:
         """Everything the robot senses now, as a plain snapshot (noise applied)."""

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from haptic.sim.control import Controller, HybridStatus, IKResult, solve_fingertip_ik
-from haptic.sim.physics import LINK_CHAINS, LINK_NAMES, ContactSummary, SensorReading, Simulation
+from haptic.sim.physics import LINK_CHAINS, LINK_NAMES, ContactSummary, LinkGeom, SensorReading, Simulation
 from haptic.sim.scene import FINGERS
 
 
@@ -90,6 +90,16 @@ class RobotInterface:
         """World positions (len(link_names), 3) [m] of the robot's own links (elbow, wrist, palm, each
         finger's link bodies, the fingertip pads) by forward kinematics; nothing of the object."""
         return self._sim.link_positions()
+
+    def link_poses(self) -> np.ndarray:
+        """Poses (len(link_names), 7) of the same links: position [m] then quaternion (w, x, y, z), world frame
+        (forward kinematics)."""
+        return self._sim.link_poses()
+
+    def link_geoms(self) -> tuple[LinkGeom, ...]:
+        """The robot's own collision geometry per link (posed by :meth:`link_poses`) and the table top of its
+        workspace: for drawing the robot as it is; nothing of the object."""
+        return self._sim.link_geoms()
 
     def fingertip_pose(self) -> tuple[np.ndarray, np.ndarray]:
         """Active fingertip position (3,) [m] and hand rotation (3, 3), from the joint encoders."""

@@ -106,7 +106,11 @@ def test_moves_report_the_hand_links_from_the_robot_bodies_only(box_run):
         assert list(links) == list(RobotInterface.link_names)
         assert len(t) >= 2 and np.all(np.diff(t) > 0) and t[0] > last
         last = t[-1]
-        assert all(v.shape == (len(t), 3) and np.isfinite(v).all() for v in links.values())
+        assert all(v.shape == (len(t), 7) and np.isfinite(v).all() for v in links.values())  # position, quaternion
+        geoms = r.info["link_geoms"]  # the robot's own collision geometry and the table top, never the object
+        assert {g.link for g in geoms} - {None} <= set(RobotInterface.link_names)
+        assert [g.name for g in geoms if g.link is None] == ["table_top"]
+        assert not any("object" in g.name for g in geoms)
     assert last == pytest.approx(sim.time)
 
 
