@@ -26,7 +26,8 @@ default framing; labels show on hover):
 - ``world/robot/<link>/<kind>s``: the link's collision geoms (capsules, spheres, cylinders, boxes, ellipsoids,
   meshes) in the link frame, static (``info["link_geoms"]``); ``world/table``: the table top
 - ``world/hand/pad``: Transform3D (a translation) to the active fingertip pad's centre (the trace's tip), per
-  tick and at the end of each move: the origin of the ``fingertip`` view, which so follows the pad
+  tick and at the end of each move (without traces: the sensor's position after each move): the origin of the
+  ``fingertip`` view, which so follows the pad
 - ``world/trace/path``: the sensor's path, one line strip per move, accumulated, coloured by move kind
   (:data:`KIND_COLORS`; the legend is the interpretation plot's)
 - ``world/trace/failed``: fingertip paths of failed moves, accumulated (physics)
@@ -48,7 +49,8 @@ default framing; labels show on hover):
 - ``plots/moves/<kind>``: a marker per move on the interpretation plot, coloured by move kind (``start``,
   ``face``, ``edge``, ``vertex``, ``failed``: a red cross): the legend of the trace's colours
 - ``plots/path_cost``: cumulative path cost [units]
-- ``plots/force``: sensed normal force per control tick [N] (physics only)
+- ``plots/force``: sensed normal force per control tick [N] on ``sim_time``; on ``move``, each move's mean
+  force while in contact (physics only)
 - ``decision/scores``: per decision, a table of its candidate moves (kind and direction) with their scores,
   expected cost and eliminations, best first
 - ``log/moves``, ``log/decisions``, ``log/episode``: text logs
@@ -110,7 +112,7 @@ ROBOT_ALPHA = 0.6
 """Opacity of the robot's geometry (the contact under a pad shows through it)."""
 TRACE_MAX_POINTS = 400
 """Most points of one move's strip in ``world/trace/path`` (a physics trace is subsampled to it)."""
-OBJECT_VIEW_DISTANCE = 3.5
+OBJECT_VIEW_DISTANCE = 2.5
 """Distance of the ``object`` view's eye from the object's centre, in object radii (at least
 :data:`MIN_VIEW_DISTANCE`)."""
 MIN_VIEW_DISTANCE = 0.12
@@ -275,6 +277,8 @@ class _State:
     blueprint_sent: bool = False
     geom_links: set[str] | None = None
     """Links whose geometry is drawn (None: no geometry reported yet)."""
+    move: int = 0
+    """The move being logged."""
     counts: tuple[float, float | None] = (math.nan, None)
     """Latest log10 interpretations and pose classes plotted."""
 
@@ -466,6 +470,8 @@ class EpisodeRecorder:
             s.position = new
             rec.log("world/sensor", rr.Points3D([new], radii=VERTEX_RADIUS, colors=[(255, 255, 255)],
                                                 labels=["sensor"], show_labels=False))  # fmt: skip
+            if trace is None or not len(trace.time):  # no pad trace: the fingertip view follows the sensor
+                rec.log("world/hand/pad", rr.Transform3D(translation=new))
 
         # contacts of this move
         if trace is not None and len(trace.time):
@@ -648,11 +654,13 @@ class EpisodeRecorder:
         if s.centre is not None:
             dist = max(OBJECT_VIEW_DISTANCE * s.radius, MIN_VIEW_DISTANCE)
             kw.update(object_eye=tuple(s.centre + dist * direction), object_target=tuple(s.centre))
+        kw.update(fingertip_eye=tuple(FINGERTIP_VIEW_DISTANCE * direction))
         if trace is not None and len(trace.time):
-            kw.update(fingertip_eye=tuple(FINGERTIP_VIEW_DISTANCE * direction), timeline="sim_time")
+            kw.update(timeline="sim_time")
         self.stream.send_blueprint(default_blueprint(Framing(**kw)), make_active=True, make_default=True)
 
     def _set_time(self, i: int) -> None:
+        self._s.move = int(i)
         self.stream.set_time("move", sequence=int(i))
         if self._s.sim_time is not None:
             self.stream.set_time("sim_time", duration=self._s.sim_time)
@@ -729,7 +737,12 @@ class EpisodeRecorder:
         rec.send_columns("world/hand/fingertip", indexes=[t], columns=rr.Points3D.columns(positions=tip))
         rec.send_columns("world/hand/pad", indexes=[t], columns=rr.Transform3D.columns(translation=tip))
         rec.log("world/hand/pad", rr.Transform3D(translation=tip[-1]))
-        rec.send_columns("plots/force", indexes=[t], columns=rr.Scalars.columns(scalars=np.asarray(trace.force)))
+        force = np.asarray(trace.force, dtype=float)
+        rec.send_columns("plots/force", indexes=[t], columns=rr.Scalars.columns(scalars=force))
+        pressing = force[force > 0]
+        if len(pressing):  # on the move timeline: the move's mean force while in contact
+            rec.send_columns("plots/force", indexes=[rr.TimeColumn("move", sequence=[self._s.move])],
+                             columns=rr.Scalars.columns(scalars=[float(pressing.mean())]))  # fmt: skip
         pts = np.asarray(trace.point_in_world, dtype=float)
         nrm = np.asarray(trace.normal_in_world, dtype=float)
         ok = np.isfinite(nrm[:, 0]) & np.isfinite(pts[:, 0])

@@ -123,6 +123,7 @@ def test_recording_reads_back_with_rerun(recorded):
     assert 2 * radius < np.linalg.norm(np.asarray(obj["position"]) - centre) < 8 * radius
     assert views["candidate moves"]["class"] == "TextDocument"
     assert _timeline(path) == "move"
+    assert views["fingertip"]["origin"] == "world/hand/pad" and ents["world/hand/pad"].rows == n, "follows the sensor"
 
 
 def test_failed_episode_leaves_no_file(tmp_path):
