@@ -124,6 +124,8 @@ VIEW_DIRECTION = (0.75, -0.9, 0.75)
 above, so the arm reaches in from behind the object."""
 NO_COUNT = -1.0
 """What the log10 plots show for zero interpretations or pose classes."""
+START_TEXT = "**the start**: the hand comes down onto the object; the planner decides from the first contacts on"
+"""The candidate table before the first decision."""
 MAX_TABLE_ROWS = 12
 """Most candidate moves listed in a decision's table (best first)."""
 
@@ -422,10 +424,7 @@ class EpisodeRecorder:
         s.centre = (lo + hi) / 2
         s.radius = max(float(np.linalg.norm(hi - lo)) / 2, 1e-3)
         rec.set_time("move", sequence=0)
-        rec.set_time("sim_time", duration=0.0)
-        rec.log("decision/scores", rr.TextDocument("**the start**: the hand comes down onto the object; the planner "
-                                                   "decides from the first contacts on",
-                                                   media_type=rr.MediaType.MARKDOWN))  # fmt: skip
+        rec.log("decision/scores", rr.TextDocument(START_TEXT, media_type=rr.MediaType.MARKDOWN))
 
     def on_move(
         self, i: int, result: MoveResult, n_interpretations: int, recognition: Recognition | None = None
@@ -657,6 +656,10 @@ class EpisodeRecorder:
         kw.update(fingertip_eye=tuple(FINGERTIP_VIEW_DISTANCE * direction))
         if trace is not None and len(trace.time):
             kw.update(timeline="sim_time")
+            self.stream.send_columns(
+                "decision/scores", indexes=[rr.TimeColumn("sim_time", duration=[float(trace.time[0])])],
+                columns=rr.TextDocument.columns(text=[START_TEXT], media_type=[rr.MediaType.MARKDOWN]),
+            )  # fmt: skip
         self.stream.send_blueprint(default_blueprint(Framing(**kw)), make_active=True, make_default=True)
 
     def _set_time(self, i: int) -> None:

@@ -123,6 +123,7 @@ def test_recording_reads_back_with_rerun(recorded):
     assert 2 * radius < np.linalg.norm(np.asarray(obj["position"]) - centre) < 8 * radius
     assert views["candidate moves"]["class"] == "TextDocument"
     assert _timeline(path) == "move"
+    assert not any("sim_time" in e.timelines for e in ents.values()), "no physics traces, no sim_time"
     assert views["fingertip"]["origin"] == "world/hand/pad" and ents["world/hand/pad"].rows == n, "follows the sensor"
 
 
@@ -372,3 +373,43 @@ def test_explore_cli_records(tmp_path, capsys, monkeypatch):
     assert main(["explore", "--object", "WEDGE01", "--spawn"]) == 1
     err = capsys.readouterr().err.strip()
     assert "\n" not in err and "--spawn" in err
+
+
+def test_link_geoms_are_drawn_where_mujoco_puts_them(tmp_path):
+    """A capsule (MuJoCo: centred, along its z) starts at -half-length along its axis in rerun; a mesh's
+    vertices go to the link frame; a sphere keeps its radius; a kind rerun cannot draw is skipped, said once."""
+    from haptic.sim import LinkGeom
+
+    quarter_y = np.array([np.cos(np.pi / 4), 0.0, np.sin(np.pi / 4), 0.0])  # 90 deg about y: z -> x
+    geoms = (
+        LinkGeom("palm", "c", "capsule", (0.01, 0.02, 0.0), np.r_[[0.1, 0.0, 0.0], quarter_y], (1, 0, 0, 1)),
+        LinkGeom("palm", "s", "sphere", (0.012, 0.0, 0.0), np.r_[[0.0, 0.0, 0.03], 1, 0, 0, 0], (1, 1, 1, 1)),
+        LinkGeom("palm", "m", "mesh", (0, 0, 0), np.r_[[0.0, 0.0, 0.1], quarter_y], (0, 1, 0, 1),
+                 vertices=np.array([[0.0, 0, 0], [0, 0, 0.01], [0, 0.01, 0]]), triangles=np.array([[0, 1, 2]])),
+        LinkGeom("palm", "h", "hfield", (1, 1, 1), np.r_[[0.0, 0, 0], 1, 0, 0, 0], (1, 1, 1, 1)),
+        LinkGeom(None, "table_top", "box", (0.3, 0.4, 0.015), np.r_[[0.6, 0, 0.335], 1, 0, 0, 0], (0.5, 0.5, 0.5, 1)),
+    )  # fmt: skip
+    poses = {"palm": np.array([[0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0]])}  # 1 m up, no rotation
+    from haptic.planning.moves import FaceMove, MoveResult
+
+    result = MoveResult(move=FaceMove(np.zeros(3)), status="timeout",
+                        info={"link_geoms": geoms, "hand_links": poses, "hand_links_time": [0.5]})  # fmt: skip
+    out = tmp_path / "geoms.rrd"
+    recorder = EpisodeRecorder(out)
+    with pytest.warns(UserWarning, match="hfield"):
+        recorder.on_failed_move(1, result)
+    recorder.close(keep=True)
+    ents = load_recording(out)
+    cap = ents["world/robot/palm/capsules"].static
+    assert cap["Capsules3D:translations"][0] == pytest.approx([0.1 - 0.02, 0.0, 0.0], abs=1e-6)  # float32
+    assert cap["Capsules3D:lengths"] == [pytest.approx(0.04)] and cap["Capsules3D:radii"] == [pytest.approx(0.01)]
+    assert ents["world/robot/palm/spheres"].static["Ellipsoids3D:half_sizes"] == [pytest.approx([0.012] * 3)]
+    mesh = np.array(ents["world/robot/palm/mesh0"].static["Mesh3D:vertex_positions"])
+    assert mesh == pytest.approx(np.array([[0.0, 0, 0.1], [0.01, 0, 0.1], [0, 0.01, 0.1]]), abs=1e-7)
+    assert ents["world/table/boxes"].static["Boxes3D:centers"] == [pytest.approx([0.6, 0.0, 0.335])]
+    assert not any("hfield" in k for k in ents)
+    # the link's pose on sim_time and at the move
+    palm = ents["world/robot/palm"]
+    assert palm.series("Transform3D:translation", "sim_time")[1][0] == [[0.0, 0.0, 1.0]]
+    moves, quats = palm.series("Transform3D:quaternion")
+    assert sorted(moves, key=str) == [1, None] and quats == [[[0.0, 0.0, 0.0, 1.0]]] * 2  # rerun's (x, y, z, w)

@@ -29,7 +29,8 @@ class RobotInterface:
     fingers = FINGERS
     """Finger names, in the order of every per-finger array."""
     link_names = LINK_NAMES
-    """Names of the rows of :meth:`link_array` (the hand's links, then the fingertip pads)."""
+    """Names of the rows of :meth:`link_array` and :meth:`link_poses` (the arm's and the hand's links, then the
+    fingertip pads)."""
     link_chains = LINK_CHAINS
     """The hand's skeleton as polylines of :attr:`link_names` (the wrist to the palm, the palm along each
     finger)."""
@@ -88,7 +89,8 @@ class RobotInterface:
 
     def link_array(self) -> np.ndarray:
         """World positions (len(link_names), 3) [m] of the robot's own links (elbow, wrist, palm, each
-        finger's link bodies, the fingertip pads) by forward kinematics; nothing of the object."""
+        finger's link bodies, the rest of the arm, the fingertip pads) by forward kinematics; nothing of the
+        object."""
         return self._sim.link_positions()
 
     def link_poses(self) -> np.ndarray:
