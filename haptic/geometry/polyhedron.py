@@ -18,7 +18,7 @@ from functools import cached_property
 import numpy as np
 
 from haptic.errors import ModelError
-from haptic.geometry.tolerances import tol
+from haptic.geometry.tolerances import Tolerances
 
 
 def _readonly(a: np.ndarray) -> np.ndarray:
@@ -47,6 +47,13 @@ class Polyhedron:
     """Vertex loops, counter-clockwise seen from outside, one per face."""
     source: str | None = None
     """Where the model came from (a file path), for messages."""
+    precision: float = 0.0
+    """How far the source rounded each coordinate: half a unit of its last written digit, 0 for exact data [m]."""
+    vertex_labels: tuple[str, ...] | None = field(default=None, repr=False)
+    """The source file's own number of each vertex (1-based for OBJ), for messages; ``None``: the index here."""
+
+    tolerances: Tolerances = field(init=False, repr=False)
+    """Numerical tolerances of this model, from its size and :attr:`precision`."""
 
     face_normals: np.ndarray = field(init=False, repr=False)
     """Outward unit normals ``n``, shape (F, 3)."""
@@ -67,12 +74,20 @@ class Polyhedron:
 
     @classmethod
     def from_faces(
-        cls, vertices, faces, name: str = "model", source: str | None = None
+        cls,
+        vertices,
+        faces,
+        name: str = "model",
+        source: str | None = None,
+        precision: float = 0.0,
+        vertex_labels=None,
     ) -> Polyhedron:
         """Validate and build a polyhedron from vertex positions [m] and CCW-from-outside face loops.
 
-        Raises :class:`ModelError` naming the model and the offending element when the input is not a closed,
-        connected, consistently outward-oriented 2-manifold with planar, non-degenerate faces.
+        ``precision`` is how far the source rounded each coordinate [m] (the tolerances follow it);
+        ``vertex_labels`` the source's own vertex numbers, for messages. Raises :class:`ModelError` naming the
+        model and the offending element when the input is not a closed, connected, consistently
+        outward-oriented 2-manifold with planar, non-degenerate faces that do not cross each other.
         """
         where = source or name
         try:
@@ -84,12 +99,20 @@ class Polyhedron:
         bad = np.flatnonzero(~np.isfinite(v).all(axis=1))
         if len(bad):
             raise ModelError(f"{where}: vertex {bad[0]} has a non-finite coordinate {v[bad[0]].tolist()}")
+        labels = None if vertex_labels is None else tuple(str(x) for x in vertex_labels)
         loops: list[tuple[int, ...]] = []
         for fi, f in enumerate(faces):
             try:
-                loop = tuple(int(i) for i in f)
-            except (TypeError, ValueError):
+                items = list(f)
+            except TypeError:
                 raise ModelError(f"{where}: face {fi} is not a list of vertex indices: {f!r}") from None
+            for i in items:
+                if isinstance(i, bool) or not isinstance(i, int | np.integer):
+                    raise ModelError(
+                        f"{where}: face {fi} has vertex index {i!r}, which is not an integer "
+                        f"(valid: whole numbers 0..{len(v) - 1})"
+                    )
+            loop = tuple(int(i) for i in items)
             if len(loop) < 3:
                 raise ModelError(f"{where}: face {fi} has {len(loop)} vertices; a face needs at least 3")
             if len(set(loop)) != len(loop):
@@ -99,19 +122,31 @@ class Polyhedron:
             loops.append(loop)
         if len(loops) < 4:
             raise ModelError(f"{where}: a closed polyhedron needs at least 4 faces, got {len(loops)}")
-        poly = cls(name=name, vertices=_readonly(v), faces=tuple(loops), source=source)
-        return poly
+        return cls(
+            name=name, vertices=_readonly(v), faces=tuple(loops), source=source, precision=float(precision),
+            vertex_labels=labels,
+        )  # fmt: skip
+
+    def vertex_label(self, i: int) -> str:
+        """How messages name vertex ``i``: by the source file's own number when known."""
+        return self.vertex_labels[i] if self.vertex_labels is not None else str(i)
 
     def __post_init__(self) -> None:
         where = self.source or self.name
         v = self.vertices
         set_ = object.__setattr__
+        t = Tolerances.for_model(float(np.linalg.norm(np.ptp(v, axis=0))), self.precision)
+        set_(self, "tolerances", t)
+        lab = self.vertex_label
 
         seen: dict[frozenset, int] = {}
         for fi, loop in enumerate(self.faces):
             key = frozenset(loop)
             if key in seen:
-                raise ModelError(f"{where}: faces {seen[key]} and {fi} are duplicates (same vertices {sorted(key)})")
+                raise ModelError(
+                    f"{where}: faces {seen[key]} and {fi} are duplicates (same vertices "
+                    f"{[lab(i) for i in sorted(key)]})"
+                )
             seen[key] = fi
 
         # edges and their left/right faces from the directed half-edges
@@ -119,8 +154,11 @@ class Polyhedron:
         for fi, loop in enumerate(self.faces):
             for k, a in enumerate(loop):
                 b = loop[(k + 1) % len(loop)]
-                if np.linalg.norm(v[a] - v[b]) < tol.merge:
-                    raise ModelError(f"{where}: face {fi} has a zero-length edge between vertices {a} and {b}")
+                if np.linalg.norm(v[a] - v[b]) < t.merge:
+                    raise ModelError(
+                        f"{where}: face {fi} has a zero-length edge: vertices {lab(a)} and {lab(b)} are the same "
+                        f"point (closer than {t.merge * 1e3:.3g} mm)"
+                    )
                 if (a, b) in half:
                     other = half[(a, b)]
                     undirected = sum(
@@ -131,11 +169,11 @@ class Polyhedron:
                     )
                     if undirected > 2:
                         raise ModelError(
-                            f"{where}: edge {a}-{b} is non-manifold: {undirected} faces meet on it (a closed "
+                            f"{where}: edge {lab(a)}-{lab(b)} is non-manifold: {undirected} faces meet on it (a closed "
                             "2-manifold has exactly 2)"
                         )
                     raise ModelError(
-                        f"{where}: faces {other} and {fi} both run edge {a}->{b} in the same direction: "
+                        f"{where}: faces {other} and {fi} both run edge {lab(a)}->{lab(b)} in the same direction: "
                         "inconsistent face orientation (loops must all be counter-clockwise seen from outside)"
                     )
                 half[(a, b)] = fi
@@ -143,7 +181,8 @@ class Polyhedron:
         for (a, b), fi in half.items():
             if (b, a) not in half:
                 raise ModelError(
-                    f"{where}: edge {a}-{b} of face {fi} has no second face: the surface is open (not watertight)"
+                    f"{where}: edge {lab(a)}-{lab(b)} of face {fi} has no second face: the surface is open "
+                    "(not watertight)"
                 )
             if a < b:
                 index[(a, b)] = len(edges)
@@ -158,7 +197,7 @@ class Polyhedron:
         for loop in self.faces:
             used[list(loop)] = True
         if not used.all():
-            raise ModelError(f"{where}: vertex {int(np.flatnonzero(~used)[0])} is used by no face")
+            raise ModelError(f"{where}: vertex {lab(int(np.flatnonzero(~used)[0]))} is used by no face")
 
         # plane of each face, planarity and area
         normals, offsets, areas = [], [], []
@@ -166,15 +205,16 @@ class Polyhedron:
             pts = v[list(loop)]
             nn = newell_normal(pts)
             area = 0.5 * np.linalg.norm(nn)
-            if area < tol.area:
-                raise ModelError(f"{where}: face {fi} has zero area (vertices {list(loop)})")
+            if area < t.area:
+                raise ModelError(f"{where}: face {fi} has zero area (vertices {[lab(i) for i in loop]})")
             n = nn / np.linalg.norm(nn)
             d = float(np.mean(pts @ n))
             dev = np.abs(pts @ n - d).max()
-            if dev > tol.planar:
+            if dev > t.planar:
+                worst = loop[int(np.argmax(np.abs(pts @ n - d)))]
                 raise ModelError(
-                    f"{where}: face {fi} is not planar: vertex off its plane by {dev * 1e3:.4g} mm "
-                    f"(tolerance {tol.planar * 1e3:g} mm)"
+                    f"{where}: face {fi} is not planar: vertex {lab(worst)} is off its plane by {dev * 1e3:.4g} mm "
+                    f"(tolerance {t.planar * 1e3:.3g} mm at this model's size and precision)"
                 )
             normals.append(n)
             offsets.append(d)
@@ -190,10 +230,10 @@ class Polyhedron:
 
         # coplanar neighbours would be an edge no finger can feel
         for e, (fl, fr) in enumerate(zip(left, right, strict=True)):
-            if np.dot(normals[fl], normals[fr]) > np.cos(tol.angle) and abs(offsets[fl] - offsets[fr]) < tol.planar:
+            if _coplanar(v, self.faces[fl], normals[fl], offsets[fl], self.faces[fr], normals[fr], offsets[fr], t):
                 raise ModelError(
-                    f"{where}: faces {fl} and {fr} are coplanar and share edge {edges[e][0]}-{edges[e][1]}: "
-                    "merge them into one face"
+                    f"{where}: faces {fl} and {fr} are coplanar and share edge {lab(edges[e][0])}-{lab(edges[e][1])} "
+                    f"(within {t.planar * 1e3:.3g} mm of one plane): merge them into one face"
                 )
 
         # each vertex's faces must form a single fan (no pinched vertices)
@@ -214,7 +254,7 @@ class Polyhedron:
                     break
             if count != len(ring):
                 raise ModelError(
-                    f"{where}: vertex {a} is non-manifold: its faces form more than one fan (a pinch point)"
+                    f"{where}: vertex {lab(a)} is non-manifold: its faces form more than one fan (a pinch point)"
                 )
 
         # connectivity over faces
@@ -240,6 +280,14 @@ class Polyhedron:
             raise ModelError(
                 f"{where}: the faces are oriented inward (signed volume {self.volume:.4g} m^3); loops must be "
                 "counter-clockwise seen from outside"
+            )
+        crossing = self_intersection(self)
+        if crossing is not None:
+            fa, fb = crossing
+            raise ModelError(
+                f"{where}: the surface intersects itself: faces {fa} (vertices {[lab(i) for i in self.faces[fa]]}) "
+                f"and {fb} (vertices {[lab(i) for i in self.faces[fb]]}) cross; a solid's faces meet only along "
+                "shared edges"
             )
 
     # ------------------------------------------------------------------------------------------ counts
@@ -403,13 +451,19 @@ class Polyhedron:
     def transformed(self, rotation: np.ndarray, translation: np.ndarray, name: str | None = None) -> Polyhedron:
         """The same solid with vertices mapped by ``w' = R w + t`` (R a proper rotation)."""
         v = self.vertices @ np.asarray(rotation).T + np.asarray(translation)
-        return Polyhedron.from_faces(v, self.faces, name=name or self.name, source=self.source)
+        return Polyhedron.from_faces(
+            v, self.faces, name=name or self.name, source=self.source, precision=self.precision,
+            vertex_labels=self.vertex_labels,
+        )  # fmt: skip
 
     def mirrored(self, name: str | None = None) -> Polyhedron:
         """The mirror image through the x = 0 plane (face loops reversed to stay outward)."""
         v = self.vertices * np.array([-1.0, 1.0, 1.0])
         faces = [tuple(reversed(loop)) for loop in self.faces]
-        return Polyhedron.from_faces(v, faces, name=name or f"{self.name}_mirror", source=self.source)
+        return Polyhedron.from_faces(
+            v, faces, name=name or f"{self.name}_mirror", source=self.source, precision=self.precision,
+            vertex_labels=self.vertex_labels,
+        )  # fmt: skip
 
     def to_trimesh(self):
         """A triangulated :class:`trimesh.Trimesh` with outward winding (for export and simulation)."""
@@ -475,3 +529,78 @@ def triangulate_polygon(vertices: np.ndarray, loop: tuple[int, ...], normal: np.
             raise ModelError(f"face loop {list(loop)} is self-intersecting or not simple: cannot triangulate")
     out.append((idx[0], idx[1], idx[2]))
     return out
+
+
+def _coplanar(v: np.ndarray, loop_a, n_a, d_a, loop_b, n_b, d_b, t: Tolerances) -> bool:
+    """True when two faces lie in one plane as far as the model's precision can tell.
+
+    Either their planes agree (normals within ``t.angle``, offsets within ``t.planar``), or each face's
+    vertices lie within ``t.planar`` of the other's plane: a bend no larger than the rounding of the
+    coordinates can explain.
+    """
+    cos = float(np.dot(n_a, n_b))
+    if cos > np.cos(t.angle) and abs(d_a - d_b) < t.planar:
+        return True
+    if cos <= 0:
+        return False
+    return bool(
+        np.abs(v[list(loop_b)] @ n_a - d_a).max() <= t.planar and np.abs(v[list(loop_a)] @ n_b - d_b).max() <= t.planar
+    )
+
+
+def self_intersection(poly: Polyhedron) -> tuple[int, int] | None:
+    """Two faces that cross each other (an edge of one passes through the inside of the other), or ``None``.
+
+    Triangles of different faces whose bounding boxes overlap and that share no edge are tested: an edge of
+    either must not pass through the other's interior by more than the planar tolerance.
+    """
+    tris = poly.triangles
+    if len(tris) == 0:
+        return None
+    faces = poly.triangle_faces
+    eps = poly.tolerances.planar
+    p = poly.vertices[tris]  # (T, 3, 3)
+    lo, hi = p.min(axis=1) - eps, p.max(axis=1) + eps
+    pairs_i, pairs_j = [], []
+    n = len(tris)
+    for s in range(0, n, 256):
+        rows = np.arange(s, min(s + 256, n))
+        ok = (lo[rows, None, :] <= hi[None, :, :]).all(axis=2) & (hi[rows, None, :] >= lo[None, :, :]).all(axis=2)
+        ok &= np.arange(n)[None, :] > rows[:, None]
+        ok &= faces[rows, None] != faces[None, :]
+        i, j = np.nonzero(ok)
+        pairs_i.append(rows[i])
+        pairs_j.append(j)
+    i = np.concatenate(pairs_i)
+    j = np.concatenate(pairs_j)
+    if len(i) == 0:
+        return None
+    shared = (tris[i][:, :, None] == tris[j][:, None, :]).sum(axis=(1, 2))
+    keep = shared < 2
+    i, j = i[keep], j[keep]
+    hit = np.zeros(len(i), dtype=bool)
+    for a, b in ((i, j), (j, i)):
+        for k in range(3):
+            hit |= _segment_crosses(p[a, k], p[a, (k + 1) % 3], p[b], eps)
+    if not hit.any():
+        return None
+    first = int(np.flatnonzero(hit)[0])
+    fa, fb = sorted((int(faces[i[first]]), int(faces[j[first]])))
+    return fa, fb
+
+
+def _segment_crosses(s0: np.ndarray, s1: np.ndarray, tri: np.ndarray, eps: float) -> np.ndarray:
+    """Per row: does segment ``s0→s1`` pass through the interior of triangle ``tri`` (rows of 3 points)?"""
+    a, b, c = tri[:, 0], tri[:, 1], tri[:, 2]
+    nn = np.cross(b - a, c - a)
+    nn /= np.maximum(np.linalg.norm(nn, axis=1), 1e-300)[:, None]
+    h0 = np.einsum("ij,ij->i", s0 - a, nn)
+    h1 = np.einsum("ij,ij->i", s1 - a, nn)
+    crosses = ((h0 > eps) & (h1 < -eps)) | ((h0 < -eps) & (h1 > eps))
+    x = s0 + (h0 / np.where(crosses, h0 - h1, 1.0))[:, None] * (s1 - s0)
+    inside = crosses
+    for u, w in ((a, b), (b, c), (c, a)):
+        edge = w - u
+        side = np.einsum("ij,ij->i", np.cross(edge, x - u), nn) / np.maximum(np.linalg.norm(edge, axis=1), 1e-300)
+        inside &= side > eps
+    return inside
