@@ -272,7 +272,7 @@ def run_episode(
         return run_physics_episode(spec, library=library, observer=observer, config=config, policy=policy)
     if spec.executor != "geometric":
         raise HapticError(f"unknown executor {spec.executor!r}; valid: geometric, physics")
-    library = library if library is not None else load_library(spec.models)
+    library = library if library is not None else load_library(spec.models, skip_invalid=spec.skip_invalid)
     true_model = resolve_model(spec.model, library)
     config = config or PlannerConfig()
     root = np.random.SeedSequence(spec.seed)

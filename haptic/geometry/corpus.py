@@ -81,7 +81,7 @@ def corpus_solids(sides: range = range(3, 13), hulls: int = 8, seed: int = 0) ->
     out: list[tuple[CorpusSolid, Polyhedron]] = []
     for kind in PLATONIC:
         v, e, f, g = _PLATONIC_COUNTS[kind]
-        out.append((CorpusSolid(f"platonic_{kind}", "platonic", v, e, f, g), platonic(kind, r)))
+        out.append((CorpusSolid(f"platonic_{kind}", "platonic", v, e, f, g), platonic(kind, 0.05)))
     for n in sides:
         # heights away from the special values at which a solid gains symmetry (cube, octahedron)
         out.append((CorpusSolid(f"prism_{n:02d}", "prism", 2 * n, 3 * n, n + 2, 2 * n), regular_prism(n, r, 0.055)))

@@ -10,6 +10,7 @@ from __future__ import annotations
 import json
 import os
 import tempfile
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -178,7 +179,12 @@ def _load_obj(path: Path, name: str) -> Polyhedron:
     t = Tolerances.for_model(float(np.linalg.norm(np.ptp(v, axis=0))), precision)
     tris: list[tuple[int, int, int]] = []
     polygon_of: list[int] = []
+    plain = _plain_triangles(v, loops, t)  # triangles need no planarity test: check them all at once
     for k, loop in enumerate(loops):
+        if plain[k]:
+            tris.append((loop[0], loop[1], loop[2]))
+            polygon_of.append(k)
+            continue
         at = f"{path}: face {k + 1} (line {face_lines[k]})"
         if len(set(loop)) != len(loop):
             raise ModelError(f"{at} repeats a vertex in its loop {[i + 1 for i in loop]}")
@@ -209,6 +215,20 @@ def _load_obj(path: Path, name: str) -> Polyhedron:
         v, np.array(tris, dtype=int), name=name, source=str(path), precision=precision, vertex_labels=labels,
         polygons=polygon_of,
     )  # fmt: skip
+
+
+def _plain_triangles(v: np.ndarray, loops: list[list[int]], t: Tolerances) -> np.ndarray:
+    """Per loop: is it a triangle of three distinct, well-separated, non-collinear points?"""
+    plain = np.array([len(loop) == 3 for loop in loops])
+    if not plain.any():
+        return plain
+    tri = np.array([loop for loop in loops if len(loop) == 3])
+    p = v[tri]
+    edges = np.linalg.norm(p - np.roll(p, -1, axis=1), axis=2).min(axis=1)
+    area2 = np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
+    distinct = (tri[:, 0] != tri[:, 1]) & (tri[:, 1] != tri[:, 2]) & (tri[:, 2] != tri[:, 0])
+    plain[np.flatnonzero(plain)] = distinct & (edges >= t.merge) & (area2 >= 2 * t.area)
+    return plain
 
 
 def _mesh_precision(path: Path, vertices: np.ndarray) -> float:
@@ -464,18 +484,73 @@ def model_files(directory: str | os.PathLike) -> list[Path]:
     return sorted(p for p in d.iterdir() if p.is_file() and p.suffix.lower() in MODEL_SUFFIXES)
 
 
-def load_library(directory: str | os.PathLike | None = None) -> dict[str, Polyhedron]:
-    """Every model of a library directory (default: the shipped ``assets/models``), by name."""
-    files = model_files(directory or DEFAULT_LIBRARY)
+@dataclass(frozen=True)
+class LibraryScan:
+    """What a library directory holds: its valid models and, for each bad file, why it is bad."""
+
+    directory: Path
+    """The library directory."""
+    models: dict[str, Polyhedron]
+    """Every valid model, by name (file stem)."""
+    errors: dict[Path, str]
+    """Every bad model file, with its one-line error message."""
+
+
+_SCANS: dict[tuple, LibraryScan] = {}
+
+
+def scan_library(directory: str | os.PathLike | None = None, progress: bool = False) -> LibraryScan:
+    """Import every model file of a library directory (default: the shipped ``assets/models``), keeping the
+    valid models and the error of each bad file. A bar on stderr shows the import when ``progress`` is set
+    (and stderr is a terminal).
+
+    The scan is remembered per process while no file of the directory changes (models are immutable).
+    """
+    where = Path(directory or DEFAULT_LIBRARY)
+    files = model_files(where)
     if not files:
-        where = directory or DEFAULT_LIBRARY
         raise ModelError(f"{where}: the library holds no model files ({', '.join(MODEL_SUFFIXES)})")
-    out: dict[str, Polyhedron] = {}
-    for f in files:
-        if f.stem in out:
-            raise ModelError(f"{f}: model name {f.stem!r} is used by two files in the library")
-        out[f.stem] = load_model(f)
-    return out
+    stamp = (str(where.resolve()), tuple((f.name, f.stat().st_mtime_ns, f.stat().st_size) for f in files))
+    if stamp in _SCANS:
+        return _SCANS[stamp]
+    models: dict[str, Polyhedron] = {}
+    errors: dict[Path, str] = {}
+    it = files
+    if progress:
+        from tqdm import tqdm
+
+        it = tqdm(files, desc=f"importing {where.name}", unit="file", disable=None, leave=False)
+    for f in it:
+        if f.stem in models:
+            errors[f] = f"{f}: model name {f.stem!r} is used by two files in the library"
+            continue
+        try:
+            models[f.stem] = load_model(f)
+        except ModelError as exc:
+            errors[f] = str(exc)
+    scan = LibraryScan(where, models, errors)
+    _SCANS.clear()  # one library is in use at a time; keep memory flat
+    _SCANS[stamp] = scan
+    return scan
+
+
+def load_library(directory: str | os.PathLike | None = None, skip_invalid: bool = False) -> dict[str, Polyhedron]:
+    """Every model of a library directory (default: the shipped ``assets/models``), by name.
+
+    A library with bad files is refused, naming every bad file and why, unless ``skip_invalid``: then the valid
+    models are returned (and the caller says which files were skipped, from :func:`scan_library`).
+    """
+    scan = scan_library(directory)
+    if scan.errors and not skip_invalid:
+        n = len(scan.errors)
+        raise ModelError(
+            f"{scan.directory}: {n} of {n + len(scan.models)} model files are invalid "
+            f"({'; '.join(scan.errors.values())}); fix or remove them, or pass --skip-invalid to use the "
+            f"{len(scan.models)} valid models"
+        )
+    if not scan.models:
+        raise ModelError(f"{scan.directory}: no valid model in the library ({len(scan.errors)} invalid files)")
+    return dict(scan.models)
 
 
 def resolve_model(spec: str, library: dict[str, Polyhedron] | None = None) -> Polyhedron:

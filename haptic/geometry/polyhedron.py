@@ -200,25 +200,35 @@ class Polyhedron:
             raise ModelError(f"{where}: vertex {lab(int(np.flatnonzero(~used)[0]))} is used by no face")
 
         # plane of each face, planarity and area
-        normals, offsets, areas = [], [], []
-        for fi, loop in enumerate(self.faces):
-            pts = v[list(loop)]
-            nn = newell_normal(pts)
-            area = 0.5 * np.linalg.norm(nn)
-            if area < t.area:
-                raise ModelError(f"{where}: face {fi} has zero area (vertices {[lab(i) for i in loop]})")
-            n = nn / np.linalg.norm(nn)
-            d = float(np.mean(pts @ n))
-            dev = np.abs(pts @ n - d).max()
-            if dev > t.planar:
-                worst = loop[int(np.argmax(np.abs(pts @ n - d)))]
-                raise ModelError(
-                    f"{where}: face {fi} is not planar: vertex {lab(worst)} is off its plane by {dev * 1e3:.4g} mm "
-                    f"(tolerance {t.planar * 1e3:.3g} mm at this model's size and precision)"
-                )
-            normals.append(n)
-            offsets.append(d)
-            areas.append(area)
+        # all faces at once: Newell sums and plane offsets accumulate in loop order
+        sizes = np.array([len(loop) for loop in self.faces])
+        flat = np.concatenate([np.asarray(loop) for loop in self.faces])
+        nxt = np.concatenate([np.roll(np.asarray(loop), -1) for loop in self.faces])
+        owner = np.repeat(np.arange(len(self.faces)), sizes)
+        nn = np.zeros((len(self.faces), 3))
+        np.add.at(nn, owner, np.cross(v[flat], v[nxt]))
+        norm = np.linalg.norm(nn, axis=1)
+        small = np.flatnonzero(0.5 * norm < t.area)
+        if len(small):
+            fi = int(small[0])
+            raise ModelError(f"{where}: face {fi} has zero area (vertices {[lab(i) for i in self.faces[fi]]})")
+        normals = nn / norm[:, None]
+        along = np.einsum("ij,ij->i", v[flat], normals[owner])
+        offsets = np.zeros(len(self.faces))
+        np.add.at(offsets, owner, along)
+        offsets /= sizes
+        off = np.abs(along - offsets[owner])
+        dev = np.zeros(len(self.faces))
+        np.maximum.at(dev, owner, off)
+        bad = np.flatnonzero(dev > t.planar)
+        if len(bad):
+            fi = int(bad[0])
+            worst = int(flat[owner == fi][int(np.argmax(off[owner == fi]))])
+            raise ModelError(
+                f"{where}: face {fi} is not planar: vertex {lab(worst)} is off its plane by {dev[fi] * 1e3:.4g} mm "
+                f"(tolerance {t.planar * 1e3:.3g} mm at this model's size and precision)"
+            )
+        areas = 0.5 * norm
 
         set_(self, "face_normals", _readonly(np.array(normals)))
         set_(self, "face_offsets", _readonly(np.array(offsets)))
@@ -471,8 +481,8 @@ class Polyhedron:
 
         return trimesh.Trimesh(vertices=np.array(self.vertices), faces=np.array(self.triangles), process=False)
 
-    def summary(self) -> dict:
-        """Counts and properties for listings."""
+    def summary(self, symmetry: list | None = None) -> dict:
+        """Counts and properties for listings (``symmetry``: the group when already found)."""
         from haptic.geometry.symmetry import symmetry_group
 
         return {
@@ -483,7 +493,7 @@ class Polyhedron:
             "euler": self.euler_characteristic,
             "genus": self.genus,
             "convex": self.is_convex,
-            "symmetry": len(symmetry_group(self)),
+            "symmetry": len(symmetry if symmetry is not None else symmetry_group(self)),
             "extents_mm": [round(float(x) * 1e3, 2) for x in self.extents],
             "volume_cm3": round(self.volume * 1e6, 3),
         }
@@ -494,6 +504,8 @@ class Polyhedron:
 
 def triangulate_polygon(vertices: np.ndarray, loop: tuple[int, ...], normal: np.ndarray) -> list[tuple[int, int, int]]:
     """Ear-clip a simple planar polygon (CCW about ``normal``) into triangles of vertex ids."""
+    if len(loop) == 3:
+        return [(loop[0], loop[1], loop[2])]
     from haptic.geometry.se3 import plane_basis
 
     u, w = plane_basis(normal)
@@ -561,18 +573,15 @@ def self_intersection(poly: Polyhedron) -> tuple[int, int] | None:
     eps = poly.tolerances.planar
     p = poly.vertices[tris]  # (T, 3, 3)
     lo, hi = p.min(axis=1) - eps, p.max(axis=1) + eps
-    pairs_i, pairs_j = [], []
-    n = len(tris)
-    for s in range(0, n, 256):
-        rows = np.arange(s, min(s + 256, n))
-        ok = (lo[rows, None, :] <= hi[None, :, :]).all(axis=2) & (hi[rows, None, :] >= lo[None, :, :]).all(axis=2)
-        ok &= np.arange(n)[None, :] > rows[:, None]
-        ok &= faces[rows, None] != faces[None, :]
-        i, j = np.nonzero(ok)
-        pairs_i.append(rows[i])
-        pairs_j.append(j)
-    i = np.concatenate(pairs_i)
-    j = np.concatenate(pairs_j)
+    # sweep along x: each triangle against those starting (in x) before it ends
+    order = np.argsort(lo[:, 0], kind="stable")
+    lo, hi, p, tris, faces = lo[order], hi[order], p[order], tris[order], faces[order]
+    stop = np.searchsorted(lo[:, 0], hi[:, 0], side="right")
+    count = np.maximum(stop - np.arange(len(tris)) - 1, 0)
+    i = np.repeat(np.arange(len(tris)), count)
+    j = i + 1 + (np.arange(len(i)) - np.repeat(np.cumsum(count) - count, count))
+    ok = (lo[i, 1:] <= hi[j, 1:]).all(axis=1) & (hi[i, 1:] >= lo[j, 1:]).all(axis=1) & (faces[i] != faces[j])
+    i, j = i[ok], j[ok]
     if len(i) == 0:
         return None
     shared = (tris[i][:, :, None] == tris[j][:, None, :]).sum(axis=(1, 2))

@@ -31,7 +31,9 @@ def congruences(a: Polyhedron, b: Polyhedron, eps: float | None = None) -> list[
     return [t for t, _ in _congruences(a, b, eps)]
 
 
-def _congruences(a: Polyhedron, b: Polyhedron, eps: float | None) -> list[tuple[SE3, tuple[int, ...]]]:
+def _congruences(a: Polyhedron, b: Polyhedron, eps: float | None) -> list[tuple[SE3, np.ndarray]]:
+    """Each congruence with its vertex correspondence (``perm[i]``: the vertex of ``b`` that vertex ``i`` of
+    ``a`` goes to)."""
     from scipy.spatial import cKDTree
 
     if (a.n_vertices, a.n_edges, a.n_faces) != (b.n_vertices, b.n_edges, b.n_faces):
@@ -52,8 +54,14 @@ def _congruences(a: Polyhedron, b: Polyhedron, eps: float | None) -> list[tuple[
     # a first correspondence is unambiguous while the candidate's error stays under half the closest vertex pair
     loose = max(eps, 0.3 * float(b.edge_lengths.min()))
     tree = cKDTree(b.vertices)
-    b_faces = {frozenset(f) for f in b.faces}
-    found: dict[tuple[int, ...], SE3] = {}
+    n = b.n_vertices
+    weights = np.random.default_rng(0).integers(1, 2**63, size=n, dtype=np.uint64)
+    a_flat, a_owner = _face_index(a)
+    b_flat, b_owner = _face_index(b)
+    b_faces = _keys(weights[b_flat], b_owner, b.n_faces)  # a face's key: the sum of its vertices' weights
+    b_edges = np.sort(b.edges, axis=1)
+    b_edges = b_edges[:, 0] * n + b_edges[:, 1]
+    found: dict[bytes, tuple[SE3, np.ndarray]] = {}
     for e in candidates:
         for forward in (True, False):
             if forward:
@@ -65,15 +73,32 @@ def _congruences(a: Polyhedron, b: Polyhedron, eps: float | None) -> list[tuple[
             dist, nearest = tree.query(a.vertices @ r.T + t, distance_upper_bound=loose)
             if not np.isfinite(dist).all() or len(np.unique(nearest)) != a.n_vertices:
                 continue
-            perm = tuple(int(i) for i in nearest)
-            if perm in found:
+            key = nearest.tobytes()
+            if key in found:
                 continue
             r, t = _fit_rotation(a.vertices, b.vertices[nearest])
             if np.linalg.norm(a.vertices @ r.T + t - b.vertices[nearest], axis=1).max() > eps:
                 continue
-            if all(frozenset(perm[i] for i in f) in b_faces for f in a.faces):
-                found[perm] = SE3(r, t)
-    return [(t, perm) for perm, t in found.items()]
+            mapped = np.sort(nearest[a.edges], axis=1)
+            if not np.isin(mapped[:, 0] * n + mapped[:, 1], b_edges).all():
+                continue
+            if np.isin(_keys(weights[nearest[a_flat]], a_owner, a.n_faces), b_faces).all():
+                found[key] = (SE3(r, t), nearest)
+    return list(found.values())
+
+
+def _face_index(poly: Polyhedron) -> tuple[np.ndarray, np.ndarray]:
+    """The faces' vertex loops end to end, and the face each entry belongs to."""
+    flat = np.concatenate([np.asarray(f) for f in poly.faces])
+    return flat, np.repeat(np.arange(poly.n_faces), [len(f) for f in poly.faces])
+
+
+def _keys(values: np.ndarray, owner: np.ndarray, count: int) -> np.ndarray:
+    """Per-group sums of 64-bit weights (wrapping): equal sets of vertices give equal keys; unequal sets of
+    random weights collide with odds of about 2^-64."""
+    keys = np.zeros(count, dtype=np.uint64)
+    np.add.at(keys, owner, values)
+    return keys
 
 
 def _fit_rotation(src: np.ndarray, dst: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -89,26 +114,36 @@ def symmetry_group(poly: Polyhedron) -> list[SE3]:
     """The proper rigid motions mapping the model onto itself (identity first).
 
     Every symmetry fixes the centroid, so each is a rotation about it: ``R (w − c) + c``. The result is checked
-    to be a group: it holds the identity and the composition of any two of its members (as vertex
-    permutations, which is exact); :class:`ModelError` says so when the model's precision leaves it not closed.
+    to be a group: it holds the identity and the composition of any two of its members, compared exactly as
+    vertex permutations on a few vertices that fix a rigid motion (three not on one line);
+    :class:`ModelError` says so when the model's precision leaves it not closed.
     """
     pairs = _congruences(poly, poly, None)
-    perms = {perm for _, perm in pairs}
-    identity = tuple(range(poly.n_vertices))
     where = poly.source or poly.name
-    if identity not in perms:
+    perm = np.array([p for _, p in pairs], dtype=np.int64).reshape(len(pairs), poly.n_vertices)
+    probe = _spanning_vertices(poly.vertices)
+    known = {row.tobytes() for row in perm[:, probe]}
+    if probe.tobytes() not in known:
         raise ModelError(f"{where}: the symmetry search did not find the identity (a bug, or a degenerate model)")
-    for _, g in pairs:
-        for _, h in pairs:
-            if tuple(g[i] for i in h) not in perms:
-                raise ModelError(
-                    f"{where}: the {len(pairs)} rotations found mapping the model onto itself are not closed under "
-                    f"composition, so they are not its symmetry group; its vertices are not placed precisely "
-                    f"enough (tolerance {poly.tolerances.match * 1e3:.3g} mm) to tell — write the file with "
-                    "more decimals"
-                )
-    pairs.sort(key=lambda tp: (tp[1] != identity, -float(np.trace(tp[0].rotation))))
+    for g in perm:
+        if any(row.tobytes() not in known for row in g[perm[:, probe]]):  # g ∘ h for every h
+            raise ModelError(
+                f"{where}: the {len(pairs)} rotations found mapping the model onto itself are not closed under "
+                f"composition, so they are not its symmetry group; its vertices are not placed precisely "
+                f"enough (tolerance {poly.tolerances.match * 1e3:.3g} mm) to tell — write the file with "
+                "more decimals"
+            )
+    identity = np.arange(poly.n_vertices)
+    pairs.sort(key=lambda tp: (not np.array_equal(tp[1], identity), -float(np.trace(tp[0].rotation))))
     return [t for t, _ in pairs]
+
+
+def _spanning_vertices(points: np.ndarray) -> np.ndarray:
+    """Three vertices not on one line (vertex 0, the farthest from it, the farthest from their line)."""
+    i = int(np.argmax(np.linalg.norm(points - points[0], axis=1)))
+    d = points[i] - points[0]
+    off = np.linalg.norm(np.cross(points - points[0], d), axis=1)
+    return np.array([0, i, int(np.argmax(off))], dtype=np.int64)
 
 
 def are_congruent(a: Polyhedron, b: Polyhedron) -> bool:
