@@ -20,7 +20,7 @@ from haptic.geometry.io import (
 )
 from haptic.geometry.polyhedron import Polyhedron
 from haptic.geometry.se3 import SE3, random_rotation, rotation_angle
-from haptic.geometry.symmetry import are_congruent, congruences, symmetry_group
+from haptic.geometry.symmetry import are_congruent, congruences, library_twin, symmetry_group
 from haptic.geometry.tolerances import Tolerances, tol
 
 __all__ = [
@@ -34,6 +34,7 @@ __all__ = [
     "congruences",
     "convex_decomposition",
     "export_mesh",
+    "library_twin",
     "LibraryScan",
     "load_library",
     "load_model",

@@ -13,6 +13,7 @@ model), and written to ``manifest.json`` beside the directories, so an import ca
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 import struct
@@ -42,7 +43,7 @@ ENCODINGS = ("obj6", "objmm3", "stl", "objtri")
 """The corpus's file encodings, one library directory each."""
 
 RADIUS = 0.04
-"""Circumradius of the formula solids [m]: each is 5–12 cm across."""
+"""Circumradius of the non-Platonic formula solids [m] (the Platonic ones: 50 mm); each is 5–12 cm across."""
 
 _PLATONIC_COUNTS = {
     "tetrahedron": (4, 6, 4, 12),
@@ -71,6 +72,7 @@ class CorpusSolid:
     """Order of the rotation group, from the formula."""
 
 
+@functools.lru_cache(maxsize=4)
 def corpus_solids(sides: range = range(3, 13), hulls: int = 8, seed: int = 0) -> list[tuple[CorpusSolid, Polyhedron]]:
     """The corpus's solids in their formula frames, with their known counts.
 

@@ -205,7 +205,7 @@ def _load_obj(path: Path, name: str) -> Polyhedron:
                 f"(tolerance {2 * t.planar * 1e3:.3g} mm at this file's size and precision)"
             )
         try:
-            pieces = triangulate_polygon(v, tuple(loop), nn)
+            pieces = triangulate_polygon(v, tuple(loop), nn, min_area=t.area)
         except ModelError as exc:
             raise ModelError(f"{at}: {exc}") from None
         tris.extend(pieces)

@@ -502,8 +502,14 @@ class Polyhedron:
         return f"Polyhedron({self.name!r}, V={self.n_vertices}, E={self.n_edges}, F={self.n_faces})"
 
 
-def triangulate_polygon(vertices: np.ndarray, loop: tuple[int, ...], normal: np.ndarray) -> list[tuple[int, int, int]]:
-    """Ear-clip a simple planar polygon (CCW about ``normal``) into triangles of vertex ids."""
+def triangulate_polygon(
+    vertices: np.ndarray, loop: tuple[int, ...], normal: np.ndarray, min_area: float = 5e-19
+) -> list[tuple[int, int, int]]:
+    """Ear-clip a simple planar polygon (CCW about ``normal``) into triangles of vertex ids.
+
+    Corners whose triangle has less than ``min_area`` [m^2] count as straight (never clipped): with rounded
+    coordinates, pass the model's area tolerance so that no sliver ear is cut.
+    """
     if len(loop) == 3:
         return [(loop[0], loop[1], loop[2])]
     from haptic.geometry.se3 import plane_basis
@@ -523,7 +529,7 @@ def triangulate_polygon(vertices: np.ndarray, loop: tuple[int, ...], normal: np.
         for k in range(m):
             i0, i1, i2 = idx[k - 1], idx[k], idx[(k + 1) % m]
             a, b, c = pts[i0], pts[i1], pts[i2]
-            if cross2(a, b, c) <= 1e-18:
+            if cross2(a, b, c) <= 2 * min_area:
                 continue  # reflex or collinear corner
             inside = False
             for j in idx:

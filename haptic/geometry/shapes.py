@@ -230,20 +230,35 @@ def random_convex_hull(
     shorter than ``min_edge`` (default a fifth of the radius), so the solid survives coordinate rounding far
     below those scales.
     """
+    from scipy.spatial import ConvexHull
+
     from haptic.errors import ModelError
 
     min_edge = radius / 5 if min_edge is None else min_edge
+    cos_turn = np.cos(np.radians(min_turn_deg))
+    spacing = np.sqrt(4 * np.pi / n_points)  # mean angular spacing of n points on the sphere [rad]
     for _ in range(1000):
-        d = rng.normal(size=(n_points, 3))
-        pts = radius * d / np.linalg.norm(d, axis=1)[:, None]
-        poly = convex_hull(pts, name=name)
-        if poly.n_vertices != n_points or poly.edge_lengths.min() < min_edge:
+        # points drawn one by one, each at least half the mean spacing from the others (fewer rejected hulls)
+        dirs: list[np.ndarray] = []
+        for _ in range(100 * n_points):
+            d = rng.normal(size=3)
+            d /= np.linalg.norm(d)
+            if all(d @ q < np.cos(spacing / 2) for q in dirs):
+                dirs.append(d)
+                if len(dirs) == n_points:
+                    break
+        if len(dirs) < n_points:
             continue
-        cos_turn = np.einsum(
-            "ij,ij->i", poly.face_normals[poly.edge_left_face], poly.face_normals[poly.edge_right_face]
-        )
-        if cos_turn.max() <= np.cos(np.radians(min_turn_deg)):
-            return poly
+        pts = radius * np.array(dirs)
+        hull = ConvexHull(pts)
+        if len(hull.vertices) != n_points:
+            continue
+        normals = hull.equations[:, :3]
+        turn = np.einsum("ij,ikj->ik", normals, normals[hull.neighbors])  # each facet against its 3 neighbours
+        tri = pts[hull.simplices]
+        edges = np.linalg.norm(tri - np.roll(tri, 1, axis=1), axis=2)
+        if turn.max() <= cos_turn and edges.min() >= min_edge:
+            return convex_hull(pts, name=name)
     raise ModelError(f"{name}: no well-shaped hull of {n_points} points in 1000 draws; use fewer points")
 
 

@@ -146,6 +146,22 @@ def _spanning_vertices(points: np.ndarray) -> np.ndarray:
     return np.array([0, i, int(np.argmax(off))], dtype=np.int64)
 
 
+def library_twin(model: Polyhedron, library: dict[str, Polyhedron]) -> tuple[str, SE3] | None:
+    """The library model congruent to ``model`` (a proper rigid motion maps one onto the other), with the
+    map ``T`` taking the library model onto ``model`` (``T(library model) = model``); ``None`` when there is none.
+
+    The same model read from another file, another encoding or another pose is found here whatever its name.
+    """
+    for name, candidate in library.items():
+        if candidate is model:
+            return name, SE3.identity()
+    for name, candidate in library.items():
+        maps = congruences(candidate, model)
+        if maps:
+            return name, maps[0]
+    return None
+
+
 def are_congruent(a: Polyhedron, b: Polyhedron) -> bool:
     """True when a proper rigid motion maps one solid onto the other (mirror images are not congruent)."""
     return bool(_congruences(a, b, None))
