@@ -49,11 +49,11 @@ class Tolerances:
         delta = np.sqrt(3.0) * float(quantum) + RELATIVE_NOISE * size
         floor = cls()
         return cls(
-            merge=max(floor.merge, 2 * delta),
-            planar=max(floor.planar, 4 * delta),
-            area=max(floor.area, (4 * delta) ** 2),
-            angle=max(floor.angle, 8 * delta / max(size, 1e-12)),
-            match=max(floor.match, 1e-5 * size, 4 * delta),
+            merge=float(max(floor.merge, 2 * delta)),
+            planar=float(max(floor.planar, 4 * delta)),
+            area=float(max(floor.area, (4 * delta) ** 2)),
+            angle=float(max(floor.angle, 8 * delta / max(size, 1e-12))),
+            match=float(max(floor.match, 1e-5 * size, 4 * delta)),
         )
 
 
