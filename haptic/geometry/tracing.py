@@ -71,9 +71,11 @@ def trace_face(
         return None
     d /= norm
     start = np.asarray(start, dtype=float)
+    # the start and the face's corners on its plane: a model read from a rounded file has its corners off the
+    # plane by up to its precision, and a point stepped over from a neighbouring face is off by as much
+    start = start - (start @ n - poly.face_offsets[face]) * n
     best = None
     loop = poly.faces[face]
-    # the face's corners on its plane: a model read from a rounded file has them off it by up to its precision
     off = poly.vertices[list(loop)] @ n - poly.face_offsets[face]
     corners = poly.vertices[list(loop)] - off[:, None] * n
     for k, e in enumerate(poly.face_edges[face]):
