@@ -35,19 +35,34 @@ def _add_models(sub: argparse._SubParsersAction) -> None:
     cp.set_defaults(run=_models_check)
 
 
-def _library(args: argparse.Namespace):
-    from haptic.geometry import load_library
+def report_skipped(models: str | None, skipped: bool) -> None:
+    """Name on stderr, one line each, the library files ``--skip-invalid`` left out."""
+    if not skipped:
+        return
+    from haptic.geometry.io import scan_library
 
-    return load_library(getattr(args, "models", None))
+    for msg in scan_library(models).errors.values():
+        print(f"haptic: skipped invalid model file: {msg}", file=sys.stderr)
 
 
 def _models_list(args: argparse.Namespace) -> int:
-    lib = _library(args)
-    rows = [m.summary() for m in lib.values()]
+    from tqdm import tqdm
+
+    from haptic.geometry.io import scan_library
+
+    scan = scan_library(args.models, progress=True)
+    models = list(scan.models.values())
+    rows = [m.summary() for m in tqdm(models, desc="symmetry", unit="model", disable=None, leave=False)]
+    for msg in scan.errors.values():
+        print(f"haptic: error: {msg}", file=sys.stderr)
+    status = 1 if scan.errors else 0
     if args.json:
         for r in rows:
             print(json.dumps(r))
-        return 0
+        return status
+    if not rows:
+        print(f"0 valid models; {len(scan.errors)} invalid files")
+        return status
     w = max(12, *(len(r["name"]) for r in rows))
     head = f"{'name':<{w}} {'V':>3} {'E':>3} {'F':>3} {'V-E+F':>5} {'genus':>5} {'convex':>6} {'sym':>4}  size [mm]"
     print(head)
@@ -58,25 +73,32 @@ def _models_list(args: argparse.Namespace) -> int:
             f"{r['name']:<{w}} {r['V']:>3} {r['E']:>3} {r['F']:>3} {r['euler']:>5} {r['genus']:>5} "
             f"{'yes' if r['convex'] else 'no':>6} {r['symmetry']:>4}  {size}"
         )
-    print(f"{len(rows)} models")
-    return 0
+    print(f"{len(rows)} models" + (f"; {len(scan.errors)} invalid files (named on stderr)" if scan.errors else ""))
+    return status
 
 
 def _models_show(args: argparse.Namespace) -> int:
     import numpy as np
 
     from haptic.geometry import convex_decomposition, resolve_model, symmetry_group
+    from haptic.geometry.io import scan_library
 
-    lib = _library(args) if not os.path.exists(args.name) else None
+    lib = None
+    if not os.path.exists(args.name):
+        scan = scan_library(args.models)
+        bad = [msg for path, msg in scan.errors.items() if path.stem == args.name]
+        if bad:
+            raise HapticError(bad[0])
+        lib = scan.models
     m = resolve_model(args.name, lib)
-    s = m.summary()
+    sym = symmetry_group(m)
+    s = {**m.summary(symmetry=sym)}
     print(f"{m.name}  ({m.source})")
     print(
         f"  V={s['V']} E={s['E']} F={s['F']}  V-E+F={s['euler']}  genus={s['genus']}  "
         f"convex={'yes' if s['convex'] else 'no'}  volume={s['volume_cm3']:g} cm^3"
     )
     print(f"  size {' x '.join(f'{x:g}' for x in s['extents_mm'])} mm; convex pieces: {len(convex_decomposition(m))}")
-    sym = symmetry_group(m)
     angles = sorted(round(float(np.degrees(np.arccos(np.clip((np.trace(t.rotation) - 1) / 2, -1, 1))))) for t in sym)
     print(f"  symmetry group: {len(sym)} proper rotations (angles {angles} deg)")
     print("  faces  (n, d [mm], vertex loop):")

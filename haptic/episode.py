@@ -15,7 +15,7 @@ import numpy as np
 
 from haptic.bench.runner import EpisodeSpec
 from haptic.errors import HapticError
-from haptic.geometry import SE3, Polyhedron, load_library, resolve_model
+from haptic.geometry import SE3, Polyhedron, library_twin, load_library, resolve_model
 from haptic.geometry.se3 import matrix_to_quat, rotation_angle
 from haptic.matching.components import DataComponent, SensorNoise
 from haptic.matching.recognition import AMBIGUOUS, EXPLORING, NO_MATCH, RECOGNIZED, Recognition, recognize
@@ -272,7 +272,7 @@ def run_episode(
         return run_physics_episode(spec, library=library, observer=observer, config=config, policy=policy)
     if spec.executor != "geometric":
         raise HapticError(f"unknown executor {spec.executor!r}; valid: geometric, physics")
-    library = library if library is not None else load_library(spec.models)
+    library = library if library is not None else load_library(spec.models, skip_invalid=spec.skip_invalid)
     true_model = resolve_model(spec.model, library)
     config = config or PlannerConfig()
     root = np.random.SeedSequence(spec.seed)
@@ -412,13 +412,16 @@ def run_loop(
     recognized = rec.model if rec is not None and outcome == RECOGNIZED else None
     err_mm = err_deg = None
     in_library = spec.model in library
+    # the library model the object is (evaluation only): by name, or for a file by congruence with one
+    twin = (spec.model, SE3.identity()) if in_library else library_twin(true_model, library)
     correct = False
     if outcome == RECOGNIZED and rec.world_from_model is not None:
-        if recognized == true_model.name and in_library:
-            err_mm, err_deg = pose_error(true_model, world_from_model, rec.world_from_model)
+        if twin is not None and recognized == twin[0]:
+            # the library model's pose in the world: the object's pose after the map of the model onto it
+            err_mm, err_deg = pose_error(library[twin[0]], world_from_model @ twin[1], rec.world_from_model)
             correct = err_mm < CORRECT_POSE_MM and err_deg < CORRECT_POSE_DEG
     elif outcome == NO_MATCH:
-        correct = not in_library
+        correct = twin is None
     n_by_kind = {k: sum(1 for c in components.values() if c.kind == k) for k in ("face", "edge", "vertex")}
     record = EpisodeRecord(
         model=true_model.name if in_library else str(Path(spec.model).name),

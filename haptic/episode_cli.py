@@ -19,6 +19,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--object", required=True, help="model name in the library, or a path to a model file")
     p.add_argument("--models", metavar="DIR", help="library directory (default: the shipped assets/models)")
+    p.add_argument(
+        "--skip-invalid", action="store_true", help="use the library's valid models when some files are bad"
+    )
     p.add_argument("--executor", choices=("geometric", "physics"), default="geometric")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--policy", default="planner", choices=POLICY_NAMES)
@@ -59,6 +62,7 @@ def summary_lines(rec: dict) -> list[str]:
 
 def run(args: argparse.Namespace) -> int:
     from haptic.bench.runner import EpisodeSpec
+    from haptic.cli import report_skipped
     from haptic.episode import run_episode
     from haptic.geometry import load_library
     from haptic.geometry.io import atomic_write
@@ -67,10 +71,11 @@ def run(args: argparse.Namespace) -> int:
         raise HapticError(f"--max-moves must be at least 1, got {args.max_moves}")
     if args.noise < 0:
         raise HapticError(f"--noise must be >= 0, got {args.noise}")
-    library = load_library(args.models)
+    library = load_library(args.models, skip_invalid=args.skip_invalid)
+    report_skipped(args.models, args.skip_invalid)
     spec = EpisodeSpec(
         model=args.object, seed=args.seed, policy=args.policy, executor=args.executor, noise=args.noise,
-        models=args.models, max_moves=args.max_moves, record=args.record,
+        models=args.models, max_moves=args.max_moves, record=args.record, skip_invalid=args.skip_invalid,
     )
     observer = None
     recorder = None

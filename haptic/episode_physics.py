@@ -38,7 +38,7 @@ def run_physics_episode(
     from haptic.sim import SensorNoise as SimNoise
     from haptic.sim.scene import TABLE_TOP_Z, scene_object_from_polyhedron
 
-    library = library if library is not None else load_library(spec.models)
+    library = library if library is not None else load_library(spec.models, skip_invalid=spec.skip_invalid)
     true_model = resolve_model(spec.model, library)
     config = config or PlannerConfig()
     if config.table_z is None:  # the robot knows its workspace: where the table top is (never the object)

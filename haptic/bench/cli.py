@@ -21,6 +21,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "table) and .png (pose classes remaining vs path cost).",
     )
     p.add_argument("--models", metavar="DIR", help="library directory (default: the shipped assets/models)")
+    p.add_argument(
+        "--skip-invalid", action="store_true", help="use the library's valid models when some files are bad"
+    )
     p.add_argument("--executor", choices=("geometric", "physics"), default="geometric")
     p.add_argument(
         "--policy", default="planner,random", help=f"comma-separated policies from {', '.join(POLICY_NAMES)}"
@@ -42,6 +45,7 @@ def run(args: argparse.Namespace) -> int:
     from haptic.bench.results import ResultsWriter
     from haptic.bench.runner import plan_sweep, run_sweep
     from haptic.bench.summary import markdown_table, plot_interpretations_vs_cost, summary_rows
+    from haptic.cli import report_skipped
     from haptic.geometry import load_library
     from haptic.geometry.io import atomic_write
     from haptic.planning.policies import POLICY_NAMES
@@ -58,11 +62,12 @@ def run(args: argparse.Namespace) -> int:
         raise BenchError("--noise levels must be >= 0")
     if args.episodes < 1:
         raise BenchError(f"--episodes must be at least 1, got {args.episodes}")
-    library = load_library(args.models)
+    library = load_library(args.models, skip_invalid=args.skip_invalid)
+    report_skipped(args.models, args.skip_invalid)
     lib_name = Path(args.models).name if args.models else "seed"
     specs = plan_sweep(
         sorted(library), args.episodes, args.seed, policies, noises,
-        executor=args.executor, models=args.models, max_moves=args.max_moves,
+        executor=args.executor, models=args.models, max_moves=args.max_moves, skip_invalid=args.skip_invalid,
     )
     out = Path(args.out)
     records = []

@@ -34,6 +34,8 @@ class EpisodeSpec:
     """Move budget: the episode ends as "budget" after this many moves."""
     record: str | None = None
     """Path of a rerun recording to write (None: none)."""
+    skip_invalid: bool = False
+    """Use the library's valid models when some of its files are bad (else refuse the library)."""
 
 
 def plan_sweep(

@@ -7,6 +7,7 @@ from haptic.geometry.decompose import convex_decomposition
 from haptic.geometry.io import (
     DEFAULT_LIBRARY,
     MODEL_SUFFIXES,
+    LibraryScan,
     atomic_write,
     export_mesh,
     load_library,
@@ -15,10 +16,11 @@ from haptic.geometry.io import (
     polyhedron_from_triangles,
     resolve_model,
     save_model,
+    scan_library,
 )
 from haptic.geometry.polyhedron import Polyhedron
 from haptic.geometry.se3 import SE3, random_rotation, rotation_angle
-from haptic.geometry.symmetry import are_congruent, congruences, symmetry_group
+from haptic.geometry.symmetry import are_congruent, congruences, library_twin, symmetry_group
 from haptic.geometry.tolerances import Tolerances, tol
 
 __all__ = [
@@ -32,6 +34,8 @@ __all__ = [
     "congruences",
     "convex_decomposition",
     "export_mesh",
+    "library_twin",
+    "LibraryScan",
     "load_library",
     "load_model",
     "model_files",
@@ -40,6 +44,7 @@ __all__ = [
     "resolve_model",
     "rotation_angle",
     "save_model",
+    "scan_library",
     "symmetry_group",
     "tol",
 ]

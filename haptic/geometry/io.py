@@ -10,13 +10,14 @@ from __future__ import annotations
 import json
 import os
 import tempfile
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from haptic.errors import ModelError
 from haptic.geometry.polyhedron import Polyhedron, newell_normal, triangulate_polygon
-from haptic.geometry.tolerances import tol
+from haptic.geometry.tolerances import FLOAT32_QUANTUM, Tolerances, decimal_quantum
 
 NATIVE_SUFFIX = ".json"
 MESH_SUFFIXES = (".obj", ".stl", ".ply")
@@ -46,29 +47,87 @@ def load_model(path: str | os.PathLike, name: str | None = None) -> Polyhedron:
     return _load_mesh(path, name)
 
 
+UNITS = {"m": 1.0, "cm": 1e-2, "mm": 1e-3}
+"""Length units a model file may declare, in metres."""
+
+
+def text_quantum(tokens: list[str]) -> float:
+    """How far numbers written as ``tokens`` were rounded, in the file's units (0 when they look exact).
+
+    The rounding of a file is that of its longest-written numbers: those with the most significant digits.
+    Among them the coarsest last digit sets the quantum (half a unit in that place). Integers, and files whose
+    numbers all have fewer than 4 significant digits (hand-written round values), count as exact.
+    """
+    best_sig, quantum = 0, 0.0
+    for tok in tokens:
+        mant, _, exp = tok.lower().partition("e")
+        if "." not in mant:
+            continue
+        whole, _, frac = mant.lstrip("+-").partition(".")
+        sig = len((whole + frac).lstrip("0"))
+        try:
+            decimals = len(frac) - (int(exp) if exp else 0)
+        except ValueError:
+            continue
+        q = decimal_quantum(decimals)
+        if sig > best_sig:
+            best_sig, quantum = sig, q
+        elif sig == best_sig:
+            quantum = max(quantum, q)
+    return quantum if best_sig >= 4 else 0.0
+
+
+def _source_precision(quantum: float, vertices: np.ndarray) -> float:
+    """A file's rounding [m], bounded by a ten-thousandth of the model's size (beyond that it is no solid)."""
+    size = float(np.linalg.norm(np.ptp(vertices, axis=0))) if len(vertices) else 0.0
+    return min(float(quantum), 1e-4 * size)
+
+
 def _load_native(path: Path, name: str) -> Polyhedron:
+    tokens: list[str] = []
+
+    def number(tok: str) -> float:
+        tokens.append(tok)
+        return float(tok)
+
     try:
-        doc = json.loads(path.read_text())
+        doc = json.loads(path.read_text(), parse_float=number)
     except (UnicodeDecodeError, json.JSONDecodeError) as exc:
         raise ModelError(f"{path}: not valid JSON ({exc})") from None
     if not isinstance(doc, dict) or "vertices" not in doc or "faces" not in doc:
         raise ModelError(f"{path}: a native model is a JSON object with 'vertices' and 'faces' lists")
     if not isinstance(doc["faces"], list):
         raise ModelError(f"{path}: 'faces' must be a list of vertex-index lists")
-    scale = {"m": 1.0, "mm": 1e-3, "cm": 1e-2}.get(doc.get("units", "m"))
+    scale = UNITS.get(doc.get("units", "m"))
     if scale is None:
-        raise ModelError(f"{path}: unknown units {doc.get('units')!r}; valid: m, cm, mm")
+        raise ModelError(f"{path}: unknown units {doc.get('units')!r}; valid: {', '.join(UNITS)}")
     try:
         vertices = np.array(doc["vertices"], dtype=float) * scale
     except (TypeError, ValueError):
         raise ModelError(f"{path}: 'vertices' must be a list of [x, y, z] numbers") from None
-    return Polyhedron.from_faces(vertices, doc["faces"], name=name, source=str(path))
+    precision = _source_precision(text_quantum(tokens) * scale, vertices.reshape(-1, 3) if vertices.size else vertices)
+    return Polyhedron.from_faces(vertices, doc["faces"], name=name, source=str(path), precision=precision)
+
+
+def _obj_units(line: str) -> float | None:
+    """The scale a ``# units: mm`` comment declares, or ``None`` when the comment declares none."""
+    words = line.lstrip("#").replace(":", " ").replace("=", " ").split()
+    if len(words) >= 2 and words[0].lower() == "units":
+        return UNITS.get(words[1].lower(), -1.0)
+    return None
 
 
 def _load_obj(path: Path, name: str) -> Polyhedron:
-    """Wavefront OBJ read directly, so that polygonal faces (convex or not) keep their loops."""
+    """Wavefront OBJ read directly, so that polygonal faces (convex or not) keep their loops.
+
+    A comment ``# units: mm`` (or ``cm``, ``m``) declares the units; metres otherwise. Vertices keep their
+    file numbers (1-based) in messages.
+    """
     vertices: list[list[float]] = []
     loops: list[list[int]] = []
+    face_lines: list[int] = []
+    tokens: list[str] = []
+    scale = 1.0
     try:
         text = path.read_text()
     except UnicodeDecodeError:
@@ -77,41 +136,109 @@ def _load_obj(path: Path, name: str) -> Polyhedron:
         parts = line.split()
         if not parts:
             continue
+        if parts[0].startswith("#"):
+            declared = _obj_units(line)
+            if declared is not None:
+                if declared < 0:
+                    raise ModelError(f"{path}: line {lineno} declares unknown units; valid: {', '.join(UNITS)}")
+                scale = declared
+            continue
         try:
             if parts[0] == "v":
+                if len(parts) < 4:
+                    raise ModelError(
+                        f"{path}: line {lineno}: a vertex needs x y z coordinates, got {len(parts) - 1}: "
+                        f"{line.strip()!r}"
+                    )
                 vertices.append([float(x) for x in parts[1:4]])
+                tokens.extend(parts[1:4])
             elif parts[0] == "f":
                 idx = [int(tok.split("/")[0]) for tok in parts[1:]]
-                loops.append([i - 1 if i > 0 else len(vertices) + i for i in idx])
+                if len(idx) < 3:
+                    raise ModelError(
+                        f"{path}: line {lineno}: a face needs at least 3 vertices, got {len(idx)}: {line.strip()!r}"
+                    )
+                loop = [i - 1 if i > 0 else len(vertices) + i for i in idx]
+                if min(loop) < 0 or max(loop) >= len(vertices) or 0 in idx:
+                    raise ModelError(
+                        f"{path}: line {lineno}: face names a vertex outside 1..{len(vertices)} "
+                        f"(the vertices defined so far): {line.strip()!r}"
+                    )
+                loops.append(loop)
+                face_lines.append(lineno)
         except ValueError:
             raise ModelError(f"{path}: line {lineno} is not a valid OBJ '{parts[0]}' record: {line.strip()!r}") \
                 from None
     if not loops:
         raise ModelError(f"{path}: the file holds no faces")
-    v = np.array(vertices, dtype=float).reshape(-1, 3)
+    v = np.array(vertices, dtype=float).reshape(-1, 3) * scale
     if not np.isfinite(v).all():
         bad = int(np.flatnonzero(~np.isfinite(v).all(axis=1))[0])
-        raise ModelError(f"{path}: vertex {bad} has a non-finite coordinate {v[bad].tolist()}")
+        raise ModelError(f"{path}: vertex {bad + 1} has a non-finite coordinate {v[bad].tolist()}")
+    precision = _source_precision(text_quantum(tokens) * scale, v)
+    t = Tolerances.for_model(float(np.linalg.norm(np.ptp(v, axis=0))), precision)
+    tris: list[tuple[int, int, int]] = []
+    polygon_of: list[int] = []
+    plain = _plain_triangles(v, loops, t)  # triangles need no planarity test: check them all at once
     for k, loop in enumerate(loops):
-        if len(loop) < 3 or min(loop) < 0 or max(loop) >= len(v):
-            raise ModelError(f"{path}: face {k} names a vertex outside 1..{len(v)} or has fewer than 3")
-    tris = []
-    for k, loop in enumerate(loops):
+        if plain[k]:
+            tris.append((loop[0], loop[1], loop[2]))
+            polygon_of.append(k)
+            continue
+        at = f"{path}: face {k + 1} (line {face_lines[k]})"
+        if len(set(loop)) != len(loop):
+            raise ModelError(f"{at} repeats a vertex in its loop {[i + 1 for i in loop]}")
+        for a, b in zip(loop, loop[1:] + loop[:1], strict=True):
+            if np.linalg.norm(v[a] - v[b]) < t.merge:
+                raise ModelError(
+                    f"{at} has a zero-length edge: vertices {a + 1} and {b + 1} are the same point "
+                    f"(closer than {t.merge * 1e3:.3g} mm)"
+                )
         nn = newell_normal(v[loop])
-        if np.linalg.norm(nn) < 2 * tol.area:
-            raise ModelError(f"{path}: face {k} has zero area")
+        if np.linalg.norm(nn) < 2 * t.area:
+            raise ModelError(f"{at} has zero area (its vertices {[i + 1 for i in loop]} are on one line)")
         n = nn / np.linalg.norm(nn)
         dev = np.ptp(v[loop] @ n)
-        if dev > 2 * tol.planar:
+        if dev > 2 * t.planar:
             raise ModelError(
-                f"{path}: face {k} is not planar: its vertices spread {dev * 1e3:.4g} mm off one plane "
-                f"(tolerance {tol.planar * 1e3:g} mm)"
+                f"{at} is not planar: its vertices spread {dev * 1e3:.4g} mm off one plane "
+                f"(tolerance {2 * t.planar * 1e3:.3g} mm at this file's size and precision)"
             )
         try:
-            tris.extend(triangulate_polygon(v, tuple(loop), nn))
+            pieces = triangulate_polygon(v, tuple(loop), nn, min_area=t.area)
         except ModelError as exc:
-            raise ModelError(f"{path}: {exc}") from None
-    return polyhedron_from_triangles(v, np.array(tris, dtype=int), name=name, source=str(path))
+            raise ModelError(f"{at}: {exc}") from None
+        tris.extend(pieces)
+        polygon_of.extend([k] * len(pieces))
+    labels = [str(i + 1) for i in range(len(v))]
+    return polyhedron_from_triangles(
+        v, np.array(tris, dtype=int), name=name, source=str(path), precision=precision, vertex_labels=labels,
+        polygons=polygon_of,
+    )  # fmt: skip
+
+
+def _plain_triangles(v: np.ndarray, loops: list[list[int]], t: Tolerances) -> np.ndarray:
+    """Per loop: is it a triangle of three distinct, well-separated, non-collinear points?"""
+    plain = np.array([len(loop) == 3 for loop in loops])
+    if not plain.any():
+        return plain
+    tri = np.array([loop for loop in loops if len(loop) == 3])
+    p = v[tri]
+    edges = np.linalg.norm(p - np.roll(p, -1, axis=1), axis=2).min(axis=1)
+    area2 = np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
+    distinct = (tri[:, 0] != tri[:, 1]) & (tri[:, 1] != tri[:, 2]) & (tri[:, 2] != tri[:, 0])
+    plain[np.flatnonzero(plain)] = distinct & (edges >= t.merge) & (area2 >= 2 * t.area)
+    return plain
+
+
+def _mesh_precision(path: Path, vertices: np.ndarray) -> float:
+    """The rounding of a mesh file's coordinates [m]: float32 unless a PLY declares doubles."""
+    if path.suffix.lower() == ".ply":
+        with open(path, "rb") as fh:
+            header = fh.read(4096).split(b"end_header")[0].decode("ascii", "replace")
+        if any(line.split()[:2] == ["property", "double"] for line in header.splitlines()):
+            return 0.0
+    return _source_precision(FLOAT32_QUANTUM * float(np.abs(vertices).max(initial=0.0)), vertices)
 
 
 def _load_mesh(path: Path, name: str) -> Polyhedron:
@@ -127,38 +254,64 @@ def _load_mesh(path: Path, name: str) -> Polyhedron:
     if not np.isfinite(vertices).all():
         bad = int(np.flatnonzero(~np.isfinite(vertices).all(axis=1))[0])
         raise ModelError(f"{path}: vertex {bad} has a non-finite coordinate {vertices[bad].tolist()}")
-    return polyhedron_from_triangles(vertices, np.asarray(mesh.faces, dtype=int), name=name, source=str(path))
+    if path.suffix.lower() == ".stl":  # STL numbers no vertices: name them by where they are
+        labels = [f"({x * 1e3:.4g}, {y * 1e3:.4g}, {z * 1e3:.4g}) mm" for x, y, z in vertices]
+    else:
+        labels = [str(i) for i in range(len(vertices))]
+    return polyhedron_from_triangles(
+        vertices, np.asarray(mesh.faces, dtype=int), name=name, source=str(path),
+        precision=_mesh_precision(path, vertices), vertex_labels=labels,
+    )  # fmt: skip
 
 
 def polyhedron_from_triangles(
-    vertices: np.ndarray, triangles: np.ndarray, name: str = "model", source: str | None = None
+    vertices: np.ndarray,
+    triangles: np.ndarray,
+    name: str = "model",
+    source: str | None = None,
+    precision: float = 0.0,
+    vertex_labels=None,
+    polygons=None,
 ) -> Polyhedron:
     """Merge a triangle mesh into planar polygonal faces and validate it.
 
-    Coincident vertices are welded; edge-connected triangles in one plane become one face (single triangles
-    stay faces of their own); vertices that end up in only two faces (collinear points on an edge) are dropped.
+    Vertices closer than the merge tolerance are welded; edge-connected triangles in one plane (as far as the
+    coordinates' ``precision`` [m] can tell: each one's far corner within the planar tolerance of the other's
+    plane) become one face, single triangles stay faces of their own; vertices that end up in only two faces
+    (points on a straight edge) are dropped. ``vertex_labels`` name the input vertices in messages;
+    ``polygons`` (one id per triangle), when given, says which triangles come from one written polygon.
     """
     where = source or name
-    v, tris = _weld(vertices, triangles)
+    vertices = np.asarray(vertices, dtype=float)
+    triangles = np.asarray(triangles, dtype=int)
+    t = Tolerances.for_model(float(np.linalg.norm(np.ptp(vertices, axis=0))), precision)
+    keep_ids, tris = _weld(vertices, triangles, t.merge)
+    v = vertices[keep_ids]
+    labels = [str(vertex_labels[i]) if vertex_labels is not None else str(i) for i in keep_ids]
     # degenerate triangles
     cr = np.cross(v[tris[:, 1]] - v[tris[:, 0]], v[tris[:, 2]] - v[tris[:, 0]])
     area2 = np.linalg.norm(cr, axis=1)
-    bad = np.flatnonzero(area2 < 2 * tol.area)
+    bad = np.flatnonzero(area2 < 2 * t.area)
     if len(bad):
-        raise ModelError(f"{where}: triangle {int(bad[0])} has zero area (a zero-length edge or collinear corners)")
+        corners = [labels[i] for i in tris[bad[0]]]
+        same = len(set(tris[bad[0]].tolist())) < 3
+        why = "two of its corners are the same point (a zero-length edge)" if same else "its corners are on a line"
+        raise ModelError(f"{where}: triangle {int(bad[0])} (vertices {corners}) has zero area: {why}")
     normals = cr / area2[:, None]
     offsets = np.einsum("ij,ij->i", normals, v[tris[:, 0]])
 
     # undirected edge -> triangles
     edge_tris: dict[tuple[int, int], list[int]] = {}
-    for t, (a, b, c) in enumerate(tris):
+    for k, (a, b, c) in enumerate(tris):
         for x, y in ((a, b), (b, c), (c, a)):
-            edge_tris.setdefault((min(x, y), max(x, y)), []).append(t)
+            edge_tris.setdefault((min(x, y), max(x, y)), []).append(k)
     for (x, y), ts in edge_tris.items():
         if len(ts) > 2:
-            raise ModelError(f"{where}: edge {x}-{y} is non-manifold: {len(ts)} triangles meet on it")
+            raise ModelError(f"{where}: edge {labels[x]}-{labels[y]} is non-manifold: {len(ts)} triangles meet on it")
         if len(ts) == 1:
-            raise ModelError(f"{where}: edge {x}-{y} has only one triangle: the mesh is open (not watertight)")
+            raise ModelError(
+                f"{where}: edge {labels[x]}-{labels[y]} has only one triangle: the mesh is open (not watertight)"
+            )
 
     parent = list(range(len(tris)))
 
@@ -168,25 +321,33 @@ def polyhedron_from_triangles(
             i = parent[i]
         return i
 
-    cos_tol = np.cos(max(tol.angle, 1e-4))
-    for (_x, _y), (t0, t1) in edge_tris.items():
-        if normals[t0] @ normals[t1] > cos_tol and abs(offsets[t0] - offsets[t1]) < max(tol.planar, 1e-6):
+    if polygons is not None:  # triangles of one written polygon are one face
+        first_of: dict[int, int] = {}
+        for k, g in enumerate(np.asarray(polygons).tolist()):
+            parent[find(k)] = find(first_of.setdefault(g, k))
+    for (x, y), (t0, t1) in edge_tris.items():
+        if normals[t0] @ normals[t1] <= 0:
+            continue
+        far0 = next(i for i in tris[t0] if i != x and i != y)
+        far1 = next(i for i in tris[t1] if i != x and i != y)
+        off0, off1 = abs(v[far1] @ normals[t0] - offsets[t0]), abs(v[far0] @ normals[t1] - offsets[t1])
+        if min(off0, off1) <= t.planar:  # one triangle's plane holds all four corners (a sliver's is ill-defined)
             parent[find(t0)] = find(t1)
     groups: dict[int, list[int]] = {}
-    for t in range(len(tris)):
-        groups.setdefault(find(t), []).append(t)
+    for k in range(len(tris)):
+        groups.setdefault(find(k), []).append(k)
 
     faces: list[list[int]] = []
     for g, members in enumerate(groups.values()):
         half = set()
-        for t in members:
-            a, b, c = tris[t]
+        for k in members:
+            a, b, c = tris[k]
             half.update({(a, b), (b, c), (c, a)})
         boundary = [(x, y) for (x, y) in half if (y, x) not in half]
         nxt: dict[int, int] = {}
         for x, y in boundary:
             if x in nxt:
-                raise ModelError(f"{where}: polygonal face {g} touches itself at vertex {x}")
+                raise ModelError(f"{where}: polygonal face {g} touches itself at vertex {labels[x]}")
             nxt[x] = y
         loops = []
         todo = set(nxt)
@@ -197,7 +358,9 @@ def polyhedron_from_triangles(
             cur = nxt[start]
             while cur != start:
                 if cur not in todo:
-                    raise ModelError(f"{where}: polygonal face {g} has an inconsistent boundary at vertex {cur}")
+                    raise ModelError(
+                        f"{where}: polygonal face {g} has an inconsistent boundary at vertex {labels[cur]}"
+                    )
                 loop.append(cur)
                 todo.discard(cur)
                 cur = nxt[cur]
@@ -216,14 +379,32 @@ def polyhedron_from_triangles(
     faces = [[i for i in f if count[i] > 2] for f in faces]
     used = sorted({i for f in faces for i in f})
     remap = {old: new for new, old in enumerate(used)}
-    return Polyhedron.from_faces(v[used], [[remap[i] for i in f] for f in faces], name=name, source=source)
+    return Polyhedron.from_faces(
+        v[used], [[remap[i] for i in f] for f in faces], name=name, source=source, precision=precision,
+        vertex_labels=[labels[i] for i in used],
+    )  # fmt: skip
 
 
-def _weld(vertices: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Merge vertices closer than the merge tolerance."""
-    key = np.round(vertices / tol.merge).astype(np.int64)
-    _, first, inverse = np.unique(key, axis=0, return_index=True, return_inverse=True)
-    return vertices[first], inverse.reshape(-1)[triangles]
+def _weld(vertices: np.ndarray, triangles: np.ndarray, merge: float) -> tuple[np.ndarray, np.ndarray]:
+    """Weld vertices closer than ``merge`` [m]: the kept input vertex of each point, and the triangles over them."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+
+    n = len(vertices)
+    pairs = cKDTree(vertices).query_pairs(merge, output_type="ndarray")
+    graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n)) if len(pairs) else None
+    if graph is None:
+        labels = np.arange(n)
+    else:
+        _, labels = connected_components(graph, directed=False)
+    # each welded point is represented by its first input vertex, and numbered in that order
+    first = np.full(labels.max() + 1, n)
+    np.minimum.at(first, labels, np.arange(n))
+    order = np.argsort(first)
+    new_id = np.empty_like(order)
+    new_id[order] = np.arange(len(order))
+    return first[order], new_id[labels][triangles]
 
 
 # ----------------------------------------------------------------------------------------------- writing
@@ -303,18 +484,73 @@ def model_files(directory: str | os.PathLike) -> list[Path]:
     return sorted(p for p in d.iterdir() if p.is_file() and p.suffix.lower() in MODEL_SUFFIXES)
 
 
-def load_library(directory: str | os.PathLike | None = None) -> dict[str, Polyhedron]:
-    """Every model of a library directory (default: the shipped ``assets/models``), by name."""
-    files = model_files(directory or DEFAULT_LIBRARY)
+@dataclass(frozen=True)
+class LibraryScan:
+    """What a library directory holds: its valid models and, for each bad file, why it is bad."""
+
+    directory: Path
+    """The library directory."""
+    models: dict[str, Polyhedron]
+    """Every valid model, by name (file stem)."""
+    errors: dict[Path, str]
+    """Every bad model file, with its one-line error message."""
+
+
+_SCANS: dict[tuple, LibraryScan] = {}
+
+
+def scan_library(directory: str | os.PathLike | None = None, progress: bool = False) -> LibraryScan:
+    """Import every model file of a library directory (default: the shipped ``assets/models``), keeping the
+    valid models and the error of each bad file. A bar on stderr shows the import when ``progress`` is set
+    (and stderr is a terminal).
+
+    The scan is remembered per process while no file of the directory changes (models are immutable).
+    """
+    where = Path(directory or DEFAULT_LIBRARY)
+    files = model_files(where)
     if not files:
-        where = directory or DEFAULT_LIBRARY
         raise ModelError(f"{where}: the library holds no model files ({', '.join(MODEL_SUFFIXES)})")
-    out: dict[str, Polyhedron] = {}
-    for f in files:
-        if f.stem in out:
-            raise ModelError(f"{f}: model name {f.stem!r} is used by two files in the library")
-        out[f.stem] = load_model(f)
-    return out
+    stamp = (str(where.resolve()), tuple((f.name, f.stat().st_mtime_ns, f.stat().st_size) for f in files))
+    if stamp in _SCANS:
+        return _SCANS[stamp]
+    models: dict[str, Polyhedron] = {}
+    errors: dict[Path, str] = {}
+    it = files
+    if progress:
+        from tqdm import tqdm
+
+        it = tqdm(files, desc=f"importing {where.name}", unit="file", disable=None, leave=False)
+    for f in it:
+        if f.stem in models:
+            errors[f] = f"{f}: model name {f.stem!r} is used by two files in the library"
+            continue
+        try:
+            models[f.stem] = load_model(f)
+        except ModelError as exc:
+            errors[f] = str(exc)
+    scan = LibraryScan(where, models, errors)
+    _SCANS.clear()  # one library is in use at a time; keep memory flat
+    _SCANS[stamp] = scan
+    return scan
+
+
+def load_library(directory: str | os.PathLike | None = None, skip_invalid: bool = False) -> dict[str, Polyhedron]:
+    """Every model of a library directory (default: the shipped ``assets/models``), by name.
+
+    A library with bad files is refused, naming every bad file and why, unless ``skip_invalid``: then the valid
+    models are returned (and the caller says which files were skipped, from :func:`scan_library`).
+    """
+    scan = scan_library(directory)
+    if scan.errors and not skip_invalid:
+        n = len(scan.errors)
+        raise ModelError(
+            f"{scan.directory}: {n} of {n + len(scan.models)} model files are invalid "
+            f"({'; '.join(scan.errors.values())}); fix or remove them, or pass --skip-invalid to use the "
+            f"{len(scan.models)} valid models"
+        )
+    if not scan.models:
+        raise ModelError(f"{scan.directory}: no valid model in the library ({len(scan.errors)} invalid files)")
+    return dict(scan.models)
 
 
 def resolve_model(spec: str, library: dict[str, Polyhedron] | None = None) -> Polyhedron:

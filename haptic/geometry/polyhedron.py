@@ -18,7 +18,7 @@ from functools import cached_property
 import numpy as np
 
 from haptic.errors import ModelError
-from haptic.geometry.tolerances import tol
+from haptic.geometry.tolerances import Tolerances
 
 
 def _readonly(a: np.ndarray) -> np.ndarray:
@@ -47,6 +47,13 @@ class Polyhedron:
     """Vertex loops, counter-clockwise seen from outside, one per face."""
     source: str | None = None
     """Where the model came from (a file path), for messages."""
+    precision: float = 0.0
+    """How far the source rounded each coordinate: half a unit of its last written digit, 0 for exact data [m]."""
+    vertex_labels: tuple[str, ...] | None = field(default=None, repr=False)
+    """The source file's own number of each vertex (1-based for OBJ), for messages; ``None``: the index here."""
+
+    tolerances: Tolerances = field(init=False, repr=False)
+    """Numerical tolerances of this model, from its size and :attr:`precision`."""
 
     face_normals: np.ndarray = field(init=False, repr=False)
     """Outward unit normals ``n``, shape (F, 3)."""
@@ -67,12 +74,20 @@ class Polyhedron:
 
     @classmethod
     def from_faces(
-        cls, vertices, faces, name: str = "model", source: str | None = None
+        cls,
+        vertices,
+        faces,
+        name: str = "model",
+        source: str | None = None,
+        precision: float = 0.0,
+        vertex_labels=None,
     ) -> Polyhedron:
         """Validate and build a polyhedron from vertex positions [m] and CCW-from-outside face loops.
 
-        Raises :class:`ModelError` naming the model and the offending element when the input is not a closed,
-        connected, consistently outward-oriented 2-manifold with planar, non-degenerate faces.
+        ``precision`` is how far the source rounded each coordinate [m] (the tolerances follow it);
+        ``vertex_labels`` the source's own vertex numbers, for messages. Raises :class:`ModelError` naming the
+        model and the offending element when the input is not a closed, connected, consistently
+        outward-oriented 2-manifold with planar, non-degenerate faces that do not cross each other.
         """
         where = source or name
         try:
@@ -84,12 +99,20 @@ class Polyhedron:
         bad = np.flatnonzero(~np.isfinite(v).all(axis=1))
         if len(bad):
             raise ModelError(f"{where}: vertex {bad[0]} has a non-finite coordinate {v[bad[0]].tolist()}")
+        labels = None if vertex_labels is None else tuple(str(x) for x in vertex_labels)
         loops: list[tuple[int, ...]] = []
         for fi, f in enumerate(faces):
             try:
-                loop = tuple(int(i) for i in f)
-            except (TypeError, ValueError):
+                items = list(f)
+            except TypeError:
                 raise ModelError(f"{where}: face {fi} is not a list of vertex indices: {f!r}") from None
+            for i in items:
+                if isinstance(i, bool) or not isinstance(i, int | np.integer):
+                    raise ModelError(
+                        f"{where}: face {fi} has vertex index {i!r}, which is not an integer "
+                        f"(valid: whole numbers 0..{len(v) - 1})"
+                    )
+            loop = tuple(int(i) for i in items)
             if len(loop) < 3:
                 raise ModelError(f"{where}: face {fi} has {len(loop)} vertices; a face needs at least 3")
             if len(set(loop)) != len(loop):
@@ -99,19 +122,31 @@ class Polyhedron:
             loops.append(loop)
         if len(loops) < 4:
             raise ModelError(f"{where}: a closed polyhedron needs at least 4 faces, got {len(loops)}")
-        poly = cls(name=name, vertices=_readonly(v), faces=tuple(loops), source=source)
-        return poly
+        return cls(
+            name=name, vertices=_readonly(v), faces=tuple(loops), source=source, precision=float(precision),
+            vertex_labels=labels,
+        )  # fmt: skip
+
+    def vertex_label(self, i: int) -> str:
+        """How messages name vertex ``i``: by the source file's own number when known."""
+        return self.vertex_labels[i] if self.vertex_labels is not None else str(i)
 
     def __post_init__(self) -> None:
         where = self.source or self.name
         v = self.vertices
         set_ = object.__setattr__
+        t = Tolerances.for_model(float(np.linalg.norm(np.ptp(v, axis=0))), self.precision)
+        set_(self, "tolerances", t)
+        lab = self.vertex_label
 
         seen: dict[frozenset, int] = {}
         for fi, loop in enumerate(self.faces):
             key = frozenset(loop)
             if key in seen:
-                raise ModelError(f"{where}: faces {seen[key]} and {fi} are duplicates (same vertices {sorted(key)})")
+                raise ModelError(
+                    f"{where}: faces {seen[key]} and {fi} are duplicates (same vertices "
+                    f"{[lab(i) for i in sorted(key)]})"
+                )
             seen[key] = fi
 
         # edges and their left/right faces from the directed half-edges
@@ -119,8 +154,11 @@ class Polyhedron:
         for fi, loop in enumerate(self.faces):
             for k, a in enumerate(loop):
                 b = loop[(k + 1) % len(loop)]
-                if np.linalg.norm(v[a] - v[b]) < tol.merge:
-                    raise ModelError(f"{where}: face {fi} has a zero-length edge between vertices {a} and {b}")
+                if np.linalg.norm(v[a] - v[b]) < t.merge:
+                    raise ModelError(
+                        f"{where}: face {fi} has a zero-length edge: vertices {lab(a)} and {lab(b)} are the same "
+                        f"point (closer than {t.merge * 1e3:.3g} mm)"
+                    )
                 if (a, b) in half:
                     other = half[(a, b)]
                     undirected = sum(
@@ -131,11 +169,11 @@ class Polyhedron:
                     )
                     if undirected > 2:
                         raise ModelError(
-                            f"{where}: edge {a}-{b} is non-manifold: {undirected} faces meet on it (a closed "
+                            f"{where}: edge {lab(a)}-{lab(b)} is non-manifold: {undirected} faces meet on it (a closed "
                             "2-manifold has exactly 2)"
                         )
                     raise ModelError(
-                        f"{where}: faces {other} and {fi} both run edge {a}->{b} in the same direction: "
+                        f"{where}: faces {other} and {fi} both run edge {lab(a)}->{lab(b)} in the same direction: "
                         "inconsistent face orientation (loops must all be counter-clockwise seen from outside)"
                     )
                 half[(a, b)] = fi
@@ -143,7 +181,8 @@ class Polyhedron:
         for (a, b), fi in half.items():
             if (b, a) not in half:
                 raise ModelError(
-                    f"{where}: edge {a}-{b} of face {fi} has no second face: the surface is open (not watertight)"
+                    f"{where}: edge {lab(a)}-{lab(b)} of face {fi} has no second face: the surface is open "
+                    "(not watertight)"
                 )
             if a < b:
                 index[(a, b)] = len(edges)
@@ -158,27 +197,38 @@ class Polyhedron:
         for loop in self.faces:
             used[list(loop)] = True
         if not used.all():
-            raise ModelError(f"{where}: vertex {int(np.flatnonzero(~used)[0])} is used by no face")
+            raise ModelError(f"{where}: vertex {lab(int(np.flatnonzero(~used)[0]))} is used by no face")
 
         # plane of each face, planarity and area
-        normals, offsets, areas = [], [], []
-        for fi, loop in enumerate(self.faces):
-            pts = v[list(loop)]
-            nn = newell_normal(pts)
-            area = 0.5 * np.linalg.norm(nn)
-            if area < tol.area:
-                raise ModelError(f"{where}: face {fi} has zero area (vertices {list(loop)})")
-            n = nn / np.linalg.norm(nn)
-            d = float(np.mean(pts @ n))
-            dev = np.abs(pts @ n - d).max()
-            if dev > tol.planar:
-                raise ModelError(
-                    f"{where}: face {fi} is not planar: vertex off its plane by {dev * 1e3:.4g} mm "
-                    f"(tolerance {tol.planar * 1e3:g} mm)"
-                )
-            normals.append(n)
-            offsets.append(d)
-            areas.append(area)
+        # all faces at once: Newell sums and plane offsets accumulate in loop order
+        sizes = np.array([len(loop) for loop in self.faces])
+        flat = np.concatenate([np.asarray(loop) for loop in self.faces])
+        nxt = np.concatenate([np.roll(np.asarray(loop), -1) for loop in self.faces])
+        owner = np.repeat(np.arange(len(self.faces)), sizes)
+        nn = np.zeros((len(self.faces), 3))
+        np.add.at(nn, owner, np.cross(v[flat], v[nxt]))
+        norm = np.linalg.norm(nn, axis=1)
+        small = np.flatnonzero(0.5 * norm < t.area)
+        if len(small):
+            fi = int(small[0])
+            raise ModelError(f"{where}: face {fi} has zero area (vertices {[lab(i) for i in self.faces[fi]]})")
+        normals = nn / norm[:, None]
+        along = np.einsum("ij,ij->i", v[flat], normals[owner])
+        offsets = np.zeros(len(self.faces))
+        np.add.at(offsets, owner, along)
+        offsets /= sizes
+        off = np.abs(along - offsets[owner])
+        dev = np.zeros(len(self.faces))
+        np.maximum.at(dev, owner, off)
+        bad = np.flatnonzero(dev > t.planar)
+        if len(bad):
+            fi = int(bad[0])
+            worst = int(flat[owner == fi][int(np.argmax(off[owner == fi]))])
+            raise ModelError(
+                f"{where}: face {fi} is not planar: vertex {lab(worst)} is off its plane by {dev[fi] * 1e3:.4g} mm "
+                f"(tolerance {t.planar * 1e3:.3g} mm at this model's size and precision)"
+            )
+        areas = 0.5 * norm
 
         set_(self, "face_normals", _readonly(np.array(normals)))
         set_(self, "face_offsets", _readonly(np.array(offsets)))
@@ -190,10 +240,10 @@ class Polyhedron:
 
         # coplanar neighbours would be an edge no finger can feel
         for e, (fl, fr) in enumerate(zip(left, right, strict=True)):
-            if np.dot(normals[fl], normals[fr]) > np.cos(tol.angle) and abs(offsets[fl] - offsets[fr]) < tol.planar:
+            if _coplanar(v, self.faces[fl], normals[fl], offsets[fl], self.faces[fr], normals[fr], offsets[fr], t):
                 raise ModelError(
-                    f"{where}: faces {fl} and {fr} are coplanar and share edge {edges[e][0]}-{edges[e][1]}: "
-                    "merge them into one face"
+                    f"{where}: faces {fl} and {fr} are coplanar and share edge {lab(edges[e][0])}-{lab(edges[e][1])} "
+                    f"(within {t.planar * 1e3:.3g} mm of one plane): merge them into one face"
                 )
 
         # each vertex's faces must form a single fan (no pinched vertices)
@@ -214,7 +264,7 @@ class Polyhedron:
                     break
             if count != len(ring):
                 raise ModelError(
-                    f"{where}: vertex {a} is non-manifold: its faces form more than one fan (a pinch point)"
+                    f"{where}: vertex {lab(a)} is non-manifold: its faces form more than one fan (a pinch point)"
                 )
 
         # connectivity over faces
@@ -240,6 +290,14 @@ class Polyhedron:
             raise ModelError(
                 f"{where}: the faces are oriented inward (signed volume {self.volume:.4g} m^3); loops must be "
                 "counter-clockwise seen from outside"
+            )
+        crossing = self_intersection(self)
+        if crossing is not None:
+            fa, fb = crossing
+            raise ModelError(
+                f"{where}: the surface intersects itself: faces {fa} (vertices {[lab(i) for i in self.faces[fa]]}) "
+                f"and {fb} (vertices {[lab(i) for i in self.faces[fb]]}) cross; a solid's faces meet only along "
+                "shared edges"
             )
 
     # ------------------------------------------------------------------------------------------ counts
@@ -403,13 +461,19 @@ class Polyhedron:
     def transformed(self, rotation: np.ndarray, translation: np.ndarray, name: str | None = None) -> Polyhedron:
         """The same solid with vertices mapped by ``w' = R w + t`` (R a proper rotation)."""
         v = self.vertices @ np.asarray(rotation).T + np.asarray(translation)
-        return Polyhedron.from_faces(v, self.faces, name=name or self.name, source=self.source)
+        return Polyhedron.from_faces(
+            v, self.faces, name=name or self.name, source=self.source, precision=self.precision,
+            vertex_labels=self.vertex_labels,
+        )  # fmt: skip
 
     def mirrored(self, name: str | None = None) -> Polyhedron:
         """The mirror image through the x = 0 plane (face loops reversed to stay outward)."""
         v = self.vertices * np.array([-1.0, 1.0, 1.0])
         faces = [tuple(reversed(loop)) for loop in self.faces]
-        return Polyhedron.from_faces(v, faces, name=name or f"{self.name}_mirror", source=self.source)
+        return Polyhedron.from_faces(
+            v, faces, name=name or f"{self.name}_mirror", source=self.source, precision=self.precision,
+            vertex_labels=self.vertex_labels,
+        )  # fmt: skip
 
     def to_trimesh(self):
         """A triangulated :class:`trimesh.Trimesh` with outward winding (for export and simulation)."""
@@ -417,8 +481,8 @@ class Polyhedron:
 
         return trimesh.Trimesh(vertices=np.array(self.vertices), faces=np.array(self.triangles), process=False)
 
-    def summary(self) -> dict:
-        """Counts and properties for listings."""
+    def summary(self, symmetry: list | None = None) -> dict:
+        """Counts and properties for listings (``symmetry``: the group when already found)."""
         from haptic.geometry.symmetry import symmetry_group
 
         return {
@@ -429,7 +493,7 @@ class Polyhedron:
             "euler": self.euler_characteristic,
             "genus": self.genus,
             "convex": self.is_convex,
-            "symmetry": len(symmetry_group(self)),
+            "symmetry": len(symmetry if symmetry is not None else symmetry_group(self)),
             "extents_mm": [round(float(x) * 1e3, 2) for x in self.extents],
             "volume_cm3": round(self.volume * 1e6, 3),
         }
@@ -438,8 +502,16 @@ class Polyhedron:
         return f"Polyhedron({self.name!r}, V={self.n_vertices}, E={self.n_edges}, F={self.n_faces})"
 
 
-def triangulate_polygon(vertices: np.ndarray, loop: tuple[int, ...], normal: np.ndarray) -> list[tuple[int, int, int]]:
-    """Ear-clip a simple planar polygon (CCW about ``normal``) into triangles of vertex ids."""
+def triangulate_polygon(
+    vertices: np.ndarray, loop: tuple[int, ...], normal: np.ndarray, min_area: float = 5e-19
+) -> list[tuple[int, int, int]]:
+    """Ear-clip a simple planar polygon (CCW about ``normal``) into triangles of vertex ids.
+
+    Corners whose triangle has less than ``min_area`` [m^2] count as straight (never clipped): with rounded
+    coordinates, pass the model's area tolerance so that no sliver ear is cut.
+    """
+    if len(loop) == 3:
+        return [(loop[0], loop[1], loop[2])]
     from haptic.geometry.se3 import plane_basis
 
     u, w = plane_basis(normal)
@@ -457,7 +529,7 @@ def triangulate_polygon(vertices: np.ndarray, loop: tuple[int, ...], normal: np.
         for k in range(m):
             i0, i1, i2 = idx[k - 1], idx[k], idx[(k + 1) % m]
             a, b, c = pts[i0], pts[i1], pts[i2]
-            if cross2(a, b, c) <= 1e-18:
+            if cross2(a, b, c) <= 2 * min_area:
                 continue  # reflex or collinear corner
             inside = False
             for j in idx:
@@ -475,3 +547,75 @@ def triangulate_polygon(vertices: np.ndarray, loop: tuple[int, ...], normal: np.
             raise ModelError(f"face loop {list(loop)} is self-intersecting or not simple: cannot triangulate")
     out.append((idx[0], idx[1], idx[2]))
     return out
+
+
+def _coplanar(v: np.ndarray, loop_a, n_a, d_a, loop_b, n_b, d_b, t: Tolerances) -> bool:
+    """True when two faces lie in one plane as far as the model's precision can tell.
+
+    Either their planes agree (normals within ``t.angle``, offsets within ``t.planar``), or each face's
+    vertices lie within ``t.planar`` of the other's plane: a bend no larger than the rounding of the
+    coordinates can explain.
+    """
+    cos = float(np.dot(n_a, n_b))
+    if cos > np.cos(t.angle) and abs(d_a - d_b) < t.planar:
+        return True
+    if cos <= 0:
+        return False
+    return bool(
+        np.abs(v[list(loop_b)] @ n_a - d_a).max() <= t.planar and np.abs(v[list(loop_a)] @ n_b - d_b).max() <= t.planar
+    )
+
+
+def self_intersection(poly: Polyhedron) -> tuple[int, int] | None:
+    """Two faces that cross each other (an edge of one passes through the inside of the other), or ``None``.
+
+    Triangles of different faces whose bounding boxes overlap and that share no edge are tested: an edge of
+    either must not pass through the other's interior by more than the planar tolerance.
+    """
+    tris = poly.triangles
+    if len(tris) == 0:
+        return None
+    faces = poly.triangle_faces
+    eps = poly.tolerances.planar
+    p = poly.vertices[tris]  # (T, 3, 3)
+    lo, hi = p.min(axis=1) - eps, p.max(axis=1) + eps
+    # sweep along x: each triangle against those starting (in x) before it ends
+    order = np.argsort(lo[:, 0], kind="stable")
+    lo, hi, p, tris, faces = lo[order], hi[order], p[order], tris[order], faces[order]
+    stop = np.searchsorted(lo[:, 0], hi[:, 0], side="right")
+    count = np.maximum(stop - np.arange(len(tris)) - 1, 0)
+    i = np.repeat(np.arange(len(tris)), count)
+    j = i + 1 + (np.arange(len(i)) - np.repeat(np.cumsum(count) - count, count))
+    ok = (lo[i, 1:] <= hi[j, 1:]).all(axis=1) & (hi[i, 1:] >= lo[j, 1:]).all(axis=1) & (faces[i] != faces[j])
+    i, j = i[ok], j[ok]
+    if len(i) == 0:
+        return None
+    shared = (tris[i][:, :, None] == tris[j][:, None, :]).sum(axis=(1, 2))
+    keep = shared < 2
+    i, j = i[keep], j[keep]
+    hit = np.zeros(len(i), dtype=bool)
+    for a, b in ((i, j), (j, i)):
+        for k in range(3):
+            hit |= _segment_crosses(p[a, k], p[a, (k + 1) % 3], p[b], eps)
+    if not hit.any():
+        return None
+    first = int(np.flatnonzero(hit)[0])
+    fa, fb = sorted((int(faces[i[first]]), int(faces[j[first]])))
+    return fa, fb
+
+
+def _segment_crosses(s0: np.ndarray, s1: np.ndarray, tri: np.ndarray, eps: float) -> np.ndarray:
+    """Per row: does segment ``s0→s1`` pass through the interior of triangle ``tri`` (rows of 3 points)?"""
+    a, b, c = tri[:, 0], tri[:, 1], tri[:, 2]
+    nn = np.cross(b - a, c - a)
+    nn /= np.maximum(np.linalg.norm(nn, axis=1), 1e-300)[:, None]
+    h0 = np.einsum("ij,ij->i", s0 - a, nn)
+    h1 = np.einsum("ij,ij->i", s1 - a, nn)
+    crosses = ((h0 > eps) & (h1 < -eps)) | ((h0 < -eps) & (h1 > eps))
+    x = s0 + (h0 / np.where(crosses, h0 - h1, 1.0))[:, None] * (s1 - s0)
+    inside = crosses
+    for u, w in ((a, b), (b, c), (c, a)):
+        edge = w - u
+        side = np.einsum("ij,ij->i", np.cross(edge, x - u), nn) / np.maximum(np.linalg.norm(edge, axis=1), 1e-300)
+        inside &= side > eps
+    return inside

@@ -71,11 +71,16 @@ def trace_face(
         return None
     d /= norm
     start = np.asarray(start, dtype=float)
+    # the start and the face's corners on its plane: a model read from a rounded file has its corners off the
+    # plane by up to its precision, and a point stepped over from a neighbouring face is off by as much
+    start = start - (start @ n - poly.face_offsets[face]) * n
     best = None
     loop = poly.faces[face]
+    off = poly.vertices[list(loop)] @ n - poly.face_offsets[face]
+    corners = poly.vertices[list(loop)] - off[:, None] * n
     for k, e in enumerate(poly.face_edges[face]):
-        a = poly.vertices[loop[k]]
-        b = poly.vertices[loop[(k + 1) % len(loop)]]
+        a = corners[k]
+        b = corners[(k + 1) % len(loop)]
         seg = b - a
         # solve start + t d = a + u seg in the plane (least squares in 3-D, exact when coplanar)
         m = np.column_stack([d, -seg])

@@ -119,11 +119,12 @@ class LibraryArrays:
             for f, loop in enumerate(m.faces):
                 fv[f + fo[i], np.asarray(loop) + vo[i]] = True
         fe = side != 0
-        ff = (fe.astype(np.int64) @ fe.T.astype(np.int64)) > 0
+        # incidence products in float32 (BLAS; counts this small are exact): integer matmul is far slower
+        ff = (fe.astype(np.float32) @ fe.T.astype(np.float32)) > 0
         np.fill_diagonal(ff, False)
-        ee = (ev.astype(np.int64) @ ev.T.astype(np.int64)) > 0
+        ee = (ev.astype(np.float32) @ ev.T.astype(np.float32)) > 0
         np.fill_diagonal(ee, False)
-        vv = (ev.T.astype(np.int64) @ ev.astype(np.int64)) > 0
+        vv = (ev.T.astype(np.float32) @ ev.astype(np.float32)) > 0
         np.fill_diagonal(vv, False)
         adjacency = {
             (0, 0): ff, (0, 1): fe, (0, 2): fv,
