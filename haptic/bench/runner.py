@@ -245,17 +245,19 @@ def ray_available() -> bool:
     return True
 
 
-def _run_ray(payload: list[dict], workers: int) -> Iterator[dict]:
-    """Episodes as Ray tasks: on the cluster named by ``RAY_ADDRESS``, else on a Ray started here with
-    ``workers`` CPUs (and shut down at the end). A task whose worker dies is retried by Ray."""
-    if not ray_available():
-        raise BenchError("--backend ray needs Ray: pip install -e '.[ray]' (or use --backend local)")
+def start_ray(workers: int) -> bool:
+    """Join the Ray cluster named by ``RAY_ADDRESS``, else start one on this machine with ``workers`` CPUs,
+    no dashboard and small memory limits (it starts in seconds). Returns False when Ray was already running
+    in this process (nothing to shut down)."""
     import ray
 
-    started = False
-    if not ray.is_initialized():
-        address = os.environ.get("RAY_ADDRESS")
-        common = {"log_to_driver": False, "configure_logging": False}
+    if ray.is_initialized():
+        return False
+    common = {"log_to_driver": False, "configure_logging": False}
+    address = os.environ.get("RAY_ADDRESS")
+    main_thread = threading.current_thread() is threading.main_thread()
+    on_sigterm = signal.getsignal(signal.SIGTERM) if main_thread else None
+    try:
         if address:
             ray.init(address=address, **common)
         else:
@@ -263,7 +265,23 @@ def _run_ray(payload: list[dict], workers: int) -> Iterator[dict]:
                 num_cpus=workers, include_dashboard=False, object_store_memory=RAY_OBJECT_STORE_BYTES,
                 _memory=RAY_MEMORY_BYTES, **common,
             )
-        started = True
+    except (ConnectionError, RuntimeError, ValueError) as exc:
+        where = f"the Ray cluster at RAY_ADDRESS={address}" if address else "a Ray on this machine"
+        raise BenchError(f"cannot start or join {where}: {exc}") from None
+    finally:
+        if on_sigterm is not None:  # ray.init takes SIGTERM over; the caller's handler stops Ray just as well
+            signal.signal(signal.SIGTERM, on_sigterm)
+    return True
+
+
+def _run_ray(payload: list[dict], workers: int) -> Iterator[dict]:
+    """Episodes as Ray tasks (see :func:`start_ray`); a Ray started here is shut down at the end. A task
+    whose worker dies is retried by Ray; each record is yielded once, as its task ends."""
+    if not ray_available():
+        raise BenchError("--backend ray needs Ray: pip install -e '.[ray]' (or use --backend local)")
+    import ray
+
+    started = start_ray(workers)
     pending: dict = {}
     try:
         remote = ray.remote(num_cpus=1, max_retries=RAY_TASK_RETRIES)(_run)
