@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import signal
 import tempfile
 from pathlib import Path
 
@@ -98,3 +99,39 @@ def check_output_dir(path: str | os.PathLike, option: str, hint: str, error=Hapt
     os.close(fd)
     os.unlink(tmp)
     return p
+
+
+class DeferredInterrupts:
+    """Hold SIGINT and SIGTERM in this thread until :meth:`release` (or the end of the ``with`` block), where a
+    pending one takes effect (KeyboardInterrupt, or the SIGTERM handler then in place).
+
+    Some libraries catch ``BaseException`` around optional imports, which would swallow a Ctrl-C arriving
+    while they load; holding the signals over start-up makes an early interrupt end the command as a later one
+    does.
+    """
+
+    SIGNALS = frozenset({signal.SIGINT, signal.SIGTERM})
+
+    def __init__(self) -> None:
+        self._previous: set | None = None
+
+    def __enter__(self) -> DeferredInterrupts:
+        self._previous = signal.pthread_sigmask(signal.SIG_BLOCK, self.SIGNALS)
+        return self
+
+    def release(self) -> None:
+        if self._previous is not None:
+            previous, self._previous = self._previous, None
+            signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+
+    def __exit__(self, *exc) -> None:
+        self.release()
+
+
+class Terminated(BaseException):
+    """SIGTERM, raised in the main thread as KeyboardInterrupt is for SIGINT (see :func:`raise_terminated`)."""
+
+
+def raise_terminated(signum, frame) -> None:
+    """A SIGTERM handler: raise :class:`Terminated`, so that ``finally`` blocks run and the command exits 143."""
+    raise Terminated()

@@ -26,6 +26,9 @@ import numpy as np
 from haptic.bench.results import read_results
 from haptic.bench.runner import key_id
 
+EXPECTED_EXIT = {"SIGINT": (130, -2), "SIGTERM": (143, -15), "SIGKILL": (-9,)}
+"""Exit codes of a killed sweep: 130 / 143 once the command runs (the summary written once the sweep has
+begun), the signal's own (negative) while Python starts; SIGKILL is never handled."""
 CASES = [(sig, to) for sig in ("SIGINT", "SIGTERM", "SIGKILL") for to in ("process", "group")]
 TIMINGS = ("wall_time_s", "decision_times_s")
 """Record fields that measure time and so differ between runs."""
@@ -68,6 +71,12 @@ def by_key(path: Path) -> tuple[dict[str, dict], int]:
     return {key_id(r["key"]): {k: v for k, v in r.items() if k not in TIMINGS} for r in records}, len(records)
 
 
+def _episodes_in(summary: Path) -> int:
+    """Episodes counted by a summary table (the column after the group keys)."""
+    rows = [line.split("|") for line in summary.read_text().splitlines()[2:] if line.startswith("|")]
+    return sum(int(r[5]) for r in rows)
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--runs", type=int, default=20)
@@ -91,9 +100,9 @@ def main(argv: list[str] | None = None) -> int:
     print(f"reference: {len(reference)} episodes in {ref_wall:.1f} s (start-up included); "
           f"kills at a random moment in [0.3, {1.1 * ref_wall:.1f}] s")
     print()
-    print("| run | signal | to | at [s] | exit | lines kept | left over | group gone [s] | resumed ran | lost | "
-          "duplicated | differ |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    print("| run | signal | to | at [s] | exit | lines kept | summary | left over | group gone [s] | resumed ran | "
+          "lost | duplicated | differ |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     cases = [CASES[i] for i in rng.permutation(len(CASES))]
     bad = 0
     totals = {"lost": 0, "duplicated": 0, "differ": 0, "left": 0}
@@ -101,7 +110,8 @@ def main(argv: list[str] | None = None) -> int:
         sig_name, to = cases[run % len(cases)]
         sig = getattr(signal, sig_name)
         out = work / f"run{run:02d}.jsonl"
-        out.unlink(missing_ok=True)
+        for stale in (out, out.with_suffix(".md")):
+            stale.unlink(missing_ok=True)
         at = float(rng.uniform(0.3, 1.1 * ref_wall))
         proc = subprocess.Popen(bench_command(args, out), env=env, start_new_session=True,
                                 stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)  # fmt: skip
@@ -115,6 +125,10 @@ def main(argv: list[str] | None = None) -> int:
         for pid in live_in_group(proc.pid):  # leave nothing behind, whatever the result
             os.kill(pid, signal.SIGKILL)
         _, kept = by_key(out)
+        summary = out.with_suffix(".md")
+        summed = summary.exists()
+        summary_ok = code not in (130, 143) or kept == (_episodes_in(summary) if summed else 0)
+        exit_ok = code in EXPECTED_EXIT[sig_name] or at != at  # an early end is checked by the resume alone
         resumed = subprocess.Popen(bench_command(args, out, "--resume"), env=env, start_new_session=True,
                                    stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)  # fmt: skip
         stdout, _ = resumed.communicate(timeout=600)
@@ -129,9 +143,9 @@ def main(argv: list[str] | None = None) -> int:
         totals["duplicated"] += duplicated
         totals["differ"] += differ
         totals["left"] += left
-        bad += bool(lost or duplicated or differ or left or resumed.returncode != 0)
-        print(f"| {run + 1} | {sig_name} | {to} | {at:.2f} | {code} | {kept} | {left} | {gone_s:.2f} | {ran} | "
-              f"{lost} | {duplicated} | {differ} |")
+        bad += bool(lost or duplicated or differ or left or resumed.returncode != 0 or not exit_ok or not summary_ok)
+        print(f"| {run + 1} | {sig_name} | {to} | {at:.2f} | {code} | {kept} | {'yes' if summed else '-'} | {left} | "
+              f"{gone_s:.2f} | {ran} | {lost} | {duplicated} | {differ} |")
     print()
     print(f"{args.runs} runs of {len(reference)} episodes: {totals['lost']} lost, {totals['duplicated']} duplicated, "
           f"{totals['differ']} differing from the uninterrupted run, {totals['left']} processes left over; "

@@ -9,13 +9,10 @@ import time
 from pathlib import Path
 
 from haptic.errors import BenchError, HapticError
+from haptic.options import DeferredInterrupts, Terminated, raise_terminated
 
 EXIT_SIGINT, EXIT_SIGTERM = 130, 143
 """Exit codes of a sweep ended by SIGINT (Ctrl-C) or SIGTERM: 128 + the signal's number."""
-
-
-class _Terminated(BaseException):
-    """SIGTERM, raised in the main thread like KeyboardInterrupt is for SIGINT."""
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -55,6 +52,11 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    with DeferredInterrupts() as held:  # an interrupt during start-up (imports, library) ends it as in the sweep
+        return _run(args, held)
+
+
+def _run(args: argparse.Namespace, held: DeferredInterrupts) -> int:
     from haptic.bench.results import ResultsWriter, drop_partial_line, iter_results
     from haptic.bench.runner import episode_key, key_id, library_name, plan_sweep, ray_available
     from haptic.geometry import load_library
@@ -78,14 +80,14 @@ def run(args: argparse.Namespace) -> int:
         sorted(library), args.episodes, args.seed, policies, args.noise,
         executor=args.executor, models=args.models, max_moves=args.max_moves,
     )
-    held = out.is_file() and out.stat().st_size > 0
-    if held and not (args.resume or args.force):
+    has_results = out.is_file() and out.stat().st_size > 0
+    if has_results and not (args.resume or args.force):
         raise BenchError(
             f"{out}: already holds results; --resume runs only the episodes of this sweep not in it yet, "
             "--force starts it over"
         )
     done: set[str] = set()
-    if held and args.resume:
+    if has_results and args.resume:
         if drop_partial_line(out):
             print(f"{out}: dropped an unfinished last line", file=sys.stderr)
         for n, rec in enumerate(iter_results(out), 1):
@@ -99,15 +101,16 @@ def run(args: argparse.Namespace) -> int:
     for path in (out.with_suffix(".md"), out.with_suffix(".png")):
         path.unlink(missing_ok=True)  # a summary never describes other results than the file's
 
-    previous = signal.signal(signal.SIGTERM, _raise_terminated)
+    previous = signal.getsignal(signal.SIGINT), signal.signal(signal.SIGTERM, raise_terminated)
     code, failure = 0, None
     t0 = time.perf_counter()
     with ResultsWriter(out, overwrite=args.force) as writer:
         try:
+            held.release()  # an interrupt held over start-up takes effect here
             _sweep(todo, args, writer)
         except KeyboardInterrupt:
             code = EXIT_SIGINT
-        except _Terminated:
+        except Terminated:
             code = EXIT_SIGTERM
         except BenchError as exc:
             failure = exc
@@ -124,8 +127,8 @@ def run(args: argparse.Namespace) -> int:
             raise failure
         _write_summary(out, lib_name, args.no_plot)
     finally:
-        signal.signal(signal.SIGINT, signal.default_int_handler)
-        signal.signal(signal.SIGTERM, previous)
+        signal.signal(signal.SIGINT, previous[0])
+        signal.signal(signal.SIGTERM, previous[1])
     if code:
         print(f"haptic: interrupted after {writer.written} episodes of {len(todo)}; every finished one is in {out} "
               "(run again with --resume to finish)", file=sys.stderr)
@@ -133,10 +136,6 @@ def run(args: argparse.Namespace) -> int:
     rate = f" ({60 * writer.written / wall:.0f} episodes/min)" if writer.written and wall > 0 else ""
     print(f"{writer.written} episodes in {wall:.1f} s{rate}; results: {out}")
     return 0
-
-
-def _raise_terminated(signum, frame) -> None:
-    raise _Terminated()
 
 
 def _sweep(specs, args: argparse.Namespace, writer) -> None:
