@@ -3,15 +3,23 @@ PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed-stamp
+RAY_STAMP := $(VENV)/.ray-stamp
 export MUJOCO_GL ?= disable
 
-.PHONY: demo test bench bench-ci lint models clean
+.PHONY: demo test bench bench-ci lint models ray clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e '.[dev]'
 	touch $(STAMP)
+
+# The Ray extra (haptic bench --backend ray), pinned in pyproject.toml; CI installs it.
+$(RAY_STAMP): $(STAMP) pyproject.toml
+	$(BIN)/python -m pip install --quiet -e '.[dev,ray]'
+	touch $(RAY_STAMP)
+
+ray: $(RAY_STAMP)
 
 demo: $(STAMP)
 	$(BIN)/haptic models list
