@@ -30,12 +30,12 @@ test: $(STAMP)
 	$(BIN)/python -m pytest -n 2 -p no:cacheprovider
 
 bench: $(STAMP)
-	$(BIN)/haptic bench --episodes 200 --policy planner,greedy,random --seed 1 --workers 2 --out out/bench/seed.jsonl
+	$(BIN)/haptic bench --episodes 200 --policy planner,greedy,random --seed 1 --workers 2 --force --out out/bench/seed.jsonl
 	$(BIN)/haptic bench --models assets/libraries/lookalike --episodes 200 --policy planner,greedy,random --seed 1 \
-		--workers 2 --out out/bench/lookalike.jsonl
+		--workers 2 --force --out out/bench/lookalike.jsonl
 
 bench-ci: $(STAMP)
-	$(BIN)/haptic bench --episodes 40 --policy planner,random --seed 1 --workers 2 --no-plot --out out/ci/seed.jsonl
+	$(BIN)/haptic bench --episodes 40 --policy planner,random --seed 1 --workers 2 --no-plot --force --out out/ci/seed.jsonl
 
 lint: $(STAMP)
 	$(BIN)/ruff check haptic tests scripts

@@ -74,3 +74,36 @@ def test_ray_resumes_a_local_sweep_with_the_same_records_and_leaves_no_process(t
         for pid in processes_with_env(f"RAY_TMPDIR={ray_tmp}".encode()):
             os.kill(pid, 9)
         shutil.rmtree(ray_tmp, ignore_errors=True)
+
+
+@pytest.mark.skipif(not Path("/proc/self/environ").exists(), reason="needs /proc to find Ray's processes")
+def test_sigterm_during_a_ray_sweep_keeps_the_lines_and_stops_ray(tmp_path):
+    import signal
+
+    out = tmp_path / "r.jsonl"
+    ray_tmp = tempfile.mkdtemp(prefix="hr", dir="/tmp")
+    env = {**os.environ, "RAY_TMPDIR": ray_tmp, "MUJOCO_GL": "disable"}
+    env.pop("RAY_ADDRESS", None)
+    cmd = [sys.executable, "-m", "haptic.cli", "bench", "--backend", "ray", "--workers", "2", "--episodes", "30",
+           "--policy", "planner", "--no-plot", "--out", str(out)]  # fmt: skip
+    try:
+        proc = subprocess.Popen(cmd, env=env, start_new_session=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                text=True)  # fmt: skip
+        deadline = time.monotonic() + 240
+        while (not out.exists() or out.stat().st_size == 0) and time.monotonic() < deadline:
+            time.sleep(0.1)
+        os.killpg(proc.pid, signal.SIGTERM)
+        _, err = proc.communicate(timeout=120)
+        assert proc.returncode == 143, err
+        assert "internal error" not in err and "--resume" in err
+        records = read_results(out)
+        assert 1 <= len(records) < 30 and len({key_id(r["key"]) for r in records}) == len(records)
+        assert f"| planner | {len(records)} |" in out.with_suffix(".md").read_text()
+        deadline = time.monotonic() + 20
+        while (left := processes_with_env(f"RAY_TMPDIR={ray_tmp}".encode())) and time.monotonic() < deadline:
+            time.sleep(0.2)
+        assert not left, f"Ray processes left: {left}"
+    finally:
+        for pid in processes_with_env(f"RAY_TMPDIR={ray_tmp}".encode()):
+            os.kill(pid, 9)
+        shutil.rmtree(ray_tmp, ignore_errors=True)
