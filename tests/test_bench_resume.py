@@ -10,6 +10,8 @@ import sys
 import time
 from pathlib import Path
 
+import pytest
+
 from haptic.bench.results import read_results
 from haptic.bench.runner import EpisodeSpec, episode_key, key_id
 from haptic.cli import main
@@ -123,3 +125,21 @@ def _live_in_group(pgid: int) -> list[int]:
     finally:
         sys.path.pop(0)
     return live_in_group(pgid)
+
+
+@pytest.mark.skipif(not Path("/proc/self/task").exists(), reason="finds the workers in /proc")
+def test_an_episode_whose_worker_dies_is_run_again(tmp_path):
+    """SIGKILL of a local worker: its episodes go to a new worker; each episode is written once."""
+    out = tmp_path / "r.jsonl"
+    cmd = [sys.executable, "-m", "haptic.cli", "bench", "--episodes", "6", "--policy", "planner", "--workers", "2",
+           "--no-plot", "--out", str(out)]  # fmt: skip
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120
+    while (not out.exists() or out.stat().st_size == 0) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    workers = [int(pid) for pid in Path(f"/proc/{proc.pid}/task/{proc.pid}/children").read_text().split()]
+    os.kill(workers[0], signal.SIGKILL)
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 0, err
+    records = read_results(out)
+    assert len(records) == 6 and len({key_id(r["key"]) for r in records}) == 6

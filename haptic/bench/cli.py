@@ -58,7 +58,7 @@ def run(args: argparse.Namespace) -> int:
 
 def _run(args: argparse.Namespace, held: DeferredInterrupts) -> int:
     from haptic.bench.results import ResultsWriter, drop_partial_line, iter_results
-    from haptic.bench.runner import episode_key, key_id, library_name, plan_sweep, ray_available
+    from haptic.bench.runner import episode_key, key_id, plan_sweep, ray_available
     from haptic.geometry import load_library
     from haptic.options import check_output_file
     from haptic.planning.policies import POLICY_NAMES
@@ -75,7 +75,6 @@ def _run(args: argparse.Namespace, held: DeferredInterrupts) -> int:
     for path in summaries:
         check_output_file(path, "--out (its summary beside it)", "out/bench/results.jsonl", BenchError)
     library = load_library(args.models)
-    lib_name = library_name(args.models)
     specs = plan_sweep(
         sorted(library), args.episodes, args.seed, policies, args.noise,
         executor=args.executor, models=args.models, max_moves=args.max_moves,
@@ -104,28 +103,28 @@ def _run(args: argparse.Namespace, held: DeferredInterrupts) -> int:
     previous = signal.getsignal(signal.SIGINT), signal.signal(signal.SIGTERM, raise_terminated)
     code, failure = 0, None
     t0 = time.perf_counter()
-    with ResultsWriter(out, overwrite=args.force) as writer:
-        try:
-            held.release()  # an interrupt held over start-up takes effect here
-            _sweep(todo, args, writer)
-        except KeyboardInterrupt:
-            code = EXIT_SIGINT
-        except Terminated:
-            code = EXIT_SIGTERM
-        except BenchError as exc:
-            failure = exc
-        finally:
-            signal.signal(signal.SIGINT, signal.SIG_IGN)  # the summary is written whatever comes next
-            signal.signal(signal.SIGTERM, signal.SIG_IGN)
-    wall = time.perf_counter() - t0
     try:
+        with ResultsWriter(out, overwrite=args.force) as writer:
+            try:
+                held.release()  # an interrupt held over start-up takes effect here
+                _sweep(todo, args, writer)
+            except KeyboardInterrupt:
+                code = EXIT_SIGINT
+            except Terminated:
+                code = EXIT_SIGTERM
+            except Exception as exc:  # reported once the summary of what was kept is written
+                failure = exc
+            finally:
+                signal.signal(signal.SIGINT, signal.SIG_IGN)  # the summary is written whatever comes next
+                signal.signal(signal.SIGTERM, signal.SIG_IGN)
+        wall = time.perf_counter() - t0
         if failure is not None:
             try:
-                _write_summary(out, lib_name, args.no_plot, quiet=True)
+                _write_summary(out, args.no_plot, quiet=True)
             except (OSError, HapticError):
-                pass  # the results file is what counts; the summary is rewritten by --resume
+                pass  # the results file is what counts; --resume writes the summary again
             raise failure
-        _write_summary(out, lib_name, args.no_plot)
+        _write_summary(out, args.no_plot)
     finally:
         signal.signal(signal.SIGINT, previous[0])
         signal.signal(signal.SIGTERM, previous[1])
@@ -153,7 +152,7 @@ def _sweep(specs, args: argparse.Namespace, writer) -> None:
                 bar.update(1)
 
 
-def _write_summary(out: Path, lib_name: str, no_plot: bool, quiet: bool = False) -> None:
+def _write_summary(out: Path, no_plot: bool, quiet: bool = False) -> None:
     """The summary table and the plot, from every record of ``out``, each written atomically."""
     from haptic.bench.results import read_results
     from haptic.bench.summary import markdown_table, plot_interpretations_vs_cost, summary_rows

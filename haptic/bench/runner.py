@@ -136,43 +136,50 @@ WORKER_RETRIES = 2
 """Times an episode is run again when the worker running it dies (killed or out of memory)."""
 
 
+QUEUED_PER_WORKER = 2
+"""Episodes sent ahead to each local worker, so that it starts the next one without waiting for the main
+process (slow to be scheduled on a busy machine)."""
+
+
 def _run_local(payload: list[dict], workers: int) -> Iterator[dict]:
     """Worker processes of this machine; each dies with the main process (see :func:`_die_with_parent`)."""
     ctx = mp.get_context("fork" if "fork" in mp.get_all_start_methods() else "spawn")
     todo = deque(range(len(payload)))
     attempts = [0] * len(payload)
-    pool: dict = {}  # connection -> [process, index of the episode it runs or None]
+    pool: dict = {}  # connection -> (process, the episodes sent to it in order, the first one running)
     try:
-        while todo or any(job is not None for _, job in pool.values()):
+        while todo or any(jobs for _, jobs in pool.values()):
             while len(pool) < min(workers, len(todo) + len(pool)):
                 here, there = ctx.Pipe()
                 proc = ctx.Process(target=_worker, args=(there, os.getpid()), daemon=True)
                 proc.start()
                 there.close()
-                pool[here] = [proc, None]
-            for conn, slot in pool.items():
-                if slot[1] is None and todo:
-                    slot[1] = todo.popleft()
-                    conn.send(payload[slot[1]])
+                pool[here] = (proc, deque())
+            for conn, (_, jobs) in pool.items():
+                while len(jobs) < QUEUED_PER_WORKER and todo:
+                    jobs.append(todo.popleft())
+                    conn.send(payload[jobs[-1]])
             for conn in mp_connection.wait(list(pool)):
-                proc, job = pool[conn]
+                proc, jobs = pool[conn]
                 try:
                     ok, value = conn.recv()
                 except (EOFError, OSError):  # the worker died
                     proc.join(1.0)
                     del pool[conn]
                     conn.close()
-                    if job is None:
+                    if not jobs:
                         continue
-                    attempts[job] += 1
-                    if attempts[job] > WORKER_RETRIES:
+                    running = jobs[0]
+                    attempts[running] += 1
+                    if attempts[running] > WORKER_RETRIES:
                         raise BenchError(
-                            f"a worker died {attempts[job]} times running episode {payload[job]['model']} seed "
-                            f"{payload[job]['seed']} (exit code {proc.exitcode}); the finished episodes are kept"
+                            f"a worker died {attempts[running]} times running episode {payload[running]['model']} "
+                            f"seed {payload[running]['seed']} (exit code {proc.exitcode}); the finished episodes "
+                            "are kept"
                         ) from None
-                    todo.appendleft(job)
+                    todo.extendleft(reversed(jobs))
                     continue
-                pool[conn][1] = None
+                jobs.popleft()
                 if not ok:
                     raise value
                 yield value
