@@ -29,6 +29,8 @@ from haptic.bench.runner import key_id
 EXPECTED_EXIT = {"SIGINT": (130, -2), "SIGTERM": (143, -15), "SIGKILL": (-9,)}
 """Exit codes of a killed sweep: 130 / 143 once the command runs (the summary written once the sweep has
 begun), the signal's own (negative) while Python starts; SIGKILL is never handled."""
+KILL_WINDOW = 0.9
+"""Kills fall in [0.3 s, this x the reference run's time]: nearly every run is killed before it ends."""
 CASES = [(sig, to) for sig in ("SIGINT", "SIGTERM", "SIGKILL") for to in ("process", "group")]
 TIMINGS = ("wall_time_s", "decision_times_s")
 """Record fields that measure time and so differ between runs."""
@@ -98,13 +100,13 @@ def main(argv: list[str] | None = None) -> int:
     ref_wall = time.perf_counter() - t0
     reference, _ = by_key(ref)
     print(f"reference: {len(reference)} episodes in {ref_wall:.1f} s (start-up included); "
-          f"kills at a random moment in [0.3, {1.1 * ref_wall:.1f}] s")
+          f"kills at a random moment in [0.3, {KILL_WINDOW * ref_wall:.1f}] s")
     print()
     print("| run | signal | to | at [s] | exit | lines kept | summary | left over | group gone [s] | resumed ran | "
           "lost | duplicated | differ |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     cases = [CASES[i] for i in rng.permutation(len(CASES))]
-    bad = 0
+    bad = killed = 0
     totals = {"lost": 0, "duplicated": 0, "differ": 0, "left": 0}
     for run in range(args.runs):
         sig_name, to = cases[run % len(cases)]
@@ -112,7 +114,7 @@ def main(argv: list[str] | None = None) -> int:
         out = work / f"run{run:02d}.jsonl"
         for stale in (out, out.with_suffix(".md")):
             stale.unlink(missing_ok=True)
-        at = float(rng.uniform(0.3, 1.1 * ref_wall))
+        at = float(rng.uniform(0.3, KILL_WINDOW * ref_wall))
         proc = subprocess.Popen(bench_command(args, out), env=env, start_new_session=True,
                                 stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)  # fmt: skip
         try:
@@ -120,6 +122,7 @@ def main(argv: list[str] | None = None) -> int:
             at = float("nan")  # it ended before the kill
         except subprocess.TimeoutExpired:
             (os.killpg if to == "group" else os.kill)(proc.pid, sig)
+            killed += 1
         code = proc.wait(timeout=120)
         gone_s, left = wait_group_gone(proc.pid, timeout=15.0)
         for pid in live_in_group(proc.pid):  # leave nothing behind, whatever the result
@@ -147,9 +150,9 @@ def main(argv: list[str] | None = None) -> int:
         print(f"| {run + 1} | {sig_name} | {to} | {at:.2f} | {code} | {kept} | {'yes' if summed else '-'} | {left} | "
               f"{gone_s:.2f} | {ran} | {lost} | {duplicated} | {differ} |")
     print()
-    print(f"{args.runs} runs of {len(reference)} episodes: {totals['lost']} lost, {totals['duplicated']} duplicated, "
-          f"{totals['differ']} differing from the uninterrupted run, {totals['left']} processes left over; "
-          f"{bad} bad runs")
+    print(f"{args.runs} runs of {len(reference)} episodes ({killed} killed, the others ended first): "
+          f"{totals['lost']} lost, {totals['duplicated']} duplicated, {totals['differ']} differing from the "
+          f"uninterrupted run, {totals['left']} processes left over; {bad} bad runs")
     return 1 if bad else 0
 
 
