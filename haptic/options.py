@@ -12,6 +12,7 @@ import math
 import os
 import signal
 import tempfile
+import threading
 from pathlib import Path
 
 from haptic.errors import HapticError
@@ -102,27 +103,37 @@ def check_output_dir(path: str | os.PathLike, option: str, hint: str, error=Hapt
 
 
 class DeferredInterrupts:
-    """Hold SIGINT and SIGTERM in this thread until :meth:`release` (or the end of the ``with`` block), where a
-    pending one takes effect (KeyboardInterrupt, or the SIGTERM handler then in place).
+    """Note SIGINT and SIGTERM instead of acting on them until :meth:`release` (or the end of the ``with``
+    block), where the first one noted is raised again for the handlers that were in place before.
 
-    Some libraries catch ``BaseException`` around optional imports, which would swallow a Ctrl-C arriving
-    while they load; holding the signals over start-up makes an early interrupt end the command as a later one
-    does.
+    Some libraries catch ``BaseException`` around optional imports, and Ray's compiled calls turn an exception
+    raised by a handler into a SystemError: a signal arriving there is taken at a point of our choosing
+    instead. Handlers can only be set in the main thread; elsewhere this does nothing.
     """
 
-    SIGNALS = frozenset({signal.SIGINT, signal.SIGTERM})
+    SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
     def __init__(self) -> None:
-        self._previous: set | None = None
+        self.noted: list[int] = []
+        """Signals received while deferred, in order."""
+        self.handlers: dict = {}
+        """The handlers in place before, restored by :meth:`release`."""
 
     def __enter__(self) -> DeferredInterrupts:
-        self._previous = signal.pthread_sigmask(signal.SIG_BLOCK, self.SIGNALS)
+        if threading.current_thread() is threading.main_thread():
+            self.handlers = {sig: signal.signal(sig, self._note) for sig in self.SIGNALS}
         return self
 
+    def _note(self, signum, frame) -> None:
+        self.noted.append(signum)
+
     def release(self) -> None:
-        if self._previous is not None:
-            previous, self._previous = self._previous, None
-            signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+        """Restore the handlers; a signal noted meanwhile is raised again now (KeyboardInterrupt, ...)."""
+        handlers, self.handlers = self.handlers, {}
+        for sig, handler in handlers.items():
+            signal.signal(sig, handler)
+        if handlers and self.noted:
+            signal.raise_signal(self.noted[0])
 
     def __exit__(self, *exc) -> None:
         self.release()

@@ -9,7 +9,7 @@ import time
 from pathlib import Path
 
 from haptic.errors import BenchError, HapticError
-from haptic.options import DeferredInterrupts, Terminated, raise_terminated
+from haptic.options import DeferredInterrupts, Terminated
 
 EXIT_SIGINT, EXIT_SIGTERM = 130, 143
 """Exit codes of a sweep ended by SIGINT (Ctrl-C) or SIGTERM: 128 + the signal's number."""
@@ -100,7 +100,8 @@ def _run(args: argparse.Namespace, held: DeferredInterrupts) -> int:
     for path in (out.with_suffix(".md"), out.with_suffix(".png")):
         path.unlink(missing_ok=True)  # a summary never describes other results than the file's
 
-    previous = signal.getsignal(signal.SIGINT), signal.signal(signal.SIGTERM, raise_terminated)
+    # the handlers taken over after the sweep; SIGTERM raises Terminated (haptic.cli.main sets that up)
+    previous = {sig: held.handlers.get(sig, signal.getsignal(sig)) for sig in (signal.SIGINT, signal.SIGTERM)}
     code, failure = 0, None
     t0 = time.perf_counter()
     try:
@@ -126,8 +127,8 @@ def _run(args: argparse.Namespace, held: DeferredInterrupts) -> int:
             raise failure
         _write_summary(out, args.no_plot)
     finally:
-        signal.signal(signal.SIGINT, previous[0])
-        signal.signal(signal.SIGTERM, previous[1])
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
     if code:
         print(f"haptic: interrupted after {writer.written} episodes of {len(todo)}; every finished one is in {out} "
               "(run again with --resume to finish)", file=sys.stderr)

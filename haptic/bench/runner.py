@@ -235,8 +235,6 @@ def _die_with_parent(parent_pid: int) -> None:
     threading.Thread(target=watch, name="die-with-parent", daemon=True).start()
 
 
-_INTERRUPTS = (signal.SIGINT, signal.SIGTERM)
-
 RAY_OBJECT_STORE_BYTES = 128 * 1024**2
 """Object store of a Ray started here: episodes pass only small records [bytes]."""
 RAY_MEMORY_BYTES = 2 * 1024**3
@@ -290,14 +288,13 @@ def _run_ray(payload: list[dict], workers: int) -> Iterator[dict]:
         raise BenchError("--backend ray needs Ray: pip install -e '.[ray]' (or use --backend local)")
     import ray
 
+    from haptic.options import DeferredInterrupts
+
     started = start_ray(workers)
     pending: dict = {}
-    # A handler that raises inside Ray's compiled calls turns into a SystemError there: the signals are noted
-    # and raised again here, between calls, where the caller's handlers take them as usual.
-    noted: list[int] = []
-    handlers = {}
-    if threading.current_thread() is threading.main_thread():
-        handlers = {sig: signal.signal(sig, lambda signum, frame: noted.append(signum)) for sig in _INTERRUPTS}
+    # An exception raised by a signal handler inside Ray's compiled calls turns into a SystemError there: the
+    # signals are noted and raised again between calls, where the caller's handlers take them as usual.
+    held = DeferredInterrupts().__enter__()
     try:
         remote = ray.remote(num_cpus=1, max_retries=RAY_TASK_RETRIES)(_run)
         window = max(8, 2 * int(ray.cluster_resources().get("CPU", workers)))
@@ -308,20 +305,17 @@ def _run_ray(payload: list[dict], workers: int) -> Iterator[dict]:
             if not pending:
                 break
             done, _ = ray.wait(list(pending), num_returns=1, timeout=0.25)
-            if noted:
-                for sig, handler in handlers.items():
-                    signal.signal(sig, handler)
-                signal.raise_signal(noted[0])
+            if held.noted:
+                held.release()
             if done:
                 del pending[done[0]]
                 yield ray.get(done[0])
     finally:
-        for sig, handler in handlers.items():
-            signal.signal(sig, handler)
         for ref in pending:
             ray.cancel(ref, force=True)
         if started:
             ray.shutdown()
+        held.release()
 
 
 def with_models(specs: Sequence[EpisodeSpec], models: str | None) -> list[EpisodeSpec]:
