@@ -3,15 +3,23 @@ PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed-stamp
+RAY_STAMP := $(VENV)/.ray-stamp
 export MUJOCO_GL ?= disable
 
-.PHONY: demo test bench bench-ci lint models clean
+.PHONY: demo test bench bench-ci lint models ray clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e '.[dev]'
 	touch $(STAMP)
+
+# The Ray extra (haptic bench --backend ray), pinned in pyproject.toml; CI installs it.
+$(RAY_STAMP): $(STAMP) pyproject.toml
+	$(BIN)/python -m pip install --quiet -e '.[dev,ray]'
+	touch $(RAY_STAMP)
+
+ray: $(RAY_STAMP)
 
 demo: $(STAMP)
 	$(BIN)/haptic models list
@@ -22,12 +30,12 @@ test: $(STAMP)
 	$(BIN)/python -m pytest -n 2 -p no:cacheprovider
 
 bench: $(STAMP)
-	$(BIN)/haptic bench --episodes 200 --policy planner,greedy,random --seed 1 --workers 2 --out out/bench/seed.jsonl
+	$(BIN)/haptic bench --episodes 200 --policy planner,greedy,random --seed 1 --workers 2 --force --out out/bench/seed.jsonl
 	$(BIN)/haptic bench --models assets/libraries/lookalike --episodes 200 --policy planner,greedy,random --seed 1 \
-		--workers 2 --out out/bench/lookalike.jsonl
+		--workers 2 --force --out out/bench/lookalike.jsonl
 
 bench-ci: $(STAMP)
-	$(BIN)/haptic bench --episodes 40 --policy planner,random --seed 1 --workers 2 --no-plot --out out/ci/seed.jsonl
+	$(BIN)/haptic bench --episodes 40 --policy planner,random --seed 1 --workers 2 --no-plot --force --out out/ci/seed.jsonl
 
 lint: $(STAMP)
 	$(BIN)/ruff check haptic tests scripts

@@ -164,9 +164,20 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    ap = build_parser()
-    args = ap.parse_args(argv)
+    import signal
+    import threading
+
+    from haptic.options import DeferredInterrupts, Terminated, raise_terminated
+
+    main_thread = threading.current_thread() is threading.main_thread()
+    on_sigterm = signal.signal(signal.SIGTERM, raise_terminated) if main_thread else None
     try:
+        with DeferredInterrupts():  # the subcommands' imports cannot swallow an early Ctrl-C
+            ap = build_parser()
+        try:
+            args = ap.parse_args(argv)
+        except SystemExit as exc:  # --help, or a usage error already printed as one line
+            return exc.code if isinstance(exc.code, int) else 2
         return int(args.run(args) or 0)
     except HapticError as exc:
         print(f"haptic: error: {exc}", file=sys.stderr)
@@ -177,6 +188,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("haptic: interrupted", file=sys.stderr)
         return 130
+    except Terminated:
+        print("haptic: terminated", file=sys.stderr)
+        return 143
     except Exception as exc:  # a bug, not bad input: one line unless asked for the traceback
         if os.environ.get("HAPTIC_DEBUG"):
             raise
@@ -185,6 +199,9 @@ def main(argv: Sequence[str] | None = None) -> int:
             file=sys.stderr,
         )
         return 2
+    finally:
+        if main_thread:
+            signal.signal(signal.SIGTERM, on_sigterm)
 
 
 if __name__ == "__main__":

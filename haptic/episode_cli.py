@@ -6,10 +6,11 @@ import argparse
 import json
 from pathlib import Path
 
-from haptic.errors import HapticError
+from haptic.errors import HapticError, RecordingError
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
+    from haptic.options import noise_level, positive_int, seed_int
     from haptic.planning.policies import POLICY_NAMES
 
     p = sub.add_parser(
@@ -23,10 +24,10 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "--skip-invalid", action="store_true", help="use the library's valid models when some files are bad"
     )
     p.add_argument("--executor", choices=("geometric", "physics"), default="geometric")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=seed_int, default=0, help="seed of the pose, noise and policy (an integer >= 0)")
     p.add_argument("--policy", default="planner", choices=POLICY_NAMES)
-    p.add_argument("--noise", type=float, default=1.0, help="sensor-noise level (x default sigma)")
-    p.add_argument("--max-moves", type=int, default=40)
+    p.add_argument("--noise", type=noise_level, default=1.0, help="sensor-noise level (x default sigma)")
+    p.add_argument("--max-moves", type=positive_int, default=40)
     p.add_argument("--json", metavar="OUT", help="write the episode's JSON record here")
     p.add_argument("--record", metavar="OUT.rrd", help="write a rerun recording here")
     p.add_argument("--spawn", action="store_true", help="open the rerun viewer (where one is installed)")
@@ -66,11 +67,13 @@ def run(args: argparse.Namespace) -> int:
     from haptic.episode import run_episode
     from haptic.geometry import load_library
     from haptic.geometry.io import atomic_write
+    from haptic.options import check_output_file
 
-    if args.max_moves < 1:
-        raise HapticError(f"--max-moves must be at least 1, got {args.max_moves}")
-    if args.noise < 0:
-        raise HapticError(f"--noise must be >= 0, got {args.noise}")
+    # output paths are checked before the episode runs, so that its result cannot be lost at the end
+    if args.json:
+        check_output_file(args.json, "--json", "out/episode.json")
+    if args.record:
+        check_output_file(args.record, "--record", "out/episode.rrd", RecordingError)
     library = load_library(args.models, skip_invalid=args.skip_invalid)
     report_skipped(args.models, args.skip_invalid)
     spec = EpisodeSpec(
@@ -92,7 +95,10 @@ def run(args: argparse.Namespace) -> int:
     for line in summary_lines(record):
         print(line)
     if args.json:
-        atomic_write(Path(args.json), json.dumps(record, indent=2) + "\n")
+        try:
+            atomic_write(Path(args.json), json.dumps(record, indent=2) + "\n")
+        except OSError as exc:
+            raise HapticError(f"{args.json}: cannot write the episode's record ({exc.strerror})") from None
         print(f"json        {args.json}")
     if args.record:
         print(f"recording   {args.record}  (open with: rerun {args.record})")

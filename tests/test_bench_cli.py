@@ -38,7 +38,7 @@ def test_bench_errors_are_one_line(tmp_path, capsys):
     assert "\n" not in err and "oracle" in err and "planner" in err
     assert main(["bench", "--episodes", "1", "--out", str(tmp_path)]) == 1
     assert "is a directory" in capsys.readouterr().err
-    assert main(["bench", "--episodes", "0"]) == 1
+    assert main(["bench", "--episodes", "0"]) == 2  # a usage error, checked by the parser
     assert "--episodes" in capsys.readouterr().err
 
 

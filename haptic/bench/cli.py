@@ -3,22 +3,29 @@
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
 import time
 from pathlib import Path
 
-from haptic.errors import BenchError
+from haptic.errors import BenchError, HapticError
+from haptic.options import DeferredInterrupts, Terminated
+
+EXIT_SIGINT, EXIT_SIGTERM = 130, 143
+"""Exit codes of a sweep ended by SIGINT (Ctrl-C) or SIGTERM: 128 + the signal's number."""
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
+    from haptic.options import noise_levels, positive_int, seed_int
     from haptic.planning.policies import POLICY_NAMES
 
     p = sub.add_parser(
         "bench",
         help="run many episodes; write one JSON line per episode, a summary table and a plot",
         description="Models x random poses x noise levels x policies. Every policy runs on the same "
-        "(model, pose) draws. Writes OUT (JSON lines, one per episode as it ends), OUT with .md (summary "
-        "table) and .png (pose classes remaining vs path cost).",
+        "(model, pose) draws. Appends to OUT (JSON lines, one per episode as it ends, each with its episode's "
+        "key) and writes, from the whole of OUT, OUT with .md (summary table) and .png (pose classes remaining "
+        "vs path cost), at the end and on interrupt (exit 130 on SIGINT, 143 on SIGTERM).",
     )
     p.add_argument("--models", metavar="DIR", help="library directory (default: the shipped assets/models)")
     p.add_argument(
@@ -28,64 +35,142 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--policy", default="planner,random", help=f"comma-separated policies from {', '.join(POLICY_NAMES)}"
     )
-    p.add_argument("--episodes", type=int, default=50, help="random (model, pose) draws (default 50)")
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--noise", default="1", help="comma-separated sensor-noise levels (x default sigma)")
+    p.add_argument("--episodes", type=positive_int, default=50, help="random (model, pose) draws (default 50)")
+    p.add_argument("--seed", type=seed_int, default=0, help="seed of the sweep's draws (an integer >= 0)")
+    p.add_argument(
+        "--noise", type=noise_levels, default="1", help="comma-separated sensor-noise levels (x default sigma)"
+    )
     p.add_argument("--out", default="out/bench/results.jsonl", help="results file (JSON lines)")
-    p.add_argument("--workers", type=int, default=1, help="worker processes (local backend)")
-    p.add_argument("--backend", choices=("local", "ray"), default="local")
-    p.add_argument("--max-moves", type=int, default=40)
+    p.add_argument("--workers", type=positive_int, default=1,
+                   help="worker processes (local backend); CPUs of a Ray started here (ray backend)")
+    p.add_argument("--backend", choices=("local", "ray"), default="local",
+                   help="ray: the cluster named by RAY_ADDRESS, else a Ray started on this machine")
+    p.add_argument("--max-moves", type=positive_int, default=40)
+    again = p.add_mutually_exclusive_group()
+    again.add_argument("--resume", action="store_true",
+                       help="keep OUT's episodes and run only those of the sweep not in it yet")
+    again.add_argument("--force", action="store_true", help="empty an existing OUT and run the whole sweep")
     p.add_argument("--no-plot", action="store_true", help="skip the PNG plot")
     p.set_defaults(run=run)
 
 
 def run(args: argparse.Namespace) -> int:
-    from tqdm import tqdm
+    with DeferredInterrupts() as held:  # an interrupt during start-up (imports, library) ends it as in the sweep
+        return _run(args, held)
 
-    from haptic.bench.results import ResultsWriter
-    from haptic.bench.runner import plan_sweep, run_sweep
-    from haptic.bench.summary import markdown_table, plot_interpretations_vs_cost, summary_rows
+
+def _run(args: argparse.Namespace, held: DeferredInterrupts) -> int:
+    from haptic.bench.results import ResultsWriter, drop_partial_line, iter_results
+    from haptic.bench.runner import episode_key, key_id, plan_sweep, ray_available
     from haptic.cli import report_skipped
     from haptic.geometry import load_library
-    from haptic.geometry.io import atomic_write
+    from haptic.options import check_output_file
     from haptic.planning.policies import POLICY_NAMES
 
+    # Everything is checked before any episode runs or any file is touched.
     policies = [p.strip() for p in args.policy.split(",") if p.strip()]
     bad = [p for p in policies if p not in POLICY_NAMES]
     if bad or not policies:
         raise BenchError(f"unknown policy {', '.join(bad) or '(none)'}; valid: {', '.join(POLICY_NAMES)}")
-    try:
-        noises = [float(x) for x in args.noise.split(",")]
-    except ValueError:
-        raise BenchError(f"--noise takes comma-separated numbers, got {args.noise!r}") from None
-    if any(n < 0 for n in noises):
-        raise BenchError("--noise levels must be >= 0")
-    if args.episodes < 1:
-        raise BenchError(f"--episodes must be at least 1, got {args.episodes}")
+    if args.backend == "ray" and not ray_available():
+        raise BenchError("--backend ray needs Ray: pip install -e '.[ray]' (or use --backend local)")
+    out = check_output_file(args.out, "--out", "out/bench/results.jsonl", BenchError)
+    summaries = [out.with_suffix(".md")] + ([] if args.no_plot else [out.with_suffix(".png")])
+    for path in summaries:
+        check_output_file(path, "--out (its summary beside it)", "out/bench/results.jsonl", BenchError)
     library = load_library(args.models, skip_invalid=args.skip_invalid)
     report_skipped(args.models, args.skip_invalid)
-    lib_name = Path(args.models).name if args.models else "seed"
     specs = plan_sweep(
-        sorted(library), args.episodes, args.seed, policies, noises,
+        sorted(library), args.episodes, args.seed, policies, args.noise,
         executor=args.executor, models=args.models, max_moves=args.max_moves, skip_invalid=args.skip_invalid,
     )
-    out = Path(args.out)
-    records = []
+    has_results = out.is_file() and out.stat().st_size > 0
+    if has_results and not (args.resume or args.force):
+        raise BenchError(
+            f"{out}: already holds results; --resume runs only the episodes of this sweep not in it yet, "
+            "--force starts it over"
+        )
+    done: set[str] = set()
+    if has_results and args.resume:
+        if drop_partial_line(out):
+            print(f"{out}: dropped an unfinished last line", file=sys.stderr)
+        for n, rec in enumerate(iter_results(out), 1):
+            if "key" not in rec:
+                raise BenchError(f"{out}: record {n} has no episode key (written before results were keyed); "
+                                 "--force starts the file over")
+            done.add(key_id(rec["key"]))
+    todo = [s for s in specs if key_id(episode_key(s)) not in done]
+    if args.resume:
+        print(f"resume: {len(specs) - len(todo)} of {len(specs)} episodes already in {out}; running {len(todo)}")
+    for path in (out.with_suffix(".md"), out.with_suffix(".png")):
+        path.unlink(missing_ok=True)  # a summary never describes other results than the file's
+
+    # the handlers taken over after the sweep; SIGTERM raises Terminated (haptic.cli.main sets that up)
+    previous = {sig: held.handlers.get(sig, signal.getsignal(sig)) for sig in (signal.SIGINT, signal.SIGTERM)}
+    code, failure = 0, None
     t0 = time.perf_counter()
-    with ResultsWriter(out) as writer:
-        bar = tqdm(total=len(specs), unit="ep", desc="bench", disable=None, file=sys.stderr)
-        for rec in run_sweep(specs, workers=args.workers, backend=args.backend):
-            rec["library"] = lib_name
-            writer.write(rec)
-            records.append(rec)
-            bar.update(1)
-        bar.close()
-    wall = time.perf_counter() - t0
+    try:
+        with ResultsWriter(out, overwrite=args.force) as writer:
+            try:
+                held.release()  # an interrupt held over start-up takes effect here
+                _sweep(todo, args, writer)
+            except KeyboardInterrupt:
+                code = EXIT_SIGINT
+            except Terminated:
+                code = EXIT_SIGTERM
+            except Exception as exc:  # reported once the summary of what was kept is written
+                failure = exc
+            finally:
+                signal.signal(signal.SIGINT, signal.SIG_IGN)  # the summary is written whatever comes next
+                signal.signal(signal.SIGTERM, signal.SIG_IGN)
+        wall = time.perf_counter() - t0
+        if failure is not None:
+            try:
+                _write_summary(out, args.no_plot, quiet=True)
+            except (OSError, HapticError):
+                pass  # the results file is what counts; --resume writes the summary again
+            raise failure
+        _write_summary(out, args.no_plot)
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+    if code:
+        print(f"haptic: interrupted after {writer.written} episodes of {len(todo)}; every finished one is in {out} "
+              "(run again with --resume to finish)", file=sys.stderr)
+        return code
+    rate = f" ({60 * writer.written / wall:.0f} episodes/min)" if writer.written and wall > 0 else ""
+    print(f"{writer.written} episodes in {wall:.1f} s{rate}; results: {out}")
+    return 0
+
+
+def _sweep(specs, args: argparse.Namespace, writer) -> None:
+    """Run ``specs`` and append each record as it ends."""
+    from contextlib import closing
+
+    from tqdm import tqdm
+
+    from haptic.bench.runner import run_sweep
+
+    with tqdm(total=len(specs), unit="ep", desc="bench", disable=None, file=sys.stderr) as bar:
+        with closing(run_sweep(specs, workers=args.workers, backend=args.backend)) as records:
+            for rec in records:
+                writer.write(rec)
+                bar.update(1)
+
+
+def _write_summary(out: Path, no_plot: bool, quiet: bool = False) -> None:
+    """The summary table and the plot, from every record of ``out``, each written atomically."""
+    from haptic.bench.results import read_results
+    from haptic.bench.summary import markdown_table, plot_interpretations_vs_cost, summary_rows
+    from haptic.geometry.io import atomic_write
+
+    records = read_results(out) if out.exists() else []
     table = markdown_table(summary_rows(records, ("library", "executor", "noise", "policy")))
     atomic_write(out.with_suffix(".md"), table)
-    print(table, end="")
-    print(f"{len(records)} episodes in {wall:.1f} s ({60 * len(records) / wall:.0f} episodes/min); results: {out}")
-    if not args.no_plot:
-        png = plot_interpretations_vs_cost(records, out.with_suffix(".png"), title=f"{lib_name} library")
-        print(f"plot: {png}")
-    return 0
+    if not quiet:
+        print(table, end="")
+    if not no_plot and records:
+        libraries = sorted({str(r.get("library")) for r in records})
+        png = plot_interpretations_vs_cost(records, out.with_suffix(".png"), title=f"{', '.join(libraries)} library")
+        if not quiet:
+            print(f"plot: {png}")

@@ -7,11 +7,13 @@ import sys
 
 import numpy as np
 
-from haptic.errors import HapticError
+from haptic.errors import HapticError, SceneError
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Register the ``scene`` subcommand on ``subparsers``; returns its parser."""
+    from haptic.options import seed_int
+
     p = subparsers.add_parser(
         "scene",
         help="compose the robot + table + object scene and export it as MJCF",
@@ -20,7 +22,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     )
     p.add_argument("--object", required=True, help="model name in the library, or a model file path")
     p.add_argument("--models", default=None, help="library directory (default: assets/models)")
-    p.add_argument("--seed", type=int, default=0, help="seed of the object's random pose (default 0)")
+    p.add_argument("--seed", type=seed_int, default=0, help="seed of the object's random pose (an integer >= 0)")
     p.add_argument("--export", default=None, metavar="DIR/scene.xml", help="write the scene here")
     p.set_defaults(run=run)
     return p
@@ -28,9 +30,12 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
 
 def run(args: argparse.Namespace) -> int:
     """Run ``haptic scene``; returns the exit code (errors: one line on stderr, exit 1)."""
+    from haptic.options import check_output_file
     from haptic.sim.scene import compose_scene, export_scene, load_object
 
     try:
+        if args.export:  # checked before the scene is composed
+            check_output_file(args.export, "--export", "out/scene/scene.xml", SceneError)
         obj = load_object(args.object, args.models)
         scene = compose_scene(obj, seed=args.seed)
         model = scene.compile()
@@ -53,7 +58,7 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="haptic")
     add_parser(ap.add_subparsers(dest="command", required=True))
     args = ap.parse_args(argv)
-    return args.func(args)
+    return args.run(args)
 
 
 if __name__ == "__main__":

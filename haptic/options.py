@@ -1,0 +1,148 @@
+"""Command-line option types and output-path checks shared by the subcommands.
+
+Every check here runs before any work is done or any file is touched, so that bad input costs nothing and
+destroys nothing. Option types raise ``argparse.ArgumentTypeError`` (the parser prints one line, exit 2);
+path checks raise the caller's :class:`~haptic.errors.HapticError` subclass (one line, exit 1).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import signal
+import tempfile
+import threading
+from pathlib import Path
+
+from haptic.errors import HapticError
+
+
+def int_at_least(low: int):
+    """An argparse type: an integer >= ``low``."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
+        if value < low:
+            raise argparse.ArgumentTypeError(f"must be at least {low}, got {value}")
+        return value
+
+    parse.__name__ = f"integer >= {low}"
+    return parse
+
+
+seed_int = int_at_least(0)
+"""A seed: any integer >= 0 (numpy seeds its generators from non-negative integers)."""
+positive_int = int_at_least(1)
+
+
+def noise_level(text: str) -> float:
+    """An argparse type: a finite sensor-noise level >= 0 (a multiple of the default σ)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if not math.isfinite(value) or value < 0:
+        raise argparse.ArgumentTypeError(f"must be a finite number >= 0, got {text!r}")
+    return value
+
+
+def noise_levels(text: str) -> list[float]:
+    """An argparse type: comma-separated noise levels, each as :func:`noise_level`."""
+    parts = [p.strip() for p in text.split(",")]
+    if not parts or any(not p for p in parts):
+        raise argparse.ArgumentTypeError(f"expected comma-separated numbers >= 0, got {text!r}")
+    return [noise_level(p) for p in parts]
+
+
+def check_output_file(path: str | os.PathLike, option: str, example: str, error=HapticError) -> Path:
+    """Check that ``path`` can be written as a regular file, without changing anything there.
+
+    Valid: an existing regular file that can be opened for writing, or a missing file whose nearest existing
+    ancestor is a directory in which a file can be created (missing directories are made at write time).
+    Raises ``error`` naming ``option``, the path and what would be valid.
+    """
+    p = Path(path)
+    hint = f"{option} takes a file such as {example}"
+    if p.exists() or p.is_symlink():
+        if p.is_dir():
+            raise error(f"{p}: is a directory; {hint}")
+        if not p.is_file():
+            raise error(f"{p}: not a regular file; {hint}")
+        try:
+            with open(p, "a"):  # append mode: neither truncates nor changes the file
+                pass
+        except OSError as exc:
+            raise error(f"{p}: cannot write ({exc.strerror}); {hint} in a writable place") from None
+        return p
+    check_output_dir(p.parent, option, hint, error)
+    return p
+
+
+def check_output_dir(path: str | os.PathLike, option: str, hint: str, error=HapticError) -> Path:
+    """Check that files can be created in directory ``path`` (made later when missing) by creating and
+    removing a temporary file in it, or in its nearest existing ancestor. ``hint`` says what is valid."""
+    p = Path(path)
+    probe = p
+    while not probe.exists():
+        if probe.parent == probe:
+            break
+        probe = probe.parent
+    if not probe.is_dir():
+        raise error(f"{p}: {probe} is not a directory; {hint}")
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=".haptic-probe-", dir=probe)
+    except OSError as exc:
+        raise error(f"{p}: cannot create files in {probe} ({exc.strerror}); {hint} in a writable place") from None
+    os.close(fd)
+    os.unlink(tmp)
+    return p
+
+
+class DeferredInterrupts:
+    """Note SIGINT and SIGTERM instead of acting on them until :meth:`release` (or the end of the ``with``
+    block), where the first one noted is raised again for the handlers that were in place before.
+
+    Some libraries catch ``BaseException`` around optional imports, and Ray's compiled calls turn an exception
+    raised by a handler into a SystemError: a signal arriving there is taken at a point of our choosing
+    instead. Handlers can only be set in the main thread; elsewhere this does nothing.
+    """
+
+    SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+    def __init__(self) -> None:
+        self.noted: list[int] = []
+        """Signals received while deferred, in order."""
+        self.handlers: dict = {}
+        """The handlers in place before, restored by :meth:`release`."""
+
+    def __enter__(self) -> DeferredInterrupts:
+        if threading.current_thread() is threading.main_thread():
+            self.handlers = {sig: signal.signal(sig, self._note) for sig in self.SIGNALS}
+        return self
+
+    def _note(self, signum, frame) -> None:
+        self.noted.append(signum)
+
+    def release(self) -> None:
+        """Restore the handlers; a signal noted meanwhile is raised again now (KeyboardInterrupt, ...)."""
+        handlers, self.handlers = self.handlers, {}
+        for sig, handler in handlers.items():
+            signal.signal(sig, handler)
+        if handlers and self.noted:
+            signal.raise_signal(self.noted[0])
+
+    def __exit__(self, *exc) -> None:
+        self.release()
+
+
+class Terminated(BaseException):
+    """SIGTERM, raised in the main thread as KeyboardInterrupt is for SIGINT (see :func:`raise_terminated`)."""
+
+
+def raise_terminated(signum, frame) -> None:
+    """A SIGTERM handler: raise :class:`Terminated`, so that ``finally`` blocks run and the command exits 143."""
+    raise Terminated()
