@@ -72,6 +72,10 @@ class PlannerConfig:
     table_risk: float = 0.5
     """Candidate moves that at least this fraction of the hypotheses predict to bring the pad onto the table
     are not offered (the executor would refuse or abort them); the rest are discounted by their risk."""
+    max_hypotheses: int | None = 128
+    """Most pose classes a policy scores moves against; above it, a reduced set chosen model by model
+    (:mod:`haptic.planning.bound`). None: no bound. 128 is above the most pose classes the shipped libraries
+    leave at a planner decision (so their decisions are unchanged) and keeps one decision well under a second."""
 
     @property
     def touch_margin(self) -> float:
