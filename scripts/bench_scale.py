@@ -16,7 +16,8 @@ against library size, log-log, with the fitted growth exponent); prints the tabl
         [--compare-bound SIZE]
 
 ``--compare-bound SIZE`` runs the episodes of library SIZE a second time with no bound on the planner's
-hypotheses (``PlannerConfig.max_hypotheses=None``) and reports the change in path cost and outcomes.
+hypotheses (``PlannerConfig.max_hypotheses=None``) and reports the change in path cost and outcomes; ``--bound N``
+sets the bound of the first runs (default: ``PlannerConfig``'s).
 """
 
 from __future__ import annotations
@@ -88,7 +89,7 @@ def _episode(task: dict) -> dict:
         state["update"] = (0.0, 0.0)
         state["last"] = now
 
-    config = PlannerConfig() if task["bound"] else PlannerConfig(max_hypotheses=None)
+    config = PlannerConfig(max_hypotheses=task["bound"])
     t0 = _clock()
     rec = run_episode(
         EpisodeSpec(**task["spec"]),
@@ -134,7 +135,7 @@ def _build_times(directory: Path) -> dict:
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
-def _run(specs: list[dict], workers: int, bound: bool = True) -> tuple[list[dict], float]:
+def _run(specs: list[dict], workers: int, bound: int | None) -> tuple[list[dict], float]:
     tasks = [{"spec": s, "bound": bound} for s in specs]
     t0 = time.perf_counter()
     with ProcessPoolExecutor(max_workers=workers, initializer=_init_worker) as pool:
@@ -233,7 +234,12 @@ def main(argv=None) -> int:
     ap.add_argument("--libraries", default="out/bench_scale/libraries")
     ap.add_argument("--out", default="out/bench_scale")
     ap.add_argument("--compare-bound", type=int, default=None, metavar="SIZE")
+    ap.add_argument("--bound", type=int, default=None, help="PlannerConfig.max_hypotheses (default: its default)")
     args = ap.parse_args(argv)
+    if args.bound is None:
+        from haptic.planning.predict import PlannerConfig
+
+        args.bound = PlannerConfig().max_hypotheses
 
     from haptic.bench.runner import plan_sweep
     from haptic.geometry import load_library
@@ -251,15 +257,16 @@ def main(argv=None) -> int:
             {"model": s.model, "seed": s.seed, "policy": s.policy, "models": str(lib_dir)}
             for s in plan_sweep(names, args.episodes, args.seed, [args.policy])
         ]
-        results, wall = _run(specs, args.workers)
+        results, wall = _run(specs, args.workers, args.bound)
         row = _summary(size, results, wall, args.workers, build)
         rows.append(row)
         print(json.dumps(row), flush=True)
         if args.compare_bound == size:
-            free, wall_free = _run(specs, args.workers, bound=False)
+            free, wall_free = _run(specs, args.workers, None)
             paired = [(a, b) for a, b in zip(results, free, strict=True)]
             compare = {
                 "models": size,
+                "bound": args.bound,
                 "episodes": len(paired),
                 "bounded_cost_mean": float(np.mean([a["path_cost"] for a, _ in paired])),
                 "unbounded_cost_mean": float(np.mean([b["path_cost"] for _, b in paired])),
@@ -276,10 +283,10 @@ def main(argv=None) -> int:
     print(table, end="")
     if compare:
         print(
-            f"bound on hypotheses, {compare['models']} models, {compare['episodes']} episodes: mean path cost "
-            f"{compare['bounded_cost_mean']:.2f} bounded vs {compare['unbounded_cost_mean']:.2f} unbounded; correct "
-            f"{compare['bounded_correct']} vs {compare['unbounded_correct']}; {compare['episodes_differing']} episodes "
-            "differ"
+            f"bound of {compare['bound']} hypotheses, {compare['models']} models, {compare['episodes']} episodes: mean "
+            f"path cost {compare['bounded_cost_mean']:.2f} bounded vs {compare['unbounded_cost_mean']:.2f} unbounded; "
+            f"correct {compare['bounded_correct']} vs {compare['unbounded_correct']}; "
+            f"{compare['episodes_differing']} episodes differ"
         )
     print(f"plot: {out / 'scale.png'}")
     return 0

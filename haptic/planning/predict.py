@@ -74,10 +74,11 @@ class PlannerConfig:
     table_risk: float = 0.5
     """Candidate moves that at least this fraction of the hypotheses predict to bring the pad onto the table
     are not offered (the executor would refuse or abort them); the rest are discounted by their risk."""
-    max_hypotheses: int | None = 128
+    max_hypotheses: int | None = 256
     """Most pose classes a policy scores moves against; above it, a reduced set chosen model by model
-    (:mod:`haptic.planning.bound`). None: no bound. 128 is above the most pose classes the shipped libraries
-    leave at a planner decision (so their decisions are unchanged) and keeps one decision well under a second."""
+    (:mod:`haptic.planning.bound`). None: no bound. 256 is above the most pose classes the shipped libraries
+    leave at a planner decision (186, look-alike library), so their decisions are unchanged; the matcher poses
+    at most 400 interpretations (``haptic.episode.MAX_POSED``), so it bounds a decision to under 2/3 of that."""
 
     @property
     def touch_margin(self) -> float:
