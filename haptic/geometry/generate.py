@@ -2,12 +2,15 @@
 
 :func:`generate_library` draws ``count`` models from a seeded generator in fixed proportions of families:
 
-- random convex polyhedra (convex hulls of random points, kept only when every edge, face and dihedral angle
-  is large enough for a fingertip to trace and tell apart), and the mirror image of some of them;
+- random convex polyhedra (hulls of random points on a sphere, stretched along the axes, kept only when every
+  edge, face and dihedral angle is large enough for a fingertip to trace and tell apart), and the mirror image
+  of some of them;
 - right prisms on regular polygons and antiprisms;
 - boxes, wedges and rectangular pyramids whose dimensions lie on a grid of ``DIMENSION_STEP`` (so two of them
   can be as close as one step in one dimension);
-- a few non-convex parts: L blocks and boxes with a slot across the top.
+- a few non-convex parts: L brackets and blocks with a slot across the top.
+
+The solids come from :mod:`haptic.geometry.shapes`; this module draws their dimensions and keeps them distinct.
 
 Every model is a validated :class:`Polyhedron`; no two are congruent (a key of their sorted dimensions, or for
 random solids their sorted edge lengths, is kept unique). :func:`write_library` writes them as native model files
@@ -24,7 +27,17 @@ import numpy as np
 
 from haptic.errors import ModelError
 from haptic.geometry.polyhedron import Polyhedron
-from haptic.geometry.shapes import box, extrusion_xz, prism, pyramid, regular_prism
+from haptic.geometry.shapes import (
+    antiprism,
+    box,
+    convex_hull,
+    extrusion_xz,
+    l_bracket,
+    pyramid,
+    random_convex_hull,
+    regular_prism,
+    slotted_block,
+)
 
 DIMENSION_STEP = 0.006
 """Grid of the dimensions of boxes, wedges, pyramids, prisms and non-convex parts [m]: well above twice the
@@ -56,22 +69,6 @@ def _grid(rng: np.random.Generator, lo: float, hi: float) -> float:
     return round(k * DIMENSION_STEP, 6)
 
 
-def convex_hull_solid(points: np.ndarray, name: str) -> Polyhedron:
-    """The convex hull of points, coplanar triangles merged into polygonal faces [m]."""
-    from scipy.spatial import ConvexHull
-
-    from haptic.geometry.io import polyhedron_from_triangles
-
-    p = np.asarray(points, dtype=float)
-    hull = ConvexHull(p)
-    tris = hull.simplices.copy()
-    centre = p[hull.vertices].mean(axis=0)
-    for i, (a, b, c) in enumerate(tris):
-        if np.cross(p[b] - p[a], p[c] - p[a]) @ (p[a] - centre) < 0:
-            tris[i] = (a, c, b)
-    return polyhedron_from_triangles(p, tris, name=name)
-
-
 def _traceable(poly: Polyhedron) -> bool:
     """Whether a random solid is one a fingertip can trace: long edges, wide faces, clear dihedral angles."""
     if float(poly.edge_lengths.min()) < MIN_EDGE:
@@ -96,28 +93,18 @@ def _traceable(poly: Polyhedron) -> bool:
 
 
 def _random_hull(rng: np.random.Generator, name: str) -> tuple[Polyhedron, tuple]:
+    """A traceable convex hull of 6–9 random points on a sphere, stretched along the axes (an affine map keeps
+    faces planar and the solid convex)."""
     for _ in range(200):
-        k = int(rng.integers(6, 11))
-        u = rng.normal(size=(k, 3))
-        u /= np.linalg.norm(u, axis=1, keepdims=True)
-        scale = rng.uniform(0.030, 0.055, size=3)
+        k = int(rng.integers(6, 10))
         try:
-            poly = convex_hull_solid(u * scale, name)
-        except (ModelError, ValueError):
+            base = random_convex_hull(rng, k, 1.0, min_turn_deg=12.0, min_edge=0.3, name=name)
+        except ModelError:
             continue
+        poly = convex_hull(base.vertices * rng.uniform(0.030, 0.055, size=3), name=name)
         if _traceable(poly):
             return poly, ("hull", *np.round(np.sort(poly.edge_lengths), 3))
     raise ModelError(f"{name}: no traceable random convex polyhedron in 200 draws")
-
-
-def antiprism_solid(sides: int, circumradius: float, height: float, name: str) -> Polyhedron:
-    """A right antiprism on a regular polygon: two rings half a step apart [m]."""
-    ang = 2 * np.pi * np.arange(sides) / sides
-    lo = np.column_stack([circumradius * np.cos(ang), circumradius * np.sin(ang), np.zeros(sides)])
-    hi = np.column_stack(
-        [circumradius * np.cos(ang + np.pi / sides), circumradius * np.sin(ang + np.pi / sides), np.full(sides, height)]
-    )
-    return convex_hull_solid(np.vstack([lo, hi]), name)
 
 
 def _family_makers() -> dict[str, Callable[[np.random.Generator, str], tuple[Polyhedron, tuple]]]:
@@ -128,9 +115,9 @@ def _family_makers() -> dict[str, Callable[[np.random.Generator, str], tuple[Pol
         s, r, h = int(rng.integers(3, 9)), _grid(rng, 0.030, 0.060), _grid(rng, 0.030, 0.090)
         return regular_prism(s, r, h, name=name), ("prism", s, r, h)
 
-    def antiprism(rng, name):
+    def antiprism_(rng, name):
         s, r, h = int(rng.integers(3, 8)), _grid(rng, 0.030, 0.060), _grid(rng, 0.030, 0.078)
-        return antiprism_solid(s, r, h, name), ("antiprism", s, r, h)
+        return antiprism(s, r, h, name=name), ("antiprism", s, r, h)
 
     def box_(rng, name):
         d = sorted(_grid(rng, 0.036, 0.120) for _ in range(3))
@@ -146,22 +133,18 @@ def _family_makers() -> dict[str, Callable[[np.random.Generator, str], tuple[Pol
         return pyramid(bx, by, h, name=name), ("pyramid", bx, by, h)
 
     def lblock(rng, name):
-        lx, ly, t, h = _grid(rng, 0.060, 0.110), _grid(rng, 0.060, 0.110), _grid(rng, 0.024, 0.042), _grid(
+        lx, lz, t, w = _grid(rng, 0.060, 0.110), _grid(rng, 0.060, 0.110), _grid(rng, 0.024, 0.042), _grid(
             rng, 0.030, 0.072
         )
-        profile = [(0, 0), (lx, 0), (lx, t), (t, t), (t, ly), (0, ly)]
-        return prism(profile, h, name=name), ("lblock", lx, ly, t, h)
+        return l_bracket(lx, lz, t, w, name=name), ("lblock", lx, lz, t, w)
 
     def slot(rng, name):
         lx, w, h = _grid(rng, 0.072, 0.120), _grid(rng, 0.048, 0.096), _grid(rng, 0.048, 0.084)
         sw, sd = _grid(rng, 0.018, 0.036), _grid(rng, 0.012, 0.024)
-        x0 = round((lx - sw) / 2, 6)
-        x1 = round(x0 + sw, 6)
-        profile = [(0, 0), (lx, 0), (lx, h), (x1, h), (x1, h - sd), (x0, h - sd), (x0, h), (0, h)]
-        return extrusion_xz(profile, w, name=name), ("slot", lx, w, h, sw, sd)
+        return slotted_block(lx, w, h, sw, sd, name=name), ("slot", lx, w, h, sw, sd)
 
     return {
-        "hull": hull, "prism": prism_, "antiprism": antiprism, "box": box_, "wedge": wedge, "pyramid": pyramid_,
+        "hull": hull, "prism": prism_, "antiprism": antiprism_, "box": box_, "wedge": wedge, "pyramid": pyramid_,
         "lblock": lblock, "slot": slot,
     }  # fmt: skip
 
