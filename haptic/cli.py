@@ -18,7 +18,7 @@ Runner = Callable[[argparse.Namespace], int]
 
 def _add_models(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("models", help="list, show and check polyhedral models")
-    msub = p.add_subparsers(dest="models_cmd", required=True, metavar="{list,show,check}")
+    msub = p.add_subparsers(dest="models_cmd", required=True, metavar="{list,show,check,generate}")
 
     lp = msub.add_parser("list", help="the models of a library: V/E/F, genus, convexity, symmetry order")
     lp.add_argument("--models", metavar="DIR", help="library directory (default: the shipped assets/models)")
@@ -33,6 +33,18 @@ def _add_models(sub: argparse._SubParsersAction) -> None:
     cp = msub.add_parser("check", help="validate model files; exit 1 if any is bad")
     cp.add_argument("files", nargs="+", metavar="FILE")
     cp.set_defaults(run=_models_check)
+
+    gp = msub.add_parser(
+        "generate",
+        help="write a deterministic library of N models (for scale tests)",
+        description="Random convex polyhedra and their mirror images, prisms and antiprisms, boxes, wedges and "
+        "pyramids of close dimensions, L blocks and slotted blocks: N models drawn from SEED, written as native "
+        "model files into a new directory OUT, then loaded back and validated like any library.",
+    )
+    gp.add_argument("--count", type=int, required=True, metavar="N", help="number of models")
+    gp.add_argument("--seed", type=int, default=0, help="seed of the draw (default 0)")
+    gp.add_argument("--out", required=True, metavar="DIR", help="new (or empty) library directory to write")
+    gp.set_defaults(run=_models_generate)
 
 
 def report_skipped(models: str | None, skipped: bool) -> None:
@@ -128,6 +140,21 @@ def _models_check(args: argparse.Namespace) -> int:
         else:
             print(f"{f}: ok  V={m.n_vertices} E={m.n_edges} F={m.n_faces} genus={m.genus}")
     return 1 if bad else 0
+
+
+def _models_generate(args: argparse.Namespace) -> int:
+    from tqdm import tqdm
+
+    from haptic.geometry.generate import iter_library, write_library
+
+    if args.count < 1:
+        raise HapticError(f"--count must be at least 1, got {args.count}")
+    bar = tqdm(iter_library(args.count, args.seed), total=args.count, unit="model", desc="generate", file=sys.stderr)
+    library = write_library(bar, args.out)
+    faces = sum(m.n_faces for m in library.values())
+    edges = sum(m.n_edges for m in library.values())
+    print(f"{len(library)} models ({faces} faces, {edges} edges) written to {args.out} and validated")
+    return 0
 
 
 def _optional_subcommands() -> list[Callable[[argparse._SubParsersAction], None]]:

@@ -15,7 +15,8 @@ import numpy as np
 
 from haptic.bench.runner import EpisodeSpec
 from haptic.errors import HapticError
-from haptic.geometry import SE3, Polyhedron, library_twin, load_library, resolve_model
+from haptic.geometry import SE3, Polyhedron, library_twin, resolve_model
+from haptic.geometry.library_cache import cached_library
 from haptic.geometry.se3 import matrix_to_quat, rotation_angle
 from haptic.matching.components import DataComponent, SensorNoise
 from haptic.matching.recognition import AMBIGUOUS, EXPLORING, NO_MATCH, RECOGNIZED, Recognition, recognize
@@ -272,7 +273,7 @@ def run_episode(
         return run_physics_episode(spec, library=library, observer=observer, config=config, policy=policy)
     if spec.executor != "geometric":
         raise HapticError(f"unknown executor {spec.executor!r}; valid: geometric, physics")
-    library = library if library is not None else load_library(spec.models, skip_invalid=spec.skip_invalid)
+    library = library if library is not None else cached_library(spec.models, skip_invalid=spec.skip_invalid)
     true_model = resolve_model(spec.model, library)
     config = config or PlannerConfig()
     root = np.random.SeedSequence(spec.seed)

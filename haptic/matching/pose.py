@@ -63,38 +63,55 @@ def pose_from_edge_pair(p_d1, b_d1, p_d2, b_d2, p_m1, b_m1, p_m2, b_m2) -> SE3:
 
 
 class _Problem:
-    """The residuals of all pairings of one interpretation, weighted by the error bounds."""
+    """The residuals of all pairings of one interpretation, weighted by the error bounds.
+
+    Every kind of pairing is stacked into arrays once, so that a residual evaluation (Gauss–Newton takes some
+    forty) is a handful of array operations whatever the number of pairings."""
 
     def __init__(self, model: Polyhedron, data: Sequence[DataComponent], faces, edges, senses, vertices):
-        self.dirs_w, self.dirs_m, self.dirs_wt = [], [], []
-        self.planes = []  # (n_m, d_m, points (k,3), weight)
-        self.lines = []  # (p_m, b_m, point, weight)
-        self.points = []  # (v_m, v_d, weight)
+        dirs_w, dirs_m, dirs_wt = [], [], []
+        plane_n, plane_d, plane_q, plane_w = [], [], [], []  # one row per touched point of a paired face
+        line_p, line_b, line_x, line_w = [], [], [], []  # two rows (interval ends) per paired edge
+        pt_m, pt_d, pt_w = [], [], []
         for i, f in faces.items():
             c = data[i]
-            self.dirs_w.append(c.normal)
-            self.dirs_m.append(model.face_normals[f])
-            self.dirs_wt.append(1.0 / max(c.normal_bound, 1e-6) ** 2)
-            self.planes.append(
-                (model.face_normals[f], model.face_offsets[f], c.points, 1.0 / max(c.position_bound, 1e-7))
-            )
+            dirs_w.append(c.normal)
+            dirs_m.append(model.face_normals[f])
+            dirs_wt.append(1.0 / max(c.normal_bound, 1e-6) ** 2)
+            k = len(c.points)
+            plane_n.append(np.repeat(model.face_normals[f][None], k, axis=0))
+            plane_d.append(np.full(k, model.face_offsets[f]))
+            plane_q.append(np.asarray(c.points, dtype=float).reshape(-1, 3))
+            plane_w.append(np.full(k, 1.0 / max(c.position_bound, 1e-7)))
         for i, e in edges.items():
             c = data[i]
             s = senses.get(i, 0)
             pm, bm = model.edge_points[e], model.edge_directions[e]
             if s != 0:
-                self.dirs_w.append(c.direction)
-                self.dirs_m.append(s * bm)
-                self.dirs_wt.append(1.0 / max(c.direction_bound, 1e-6) ** 2)
+                dirs_w.append(c.direction)
+                dirs_m.append(s * bm)
+                dirs_wt.append(1.0 / max(c.direction_bound, 1e-6) ** 2)
             rho = max(c.position_bound, 1e-7)
-            self.lines.append((pm, bm, c.point, 1.0 / rho))
-            self.lines.append((pm, bm, c.end_point, 1.0 / (rho + c.length * c.direction_bound)))
+            line_p += [pm, pm]
+            line_b += [bm, bm]
+            line_x += [c.point, c.end_point]
+            line_w += [1.0 / rho, 1.0 / (rho + c.length * c.direction_bound)]
         for i, v in vertices.items():
             c = data[i]
-            self.points.append((model.vertices[v], c.position, 1.0 / max(c.position_bound, 1e-7)))
-        self.dirs_w = np.array(self.dirs_w).reshape(-1, 3)
-        self.dirs_m = np.array(self.dirs_m).reshape(-1, 3)
-        self.dirs_wt = np.array(self.dirs_wt)
+            pt_m.append(model.vertices[v])
+            pt_d.append(c.position)
+            pt_w.append(1.0 / max(c.position_bound, 1e-7))
+        self.dirs_w = np.array(dirs_w, dtype=float).reshape(-1, 3)
+        self.dirs_m = np.array(dirs_m, dtype=float).reshape(-1, 3)
+        self.dirs_wt = np.array(dirs_wt, dtype=float)
+        self._dirs_sw = np.sqrt(self.dirs_wt)[:, None]
+        cat = (lambda xs, shape: np.concatenate(xs) if xs else np.zeros(shape))  # noqa: E731
+        self.plane_n, self.plane_d = cat(plane_n, (0, 3)), cat(plane_d, (0,))
+        self.plane_q, self.plane_w = cat(plane_q, (0, 3)), cat(plane_w, (0,))
+        arr = (lambda xs, shape: np.array(xs, dtype=float).reshape(shape))  # noqa: E731
+        self.line_p, self.line_b = arr(line_p, (-1, 3)), arr(line_b, (-1, 3))
+        self.line_x, self.line_w = arr(line_x, (-1, 3)), arr(line_w, (-1,))
+        self.pt_m, self.pt_d, self.pt_w = arr(pt_m, (-1, 3)), arr(pt_d, (-1, 3)), arr(pt_w, (-1,))
 
     def rotation(self) -> np.ndarray | None:
         if len(self.dirs_m) < 2:
@@ -106,38 +123,31 @@ class _Problem:
         return proper_rotation_fit(self.dirs_w, self.dirs_m, self.dirs_wt)
 
     def translation(self, r: np.ndarray) -> np.ndarray | None:
-        rows, rhs = [], []
-        for n_m, d_m, pts, w in self.planes:
-            n = r @ n_m
-            for q in pts:
-                rows.append(w * n)
-                rhs.append(w * (n @ q - d_m))
-        for p_m, b_m, x, w in self.lines:
-            b = r @ b_m
-            perp = np.eye(3) - np.outer(b, b)
-            rows.extend(w * perp)
-            rhs.extend(w * perp @ (x - r @ p_m))
-        for v_m, v_d, w in self.points:
-            rows.extend(w * np.eye(3))
-            rhs.extend(w * (v_d - r @ v_m))
-        if not rows:
+        n = self.plane_n @ r.T  # rotated normals, one per touched point
+        plane_rows = self.plane_w[:, None] * n
+        plane_rhs = self.plane_w * (np.einsum("ij,ij->i", n, self.plane_q) - self.plane_d)
+        b = self.line_b @ r.T
+        perp = np.eye(3)[None] - b[:, :, None] * b[:, None, :]  # (L, 3, 3)
+        line_rows = (self.line_w[:, None, None] * perp).reshape(-1, 3)
+        line_rhs = (self.line_w[:, None] * np.einsum("lij,lj->li", perp, self.line_x - self.line_p @ r.T)).reshape(-1)
+        pt_rows = (self.pt_w[:, None, None] * np.eye(3)[None]).reshape(-1, 3)
+        pt_rhs = (self.pt_w[:, None] * (self.pt_d - self.pt_m @ r.T)).reshape(-1)
+        a = np.concatenate([plane_rows, line_rows, pt_rows])
+        if not len(a):
             return None
-        a, y = np.array(rows), np.array(rhs)
+        y = np.concatenate([plane_rhs, line_rhs, pt_rhs])
         sv = np.linalg.svd(a, compute_uv=False)
         if len(sv) < 3 or sv[-1] < MIN_CONDITION * sv[0]:
             return None
         return np.linalg.lstsq(a, y, rcond=None)[0]
 
     def residuals(self, r: np.ndarray, t: np.ndarray) -> np.ndarray:
-        out = [((self.dirs_w - self.dirs_m @ r.T) * np.sqrt(self.dirs_wt)[:, None]).ravel()]
-        for n_m, d_m, pts, w in self.planes:
-            out.append(w * ((pts - t) @ r @ n_m - d_m))
-        for p_m, b_m, x, w in self.lines:
-            y = r.T @ (x - t) - p_m
-            out.append(w * (y - (y @ b_m) * b_m))
-        for v_m, v_d, w in self.points:
-            out.append(w * (r.T @ (v_d - t) - v_m))
-        return np.concatenate(out)
+        dirs = ((self.dirs_w - self.dirs_m @ r.T) * self._dirs_sw).ravel()
+        planes = self.plane_w * (np.einsum("ij,ij->i", (self.plane_q - t) @ r, self.plane_n) - self.plane_d)
+        y = (self.line_x - t) @ r - self.line_p
+        lines = (self.line_w[:, None] * (y - np.einsum("ij,ij->i", y, self.line_b)[:, None] * self.line_b)).ravel()
+        pts = (self.pt_w[:, None] * ((self.pt_d - t) @ r - self.pt_m)).ravel()
+        return np.concatenate([dirs, planes, lines, pts])
 
 
 def _exp_so3(w: np.ndarray) -> np.ndarray:
@@ -148,17 +158,22 @@ def _exp_so3(w: np.ndarray) -> np.ndarray:
     return np.eye(3) + np.sin(th) / th * k + (1 - np.cos(th)) / th**2 * k @ k
 
 
+_FD_STEP = 1e-7
+"""Finite-difference step of the Gauss–Newton Jacobian."""
+_FD_XI = tuple(np.eye(6)[j] * _FD_STEP for j in range(6))
+_FD_ROT = tuple(_exp_so3(xi[:3]) for xi in _FD_XI)
+"""The six perturbations of the Jacobian and their rotations, computed once."""
+
+
 def refine_pose(problem: _Problem, pose: SE3, iterations: int = 6) -> SE3:
     """Gauss–Newton on the weighted residuals, perturbing the pose on the left (world frame)."""
     r, t = pose.rotation, pose.translation
-    h = 1e-7
+    h = _FD_STEP
     for _ in range(iterations):
         f0 = problem.residuals(r, t)
         jac = np.empty((len(f0), 6))
         for j in range(6):
-            xi = np.zeros(6)
-            xi[j] = h
-            dr = _exp_so3(xi[:3])
+            xi, dr = _FD_XI[j], _FD_ROT[j]
             jac[:, j] = (problem.residuals(dr @ r, dr @ t + xi[3:]) - f0) / h
         step, *_ = np.linalg.lstsq(jac, -f0, rcond=None)
         dr = _exp_so3(step[:3])

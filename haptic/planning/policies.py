@@ -15,7 +15,7 @@ components) and draws any random choice from the generator it is given.
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -140,6 +140,14 @@ def eliminates(pred: Prediction, config: PlannerConfig) -> np.ndarray:
     return np.where(fails[:, None], beyond, d)
 
 
+def bounded(ctx: Context) -> Context:
+    """``ctx`` with at most ``config.max_hypotheses`` hypotheses (:mod:`haptic.planning.bound`)."""
+    from haptic.planning.bound import reduce_hypotheses
+
+    kept = reduce_hypotheses(ctx.hypotheses, ctx.config.max_hypotheses)
+    return ctx if len(kept) == len(ctx.hypotheses) else replace(ctx, hypotheses=tuple(kept))
+
+
 def _fresh_moves(ctx: Context) -> list[Move]:
     """Candidate moves, less vertex moves that every hypothesis says circle back to an explored edge, and
     (while others remain) face moves that the hypotheses, by at least half their weight, say cross the edge a face
@@ -213,6 +221,7 @@ class _ScoringPolicy(Policy):
         return cands[int(rng.choice(best))].move
 
     def choose(self, ctx: Context, rng: np.random.Generator) -> Decision:
+        ctx = bounded(ctx)
         scored = _score_all(ctx)
         if not scored:
             raise PlanningError("no admissible move from the current sensor state")

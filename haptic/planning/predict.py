@@ -8,8 +8,10 @@ would cost there. The planner compares these predictions (:mod:`haptic.planning.
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -72,6 +74,11 @@ class PlannerConfig:
     table_risk: float = 0.5
     """Candidate moves that at least this fraction of the hypotheses predict to bring the pad onto the table
     are not offered (the executor would refuse or abort them); the rest are discounted by their risk."""
+    max_hypotheses: int | None = 256
+    """Most pose classes a policy scores moves against; above it, a reduced set chosen model by model
+    (:mod:`haptic.planning.bound`). None: no bound. 256 is above the most pose classes the shipped libraries
+    leave at a planner decision (186, look-alike library), so their decisions are unchanged; the matcher poses
+    at most 400 interpretations (``haptic.episode.MAX_POSED``), so it bounds a decision to under 2/3 of that."""
 
     @property
     def touch_margin(self) -> float:
@@ -100,6 +107,11 @@ class Hypothesis:
     """Interpretations in this pose class."""
     leaves: tuple[int, ...] = ()
     """The matcher's leaf indices of this pose class's interpretations (when known)."""
+
+    @cached_property
+    def model_from_world(self) -> SE3 | None:
+        """The inverse pose (computed once)."""
+        return None if self.world_from_model is None else self.world_from_model.inverse()
 
 
 @dataclass(frozen=True, eq=False)
@@ -260,13 +272,91 @@ def trace_in(h: Hypothesis, move: FaceMove, state: SensorState) -> FaceTrace | N
     f_m = h.faces.get(state.face)
     if h.world_from_model is None or f_m is None:
         return None
-    model_from_world = h.world_from_model.inverse()
+    model_from_world = h.model_from_world
     poly, p_m = h.poly, model_from_world.apply(state.position)
     n = poly.face_normals[f_m]
     p_m = p_m - (p_m @ n - poly.face_offsets[f_m]) * n
     d_m = model_from_world.rotate(move.direction)
     hit = trace_face(poly, f_m, p_m, d_m)
     return None if hit is None else FaceTrace(f_m, p_m, d_m, hit)
+
+
+_LOOPS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _face_loop(poly: Polyhedron, face: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """A face's sides as arrays (cached per model): start vertices ``a`` (K, 3), side vectors (K, 3), edge ids
+    and the faces beyond them (K,), in loop order (as :func:`~haptic.geometry.tracing.trace_face` walks them)."""
+    per = _LOOPS.setdefault(poly, {})
+    if face not in per:
+        loop = poly.faces[face]
+        a = poly.vertices[list(loop)]
+        seg = np.roll(a, -1, axis=0) - a
+        edges = np.asarray(poly.face_edges[face], dtype=np.int64)
+        beyond = np.where(poly.edge_left_face[edges] == face, poly.edge_right_face[edges], poly.edge_left_face[edges])
+        per[face] = (a, seg, edges, beyond)
+    return per[face]
+
+
+def trace_all(hypotheses: Sequence[Hypothesis], move: FaceMove, state: SensorState) -> list[FaceTrace | None]:
+    """:func:`trace_in` for every hypothesis at once: the sides of every hypothesis's current face are stacked
+    (padded to the longest loop) and the crossing of the trace with each side solved in one array operation
+    (in the face's plane, ``start + t d = a + u (b − a)``); the first side met ahead, clear of its ends, is the
+    hit. The same outcome as :func:`~haptic.geometry.tracing.trace_face` for each hypothesis."""
+    out: list[FaceTrace | None] = [None] * len(hypotheses)
+    rows, starts, dirs, dirs_raw, normals, loops = [], [], [], [], [], []
+    for i, h in enumerate(hypotheses):
+        f_m = h.faces.get(state.face)
+        if h.world_from_model is None or f_m is None:
+            continue
+        model_from_world = h.model_from_world
+        poly, p_m = h.poly, model_from_world.apply(state.position)
+        n = poly.face_normals[f_m]
+        p_m = p_m - (p_m @ n - poly.face_offsets[f_m]) * n
+        d_m = model_from_world.rotate(move.direction)
+        d = d_m - (d_m @ n) * n
+        norm = np.linalg.norm(d)
+        if norm < 1e-9:
+            continue
+        rows.append(i)
+        starts.append(p_m)
+        dirs.append(d / norm)
+        dirs_raw.append(d_m)
+        normals.append(n)
+        loops.append(_face_loop(poly, f_m))
+    if not rows:
+        return out
+    k = max(len(lp[2]) for lp in loops)
+    m = len(rows)
+    a = np.zeros((m, k, 3))
+    seg = np.zeros((m, k, 3))
+    real = np.zeros((m, k), dtype=bool)
+    for j, lp in enumerate(loops):
+        a[j, : len(lp[2])], seg[j, : len(lp[2])], real[j, : len(lp[2])] = lp[0], lp[1], True
+    start, d, n = np.array(starts), np.array(dirs), np.array(normals)
+    r = a - start[:, None]
+    den = np.einsum("mkc,mc->mk", np.cross(d[:, None], seg), n)
+    safe = np.where(np.abs(den) > 1e-15, den, 1.0)
+    t = np.einsum("mkc,mc->mk", np.cross(r, seg), n) / safe
+    u = np.einsum("mkc,mkc->mk", np.cross(r, d[:, None]), n[:, None].repeat(k, axis=1)) / safe
+    miss = start[:, None] + t[..., None] * d[:, None] - (a + u[..., None] * seg)
+    ok = real & (np.abs(den) > 1e-15) & (t > 1e-12) & (u >= -1e-12) & (u <= 1 + 1e-12)
+    ok &= np.linalg.norm(miss, axis=2) <= 1e-7
+    t_ok = np.where(ok, t, np.inf)
+    best = np.argmin(t_ok, axis=1)
+    for j, i in enumerate(rows):
+        b = int(best[j])
+        if not np.isfinite(t_ok[j, b]):
+            continue
+        seg_len = float(np.linalg.norm(seg[j, b]))
+        if min(u[j, b], 1 - u[j, b]) * seg_len < 1e-6:
+            continue
+        _, _, edges, beyond = loops[j]
+        tj = float(t[j, b])
+        hit = FaceHit(edge=int(edges[b]), distance=tj, point=start[j] + tj * d[j], next_face=int(beyond[b]))
+        f_m = hypotheses[i].faces[state.face]
+        out[i] = FaceTrace(f_m, starts[j], dirs_raw[j], hit)
+    return out
 
 
 def predict_one(
@@ -278,17 +368,22 @@ def predict_one(
 
 
 def _predict_one(
-    h: Hypothesis, move: Move, state: SensorState, components: Mapping[int, DataComponent], config: PlannerConfig
+    h: Hypothesis,
+    move: Move,
+    state: SensorState,
+    components: Mapping[int, DataComponent],
+    config: PlannerConfig,
+    trace: FaceTrace | None | bool = False,
 ) -> tuple[np.ndarray, float, float]:
     nan_face, nan_edge, nan_vertex = np.full(3, np.nan), np.full(1, np.nan), np.full(2, np.nan)
     costs = config.costs
     if h.world_from_model is None:
         return {"face": nan_face, "edge": nan_edge, "vertex": nan_vertex}[move.kind], np.nan, np.nan
-    model_from_world = h.world_from_model.inverse()
+    model_from_world = h.model_from_world
     p_m = model_from_world.apply(state.position)
     poly = h.poly
     if isinstance(move, FaceMove):
-        tr = trace_in(h, move, state)
+        tr = trace_in(h, move, state) if trace is False else trace
         if tr is None:
             return nan_face, np.nan, np.nan
         hit = tr.hit
@@ -340,8 +435,9 @@ def predict(
 ) -> Prediction:
     """Every hypothesis's predicted outcome and cost for one candidate move."""
     rows, costs, clear = [], [], []
-    for h in hypotheses:
-        o, c, cl = _predict_one(h, move, state, components, config)
+    traces = trace_all(hypotheses, move, state) if isinstance(move, FaceMove) else [False] * len(hypotheses)
+    for h, tr in zip(hypotheses, traces, strict=True):
+        o, c, cl = _predict_one(h, move, state, components, config, tr)
         rows.append(o)
         costs.append(c)
         clear.append(cl)

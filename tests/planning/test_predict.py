@@ -79,3 +79,36 @@ def test_predicted_eliminations_agree_with_the_matcher():
         P.PlannerPolicy.choose = original
     assert total > 500
     assert agree / total > 0.95
+
+
+def test_trace_all_equals_trace_in_for_each_hypothesis():
+    """The batched face trace gives each hypothesis the trace of its own world."""
+    from haptic.geometry import tracing
+    from haptic.geometry.generate import generate_library
+    from haptic.planning.moves import FaceMove, SensorState
+    from haptic.planning.predict import trace_all, trace_in
+
+    models = generate_library(12, seed=4)
+    rng = np.random.default_rng(0)
+    pos = np.array([0.01, 0.02, 0.03])
+    hyps = []
+    for _ in range(200):
+        m = models[int(rng.integers(len(models)))]
+        f = int(rng.integers(m.n_faces))
+        q = tracing.random_face_point(m, f, rng, margin=0.002)
+        r = SE3.random(rng).rotation
+        hyps.append(Hypothesis(m.name, m, SE3(r, pos - r @ q), {0: f}, {}, {}))
+    hyps.append(Hypothesis("none", models[0], None, {0: 0}, {}, {}))
+    state = SensorState(position=pos, face=0)
+    met = 0
+    for _ in range(3):
+        d = rng.normal(size=3)
+        move = FaceMove(d / np.linalg.norm(d))
+        for a, b in zip(trace_all(hyps, move, state), [trace_in(h, move, state) for h in hyps], strict=True):
+            assert (a is None) == (b is None)
+            if a is not None:
+                met += 1
+                assert (a.face, a.hit.edge, a.hit.next_face) == (b.face, b.hit.edge, b.hit.next_face)
+                assert abs(a.hit.distance - b.hit.distance) < 1e-12
+                assert np.allclose(a.hit.point, b.hit.point, atol=1e-12)
+    assert met > 500
