@@ -11,6 +11,7 @@ from haptic.errors import BenchError
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
+    from haptic.matching.verify import DEFAULT_VERIFY, VERIFY_MODES
     from haptic.planning.policies import POLICY_NAMES
 
     p = sub.add_parser(
@@ -27,7 +28,11 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--episodes", type=int, default=50, help="random (model, pose) draws (default 50)")
     p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--noise", default="1", help="comma-separated sensor-noise levels (x default sigma)")
+    p.add_argument("--noise", default="1", help="comma-separated sensor-noise levels (x default sigma, 0 to 10)")
+    p.add_argument(
+        "--verify", choices=VERIFY_MODES, default=DEFAULT_VERIFY,
+        help=f"verification before recognition (default {DEFAULT_VERIFY}): none, fast or full",
+    )
     p.add_argument("--out", default="out/bench/results.jsonl", help="results file (JSON lines)")
     p.add_argument("--workers", type=int, default=1, help="worker processes (local backend)")
     p.add_argument("--backend", choices=("local", "ray"), default="local")
@@ -44,25 +49,21 @@ def run(args: argparse.Namespace) -> int:
     from haptic.bench.summary import markdown_table, plot_interpretations_vs_cost, summary_rows
     from haptic.geometry import load_library
     from haptic.geometry.io import atomic_write
+    from haptic.matching.components import check_noise_level
     from haptic.planning.policies import POLICY_NAMES
 
     policies = [p.strip() for p in args.policy.split(",") if p.strip()]
     bad = [p for p in policies if p not in POLICY_NAMES]
     if bad or not policies:
         raise BenchError(f"unknown policy {', '.join(bad) or '(none)'}; valid: {', '.join(POLICY_NAMES)}")
-    try:
-        noises = [float(x) for x in args.noise.split(",")]
-    except ValueError:
-        raise BenchError(f"--noise takes comma-separated numbers, got {args.noise!r}") from None
-    if any(n < 0 for n in noises):
-        raise BenchError("--noise levels must be >= 0")
+    noises = [check_noise_level(x) for x in args.noise.split(",")]
     if args.episodes < 1:
         raise BenchError(f"--episodes must be at least 1, got {args.episodes}")
     library = load_library(args.models)
     lib_name = Path(args.models).name if args.models else "seed"
     specs = plan_sweep(
         sorted(library), args.episodes, args.seed, policies, noises,
-        executor=args.executor, models=args.models, max_moves=args.max_moves,
+        executor=args.executor, models=args.models, max_moves=args.max_moves, verify=args.verify,
     )
     out = Path(args.out)
     records = []
@@ -76,7 +77,7 @@ def run(args: argparse.Namespace) -> int:
             bar.update(1)
         bar.close()
     wall = time.perf_counter() - t0
-    table = markdown_table(summary_rows(records, ("library", "executor", "noise", "policy")))
+    table = markdown_table(summary_rows(records, ("library", "executor", "noise", "verify", "policy")))
     atomic_write(out.with_suffix(".md"), table)
     print(table, end="")
     print(f"{len(records)} episodes in {wall:.1f} s ({60 * len(records) / wall:.0f} episodes/min); results: {out}")

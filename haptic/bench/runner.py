@@ -34,6 +34,8 @@ class EpisodeSpec:
     """Move budget: the episode ends as "budget" after this many moves."""
     record: str | None = None
     """Path of a rerun recording to write (None: none)."""
+    verify: str = "none"
+    """Verification before recognition: "none", "fast" or "full" (:mod:`haptic.matching.verify`)."""
 
 
 def plan_sweep(
