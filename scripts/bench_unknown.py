@@ -9,7 +9,8 @@ mode; with ``--baseline N`` it also runs N library objects (the planner's usual 
 the mean path cost of each mode over that without verification.
 
     .venv/bin/python scripts/bench_unknown.py --verify none,fast,full --episodes 2 --workers 2
-    .venv/bin/python scripts/bench_unknown.py --models assets/libraries/lookalike --episodes 1 --baseline 100
+    .venv/bin/python scripts/bench_unknown.py --models assets/libraries/lookalike --episodes 1 --verify full \
+        --baseline 100 --baseline-verify none,full
     .venv/bin/python scripts/bench_unknown.py --executor physics --episodes 1 --models-only BOX01,WEDGE01
 
 Results (one JSON line per episode) go to ``OUT/<library>_<executor>.jsonl``, the table to the same name with
@@ -114,6 +115,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--verify", default="none,fast,full", help="comma-separated verification modes")
     ap.add_argument("--episodes", type=int, default=2, help="episodes (random poses) per variant")
     ap.add_argument("--baseline", type=int, default=0, help="library episodes per mode for the cost of verification")
+    ap.add_argument("--baseline-verify", default="", help="modes of the library episodes (default: those of --verify)")
     ap.add_argument("--noise", type=float, default=1.0)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--workers", type=int, default=2)
@@ -142,7 +144,7 @@ def main(argv: list[str] | None = None) -> int:
                         ))  # fmt: skip
                         meta.append((name, kind, size))
         if args.baseline:
-            for mode in modes:
+            for mode in [m for m in args.baseline_verify.split(",") if m] or modes:
                 for s in plan_sweep(names, args.baseline, args.seed + 1, ["planner"], (args.noise,),
                                     executor=args.executor, models=args.models, max_moves=args.max_moves,
                                     verify=mode):  # fmt: skip

@@ -172,11 +172,11 @@ def check_noise_level(level: float, option: str = "--noise") -> float:
     :class:`~haptic.errors.HapticError` naming the option and the valid range."""
     from haptic.errors import HapticError
 
+    lo, hi = NOISE_LEVELS
     try:
         x = float(level)
     except (TypeError, ValueError):
-        raise HapticError(f"{option} takes a number, got {level!r}") from None
-    lo, hi = NOISE_LEVELS
+        raise HapticError(f"{option} takes a number from {lo:g} to {hi:g}, got {level!r}") from None
     if not np.isfinite(x) or not lo <= x <= hi:
         raise HapticError(f"{option} {level!r} is out of range: a noise level is a finite number from {lo:g} "
                           f"(noiseless) to {hi:g} (x the default sensor noise)")  # fmt: skip
