@@ -428,6 +428,8 @@ def run_loop(
             if obs.on_move:
                 obs.on_move(n_moves, result, tree.count, rec)
 
+    if verifier is not None and outcome == NO_MATCH and verifier.status == "verifying":
+        verifier.status = "mismatch"  # the matcher itself left no interpretation during the verification
     recognized = rec.model if rec is not None and outcome == RECOGNIZED else None
     err_mm = err_deg = None
     in_library = spec.model in library

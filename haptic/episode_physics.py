@@ -27,7 +27,10 @@ def noise_models(level: float):
     """One noise level for the simulated hand: the simulated sensors' noise (PHYSICS_NOTES levels x ``level``),
     the segmenter's bounds (its σ x ``level``, the systematic floors unchanged), hence the matcher's bounds
     (the segmented components carry them), and the planner's outcome bounds (:class:`SensorNoise` x ``level``).
-    Returns ``(sim noise, segment bounds, planner noise)``; ``level`` must be within
+    The bounds do not shrink below the default level (``max(level, 1)``): the simulated contacts scatter by
+    about that much with ideal sensors (contact discretisation, pad compliance; noiseless, normals beside a
+    seam of the simulated pieces read 1.5° off), and a segmenter fitting with σ = 0 fails. Returns ``(sim
+    noise, segment bounds, planner noise)``; ``level`` must be within
     :data:`~haptic.matching.components.NOISE_LEVELS`."""
     from haptic.executor.segment import SegmentBounds
     from haptic.matching.components import check_noise_level
@@ -36,8 +39,9 @@ def noise_models(level: float):
     level = check_noise_level(level)
     n = SimNoise.from_notes()
     sim_noise = SimNoise(n.force_std * level, n.normal_std * level, n.point_std * level, n.joint_std * level)
-    bounds = SegmentBounds.from_noise(n.force_std, n.normal_std, n.point_std).scaled(level)
-    return sim_noise, bounds, SensorNoise().scaled(level)
+    bounded = max(level, 1.0)
+    bounds = SegmentBounds.from_noise(n.force_std, n.normal_std, n.point_std).scaled(bounded)
+    return sim_noise, bounds, SensorNoise().scaled(bounded)
 
 
 def run_physics_episode(
