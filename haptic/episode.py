@@ -18,7 +18,7 @@ from haptic.errors import HapticError
 from haptic.geometry import SE3, Polyhedron, library_twin, resolve_model
 from haptic.geometry.library_cache import cached_library
 from haptic.geometry.se3 import matrix_to_quat, rotation_angle
-from haptic.matching.components import DataComponent, SensorNoise
+from haptic.matching.components import DataComponent, SensorNoise, check_noise_level
 from haptic.matching.recognition import AMBIGUOUS, EXPLORING, NO_MATCH, RECOGNIZED, Recognition, recognize
 from haptic.matching.tree import InterpretationTree
 from haptic.planning.moves import CostModel, Move, MoveResult
@@ -71,6 +71,8 @@ class EpisodeRecord:
     sim_time_s: float | None = None
     perception: dict | None = None
     detail: str = ""
+    verify: str = "none"
+    verified: dict | None = None
 
     def to_json(self) -> dict:
         return asdict(self)
@@ -279,7 +281,7 @@ def run_episode(
     root = np.random.SeedSequence(spec.seed)
     pose_rng, exec_rng, policy_rng = (np.random.default_rng(s) for s in root.spawn(3))
     world_from_model = SE3.random(pose_rng, translation_scale=0.1)
-    noise = SensorNoise().scaled(spec.noise)
+    noise = SensorNoise().scaled(check_noise_level(spec.noise))
     executor = make_geometric_executor(true_model, world_from_model, noise, exec_rng, config.costs)
     return run_loop(
         spec, library, true_model, world_from_model, executor, noise, config,
@@ -317,6 +319,11 @@ def run_loop(
     rec: Recognition | None = None
     outcome, detail = EXPLORING, ""
     fallback = RandomPolicy()
+    verifier = None
+    if spec.verify != "none":
+        from haptic.planning.verify import Verifier
+
+        verifier = Verifier(spec.verify, noise, config)
 
     touched: list[tuple[np.ndarray, np.ndarray]] = []
 
@@ -355,14 +362,26 @@ def run_loop(
             obs.on_move(0, first, tree.count, rec)
         fixed = ["face", "edge", "vertex"]
         while True:
-            if rec is not None and rec.status in (RECOGNIZED, AMBIGUOUS, NO_MATCH):
+            verifying = verifier is not None and rec is not None and rec.status == RECOGNIZED
+            if verifying:
+                verdict = verifier.verdict(tree, rec, cost)
+                if verdict != "verifying":
+                    outcome = NO_MATCH if verdict == "mismatch" else RECOGNIZED
+                    if verdict == "mismatch":
+                        chk = verifier.check
+                        detail = (f"verification: data component {chk.component} ({chk.what}) off the recognised "
+                                  f"pose by {chk.worst:.2f} bounds")  # fmt: skip
+                    break
+            elif rec is not None and rec.status in (RECOGNIZED, AMBIGUOUS, NO_MATCH):
                 outcome = rec.status
                 break
             if cost > spec.budget or n_moves >= spec.max_moves:
                 outcome = "budget"
                 break
             move = None
-            if fixed:
+            if verifying:
+                move = verifier.choose(hypotheses_from(tree, rec)[0], state, components, tuple(failed_here))
+            if fixed and move is None:
                 hyps = (
                     tuple(hypotheses_from(tree, rec))
                     if config.table_z is not None and rec is not None and rec.classes else ()
@@ -372,7 +391,7 @@ def run_loop(
                 t_dec = time.perf_counter()
                 hyps = hypotheses_from(tree, rec) if rec is not None and rec.classes else []
                 ctx = Context(hyps, state, components, noise, config, avoid=tuple(failed_here), tree=tree)
-                chooser = policy if len(hyps) >= 2 else fallback
+                chooser = policy if len(hyps) >= 2 and not verifying else fallback
                 try:
                     decision = chooser.choose(ctx, rng)
                 except HapticError as exc:
@@ -410,6 +429,8 @@ def run_loop(
             if obs.on_move:
                 obs.on_move(n_moves, result, tree.count, rec)
 
+    if verifier is not None and outcome == NO_MATCH and verifier.status == "verifying":
+        verifier.status = "mismatch"  # the matcher itself left no interpretation during the verification
     recognized = rec.model if rec is not None and outcome == RECOGNIZED else None
     err_mm = err_deg = None
     in_library = spec.model in library
@@ -452,6 +473,8 @@ def run_loop(
         decision_times_s=[round(t, 6) for t in decision_times],
         failed_moves=failed_total,
         detail=detail,
+        verify=spec.verify,
+        verified=verifier.record(cost) if verifier is not None else None,
     )
     if obs.on_end:
         obs.on_end(record)

@@ -10,6 +10,7 @@ from haptic.errors import HapticError, RecordingError
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
+    from haptic.matching.verify import DEFAULT_VERIFY, VERIFY_MODES
     from haptic.options import noise_level, positive_int, seed_int
     from haptic.planning.policies import POLICY_NAMES
 
@@ -26,8 +27,13 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--executor", choices=("geometric", "physics"), default="geometric")
     p.add_argument("--seed", type=seed_int, default=0, help="seed of the pose, noise and policy (an integer >= 0)")
     p.add_argument("--policy", default="planner", choices=POLICY_NAMES)
-    p.add_argument("--noise", type=noise_level, default=1.0, help="sensor-noise level (x default sigma)")
+    p.add_argument("--noise", type=noise_level, default=1.0, help="sensor-noise level, x the default sigma (0 to 10)")
     p.add_argument("--max-moves", type=positive_int, default=40)
+    p.add_argument(
+        "--verify", choices=VERIFY_MODES, default=DEFAULT_VERIFY,
+        help=f"verification before recognition (default {DEFAULT_VERIFY}): none, fast (pose check; every face "
+        "and edge measured) or full (also every vertex)",
+    )  # fmt: skip
     p.add_argument("--json", metavar="OUT", help="write the episode's JSON record here")
     p.add_argument("--record", metavar="OUT.rrd", help="write a rerun recording here")
     p.add_argument("--spawn", action="store_true", help="open the rerun viewer (where one is installed)")
@@ -45,6 +51,16 @@ def summary_lines(rec: dict) -> list[str]:
         f"data        {rec['faces']} faces, {rec['edges']} edges, {rec['vertices']} vertices",
         "interpret.  " + " -> ".join(str(c) for c in rec["interpretations"]),
     ]
+    lines.append("verdict     " + verdict_line(rec))
+    v = rec.get("verified")
+    if v:
+        line = f"verified    {v['mode']}: {v['status']}"
+        if "faces" in v:
+            line += (f"; measured {v['faces']}/{v['faces_reachable']} faces, {v['edges']}/{v['edges_reachable']} "
+                     f"edges, {v['vertices']}/{v['vertices_reachable']} vertices (reachable)")  # fmt: skip
+        if "pose_residual" in v:
+            line += f"; largest residual {v['pose_residual']:.2f} x its bound ({v['pose_what']})"
+        lines.append(line + f"; {v['moves']} moves, cost {v['cost']:.1f}")
     if rec["pose_error_mm"] is not None:
         lines.append(f"pose error  {rec['pose_error_mm']:.3f} mm, {rec['pose_error_deg']:.3f} deg")
     time_line = f"wall time   {rec['wall_time_s']:.2f} s"
@@ -59,6 +75,14 @@ def summary_lines(rec: dict) -> list[str]:
     if rec.get("detail"):
         lines.append(f"detail      {rec['detail']}")
     return lines
+
+
+def verdict_line(rec: dict) -> str:
+    """The outcome as the summary tables count it: correct, wrong model, right model at a wrong pose, no-match
+    (right or wrong: only an object outside the library should end so), or the outcome as it is."""
+    from haptic.bench.summary import outcome_class
+
+    return outcome_class(rec)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -79,6 +103,7 @@ def run(args: argparse.Namespace) -> int:
     spec = EpisodeSpec(
         model=args.object, seed=args.seed, policy=args.policy, executor=args.executor, noise=args.noise,
         models=args.models, max_moves=args.max_moves, record=args.record, skip_invalid=args.skip_invalid,
+        verify=args.verify,
     )
     observer = None
     recorder = None

@@ -23,6 +23,27 @@ STEEP_DESCENT_RISK = 0.5
 moves often lose the surface rolling over the edge they meet)."""
 
 
+def noise_models(level: float):
+    """One noise level for the simulated hand: the simulated sensors' noise (PHYSICS_NOTES levels x ``level``),
+    the segmenter's bounds (its σ x ``level``, the systematic floors unchanged), hence the matcher's bounds
+    (the segmented components carry them), and the planner's outcome bounds (:class:`SensorNoise` x ``level``).
+    The bounds do not shrink below the default level (``max(level, 1)``): the simulated contacts scatter by
+    about that much with ideal sensors (contact discretisation, pad compliance; noiseless, normals beside a
+    seam of the simulated pieces read 1.5° off), and a segmenter fitting with σ = 0 fails. Returns ``(sim
+    noise, segment bounds, planner noise)``; ``level`` must be within
+    :data:`~haptic.matching.components.NOISE_LEVELS`."""
+    from haptic.executor.segment import SegmentBounds
+    from haptic.matching.components import check_noise_level
+    from haptic.sim import SensorNoise as SimNoise
+
+    level = check_noise_level(level)
+    n = SimNoise.from_notes()
+    sim_noise = SimNoise(n.force_std * level, n.normal_std * level, n.point_std * level, n.joint_std * level)
+    bounded = max(level, 1.0)
+    bounds = SegmentBounds.from_noise(n.force_std, n.normal_std, n.point_std).scaled(bounded)
+    return sim_noise, bounds, SensorNoise().scaled(bounded)
+
+
 def run_physics_episode(
     spec: EpisodeSpec,
     library: dict[str, Polyhedron] | None = None,
@@ -35,7 +56,6 @@ def run_physics_episode(
     from haptic.executor.physics import PhysicsExecutor
     from haptic.executor.primitives import TouchConfig
     from haptic.sim import RobotInterface, Simulation, compose_scene, random_object_pose
-    from haptic.sim import SensorNoise as SimNoise
     from haptic.sim.scene import TABLE_TOP_Z, scene_object_from_polyhedron
 
     library = library if library is not None else load_library(spec.models, skip_invalid=spec.skip_invalid)
@@ -50,14 +70,9 @@ def run_physics_episode(
     pose_rng, exec_rng, policy_rng, sim_seq = (np.random.default_rng(s) for s in root.spawn(4))
     obj = scene_object_from_polyhedron(true_model)
     pose = random_object_pose(obj, pose_rng)
-    sim_noise = SimNoise.from_notes()
-    if spec.noise != 1.0:
-        sim_noise = SimNoise(
-            sim_noise.force_std * spec.noise, sim_noise.normal_std * spec.noise,
-            sim_noise.point_std * spec.noise, sim_noise.joint_std * spec.noise,
-        )  # fmt: skip
+    sim_noise, bounds, noise = noise_models(spec.noise)
     sim = Simulation(compose_scene(obj, pose), noise=sim_noise, seed=int(sim_seq.integers(2**31 - 1)))
-    executor = PhysicsExecutor(RobotInterface(sim), costs=config.costs, rng=exec_rng)
+    executor = PhysicsExecutor(RobotInterface(sim), bounds=bounds, costs=config.costs, rng=exec_rng)
     results = []
     execute, start = executor.execute, executor.start
 
@@ -74,7 +89,7 @@ def run_physics_episode(
     executor.start, executor.execute = logged_start, logged_execute  # keep the move results for scoring
     world_from_model = SE3(np.asarray(pose)[:3, :3], np.asarray(pose)[:3, 3])
     record = run_loop(
-        spec, library, true_model, world_from_model, executor, SensorNoise(), config,
+        spec, library, true_model, world_from_model, executor, noise, config,
         policy or make_policy(spec.policy), policy_rng, observer,
     )  # fmt: skip
     record.sim_time_s = round(float(sim.time), 4)

@@ -40,13 +40,20 @@ positive_int = int_at_least(1)
 
 
 def noise_level(text: str) -> float:
-    """An argparse type: a finite sensor-noise level >= 0 (a multiple of the default σ)."""
+    """An argparse type: a finite sensor-noise level within
+    :data:`~haptic.matching.components.NOISE_LEVELS` (a multiple of the default σ)."""
+    from haptic.matching.components import NOISE_LEVELS
+
+    lo, hi = NOISE_LEVELS
     try:
         value = float(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
-    if not math.isfinite(value) or value < 0:
-        raise argparse.ArgumentTypeError(f"must be a finite number >= 0, got {text!r}")
+        raise argparse.ArgumentTypeError(f"expected a number from {lo:g} to {hi:g}, got {text!r}") from None
+    if not math.isfinite(value) or not lo <= value <= hi:
+        raise argparse.ArgumentTypeError(
+            f"a noise level is a finite number from {lo:g} (noiseless) to {hi:g} (x the default sensor noise), "
+            f"got {text!r}"
+        )
     return value
 
 
@@ -54,7 +61,7 @@ def noise_levels(text: str) -> list[float]:
     """An argparse type: comma-separated noise levels, each as :func:`noise_level`."""
     parts = [p.strip() for p in text.split(",")]
     if not parts or any(not p for p in parts):
-        raise argparse.ArgumentTypeError(f"expected comma-separated numbers >= 0, got {text!r}")
+        raise argparse.ArgumentTypeError(f"expected comma-separated noise levels, got {text!r}")
     return [noise_level(p) for p in parts]
 
 

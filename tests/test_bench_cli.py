@@ -63,4 +63,4 @@ def test_bench_physics_executor_on_a_small_library(tmp_path, capsys):
     assert all(r["outcome"] in ("recognized", "ambiguous", "no-match", "budget", "failed") for r in records)
     assert any(r["outcome"] == "recognized" for r in records)
     printed = capsys.readouterr().out
-    assert "| small | physics | 1.0 | planner | 2 |" in printed and "episodes/min" in printed
+    assert "| small | physics | 1.0 | full | planner | 2 |" in printed and "episodes/min" in printed

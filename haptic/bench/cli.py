@@ -16,6 +16,7 @@ EXIT_SIGINT, EXIT_SIGTERM = 130, 143
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
+    from haptic.matching.verify import DEFAULT_VERIFY, VERIFY_MODES
     from haptic.options import noise_levels, positive_int, seed_int
     from haptic.planning.policies import POLICY_NAMES
 
@@ -38,7 +39,11 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--episodes", type=positive_int, default=50, help="random (model, pose) draws (default 50)")
     p.add_argument("--seed", type=seed_int, default=0, help="seed of the sweep's draws (an integer >= 0)")
     p.add_argument(
-        "--noise", type=noise_levels, default="1", help="comma-separated sensor-noise levels (x default sigma)"
+        "--noise", type=noise_levels, default="1", help="comma-separated sensor-noise levels (x default sigma, 0 to 10)"
+    )
+    p.add_argument(
+        "--verify", choices=VERIFY_MODES, default=DEFAULT_VERIFY,
+        help=f"verification before recognition (default {DEFAULT_VERIFY}): none, fast or full",
     )
     p.add_argument("--out", default="out/bench/results.jsonl", help="results file (JSON lines)")
     p.add_argument("--workers", type=positive_int, default=1,
@@ -83,6 +88,7 @@ def _run(args: argparse.Namespace, held: DeferredInterrupts) -> int:
     specs = plan_sweep(
         sorted(library), args.episodes, args.seed, policies, args.noise,
         executor=args.executor, models=args.models, max_moves=args.max_moves, skip_invalid=args.skip_invalid,
+        verify=args.verify,
     )
     has_results = out.is_file() and out.stat().st_size > 0
     if has_results and not (args.resume or args.force):
@@ -165,7 +171,7 @@ def _write_summary(out: Path, no_plot: bool, quiet: bool = False) -> None:
     from haptic.geometry.io import atomic_write
 
     records = read_results(out) if out.exists() else []
-    table = markdown_table(summary_rows(records, ("library", "executor", "noise", "policy")))
+    table = markdown_table(summary_rows(records, ("library", "executor", "noise", "verify", "policy")))
     atomic_write(out.with_suffix(".md"), table)
     if not quiet:
         print(table, end="")

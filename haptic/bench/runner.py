@@ -44,6 +44,8 @@ class EpisodeSpec:
     """Path of a rerun recording to write (None: none)."""
     skip_invalid: bool = False
     """Use the library's valid models when some of its files are bad (else refuse the library)."""
+    verify: str = "none"
+    """Verification before recognition: "none", "fast" or "full" (:mod:`haptic.matching.verify`)."""
 
 
 def plan_sweep(

@@ -17,6 +17,17 @@ def _group(records: Sequence[dict], keys: Sequence[str]) -> dict[tuple, list[dic
     return dict(sorted(out.items(), key=lambda kv: tuple(str(x) for x in kv[0])))
 
 
+def outcome_class(r: dict) -> str:
+    """How an episode ended, failures told apart: "correct", "wrong model" (a library model that is not the
+    object, or any model for an object outside the library), "wrong pose" (the right model at a pose off by
+    more than the correctness tolerance), "no-match", or the outcome itself (ambiguous, budget, failed)."""
+    if r["outcome"] == "recognized":
+        if r.get("correct"):
+            return "correct"
+        return "wrong model" if r.get("recognized") != r.get("model") else "wrong pose"
+    return r["outcome"]
+
+
 def summary_rows(records: Sequence[dict], keys: Sequence[str] = ("library", "policy")) -> list[dict]:
     """One row per group: episodes, outcome counts, moves and path cost (mean and median) of the recognised
     episodes, and the mean path cost spent over all episodes (an episode that ran out of budget counts with
@@ -35,6 +46,8 @@ def summary_rows(records: Sequence[dict], keys: Sequence[str] = ("library", "pol
             correct=correct,
             correct_pct=100.0 * correct / len(rs),
             recognized=len(ok),
+            wrong_model=sum(outcome_class(r) == "wrong model" for r in rs),
+            wrong_pose=sum(outcome_class(r) == "wrong pose" for r in rs),
             ambiguous=sum(r["outcome"] == "ambiguous" for r in rs),
             no_match=sum(r["outcome"] == "no-match" for r in rs),
             budget=sum(r["outcome"] == "budget" for r in rs),
@@ -61,14 +74,17 @@ def markdown_table(rows: Sequence[dict]) -> str:
     """The summary rows as a markdown table."""
     if not rows:
         return "(no episodes)\n"
-    group_keys = [k for k in rows[0] if k in ("library", "policy", "executor", "noise", "model")]
-    cols = [*group_keys, "episodes", "correct %", "ambig.", "no-match", "budget", "failed", "moves mean",
-            "moves median", "cost mean", "cost median", "cost mean (all)", "decide ms", "pose mm", "pose deg"]
+    group_keys = [k for k in rows[0] if k in ("library", "policy", "executor", "noise", "verify", "model")]
+    cols = [*group_keys, "episodes", "correct %", "wrong model", "wrong pose", "ambig.", "no-match", "budget",
+            "failed", "moves mean", "moves median", "cost mean", "cost median", "cost mean (all)", "decide ms",
+            "pose mm", "pose deg"]
     lines = ["| " + " | ".join(cols) + " |", "|" + "|".join("---" for _ in cols) + "|"]
     for r in rows:
         vals = [str(r[k]) for k in group_keys] + [
             str(r["episodes"]),
             f"{r['correct_pct']:.1f}",
+            str(r["wrong_model"]),
+            str(r["wrong_pose"]),
             str(r["ambiguous"]),
             str(r["no_match"]),
             str(r["budget"]),

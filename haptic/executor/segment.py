@@ -16,7 +16,7 @@ used, plus the fit residuals) and a systematic floor (pad compliance, contact-po
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -77,6 +77,12 @@ class SegmentBounds:
     def from_noise(cls, force_std: float, normal_std: float, point_std: float, **kw) -> SegmentBounds:
         """Bounds for a sensor with these standard deviations [N, rad, m]."""
         return cls(normal_sigma=normal_std, point_sigma=point_std, force_sigma=force_std, **kw)
+
+    def scaled(self, level: float) -> SegmentBounds:
+        """The bounds for a sensor whose noise is ``level`` times this one's (the statistical σ scale; the
+        systematic floors, pad compliance and detection delay, do not)."""
+        return replace(self, normal_sigma=self.normal_sigma * level, point_sigma=self.point_sigma * level,
+                       force_sigma=self.force_sigma * level)  # fmt: skip
 
     def bound(self, sigma: float, floor: float) -> float:
         return self.k * math.sqrt(sigma * sigma + floor * floor)

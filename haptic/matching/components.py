@@ -161,6 +161,28 @@ class SensorNoise:
         )
 
 
+NOISE_LEVELS = (0.0, 10.0)
+"""The accepted range of a noise level (``--noise``): 0 (noiseless) to 10 × the default σ. Beyond it the error
+bounds are so wide that the matcher keeps interpretations by the million (the tree's memory grows without a
+useful verdict); see README, "Noise"."""
+
+
+def check_noise_level(level: float, option: str = "--noise") -> float:
+    """``level`` as a float when it is a finite number within :data:`NOISE_LEVELS`, else a
+    :class:`~haptic.errors.HapticError` naming the option and the valid range."""
+    from haptic.errors import HapticError
+
+    lo, hi = NOISE_LEVELS
+    try:
+        x = float(level)
+    except (TypeError, ValueError):
+        raise HapticError(f"{option} takes a number from {lo:g} to {hi:g}, got {level!r}") from None
+    if not np.isfinite(x) or not lo <= x <= hi:
+        raise HapticError(f"{option} {level!r} is out of range: a noise level is a finite number from {lo:g} "
+                          f"(noiseless) to {hi:g} (x the default sensor noise)")  # fmt: skip
+    return x
+
+
 # ------------------------------------------------------------------------------------------- serialisation
 
 
@@ -218,7 +240,9 @@ __all__ = [
     "DataEdge",
     "DataFace",
     "DataVertex",
+    "NOISE_LEVELS",
     "SensorNoise",
+    "check_noise_level",
     "component_from_dict",
     "component_to_dict",
     "from_json",

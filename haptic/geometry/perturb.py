@@ -1,0 +1,129 @@
+"""Perturbed variants of a model: objects close to a library model but not in it.
+
+They are what a user's real part looks like next to the library's nominal model (one dimension off, a corner
+dented, an edge broken), and what the verification before recognition must turn away as ``no-match``. Each
+function returns a new validated :class:`Polyhedron`; geometry that the change would invalidate (a vertex moved
+through a face, a chamfer larger than its faces) raises :class:`~haptic.errors.ModelError`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from haptic.errors import ModelError
+from haptic.geometry.polyhedron import Polyhedron, triangulate_polygon
+
+
+def scale_dimension(poly: Polyhedron, axis: int, factor: float, name: str | None = None) -> Polyhedron:
+    """The model stretched by ``factor`` along model axis ``axis`` (0, 1, 2) about its centroid: an affine map,
+    so faces stay planar (a box 100 mm long becomes 103 mm long at factor 1.03)."""
+    if axis not in (0, 1, 2) or not np.isfinite(factor) or factor <= 0:
+        raise ModelError(f"{poly.name}: scale_dimension takes axis 0, 1 or 2 and a factor > 0, got {axis}, {factor}")
+    v = np.array(poly.vertices)
+    c = poly.centroid
+    v[:, axis] = c[axis] + factor * (v[:, axis] - c[axis])
+    return Polyhedron.from_faces(v, poly.faces, name=name or f"{poly.name}_x{axis}_{factor:g}")
+
+
+def vertex_normal(poly: Polyhedron, vertex: int) -> np.ndarray:
+    """Unit mean of the outward normals of the faces at ``vertex`` (weighted equally)."""
+    n = poly.face_normals[list(poly.vertex_faces[vertex])].sum(axis=0)
+    return n / max(float(np.linalg.norm(n)), 1e-12)
+
+
+def move_vertex(poly: Polyhedron, vertex: int, offset: float, name: str | None = None) -> Polyhedron:
+    """The model with one vertex moved ``offset`` [m] along its outward vertex normal (:func:`vertex_normal`).
+
+    Each face at the vertex keeps its plane away from it: the corner triangle (the vertex and its two
+    neighbours in the loop) becomes a face of its own, tilted, and the rest of the face stays (a triangle face
+    tilts whole; a face the move runs in the plane of stays whole). Where the corner triangle would leave the
+    face (a reflex corner) the face is triangulated.
+    """
+    v = np.array(poly.vertices)
+    moved = v.copy()
+    along = vertex_normal(poly, vertex)
+    moved[vertex] = v[vertex] + offset * along
+    faces: list[tuple[int, ...]] = []
+    for fi, loop in enumerate(poly.faces):
+        if vertex not in loop or len(loop) == 3 or abs(float(poly.face_normals[fi] @ along)) < 1e-9:
+            faces.append(loop)
+            continue
+        k = loop.index(vertex)
+        prev, nxt = loop[k - 1], loop[(k + 1) % len(loop)]
+        n = poly.face_normals[fi]
+        convex_corner = float(np.cross(v[vertex] - v[prev], v[nxt] - v[vertex]) @ n) > 0
+        if convex_corner:
+            faces.append((prev, vertex, nxt))
+            faces.append(tuple(i for i in loop if i != vertex))
+        else:
+            faces.extend(triangulate_polygon(v, loop, n))
+    return Polyhedron.from_faces(moved, faces, name=name or f"{poly.name}_v{vertex}_{offset * 1e3:g}mm")
+
+
+def chamfer_edge(poly: Polyhedron, edge: int, size: float, name: str | None = None) -> Polyhedron:
+    """The model with convex edge ``edge`` bevelled: a plane through the two lines ``size`` [m] in from the edge
+    on its two faces cuts the edge off. The cut must stay local: only the edge's two end vertices may lie beyond
+    the plane (else :class:`ModelError`)."""
+    if poly.edge_convexity[edge] <= 0:
+        raise ModelError(f"{poly.name}: edge {edge} is concave; only a convex edge can be chamfered")
+    v = np.asarray(poly.vertices)
+    p, b = poly.edge_points[edge], poly.edge_directions[edge]
+    fl, fr = int(poly.edge_left_face[edge]), int(poly.edge_right_face[edge])
+    in_l = np.cross(poly.face_normals[fl], b)  # left face lies left of b: n × b points into it
+    in_r = -np.cross(poly.face_normals[fr], b)
+    a_l, a_r = p + size * in_l, p + size * in_r
+    n = np.cross(b, a_l - a_r)
+    n /= np.linalg.norm(n)
+    if n @ (p - a_l) < 0:
+        n = -n  # n points to the side that is cut off (where the edge is)
+    side = (v - a_l) @ n
+    ends = set(int(i) for i in poly.edges[edge])
+    beyond = {int(i) for i in np.flatnonzero(side > 1e-9)}
+    if beyond != ends:
+        raise ModelError(
+            f"{poly.name}: a {size * 1e3:g} mm chamfer of edge {edge} would cut vertices {sorted(beyond - ends)} "
+            "too (a smaller chamfer or another edge would stay local)"
+        )
+    points: list[np.ndarray] = []
+
+    def index_of(q: np.ndarray) -> int:
+        for i, x in enumerate(points):
+            if np.linalg.norm(x - q) < 1e-9:
+                return i
+        points.append(q)
+        return len(points) - 1
+
+    keep = {int(i): index_of(v[i]) for i in range(len(v)) if int(i) not in ends}
+    faces: list[list[int]] = []
+    cut: dict[int, int] = {}  # cap: cut point -> next cut point, following the clipped faces
+    for loop in poly.faces:
+        out: list[int] = []
+        for k, a in enumerate(loop):
+            c = loop[(k + 1) % len(loop)]
+            if a not in ends:
+                out.append(keep[a])
+            if (a in ends) != (c in ends):
+                t = side[a] / (side[a] - side[c])
+                out.append(index_of(v[a] + t * (v[c] - v[a])))
+        if len(out) < 3:
+            raise ModelError(f"{poly.name}: the {size * 1e3:g} mm chamfer of edge {edge} removes a whole face")
+        faces.append(out)
+        if len(out) != len(loop) or any(i in ends for i in loop):
+            # the cut runs along this face between two new points: the cap runs it the other way
+            new = [i for i in out if i >= 0 and not any(np.allclose(points[i], v[j]) for j in keep)]
+            for k, i in enumerate(out):
+                j = out[(k + 1) % len(out)]
+                if i in new and j in new:
+                    cut[j] = i
+    start = next(iter(cut))
+    cap, cur = [start], cut[start]
+    while cur != start:
+        cap.append(cur)
+        cur = cut[cur]
+        if len(cap) > len(cut):
+            raise ModelError(f"{poly.name}: the chamfer of edge {edge} does not close")
+    faces.append(cap)
+    return Polyhedron.from_faces(np.array(points), faces, name=name or f"{poly.name}_e{edge}_ch{size * 1e3:g}mm")
+
+
+__all__ = ["chamfer_edge", "move_vertex", "scale_dimension", "vertex_normal"]

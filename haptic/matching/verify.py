@@ -1,0 +1,232 @@
+"""Verification before recognition: the pose check and what of a model the data have measured.
+
+When one pose class is left the matcher has shown only that no *other* library interpretation fits; an object
+outside the library that is close to one model (one dimension a few percent off, a corner moved) fits that
+model's interpretation until the data measure where it differs. Two checks make a recognition a promise:
+
+- **The pose check** (:func:`pose_check`): the recognised pose, a least-squares fit over every data component
+  (:func:`~haptic.matching.pose.estimate_pose`), must explain each component within its error bounds: a face's
+  normal and every touched point (on the model face's polygon, not only its plane), an edge's direction and
+  both ends of its explored interval (on the model edge's line *and* within the edge's extent), a vertex's
+  position. The pairwise tests of the tree (seed §2.4) each allow the full lever arm of an angular error, so
+  that a 3 mm change of a 100 mm box passes every one of them; one pose fitted to all the data removes most of
+  that slack: a change of ``d`` leaves a residual of about ``d / 2`` on the components at either side of it.
+- **Coverage** (:func:`coverage`): which model faces, edges and vertices the interpretation pairs with data.
+  Verification moves are chosen (:mod:`haptic.planning.verify`) until a coverage target (:data:`TARGETS`) is
+  met; each new component is tested by the tree and by the pose check.
+
+Like Grimson & Huttenlocher's acceptance test ("On the verification of hypothesized matches in model-based
+recognition", MIT AI Memo 1110, 1989) the thresholds derive from the noise model, not from an ad-hoc fraction:
+each residual is compared with its component's own bound ``k σ``, times :data:`POSE_SAFETY` for the error of
+the fitted pose itself; and the coverage target says which features must have been measured, so that a
+change of a feature that is measured is caught by the residual test whatever the number of other features.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from haptic.geometry.distance import point_triangle_distance
+from haptic.geometry.polyhedron import Polyhedron
+from haptic.geometry.se3 import SE3
+from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex
+from haptic.matching.tree import Interpretation
+
+VERIFY_MODES = ("none", "fast", "full")
+"""``none``: recognise as soon as one pose class is left (no checks); ``fast``: the pose check, and every
+reachable face and edge of the model measured; ``full``: the pose check, and every reachable face, edge and
+vertex."""
+DEFAULT_VERIFY = "full"
+"""The default of ``haptic explore`` and ``haptic bench``: the cheapest mode that keeps 0 false recognitions on
+``scripts/bench_unknown.py`` (perturbations ≥ 3 % or ≥ 3 mm)."""
+TARGETS = {
+    "none": (0.0, 0.0, 0.0),
+    "fast": (1.0, 1.0, 0.0),
+    "full": (1.0, 1.0, 1.0),
+}
+"""Coverage target per mode: fractions of the reachable model faces, edges and vertices to be measured."""
+POSE_SAFETY = 2.0
+"""A residual of the fitted pose may reach this many times its component's error bound: the fitted pose is
+itself off by the noise of the data it is fitted to. Measured on the seed library (random walks of 4-19 moves,
+noise 0.5-8x): with every noise draw exactly at its bound (the worst case) the true interpretation's largest
+ratio reached 1.88 (193 walks), with noise drawn inside the bounds 1.15 (200 walks)."""
+ROUND_OFF = 1e-7
+"""Added to every bound: arithmetic round-off [m or rad]."""
+
+
+def check_verify_mode(mode: str) -> str:
+    """``mode`` when it is one of :data:`VERIFY_MODES`, else a :class:`~haptic.errors.HapticError` naming them."""
+    from haptic.errors import HapticError
+
+    if mode not in VERIFY_MODES:
+        raise HapticError(f"--verify {mode!r} is not a verification mode; valid: {', '.join(VERIFY_MODES)}")
+    return mode
+
+
+@dataclass(frozen=True)
+class PoseCheck:
+    """The result of :func:`pose_check`."""
+
+    ok: bool
+    """Whether every residual is within ``POSE_SAFETY`` times its bound."""
+    worst: float
+    """The largest ratio of a residual to its bound (0 without data)."""
+    component: int | None
+    """Id of the data component of the largest ratio."""
+    what: str
+    """What that residual measures ("face normal", "face point", "edge direction", "edge line", "edge extent",
+    "vertex")."""
+    world_from_model: SE3 | None
+    """The fitted pose (None: undetermined)."""
+
+
+def _angle(u: np.ndarray, v: np.ndarray) -> float:
+    return float(np.arccos(np.clip(u @ v / (np.linalg.norm(u) * np.linalg.norm(v)), -1.0, 1.0)))
+
+
+def residual_ratios(
+    model: Polyhedron, data: Sequence[DataComponent], it: Interpretation, world_from_model: SE3
+) -> list[tuple[float, int, str]]:
+    """``(residual / bound, data id, what)`` of every measured quantity of interpretation ``it`` at a pose."""
+    inv = world_from_model.inverse()
+    out: list[tuple[float, int, str]] = []
+    for i, f in it.faces.items():
+        c = data[i]
+        assert isinstance(c, DataFace)
+        n_m = model.face_normals[f]
+        out.append((_angle(inv.rotate(c.normal), n_m) / (c.normal_bound + ROUND_OFF), i, "face normal"))
+        q = inv.apply(c.points)
+        # distance to the model face's polygon: off its plane, or beyond its boundary
+        tri = model.vertices[model.triangles[model.triangle_faces == f]]
+        d = point_triangle_distance(q, tri).min(axis=1)
+        out.append((float(d.max()) / (c.position_bound + ROUND_OFF), i, "face point"))
+    for i, e in it.edges.items():
+        c = data[i]
+        assert isinstance(c, DataEdge)
+        p_m, b_m, l_m = model.edge_points[e], model.edge_directions[e], float(model.edge_lengths[e])
+        s = it.edge_senses.get(i, 0)
+        if s != 0:
+            turn = _angle(inv.rotate(c.direction), s * b_m)
+            out.append((turn / (c.direction_bound + ROUND_OFF), i, "edge direction"))
+        ends = inv.apply(np.array([c.point, c.end_point])) - p_m
+        along = ends @ b_m
+        perp = np.linalg.norm(ends - along[:, None] * b_m, axis=1)
+        rho = c.position_bound + ROUND_OFF
+        out.append((float(perp[0]) / rho, i, "edge line"))
+        out.append((float(perp[1]) / (rho + c.length * c.direction_bound), i, "edge line"))
+        beyond = float(np.maximum(-along, along - l_m).max())
+        out.append((max(beyond, 0.0) / (c.length_bound + ROUND_OFF), i, "edge extent"))
+    for i, v in it.vertices.items():
+        c = data[i]
+        assert isinstance(c, DataVertex)
+        d = float(np.linalg.norm(inv.apply(c.position) - model.vertices[v]))
+        out.append((d / (c.position_bound + ROUND_OFF), i, "vertex"))
+    return out
+
+
+def pose_check(model: Polyhedron, data: Sequence[DataComponent], it: Interpretation) -> PoseCheck:
+    """Whether interpretation ``it``'s least-squares pose (``it.world_from_model``, refined over all its
+    pairings) explains every data component within ``POSE_SAFETY`` times its bounds."""
+    pose = it.world_from_model
+    if pose is None:
+        return PoseCheck(False, float("inf"), None, "pose undetermined", None)
+    ratios = residual_ratios(model, data, it, pose)
+    if not ratios:
+        return PoseCheck(True, 0.0, None, "", pose)
+    worst, cid, what = max(ratios, key=lambda r: r[0])
+    return PoseCheck(bool(worst <= POSE_SAFETY), float(worst), cid, what, pose)
+
+
+@dataclass(frozen=True)
+class Coverage:
+    """Which of a model's faces, edges and vertices the data have measured (under one interpretation)."""
+
+    faces: frozenset[int]
+    """Model faces paired with a data face."""
+    edges: frozenset[int]
+    """Model edges paired with a data edge."""
+    vertices: frozenset[int]
+    """Model vertices paired with a data vertex."""
+    reachable_faces: frozenset[int]
+    """Model faces that count towards the target (all of them without a table)."""
+    reachable_edges: frozenset[int]
+    """Model edges that count."""
+    reachable_vertices: frozenset[int]
+    """Model vertices that count."""
+
+    def fractions(self) -> tuple[float, float, float]:
+        """Measured fraction of the reachable faces, edges and vertices (1 when none is reachable)."""
+
+        def frac(got: frozenset[int], of: frozenset[int]) -> float:
+            return len(got & of) / len(of) if of else 1.0
+
+        return (
+            frac(self.faces, self.reachable_faces),
+            frac(self.edges, self.reachable_edges),
+            frac(self.vertices, self.reachable_vertices),
+        )
+
+    def missing(self, mode: str) -> tuple[frozenset[int], frozenset[int], frozenset[int]]:
+        """The reachable faces, edges and vertices still to be measured for ``mode``'s target."""
+        tf, te, tv = TARGETS[mode]
+        return (
+            self.reachable_faces - self.faces if tf > 0 else frozenset(),
+            self.reachable_edges - self.edges if te > 0 else frozenset(),
+            self.reachable_vertices - self.vertices if tv > 0 else frozenset(),
+        )
+
+    def measured(self) -> int:
+        """Number of reachable features measured (faces, edges and vertices together)."""
+        return (len(self.faces & self.reachable_faces) + len(self.edges & self.reachable_edges)
+                + len(self.vertices & self.reachable_vertices))  # fmt: skip
+
+    def met(self, mode: str) -> bool:
+        """Whether ``mode``'s coverage target is met."""
+        got = self.fractions()
+        return all(g >= t - 1e-12 for g, t in zip(got, TARGETS[mode], strict=True))
+
+    def record(self, model: Polyhedron) -> dict:
+        """The JSON summary: counts measured, counts reachable, totals and fractions."""
+        ff, fe, fv = self.fractions()
+        return {
+            "faces": len(self.faces), "edges": len(self.edges), "vertices": len(self.vertices),
+            "faces_reachable": len(self.reachable_faces), "edges_reachable": len(self.reachable_edges),
+            "vertices_reachable": len(self.reachable_vertices),
+            "faces_total": model.n_faces, "edges_total": model.n_edges, "vertices_total": model.n_vertices,
+            "faces_fraction": round(ff, 4), "edges_fraction": round(fe, 4), "vertices_fraction": round(fv, 4),
+        }  # fmt: skip
+
+
+def coverage(
+    model: Polyhedron,
+    it: Interpretation,
+    reachable: tuple[frozenset[int], frozenset[int], frozenset[int]] | None = None,
+) -> Coverage:
+    """What interpretation ``it`` has measured of ``model``; ``reachable``: the faces, edges and vertices that
+    count (default: all)."""
+    if reachable is None:
+        reachable = (frozenset(range(model.n_faces)), frozenset(range(model.n_edges)),
+                     frozenset(range(model.n_vertices)))  # fmt: skip
+    return Coverage(
+        frozenset(int(f) for f in it.faces.values()),
+        frozenset(int(e) for e in it.edges.values()),
+        frozenset(int(v) for v in it.vertices.values()),
+        *reachable,
+    )
+
+
+__all__ = [
+    "DEFAULT_VERIFY",
+    "POSE_SAFETY",
+    "TARGETS",
+    "VERIFY_MODES",
+    "Coverage",
+    "PoseCheck",
+    "check_verify_mode",
+    "coverage",
+    "pose_check",
+    "residual_ratios",
+]

@@ -1,0 +1,122 @@
+"""Verification in the episode loop, coherent noise levels, and the outcome columns of the summaries."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from haptic.bench.runner import EpisodeSpec
+from haptic.bench.summary import markdown_table, outcome_class, summary_rows
+from haptic.cli import main
+from haptic.episode import run_episode
+from haptic.errors import HapticError
+from haptic.geometry import load_library, save_model
+from haptic.geometry.perturb import chamfer_edge, move_vertex, scale_dimension
+from haptic.matching.components import check_noise_level
+
+LIB = load_library()
+LOOKALIKE = "assets/libraries/lookalike"
+
+# Fixed-seed episodes as the loop ran them before verification existed (outcome, moves, path cost,
+# interpretations after each move): --verify none must reproduce them exactly.
+BEFORE = [
+    ["WEDGE01", 5, 2.0, None, "recognized", 4, 25.521906, [76, 210, 74, 60, 1]],
+    ["LBLOCK01", 7, 0.5, None, "recognized", 6, 29.01837, [76, 210, 210, 132, 25, 9, 1]],
+    ["PYR01", 11, 4.0, None, "recognized", 3, 12.431959, [76, 24, 24, 2]],
+    ["LA_NOTCH_30x20", 9, 1.0, LOOKALIKE, "recognized", 8, 48.39866, [219, 700, 692, 488, 78, 72, 24, 4, 2]],
+]
+
+
+@pytest.mark.parametrize("row", BEFORE, ids=[f"{r[0]}-{r[1]}" for r in BEFORE])
+def test_verify_none_is_the_loop_as_before(row):
+    model, seed, noise, lib, outcome, moves, cost, counts = row
+    r = run_episode(EpisodeSpec(model=model, seed=seed, noise=noise, models=lib, verify="none")).to_json()
+    assert (r["outcome"], r["moves"], r["path_cost"], r["interpretations"]) == (outcome, moves, cost, counts)
+    assert r["verified"] is None
+
+
+CASES = [  # (model, perturbation, seed): episodes of scripts/bench_unknown.py recognised without verification
+    ("PYR01", lambda p: scale_dimension(p, 0, 1.03), 2141492029),
+    ("TETRA01R", lambda p: scale_dimension(p, 2, 1.03), 666239354),
+    ("PYR01", lambda p: move_vertex(p, 0, 4e-3), 1472190200),
+    ("PYR01", lambda p: chamfer_edge(p, 1, 4e-3), 1396850658),
+]
+
+
+@pytest.mark.parametrize("case", CASES, ids=["PYR01-x1.03", "TETRA01R-z1.03", "PYR01-vertex4mm", "PYR01-chamfer"])
+def test_perturbed_object_recognised_without_verification_ends_as_no_match_with_it(case, tmp_path):
+    name, make, seed = case
+    path = tmp_path / f"{name}_variant.json"
+    save_model(make(LIB[name]), path)
+    none = run_episode(EpisodeSpec(model=str(path), seed=seed, verify="none"), library=LIB).to_json()
+    full = run_episode(EpisodeSpec(model=str(path), seed=seed, verify="full"), library=LIB).to_json()
+    assert none["outcome"] == "recognized" and outcome_class(none) == "wrong model"
+    assert full["outcome"] == "no-match" and full["correct"]
+
+
+def test_full_verification_records_what_was_verified():
+    r = run_episode(EpisodeSpec(model="TETRA01R", seed=1, verify="full"), library=LIB).to_json()
+    v = r["verified"]
+    assert r["outcome"] == "recognized" and r["correct"]
+    assert v["status"] == "confirmed" and v["mode"] == "full"
+    assert (v["faces"], v["edges"], v["vertices"]) == (4, 6, 4) and v["vertices_fraction"] == 1.0
+    assert v["pose_residual"] <= 2.0 and v["moves"] >= 1 and v["cost"] > 0
+
+
+@pytest.mark.parametrize("bad", ["nan", "inf", "-1", "1e3", "ten"])
+def test_noise_out_of_range_is_one_line_and_no_episode(bad, capsys):
+    assert main(["explore", "--object", "BOX01", "--noise", bad]) != 0
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "--noise" in err and "0" in err and "10" in err
+    with pytest.raises(HapticError):
+        check_noise_level(bad)
+    with pytest.raises(HapticError):
+        run_episode(EpisodeSpec(model="BOX01", seed=0, noise=float(bad) if bad != "ten" else math.nan))
+
+
+def test_physics_noise_level_sets_sensor_segmenter_and_planner_bounds():
+    from haptic.episode_physics import noise_models
+    from haptic.executor.segment import SegmentBounds
+
+    sim1, seg1, plan1 = noise_models(1.0)
+    sim4, seg4, plan4 = noise_models(4.0)
+    assert seg1 == SegmentBounds()  # level 1 is the executor's default
+    sim0, seg0, plan0 = noise_models(0.0)
+    assert sim0.normal_std == 0 and seg0 == seg1 and plan0 == plan1  # bounds never below the default level
+    assert np.isclose(sim4.normal_std, 4 * sim1.normal_std) and np.isclose(sim4.point_std, 4 * sim1.point_std)
+    assert np.isclose(seg4.normal_sigma, 4 * seg1.normal_sigma) and np.isclose(seg4.point_sigma, 4 * seg1.point_sigma)
+    assert seg4.position_floor == seg1.position_floor  # systematic floors do not scale
+    assert np.isclose(plan4.normal_sigma, 4 * plan1.normal_sigma)
+    assert seg4.bound(seg4.point_sigma, seg4.position_floor) > seg1.bound(seg1.point_sigma, seg1.position_floor)
+
+
+def _rec(**kw):
+    base = dict(model="BOX01", recognized="BOX01", outcome="recognized", correct=True, moves=3, path_cost=10.0,
+                library="seed", policy="planner", pose_error_mm=0.1, pose_error_deg=0.1)  # fmt: skip
+    return {**base, **kw}
+
+
+def test_outcome_columns_tell_failures_apart():
+    recs = [
+        _rec(),
+        _rec(recognized="BOX01N", correct=False),
+        _rec(correct=False, pose_error_mm=120.0),
+        _rec(model="BOX01_x1.03.json", recognized="BOX01", correct=False),
+        _rec(model="BOX01_x1.03.json", recognized=None, outcome="no-match"),
+    ]
+    assert [outcome_class(r) for r in recs] == ["correct", "wrong model", "wrong pose", "wrong model", "no-match"]
+    row = summary_rows(recs)[0]
+    assert (row["wrong_model"], row["wrong_pose"], row["no_match"]) == (2, 1, 1)
+    table = markdown_table([row])
+    assert "wrong model" in table and "wrong pose" in table and "| 2 | 1 |" in table
+
+
+def test_bench_cli_verify_option(tmp_path, capsys):
+    out = tmp_path / "r.jsonl"
+    code = main(["bench", "--episodes", "2", "--policy", "planner", "--verify", "fast", "--no-plot",
+                 "--out", str(out)])  # fmt: skip
+    assert code == 0
+    recs = [json.loads(line) for line in out.read_text().splitlines()]
+    assert {r["verify"] for r in recs} == {"fast"}
+    assert "wrong model" in capsys.readouterr().out
