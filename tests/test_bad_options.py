@@ -66,13 +66,14 @@ def bench(out: Path, *extra: str) -> int:
     [
         (["--workers", "0"], 2, ["--workers", "at least 1"]),
         (["--noise", "nan"], 2, ["--noise", "finite"]),
-        (["--noise", "1,-1"], 2, ["--noise", ">= 0"]),
+        (["--noise", "1,-1"], 2, ["--noise", "from 0"]),
+        (["--noise", "1e3"], 2, ["--noise", "to 10"]),
         (["--max-moves", "0"], 2, ["--max-moves", "at least 1"]),
         (["--seed", "-1"], 2, ["--seed", "at least 0"]),
         (["--episodes", "0"], 2, ["--episodes"]),
         (["--models", "/nonexistent/library"], 1, ["/nonexistent/library"]),
     ],
-    ids=["workers-0", "noise-nan", "noise-negative", "max-moves-0", "seed-negative", "episodes-0", "no-library"],
+    ids=["workers-0", "noise-nan", "noise-negative", "noise-too-large", "max-moves-0", "seed-negative", "episodes-0", "no-library"],
 )
 def test_bench_bad_option_leaves_results_untouched(results, capsys, extra, expected, words):
     code = bench(results, "--force", *extra)
