@@ -4,7 +4,9 @@ For generated libraries (``haptic models generate``) of each size: the library b
 validating the files; building the matcher's arrays), the peak memory of a worker, the decision time — the
 matcher update after a move (its components added to the interpretation tree, then the verdict) plus the
 policy's choice of the next move (pose classes to hypotheses, scoring) — as median and 95th percentile over
-every decision the policy makes, the episode wall time, episodes per minute on the workers, and the outcomes.
+every decision the loop makes (``fallback_decisions`` counts those it leaves to a random move because the
+matcher has no pose classes yet: more than ``haptic.episode.MAX_POSED`` interpretations, or poses
+undetermined), the episode wall time, episodes per minute on the workers, and the outcomes.
 Wall-clock and CPU time of the deciding process are both reported: on a shared machine the wall clock counts
 the time other processes held the core.
 
@@ -70,6 +72,7 @@ def _episode(task: dict) -> dict:
     from haptic.planning.predict import PlannerConfig
 
     decisions: list[tuple[float, float, float, float]] = []
+    fallback = [0]  # decisions taken by the loop's random fallback (no pose classes yet: too many or unposed)
     state = {"update": (0.0, 0.0), "last": _clock()}
 
     def on_move(n, result, count, rec):
@@ -84,6 +87,7 @@ def _episode(task: dict) -> dict:
 
     def on_decision(n, decision):
         now = _clock()
+        fallback[0] += not decision.candidates
         last = state["last"]
         decisions.append((*state["update"], now[0] - last[0], now[1] - last[1]))
         state["update"] = (0.0, 0.0)
@@ -100,7 +104,7 @@ def _episode(task: dict) -> dict:
     return {
         "model": rec["model"], "outcome": rec["outcome"], "correct": rec["correct"], "recognized": rec["recognized"],
         "moves": rec["moves"], "path_cost": rec["path_cost"], "seed": rec["seed"],
-        "wall_s": t1[0] - t0[0], "cpu_s": t1[1] - t0[1], "decisions": decisions,
+        "wall_s": t1[0] - t0[0], "cpu_s": t1[1] - t0[1], "decisions": decisions, "fallback": fallback[0],
         "max_interpretations": max(rec["interpretations"]) if rec["interpretations"] else 0,
         "peak_rss_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
     }  # fmt: skip
@@ -154,7 +158,7 @@ def _summary(size: int, results: list[dict], wall: float, workers: int, build: d
         "load_s": build["load_s"], "arrays_s": build["arrays_s"],
         "episodes": n, "correct_pct": 100.0 * sum(r["correct"] for r in results) / n, "wrong": wrong,
         "outcomes": {o: sum(r["outcome"] == o for r in results) for o in sorted({r["outcome"] for r in results})},
-        "decisions": len(d),
+        "decisions": len(d), "fallback_decisions": sum(r["fallback"] for r in results),
         "decision_median_s": q(total_wall, 50), "decision_p95_s": q(total_wall, 95),
         "decision_cpu_median_s": q(total_cpu, 50), "decision_cpu_p95_s": q(total_cpu, 95),
         "update_median_s": q(d[:, 0], 50), "update_p95_s": q(d[:, 0], 95),

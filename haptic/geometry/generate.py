@@ -219,9 +219,12 @@ def write_library(models: Iterable[Polyhedron], out: str | os.PathLike) -> dict[
         for m in models:
             save_model(m, tmp / f"{m.name}.json")
         load_library(tmp)
-        if out.exists():
-            out.rmdir()
-        tmp.rename(out)
+        try:
+            if out.exists():
+                out.rmdir()
+            tmp.rename(out)
+        except OSError:
+            raise ModelError(f"{out}: another library was written there meanwhile; give a new directory") from None
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
