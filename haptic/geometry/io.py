@@ -105,7 +105,8 @@ def _load_native(path: Path, name: str) -> Polyhedron:
         vertices = np.array(doc["vertices"], dtype=float) * scale
     except (TypeError, ValueError):
         raise ModelError(f"{path}: 'vertices' must be a list of [x, y, z] numbers") from None
-    precision = _source_precision(text_quantum(tokens) * scale, vertices.reshape(-1, 3) if vertices.size else vertices)
+    shaped = vertices.ndim == 2 and vertices.shape[1:] == (3,) and len(vertices) > 0
+    precision = _source_precision(text_quantum(tokens) * scale, vertices) if shaped else 0.0
     return Polyhedron.from_faces(vertices, doc["faces"], name=name, source=str(path), precision=precision)
 
 
@@ -158,13 +159,9 @@ def _load_obj(path: Path, name: str) -> Polyhedron:
                     raise ModelError(
                         f"{path}: line {lineno}: a face needs at least 3 vertices, got {len(idx)}: {line.strip()!r}"
                     )
-                loop = [i - 1 if i > 0 else len(vertices) + i for i in idx]
-                if min(loop) < 0 or max(loop) >= len(vertices) or 0 in idx:
-                    raise ModelError(
-                        f"{path}: line {lineno}: face names a vertex outside 1..{len(vertices)} "
-                        f"(the vertices defined so far): {line.strip()!r}"
-                    )
-                loops.append(loop)
+                if 0 in idx or (min(idx) < 0 and len(vertices) + min(idx) < 0):
+                    raise ModelError(f"{path}: line {lineno}: face names vertex 0 or one before the first: {line!r}")
+                loops.append([i - 1 if i > 0 else len(vertices) + i for i in idx])
                 face_lines.append(lineno)
         except ValueError:
             raise ModelError(f"{path}: line {lineno} is not a valid OBJ '{parts[0]}' record: {line.strip()!r}") \
@@ -172,6 +169,12 @@ def _load_obj(path: Path, name: str) -> Polyhedron:
     if not loops:
         raise ModelError(f"{path}: the file holds no faces")
     v = np.array(vertices, dtype=float).reshape(-1, 3) * scale
+    for k, loop in enumerate(loops):
+        if max(loop) >= len(v):
+            raise ModelError(
+                f"{path}: line {face_lines[k]}: face names a vertex outside 1..{len(v)} (the file's vertices): "
+                f"{[i + 1 for i in loop]}"
+            )
     if not np.isfinite(v).all():
         bad = int(np.flatnonzero(~np.isfinite(v).all(axis=1))[0])
         raise ModelError(f"{path}: vertex {bad + 1} has a non-finite coordinate {v[bad].tolist()}")
