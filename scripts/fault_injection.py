@@ -74,9 +74,12 @@ def by_key(path: Path) -> tuple[dict[str, dict], int]:
 
 
 def _episodes_in(summary: Path) -> int:
-    """Episodes counted by a summary table (the column after the group keys)."""
-    rows = [line.split("|") for line in summary.read_text().splitlines()[2:] if line.startswith("|")]
-    return sum(int(r[5]) for r in rows)
+    """Episodes counted by a summary table (its "episodes" column)."""
+    lines = [line.split("|") for line in summary.read_text().splitlines() if line.startswith("|")]
+    if not lines:
+        return 0
+    column = [c.strip() for c in lines[0]].index("episodes")
+    return sum(int(r[column]) for r in lines[2:])
 
 
 def main(argv: list[str] | None = None) -> int:

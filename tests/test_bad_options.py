@@ -73,7 +73,10 @@ def bench(out: Path, *extra: str) -> int:
         (["--episodes", "0"], 2, ["--episodes"]),
         (["--models", "/nonexistent/library"], 1, ["/nonexistent/library"]),
     ],
-    ids=["workers-0", "noise-nan", "noise-negative", "noise-too-large", "max-moves-0", "seed-negative", "episodes-0", "no-library"],
+    ids=[
+        "workers-0", "noise-nan", "noise-negative", "noise-too-large", "max-moves-0", "seed-negative", "episodes-0",
+        "no-library",
+    ],
 )
 def test_bench_bad_option_leaves_results_untouched(results, capsys, extra, expected, words):
     code = bench(results, "--force", *extra)
