@@ -30,7 +30,7 @@ import numpy as np
 
 from haptic.bench.runner import EpisodeSpec, plan_sweep, run_sweep
 from haptic.errors import HapticError, ModelError
-from haptic.geometry import Polyhedron, load_library, save_model
+from haptic.geometry import Polyhedron, are_congruent, load_library, save_model
 from haptic.geometry.io import atomic_write
 from haptic.geometry.perturb import chamfer_edge, move_vertex, scale_dimension
 
@@ -65,6 +65,13 @@ def variants(poly: Polyhedron, rng: np.random.Generator) -> list[tuple[str, str,
         except ModelError:
             continue
     return out
+
+
+def _same_shape(a: Polyhedron, b: Polyhedron) -> bool:
+    """Whether two models are congruent (the variant is in the library after all)."""
+    if (a.n_vertices, a.n_edges, a.n_faces) != (b.n_vertices, b.n_edges, b.n_faces):
+        return False
+    return are_congruent(a, b)
 
 
 def table(records: list[dict]) -> str:
@@ -133,6 +140,10 @@ def main(argv: list[str] | None = None) -> int:
         specs, meta = [], []
         for name in names:
             for kind, size, poly in variants(library[name], np.random.default_rng(rng.integers(2**31))):
+                twin = next((m.name for m in library.values() if _same_shape(poly, m)), None)
+                if twin is not None:  # e.g. a box 60 mm high made 66 mm: a model of the library
+                    print(f"{poly.name} is library model {twin}: left out", file=sys.stderr)
+                    continue
                 path = vdir / f"{poly.name}.json"
                 save_model(poly, path)
                 seeds = rng.integers(2**31 - 1, size=args.episodes)
