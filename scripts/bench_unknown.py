@@ -2,7 +2,8 @@
 
 Each model of the library gets these variants (:mod:`haptic.geometry.perturb`): one dimension (a model axis,
 drawn per model) scaled by 0.97, 1.03, 1.05 and 1.10; one vertex (drawn per model) moved 2, 4 and 8 mm along its
-outward normal; one convex edge (the longest that allows it) chamfered with 4 mm legs. Each variant is written
+outward normal; one convex edge (the longest that allows it) chamfered with 4 mm legs; a variant congruent to
+a library model (a box made exactly as tall as another) is left out. Each variant is written
 as a model file and explored as ``--object FILE`` against the library: the right outcome is ``no-match``; a
 ``recognized`` outcome is a false recognition. The table gives them by perturbation and size, per verification
 mode; with ``--baseline N`` it also runs N library objects (the planner's usual episodes) per mode and reports
