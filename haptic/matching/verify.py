@@ -87,6 +87,12 @@ def _angle(u: np.ndarray, v: np.ndarray) -> float:
     return float(np.arccos(np.clip(u @ v / (np.linalg.norm(u) * np.linalg.norm(v)), -1.0, 1.0)))
 
 
+def _coplanar(model: Polyhedron, f: int) -> np.ndarray:
+    """Face ``f`` and the model faces in its plane with its outward normal."""
+    n, d = model.face_normals[f], model.face_offsets[f]
+    return np.flatnonzero((model.face_normals @ n > 1.0 - 1e-9) & (np.abs(model.face_offsets - d) < 1e-7))
+
+
 def residual_ratios(
     model: Polyhedron, data: Sequence[DataComponent], it: Interpretation, world_from_model: SE3
 ) -> list[tuple[float, int, str]]:
@@ -99,8 +105,10 @@ def residual_ratios(
         n_m = model.face_normals[f]
         out.append((_angle(inv.rotate(c.normal), n_m) / (c.normal_bound + ROUND_OFF), i, "face normal"))
         q = inv.apply(c.points)
-        # distance to the model face's polygon: off its plane, or beyond its boundary
-        tri = model.vertices[model.triangles[model.triangle_faces == f]]
+        # distance to the model face's polygon (or a coplanar face's: the robot cannot tell which of two faces
+        # in one plane it touched, and the interpretation may pair either): off its plane, or beyond them
+        same = _coplanar(model, f)
+        tri = model.vertices[model.triangles[np.isin(model.triangle_faces, same)]]
         d = point_triangle_distance(q, tri).min(axis=1)
         out.append((float(d.max()) / (c.position_bound + ROUND_OFF), i, "face point"))
     for i, e in it.edges.items():

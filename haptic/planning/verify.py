@@ -28,6 +28,8 @@ MAX_VERIFY_MOVES = 24
 """Verification moves after which the verification ends with what it has measured (status "incomplete"), so
 that an object in the library is not left unrecognised for features the moves reach only slowly (concave
 corners): measured, 5 of 20 seed-library episodes ran out of their 40-move budget without it."""
+MAX_CHECKED_LEAVES = 16
+"""Interpretations of the pose class tried by the pose check (the first that passes counts)."""
 MIN_SAMPLES = 3
 """A face counts as reachable on the table when at least this many of its sample points are touchable."""
 
@@ -189,10 +191,19 @@ class Verifier:
         from haptic.matching.verify import coverage, pose_check
 
         cls = rec.classes[0]
-        it = tree.interpretation(cls.leaves[0], with_pose=True, refine=True)
         if self.started_at is None:
             self.started_at = cost
-        self.check = pose_check(cls.model, tree.data, it)
+        # the class's interpretations put the model at one pose; they may pair a component with different model
+        # components that the data cannot tell apart (coplanar faces, collinear edges): the best one counts
+        best = None
+        for leaf in cls.leaves[:MAX_CHECKED_LEAVES]:
+            cand = tree.interpretation(leaf, with_pose=True, refine=True)
+            chk = pose_check(cls.model, tree.data, cand)
+            if best is None or chk.worst < best[1].worst:
+                best = (cand, chk)
+            if chk.ok:
+                break
+        it, self.check = best
         if self.check.world_from_model is not None:
             if cls.name not in self._reach:
                 self._reach[cls.name] = reachable_features(cls.model, self.check.world_from_model, self.config)
