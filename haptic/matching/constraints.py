@@ -15,8 +15,10 @@ true interval end, the other end ``p + l b`` within ``λ`` along the line, and `
 the bounds of the data components involved (model components are exact): angles add (triangle inequality on
 the sphere); positions add; a direction error ``β`` at lever arm ``r`` adds ``r β``; a quantity measured along
 one line where it meets another (closest approach) divides perpendicular errors by ``sin θ``, the smallest
-angle between the lines that the data allows. Propagated (first-order) terms are multiplied by
-:data:`SAFETY` to cover second-order effects; exact sums are not.
+angle between the lines that the data allows, and for skew lines at distance ``h`` a tilt ``β`` of either line
+out of the plane of the two directions turns the common normal by ``β / sin θ``, adding ``h β / sin² θ``.
+Propagated (first-order) terms are multiplied by :data:`SAFETY` to cover second-order effects; exact sums are
+not.
 """
 
 from __future__ import annotations
