@@ -15,8 +15,10 @@ true interval end, the other end ``p + l b`` within ``λ`` along the line, and `
 the bounds of the data components involved (model components are exact): angles add (triangle inequality on
 the sphere); positions add; a direction error ``β`` at lever arm ``r`` adds ``r β``; a quantity measured along
 one line where it meets another (closest approach) divides perpendicular errors by ``sin θ``, the smallest
-angle between the lines that the data allows. Propagated (first-order) terms are multiplied by
-:data:`SAFETY` to cover second-order effects; exact sums are not.
+angle between the lines that the data allows, and for skew lines at distance ``h`` a tilt ``β`` of either line
+out of the plane of the two directions turns the common normal by ``β / sin θ``, adding ``h β / sin² θ``.
+Propagated (first-order) terms are multiplied by :data:`SAFETY` to cover second-order effects; exact sums are
+not.
 """
 
 from __future__ import annotations
@@ -160,15 +162,21 @@ def min_sine(theta_d, beta_1, beta_2) -> np.ndarray:
     return np.sin(np.clip(th, 0.0, np.pi / 2))
 
 
-def edge_position_epsilon(s_d1, s_d2, sin_min, lam_1, rho_1, rho_2, beta_1, beta_2) -> np.ndarray:
+def edge_position_epsilon(s_d1, s_d2, sin_min, lam_1, rho_1, rho_2, beta_1, beta_2, h_d=0.0) -> np.ndarray:
     """ε of the position test along edge 1 (first-order propagation, see the module docstring):
 
-    ``ε = λ_1 + SAFETY (ρ_1 + ρ_2 + |s_d1| β_1 + |s_d2| β_2) / sin θ_min``. Moving ``p_1`` along its line moves
-    ``s_d1`` by as much (``λ_1``); a perpendicular error ``ρ`` of either line, or the swing ``|s| β`` of a line
-    turned about its ``p`` at the meeting point, slides the meeting point along line 1 by that over ``sin θ``.
+    ``ε = λ_1 + SAFETY ((ρ_1 + ρ_2 + |s_d1| β_1 + |s_d2| β_2) / sin θ_min + |h_d| (β_1 + β_2) / sin² θ_min)``.
+    Moving ``p_1`` along its line moves ``s_d1`` by as much (``λ_1``); a perpendicular error ``ρ`` of either
+    line, or the swing ``|s| β`` of a line turned about its ``p`` at the meeting point, slides the meeting point
+    along line 1 by that over ``sin θ``. Skew lines (§2.6, ``h_d`` the data skew distance) add a term: the
+    closest point on line 1 is where it crosses the plane through line 2 spanned by line 2 and the common
+    normal ``n``; tilting either line out of the plane of the two directions by ``β`` turns ``n``, and with it
+    that plane, by ``β / sin θ``, which at distance ``|h|`` from line 1 moves the crossing by
+    ``|h| β / sin² θ`` (zero for lines that meet, as adjacent edges do).
     """
     with np.errstate(divide="ignore", invalid="ignore"):
         prop = (rho_1 + rho_2 + np.abs(s_d1) * beta_1 + np.abs(s_d2) * beta_2) / sin_min
+        prop = prop + np.abs(h_d) * (beta_1 + beta_2) / (sin_min * sin_min)
     return lam_1 + SAFETY * prop + LENGTH_FLOOR
 
 
@@ -295,13 +303,14 @@ def edge_pair_tests(
     usable = sin_min >= MIN_SIN
     s_d1, s_d2 = closest_approach(p_d1, b_d1, p_d2, b_d2)
     s_m1, s_m2 = closest_approach(p_m1, b_m1, p_m2, b_m2)
+    h_d = skew_distance(p_d1, b_d1, p_d2, b_d2)
     with np.errstate(invalid="ignore"):
-        eps_1 = edge_position_epsilon(s_d1, s_d2, sin_min, lam_1, rho_1, rho_2, beta_1, beta_2)
-        eps_2 = edge_position_epsilon(s_d2, s_d1, sin_min, lam_2, rho_2, rho_1, beta_2, beta_1)
+        eps_1 = edge_position_epsilon(s_d1, s_d2, sin_min, lam_1, rho_1, rho_2, beta_1, beta_2, h_d)
+        eps_2 = edge_position_epsilon(s_d2, s_d1, sin_min, lam_2, rho_2, rho_1, beta_2, beta_1, h_d)
         gen_ok = edge_position_test(s_d1, l_d1, s_m1, l_m1, eps_1, start_1, end_1)
         gen_ok &= edge_position_test(s_d2, l_d2, s_m2, l_m2, eps_2, start_2, end_2)
         gen_ok &= skew_distance_test(
-            skew_distance(p_d1, b_d1, p_d2, b_d2),
+            h_d,
             skew_distance(p_m1, b_m1, p_m2, b_m2),
             skew_epsilon(d_norm, sin_min, rho_1, rho_2, beta_1, beta_2),
         )

@@ -70,6 +70,30 @@ def test_edge_position_test_contains_the_interval():
     assert not C.edge_position_test(1.5, 1.0, 2.0, 10.0, 0.01, start_at_vertex=True)
 
 
+def test_edge_position_epsilon_bounds_the_closest_approach_of_skew_lines():
+    """Errors at their bounds (each line offset by ρ and tilted by β about its p) move the closest approach along
+    line 1 by no more than ε − λ; for skew lines the tilt out of the plane of the two directions moves it by
+    ``h β / sin² θ``, more than the terms without the skew distance allow."""
+    rng = _rng(7)
+    rho, beta, h, theta = 0.6e-3, np.deg2rad(0.9), 0.08, np.deg2rad(31.5)
+    b1, b2 = np.array([1.0, 0, 0]), np.array([np.cos(theta), np.sin(theta), 0])
+    p1, p2 = np.array([-0.004, 0, 0]), np.array([0, 0, h]) - 0.01 * b2
+    s1, s2 = C.closest_approach(p1, b1, p2, b2)
+    sin_min = C.min_sine(theta, beta, beta)
+    eps = C.edge_position_epsilon(s1, s2, sin_min, 0.0, rho, rho, beta, beta, h)
+    without_skew = C.edge_position_epsilon(s1, s2, sin_min, 0.0, rho, rho, beta, beta)
+    worst = 0.0
+    for _ in range(300):
+        q = []
+        for p, b in ((p1, b1), (p2, b2)):
+            tilt = _unit(np.cross(b, rng.normal(size=3)))
+            off = _unit(np.cross(b, rng.normal(size=3)))
+            q += [p + rho * off, np.cos(beta) * b + np.sin(beta) * tilt]
+        worst = max(worst, abs(C.closest_approach(*q)[0] - s1))
+    assert worst < eps
+    assert worst > without_skew
+
+
 def test_parallel_order_for_two_intervals_on_one_edge():
     # same model edge (x_m = 0, lengths 10): two data intervals of length 2 at most 8 apart either way
     assert C.parallel_order_test(7.9, 2.0, 2.0, 0.0, 10.0, 10.0, 0.01)

@@ -5,7 +5,7 @@ drawn inside the bounds and once with every draw exactly at its bound (the worst
 """
 
 import numpy as np
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from haptic.executor.geometric import GeometricExecutor, GeometricSettings, random_walk
@@ -54,6 +54,8 @@ def test_true_interpretation_survives_noise_inside_bounds(name, seed, n_moves, l
 
 @settings(_common, max_examples=400)
 @given(name=st.sampled_from(NAMES), seed=st.integers(0, 2**31), n_moves=st.integers(1, 8))
+# skew (non-adjacent) edge pair: the closest approach moves with the tilt of either line times the skew distance
+@example(name="WEDGE01", seed=123, n_moves=6)
 def test_true_interpretation_survives_noise_at_the_bounds(name, seed, n_moves):
     _check(name, seed, n_moves, 1.0, at_bounds=True)
 
