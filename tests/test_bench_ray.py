@@ -12,6 +12,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from contextlib import contextmanager
 from pathlib import Path
 
 import pytest
@@ -48,6 +49,26 @@ def processes_with_env(entry: bytes) -> list[int]:
     return pids
 
 
+@contextmanager
+def private_ray():
+    """The environment of a bench that starts its own Ray in a fresh RAY_TMPDIR; on leaving, every process of that
+    Ray must be gone within 20 s (those left are killed, and the test fails)."""
+    ray_tmp = tempfile.mkdtemp(prefix="hr", dir="/tmp")  # short: Ray's socket paths must fit 107 bytes
+    entry = f"RAY_TMPDIR={ray_tmp}".encode()
+    env = {**os.environ, "RAY_TMPDIR": ray_tmp, "MUJOCO_GL": "disable"}
+    env.pop("RAY_ADDRESS", None)
+    try:
+        yield env
+        deadline = time.monotonic() + 20
+        while (left := processes_with_env(entry)) and time.monotonic() < deadline:
+            time.sleep(0.2)
+        assert not left, f"Ray processes left: {left}"
+    finally:
+        for pid in processes_with_env(entry):
+            os.kill(pid, 9)
+        shutil.rmtree(ray_tmp, ignore_errors=True)
+
+
 @pytest.mark.skipif(not Path("/proc/self/environ").exists(), reason="needs /proc to find Ray's processes")
 def test_ray_resumes_a_local_sweep_with_the_same_records_and_leaves_no_process(tmp_path):
     local, mixed = tmp_path / "local.jsonl", tmp_path / "mixed.jsonl"
@@ -56,24 +77,13 @@ def test_ray_resumes_a_local_sweep_with_the_same_records_and_leaves_no_process(t
     lines = local.read_text().splitlines(keepends=True)
     mixed.write_text("".join(lines[:2]))  # the local backend did two; Ray resumes the other four
 
-    ray_tmp = tempfile.mkdtemp(prefix="hr", dir="/tmp")  # short: Ray's socket paths must fit 107 bytes
-    env = {**os.environ, "RAY_TMPDIR": ray_tmp, "MUJOCO_GL": "disable"}
-    env.pop("RAY_ADDRESS", None)
     cmd = [sys.executable, "-m", "haptic.cli", *args, "--backend", "ray", "--workers", "2", "--resume",
            "--out", str(mixed)]  # fmt: skip
-    try:
+    with private_ray() as env:
         r = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=300)
         assert r.returncode == 0, r.stderr
         assert "running 4" in r.stdout
         assert untimed(read_results(mixed)) == untimed(read_results(local))
-        deadline = time.monotonic() + 20
-        while (left := processes_with_env(f"RAY_TMPDIR={ray_tmp}".encode())) and time.monotonic() < deadline:
-            time.sleep(0.2)
-        assert not left, f"Ray processes left: {left}"
-    finally:
-        for pid in processes_with_env(f"RAY_TMPDIR={ray_tmp}".encode()):
-            os.kill(pid, 9)
-        shutil.rmtree(ray_tmp, ignore_errors=True)
 
 
 @pytest.mark.skipif(not Path("/proc/self/environ").exists(), reason="needs /proc to find Ray's processes")
@@ -81,12 +91,9 @@ def test_sigterm_during_a_ray_sweep_keeps_the_lines_and_stops_ray(tmp_path):
     import signal
 
     out = tmp_path / "r.jsonl"
-    ray_tmp = tempfile.mkdtemp(prefix="hr", dir="/tmp")
-    env = {**os.environ, "RAY_TMPDIR": ray_tmp, "MUJOCO_GL": "disable"}
-    env.pop("RAY_ADDRESS", None)
     cmd = [sys.executable, "-m", "haptic.cli", "bench", "--backend", "ray", "--workers", "2", "--episodes", "30",
            "--policy", "planner", "--no-plot", "--out", str(out)]  # fmt: skip
-    try:
+    with private_ray() as env:
         proc = subprocess.Popen(cmd, env=env, start_new_session=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                                 text=True)  # fmt: skip
         deadline = time.monotonic() + 240
@@ -99,11 +106,3 @@ def test_sigterm_during_a_ray_sweep_keeps_the_lines_and_stops_ray(tmp_path):
         records = read_results(out)
         assert 1 <= len(records) < 30 and len({key_id(r["key"]) for r in records}) == len(records)
         assert f"| planner | {len(records)} |" in out.with_suffix(".md").read_text()
-        deadline = time.monotonic() + 20
-        while (left := processes_with_env(f"RAY_TMPDIR={ray_tmp}".encode())) and time.monotonic() < deadline:
-            time.sleep(0.2)
-        assert not left, f"Ray processes left: {left}"
-    finally:
-        for pid in processes_with_env(f"RAY_TMPDIR={ray_tmp}".encode()):
-            os.kill(pid, 9)
-        shutil.rmtree(ray_tmp, ignore_errors=True)
