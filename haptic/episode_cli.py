@@ -86,9 +86,9 @@ def verdict_line(rec: dict) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    from haptic.bench.runner import EpisodeSpec
     from haptic.cli import report_skipped
-    from haptic.episode import run_episode
+    from haptic.episode.spec import EpisodeSpec
+    from haptic.episode.worlds import run_episode
     from haptic.geometry import load_library
     from haptic.geometry.io import atomic_write
     from haptic.options import check_output_file

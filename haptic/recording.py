@@ -1,6 +1,6 @@
 """Rerun recordings of episodes: the only module of the package that imports ``rerun``.
 
-:class:`EpisodeRecorder` turns the hooks of :class:`~haptic.episode.EpisodeObserver` into a rerun recording,
+:class:`EpisodeRecorder` turns the hooks of :class:`~haptic.episode.loop.EpisodeObserver` into a rerun recording,
 saved to an ``.rrd`` file (written to a temporary file beside the target and renamed when the episode ended,
 so a failed episode never leaves a partial recording at the target path) and/or streamed to a spawned viewer.
 
@@ -82,7 +82,7 @@ from haptic.geometry.se3 import plane_basis
 from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex
 
 if TYPE_CHECKING:
-    from haptic.episode import EpisodeObserver, EpisodeRecord
+    from haptic.episode.loop import EpisodeObserver, EpisodeRecord
     from haptic.matching.recognition import Recognition
     from haptic.planning.moves import Move, MoveResult, SensorState
     from haptic.planning.policies import Decision
@@ -290,7 +290,7 @@ class EpisodeRecorder:
 
     ``EpisodeRecorder(path)`` saves headless to ``path`` (an ``.rrd``); ``spawn=True`` also opens a viewer
     (raises :class:`RecordingError` with one line when none can start). Pass :meth:`observer` to
-    :func:`~haptic.episode.run_episode`, then call :meth:`close`: the file appears at ``path`` only when the
+    :func:`~haptic.episode.worlds.run_episode`, then call :meth:`close`: the file appears at ``path`` only when the
     episode ended (``on_end`` was called) or ``close(keep=True)``; otherwise the temporary file is removed.
     Also a context manager (an exception discards the recording).
     """
@@ -348,10 +348,10 @@ class EpisodeRecorder:
     # ------------------------------------------------------------------------------------------ lifecycle
 
     def observer(self) -> EpisodeObserver:
-        """The :class:`~haptic.episode.EpisodeObserver` that feeds this recorder."""
+        """The :class:`~haptic.episode.loop.EpisodeObserver` that feeds this recorder."""
         from dataclasses import fields
 
-        from haptic.episode import EpisodeObserver
+        from haptic.episode.loop import EpisodeObserver
 
         hooks = {
             "on_start": self.on_start,
@@ -520,7 +520,7 @@ class EpisodeRecorder:
     def on_failed_move(self, i: int, result: MoveResult) -> None:
         """A move that failed (no components): its trace, when there is one, in ``world/trace/failed``, a cross
         on the interpretation plot (the counts unchanged) and a warning in ``log/moves``. (Called by the loop
-        when :class:`~haptic.episode.EpisodeObserver` has an ``on_failed_move`` hook.)"""
+        when :class:`~haptic.episode.loop.EpisodeObserver` has an ``on_failed_move`` hook.)"""
         rec, s = self.stream, self._s
         trace = _trace_of(result)
         if trace is not None and len(trace.time):

@@ -20,7 +20,8 @@ from concurrent.futures import ProcessPoolExecutor
 import numpy as np
 from tqdm import tqdm
 
-from haptic.bench.runner import EpisodeSpec, plan_sweep
+from haptic.bench.runner import plan_sweep
+from haptic.episode.spec import EpisodeSpec
 
 SMALL = ["BOX01", "WEDGE01", "BOX01N", "BOX01P", "PYR01", "TETRA01L", "TETRA01R"]
 
@@ -32,7 +33,7 @@ def _library():
 
 
 def _policy_run(spec: EpisodeSpec, depth: int) -> dict:
-    from haptic.episode import run_episode
+    from haptic.episode.worlds import run_episode
     from haptic.planning.policies import make_policy
 
     options = {"depth": depth} if spec.policy == "optimal" else {}

@@ -5,7 +5,7 @@ validating the files; building the matcher's arrays), the peak memory of a worke
 matcher update after a move (its components added to the interpretation tree, then the verdict) plus the
 policy's choice of the next move (pose classes to hypotheses, scoring) — as median and 95th percentile over
 every decision the loop makes (``fallback_decisions`` counts those it leaves to a random move because the
-matcher has no pose classes yet: more than ``haptic.episode.MAX_POSED`` interpretations, or poses
+matcher has no pose classes yet: more than ``haptic.episode.loop.MAX_POSED`` interpretations, or poses
 undetermined), the episode wall time, episodes per minute on the workers, and the outcomes.
 Wall-clock and CPU time of the deciding process are both reported: on a shared machine the wall clock counts
 the time other processes held the core.
@@ -59,16 +59,17 @@ class _TimedExecutor:
 
 
 def _init_worker() -> None:
-    import haptic.episode as episode
+    import haptic.episode.worlds as worlds
 
-    make = episode.make_geometric_executor
-    episode.make_geometric_executor = lambda *a, **k: _TimedExecutor(make(*a, **k))
+    make = worlds.make_geometric_executor
+    worlds.make_geometric_executor = lambda *a, **k: _TimedExecutor(make(*a, **k))
 
 
 def _episode(task: dict) -> dict:
     """One episode with timings: per policy decision, (update wall, update cpu, decide wall, decide cpu)."""
-    from haptic.bench.runner import EpisodeSpec
-    from haptic.episode import EpisodeObserver, run_episode
+    from haptic.episode.loop import EpisodeObserver
+    from haptic.episode.spec import EpisodeSpec
+    from haptic.episode.worlds import run_episode
     from haptic.planning.predict import PlannerConfig
 
     decisions: list[tuple[float, float, float, float]] = []

@@ -29,7 +29,8 @@ from pathlib import Path
 
 import numpy as np
 
-from haptic.bench.runner import EpisodeSpec, plan_sweep, run_sweep
+from haptic.bench.runner import plan_sweep, run_sweep
+from haptic.episode.spec import EpisodeSpec
 from haptic.errors import HapticError, ModelError
 from haptic.geometry import Polyhedron, are_congruent, load_library, save_model
 from haptic.geometry.io import atomic_write

@@ -13,9 +13,9 @@ from dataclasses import replace
 
 import numpy as np
 
-import haptic.episode_physics as EP
-from haptic.bench.runner import EpisodeSpec
-from haptic.episode import EpisodeObserver
+from haptic.episode.loop import EpisodeObserver
+from haptic.episode.spec import EpisodeSpec
+from haptic.episode.worlds import run_episode
 from haptic.executor.evaluate import score_components
 from haptic.geometry import load_library
 from haptic.matching.components import to_json
@@ -49,7 +49,7 @@ def on_failed(i, res):
 
 spec = EpisodeSpec(model=args.model, seed=args.seed, executor="physics")
 obs = EpisodeObserver(on_start=on_start, on_move=on_move, on_failed_move=on_failed)
-r = EP.run_physics_episode(spec, library=lib, observer=obs)
+r = run_episode(spec, library=lib, observer=obs)
 print(r.outcome, r.interpretations, r.perception)
 
 model = lib[args.model]

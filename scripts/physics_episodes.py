@@ -21,8 +21,8 @@ from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
-from haptic.bench.runner import EpisodeSpec
-from haptic.episode import run_episode
+from haptic.episode.spec import EpisodeSpec
+from haptic.episode.worlds import run_episode
 from haptic.errors import HapticError
 from haptic.geometry.io import atomic_write
 

@@ -26,8 +26,9 @@ import time
 from dataclasses import fields
 from pathlib import Path
 
-from haptic.bench.runner import EpisodeSpec
-from haptic.episode import EpisodeObserver, run_episode
+from haptic.episode.loop import EpisodeObserver
+from haptic.episode.spec import EpisodeSpec
+from haptic.episode.worlds import run_episode
 from haptic.errors import HapticError
 from haptic.recording import EpisodeRecorder, load_recording
 

@@ -13,9 +13,10 @@ from pathlib import Path
 import pytest
 
 from haptic.bench.results import read_results
-from haptic.bench.runner import EpisodeSpec, episode_key, key_id
+from haptic.bench.runner import episode_key, key_id
 from haptic.cli import main
-from haptic.episode import EpisodeRecord
+from haptic.episode.loop import EpisodeRecord
+from haptic.episode.spec import EpisodeSpec
 
 TIMINGS = ("wall_time_s", "decision_times_s")
 

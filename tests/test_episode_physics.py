@@ -5,8 +5,9 @@ import math
 
 import numpy as np
 
-from haptic.bench.runner import EpisodeSpec
-from haptic.episode import EpisodeObserver, run_episode
+from haptic.episode.loop import EpisodeObserver
+from haptic.episode.spec import EpisodeSpec
+from haptic.episode.worlds import run_episode
 
 
 def test_a_physics_episode_recognises_the_pyramid():
@@ -42,7 +43,7 @@ def test_a_slot_against_the_table_shows_as_an_edge_on_the_side():
 def test_touched_points_lie_on_the_true_surface():
     # the evidence the episode checks pose classes against: every touched point on a face of the object that
     # faces the way the sensed normal does
-    from haptic.episode import touched_points
+    from haptic.episode.loop import touched_points
     from haptic.planning.predict import PlannerConfig
     from haptic.planning.reach import touch_distance
     from haptic.sim.scene import TABLE_TOP_Z

@@ -9,8 +9,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from haptic.bench.runner import EpisodeSpec
-from haptic.episode import EpisodeObserver, EpisodeRecord, run_episode
+from haptic.episode.loop import EpisodeObserver, EpisodeRecord
+from haptic.episode.spec import EpisodeSpec
+from haptic.episode.worlds import run_episode
 from haptic.recording import EpisodeRecorder, RecordingError, load_recording
 
 SPEC = EpisodeSpec(model="WEDGE01", seed=3, policy="planner")

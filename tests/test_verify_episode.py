@@ -6,10 +6,10 @@ import math
 import numpy as np
 import pytest
 
-from haptic.bench.runner import EpisodeSpec
 from haptic.bench.summary import markdown_table, outcome_class, summary_rows
 from haptic.cli import main
-from haptic.episode import run_episode
+from haptic.episode.spec import EpisodeSpec
+from haptic.episode.worlds import run_episode
 from haptic.errors import HapticError
 from haptic.geometry import load_library, save_model
 from haptic.geometry.perturb import chamfer_edge, move_vertex, scale_dimension
@@ -76,7 +76,7 @@ def test_noise_out_of_range_is_one_line_and_no_episode(bad, capsys):
 
 
 def test_physics_noise_level_sets_sensor_segmenter_and_planner_bounds():
-    from haptic.episode_physics import noise_models
+    from haptic.episode.worlds import noise_models
     from haptic.executor.segment import SegmentBounds
 
     sim1, seg1, plan1 = noise_models(1.0)

@@ -14,10 +14,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from haptic.bench.runner import EpisodeSpec
-from haptic.episode import _fixed_move, make_geometric_executor
-from haptic.geometry import SE3, Polyhedron, load_library, resolve_model
-from haptic.matching.components import SensorNoise
+from haptic.episode.loop import _fixed_move
+from haptic.episode.spec import EpisodeSpec
+from haptic.episode.worlds import GeometricWorld
+from haptic.geometry import Polyhedron, load_library
 from haptic.matching.recognition import RECOGNIZED, recognize
 from haptic.matching.tree import InterpretationTree
 from haptic.planning.predict import PlannerConfig, candidate_moves
@@ -60,13 +60,8 @@ def hindsight_optimum(
 ) -> OracleResult:
     """Search the cheapest recognising continuation of ``spec``'s episode (same pose, start and fixed moves)."""
     library = library if library is not None else load_library(spec.models)
-    config = config or PlannerConfig()
-    true_model = resolve_model(spec.model, library)
-    root = np.random.SeedSequence(spec.seed)
-    pose_rng, exec_rng, policy_rng = (np.random.default_rng(s) for s in root.spawn(3))
-    world_from_model = SE3.random(pose_rng, translation_scale=0.1)
-    noise = SensorNoise().scaled(spec.noise)
-    ex = make_geometric_executor(true_model, world_from_model, noise, exec_rng, config.costs)
+    episode = GeometricWorld.build(spec, library, config)  # the same pose, start and noise as the episode's
+    config, ex, policy_rng = episode.config, episode.executor, episode.policy_rng
     tree = InterpretationTree(library)
     comps: dict = {}
     first = ex.start()

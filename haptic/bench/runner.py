@@ -12,40 +12,13 @@ import threading
 import time
 from collections import deque
 from collections.abc import Iterator, Sequence
-from dataclasses import MISSING, asdict, dataclass, fields, replace
+from dataclasses import MISSING, asdict, fields, replace
 from pathlib import Path
 
 import numpy as np
 
+from haptic.episode.spec import EpisodeSpec
 from haptic.errors import BenchError
-
-
-@dataclass(frozen=True)
-class EpisodeSpec:
-    """Everything that determines one episode (with the library's files)."""
-
-    model: str
-    """True model: a name in the library, or a path to a model file."""
-    seed: int
-    """Seed of the episode's generator: the pose, the start, the noise and the policy's random choices."""
-    policy: str = "planner"
-    """Policy name."""
-    executor: str = "geometric"
-    """"geometric" (ideal sensor with noise) or "physics" (MuJoCo hand)."""
-    noise: float = 1.0
-    """Sensor-noise level: multiplies every σ of the default noise model (0 = noiseless)."""
-    models: str | None = None
-    """Library directory (None: the shipped library)."""
-    budget: float = 600.0
-    """Cost budget: the episode ends as "budget" once its path cost passes this [units]."""
-    max_moves: int = 40
-    """Move budget: the episode ends as "budget" after this many moves."""
-    record: str | None = None
-    """Path of a rerun recording to write (None: none)."""
-    skip_invalid: bool = False
-    """Use the library's valid models when some of its files are bad (else refuse the library)."""
-    verify: str = "none"
-    """Verification before recognition: "none", "fast" or "full" (:mod:`haptic.matching.verify`)."""
 
 
 def plan_sweep(
@@ -103,7 +76,7 @@ def key_id(key: dict) -> str:
 
 def _run(spec_dict: dict) -> dict:
     """One episode's JSON record, with its library's name and its key."""
-    from haptic.episode import run_episode
+    from haptic.episode.worlds import run_episode
 
     spec = EpisodeSpec(**spec_dict)
     record = run_episode(spec).to_json()

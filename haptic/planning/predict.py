@@ -78,7 +78,7 @@ class PlannerConfig:
     """Most pose classes a policy scores moves against; above it, a reduced set chosen model by model
     (:mod:`haptic.planning.bound`). None: no bound. 256 is above the most pose classes the shipped libraries
     leave at a planner decision (186, look-alike library), so their decisions are unchanged; the matcher poses
-    at most 400 interpretations (``haptic.episode.MAX_POSED``), so it bounds a decision to under 2/3 of that."""
+    at most 400 interpretations (``haptic.episode.loop.MAX_POSED``), so it bounds a decision to under 2/3 of that."""
 
     @property
     def touch_margin(self) -> float:

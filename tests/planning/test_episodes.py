@@ -5,8 +5,9 @@ import json
 import numpy as np
 import pytest
 
-from haptic.bench.runner import EpisodeSpec, plan_sweep
-from haptic.episode import run_episode
+from haptic.bench.runner import plan_sweep
+from haptic.episode.spec import EpisodeSpec
+from haptic.episode.worlds import run_episode
 from haptic.geometry import load_library, save_model
 from haptic.geometry.shapes import box
 

@@ -3,8 +3,9 @@
 import numpy as np
 import pytest
 
-from haptic.bench.runner import EpisodeSpec, plan_sweep
-from haptic.episode import run_episode
+from haptic.bench.runner import plan_sweep
+from haptic.episode.spec import EpisodeSpec
+from haptic.episode.worlds import run_episode
 from haptic.errors import HapticError
 from haptic.geometry import load_library
 from haptic.planning.efficiency import class_weights

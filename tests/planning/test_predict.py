@@ -51,8 +51,8 @@ def test_true_hypothesis_predicts_the_executed_distance():
 def test_predicted_eliminations_agree_with_the_matcher():
     """The planner's attribute predictions (seed §4.1) against the matcher given each hypothesis's simulated
     data: over real decision points, the two agree on nearly every (true, eliminated) pair."""
-    from haptic.bench.runner import EpisodeSpec
-    from haptic.episode import run_episode
+    from haptic.episode.spec import EpisodeSpec
+    from haptic.episode.worlds import run_episode
     from haptic.planning import policies as P
     from haptic.planning.efficiency import distinguishable
     from haptic.planning.predict import predict

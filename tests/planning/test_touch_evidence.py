@@ -3,7 +3,7 @@ reaches, and the episode sets aside pose classes that leave touched points off t
 
 import numpy as np
 
-from haptic.episode import _fits_touches
+from haptic.episode.loop import _fits_touches
 from haptic.geometry import SE3, load_library
 from haptic.matching.recognition import PoseClass
 from haptic.planning.moves import FaceMove

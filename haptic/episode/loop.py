@@ -1,4 +1,5 @@
-"""One episode: executor → matcher → planner until recognised, ambiguous, no-match, out of budget, or failed.
+"""The closed loop of one episode: executor → matcher → planner until recognised, ambiguous, no-match, out of
+budget, or failed.
 
 The loop sees the object only through the executor's data components. The true model and pose are used
 here only to place the object (for the geometric executor) and, at the end, to score the outcome.
@@ -8,21 +9,20 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 
 import numpy as np
 
-from haptic.bench.runner import EpisodeSpec
+from haptic.episode.spec import EpisodeSpec
 from haptic.errors import HapticError
-from haptic.geometry import SE3, Polyhedron, library_twin, resolve_model
-from haptic.geometry.library_cache import cached_library
+from haptic.geometry import SE3, Polyhedron, library_twin
 from haptic.geometry.se3 import matrix_to_quat, rotation_angle
-from haptic.matching.components import DataComponent, SensorNoise, check_noise_level
+from haptic.matching.components import DataComponent, SensorNoise
 from haptic.matching.recognition import AMBIGUOUS, EXPLORING, NO_MATCH, RECOGNIZED, Recognition, recognize
 from haptic.matching.tree import InterpretationTree
-from haptic.planning.moves import CostModel, Move, MoveResult
-from haptic.planning.policies import Context, Decision, Policy, RandomPolicy, make_policy
+from haptic.planning.moves import Move, MoveResult
+from haptic.planning.policies import Context, Decision, Policy, RandomPolicy
 from haptic.planning.predict import (
     Hypothesis,
     PlannerConfig,
@@ -87,6 +87,24 @@ class EpisodeObserver:
     on_decision: Callable[[int, Decision], None] | None = None
     on_failed_move: Callable[[int, MoveResult], None] | None = None
     on_end: Callable[[EpisodeRecord], None] | None = None
+
+
+def chain_observers(*observers: EpisodeObserver | None) -> EpisodeObserver:
+    """One observer whose every hook calls the hooks of ``observers`` in order (None entries are skipped)."""
+    present = [o for o in observers if o is not None]
+
+    def hook(name: str):
+        fns = [getattr(o, name) for o in present if getattr(o, name) is not None]
+        if not fns:
+            return None
+
+        def call(*args) -> None:
+            for fn in fns:
+                fn(*args)
+
+        return call
+
+    return EpisodeObserver(**{f.name: hook(f.name) for f in fields(EpisodeObserver)})
 
 
 def hypotheses_from(tree: InterpretationTree, rec: Recognition) -> list[Hypothesis]:
@@ -253,40 +271,6 @@ def _away_from_table(moves: list[Move], state, components, config: PlannerConfig
         up = np.array([m.sense * float(b[2]) for m in moves])
     keep = up >= -0.2 if (up >= -0.2).any() else up >= up.max() - 1e-9
     return [m for m, k in zip(moves, keep, strict=True) if k]
-
-
-def make_geometric_executor(model: Polyhedron, world_from_model: SE3, noise: SensorNoise, rng, costs: CostModel):
-    from haptic.executor.geometric import GeometricExecutor
-
-    return GeometricExecutor(model, world_from_model, noise=noise, rng=rng, costs=costs)
-
-
-def run_episode(
-    spec: EpisodeSpec,
-    library: dict[str, Polyhedron] | None = None,
-    observer: EpisodeObserver | None = None,
-    config: PlannerConfig | None = None,
-    policy: Policy | None = None,
-) -> EpisodeRecord:
-    """Run one episode with the geometric executor (the physics executor: :mod:`haptic.episode_physics`)."""
-    if spec.executor == "physics":
-        from haptic.episode_physics import run_physics_episode
-
-        return run_physics_episode(spec, library=library, observer=observer, config=config, policy=policy)
-    if spec.executor != "geometric":
-        raise HapticError(f"unknown executor {spec.executor!r}; valid: geometric, physics")
-    library = library if library is not None else cached_library(spec.models, skip_invalid=spec.skip_invalid)
-    true_model = resolve_model(spec.model, library)
-    config = config or PlannerConfig()
-    root = np.random.SeedSequence(spec.seed)
-    pose_rng, exec_rng, policy_rng = (np.random.default_rng(s) for s in root.spawn(3))
-    world_from_model = SE3.random(pose_rng, translation_scale=0.1)
-    noise = SensorNoise().scaled(check_noise_level(spec.noise))
-    executor = make_geometric_executor(true_model, world_from_model, noise, exec_rng, config.costs)
-    return run_loop(
-        spec, library, true_model, world_from_model, executor, noise, config,
-        policy or make_policy(spec.policy), policy_rng, observer,
-    )
 
 
 def run_loop(

@@ -1,0 +1,204 @@
+"""The worlds an episode runs in, built from its :class:`~haptic.episode.spec.EpisodeSpec` in one place.
+
+:meth:`GeometricWorld.build` and :meth:`PhysicsWorld.build` are where an episode's seed is split into the
+generators of the pose, the executor, the policy (and the simulation), where one noise level becomes every
+noise model, and (on the simulated hand) where the planner learns its workspace. The object's true model and
+pose are read here only to place it and, in :meth:`Episode.finish`, to score the outcome; the loop
+(:func:`~haptic.episode.loop.run_loop`) sees the object only through the executor's data components.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from haptic.episode.loop import EpisodeObserver, EpisodeRecord, chain_observers, run_loop
+from haptic.episode.spec import EpisodeSpec
+from haptic.errors import HapticError
+from haptic.geometry import SE3, Polyhedron, load_library, resolve_model
+from haptic.geometry.library_cache import cached_library
+from haptic.matching.components import SensorNoise, check_noise_level
+from haptic.planning.moves import CostModel, MoveResult
+from haptic.planning.policies import Policy, make_policy
+from haptic.planning.predict import PlannerConfig
+
+STEEP_DESCENT_RISK = 0.5
+"""Failure risk the planner charges a face move heading steeply down on the simulated hand (measured: such
+moves often lose the surface rolling over the edge they meet)."""
+
+
+@dataclass
+class Episode:
+    """An episode built from its spec: what the loop needs, and what scores the record at the end."""
+
+    spec: EpisodeSpec
+    """What defines the episode."""
+    library: dict[str, Polyhedron]
+    """The models the matcher knows, by name."""
+    true_model: Polyhedron
+    """The object (evaluation only: the loop never reads it)."""
+    world_from_model: SE3
+    """The object's true pose (evaluation only)."""
+    executor: object
+    """Carries out moves: ``start()`` and ``execute(move)``, each returning a :class:`MoveResult`."""
+    noise: SensorNoise
+    """The planner's outcome bounds."""
+    config: PlannerConfig
+    """The planner's settings (with the workspace, on the simulated hand)."""
+    policy_rng: np.random.Generator
+    """The policy's (and the opening sequence's) generator."""
+    observer: EpisodeObserver | None = None
+    """The world's own observer (on the simulated hand: it keeps the move results for scoring perception)."""
+    finish: Callable[[EpisodeRecord], None] | None = field(default=None, repr=False)
+    """Completes the record after the loop (simulated time, perception scored against the truth)."""
+
+    def run(self, policy: Policy | None = None, observer: EpisodeObserver | None = None) -> EpisodeRecord:
+        """The closed loop over this episode, then :attr:`finish`."""
+        record = run_loop(
+            self.spec, self.library, self.true_model, self.world_from_model, self.executor, self.noise, self.config,
+            policy or make_policy(self.spec.policy), self.policy_rng, chain_observers(observer, self.observer),
+        )  # fmt: skip
+        if self.finish is not None:
+            self.finish(record)
+        return record
+
+
+def make_geometric_executor(model: Polyhedron, world_from_model: SE3, noise: SensorNoise, rng, costs: CostModel):
+    from haptic.executor.geometric import GeometricExecutor
+
+    return GeometricExecutor(model, world_from_model, noise=noise, rng=rng, costs=costs)
+
+
+class GeometricWorld:
+    """The ideal sensor: the object floats at a random pose; moves are computed from the true model, with noise."""
+
+    name = "geometric"
+
+    @staticmethod
+    def build(
+        spec: EpisodeSpec,
+        library: dict[str, Polyhedron] | None = None,
+        config: PlannerConfig | None = None,
+    ) -> Episode:
+        library = library if library is not None else cached_library(spec.models, skip_invalid=spec.skip_invalid)
+        true_model = resolve_model(spec.model, library)
+        config = config or PlannerConfig()
+        root = np.random.SeedSequence(spec.seed)
+        pose_rng, exec_rng, policy_rng = (np.random.default_rng(s) for s in root.spawn(3))
+        world_from_model = SE3.random(pose_rng, translation_scale=0.1)
+        noise = SensorNoise().scaled(check_noise_level(spec.noise))
+        executor = make_geometric_executor(true_model, world_from_model, noise, exec_rng, config.costs)
+        return Episode(spec, library, true_model, world_from_model, executor, noise, config, policy_rng)
+
+
+def noise_models(level: float):
+    """One noise level for the simulated hand: the simulated sensors' noise (PHYSICS_NOTES levels x ``level``),
+    the segmenter's bounds (its σ x ``level``, the systematic floors unchanged), hence the matcher's bounds
+    (the segmented components carry them), and the planner's outcome bounds (:class:`SensorNoise` x ``level``).
+    The bounds do not shrink below the default level (``max(level, 1)``): the simulated contacts scatter by
+    about that much with ideal sensors (contact discretisation, pad compliance; noiseless, normals beside a
+    seam of the simulated pieces read 1.5° off), and a segmenter fitting with σ = 0 fails. Returns ``(sim
+    noise, segment bounds, planner noise)``; ``level`` must be within
+    :data:`~haptic.matching.components.NOISE_LEVELS`."""
+    from haptic.executor.segment import SegmentBounds
+    from haptic.matching.components import check_noise_level
+    from haptic.sim import SensorNoise as SimNoise
+
+    level = check_noise_level(level)
+    n = SimNoise.from_notes()
+    sim_noise = SimNoise(n.force_std * level, n.normal_std * level, n.point_std * level, n.joint_std * level)
+    bounded = max(level, 1.0)
+    bounds = SegmentBounds.from_noise(n.force_std, n.normal_std, n.point_std).scaled(bounded)
+    return sim_noise, bounds, SensorNoise().scaled(bounded)
+
+
+class PhysicsWorld:
+    """The simulated hand: the object rests on the table at a seeded random pose; the executor gets only a
+    :class:`~haptic.sim.RobotInterface`. Ground truth is read here, outside the executor, only to report the
+    pose and to score perception and recognition afterwards."""
+
+    name = "physics"
+
+    @staticmethod
+    def build(
+        spec: EpisodeSpec,
+        library: dict[str, Polyhedron] | None = None,
+        config: PlannerConfig | None = None,
+    ) -> Episode:
+        from haptic.executor.evaluate import score_components
+        from haptic.executor.physics import PhysicsExecutor
+        from haptic.executor.primitives import TouchConfig
+        from haptic.sim import RobotInterface, Simulation, compose_scene, random_object_pose
+        from haptic.sim.scene import TABLE_TOP_Z, scene_object_from_polyhedron
+
+        library = library if library is not None else load_library(spec.models, skip_invalid=spec.skip_invalid)
+        true_model = resolve_model(spec.model, library)
+        config = config or PlannerConfig()
+        if config.table_z is None:  # the robot knows its workspace: where the table top is (never the object)
+            config = replace(
+                config, table_z=TABLE_TOP_Z, steep_descent_risk=STEEP_DESCENT_RISK,
+                max_undercut=TouchConfig().max_undercut, touch_evidence=True,
+            )
+        root = np.random.SeedSequence(spec.seed)
+        pose_rng, exec_rng, policy_rng, sim_seq = (np.random.default_rng(s) for s in root.spawn(4))
+        obj = scene_object_from_polyhedron(true_model)
+        pose = random_object_pose(obj, pose_rng)
+        sim_noise, bounds, noise = noise_models(spec.noise)
+        sim = Simulation(compose_scene(obj, pose), noise=sim_noise, seed=int(sim_seq.integers(2**31 - 1)))
+        executor = PhysicsExecutor(RobotInterface(sim), bounds=bounds, costs=config.costs, rng=exec_rng)
+        results: list[MoveResult] = []  # every move's result, for scoring perception
+
+        def keep(*args) -> None:
+            results.append(args[1])
+
+        def finish(record: EpisodeRecord) -> None:
+            record.sim_time_s = round(float(sim.time), 4)
+            truth = sim.ground_truth()
+            score = score_components(executor.components, true_model, truth.world_from_object, results)
+            record.perception = _jsonable(score.summary())
+
+        world_from_model = SE3(np.asarray(pose)[:3, :3], np.asarray(pose)[:3, 3])
+        return Episode(
+            spec, library, true_model, world_from_model, executor, noise, config, policy_rng,
+            observer=EpisodeObserver(on_move=keep, on_failed_move=keep), finish=finish,
+        )  # fmt: skip
+
+
+WORLDS = {w.name: w for w in (GeometricWorld, PhysicsWorld)}
+"""The worlds by executor name (``EpisodeSpec.executor``)."""
+
+
+def build_episode(
+    spec: EpisodeSpec, library: dict[str, Polyhedron] | None = None, config: PlannerConfig | None = None
+) -> Episode:
+    """The episode ``spec`` defines, in the world of its executor."""
+    world = WORLDS.get(spec.executor)
+    if world is None:
+        raise HapticError(f"unknown executor {spec.executor!r}; valid: {', '.join(WORLDS)}")
+    return world.build(spec, library, config)
+
+
+def run_episode(
+    spec: EpisodeSpec,
+    library: dict[str, Polyhedron] | None = None,
+    observer: EpisodeObserver | None = None,
+    config: PlannerConfig | None = None,
+    policy: Policy | None = None,
+) -> EpisodeRecord:
+    """Run one episode: built in its world (:func:`build_episode`), then the closed loop."""
+    return build_episode(spec, library, config).run(policy, observer)
+
+
+def _jsonable(x):
+    if isinstance(x, dict):
+        return {str(k): _jsonable(v) for k, v in x.items()}
+    if isinstance(x, list | tuple):
+        return [_jsonable(v) for v in x]
+    if isinstance(x, float | np.floating):
+        v = float(x)
+        return None if not np.isfinite(v) else round(v, 6)
+    if isinstance(x, np.integer):
+        return int(x)
+    return x
