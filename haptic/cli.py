@@ -61,10 +61,11 @@ def _models_list(args: argparse.Namespace) -> int:
     from tqdm import tqdm
 
     from haptic.geometry.io import scan_library
+    from haptic.geometry.symmetry import model_summary
 
     scan = scan_library(args.models, progress=True)
     models = list(scan.models.values())
-    rows = [m.summary() for m in tqdm(models, desc="symmetry", unit="model", disable=None, leave=False)]
+    rows = [model_summary(m) for m in tqdm(models, desc="symmetry", unit="model", disable=None, leave=False)]
     for msg in scan.errors.values():
         print(f"haptic: error: {msg}", file=sys.stderr)
     status = 1 if scan.errors else 0
@@ -94,6 +95,7 @@ def _models_show(args: argparse.Namespace) -> int:
 
     from haptic.geometry import convex_decomposition, resolve_model, symmetry_group
     from haptic.geometry.io import scan_library
+    from haptic.geometry.symmetry import model_summary
 
     lib = None
     if not os.path.exists(args.name):
@@ -104,7 +106,7 @@ def _models_show(args: argparse.Namespace) -> int:
         lib = scan.models
     m = resolve_model(args.name, lib)
     sym = symmetry_group(m)
-    s = {**m.summary(symmetry=sym)}
+    s = model_summary(m, symmetry=sym)
     print(f"{m.name}  ({m.source})")
     print(
         f"  V={s['V']} E={s['E']} F={s['F']}  V-E+F={s['euler']}  genus={s['genus']}  "

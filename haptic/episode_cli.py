@@ -12,7 +12,7 @@ from haptic.errors import HapticError, RecordingError
 def add_parser(sub: argparse._SubParsersAction) -> None:
     from haptic.matching.verify import DEFAULT_VERIFY, VERIFY_MODES
     from haptic.options import noise_level, positive_int, seed_int
-    from haptic.planning.policies import POLICY_NAMES
+    from haptic.planning.registry import POLICY_NAMES
 
     p = sub.add_parser(
         "explore",

@@ -16,6 +16,7 @@ import threading
 from pathlib import Path
 
 from haptic.errors import HapticError
+from haptic.matching.components import NOISE_LEVELS
 
 
 def int_at_least(low: int):
@@ -42,8 +43,6 @@ positive_int = int_at_least(1)
 def noise_level(text: str) -> float:
     """An argparse type: a finite sensor-noise level within
     :data:`~haptic.matching.components.NOISE_LEVELS` (a multiple of the default σ)."""
-    from haptic.matching.components import NOISE_LEVELS
-
     lo, hi = NOISE_LEVELS
     try:
         value = float(text)

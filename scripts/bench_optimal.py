@@ -34,7 +34,7 @@ def _library():
 
 def _policy_run(spec: EpisodeSpec, depth: int) -> dict:
     from haptic.episode.worlds import run_episode
-    from haptic.planning.policies import make_policy
+    from haptic.planning.registry import make_policy
 
     options = {"depth": depth} if spec.policy == "optimal" else {}
     t0 = time.perf_counter()

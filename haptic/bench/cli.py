@@ -18,7 +18,7 @@ EXIT_SIGINT, EXIT_SIGTERM = 130, 143
 def add_parser(sub: argparse._SubParsersAction) -> None:
     from haptic.matching.verify import DEFAULT_VERIFY, VERIFY_MODES
     from haptic.options import noise_levels, positive_int, seed_int
-    from haptic.planning.policies import POLICY_NAMES
+    from haptic.planning.registry import POLICY_NAMES
 
     p = sub.add_parser(
         "bench",
@@ -70,7 +70,7 @@ def _run(args: argparse.Namespace, held: DeferredInterrupts) -> int:
     from haptic.cli import report_skipped
     from haptic.geometry import load_library
     from haptic.options import check_output_file
-    from haptic.planning.policies import POLICY_NAMES
+    from haptic.planning.registry import POLICY_NAMES
 
     # Everything is checked before any episode runs or any file is touched.
     policies = [p.strip() for p in args.policy.split(",") if p.strip()]

@@ -18,7 +18,7 @@ from haptic.episode.loop import _fixed_move
 from haptic.episode.spec import EpisodeSpec
 from haptic.episode.worlds import GeometricWorld
 from haptic.geometry import Polyhedron, load_library
-from haptic.matching.recognition import RECOGNIZED, recognize
+from haptic.matching.recognition import RECOGNIZED, model_symmetries, recognize
 from haptic.matching.tree import InterpretationTree
 from haptic.planning.predict import PlannerConfig, candidate_moves
 
@@ -26,8 +26,6 @@ from haptic.planning.predict import PlannerConfig, candidate_moves
 def _may_be_recognized(tree: InterpretationTree) -> bool:
     """Cheap necessary condition: one model left, with no more interpretations than one pose class can hold
     (one per symmetry of the model)."""
-    from haptic.matching.recognition import model_symmetries
-
     alive = tree.models_alive()
     if len(alive) != 1:
         return False

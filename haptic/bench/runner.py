@@ -18,7 +18,9 @@ from pathlib import Path
 import numpy as np
 
 from haptic.episode.spec import EpisodeSpec
+from haptic.episode.worlds import run_episode
 from haptic.errors import BenchError
+from haptic.options import DeferredInterrupts
 
 
 def plan_sweep(
@@ -76,8 +78,6 @@ def key_id(key: dict) -> str:
 
 def _run(spec_dict: dict) -> dict:
     """One episode's JSON record, with its library's name and its key."""
-    from haptic.episode.worlds import run_episode
-
     spec = EpisodeSpec(**spec_dict)
     record = run_episode(spec).to_json()
     record["library"] = library_name(spec.models)
@@ -264,8 +264,6 @@ def _run_ray(payload: list[dict], workers: int) -> Iterator[dict]:
     if not ray_available():
         raise BenchError("--backend ray needs Ray: pip install -e '.[ray]' (or use --backend local)")
     import ray
-
-    from haptic.options import DeferredInterrupts
 
     started = start_ray(workers)
     pending: dict = {}

@@ -9,6 +9,8 @@ from pathlib import Path
 
 import numpy as np
 
+from haptic.geometry.io import atomic_write
+
 
 def _group(records: Sequence[dict], keys: Sequence[str]) -> dict[tuple, list[dict]]:
     out: dict[tuple, list[dict]] = defaultdict(list)
@@ -112,8 +114,6 @@ def plot_interpretations_vs_cost(records: Sequence[dict], path: str | os.PathLik
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-
-    from haptic.geometry.io import atomic_write
 
     groups = _group(records, ("library", "policy"))
     fig, ax = plt.subplots(figsize=(7.5, 4.5), dpi=120)

@@ -19,10 +19,20 @@ from haptic.errors import HapticError
 from haptic.geometry import SE3, Polyhedron, library_twin
 from haptic.geometry.se3 import matrix_to_quat, rotation_angle
 from haptic.matching.components import DataComponent, SensorNoise
-from haptic.matching.recognition import AMBIGUOUS, EXPLORING, NO_MATCH, RECOGNIZED, Recognition, recognize
+from haptic.matching.recognition import (
+    AMBIGUOUS,
+    EXPLORING,
+    NO_MATCH,
+    RECOGNIZED,
+    PoseTolerance,
+    Recognition,
+    model_symmetries,
+    recognize,
+    same_solid,
+)
 from haptic.matching.tree import InterpretationTree
 from haptic.planning.moves import Move, MoveResult
-from haptic.planning.policies import Context, Decision, Policy, RandomPolicy
+from haptic.planning.policies import Context, Decision, Policy, RandomPolicy, same_move
 from haptic.planning.predict import (
     Hypothesis,
     PlannerConfig,
@@ -32,6 +42,7 @@ from haptic.planning.predict import (
     table_safe_moves,
     vertex_sweep_off_table,
 )
+from haptic.planning.reach import indistinguishable, touch_distance
 
 MAX_POSED = 400
 """Largest number of interpretations whose poses are computed to group them into pose classes."""
@@ -129,8 +140,6 @@ def hypotheses_from(tree: InterpretationTree, rec: Recognition) -> list[Hypothes
 
 def pose_error(model: Polyhedron, truth: SE3, estimate: SE3) -> tuple[float, float]:
     """Pose error up to the model's symmetry: centroid displacement [mm] and rotation angle [deg]."""
-    from haptic.matching.recognition import model_symmetries
-
     c = model.centroid
     dist = float(np.linalg.norm(truth.apply(c) - estimate.apply(c))) * 1e3
     ang = min(rotation_angle(truth.rotation.T @ (estimate @ s).rotation) for s in model_symmetries(model))
@@ -178,8 +187,6 @@ def touched_points(result: MoveResult, config: PlannerConfig) -> tuple[np.ndarra
 
 def _fits_touches(c, touched: tuple[np.ndarray, np.ndarray], config: PlannerConfig) -> bool:
     """Whether pose class ``c`` has every touched point on a face of its sensed normal (but a few strays)."""
-    from haptic.planning.reach import touch_distance
-
     d = touch_distance(c.model, c.world_from_model, *touched)
     return int((d > config.touch_tol).sum()) < config.touch_outliers
 
@@ -199,9 +206,6 @@ def _on_the_table(
     where the fingertip
     cannot reach (:func:`~haptic.planning.reach.indistinguishable`: their difference faces the table) are
     ambiguous."""
-    from haptic.matching.recognition import PoseTolerance, same_solid
-    from haptic.planning.reach import indistinguishable
-
     if not rec.classes or not pose_fixed_by(components):
         return rec
     keep = tuple(c for c in rec.classes if rests_on_table(c.model, c.world_from_model, config)) or rec.classes
@@ -241,8 +245,6 @@ def _fixed_move(
     admissible direction (not one that already failed from here). With a table (``config.table_z``), away
     from it: not a move the data or the hypotheses predict to run into it, and among the rest those heading
     up rather than down (face and edge moves) or whose vertex circle stays clear of it."""
-    from haptic.planning.policies import same_move
-
     moves = [
         m for m in candidate_moves(state, components, config)
         if m.kind == kind and not any(same_move(m, bad) for bad in avoid)

@@ -17,12 +17,14 @@ import numpy as np
 from haptic.episode.loop import EpisodeObserver, EpisodeRecord, chain_observers, run_loop
 from haptic.episode.spec import EpisodeSpec
 from haptic.errors import HapticError
+from haptic.executor.geometric import GeometricExecutor
 from haptic.geometry import SE3, Polyhedron, load_library, resolve_model
 from haptic.geometry.library_cache import cached_library
 from haptic.matching.components import SensorNoise, check_noise_level
 from haptic.planning.moves import CostModel, MoveResult
-from haptic.planning.policies import Policy, make_policy
+from haptic.planning.policies import Policy
 from haptic.planning.predict import PlannerConfig
+from haptic.planning.registry import make_policy
 
 STEEP_DESCENT_RISK = 0.5
 """Failure risk the planner charges a face move heading steeply down on the simulated hand (measured: such
@@ -66,8 +68,6 @@ class Episode:
 
 
 def make_geometric_executor(model: Polyhedron, world_from_model: SE3, noise: SensorNoise, rng, costs: CostModel):
-    from haptic.executor.geometric import GeometricExecutor
-
     return GeometricExecutor(model, world_from_model, noise=noise, rng=rng, costs=costs)
 
 
@@ -103,7 +103,6 @@ def noise_models(level: float):
     noise, segment bounds, planner noise)``; ``level`` must be within
     :data:`~haptic.matching.components.NOISE_LEVELS`."""
     from haptic.executor.segment import SegmentBounds
-    from haptic.matching.components import check_noise_level
     from haptic.sim import SensorNoise as SimNoise
 
     level = check_noise_level(level)

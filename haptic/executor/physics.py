@@ -37,6 +37,7 @@ from haptic.executor.segment import (
     LineFit,
     SegmentBounds,
     Segmenter,
+    face_rows,
     fit_face,
     line_from_points,
     normal_turn_rate,
@@ -229,8 +230,6 @@ class PhysicsExecutor:
         return fit_face(pts, nrm, self.bounds)
 
     def _store_face(self, fid: int, trace: ContactTrace, fit: FaceFit) -> None:
-        from haptic.executor.segment import face_rows
-
         mask = face_rows(trace, fit.normal, self.bounds.face_cone)
         pts, nrm = trace.point_in_world[mask], trace.normal_in_world[mask]
         self._faces[fid] = _FaceData(pts, nrm, pts[-1].copy())

@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from haptic.errors import ModelError
+from haptic.geometry.io import load_library, save_model
 from haptic.geometry.polyhedron import Polyhedron
 from haptic.geometry.shapes import (
     antiprism,
@@ -207,8 +208,6 @@ def write_library(models: Iterable[Polyhedron], out: str | os.PathLike) -> dict[
     end."""
     import shutil
     import tempfile
-
-    from haptic.geometry.io import load_library, save_model
 
     out = Path(out)
     if out.exists() and (not out.is_dir() or any(out.iterdir())):

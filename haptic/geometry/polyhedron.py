@@ -18,6 +18,7 @@ from functools import cached_property
 import numpy as np
 
 from haptic.errors import ModelError
+from haptic.geometry.se3 import plane_basis
 from haptic.geometry.tolerances import Tolerances
 
 
@@ -481,23 +482,6 @@ class Polyhedron:
 
         return trimesh.Trimesh(vertices=np.array(self.vertices), faces=np.array(self.triangles), process=False)
 
-    def summary(self, symmetry: list | None = None) -> dict:
-        """Counts and properties for listings (``symmetry``: the group when already found)."""
-        from haptic.geometry.symmetry import symmetry_group
-
-        return {
-            "name": self.name,
-            "V": self.n_vertices,
-            "E": self.n_edges,
-            "F": self.n_faces,
-            "euler": self.euler_characteristic,
-            "genus": self.genus,
-            "convex": self.is_convex,
-            "symmetry": len(symmetry if symmetry is not None else symmetry_group(self)),
-            "extents_mm": [round(float(x) * 1e3, 2) for x in self.extents],
-            "volume_cm3": round(self.volume * 1e6, 3),
-        }
-
     def __repr__(self) -> str:
         return f"Polyhedron({self.name!r}, V={self.n_vertices}, E={self.n_edges}, F={self.n_faces})"
 
@@ -512,8 +496,6 @@ def triangulate_polygon(
     """
     if len(loop) == 3:
         return [(loop[0], loop[1], loop[2])]
-    from haptic.geometry.se3 import plane_basis
-
     u, w = plane_basis(normal)
     pts = {i: np.array([vertices[i] @ u, vertices[i] @ w]) for i in loop}
     idx = list(loop)

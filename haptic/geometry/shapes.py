@@ -7,7 +7,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from haptic.errors import ModelError
 from haptic.geometry.polyhedron import Polyhedron
+from haptic.geometry.se3 import plane_basis
 
 
 def box(lx: float, ly: float, lz: float, name: str = "box") -> Polyhedron:
@@ -104,8 +106,6 @@ def convex_hull(points, name: str = "hull") -> Polyhedron:
     """
     from scipy.spatial import ConvexHull, QhullError
 
-    from haptic.errors import ModelError
-
     p = np.asarray(points, dtype=float)
     try:
         hull = ConvexHull(p)
@@ -137,8 +137,6 @@ def _ccw_corners(points: np.ndarray, ids: list[int], normal: np.ndarray) -> list
     """The corners of a convex planar point set, counter-clockwise seen from the side ``normal`` points to."""
     from scipy.spatial import ConvexHull
 
-    from haptic.geometry.se3 import plane_basis
-
     u, w = plane_basis(normal)
     q = points[ids]
     flat = np.column_stack([q @ u, q @ w])
@@ -154,8 +152,6 @@ def _ccw_corners(points: np.ndarray, ids: list[int], normal: np.ndarray) -> list
 def platonic(kind: str, circumradius: float, name: str | None = None) -> Polyhedron:
     """A Platonic solid centred at the origin with its vertices at ``circumradius`` from the centre [m]."""
     from itertools import product
-
-    from haptic.errors import ModelError
 
     phi = (1 + 5**0.5) / 2
     signs = list(product((-1.0, 1.0), repeat=3))
@@ -231,8 +227,6 @@ def random_convex_hull(
     below those scales.
     """
     from scipy.spatial import ConvexHull
-
-    from haptic.errors import ModelError
 
     min_edge = radius / 5 if min_edge is None else min_edge
     cos_turn = np.cos(np.radians(min_turn_deg))

@@ -165,3 +165,19 @@ def library_twin(model: Polyhedron, library: dict[str, Polyhedron]) -> tuple[str
 def are_congruent(a: Polyhedron, b: Polyhedron) -> bool:
     """True when a proper rigid motion maps one solid onto the other (mirror images are not congruent)."""
     return bool(_congruences(a, b, None))
+
+
+def model_summary(poly: Polyhedron, symmetry: list | None = None) -> dict:
+    """Counts and properties of a model for listings (``symmetry``: its group when already found)."""
+    return {
+        "name": poly.name,
+        "V": poly.n_vertices,
+        "E": poly.n_edges,
+        "F": poly.n_faces,
+        "euler": poly.euler_characteristic,
+        "genus": poly.genus,
+        "convex": poly.is_convex,
+        "symmetry": len(symmetry if symmetry is not None else symmetry_group(poly)),
+        "extents_mm": [round(float(x) * 1e3, 2) for x in poly.extents],
+        "volume_cm3": round(poly.volume * 1e6, 3),
+    }

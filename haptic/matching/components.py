@@ -18,6 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from haptic.errors import HapticError
+
 
 def _vec(x) -> np.ndarray:
     a = np.array(x, dtype=float)
@@ -170,8 +172,6 @@ useful verdict); see README, "Noise"."""
 def check_noise_level(level: float, option: str = "--noise") -> float:
     """``level`` as a float when it is a finite number within :data:`NOISE_LEVELS`, else a
     :class:`~haptic.errors.HapticError` naming the option and the valid range."""
-    from haptic.errors import HapticError
-
     lo, hi = NOISE_LEVELS
     try:
         x = float(level)

@@ -33,15 +33,9 @@ from haptic.errors import PlanningError
 from haptic.matching.components import DataComponent
 from haptic.planning.efficiency import class_weights
 from haptic.planning.moves import Move, SensorState
-from haptic.planning.policies import (
-    Context,
-    Decision,
-    PlannerPolicy,
-    Policy,
-    Scored,
-    _score_all,
-)
+from haptic.planning.policies import PlannerPolicy, Policy
 from haptic.planning.predict import Hypothesis
+from haptic.planning.scoring import Context, Decision, Scored, score_all
 from haptic.planning.search import Branch, branches
 
 
@@ -72,7 +66,7 @@ class OptimalPolicy(Policy):
         weights = class_weights([h.model for h in hyps])
         search = _Search(ctx, self.rollout_moves, self.unresolved_cost)
         scored = []
-        for pred, _eff, elim, cost, risk in _score_all(ctx):
+        for pred, _eff, elim, cost, risk in score_all(ctx):
             q = search.q(hyps, weights, pred.move, ctx.state, ctx.components, self.depth)
             if q is not None:
                 scored.append(Scored(pred.move, -q, cost, elim, risk))
@@ -99,7 +93,7 @@ class _Search:
     def _moves(self, hyps, state, components) -> list[tuple[Move, float, float]]:
         """Candidate moves from a node with the planner's score (efficiency) and expected cost."""
         sub = Context(hyps, state, components, self.ctx.noise, self.ctx.config)
-        return [(p.move, eff, cost) for p, eff, _elim, cost, _risk in _score_all(sub)]
+        return [(p.move, eff, cost) for p, eff, _elim, cost, _risk in score_all(sub)]
 
     def q(
         self,

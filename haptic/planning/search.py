@@ -9,21 +9,16 @@ more than one move away), and to check predictions against the matcher itself
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
-from haptic.geometry.tracing import circle_vertex, trace_edge
-from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex, SensorNoise
+from haptic.matching.components import DataComponent, SensorNoise
 from haptic.planning.efficiency import class_weights, outcome_groups
-from haptic.planning.moves import EdgeMove, FaceMove, Move, SensorState, VertexMove
-from haptic.planning.policies import Context, refusal, same_move, score_prediction
-from haptic.planning.predict import Hypothesis, PlannerConfig, candidate_moves, predict, trace_in
-
-STEP_ONTO = 0.003
-"""How far onto the next face a simulated face or vertex move steps for its normal [m]."""
-EDGE_PROBE = 0.004
-"""Length of edge explored when an edge is first met [m]."""
+from haptic.planning.moves import Move, SensorState
+from haptic.planning.predict import Hypothesis, PlannerConfig, candidate_moves, predict
+from haptic.planning.scoring import Context, refusal, same_move, score_prediction
+from haptic.planning.simulate import simulate
 
 
 @dataclass(frozen=True, eq=False)
@@ -40,103 +35,6 @@ class Branch:
     """Data so far plus the move's simulated components."""
     cost: float
     """Weighted mean cost of the move within the group [units]."""
-
-
-def simulate(
-    h: Hypothesis,
-    move: Move,
-    state: SensorState,
-    components: Mapping[int, DataComponent],
-    config: PlannerConfig,
-    noise: SensorNoise | None = None,
-) -> tuple[Hypothesis, SensorState, dict[int, DataComponent]] | None:
-    """The move carried out exactly in hypothesis ``h``'s world: its extended correspondence, the new sensor
-    state and the new (noiseless) data components; None when ``h`` cannot say (no pose, meets a vertex) or
-    when a vertex move would only circle back to an edge and face already explored."""
-    if h.world_from_model is None:
-        return None
-    t = h.world_from_model
-    poly = h.poly
-    p_m = t.inverse().apply(state.position)
-    nxt = max(components) + 1 if components else 0
-    new: dict[int, DataComponent] = {}
-    faces, edges, vertices = dict(h.faces), dict(h.edges), dict(h.vertices)
-
-    k = noise.k if noise is not None else 0.0
-    nb = k * noise.normal_sigma if noise is not None else 0.0
-    db = k * noise.direction_sigma if noise is not None else 0.0
-    pb = k * noise.position_sigma if noise is not None else 0.0
-    lb = k * noise.length_sigma if noise is not None else 0.0
-
-    def face_comp(fid: int, g: int, point_m: np.ndarray, adjacent) -> DataFace:
-        return DataFace(fid, t.rotate(poly.face_normals[g]), t.apply(point_m)[None, :], nb, pb, adjacent)
-
-    if isinstance(move, FaceMove | VertexMove):
-        if isinstance(move, FaceMove):
-            tr = trace_in(h, move, state)
-            if tr is None:
-                return None
-            e_m, g_m, at_m, from_face = tr.hit.edge, tr.hit.next_face, tr.hit.point, state.face
-        else:
-            e0, v_m, a_m = (h.edges.get(state.edge), h.vertices.get(state.vertex), h.faces.get(move.across_face))
-            if e0 is None or v_m is None or a_m is None:
-                return None
-            try:
-                vh = circle_vertex(poly, v_m, e0, a_m, config.vertex_radius)
-            except ValueError:
-                return None
-            e_m, g_m, from_face = vh.edge, vh.next_face, move.across_face
-            away = poly.edge_directions[e_m] * (1.0 if poly.edges[e_m, 0] == v_m else -1.0)
-            at_m = poly.vertices[v_m] + config.vertex_radius * away
-        if e_m in h.edges.values() and g_m in h.faces.values() and isinstance(move, VertexMove):
-            return None  # circles back to an edge and face already explored: nothing new to see
-        b_m = poly.edge_directions[e_m]
-        s = float(np.clip((at_m - poly.edge_points[e_m]) @ b_m, 0.0, poly.edge_lengths[e_m]))
-        lo = max(0.0, s - EDGE_PROBE / 2)
-        hi = min(float(poly.edge_lengths[e_m]), s + EDGE_PROBE / 2)
-        eid, fid = nxt, nxt + 1
-        adj = (from_face,) if isinstance(move, FaceMove) else (state.vertex, from_face)
-        inward = np.cross(poly.face_normals[g_m], b_m)
-        if poly.edge_left_face[e_m] != g_m:
-            inward = -inward
-        onto = at_m + STEP_ONTO * inward
-        f_from = h.faces[from_face]
-        back = np.cross(poly.face_normals[f_from], b_m)
-        if poly.edge_left_face[e_m] != f_from:
-            back = -back
-        sides = ((from_face, t.apply(at_m + STEP_ONTO * back)), (fid, t.apply(onto)))
-        new[eid] = DataEdge(
-            eid, t.rotate(b_m), t.apply(poly.edge_points[e_m] + lo * b_m), hi - lo, db, pb, lb,
-            adjacent=adj, side_points=sides,
-        )  # fmt: skip
-        new[fid] = face_comp(fid, g_m, onto, (eid,))
-        edges[eid], faces[fid] = e_m, g_m
-        vertex = state.vertex if isinstance(move, VertexMove) else None
-        new_state = SensorState(t.apply(onto), fid, eid, vertex, (from_face, fid))
-    elif isinstance(move, EdgeMove):
-        e_m = h.edges.get(state.edge)
-        data_edge = components.get(state.edge)
-        if e_m is None or not isinstance(data_edge, DataEdge):
-            return None
-        sense_m = move.sense if t.rotate(poly.edge_directions[e_m]) @ data_edge.direction > 0 else -move.sense
-        eh = trace_edge(poly, e_m, p_m, sense_m)
-        vid = nxt
-        v_w = t.apply(poly.vertices[eh.vertex])
-        b, p, length = data_edge.direction, data_edge.point, data_edge.length
-        if move.sense > 0:
-            ext = replace(data_edge, length=max(length, float((v_w - p) @ b)), end_vertex=vid)
-        else:
-            end = p + length * b
-            ext = replace(data_edge, point=v_w, length=max(0.0, float((end - v_w) @ b)), start_vertex=vid)
-        new[ext.id] = ext
-        new[vid] = DataVertex(vid, v_w, pb, (ext.id,))
-        vertices[vid] = eh.vertex
-        new_state = SensorState(v_w, state.face, state.edge, vid, state.edge_faces)
-    else:
-        raise TypeError(f"unknown move {move!r}")
-    merged = dict(components)
-    merged.update(new)
-    return replace(h, faces=faces, edges=edges, vertices=vertices), new_state, merged
 
 
 def branches(

@@ -30,7 +30,7 @@ import numpy as np
 
 from haptic.errors import SceneError
 from haptic.sim.physics import N_ARM, ContactSummary, Simulation, finger_index
-from haptic.sim.scene import FINGERS
+from haptic.sim.scene import ARM_HOME, FINGERS
 
 
 @dataclass(frozen=True)
@@ -135,7 +135,6 @@ def solve_fingertip_ik(
     lo, hi = m.jnt_range[:N_ARM, 0], m.jnt_range[:N_ARM, 1]
     jacp, jacr = np.zeros((3, m.nv)), np.zeros((3, m.nv))
     starts = [sim.data.qpos[sim.arm].copy() if arm_q0 is None else np.asarray(arm_q0, dtype=float)]
-    from haptic.sim.scene import ARM_HOME
 
     starts.append(ARM_HOME.copy())
     best: IKResult | None = None

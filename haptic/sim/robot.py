@@ -13,7 +13,15 @@ from __future__ import annotations
 import numpy as np
 
 from haptic.sim.control import Controller, HybridStatus, IKResult, solve_fingertip_ik
-from haptic.sim.physics import LINK_CHAINS, LINK_NAMES, ContactSummary, LinkGeom, SensorReading, Simulation
+from haptic.sim.physics import (
+    LINK_CHAINS,
+    LINK_NAMES,
+    ContactSummary,
+    LinkGeom,
+    SensorReading,
+    Simulation,
+    finger_index,
+)
 from haptic.sim.scene import FINGERS
 
 
@@ -118,6 +126,4 @@ class RobotInterface:
         self._ctl.step(ticks)
 
     def _ctl_finger_index(self, finger: str) -> int:
-        from haptic.sim.physics import finger_index
-
         return finger_index(finger)

@@ -23,6 +23,7 @@ from dm_control import mjcf
 from scipy.spatial import ConvexHull, QhullError
 
 from haptic.errors import HapticError, SceneError
+from haptic.geometry import convex_decomposition, load_library, resolve_model
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
 ARM_XML = REPO_ROOT / "assets" / "mjcf" / "arm" / "puma560.xml"
@@ -125,8 +126,6 @@ def scene_object_from_parts(name: str, parts: Sequence[np.ndarray]) -> SceneObje
 
 def scene_object_from_polyhedron(poly) -> SceneObject:
     """A :class:`SceneObject` from a ``haptic.geometry.Polyhedron`` (convex pieces for non-convex solids)."""
-    from haptic.geometry import convex_decomposition
-
     parts = [np.asarray(poly.vertices, dtype=float)] if poly.is_convex else convex_decomposition(poly)
     return scene_object_from_parts(poly.name, parts)
 
@@ -136,8 +135,6 @@ def load_object(name: str, models_dir: str | os.PathLike | None = None) -> Scene
 
     Raises :class:`SceneError` naming the valid model names when ``name`` is unknown.
     """
-    from haptic.geometry import load_library, resolve_model
-
     try:
         library = load_library(models_dir)
         poly = resolve_model(name, library)

@@ -7,8 +7,8 @@ import numpy as np
 from haptic.geometry import SE3, load_library
 from haptic.matching.components import DataFace, SensorNoise
 from haptic.planning.moves import FaceMove, SensorState
-from haptic.planning.policies import Context, _fresh_moves, eliminates
 from haptic.planning.predict import Hypothesis, PlannerConfig, predict
+from haptic.planning.scoring import Context, eliminates, fresh_moves
 
 LIB = load_library()
 CFG = PlannerConfig(table_z=0.0, max_undercut=np.deg2rad(30.0), touch_evidence=True)
@@ -53,7 +53,7 @@ def test_moves_toward_an_edge_that_failed_are_tried_last():
     hyps, state, comps = _setup(0.25)
     failed = FaceMove(np.array([0.0, 0.0, 1.0]))  # up to the top edge
     ctx = Context(hyps, state, comps, SensorNoise(), CFG, avoid=(failed,))
-    fresh = _fresh_moves(ctx)
+    fresh = fresh_moves(ctx)
     # 10 mm under the top edge, every move heading up (at 45°, 90°, 135°) crosses it: left out while the
     # five heading sideways or down remain
     assert len(fresh) == 5 and all(float(m.direction[2]) < 1e-9 for m in fresh)

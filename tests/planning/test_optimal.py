@@ -10,7 +10,8 @@ from haptic.errors import HapticError
 from haptic.geometry import load_library
 from haptic.planning.efficiency import class_weights
 from haptic.planning.optimal import OptimalPolicy, _Search
-from haptic.planning.policies import PlannerPolicy, make_policy
+from haptic.planning.policies import PlannerPolicy
+from haptic.planning.registry import make_policy
 
 SMALL = ["BOX01", "WEDGE01", "BOX01N", "BOX01P", "PYR01", "TETRA01L", "TETRA01R"]
 LIB = {k: v for k, v in load_library().items() if k in SMALL}

@@ -56,6 +56,7 @@ def test_predicted_eliminations_agree_with_the_matcher():
     from haptic.planning import policies as P
     from haptic.planning.efficiency import distinguishable
     from haptic.planning.predict import predict
+    from haptic.planning.scoring import fresh_moves
     from haptic.planning.search import matcher_eliminations
 
     agree = total = 0
@@ -63,7 +64,7 @@ def test_predicted_eliminations_agree_with_the_matcher():
 
     def checking(self, ctx, rng):
         nonlocal agree, total
-        for move in P._fresh_moves(ctx)[:6]:
+        for move in fresh_moves(ctx)[:6]:
             d_matcher, _ = matcher_eliminations(ctx, move)
             pred = predict(ctx.hypotheses, move, ctx.state, ctx.components, ctx.noise, ctx.config)
             d_attr = distinguishable(pred.outcomes, pred.bounds)

@@ -7,8 +7,8 @@ from haptic.episode.loop import _fits_touches
 from haptic.geometry import SE3, load_library
 from haptic.matching.recognition import PoseClass
 from haptic.planning.moves import FaceMove
-from haptic.planning.policies import eliminates, refusal
 from haptic.planning.predict import PlannerConfig, Prediction
+from haptic.planning.scoring import eliminates, refusal
 
 LIB = load_library()
 

@@ -1,0 +1,113 @@
+"""The import graph of ``haptic``: module-level and function-level imports, read with ``ast``.
+
+It has no cycle, between modules or between layers, and the pure core (geometry, matching, planning) imports
+nothing of the layers built on it, nor a simulator or a viewer.
+"""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import networkx as nx
+import pytest
+
+import haptic
+
+CORE = ("haptic.geometry", "haptic.matching", "haptic.planning")
+OUTER = ("haptic.sim", "haptic.executor", "haptic.episode", "haptic.bench", "haptic.recording", "haptic.env")
+HEAVY = ("mujoco", "dm_control", "rerun", "gymnasium")
+"""Third-party packages the pure core must not import."""
+
+
+def _modules(root: Path) -> dict[str, Path]:
+    """Module name -> file, for every module of the package at ``root``."""
+    out = {}
+    for f in root.rglob("*.py"):
+        parts = list(f.relative_to(root.parent).with_suffix("").parts)
+        if parts[-1] == "__init__":
+            parts = parts[:-1]
+        out[".".join(parts)] = f
+    return out
+
+
+def import_graph(root: Path) -> tuple[nx.DiGraph, dict[str, set[str]]]:
+    """The package's modules and the imports between them (every ``import`` and ``from ... import``, at module
+    level or inside functions), and the top-level third-party packages each module imports."""
+    mods = _modules(root)
+    pkg = root.name
+    graph, external = nx.DiGraph(), {}
+
+    def resolve(name: str) -> str | None:
+        while name and name not in mods:
+            name = name.rpartition(".")[0]
+        return name or None
+
+    for mod, path in mods.items():
+        graph.add_node(mod)
+        external[mod] = set()
+        for node in ast.walk(ast.parse(path.read_text(), filename=str(path))):
+            if isinstance(node, ast.Import):
+                targets = [a.name for a in node.names]
+            elif isinstance(node, ast.ImportFrom):
+                base = node.module or ""
+                if node.level:
+                    here = mod if path.name == "__init__.py" else mod.rpartition(".")[0]
+                    for _ in range(node.level - 1):
+                        here = here.rpartition(".")[0]
+                    base = f"{here}.{base}" if base else here
+                targets = [f"{base}.{a.name}" if f"{base}.{a.name}" in mods else base for a in node.names]
+            else:
+                continue
+            for t in targets:
+                if t.split(".")[0] != pkg:
+                    external[mod].add(t.split(".")[0])
+                elif (target := resolve(t)) is not None and target != mod:
+                    graph.add_edge(mod, target)
+    return graph, external
+
+
+def layer(module: str) -> str:
+    """The layer of a module: ``haptic.planning.policies`` -> ``haptic.planning``."""
+    return ".".join(module.split(".")[:2])
+
+
+@pytest.fixture(scope="module")
+def graph():
+    return import_graph(Path(haptic.__file__).parent)
+
+
+def test_no_module_imports_another_that_imports_it_back(graph):
+    g, _ = graph
+    assert len(g) > 50
+    cycles = sorted(nx.simple_cycles(g), key=len)
+    assert not cycles, "import cycles: " + "; ".join(" -> ".join(c) for c in cycles[:10])
+
+
+def test_layers_depend_one_way(graph):
+    g, _ = graph
+    layers = nx.DiGraph((layer(a), layer(b)) for a, b in g.edges if layer(a) != layer(b))
+    assert not list(nx.simple_cycles(layers)), sorted(layers.edges)
+
+
+def test_the_pure_core_imports_no_outer_layer_and_no_simulator(graph):
+    g, external = graph
+    up = sorted((a, b) for a, b in g.edges if a.startswith(CORE) and b.startswith(OUTER))
+    assert not up, f"the pure core imports outer layers: {up}"
+    heavy = sorted((m, p) for m, pkgs in external.items() if m.startswith(CORE) for p in pkgs if p in HEAVY)
+    assert not heavy, f"the pure core imports a simulator, viewer or environment package: {heavy}"
+
+
+def test_the_graph_sees_function_level_and_relative_imports(tmp_path):
+    """The checks could fail: a cycle hidden in a function, and an upward relative import, are found."""
+    pkg = tmp_path / "pkg"
+    (pkg / "core").mkdir(parents=True)
+    (pkg / "__init__.py").write_text("")
+    (pkg / "core" / "__init__.py").write_text("")
+    (pkg / "core" / "a.py").write_text("def f():\n    from pkg.core import b\n")
+    (pkg / "core" / "b.py").write_text("from . import a\nfrom ..sim import thing\nimport mujoco\n")
+    (pkg / "sim.py").write_text("")
+    g, external = import_graph(pkg)
+    assert [sorted(c) for c in nx.simple_cycles(g)] == [["pkg.core.a", "pkg.core.b"]]
+    assert g.has_edge("pkg.core.b", "pkg.sim")
+    assert external["pkg.core.b"] == {"mujoco"}
