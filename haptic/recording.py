@@ -5,7 +5,7 @@ saved to an ``.rrd`` file (written to a temporary file beside the target and ren
 so a failed episode never leaves a partial recording at the target path) and/or streamed to a spawned viewer.
 
 Timelines: ``move`` (sequence: 0 is the start, then one step per move) and, when the executor reports contact
-traces (the physics executor's ``info["trace"]``), ``sim_time`` (simulated time [s]); a physics recording
+traces (the physics executor's ``MoveResult.trace``), ``sim_time`` (simulated time [s]); a physics recording
 opens on ``sim_time``. Everything drawn has a value on both timelines (per control tick on ``sim_time``, the
 state at the end of each move on ``move``).
 
@@ -1017,9 +1017,8 @@ def _subsample(a: np.ndarray, k: int) -> np.ndarray:
 
 
 def _trace_of(result: MoveResult) -> Any:
-    """The contact trace in ``result.info["trace"]`` when it looks like one, else None."""
-    info = getattr(result, "info", None)
-    tr = info.get("trace") if isinstance(info, dict) else None
+    """The move's contact trace (``result.trace``) when it looks like one, else None."""
+    tr = getattr(result, "trace", None)
     needed = ("time", "tip_in_world", "point_in_world", "normal_in_world", "force")
     if tr is None or not all(hasattr(tr, a) for a in needed):
         return None

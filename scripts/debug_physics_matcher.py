@@ -13,11 +13,11 @@ from dataclasses import replace
 
 import numpy as np
 
+from haptic.episode.evaluate import score_components
 from haptic.episode.loop import EpisodeObserver
 from haptic.episode.spec import EpisodeSpec
 from haptic.episode.worlds import run_episode
-from haptic.executor.evaluate import score_components
-from haptic.geometry import load_library
+from haptic.geometry import SE3, load_library
 from haptic.matching.components import to_json
 from haptic.matching.tree import InterpretationTree
 
@@ -54,7 +54,7 @@ print(r.outcome, r.interpretations, r.perception)
 
 model = lib[args.model]
 T = np.asarray(start["T"], dtype=float)
-scores = {s.id: s for s in score_components(comps, model, T).components}
+scores = {s.id: s for s in score_components(comps, model, SE3.from_matrix(T)).components}
 truth = []
 for i in sorted(scores):
     s = scores[i]

@@ -10,7 +10,7 @@ whose directions are chosen with the ground truth (an oracle standing in for the
 as blind as ever) towards the nearest concave edge of the current face -- or, from a face without one, towards
 the middle of the edge to a face that has one --, until one is reported or 6 moves are spent.
 
-The components are scored against ground truth by ``haptic.executor.evaluate`` (outside the executor); every
+The components are scored against ground truth by ``haptic.episode.evaluate`` (outside the executor); every
 component of every run is also fed, unchanged, to the interpretation-tree matcher, and the run counts as
 accepted when the true model survives every one of them.
 
@@ -28,9 +28,9 @@ from collections import Counter
 
 import numpy as np
 
-from haptic.executor.evaluate import score_components, score_face
+from haptic.episode.evaluate import score_components, score_face
 from haptic.executor.physics import PhysicsExecutor
-from haptic.geometry import load_library
+from haptic.geometry import SE3, load_library
 from haptic.matching.tree import InterpretationTree
 from haptic.planning.moves import EdgeMove, FaceMove, Move, VertexMove
 from haptic.sim import RobotInterface, SensorNoise, Simulation, compose_scene, random_object_pose
@@ -137,7 +137,7 @@ def concave_probe(sim: Simulation, ex: PhysicsExecutor, poly, results: list, max
 
 
 def _tol():
-    from haptic.executor.evaluate import EvaluationTolerances
+    from haptic.episode.evaluate import EvaluationTolerances
 
     return EvaluationTolerances()
 
@@ -182,7 +182,7 @@ def main(argv=None) -> int:
                 c[f"{r.move.kind}_table"] += (not r.ok) and _is_table(r)
             c["start_ok"] += results[0].ok
             gt = sim.ground_truth()
-            score = score_components(ex.components, poly, gt.world_from_object, results)
+            score = score_components(ex.components, poly, SE3.from_matrix(gt.world_from_object), results)
             faces.extend(score.errors("face", "angle"))
             dirs.extend(score.errors("edge", "angle"))
             epos.extend(score.errors("edge", "position"))

@@ -161,9 +161,9 @@ def test_context_manager_discards_on_error_and_keeps_on_success(tmp_path):
 
 def test_physics_trace_and_hand_links_are_recorded(tmp_path):
     """A physics-style move result: the contact trace on the sim_time timeline, hand links, force."""
-    from haptic.executor.primitives import ContactTrace
     from haptic.geometry import SE3, load_library
     from haptic.matching.components import DataFace
+    from haptic.matching.trace import ContactTrace
     from haptic.planning.moves import FaceMove, MoveResult, SensorState
 
     n = 50
@@ -178,7 +178,7 @@ def test_physics_trace_and_hand_links_are_recorded(tmp_path):
     links = {"palm": tip + [0, 0, 0.1], "index_tip": np.tile(np.eye(4), (n, 1, 1)), "bad": np.zeros((n, 2))}
     result = MoveResult(
         move=FaceMove(np.zeros(3)), status="ok", components=(face,), cost=1.0,
-        state=SensorState(position=pts[-1], face=0), info={"trace": trace, "hand_links": links, "sim_time": 0.1},
+        state=SensorState(position=pts[-1], face=0), trace=trace, info={"hand_links": links, "sim_time": 0.1},
     )  # fmt: skip
     out = tmp_path / "physics.rrd"
     recorder = EpisodeRecorder(out)
@@ -188,7 +188,7 @@ def test_physics_trace_and_hand_links_are_recorded(tmp_path):
     later = ContactTrace(*(a[:20] for a in trace._arrays()))
     later = ContactTrace(later.time + 1.0, *later._arrays()[1:])
     failed = MoveResult(move=FaceMove(np.array([1.0, 0, 0])), status="timeout", cost=0.5,
-                        state=result.state, info={"trace": later, "reason": "no edge"})  # fmt: skip
+                        state=result.state, trace=later, info={"reason": "no edge"})  # fmt: skip
     recorder.on_failed_move(1, failed)
     recorder.close(keep=True)
 

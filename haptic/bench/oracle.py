@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from haptic.episode.loop import _fixed_move
+from haptic.episode.opening import opening_move
 from haptic.episode.spec import EpisodeSpec
 from haptic.episode.worlds import GeometricWorld
 from haptic.geometry import Polyhedron, load_library
@@ -71,7 +71,7 @@ def hindsight_optimum(
     for kind in ("face", "edge", "vertex"):
         if recognize(tree).status == RECOGNIZED:
             return OracleResult(True, cost, n_moves, 0, cost)
-        move = _fixed_move(kind, state, comps, config, policy_rng)
+        move = opening_move(kind, state, comps, config, policy_rng)
         if move is None:
             continue
         res = ex.execute(move)

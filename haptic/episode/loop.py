@@ -11,45 +11,28 @@ import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
+from typing import Protocol
 
 import numpy as np
 
+from haptic.episode.opening import opening_move
+from haptic.episode.perception import on_the_table, touched_points
+from haptic.episode.scoring import score_outcome
 from haptic.episode.spec import EpisodeSpec
 from haptic.errors import HapticError
-from haptic.geometry import SE3, Polyhedron, library_twin
-from haptic.geometry.se3 import matrix_to_quat, rotation_angle
+from haptic.geometry import SE3, Polyhedron
+from haptic.geometry.se3 import matrix_to_quat
 from haptic.matching.components import DataComponent, SensorNoise
-from haptic.matching.recognition import (
-    AMBIGUOUS,
-    EXPLORING,
-    NO_MATCH,
-    RECOGNIZED,
-    PoseTolerance,
-    Recognition,
-    model_symmetries,
-    recognize,
-    same_solid,
-)
+from haptic.matching.recognition import AMBIGUOUS, EXPLORING, NO_MATCH, RECOGNIZED, Recognition, recognize
 from haptic.matching.tree import InterpretationTree
 from haptic.planning.moves import Move, MoveResult
-from haptic.planning.policies import Context, Decision, Policy, RandomPolicy, same_move
-from haptic.planning.predict import (
-    Hypothesis,
-    PlannerConfig,
-    candidate_moves,
-    pose_fixed_by,
-    rests_on_table,
-    table_safe_moves,
-    vertex_sweep_off_table,
-)
-from haptic.planning.reach import indistinguishable, touch_distance
+from haptic.planning.policies import Context, Decision, Policy, RandomPolicy
+from haptic.planning.predict import Hypothesis, PlannerConfig
 
 MAX_POSED = 400
 """Largest number of interpretations whose poses are computed to group them into pose classes."""
 MAX_FAILED_MOVES = 4
 """Consecutive failed moves after which the episode ends as "failed"."""
-CORRECT_POSE_MM, CORRECT_POSE_DEG = 5.0, 5.0
-"""A recognition is correct when the model is right and the pose within these of the truth."""
 
 
 @dataclass
@@ -100,7 +83,32 @@ class EpisodeObserver:
     on_end: Callable[[EpisodeRecord], None] | None = None
 
 
-def chain_observers(*observers: EpisodeObserver | None) -> EpisodeObserver:
+class Executor(Protocol):
+    """What carries out moves (the geometric executor, the simulated hand): each call returns a
+    :class:`MoveResult` with the data components the move produced and, when it keeps them, its touches and
+    contact trace."""
+
+    def start(self) -> MoveResult:
+        """Find the object and settle on a face (the episode's first data)."""
+        ...
+
+    def execute(self, move: Move) -> MoveResult:
+        """Carry out ``move`` from the current sensor state."""
+        ...
+
+
+class Observer(Protocol):
+    """What watches an episode (recordings, progress, scoring): it sees every move result through the loop's
+    hooks, each of which may be None. :class:`EpisodeObserver` is one; :func:`chain_observers` joins several."""
+
+    on_start: Callable[[Polyhedron, SE3], None] | None
+    on_move: Callable[[int, MoveResult, int, Recognition | None], None] | None
+    on_decision: Callable[[int, Decision], None] | None
+    on_failed_move: Callable[[int, MoveResult], None] | None
+    on_end: Callable[[EpisodeRecord], None] | None
+
+
+def chain_observers(*observers: Observer | None) -> EpisodeObserver:
     """One observer whose every hook calls the hooks of ``observers`` in order (None entries are skipped)."""
     present = [o for o in observers if o is not None]
 
@@ -138,154 +146,17 @@ def hypotheses_from(tree: InterpretationTree, rec: Recognition) -> list[Hypothes
     return out
 
 
-def pose_error(model: Polyhedron, truth: SE3, estimate: SE3) -> tuple[float, float]:
-    """Pose error up to the model's symmetry: centroid displacement [mm] and rotation angle [deg]."""
-    c = model.centroid
-    dist = float(np.linalg.norm(truth.apply(c) - estimate.apply(c))) * 1e3
-    ang = min(rotation_angle(truth.rotation.T @ (estimate @ s).rotation) for s in model_symmetries(model))
-    return dist, float(np.degrees(ang))
-
-
-TOUCH_PHASES = ("face", "circle")
-"""Trace phases whose contacts count: the pad sliding on one face (rolling over an edge, or resting on an edge
-or a vertex, it may touch two faces at once, and the sensed point is their mean)."""
-TOUCH_CONE = np.deg2rad(8.0)
-"""Within a phase, rows whose sensed normal is farther than this from the phase's median normal are not on
-the face slid on (the pad in a corner, or turning at an edge) and do not count [rad]."""
-
-
-def touched_points(result: MoveResult, config: PlannerConfig) -> tuple[np.ndarray, np.ndarray]:
-    """The contact points and sensed normals of a move's trace (the physics executor's sensing, in
-    ``result.info["trace"]``) while sliding on a face, thinned to one per ``config.touch_spacing`` of the
-    trace, none within the pad's radius of the table (where the pad may touch the table and the object at
-    once); shapes (P, 3), (P, 3), with P = 0 when the executor keeps no trace."""
-    from haptic.executor.primitives import PHASES
-
-    none = (np.zeros((0, 3)), np.zeros((0, 3)))
-    trace = result.info.get("trace") if isinstance(result.info, dict) else None
-    if trace is None or not len(trace):
-        return none
-    pts, nrm = [], []
-    for ph in TOUCH_PHASES:
-        ok = trace.in_contact & (trace.phase == PHASES.index(ph))
-        p, n = trace.point_in_world[ok], trace.normal_in_world[ok]
-        if config.table_z is not None:
-            high = p[:, 2] > config.table_z + config.pad_radius
-            p, n = p[high], n[high]
-        if not len(p):
-            continue
-        med = np.median(n, axis=0)
-        on = n @ (med / np.linalg.norm(med)) > np.cos(TOUCH_CONE)
-        last = None
-        for q, m in zip(p[on], n[on], strict=True):
-            if last is None or float(np.linalg.norm(q - last)) >= config.touch_spacing:
-                pts.append(q)
-                nrm.append(m)
-                last = q
-    return (np.array(pts), np.array(nrm)) if pts else none
-
-
-def _fits_touches(c, touched: tuple[np.ndarray, np.ndarray], config: PlannerConfig) -> bool:
-    """Whether pose class ``c`` has every touched point on a face of its sensed normal (but a few strays)."""
-    d = touch_distance(c.model, c.world_from_model, *touched)
-    return int((d > config.touch_tol).sum()) < config.touch_outliers
-
-
-def _on_the_table(
-    rec: Recognition,
-    tree: InterpretationTree,
-    components,
-    config: PlannerConfig,
-    touched: tuple[np.ndarray, np.ndarray] | None = None,
-) -> Recognition:
-    """The matcher's verdict with the workspace prior that the object rests on the table (``config.table_z``):
-    once the data fix the poses, pose classes that would put the model through the table or float it above
-    it are set aside, and the verdict is taken again over the rest (left as it is when that would leave no
-    class: the prior is then doubted, not the data). With ``touched`` points (every contact sensed so far),
-    classes that leave some of them off their faces are set aside too. A few classes left that differ only
-    where the fingertip
-    cannot reach (:func:`~haptic.planning.reach.indistinguishable`: their difference faces the table) are
-    ambiguous."""
-    if not rec.classes or not pose_fixed_by(components):
-        return rec
-    keep = tuple(c for c in rec.classes if rests_on_table(c.model, c.world_from_model, config)) or rec.classes
-    if touched is not None and len(touched[0]) and len(keep) <= MAX_TOUCH_CHECK:
-        keep = tuple(c for c in keep if _fits_touches(c, touched, config)) or keep
-    if len(keep) == len(rec.classes) and rec.status != EXPLORING:
-        return rec
-    models = tuple(sorted({c.name for c in keep}))
-    if len(keep) == 1:
-        return Recognition(RECOGNIZED, keep[0].name, keep[0].world_from_model, keep, rec.count, models)
-    tol = PoseTolerance.from_data(tree.data)
-    status = AMBIGUOUS if all(same_solid(keep[0], c, tol) for c in keep[1:]) else EXPLORING
-    if status == EXPLORING and len(keep) <= MAX_HIDDEN_CHECK and all(
-        indistinguishable(keep[0].model, keep[0].world_from_model, c.model, c.world_from_model, config)
-        for c in keep[1:]
-    ):
-        status = AMBIGUOUS
-    return Recognition(status, None, None, keep, rec.count, models)
-
-
-MAX_HIDDEN_CHECK = 4
-"""Pose classes up to which an episode on the table checks whether what tells them apart is out of reach."""
-MAX_TOUCH_CHECK = 24
-"""Pose classes up to which the touched points are checked against each class's surface."""
-
-
-def _fixed_move(
-    kind: str,
-    state,
-    components,
-    config: PlannerConfig,
-    rng: np.random.Generator,
-    avoid: tuple = (),
-    hypotheses: tuple = (),
-) -> Move | None:
-    """The seed's initial sequence (§4.1): a face move, an edge move, a vertex move, each in a random
-    admissible direction (not one that already failed from here). With a table (``config.table_z``), away
-    from it: not a move the data or the hypotheses predict to run into it, and among the rest those heading
-    up rather than down (face and edge moves) or whose vertex circle stays clear of it."""
-    moves = [
-        m for m in candidate_moves(state, components, config)
-        if m.kind == kind and not any(same_move(m, bad) for bad in avoid)
-    ]
-    if not moves:
-        return None
-    if config.table_z is not None:
-        moves = _away_from_table(table_safe_moves(moves, hypotheses, state, components, config), state,
-                                 components, config)  # fmt: skip
-    return moves[int(rng.integers(len(moves)))]
-
-
-def _away_from_table(moves: list[Move], state, components, config: PlannerConfig) -> list[Move]:
-    """The moves of ``moves`` that head away from the table: face moves and edge moves not heading down by
-    more than ~12°; vertex moves whose circle can sweep half a turn off the table (else the widest sweep)."""
-    if not moves:
-        return moves
-    if moves[0].kind == "vertex":
-        sweep = np.array([vertex_sweep_off_table(state, components, m.across_face, config) for m in moves])
-        keep = sweep >= np.pi if (sweep >= np.pi).any() else sweep >= sweep.max() - 1e-9
-        return [m for m, k in zip(moves, keep, strict=True) if k]
-    if moves[0].kind == "face":
-        up = np.array([float(m.direction[2]) for m in moves])
-    else:
-        b = components[state.edge].direction
-        up = np.array([m.sense * float(b[2]) for m in moves])
-    keep = up >= -0.2 if (up >= -0.2).any() else up >= up.max() - 1e-9
-    return [m for m, k in zip(moves, keep, strict=True) if k]
-
-
 def run_loop(
     spec: EpisodeSpec,
     library: dict[str, Polyhedron],
     true_model: Polyhedron,
     world_from_model: SE3,
-    executor,
+    executor: Executor,
     noise: SensorNoise,
     config: PlannerConfig,
     policy: Policy,
     rng: np.random.Generator,
-    observer: EpisodeObserver | None = None,
+    observer: Observer | None = None,
 ) -> EpisodeRecord:
     """The closed loop over any executor with ``start()`` and ``execute(move)``."""
     t0 = time.perf_counter()
@@ -319,9 +190,9 @@ def run_loop(
         if config.table_z is None:
             return r
         if not touched:
-            return _on_the_table(r, tree, components, config)
+            return on_the_table(r, tree, components, config)
         both = (np.concatenate([p for p, _ in touched]), np.concatenate([n for _, n in touched]))
-        return _on_the_table(r, tree, components, config, both)
+        return on_the_table(r, tree, components, config, both)
 
     def absorb(result: MoveResult) -> None:
         nonlocal cost, rec
@@ -372,7 +243,7 @@ def run_loop(
                     tuple(hypotheses_from(tree, rec))
                     if config.table_z is not None and rec is not None and rec.classes else ()
                 )  # fmt: skip
-                move = _fixed_move(fixed.pop(0), state, components, config, rng, tuple(failed_here), hyps)
+                move = opening_move(fixed.pop(0), state, components, config, rng, tuple(failed_here), hyps)
             if move is None:
                 t_dec = time.perf_counter()
                 hyps = hypotheses_from(tree, rec) if rec is not None and rec.classes else []
@@ -418,18 +289,9 @@ def run_loop(
     if verifier is not None and outcome == NO_MATCH and verifier.status == "verifying":
         verifier.status = "mismatch"  # the matcher itself left no interpretation during the verification
     recognized = rec.model if rec is not None and outcome == RECOGNIZED else None
-    err_mm = err_deg = None
+    recognized = rec.model if rec is not None and outcome == RECOGNIZED else None
     in_library = spec.model in library
-    # the library model the object is (evaluation only): by name, or for a file by congruence with one
-    twin = (spec.model, SE3.identity()) if in_library else library_twin(true_model, library)
-    correct = False
-    if outcome == RECOGNIZED and rec.world_from_model is not None:
-        if twin is not None and recognized == twin[0]:
-            # the library model's pose in the world: the object's pose after the map of the model onto it
-            err_mm, err_deg = pose_error(library[twin[0]], world_from_model @ twin[1], rec.world_from_model)
-            correct = err_mm < CORRECT_POSE_MM and err_deg < CORRECT_POSE_DEG
-    elif outcome == NO_MATCH:
-        correct = twin is None
+    err_mm, err_deg, correct = score_outcome(spec, library, true_model, world_from_model, outcome, rec)
     n_by_kind = {k: sum(1 for c in components.values() if c.kind == k) for k in ("face", "edge", "vertex")}
     record = EpisodeRecord(
         model=true_model.name if in_library else str(Path(spec.model).name),

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from haptic.episode.loop import EpisodeObserver, EpisodeRecord, chain_observers, run_loop
+from haptic.episode.loop import EpisodeObserver, EpisodeRecord, Executor, Observer, chain_observers, run_loop
 from haptic.episode.spec import EpisodeSpec
 from haptic.errors import HapticError
 from haptic.executor.geometric import GeometricExecutor
@@ -43,8 +43,8 @@ class Episode:
     """The object (evaluation only: the loop never reads it)."""
     world_from_model: SE3
     """The object's true pose (evaluation only)."""
-    executor: object
-    """Carries out moves: ``start()`` and ``execute(move)``, each returning a :class:`MoveResult`."""
+    executor: Executor
+    """Carries out moves."""
     noise: SensorNoise
     """The planner's outcome bounds."""
     config: PlannerConfig
@@ -56,7 +56,7 @@ class Episode:
     finish: Callable[[EpisodeRecord], None] | None = field(default=None, repr=False)
     """Completes the record after the loop (simulated time, perception scored against the truth)."""
 
-    def run(self, policy: Policy | None = None, observer: EpisodeObserver | None = None) -> EpisodeRecord:
+    def run(self, policy: Policy | None = None, observer: Observer | None = None) -> EpisodeRecord:
         """The closed loop over this episode, then :attr:`finish`."""
         record = run_loop(
             self.spec, self.library, self.true_model, self.world_from_model, self.executor, self.noise, self.config,
@@ -126,7 +126,7 @@ class PhysicsWorld:
         library: dict[str, Polyhedron] | None = None,
         config: PlannerConfig | None = None,
     ) -> Episode:
-        from haptic.executor.evaluate import score_components
+        from haptic.episode.evaluate import score_components
         from haptic.executor.physics import PhysicsExecutor
         from haptic.executor.primitives import TouchConfig
         from haptic.sim import RobotInterface, Simulation, compose_scene, random_object_pose
@@ -155,10 +155,10 @@ class PhysicsWorld:
         def finish(record: EpisodeRecord) -> None:
             record.sim_time_s = round(float(sim.time), 4)
             truth = sim.ground_truth()
-            score = score_components(executor.components, true_model, truth.world_from_object, results)
+            score = score_components(executor.components, true_model, SE3.from_matrix(truth.world_from_object), results)
             record.perception = _jsonable(score.summary())
 
-        world_from_model = SE3(np.asarray(pose)[:3, :3], np.asarray(pose)[:3, 3])
+        world_from_model = SE3.from_matrix(pose)
         return Episode(
             spec, library, true_model, world_from_model, executor, noise, config, policy_rng,
             observer=EpisodeObserver(on_move=keep, on_failed_move=keep), finish=finish,
@@ -182,7 +182,7 @@ def build_episode(
 def run_episode(
     spec: EpisodeSpec,
     library: dict[str, Polyhedron] | None = None,
-    observer: EpisodeObserver | None = None,
+    observer: Observer | None = None,
     config: PlannerConfig | None = None,
     policy: Policy | None = None,
 ) -> EpisodeRecord:

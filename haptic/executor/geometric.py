@@ -100,18 +100,11 @@ class GeometricExecutor:
         n = float(np.linalg.norm(x))
         return x if n <= bound or n == 0 else x * (bound / n)
 
-    def _perp_basis(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        a = np.cross(u, [1.0, 0.0, 0.0])
-        if np.linalg.norm(a) < 0.1:
-            a = np.cross(u, [0.0, 1.0, 0.0])
-        a /= np.linalg.norm(a)
-        return a, np.cross(u, a)
-
     def _turn(self, u: np.ndarray, sigma: float) -> np.ndarray:
         """``u`` turned by a random angle (2-D Gaussian σ per axis, truncated to k σ)."""
         if sigma <= 0:
             return u.copy()
-        a, b = self._perp_basis(u)
+        a, b = plane_basis(u, assume_unit=True)
         w = self._clip(self.rng.normal(0.0, sigma, 2), self.noise.k * sigma)
         ang = float(np.linalg.norm(w))
         if ang == 0:
@@ -122,7 +115,7 @@ class GeometricExecutor:
     def _perp_offset(self, u: np.ndarray, sigma: float) -> np.ndarray:
         if sigma <= 0:
             return np.zeros(3)
-        a, b = self._perp_basis(u)
+        a, b = plane_basis(u, assume_unit=True)
         w = self._clip(self.rng.normal(0.0, sigma, 2), self.noise.k * sigma)
         return w[0] * a + w[1] * b
 

@@ -23,8 +23,6 @@ import numpy as np
 
 from haptic.errors import HapticError
 from haptic.executor.primitives import (
-    PHASES,
-    ContactTrace,
     PrimitiveResult,
     TouchConfig,
     Toucher,
@@ -43,7 +41,8 @@ from haptic.executor.segment import (
     normal_turn_rate,
 )
 from haptic.matching.components import DataComponent
-from haptic.planning.moves import CostModel, EdgeMove, FaceMove, Move, MoveResult, SensorState, VertexMove
+from haptic.matching.trace import PHASES, ContactTrace
+from haptic.planning.moves import CostModel, EdgeMove, FaceMove, Move, MoveResult, SensorState, Touches, VertexMove
 from haptic.sim.robot import RobotInterface
 from haptic.sim.scene import OBJECT_REGION, TABLE_TOP_Z
 
@@ -54,6 +53,20 @@ RIDGE_PROBE = 0.004
 """An edge measured from a roll alone is followed this far each way from where the roll ended [m] ..."""
 RIDGE_MIN_SPAN = 0.003
 """... and its ridge contacts must span at least this along it [m]."""
+
+
+TOUCH_PHASES = ("face", "circle")
+"""Trace phases whose contacts count as touches: the pad sliding on one face (rolling over an edge, or resting
+on an edge or a vertex, it may touch two faces at once, and the sensed point is their mean)."""
+
+
+def touches_of(trace: ContactTrace) -> tuple[Touches, ...]:
+    """The contacts of ``trace`` sensed while sliding on a face, one group per phase of :data:`TOUCH_PHASES`."""
+    out = []
+    for ph in TOUCH_PHASES:
+        ok = trace.in_contact & (trace.phase == PHASES.index(ph))
+        out.append(Touches(trace.point_in_world[ok], trace.normal_in_world[ok]))
+    return tuple(out)
 
 
 @dataclass(frozen=True)
@@ -174,10 +187,11 @@ class PhysicsExecutor:
         trace = ContactTrace.concatenate([p.trace for p in pieces])
         self.traces.append(trace)
         info = dict(res.info)
-        info.update(trace=trace, **self._hand_links())
+        info.update(**self._hand_links())
         info.update(sim_time=self.robot.time - t0, wall_time=time.perf_counter() - w0)
         return MoveResult(move=res.move, status=res.status, components=res.components, distance=res.distance,
-                          cost=res.cost, state=res.state, info=info)  # fmt: skip
+                          cost=res.cost, state=res.state, touches=touches_of(trace), trace=trace,
+                          info=info)  # fmt: skip
 
     def _hand_links(self) -> dict:
         """The hand's link poses sampled during the move (the robot's own forward kinematics), for

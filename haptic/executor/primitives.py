@@ -25,6 +25,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from haptic.geometry.se3 import plane_basis
+from haptic.matching.trace import PHASES, ContactTrace, empty_trace
 from haptic.sim.robot import RobotInterface
 
 DOWN = np.diag([-1.0, 1.0, -1.0])
@@ -35,10 +37,6 @@ UNDERCUT_SLACK = math.radians(3.0)
 """Rolling off a face that itself leans under near the limit, the roll ends for the undercut only once the
 normal leans this much further than the face's (not on a noisy first reading) [rad]."""
 """Failure statuses of a primitive (the move statuses of :class:`~haptic.planning.moves.MoveResult`)."""
-
-PHASES = ("free", "approach", "settle", "face", "roll", "stroke", "ridge", "vertex", "circle")
-"""Phase labels of the trace samples (``ContactTrace.phase`` holds indices into this tuple)."""
-
 
 @dataclass(frozen=True)
 class TouchConfig:
@@ -121,58 +119,6 @@ class TouchConfig:
 
 
 @dataclass(frozen=True, eq=False)
-class ContactTrace:
-    """What the fingertip recorded, one row per control tick (world frame)."""
-
-    time: np.ndarray
-    """Simulation time (n,) [s]."""
-    tip_in_world: np.ndarray
-    """Pad centre (n, 3) [m] (forward kinematics of the encoders)."""
-    hand_rotation: np.ndarray
-    """Hand rotation ``world_from_hand`` (n, 3, 3)."""
-    point_in_world: np.ndarray
-    """Sensed contact point (n, 3) [m]; NaN without contact."""
-    normal_in_world: np.ndarray
-    """Sensed unit normal (n, 3), out of the touched surface; NaN without contact."""
-    force: np.ndarray
-    """Sensed normal force (n,) [N]."""
-    phase: np.ndarray
-    """Phase index (n,) into :data:`PHASES`."""
-
-    def __len__(self) -> int:
-        return len(self.time)
-
-    @property
-    def in_contact(self) -> np.ndarray:
-        """Rows with a valid contact (n,) bool."""
-        return np.isfinite(self.normal_in_world[:, 0])
-
-    def select(self, mask: np.ndarray) -> ContactTrace:
-        """The rows where ``mask`` holds."""
-        return ContactTrace(*(a[mask] for a in self._arrays()))
-
-    def tail(self, k: int) -> ContactTrace:
-        """The last ``k`` rows."""
-        return ContactTrace(*(a[max(len(self) - k, 0) :] for a in self._arrays()))
-
-    def _arrays(self):
-        return (self.time, self.tip_in_world, self.hand_rotation, self.point_in_world, self.normal_in_world,
-                self.force, self.phase)  # fmt: skip
-
-    @staticmethod
-    def concatenate(traces: list[ContactTrace]) -> ContactTrace:
-        traces = [t for t in traces if len(t)]
-        if not traces:
-            return empty_trace()
-        return ContactTrace(*(np.concatenate(cols) for cols in zip(*(t._arrays() for t in traces), strict=True)))
-
-
-def empty_trace() -> ContactTrace:
-    return ContactTrace(np.zeros(0), np.zeros((0, 3)), np.zeros((0, 3, 3)), np.zeros((0, 3)), np.zeros((0, 3)),
-                        np.zeros(0), np.zeros(0, dtype=int))  # fmt: skip
-
-
-@dataclass(frozen=True, eq=False)
 class PrimitiveResult:
     """How a primitive ended, what it recorded and how far it went."""
 
@@ -205,10 +151,7 @@ def angle(a: np.ndarray, b: np.ndarray) -> float:
 
 def perpendicular(v: np.ndarray) -> np.ndarray:
     """A unit vector perpendicular to ``v``."""
-    a = np.cross(v, [1.0, 0.0, 0.0])
-    if a @ a < 0.01:
-        a = np.cross(v, [0.0, 1.0, 0.0])
-    return unit(a)
+    return plane_basis(v, assume_unit=True)[0]
 
 
 class Toucher:

@@ -20,8 +20,9 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from haptic.executor.primitives import ContactTrace, unit
+from haptic.executor.primitives import perpendicular, unit
 from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex
+from haptic.matching.trace import ContactTrace
 
 
 @dataclass(frozen=True)
@@ -166,19 +167,12 @@ def normal_turn_rate(coords: np.ndarray, normals: np.ndarray) -> float:
     slope of the normals' tangent components over ``coords`` (k, m) (pad centres in m in-plane axes) [rad/m].
     Zero on a face; 1/r while rolling on an edge or a vertex."""
     n0 = unit(normals.sum(axis=0))
-    a = perpendicular_unit(n0)
+    a = perpendicular(n0)
     b = np.cross(n0, a)
     y = np.column_stack([normals @ a, normals @ b])
     x = np.column_stack([coords - coords.mean(axis=0), np.ones(len(coords))])
     sol, *_ = np.linalg.lstsq(x, y - y.mean(axis=0), rcond=None)
     return float(np.linalg.svd(sol[:-1], compute_uv=False)[0])
-
-
-def perpendicular_unit(v: np.ndarray) -> np.ndarray:
-    a = np.cross(v, [1.0, 0.0, 0.0])
-    if a @ a < 0.01:
-        a = np.cross(v, [0.0, 1.0, 0.0])
-    return unit(a)
 
 
 def angle_between(a: np.ndarray, b: np.ndarray) -> float:
@@ -391,7 +385,7 @@ class Segmenter:
         if off > b.max_roll_offset:
             return f"the roll lies {off * 1e3:.1f} mm off the face's plane"
         # the edge direction e ⊥ n_a: e = cos φ u + sin φ w; each rolling normal gives n·e = 0
-        u = perpendicular_unit(n_a)
+        u = perpendicular(n_a)
         w = np.cross(n_a, u)
         m = np.column_stack([n @ u, n @ w])
         _, _, vt = np.linalg.svd(m, full_matrices=False)

@@ -46,7 +46,16 @@ class SE3:
     def __matmul__(self, other: SE3) -> SE3:
         return SE3(self.rotation @ other.rotation, self.rotation @ other.translation + self.translation)
 
+    @classmethod
+    def from_matrix(cls, matrix) -> SE3:
+        """The transform of a homogeneous matrix (4, 4) (its last row is not checked)."""
+        m = np.asarray(matrix, dtype=float)
+        if m.shape != (4, 4):
+            raise ValueError(f"a rigid transform matrix has shape (4, 4), got {m.shape}")
+        return cls(m[:3, :3].copy(), m[:3, 3].copy())
+
     def as_matrix(self) -> np.ndarray:
+        """The homogeneous matrix (4, 4)."""
         m = np.eye(4)
         m[:3, :3] = self.rotation
         m[:3, 3] = self.translation
@@ -109,9 +118,13 @@ def frame_from_edge(direction: np.ndarray, face_normal: np.ndarray) -> np.ndarra
     return np.column_stack([b, n, np.cross(b, n)])
 
 
-def plane_basis(normal: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Two unit vectors ``(u, w)`` spanning the plane normal to ``normal``, with ``u × w = n``."""
-    n = np.asarray(normal, dtype=float) / np.linalg.norm(normal)
+def plane_basis(normal: np.ndarray, assume_unit: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """Two unit vectors ``(u, w)`` spanning the plane normal to ``normal``, with ``u × w = n``: ``u`` is
+    ``n × x̂`` normalised (``n × ŷ`` when ``n`` is within ~6° of x̂). With ``assume_unit``, ``normal`` is taken
+    as a unit vector as it is (not normalised again)."""
+    n = np.asarray(normal, dtype=float)
+    if not assume_unit:
+        n = n / np.linalg.norm(n)
     u = np.cross(n, [1.0, 0.0, 0.0])
     if np.linalg.norm(u) < 0.1:
         u = np.cross(n, [0.0, 1.0, 0.0])

@@ -8,10 +8,12 @@ A move is chosen by the planner and carried out by an executor (geometric or phy
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from enum import StrEnum
 
 import numpy as np
 
 from haptic.matching.components import DataComponent
+from haptic.matching.trace import ContactTrace
 
 
 @dataclass(frozen=True)
@@ -100,14 +102,38 @@ class VertexMove:
 Move = FaceMove | EdgeMove | VertexMove
 
 
+class MoveStatus(StrEnum):
+    """How a move ended: ``ok``, or why it failed. A ``str``, so records and messages show the bare value."""
+
+    OK = "ok"
+    NO_CONTACT = "no-contact"
+    UNREACHABLE = "unreachable"
+    TIMEOUT = "timeout"
+    UNSTABLE = "unstable"
+    INVALID = "invalid"
+
+
+@dataclass(frozen=True, eq=False)
+class Touches:
+    """Contacts sensed while the pad slid on one face during a move, in order (world frame)."""
+
+    point_in_world: np.ndarray
+    """Sensed contact points (P, 3) [m]."""
+    normal_in_world: np.ndarray
+    """Sensed unit normals (P, 3), out of the touched surface."""
+
+    def __len__(self) -> int:
+        return len(self.point_in_world)
+
+
 @dataclass(frozen=True, eq=False)
 class MoveResult:
     """What a move yielded."""
 
     move: Move
     """The move as asked."""
-    status: str
-    """"ok", or why it failed: "no-contact", "unreachable", "timeout", "unstable", "invalid"."""
+    status: MoveStatus
+    """:attr:`MoveStatus.OK`, or why it failed (a plain string is accepted and converted)."""
     components: tuple[DataComponent, ...] = ()
     """New components, and re-reported (extended) edges, in order of acquisition."""
     distance: float = 0.0
@@ -116,9 +142,17 @@ class MoveResult:
     """Cost of the move by the cost model [units]."""
     state: SensorState | None = None
     """Sensor state after the move (None when the move failed and the state is unknown)."""
+    touches: tuple[Touches, ...] = ()
+    """The contacts sensed while sliding on a face, one group per stroke (the executor decides which of its
+    samples count: none from an executor without a contact trace)."""
+    trace: ContactTrace | None = None
+    """Everything the fingertip sensed during the move (None: the executor keeps no trace)."""
     info: dict = field(default_factory=dict)
-    """Executor-specific extras (trace, simulated time)."""
+    """Executor-specific extras (the reason of a failure, the hand's link poses, simulated time)."""
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "status", MoveStatus(self.status))
 
     @property
     def ok(self) -> bool:
-        return self.status == "ok"
+        return self.status == MoveStatus.OK

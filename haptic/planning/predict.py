@@ -16,7 +16,7 @@ from functools import cached_property
 import numpy as np
 
 from haptic.geometry.polyhedron import Polyhedron
-from haptic.geometry.se3 import SE3
+from haptic.geometry.se3 import SE3, plane_basis
 from haptic.geometry.tracing import FaceHit, circle_vertex, trace_edge, trace_face
 from haptic.matching.components import DataComponent, DataEdge, DataFace, SensorNoise
 from haptic.planning.moves import CostModel, EdgeMove, FaceMove, Move, SensorState, VertexMove
@@ -223,11 +223,7 @@ def face_directions(
             inward = -inward
         angles = (np.arange(n) + 0.5) * np.pi / n
         return [np.cos(a) * b + np.sin(a) * inward for a in angles]
-    u = np.cross(normal, [1.0, 0.0, 0.0])
-    if np.linalg.norm(u) < 0.1:
-        u = np.cross(normal, [0.0, 1.0, 0.0])
-    u /= np.linalg.norm(u)
-    w = np.cross(normal, u)
+    u, w = plane_basis(normal, assume_unit=True)
     angles = np.arange(n) * 2 * np.pi / n
     return [np.cos(a) * u + np.sin(a) * w for a in angles]
 

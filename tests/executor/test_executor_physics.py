@@ -11,9 +11,9 @@ import pytest
 import haptic.executor.physics as physics_module
 import haptic.executor.primitives as primitives_module
 import haptic.executor.segment as segment_module
-from haptic.executor.evaluate import score_components
+from haptic.episode.evaluate import score_components
 from haptic.executor.physics import PhysicsExecutor
-from haptic.geometry import load_library
+from haptic.geometry import SE3, load_library
 from haptic.planning.moves import EdgeMove, FaceMove, VertexMove
 from haptic.sim import RobotInterface, SensorNoise, Simulation, compose_scene, random_object_pose
 from haptic.sim.scene import scene_object_from_polyhedron
@@ -58,7 +58,7 @@ def test_start_and_face_move_report_accurate_components(box_run):
     assert edge.adjacent == (results[0].components[0].id,) and face.adjacent == (edge.id,)
     st = results[-1].state
     assert st.face == face.id and st.edge == edge.id and st.edge_faces == (results[0].components[0].id, face.id)
-    score = score_components(ex.components, poly, sim.ground_truth().world_from_object, results)
+    score = score_components(ex.components, poly, SE3.from_matrix(sim.ground_truth().world_from_object), results)
     assert score.spurious == 0 and score.missed == 0
     assert score.errors("face", "angle").max() < 0.5
     assert score.errors("edge", "angle").max() < 1.0
@@ -174,7 +174,7 @@ def test_edge_and_vertex_moves_report_like_the_geometric_executor(sequence_run):
     assert vertex_move.state.vertex == vertex.id and vertex_move.state.edge == new_edge.id
     assert edge_move.cost == pytest.approx(ex.costs.edge_move(edge_move.distance))
     assert vertex_move.cost == pytest.approx(ex.costs.vertex_move(vertex_move.distance))
-    score = score_components(ex.components, poly, sim.ground_truth().world_from_object, results)
+    score = score_components(ex.components, poly, SE3.from_matrix(sim.ground_truth().world_from_object), results)
     assert score.spurious == 0 and score.missed == 0
     assert score.errors("vertex", "position").max() < 1.0
     assert score.errors("edge", "position").max() < 1.0

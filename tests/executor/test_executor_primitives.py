@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from haptic.executor.primitives import ContactTrace, Toucher
+from haptic.executor.primitives import Toucher
 from haptic.executor.segment import SegmentBounds, face_rows, fit_face
+from haptic.matching.trace import ContactTrace
 from haptic.sim import RobotInterface, SensorNoise, Simulation, compose_scene
 from haptic.sim.scene import TABLE_TOP_Z, scene_object_from_parts
 

@@ -6,8 +6,9 @@ import math
 
 import numpy as np
 
-from haptic.executor.primitives import ContactTrace, unit
+from haptic.executor.primitives import unit
 from haptic.executor.segment import FaceFit, LineFit, SegmentBounds, Segmenter, fit_face, normal_turn_rate
+from haptic.matching.trace import ContactTrace
 
 R_PAD = 0.012
 

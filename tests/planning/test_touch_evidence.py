@@ -3,7 +3,7 @@ reaches, and the episode sets aside pose classes that leave touched points off t
 
 import numpy as np
 
-from haptic.episode.loop import _fits_touches
+from haptic.episode.perception import fits_touches
 from haptic.geometry import SE3, load_library
 from haptic.matching.recognition import PoseClass
 from haptic.planning.moves import FaceMove
@@ -52,8 +52,8 @@ def test_touches_off_a_class_surface_set_it_aside():
     noisy = touched + np.random.default_rng(0).normal(0.0, 0.0002, touched.shape)
     up = np.tile([0.0, 0.0, 1.0], (len(xs), 1))
     cfg = PlannerConfig()
-    assert _fits_touches(PoseClass(box, (0,), pose), (noisy, up), cfg)
-    assert not _fits_touches(PoseClass(slotted, (0,), pose), (noisy, up), cfg)
+    assert fits_touches(PoseClass(box, (0,), pose), (noisy, up), cfg)
+    assert not fits_touches(PoseClass(slotted, (0,), pose), (noisy, up), cfg)
 
 
 def test_a_touch_just_past_an_edge_is_off_the_face_however_near_the_surface():
@@ -65,6 +65,6 @@ def test_a_touch_just_past_an_edge_is_off_the_face_however_near_the_surface():
     side = flip.apply(np.column_stack([np.full_like(zs, 0.05), np.zeros_like(zs), 0.06 - zs]))
     normal = np.tile(flip.rotate(np.array([0.0, -1.0, 0.0])), (len(zs), 1))
     cfg = PlannerConfig()
-    assert _fits_touches(PoseClass(box, (0,), flip), (side, normal), cfg)
-    assert not _fits_touches(PoseClass(slotted, (0,), flip), (side, normal), cfg)
-    assert _fits_touches(PoseClass(slotted, (0,), flip), (side[:-3], normal[:-3]), cfg)  # to 3 mm past: one stray
+    assert fits_touches(PoseClass(box, (0,), flip), (side, normal), cfg)
+    assert not fits_touches(PoseClass(slotted, (0,), flip), (side, normal), cfg)
+    assert fits_touches(PoseClass(slotted, (0,), flip), (side[:-3], normal[:-3]), cfg)  # to 3 mm past: one stray

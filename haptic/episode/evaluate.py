@@ -24,8 +24,9 @@ import numpy as np
 from haptic.geometry import tracing
 from haptic.geometry.distance import point_triangle_distance
 from haptic.geometry.polyhedron import Polyhedron
-from haptic.geometry.se3 import plane_basis
+from haptic.geometry.se3 import SE3, plane_basis
 from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex
+from haptic.matching.trace import PHASES
 
 
 @dataclass(frozen=True)
@@ -163,17 +164,16 @@ def score_vertex(c: DataVertex, model: Polyhedron, rot: np.ndarray, trans: np.nd
 def score_components(
     components,
     model: Polyhedron,
-    world_from_model: np.ndarray,
+    world_from_model: SE3,
     results=None,
     tolerances: EvaluationTolerances | None = None,
 ) -> PerceptionScore:
     """Score ``components`` (every report; the latest of each id counts) against ``model`` at
-    ``world_from_model`` (4, 4). With the move ``results`` (``MoveResult`` records, start first), also count
+    ``world_from_model``. With the move ``results`` (``MoveResult`` records, start first), also count
     missed components: the first true edge on a face move's ideal straight path, and the true vertex an edge
     move runs to, must be the ones reported."""
     tol = tolerances or EvaluationTolerances()
-    t = np.asarray(world_from_model, dtype=float)
-    rot, trans = t[:3, :3], t[:3, 3]
+    rot, trans = world_from_model.rotation, world_from_model.translation
     scores = []
     for c in _latest(components):
         if isinstance(c, DataFace):
@@ -277,9 +277,9 @@ def _missed(
         if r.ok and r.move.kind == "face" and prev_state is not None and r.components:
             f_score = by_id.get(prev_state.face)
             e_score = by_id.get(r.components[0].id)
-            trace = r.info.get("trace")
+            trace = r.trace
             if f_score and f_score.true_id is not None and e_score and trace is not None:
-                rows = trace.in_contact & (trace.phase == 3)  # "face" rows: where the straight trace began
+                rows = trace.in_contact & (trace.phase == PHASES.index("face"))  # where the straight trace began
                 if rows.any():
                     start = trace.point_in_world[np.flatnonzero(rows)[0]]
                     d = np.asarray(r.move.direction, float)

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from haptic.executor.evaluate import EvaluationTolerances, score_face
+from haptic.episode.evaluate import EvaluationTolerances, score_face
 from haptic.geometry import load_library
 from haptic.matching.components import DataFace
 
@@ -26,7 +26,7 @@ def test_the_first_felt_edge_skips_a_reflex_corner_the_pad_bridges():
     # crossing the slot's wall 3.2 mm above its floor cuts the slot's corner for 5 mm, never more than 1.8 mm
     # off the face: the pad, resting on the face around the corner, bridges it; the first edge it feels is
     # the bottom edge
-    from haptic.executor.evaluate import first_felt_edge
+    from haptic.episode.evaluate import first_felt_edge
     from haptic.geometry import tracing
 
     poly, tol = LIB["BOX01N"], EvaluationTolerances()
@@ -49,7 +49,7 @@ def test_the_pad_tracing_a_low_wall_first_meets_the_floor():
     # BOX01P's block wall x = 35 mm stands 20 mm over the top face (z 60-80 mm): a path along it sinking
     # 0.19 per unit would reach the wall's far end at z 64 mm, but the 12 mm pad's underside meets the floor
     # once the contact comes down to 72 mm: the concave edge at the wall's foot is the first felt
-    from haptic.executor.evaluate import first_felt_edge
+    from haptic.episode.evaluate import first_felt_edge
     from haptic.geometry import tracing
 
     poly, tol = LIB["BOX01P"], EvaluationTolerances()
