@@ -17,7 +17,7 @@ import mujoco
 import numpy as np
 
 from haptic.sim.control import ControlGains, Controller
-from haptic.sim.physics import SensorNoise, Simulation
+from haptic.sim.physics import SimulatedSensorNoise, Simulation
 from haptic.sim.scene import TABLE_TOP_Z, compose_scene, scene_object_from_parts
 
 
@@ -37,7 +37,7 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
 
     scene, top_z = _box_scene()
-    sim = Simulation(scene, noise=SensorNoise.from_notes(), seed=0)
+    sim = Simulation(scene, noise=SimulatedSensorNoise.from_notes(), seed=0)
     ctl = Controller(sim, "index", ControlGains(control_every=args.control_every))
     ctl.move_fingertip(np.array([0.56, 0.0, top_z + 0.015]))
     ctl.step(int(0.5 / ctl.tick_period))

@@ -33,7 +33,7 @@ from haptic.executor.physics import PhysicsExecutor
 from haptic.geometry import SE3, load_library
 from haptic.matching.tree import InterpretationTree
 from haptic.planning.moves import EdgeMove, FaceMove, Move, VertexMove
-from haptic.sim import RobotInterface, SensorNoise, Simulation, compose_scene, random_object_pose
+from haptic.sim import RobotInterface, SimulatedSensorNoise, Simulation, compose_scene, random_object_pose
 from haptic.sim.scene import scene_object_from_polyhedron
 
 SEED_OBJECTS = ("BOX01", "WEDGE01", "BOX01N", "BOX01P", "PYR01", "TETRA01L", "TETRA01R")
@@ -60,7 +60,7 @@ def explore(poly, seed: int, plan=PLAN, retries: int = 4):
     """One exploration of ``poly`` at a random pose; returns (simulation, executor, results)."""
     obj = scene_object_from_polyhedron(poly)
     pose = random_object_pose(obj, np.random.default_rng(seed))
-    sim = Simulation(compose_scene(obj, pose), noise=SensorNoise.from_notes(), seed=seed)
+    sim = Simulation(compose_scene(obj, pose), noise=SimulatedSensorNoise.from_notes(), seed=seed)
     ex = PhysicsExecutor(RobotInterface(sim), rng=np.random.default_rng(seed))
     rng = np.random.default_rng(seed + 7919)
     results = [ex.start()]

@@ -27,6 +27,7 @@ from haptic.geometry.polyhedron import Polyhedron
 from haptic.geometry.se3 import SE3, plane_basis
 from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex
 from haptic.matching.trace import PHASES
+from haptic.sim.scene import PAD_RADIUS
 
 
 @dataclass(frozen=True)
@@ -191,8 +192,6 @@ def score_components(
     return PerceptionScore(tuple(scores), sum(1 for s in scores if s.true_id is None), missed, concave, details)
 
 
-PAD_RADIUS = 0.012
-"""Radius of the fingertip pad [m] (the hand's geometry, for what its path can feel)."""
 MIN_TILT = math.radians(10.0)
 """The least angle between the two faces of an edge of the library: a pad tilted less than this over the
 rim of a face cannot be told from one on a real edge that shallow."""

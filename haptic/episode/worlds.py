@@ -103,7 +103,7 @@ def noise_models(level: float):
     noise, segment bounds, planner noise)``; ``level`` must be within
     :data:`~haptic.matching.components.NOISE_LEVELS`."""
     from haptic.executor.segment import SegmentBounds
-    from haptic.sim import SensorNoise as SimNoise
+    from haptic.sim import SimulatedSensorNoise as SimNoise
 
     level = check_noise_level(level)
     n = SimNoise.from_notes()
@@ -127,25 +127,27 @@ class PhysicsWorld:
         config: PlannerConfig | None = None,
     ) -> Episode:
         from haptic.episode.evaluate import score_components
-        from haptic.executor.physics import PhysicsExecutor
+        from haptic.executor.physics import PhysicsExecutor, PhysicsSettings
         from haptic.executor.primitives import TouchConfig
         from haptic.sim import RobotInterface, Simulation, compose_scene, random_object_pose
-        from haptic.sim.scene import TABLE_TOP_Z, scene_object_from_polyhedron
+        from haptic.sim.scene import scene_object_from_polyhedron
 
         library = library if library is not None else load_library(spec.models, skip_invalid=spec.skip_invalid)
         true_model = resolve_model(spec.model, library)
         config = config or PlannerConfig()
-        if config.table_z is None:  # the robot knows its workspace: where the table top is (never the object)
-            config = replace(
-                config, table_z=TABLE_TOP_Z, steep_descent_risk=STEEP_DESCENT_RISK,
-                max_undercut=TouchConfig().max_undercut, touch_evidence=True,
-            )
         root = np.random.SeedSequence(spec.seed)
         pose_rng, exec_rng, policy_rng, sim_seq = (np.random.default_rng(s) for s in root.spawn(4))
         obj = scene_object_from_polyhedron(true_model)
         pose = random_object_pose(obj, pose_rng)
+        scene = compose_scene(obj, pose)
+        if config.table_z is None:  # the robot knows its workspace from the scene (never the object)
+            ws = scene.workspace
+            config = replace(
+                config, table_z=ws.table_top_z, pad_radius=ws.pad_radius, vertex_radius=PhysicsSettings().vertex_radius,
+                steep_descent_risk=STEEP_DESCENT_RISK, max_undercut=TouchConfig().max_undercut, touch_evidence=True,
+            )  # fmt: skip
         sim_noise, bounds, noise = noise_models(spec.noise)
-        sim = Simulation(compose_scene(obj, pose), noise=sim_noise, seed=int(sim_seq.integers(2**31 - 1)))
+        sim = Simulation(scene, noise=sim_noise, seed=int(sim_seq.integers(2**31 - 1)))
         executor = PhysicsExecutor(RobotInterface(sim), bounds=bounds, costs=config.costs, rng=exec_rng)
         results: list[MoveResult] = []  # every move's result, for scoring perception
 

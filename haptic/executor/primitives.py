@@ -28,6 +28,7 @@ import numpy as np
 from haptic.geometry.se3 import plane_basis
 from haptic.matching.trace import PHASES, ContactTrace, empty_trace
 from haptic.sim.robot import RobotInterface
+from haptic.sim.scene import PAD_RADIUS
 
 DOWN = np.diag([-1.0, 1.0, -1.0])
 """Hand rotation ``world_from_hand`` with the fingers pointing down (the tracing posture)."""
@@ -174,7 +175,7 @@ class Toucher:
         self.contact_ticks = 0  # consecutive valid-contact samples
         self.weak_ticks = 0  # consecutive samples with force below loss_fraction × force
         self.hybrid = False
-        self.pad_radius = 0.012  # refined from the sensed contact (|tip − contact point|)
+        self.pad_radius = PAD_RADIUS  # refined from the sensed contact (|tip − contact point|)
         self._rows: list[tuple] = []
         self._ticks = 0
         self._links: list[tuple[float, np.ndarray]] = []  # (time, link positions) samples

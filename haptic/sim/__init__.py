@@ -13,8 +13,8 @@ from haptic.sim.physics import (  # noqa: E402
     FingertipContact,
     GroundTruth,
     LinkGeom,
-    SensorNoise,
     SensorReading,
+    SimulatedSensorNoise,
     Simulation,
 )
 from haptic.sim.robot import RobotInterface  # noqa: E402
@@ -43,7 +43,7 @@ __all__ = [
     "LinkGeom",
     "RobotInterface",
     "SceneObject",
-    "SensorNoise",
+    "SimulatedSensorNoise",
     "SensorReading",
     "Simulation",
     "compose_scene",

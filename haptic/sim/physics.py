@@ -56,8 +56,10 @@ def merge_patches(points: np.ndarray, normals: np.ndarray, forces: np.ndarray) -
 
 
 @dataclass(frozen=True)
-class SensorNoise:
-    """Zero-mean Gaussian noise of the robot's sensors (all zero: ideal sensors)."""
+class SimulatedSensorNoise:
+    """Zero-mean Gaussian noise of the simulated sensors, per sample (all zero: ideal sensors). The matcher and
+    planner work with the bounds of segmented components instead (:class:`haptic.matching.components.SensorNoise`;
+    :func:`haptic.episode.worlds.noise_models` derives both from one noise level)."""
 
     force_std: float = 0.0
     """σF: touch / contact normal force [N]."""
@@ -74,7 +76,7 @@ class SensorNoise:
         return self.force_std > 0 or self.normal_std > 0 or self.point_std > 0 or self.joint_std > 0
 
     @classmethod
-    def from_notes(cls) -> SensorNoise:
+    def from_notes(cls) -> SimulatedSensorNoise:
         """The levels of PHYSICS_NOTES: σF 0.02 N, σn 1°, σp 0.2 mm."""
         return cls(force_std=0.02, normal_std=np.deg2rad(1.0), point_std=2e-4)
 
@@ -228,13 +230,13 @@ class Simulation:
         self,
         scene: ComposedScene,
         *,
-        noise: SensorNoise | None = None,
+        noise: SimulatedSensorNoise | None = None,
         seed: int = 0,
     ) -> None:
         self._scene = scene
         self.model: mujoco.MjModel = scene.compile()
         self.data: mujoco.MjData = mujoco.MjData(self.model)
-        self.noise = noise or SensorNoise()
+        self.noise = noise or SimulatedSensorNoise()
         self._seed = seed
         self._rng = np.random.default_rng(seed)
         m = self.model

@@ -38,8 +38,28 @@ FINGERS = ("index", "middle", "ring", "thumb")
 FINGER_PREFIX = {"index": "ff", "middle": "mf", "ring": "rf", "thumb": "th"}
 HAND_JOINTS = tuple(f"{FINGER_PREFIX[f]}_j{k}" for f in FINGERS for k in range(4))
 
-TABLE_TOP_Z = 0.35
-"""Height of the table's top surface in the world frame [m] (see scenes/tabletop.xml)."""
+
+def _table_top_z(root: mjcf.RootElement) -> float:
+    """Height of the table's top surface in the world frame [m]: its ``table_surface`` site."""
+    site, table = root.find("site", "table_surface"), root.find("body", "table")
+    if site is None or table is None:
+        raise SceneError(f"{TABLETOP_XML}: no body 'table' with a site 'table_surface' (the table's top surface)")
+    return float(table.pos[2] + site.pos[2])
+
+
+def _pad_radius(root: mjcf.RootElement, prefix: str = "", finger: str = "index") -> float:
+    """Radius of ``finger``'s fingertip pad (a sphere) [m]."""
+    pad = root.find("geom", f"{prefix}{FINGER_PREFIX[finger]}_pad")
+    if pad is None:
+        raise SceneError(f"{HAND_XML}: no geom {FINGER_PREFIX[finger]}_pad (the {finger} fingertip's pad)")
+    size = pad.size if pad.size is not None else pad.dclass.geom.size
+    return float(size[0])
+
+
+TABLE_TOP_Z = _table_top_z(mjcf.from_path(str(TABLETOP_XML)))
+"""Height of the table's top surface in the world frame [m], read from scenes/tabletop.xml."""
+PAD_RADIUS = _pad_radius(mjcf.from_path(str(HAND_XML)))
+"""Radius of the tracing (index) fingertip's pad [m], read from assets/mjcf/hand/hand.xml."""
 OBJECT_REGION = ((0.46, 0.62), (-0.10, 0.10))
 """Where a random object centre is placed on the table: ((x_min, x_max), (y_min, y_max)) in world [m]."""
 
@@ -66,6 +86,16 @@ HAND_TRACE = np.array(
     ]
 )
 """Hand posture [rad] (order of ``HAND_JOINTS``) for tracing with the index finger, the others curled away."""
+
+
+@dataclass(frozen=True)
+class Workspace:
+    """The robot's workspace as a composed scene defines it (what the planner may assume; no object)."""
+
+    table_top_z: float
+    """Height of the table's top surface in the world frame [m]."""
+    pad_radius: float
+    """Radius of the tracing fingertip's pad [m]."""
 
 
 @dataclass(frozen=True)
@@ -96,6 +126,11 @@ class ComposedScene:
 
     def to_xml_string(self) -> str:
         return self.mjcf_model.to_xml_string()
+
+    @property
+    def workspace(self) -> Workspace:
+        """What the robot knows of its workspace, read from this scene (never the object)."""
+        return Workspace(_table_top_z(self.mjcf_model), _pad_radius(self.mjcf_model, HAND_PREFIX))
 
     def compile(self) -> mujoco.MjModel:
         """The plain MuJoCo model of this scene."""

@@ -15,7 +15,7 @@ from haptic.episode.evaluate import score_components
 from haptic.executor.physics import PhysicsExecutor
 from haptic.geometry import SE3, load_library
 from haptic.planning.moves import EdgeMove, FaceMove, VertexMove
-from haptic.sim import RobotInterface, SensorNoise, Simulation, compose_scene, random_object_pose
+from haptic.sim import RobotInterface, SimulatedSensorNoise, Simulation, compose_scene, random_object_pose
 from haptic.sim.scene import scene_object_from_polyhedron
 
 FACE_DIRECTIONS = 6
@@ -25,7 +25,7 @@ def _setup(name: str, seed: int):
     poly = load_library()[name]
     obj = scene_object_from_polyhedron(poly)
     pose = random_object_pose(obj, np.random.default_rng(seed))
-    sim = Simulation(compose_scene(obj, pose), noise=SensorNoise.from_notes(), seed=seed)
+    sim = Simulation(compose_scene(obj, pose), noise=SimulatedSensorNoise.from_notes(), seed=seed)
     return poly, sim
 
 
@@ -220,7 +220,7 @@ def test_start_finds_an_object_at_a_corner_of_the_region(corner):
     (x0, x1), (y0, y1) = OBJECT_REGION
     target = np.array([(x0, x1)[corner[0]], (y0, y1)[corner[1]]])
     pose[:2, 3] += target - 0.5 * (v.min(axis=0) + v.max(axis=0))[:2]  # bounding-box centre on the corner
-    sim = Simulation(compose_scene(obj, pose), noise=SensorNoise.from_notes(), seed=5)
+    sim = Simulation(compose_scene(obj, pose), noise=SimulatedSensorNoise.from_notes(), seed=5)
     r = PhysicsExecutor(RobotInterface(sim), rng=np.random.default_rng(5)).start()
     assert r.ok, r.info.get("reason")
 
@@ -235,7 +235,8 @@ def test_start_lands_again_when_the_l_stroke_rolled_on_an_edge():
     obj = scene_object_from_polyhedron(poly)
     pose_rng, exec_rng, _, sim_seq = (np.random.default_rng(s) for s in np.random.SeedSequence(7).spawn(4))
     pose = random_object_pose(obj, pose_rng)
-    sim = Simulation(compose_scene(obj, pose), noise=SensorNoise.from_notes(), seed=int(sim_seq.integers(2**31 - 1)))
+    noise = SimulatedSensorNoise.from_notes()
+    sim = Simulation(compose_scene(obj, pose), noise=noise, seed=int(sim_seq.integers(2**31 - 1)))
     r = PhysicsExecutor(RobotInterface(sim), rng=exec_rng).start()
     assert r.ok, r.info.get("reason")
     n = r.components[0].normal

@@ -7,7 +7,7 @@ import numpy as np
 from haptic.executor.primitives import Toucher
 from haptic.executor.segment import SegmentBounds, face_rows, fit_face
 from haptic.matching.trace import ContactTrace
-from haptic.sim import RobotInterface, SensorNoise, Simulation, compose_scene
+from haptic.sim import RobotInterface, SimulatedSensorNoise, Simulation, compose_scene
 from haptic.sim.scene import TABLE_TOP_Z, scene_object_from_parts
 
 HALF = np.array([0.05, 0.04, 0.03])
@@ -18,8 +18,8 @@ def _box_sim(seed: int = 0) -> Simulation:
     parts = [np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]) * HALF]
     pose = np.eye(4)
     pose[:3, 3] = CENTRE
-    return Simulation(compose_scene(scene_object_from_parts("box", parts), pose), noise=SensorNoise.from_notes(),
-                      seed=seed)  # fmt: skip
+    scene = compose_scene(scene_object_from_parts("box", parts), pose)
+    return Simulation(scene, noise=SimulatedSensorNoise.from_notes(), seed=seed)
 
 
 def test_approach_trace_roll_stroke_on_a_box():
@@ -68,13 +68,13 @@ def test_lift_and_approach_inside_a_narrow_slot():
     reaches the wall."""
     from haptic.executor.primitives import Toucher
     from haptic.geometry import load_library
-    from haptic.sim import RobotInterface, SensorNoise, Simulation, compose_scene, random_object_pose
+    from haptic.sim import RobotInterface, SimulatedSensorNoise, Simulation, compose_scene, random_object_pose
     from haptic.sim.scene import scene_object_from_polyhedron
 
     poly = load_library()["BOX01N"]
     obj = scene_object_from_polyhedron(poly)
     pose = random_object_pose(obj, np.random.default_rng(2017))  # upright: the slot opens upwards
-    sim = Simulation(compose_scene(obj, pose), noise=SensorNoise.from_notes(), seed=2017)
+    sim = Simulation(compose_scene(obj, pose), noise=SimulatedSensorNoise.from_notes(), seed=2017)
     gt = sim.ground_truth().world_from_object  # the test's setup only; the toucher never sees it
     rot, trans = gt[:3, :3], gt[:3, 3]
     assert (rot @ [0.0, 0.0, 1.0])[2] > 0.99

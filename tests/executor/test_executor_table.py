@@ -8,14 +8,14 @@ import numpy as np
 
 from haptic.executor.physics import PhysicsExecutor
 from haptic.geometry import load_library
-from haptic.sim import RobotInterface, SensorNoise, Simulation, compose_scene, random_object_pose
+from haptic.sim import RobotInterface, SimulatedSensorNoise, Simulation, compose_scene, random_object_pose
 from haptic.sim.scene import TABLE_TOP_Z, scene_object_from_polyhedron
 
 
 def _executor() -> PhysicsExecutor:
     obj = scene_object_from_polyhedron(load_library()["BOX01"])
     pose = random_object_pose(obj, np.random.default_rng(3))
-    sim = Simulation(compose_scene(obj, pose), noise=SensorNoise.from_notes(), seed=3)
+    sim = Simulation(compose_scene(obj, pose), noise=SimulatedSensorNoise.from_notes(), seed=3)
     return PhysicsExecutor(RobotInterface(sim), rng=np.random.default_rng(3))
 
 

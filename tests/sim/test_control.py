@@ -8,7 +8,7 @@ import pytest
 from conftest import BOX_CENTRE, BOX_HALF
 
 from haptic.sim.control import ControlGains, Controller, solve_fingertip_ik
-from haptic.sim.physics import SensorNoise, Simulation
+from haptic.sim.physics import SimulatedSensorNoise, Simulation
 from haptic.sim.scene import HAND_TRACE
 
 TOP_Z = BOX_CENTRE[2] + BOX_HALF[2]
@@ -83,7 +83,7 @@ def _slide(sim: Simulation, velocity, seconds=1.5, settle=0.3):
     return np.array(forces), travel, ctl
 
 
-@pytest.mark.parametrize("noise", [None, SensorNoise.from_notes()], ids=["ideal", "noisy"])
+@pytest.mark.parametrize("noise", [None, SimulatedSensorNoise.from_notes()], ids=["ideal", "noisy"])
 @pytest.mark.parametrize("direction", [(1.0, 0.0), (0.0, 1.0)], ids=["x", "y"])
 def test_hybrid_holds_1N_while_sliding_at_2cm_per_s(box_scene, noise, direction):
     sim = Simulation(box_scene, noise=noise, seed=3)

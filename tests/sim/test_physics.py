@@ -11,7 +11,7 @@ from conftest import BOX_CENTRE, BOX_HALF, box_parts, box_pose
 
 from haptic.errors import SceneError
 from haptic.sim.control import Controller
-from haptic.sim.physics import FingertipContact, SensorNoise, SensorReading, Simulation
+from haptic.sim.physics import FingertipContact, SensorReading, SimulatedSensorNoise, Simulation
 from haptic.sim.robot import RobotInterface
 from haptic.sim.scene import FINGERS, compose_scene, scene_object_from_parts
 
@@ -52,7 +52,7 @@ def test_contact_readout_on_a_top_face(box_scene):
 
 def test_sensor_noise_is_seeded(box_scene):
     def reading(seed):
-        sim = Simulation(box_scene, noise=SensorNoise.from_notes(), seed=seed)
+        sim = Simulation(box_scene, noise=SimulatedSensorNoise.from_notes(), seed=seed)
         _press_index_on_top(sim)
         return sim.read_sensors()
 
