@@ -8,7 +8,7 @@ here only to place the object (for the geometric executor) and, at the end, to s
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Generator
 from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 from typing import Protocol
@@ -146,6 +146,16 @@ def hypotheses_from(tree: InterpretationTree, rec: Recognition) -> list[Hypothes
     return out
 
 
+@dataclass(frozen=True, eq=False)
+class DecisionPoint:
+    """Where the loop asks its policy for the next move (:func:`loop_steps` yields one)."""
+
+    context: Context
+    """What the policy decides from: two or more pose classes left, no verification under way."""
+    rng: np.random.Generator
+    """The episode's policy generator (the one the opening moves draw from too)."""
+
+
 def run_loop(
     spec: EpisodeSpec,
     library: dict[str, Polyhedron],
@@ -158,7 +168,44 @@ def run_loop(
     rng: np.random.Generator,
     observer: Observer | None = None,
 ) -> EpisodeRecord:
-    """The closed loop over any executor with ``start()`` and ``execute(move)``."""
+    """The closed loop over any executor with ``start()`` and ``execute(move)``, ``policy`` answering every
+    :class:`DecisionPoint` of :func:`loop_steps`."""
+    steps = loop_steps(spec, library, true_model, world_from_model, executor, noise, config, rng, observer)
+    return drive(steps, lambda point: policy.choose(point.context, point.rng))
+
+
+def drive(steps: Generator[DecisionPoint, Decision, EpisodeRecord], choose: Callable[[DecisionPoint], Decision]):
+    """Run :func:`loop_steps` to its end, answering each decision point with ``choose`` (a
+    :class:`~haptic.errors.HapticError` it raises ends the episode as failed); returns the record."""
+    try:
+        point = next(steps)
+        while True:
+            try:
+                decision = choose(point)
+            except HapticError as exc:
+                point = steps.throw(exc)
+            else:
+                point = steps.send(decision)
+    except StopIteration as end:
+        return end.value
+
+
+def loop_steps(
+    spec: EpisodeSpec,
+    library: dict[str, Polyhedron],
+    true_model: Polyhedron,
+    world_from_model: SE3,
+    executor: Executor,
+    noise: SensorNoise,
+    config: PlannerConfig,
+    rng: np.random.Generator,
+    observer: Observer | None = None,
+) -> Generator[DecisionPoint, Decision, EpisodeRecord]:
+    """The closed loop as a generator: it yields a :class:`DecisionPoint` whenever the policy is to choose
+    and takes the :class:`Decision` sent back (a ``HapticError`` thrown in ends the episode as failed); it
+    returns the :class:`EpisodeRecord`. Opening moves, verification moves and the random fallback (fewer than
+    two pose classes) are chosen inside. :func:`run_loop` drives it with a policy, :mod:`haptic.env` with
+    the actions of an agent."""
     t0 = time.perf_counter()
     obs = observer or EpisodeObserver()
     if obs.on_start:
@@ -248,9 +295,11 @@ def run_loop(
                 t_dec = time.perf_counter()
                 hyps = hypotheses_from(tree, rec) if rec is not None and rec.classes else []
                 ctx = Context(hyps, state, components, noise, config, avoid=tuple(failed_here), tree=tree)
-                chooser = policy if len(hyps) >= 2 and not verifying else fallback
                 try:
-                    decision = chooser.choose(ctx, rng)
+                    if len(hyps) >= 2 and not verifying:
+                        decision = yield DecisionPoint(ctx, rng)
+                    else:
+                        decision = fallback.choose(ctx, rng)
                 except HapticError as exc:
                     outcome, detail = "failed", f"no move: {exc}"
                     break
