@@ -1,6 +1,8 @@
 """The ``haptic`` command.
 
 Every subcommand turns a :class:`~haptic.errors.HapticError` into one line on stderr and a non-zero exit.
+Function-local imports here are deliberate: a subcommand's modules load only when it runs, so that ``--help``
+and a bad option answer at once, without numpy's stack, MuJoCo or rerun.
 """
 
 from __future__ import annotations

@@ -1,4 +1,8 @@
-"""``haptic explore``: one episode, a summary on stdout, optionally its JSON record and a rerun recording."""
+"""``haptic explore``: one episode, a summary on stdout, optionally its JSON record and a rerun recording.
+
+Function-local imports here are deliberate: a subcommand's modules load only when it runs, so that ``--help``
+and a bad option answer at once, without numpy's stack, MuJoCo or rerun.
+"""
 
 from __future__ import annotations
 

@@ -76,13 +76,14 @@ import numpy as np
 import rerun as rr
 import rerun.blueprint as rrb
 
+from haptic.episode.loop import EpisodeObserver
 from haptic.errors import RecordingError
 from haptic.geometry import SE3, Polyhedron
 from haptic.geometry.se3 import plane_basis
 from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex
 
 if TYPE_CHECKING:
-    from haptic.episode.loop import EpisodeObserver, EpisodeRecord
+    from haptic.episode.loop import EpisodeRecord
     from haptic.matching.recognition import Recognition
     from haptic.planning.moves import Move, MoveResult, SensorState
     from haptic.planning.policies import Decision
@@ -350,8 +351,6 @@ class EpisodeRecorder:
     def observer(self) -> EpisodeObserver:
         """The :class:`~haptic.episode.loop.EpisodeObserver` that feeds this recorder."""
         from dataclasses import fields
-
-        from haptic.episode.loop import EpisodeObserver
 
         hooks = {
             "on_start": self.on_start,

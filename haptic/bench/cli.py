@@ -1,4 +1,8 @@
-"""``haptic bench``: a sweep of episodes, a results file, a summary table and a plot."""
+"""``haptic bench``: a sweep of episodes, a results file, a summary table and a plot.
+
+Function-local imports here are deliberate: a subcommand's modules load only when it runs, so that ``--help``
+and a bad option answer at once, without numpy's stack, MuJoCo or rerun.
+"""
 
 from __future__ import annotations
 

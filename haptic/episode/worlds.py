@@ -102,7 +102,7 @@ def noise_models(level: float):
     seam of the simulated pieces read 1.5° off), and a segmenter fitting with σ = 0 fails. Returns ``(sim
     noise, segment bounds, planner noise)``; ``level`` must be within
     :data:`~haptic.matching.components.NOISE_LEVELS`."""
-    from haptic.executor.segment import SegmentBounds
+    from haptic.executor.segment import SegmentBounds  # the simulated hand's modules load only for its episodes
     from haptic.sim import SimulatedSensorNoise as SimNoise
 
     level = check_noise_level(level)
@@ -126,6 +126,7 @@ class PhysicsWorld:
         library: dict[str, Polyhedron] | None = None,
         config: PlannerConfig | None = None,
     ) -> Episode:
+        # MuJoCo and the physics executor load only for physics episodes (geometric sweeps never import them)
         from haptic.episode.evaluate import score_components
         from haptic.executor.physics import PhysicsExecutor, PhysicsSettings
         from haptic.executor.primitives import TouchConfig

@@ -1,4 +1,8 @@
-"""``haptic scene``: compose a scene with an object on the table and export it as a standalone MJCF."""
+"""``haptic scene``: compose a scene with an object on the table and export it as a standalone MJCF.
+
+Function-local imports here are deliberate: a subcommand's modules load only when it runs, so that ``--help``
+and a bad option answer at once, without numpy's stack, MuJoCo or rerun.
+"""
 
 from __future__ import annotations
 
