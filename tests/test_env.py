@@ -49,8 +49,8 @@ def test_the_geometric_environment_passes_the_gymnasium_checks(small_library):
 
 @pytest.mark.slow
 def test_the_physics_environment_passes_the_gymnasium_checks(small_library):
-    """Short: at most 4 moves per episode (the start's opening sequence and one decision)."""
-    check_env(ExploreEnv(executor="physics", models=small_library, verify="none", max_moves=4), skip_render_check=True)
+    """Short: at most 8 moves per episode (the opening sequence and a few decisions), a three-model library."""
+    check_env(ExploreEnv(executor="physics", models=small_library, verify="none", max_moves=8), skip_render_check=True)
 
 
 def test_the_planner_through_the_environment_is_the_bench_planner():

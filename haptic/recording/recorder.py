@@ -1,62 +1,4 @@
-"""Rerun recordings of episodes: the only module of the package that imports ``rerun``.
-
-:class:`EpisodeRecorder` turns the hooks of :class:`~haptic.episode.loop.EpisodeObserver` into a rerun recording,
-saved to an ``.rrd`` file (written to a temporary file beside the target and renamed when the episode ended,
-so a failed episode never leaves a partial recording at the target path) and/or streamed to a spawned viewer.
-
-Timelines: ``move`` (sequence: 0 is the start, then one step per move) and, when the executor reports contact
-traces (the physics executor's ``MoveResult.trace``), ``sim_time`` (simulated time [s]); a physics recording
-opens on ``sim_time``. Everything drawn has a value on both timelines (per control tick on ``sim_time``, the
-state at the end of each move on ``move``).
-
-The default blueprint (:func:`default_blueprint`, sent when the first move arrives) frames the work: the
-``object`` view's eye is on the object's region, the ``fingertip`` view follows the active pad close up; the
-plots are the interpretations and pose classes (log10), the normal force and the path cost, each on its own
-axis; the candidate table and the logs beside them.
-
-Entities (world frame, metres, Z up; marks are sized to the object or in screen points, so they read at the
-default framing; labels show on hover):
-
-- ``world/truth``: Transform3D ``world_from_model`` of the true pose (static)
-- ``world/truth/object``: the true model's mesh, model frame (static; the ground-truth layer)
-- ``world/truth/edges``: its edges as line strips (static)
-- ``world/estimate``, ``.../edges``: the recognised model at its estimated pose, once recognised
-- ``world/robot/<link>``: Transform3D of each robot link (``info["hand_links"]`` poses), per sampled tick
-  (``sim_time``) and at the end of each move (``move``)
-- ``world/robot/<link>/<kind>s``: the link's collision geoms (capsules, spheres, cylinders, boxes, ellipsoids,
-  meshes) in the link frame, static (``info["link_geoms"]``); ``world/table``: the table top
-- ``world/hand/pad``: Transform3D (a translation) to the active fingertip pad's centre (the trace's tip), per
-  tick and at the end of each move (without traces: the sensor's position after each move): the origin of the
-  ``fingertip`` view, which so follows the pad
-- ``world/trace/path``: the sensor's path, one line strip per move, accumulated, coloured by move kind
-  (:data:`KIND_COLORS`; the legend is the interpretation plot's)
-- ``world/trace/failed``: fingertip paths of failed moves, accumulated (physics)
-- ``world/sensor``: sensor position after the latest move
-- ``world/contacts/points``, ``/normals``: the latest move's contact points and their normals (arrows)
-- ``world/data/faces/patches``: data faces as small patches in their planes, accumulated
-- ``world/data/faces/normals``: one arrow per data face (its normal), labelled ``f<id>``
-- ``world/data/faces/points``: the points touched on the data faces
-- ``world/data/edges``: one segment per data edge (its explored interval), ``e<id>``
-- ``world/data/vertices``: one point per data vertex, ``v<id>``
-- ``world/decision/candidates``: each candidate move of the decision, coloured by score
-- ``world/decision/chosen``: the chosen move
-- ``world/hand/fingertip``: pad centre per control tick (physics only)
-- ``world/hand/contact/points``, ``/normals``: sensed contact per control tick (physics only)
-- ``world/hand/links``, ``world/hand/skeleton``: link origins and the links joined as line strips
-  (``info["hand_link_chains"]``), drawn only when a result reports links without their geometry
-- ``plots/interpretations``, ``plots/pose_classes``: log10 of the surviving interpretations and pose classes
-  after each move (-1 stands for none); a failed move repeats the count
-- ``plots/moves/<kind>``: a marker per move on the interpretation plot, coloured by move kind (``start``,
-  ``face``, ``edge``, ``vertex``, ``failed``: a red cross): the legend of the trace's colours
-- ``plots/path_cost``: cumulative path cost [units]
-- ``plots/force``: sensed normal force per control tick [N] on ``sim_time``; on ``move``, each move's mean
-  force while in contact (physics only)
-- ``decision/scores``: per decision, a table of its candidate moves (kind and direction) with their scores,
-  expected cost and eliminations, best first
-- ``log/moves``, ``log/decisions``, ``log/episode``: text logs
-
-Read a recording back with :func:`load_recording` (rerun's :class:`rerun.chunk.RrdReader`).
-"""
+"""The episode recorder: the observer hooks of the loop turned into a rerun recording (file or viewer)."""
 
 from __future__ import annotations
 
@@ -74,153 +16,66 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import rerun as rr
-import rerun.blueprint as rrb
 
 from haptic.episode.loop import EpisodeObserver
 from haptic.errors import RecordingError
 from haptic.geometry import SE3, Polyhedron
-from haptic.geometry.se3 import plane_basis
 from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex
+from haptic.recording.blueprint import Framing, default_blueprint
+from haptic.recording.drawing import (
+    _chain_index,
+    _contacts,
+    _decision_table,
+    _entity_name,
+    _geom_archetypes,
+    _log_count,
+    _mesh,
+    _move_name,
+    _patch,
+    _score_color,
+    _subsample,
+    _trace_of,
+    _transform,
+    _waypoints,
+    _wireframe,
+)
+from haptic.recording.style import (
+    APPLICATION_ID,
+    ARROW_RADIUS,
+    CANDIDATE_SCALE,
+    CONTACT_COLOR,
+    CONTACT_NORMAL_SCALE,
+    CONTACT_RADIUS,
+    DEFAULT_RADIUS,
+    EDGE_COLOR,
+    EDGE_RADIUS,
+    ESTIMATE_COLOR,
+    FACE_COLOR,
+    FINGERTIP_VIEW_DISTANCE,
+    INTERPRETATIONS_COLOR,
+    KIND_COLORS,
+    MIN_VIEW_DISTANCE,
+    MOVE_CONTACTS,
+    MOVE_NORMALS,
+    NORMAL_SCALE,
+    OBJECT_VIEW_DISTANCE,
+    POSE_CLASSES_COLOR,
+    ROBOT_ALPHA,
+    START_TEXT,
+    TRACE_MAX_POINTS,
+    TRACE_RADIUS,
+    TRUTH_COLOR,
+    VERTEX_COLOR,
+    VERTEX_RADIUS,
+    VIEW_DIRECTION,
+    VIEWER_PORT,
+)
 
 if TYPE_CHECKING:
     from haptic.episode.loop import EpisodeRecord
     from haptic.matching.recognition import Recognition
     from haptic.planning.moves import Move, MoveResult, SensorState
     from haptic.planning.policies import Decision
-
-APPLICATION_ID = "haptic"
-"""Rerun application id of every episode recording (the viewer keeps one blueprint per application)."""
-
-VIEWER_PORT = 9876
-"""Port of a spawned viewer."""
-
-PATCH_RADIUS = 0.006
-"""Half-size of a data face's patch beyond its touched points [m]."""
-NORMAL_SCALE = 0.4
-"""Length of a face-normal arrow, as a fraction of the object's radius."""
-CONTACT_NORMAL_SCALE = 0.25
-"""Length of a contact-normal arrow, as a fraction of the object's radius."""
-CANDIDATE_SCALE = 0.5
-"""Length of the best candidate move's arrow, as a fraction of the object's radius (the others scale down
-with their score, to half of it)."""
-DEFAULT_RADIUS = 0.04
-"""Object radius assumed before the episode's object is known [m]."""
-MOVE_CONTACTS = 60
-"""Most contact points of one move in ``world/contacts/points`` (a physics trace is subsampled to it)."""
-MOVE_NORMALS = 12
-"""Most contact normals of one move drawn in ``world/contacts/normals`` (evenly spaced along the move)."""
-ROBOT_ALPHA = 0.6
-"""Opacity of the robot's geometry (the contact under a pad shows through it)."""
-TRACE_MAX_POINTS = 400
-"""Most points of one move's strip in ``world/trace/path`` (a physics trace is subsampled to it)."""
-OBJECT_VIEW_DISTANCE = 2.5
-"""Distance of the ``object`` view's eye from the object's centre, in object radii (at least
-:data:`MIN_VIEW_DISTANCE`)."""
-MIN_VIEW_DISTANCE = 0.12
-"""Closest the ``object`` view's eye starts to the object's centre [m]."""
-FINGERTIP_VIEW_DISTANCE = 0.09
-"""Distance of the ``fingertip`` view's eye from the pad [m]."""
-VIEW_DIRECTION = (0.75, -0.9, 0.75)
-"""Direction (world) from the looked-at point to the eye of both views: from the far side of the table and
-above, so the arm reaches in from behind the object."""
-NO_COUNT = -1.0
-"""What the log10 plots show for zero interpretations or pose classes."""
-START_TEXT = "**the start**: the hand comes down onto the object; the planner decides from the first contacts on"
-"""The candidate table before the first decision."""
-MAX_TABLE_ROWS = 12
-"""Most candidate moves listed in a decision's table (best first)."""
-
-# sizes in screen points (rerun draws negative radii as points on screen, whatever the zoom)
-TRACE_RADIUS = rr.components.Radius.ui_points(2.0)
-CONTACT_RADIUS = rr.components.Radius.ui_points(4.0)
-ARROW_RADIUS = rr.components.Radius.ui_points(1.5)
-EDGE_RADIUS = rr.components.Radius.ui_points(3.0)
-VERTEX_RADIUS = rr.components.Radius.ui_points(6.0)
-
-KIND_COLORS: dict[str, tuple[int, int, int]] = {
-    "start": (170, 170, 170),
-    "face": (70, 130, 230),
-    "edge": (240, 150, 40),
-    "vertex": (190, 90, 220),
-    "failed": (230, 50, 50),
-}
-"""Colour of each move kind (path strips, move markers on the interpretation plot, candidates)."""
-FACE_COLOR = (70, 130, 230, 140)
-EDGE_COLOR = (240, 150, 40)
-VERTEX_COLOR = (220, 40, 60)
-CONTACT_COLOR = (250, 220, 50)
-TRUTH_COLOR = (235, 225, 190, 120)
-ESTIMATE_COLOR = (60, 200, 90)
-INTERPRETATIONS_COLOR = (225, 225, 225)
-POSE_CLASSES_COLOR = (60, 190, 170)
-
-
-# ---------------------------------------------------------------------------------------------- blueprint
-
-
-@dataclass(frozen=True)
-class Framing:
-    """Where the default blueprint's 3-D views start looking (world frame)."""
-
-    object_eye: tuple[float, float, float] | None = None
-    """Eye of the ``object`` view [m] (None: the viewer's own framing of everything)."""
-    object_target: tuple[float, float, float] | None = None
-    """Point the ``object`` view looks at and orbits: the object's centre [m]."""
-    fingertip_eye: tuple[float, float, float] | None = None
-    """Eye of the ``fingertip`` view relative to the pad [m] (the view's origin is ``world/hand/pad``, which
-    moves with the pad, so the eye follows it)."""
-    timeline: str = "move"
-    """Timeline the recording opens on (``sim_time`` when there are physics traces)."""
-
-
-def default_blueprint(framing: Framing | None = None) -> rrb.Blueprint:
-    """The layout a recording opens with: on the left the ``object`` 3-D view (its eye on the object's region)
-    over the ``fingertip`` view (following the active pad close up) and the latest decision's candidate table;
-    on the right the interpretations and pose classes (log10, with a marker per move coloured by its kind and
-    failed moves crossed), the normal force, the path cost and the logs."""
-    f = framing or Framing()
-    up = (0.0, 0.0, 1.0)
-    obj_eye = (
-        rrb.EyeControls3D(position=f.object_eye, look_target=f.object_target, eye_up=up)
-        if f.object_eye is not None else None
-    )  # fmt: skip
-    tip_eye = (
-        rrb.EyeControls3D(position=f.fingertip_eye, look_target=(0.0, 0.0, 0.0), eye_up=up)
-        if f.fingertip_eye is not None else None
-    )  # fmt: skip
-    return rrb.Blueprint(
-        rrb.Horizontal(
-            rrb.Vertical(
-                rrb.Spatial3DView(origin="world", name="object", eye_controls=obj_eye,
-                                  background=rrb.BackgroundKind.GradientBright),
-                rrb.Horizontal(
-                    rrb.Spatial3DView(origin="world/hand/pad", contents="/world/**", name="fingertip",
-                                      eye_controls=tip_eye, background=rrb.BackgroundKind.GradientBright),
-                    rrb.TextDocumentView(origin="decision", name="candidate moves"),
-                    column_shares=[1, 1],
-                ),
-                row_shares=[3, 2],
-            ),
-            rrb.Vertical(
-                rrb.TimeSeriesView(
-                    origin="plots", name="interpretations, pose classes (log10)",
-                    contents=["plots/interpretations", "plots/pose_classes", "plots/moves/**"],
-                    plot_legend=rrb.PlotLegend(corner=rrb.Corner2D.RightTop),
-                ),  # fmt: skip
-                rrb.TimeSeriesView(origin="plots", contents=["plots/force"], name="normal force [N]"),
-                rrb.TimeSeriesView(origin="plots", contents=["plots/path_cost"], name="path cost [units]"),
-                rrb.TextLogView(origin="log", name="log"),
-                row_shares=[3, 2, 2, 2],
-            ),
-            column_shares=[3, 2],
-        ),
-        rrb.TimePanel(timeline=f.timeline, state="collapsed"),
-        rrb.SelectionPanel(state="collapsed"),
-        rrb.BlueprintPanel(state="collapsed"),
-    )
-
-
-# ---------------------------------------------------------------------------------------------- recorder
 
 
 def _viewer_executable() -> str:
@@ -907,338 +762,3 @@ class EpisodeRecorder:
         st = self._s.state
         cid = getattr(st, kind, None) if st is not None else None
         return self._s.components.get(cid) if cid is not None else None
-
-
-# ---------------------------------------------------------------------------------------------- geometry
-
-
-def _transform(t: SE3) -> rr.Transform3D:
-    return rr.Transform3D(translation=np.asarray(t.translation, dtype=float), mat3x3=np.asarray(t.rotation))
-
-
-def _mesh(model: Polyhedron, color: tuple[int, ...]) -> rr.Mesh3D:
-    """Flat-shaded mesh in the model frame (vertices repeated per triangle so each face keeps its normal)."""
-    tris = np.asarray(model.triangles)
-    pos = np.asarray(model.vertices, dtype=float)[tris].reshape(-1, 3)
-    nrm = np.repeat(np.asarray(model.face_normals, dtype=float)[np.asarray(model.triangle_faces)], 3, axis=0)
-    return rr.Mesh3D(
-        vertex_positions=pos, triangle_indices=np.arange(len(pos)).reshape(-1, 3), vertex_normals=nrm,
-        albedo_factor=color,
-    )  # fmt: skip
-
-
-def _wireframe(model: Polyhedron, color: tuple[int, ...], radius: float) -> rr.LineStrips3D:
-    v = np.asarray(model.vertices, dtype=float)
-    return rr.LineStrips3D([v[list(e)] for e in np.asarray(model.edges)], colors=[color], radii=radius)
-
-
-def _patch(face: DataFace) -> tuple[np.ndarray, np.ndarray]:
-    """A square in the face's plane around its touched points (half-size: their spread + PATCH_RADIUS)."""
-    n = face.normal
-    a, b = plane_basis(n)
-    c = face.points.mean(axis=0)
-    c = c - (c @ n - face.offset) * n
-    rel = face.points - c
-    ha = float(np.abs(rel @ a).max()) + PATCH_RADIUS
-    hb = float(np.abs(rel @ b).max()) + PATCH_RADIUS
-    v = np.array([c - ha * a - hb * b, c + ha * a - hb * b, c + ha * a + hb * b, c - ha * a + hb * b])
-    return v, np.array([[0, 1, 2], [0, 2, 3]])
-
-
-def _edge_crossing(start: np.ndarray, direction: np.ndarray, edge: DataEdge) -> np.ndarray | None:
-    """Where the ray ``start + t direction`` passes closest to the edge's line (the point on the line)."""
-    d = np.asarray(direction, dtype=float)
-    b = edge.direction
-    w = start - edge.point
-    m = np.array([[d @ d, -(d @ b)], [d @ b, -(b @ b)]])
-    if abs(np.linalg.det(m)) < 1e-12:
-        return None
-    _, u = np.linalg.solve(m, [-(w @ d), -(w @ b)])
-    return edge.point + u * b
-
-
-def _waypoints(prev: np.ndarray | None, result: MoveResult, new: np.ndarray | None) -> np.ndarray:
-    """The sensed points of a move in the order they were met, from the previous sensor position to the new
-    one: the geometric executor's path (it has no fingertip trajectory)."""
-    pts: list[np.ndarray] = [prev] if prev is not None else []
-    move = result.move
-    for c in result.components:
-        if isinstance(c, DataFace):
-            pts.extend(c.points)
-        elif isinstance(c, DataVertex):
-            pts.append(c.position)
-        elif isinstance(c, DataEdge):
-            if getattr(move, "kind", None) == "edge":
-                continue  # the path runs along the edge to the vertex (or its end), added below
-            start = pts[-1] if pts else None
-            hit = None
-            if start is not None and getattr(move, "kind", None) == "face":
-                hit = _edge_crossing(start, move.direction, c)
-            elif c.side_points:
-                q = c.side_points[0][1]
-                pts.append(q)
-                hit = c.point + ((q - c.point) @ c.direction) * c.direction
-            if hit is not None:
-                pts.append(hit)
-    if getattr(move, "kind", None) == "edge" and not any(isinstance(c, DataVertex) for c in result.components):
-        e = next((c for c in result.components if isinstance(c, DataEdge)), None)
-        if e is not None and prev is not None:
-            ends = [e.point, e.end_point]
-            pts.append(max(ends, key=lambda q: float(np.linalg.norm(q - prev))))
-    if new is not None:
-        pts.append(new)
-    out: list[np.ndarray] = []
-    for p in pts:
-        p = np.asarray(p, dtype=float)
-        if not out or np.linalg.norm(p - out[-1]) > 1e-9:
-            out.append(p)
-    return np.array(out).reshape(-1, 3)
-
-
-def _contacts(components: tuple[DataComponent, ...]) -> tuple[np.ndarray, np.ndarray]:
-    """Contact points and normals of a move from its components (geometric executor): face points with the
-    face normal."""
-    pts, nrm = [], []
-    for c in components:
-        if isinstance(c, DataFace):
-            pts.extend(c.points)
-            nrm.extend([c.normal] * len(c.points))
-    if not pts:
-        return np.zeros((0, 3)), np.zeros((0, 3))
-    return np.array(pts), np.array(nrm)
-
-
-def _subsample(a: np.ndarray, k: int) -> np.ndarray:
-    """At most ``k`` rows of ``a``, evenly spaced, first and last kept."""
-    if len(a) <= k:
-        return a
-    return a[np.unique(np.linspace(0, len(a) - 1, k).round().astype(int))]
-
-
-def _trace_of(result: MoveResult) -> Any:
-    """The move's contact trace (``result.trace``) when it looks like one, else None."""
-    tr = getattr(result, "trace", None)
-    needed = ("time", "tip_in_world", "point_in_world", "normal_in_world", "force")
-    if tr is None or not all(hasattr(tr, a) for a in needed):
-        return None
-    return tr
-
-
-def _score_color(r: float) -> tuple[int, int, int]:
-    """Dark blue (worst) to yellow (best)."""
-    r = float(min(max(r, 0.0), 1.0))
-    lo, hi = np.array([40, 30, 120]), np.array([250, 230, 40])
-    return tuple(int(x) for x in lo + r * (hi - lo))
-
-
-def _chain_index(names: list[str], chains: Any) -> list[np.ndarray]:
-    """Row indices of each polyline of link names (chains naming an unknown link, or with fewer than two
-    links, are left out)."""
-    if not chains:
-        return []
-    where = {name: j for j, name in enumerate(names)}
-    out = []
-    for chain in chains:
-        idx = [where.get(str(name)) for name in chain]
-        if len(idx) >= 2 and None not in idx:
-            out.append(np.array(idx))
-    return out
-
-
-def _log_count(n: float) -> float:
-    """What the log10 plots show for ``n`` interpretations or pose classes (:data:`NO_COUNT` for none)."""
-    return math.log10(n) if n >= 1 else NO_COUNT
-
-
-def _entity_name(name: Any) -> str:
-    """A link name as one entity-path part (slashes and spaces replaced)."""
-    return str(name).replace("/", "_").replace(" ", "_") or "_"
-
-
-def _quat_xyzw(wxyz: np.ndarray) -> np.ndarray:
-    return np.asarray(wxyz, dtype=float)[..., [1, 2, 3, 0]]
-
-
-def _rotate(wxyz: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """``v`` (3,) rotated by the unit quaternion (w, x, y, z)."""
-    w, q = float(wxyz[0]), np.asarray(wxyz[1:], dtype=float)
-    return v + 2.0 * np.cross(q, np.cross(q, v) + w * v)
-
-
-def _geom_archetypes(kind: str, geoms: list[Any], alpha: float = 1.0) -> list[tuple[str, Any]]:
-    """Rerun archetypes drawing ``geoms`` (all of one kind, in their link's frame; their opacity times
-    ``alpha``): (entity suffix, archetype) pairs. Raises ValueError for a kind rerun cannot draw here."""
-    pose = np.array([np.asarray(g.pose, dtype=float) for g in geoms]).reshape(len(geoms), 7)
-    size = np.array([np.asarray(g.size, dtype=float) for g in geoms]).reshape(len(geoms), 3)
-    colors = [tuple(int(round(255 * float(c) * (alpha if j == 3 else 1.0))) for j, c in enumerate(g.rgba))
-              for g in geoms]  # fmt: skip
-    pos, quat = pose[:, :3], pose[:, 3:]
-    solid = rr.components.FillMode.Solid
-    if kind == "sphere":
-        return [("spheres", rr.Ellipsoids3D(half_sizes=np.repeat(size[:, :1], 3, axis=1), centers=pos,
-                                            colors=colors, fill_mode=solid))]  # fmt: skip
-    if kind == "ellipsoid":
-        return [("ellipsoids", rr.Ellipsoids3D(half_sizes=size, centers=pos, quaternions=_quat_xyzw(quat),
-                                               colors=colors, fill_mode=solid))]  # fmt: skip
-    if kind == "capsule":  # MuJoCo: centred, along z from -h to +h; rerun: from the origin to (0, 0, length)
-        start = np.array([p - _rotate(q, np.array([0.0, 0.0, h])) for p, q, h in zip(pos, quat, size[:, 1],
-                                                                                      strict=True)])  # fmt: skip
-        return [("capsules", rr.Capsules3D(lengths=2 * size[:, 1], radii=size[:, 0], translations=start,
-                                           quaternions=_quat_xyzw(quat), colors=colors, fill_mode=solid))]  # fmt: skip
-    if kind == "cylinder":
-        cylinders = rr.Cylinders3D(lengths=2 * size[:, 1], radii=size[:, 0], centers=pos,
-                                   quaternions=_quat_xyzw(quat), colors=colors, fill_mode=solid)  # fmt: skip
-        return [("cylinders", cylinders)]
-    if kind == "box":
-        return [("boxes", rr.Boxes3D(half_sizes=size, centers=pos, quaternions=_quat_xyzw(quat), colors=colors,
-                                     fill_mode=solid))]  # fmt: skip
-    if kind == "mesh":
-        out = []
-        for j, (g, p, q, c) in enumerate(zip(geoms, pos, quat, colors, strict=True)):
-            if g.vertices is None or g.triangles is None:
-                raise ValueError(f"mesh geom {g.name!r} has no vertices or triangles")
-            v = np.array([p + _rotate(q, x) for x in np.asarray(g.vertices, dtype=float)])
-            out.append((f"mesh{j}", rr.Mesh3D(vertex_positions=v, triangle_indices=np.asarray(g.triangles),
-                                               albedo_factor=c)))  # fmt: skip
-        return out
-    raise ValueError(f"geom kind {kind!r} (drawn: sphere, ellipsoid, capsule, cylinder, box, mesh)")
-
-
-def _bar(r: float, width: int = 20) -> str:
-    """A text bar of ``r`` in [0, 1], in ASCII (the viewer's fonts lack block characters)."""
-    n = round(max(0.0, min(1.0, r)) * width)
-    return "`" + "=" * n + " " * (width - n) + "`"
-
-
-def _decision_table(i: int, decision: Decision) -> str:
-    """Markdown: the decision's candidate moves, best first, with a bar of their score against the best."""
-    cands = sorted(decision.candidates, key=lambda c: -c.score if math.isfinite(c.score) else math.inf)
-    head = f"**move {i}**: chose **{_move_name(decision.move)}**"
-    if not cands:
-        return head + " (no scored candidates: the fallback policy)"
-    best = max((float(c.score) for c in cands if math.isfinite(c.score)), default=0.0)
-    rows = [head + f" among {len(cands)} candidates", "",
-            "| move | score | | exp. cost | exp. eliminated |", "|---|---|---|--:|--:|"]  # fmt: skip
-    shown = cands[:MAX_TABLE_ROWS]
-    for c in shown:
-        name = f"**{_move_name(c.move)}** (chosen)" if c.move == decision.move else _move_name(c.move)
-        r = float(c.score) / best if best > 0 and math.isfinite(c.score) else 0.0
-        rows.append(f"| {name} | {_bar(r)} | {c.score:.3g} | {c.expected_cost:.2f} | "
-                    f"{c.expected_eliminated:.2f} |")  # fmt: skip
-    if len(cands) > len(shown):
-        rows.append(f"| ... {len(cands) - len(shown)} more | | | | |")
-    return "\n".join(rows)
-
-
-def _move_name(move: Move) -> str:
-    """The move's kind and direction: ``face (+0.92, +0.33, -0.22)`` (a world direction), ``edge +``,
-    ``vertex across f2``."""
-    kind = getattr(move, "kind", "?")
-    if kind == "face":
-        d = np.asarray(move.direction, dtype=float)
-        return f"face ({d[0]:+.2f}, {d[1]:+.2f}, {d[2]:+.2f})"
-    if kind == "edge":
-        return f"edge {'+' if move.sense > 0 else '-'}"
-    if kind == "vertex":
-        return f"vertex across f{move.across_face}"
-    return str(move)
-
-
-# ---------------------------------------------------------------------------------------------- reading back
-
-
-@dataclass
-class EntityData:
-    """One entity of a recording read back."""
-
-    path: str
-    """Entity path, e.g. ``/plots/interpretations``."""
-    static: dict[str, list]
-    """Component column (``Archetype:field``) -> its static value (a list of instances)."""
-    timelines: dict[str, list]
-    """Timeline name -> one value per temporal row, in logging order (sequence: int; duration: seconds; None
-    where the row has no value on that timeline)."""
-    components: dict[str, list]
-    """Component column -> one value per temporal row (a list of instances, or None where not logged)."""
-
-    @property
-    def rows(self) -> int:
-        """Number of temporal rows."""
-        return max((len(v) for v in self.timelines.values()), default=0)
-
-    def series(self, component: str, timeline: str = "move") -> tuple[list, list]:
-        """``(times, values)`` of the temporal rows that hold ``component``, in logging order."""
-        values = self.components.get(component, [])
-        times = self.timelines.get(timeline, [None] * len(values))
-        keep = [i for i, v in enumerate(values) if v is not None]
-        return [times[i] for i in keep], [values[i] for i in keep]
-
-
-def load_recording(path: str | os.PathLike, *, blueprint: bool = False) -> dict[str, EntityData]:
-    """Every entity of the (first) recording in an ``.rrd`` file, read with rerun's own
-    :class:`rerun.chunk.RrdReader`; keys are entity paths without the leading slash. ``blueprint=True``
-    reads the file's (last) blueprint instead: its views (``view/<id>``, with ``ViewBlueprint:*`` and their
-    properties, such as ``view/<id>/EyeControls3D``), containers and panels, on the ``blueprint`` timeline."""
-    import pyarrow as pa
-    from rerun.chunk import RrdReader
-
-    p = Path(path)
-    if not p.is_file():
-        raise RecordingError(f"{p}: no such recording")
-    try:
-        reader = RrdReader(p)
-        if blueprint:
-            stores = reader.blueprints()
-            if not stores:
-                raise RecordingError(f"{p}: the recording holds no blueprint")
-            chunks = reader.stream(store=stores[-1]).to_chunks()
-        else:
-            chunks = reader.stream().to_chunks()
-    except RecordingError:
-        raise
-    except Exception as exc:  # noqa: BLE001 -- rerun raises plain exceptions on a bad file
-        raise RecordingError(f"{p}: not a readable rerun recording ({exc})") from exc
-    temporal: dict[str, list[tuple[bytes, dict]]] = {}
-    static: dict[str, dict[str, list]] = {}
-    for ch in chunks:
-        batch = ch.to_record_batch()
-        row_ids: list[bytes] = [b""] * ch.num_rows
-        cols: dict[tuple[str, str], list] = {}
-        for fld, col in zip(batch.schema, batch.columns, strict=True):
-            kind = (fld.metadata or {}).get(b"rerun:kind", b"").decode()
-            if kind == "index" and pa.types.is_duration(fld.type):  # to seconds (as_py would drop nanoseconds)
-                scale = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}[fld.type.unit]
-                cols[("t", fld.name)] = [v * scale if v is not None else None for v in col.cast(pa.int64()).to_pylist()]
-                continue
-            if kind == "index" and pa.types.is_timestamp(fld.type):  # nanoseconds since the epoch, as int
-                cols[("t", fld.name)] = col.cast(pa.int64()).to_pylist()
-                continue
-            values = col.to_pylist()
-            if kind == "control":
-                row_ids = [bytes(x) if x is not None else b"" for x in values]
-            elif kind == "index":
-                cols[("t", fld.name)] = values
-            else:
-                cols[("c", fld.name)] = values
-        ep = ch.entity_path.lstrip("/")
-        if ch.is_static:
-            for (_, name), values in cols.items():
-                if values and values[-1] is not None:
-                    static.setdefault(ep, {})[name] = values[-1]
-            continue
-        for r in range(ch.num_rows):
-            temporal.setdefault(ep, []).append((row_ids[r], {k: v[r] for k, v in cols.items()}))
-    out: dict[str, EntityData] = {}
-    for ep in sorted(set(temporal) | set(static)):
-        rows = sorted(temporal.get(ep, []), key=lambda x: x[0])  # row ids (TUIDs) sort in logging order
-        keys = sorted({k for _, d in rows for k in d})
-        out[ep] = EntityData(
-            path="/" + ep,
-            static=static.get(ep, {}),
-            timelines={k[1]: [d.get(k) for _, d in rows] for k in keys if k[0] == "t"},
-            components={k[1]: [d.get(k) for _, d in rows] for k in keys if k[0] == "c"},
-        )
-    return out
-
-
-__all__ = ["EntityData", "EpisodeRecorder", "RecordingError", "default_blueprint", "load_recording"]
