@@ -11,6 +11,7 @@ solid in the world (models congruent by a proper rigid motion), so no further da
 from __future__ import annotations
 
 import weakref
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -101,21 +102,47 @@ class Recognition:
     """Names of the models with surviving interpretations."""
 
 
+def _same_pose_as(a: SE3, rotations: np.ndarray, translations: np.ndarray, model: Polyhedron, tol: PoseTolerance):
+    """:func:`equivalent_by_symmetry` of the pose ``a`` and each of N poses ``(rotations, translations)``."""
+    c = model.centroid
+    tb = translations + rotations @ c  # the centroid placed by each pose
+    out = np.zeros(len(rotations), dtype=bool)
+    for s in model_symmetries(model):
+        r_as, t_as = a.rotation @ s.rotation, a.rotation @ s.translation + a.translation
+        cos = (np.einsum("ij,nij->n", r_as, rotations) - 1.0) / 2.0
+        near = np.arccos(np.clip(cos, -1.0, 1.0)) <= tol.angle
+        near &= np.linalg.norm(r_as @ c + t_as - tb, axis=1) <= tol.distance
+        out |= near
+    return out
+
+
+def _group(models: Sequence[Polyhedron], model_index: np.ndarray, poses: Sequence[SE3], tol: PoseTolerance):
+    """Positions of the poses grouped into pose classes, in the order of each class's first member: each pose
+    joins the first earlier class of its model whose first pose it equals up to a symmetry (vectorised over the
+    poses of each model)."""
+    rot = np.stack([p.rotation for p in poses])
+    trans = np.stack([p.translation for p in poses])
+    groups: list[list[int]] = []
+    for m in dict.fromkeys(model_index.tolist()):
+        left = np.flatnonzero(model_index == m)
+        while len(left):
+            rep, rest = int(left[0]), left[1:]
+            same = _same_pose_as(poses[rep], rot[rest], trans[rest], models[rep], tol)
+            groups.append([rep, *rest[same].tolist()])
+            left = rest[~same]
+    return sorted(groups)
+
+
 def group_pose_classes(interpretations: list[Interpretation], tol: PoseTolerance) -> list[PoseClass] | None:
     """Group interpretations into pose classes; None when some interpretation has no pose yet."""
-    reps: list[tuple[Interpretation, list[int]]] = []
-    for it in interpretations:
-        if it.world_from_model is None:
-            return None
-        for rep, members in reps:
-            if rep.model_index == it.model_index and equivalent_by_symmetry(
-                rep.world_from_model, it.world_from_model, it.model, tol
-            ):
-                members.append(it.leaf)
-                break
-        else:
-            reps.append((it, [it.leaf]))
-    return [PoseClass(rep.model, tuple(m), rep.world_from_model) for rep, m in reps]
+    if any(it.world_from_model is None for it in interpretations):
+        return None
+    if not interpretations:
+        return []
+    models = [it.model for it in interpretations]
+    poses = [it.world_from_model for it in interpretations]
+    groups = _group(models, np.array([it.model_index for it in interpretations]), poses, tol)
+    return [PoseClass(models[g[0]], tuple(interpretations[i].leaf for i in g), poses[g[0]]) for g in groups]
 
 
 def same_solid(a: PoseClass, b: PoseClass, tol: PoseTolerance) -> bool:
@@ -138,15 +165,17 @@ def recognize(tree: InterpretationTree, max_interpretations: int = 64, tol: Pose
     if n > max_interpretations:
         return Recognition(EXPLORING, None, None, (), n, models)
     tol = tol if tol is not None else PoseTolerance.from_data(tree.data)
-    interps = [tree.interpretation(i, with_pose=True, refine=False) for i in range(n)]
-    classes = group_pose_classes(interps, tol)
-    if classes is None:
+    poses = tree.poses(range(n), refine=False)
+    if any(p is None for p in poses):
         return Recognition(EXPLORING, None, None, (), n, models)
-    refined = []
-    for c in classes:
-        it = tree.interpretation(c.leaves[0], with_pose=True, refine=True)
-        refined.append(PoseClass(c.model, c.leaves, it.world_from_model or c.world_from_model))
-    classes = refined
+    lib = tree.library
+    model_index = tree.model_indices
+    groups = _group([lib.models[i] for i in model_index], model_index, poses, tol)
+    refined = tree.poses([g[0] for g in groups], refine=True)
+    classes = [
+        PoseClass(lib.models[model_index[g[0]]], tuple(g), r if r is not None else poses[g[0]])
+        for g, r in zip(groups, refined, strict=True)
+    ]
     if len(classes) == 1:
         c = classes[0]
         return Recognition(RECOGNIZED, c.name, c.world_from_model, tuple(classes), n, models)
