@@ -63,6 +63,16 @@ def _lstsq(a: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return x[..., 0], s
 
 
+def _gauss_newton_step(jac: np.ndarray, f0: np.ndarray) -> np.ndarray:
+    """The steps minimising ``‖J x + f₀‖`` (N, 6): by the normal equations (6 × 6 per problem), or by the SVD
+    least squares where those are singular."""
+    jt = np.swapaxes(jac, -1, -2)
+    try:
+        return np.linalg.solve(jt @ jac, -(jt @ f0[..., None]))[..., 0]
+    except np.linalg.LinAlgError:
+        return _lstsq(jac, -f0)[0]
+
+
 class StackedPoses:
     """The weighted residuals of N interpretations of the same data, stacked (leading axis N).
 
@@ -171,16 +181,16 @@ class StackedPoses:
         return t, s[:, -1] >= MIN_CONDITION * s[:, 0]
 
     def residuals(self, r: np.ndarray, t: np.ndarray) -> np.ndarray:
-        """All weighted residuals at poses ``(r, t)``, shape (N, rows)."""
-        n = len(r)
-        dirs = ((self.dirs_w - self.dirs_m @ np.swapaxes(r, -1, -2)) * self._dirs_sw[..., None]).reshape(n, -1)
-        q = (self.plane_q - t[:, None]) @ r
-        planes = self.plane_w * (np.einsum("nij,nij->ni", q, self.plane_n) - self.plane_d)
-        y = (self.line_x - t[:, None]) @ r - self.line_p
-        along = np.einsum("nij,nij->ni", y, self.line_b)[..., None] * self.line_b
-        lines = (self.line_w[:, None] * (y - along)).reshape(n, -1)
-        pts = (self.pt_w[:, None] * ((self.pt_d - t[:, None]) @ r - self.pt_m)).reshape(n, -1)
-        return np.concatenate([dirs, planes, lines, pts], axis=1)
+        """All weighted residuals at poses ``r`` (..., N, 3, 3), ``t`` (..., N, 3): shape (..., N, rows)."""
+        lead = r.shape[:-2]
+        dirs = ((self.dirs_w - self.dirs_m @ np.swapaxes(r, -1, -2)) * self._dirs_sw[..., None]).reshape(*lead, -1)
+        q = (self.plane_q - t[..., None, :]) @ r
+        planes = self.plane_w * (np.einsum("...ij,...ij->...i", q, self.plane_n) - self.plane_d)
+        y = (self.line_x - t[..., None, :]) @ r - self.line_p
+        along = np.einsum("...ij,...ij->...i", y, self.line_b)[..., None] * self.line_b
+        lines = (self.line_w[:, None] * (y - along)).reshape(*lead, -1)
+        pts = (self.pt_w[:, None] * ((self.pt_d - t[..., None, :]) @ r - self.pt_m)).reshape(*lead, -1)
+        return np.concatenate([dirs, planes, lines, pts], axis=-1)
 
     def initial(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(R, t, ok)``: the closed-form poses (rotation from directions, then translation), unrefined."""
@@ -204,11 +214,10 @@ class StackedPoses:
             prob = self if len(active) == self.n else self.subset(active)
             ra, ta = r[active], t[active]
             f0 = prob.residuals(ra, ta)
-            jac = np.empty((len(active), f0.shape[1], 6))
-            for j in range(6):
-                xi, dr = _FD_XI[j], _FD_ROT[j]
-                jac[:, :, j] = (prob.residuals(dr @ ra, ta @ dr.T + xi[3:]) - f0) / _FD_STEP
-            step, _ = _lstsq(jac, -f0)
+            # the six perturbed poses at once, leading axis 6
+            f = prob.residuals(_FD_ROT[:, None] @ ra, np.einsum("jab,nb->jna", _FD_ROT, ta) + _FD_XI[:, None, 3:])
+            jac = np.moveaxis((f - f0) / _FD_STEP, 0, -1)
+            step = _gauss_newton_step(jac, f0)
             dr = exp_so3(step[:, :3])
             ra, ta = dr @ ra, (dr @ ta[..., None])[..., 0] + step[:, 3:]
             u, _, vt = np.linalg.svd(ra)
@@ -219,8 +228,8 @@ class StackedPoses:
 
 _FD_STEP = 1e-7
 """Finite-difference step of the Gauss–Newton Jacobian."""
-_FD_XI = tuple(np.eye(6)[j] * _FD_STEP for j in range(6))
-_FD_ROT = tuple(exp_so3(xi[:3]) for xi in _FD_XI)
+_FD_XI = np.eye(6) * _FD_STEP
+_FD_ROT = exp_so3(_FD_XI[:, :3])
 """The six perturbations of the Jacobian and their rotations, computed once."""
 
 

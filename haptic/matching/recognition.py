@@ -24,6 +24,7 @@ from haptic.matching.tree import Interpretation, InterpretationTree
 RECOGNIZED, AMBIGUOUS, NO_MATCH, EXPLORING = "recognized", "ambiguous", "no-match", "exploring"
 
 _SYMMETRY: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+_SYMMETRY_ARRAYS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 _CONGRUENCE: dict[tuple[int, int], list[SE3]] = {}
 
 
@@ -102,18 +103,26 @@ class Recognition:
     """Names of the models with surviving interpretations."""
 
 
+def _symmetry_arrays(model: Polyhedron) -> tuple[np.ndarray, np.ndarray]:
+    """The model's symmetries stacked: rotations (S, 3, 3) and translations (S, 3) (cached per model object)."""
+    if model not in _SYMMETRY_ARRAYS:
+        sym = model_symmetries(model)
+        _SYMMETRY_ARRAYS[model] = (np.stack([s.rotation for s in sym]), np.stack([s.translation for s in sym]))
+    return _SYMMETRY_ARRAYS[model]
+
+
 def _same_pose_as(a: SE3, rotations: np.ndarray, translations: np.ndarray, model: Polyhedron, tol: PoseTolerance):
-    """:func:`equivalent_by_symmetry` of the pose ``a`` and each of N poses ``(rotations, translations)``."""
+    """:func:`equivalent_by_symmetry` of the pose ``a`` and each of N poses ``(rotations, translations)``,
+    vectorised over the poses and the model's symmetries."""
     c = model.centroid
     tb = translations + rotations @ c  # the centroid placed by each pose
-    out = np.zeros(len(rotations), dtype=bool)
-    for s in model_symmetries(model):
-        r_as, t_as = a.rotation @ s.rotation, a.rotation @ s.translation + a.translation
-        cos = (np.einsum("ij,nij->n", r_as, rotations) - 1.0) / 2.0
-        near = np.arccos(np.clip(cos, -1.0, 1.0)) <= tol.angle
-        near &= np.linalg.norm(r_as @ c + t_as - tb, axis=1) <= tol.distance
-        out |= near
-    return out
+    s_rot, s_trans = _symmetry_arrays(model)
+    r_as = a.rotation @ s_rot  # a ∘ S for every symmetry S
+    c_as = r_as @ c + s_trans @ a.rotation.T + a.translation
+    cos = (np.einsum("sij,nij->sn", r_as, rotations) - 1.0) / 2.0
+    near = np.arccos(np.clip(cos, -1.0, 1.0)) <= tol.angle
+    near &= np.linalg.norm(c_as[:, None] - tb[None], axis=2) <= tol.distance
+    return near.any(axis=0)
 
 
 def _group(models: Sequence[Polyhedron], model_index: np.ndarray, poses: Sequence[SE3], tol: PoseTolerance):
