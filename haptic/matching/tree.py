@@ -6,7 +6,9 @@ each data edge, the *sense* that pairs its direction with the model edge's (``b_
 
 Adding a component extends every leaf (§2.3): (1) candidates from adjacency — for each data component reported
 adjacent to the new one, the model components adjacent to its partner in this leaf, intersected; the first
-component pairs with every model component of its kind in the library; (2) the intrinsic test (edge length);
+component pairs with every model component of its kind in the library (a first edge: every model edge long
+enough, found by bisection in the library's length index, :meth:`~haptic.matching.library.LibraryArrays.
+edges_longer_than`); (2) the intrinsic test (edge length);
 (3) geometric relations with the earlier components. Each candidate that passes becomes a child; a leaf without
 a valid child is pruned. All of it is vectorised over the candidate children.
 
@@ -322,7 +324,11 @@ class InterpretationTree:
         """Seed §2.3 step 1: ``(parent leaf, candidate model component)`` pairs."""
         lib = self.library
         if len(self._data) == 0:
-            cands = np.arange(lib.count(kind))
+            if kind == EDGE:  # the length index; the intrinsic test then decides at the boundary
+                eps = C.edge_length_epsilon(comp.length_bound, comp.position_bound, comp.direction_bound)
+                cands = lib.edges_longer_than(float(comp.length - eps) - 1e-9)
+            else:  # a face or a vertex has no invariant of its own yet: every one of its kind
+                cands = np.arange(lib.count(kind))
             return np.zeros(len(cands), dtype=np.int64), cands
         n = self.count
         if n == 0:
