@@ -33,8 +33,9 @@ from haptic.planning.predict import (
     vertex_sweep_off_table,
 )
 
-MAX_POSED = 400
-"""Largest number of interpretations whose poses are computed to group them into pose classes."""
+MAX_POSED = 4000
+"""Largest number of interpretations whose poses are computed to group them into pose classes (all of them in one
+batch); above it the loop takes a random move."""
 MAX_FAILED_MOVES = 4
 """Consecutive failed moves after which the episode ends as "failed"."""
 CORRECT_POSE_MM, CORRECT_POSE_DEG = 5.0, 5.0
