@@ -4,11 +4,11 @@ All interpretations of a tree pair the same data components, each with a compone
 least-squares problems have one structure: the same rows (a direction per paired face and per edge of known
 sense, a plane row per touched point, two line rows per edge, a point per vertex), the same data side, and
 model sides that differ only in which model component fills each row. :class:`StackedPoses` holds the model
-side as arrays with a leading axis over interpretations, and every step of :func:`~haptic.matching.pose.
-estimate_pose` — the proper-rotation fit of the directions, the linear least squares for the translation, and
-the Gauss–Newton refinement — runs as one batched array operation over all of them. An edge whose sense is
-not known yet keeps its direction row with weight 0 (it then constrains position only, as in the single
-problem).
+side as arrays with a leading axis over interpretations, and every step of
+:func:`~haptic.matching.pose.estimate_pose` — the proper-rotation fit of the directions, the linear least
+squares for the translation, and the Gauss–Newton refinement — runs as one batched array operation over all of
+them. An edge whose sense is not known yet keeps its direction row with weight 0 (it then constrains position
+only, as in the single problem).
 """
 
 from __future__ import annotations

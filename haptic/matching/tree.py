@@ -7,9 +7,9 @@ each data edge, the *sense* that pairs its direction with the model edge's (``b_
 Adding a component extends every leaf (§2.3): (1) candidates from adjacency — for each data component reported
 adjacent to the new one, the model components adjacent to its partner in this leaf, intersected; the first
 component pairs with every model component of its kind in the library (a first edge: every model edge long
-enough, found by bisection in the library's length index, :meth:`~haptic.matching.library.LibraryArrays.
-edges_longer_than`); (2) the intrinsic test (edge length);
-(3) geometric relations with the earlier components. Each candidate that passes becomes a child; a leaf without
+enough, found by bisection in the library's length index,
+:meth:`~haptic.matching.library.LibraryArrays.edges_longer_than`); (2) the intrinsic test (edge length); (3)
+geometric relations with the earlier components. Each candidate that passes becomes a child; a leaf without
 a valid child is pruned. All of it is vectorised over the candidate children.
 
 Senses. Seed §2.4 forces the directions of a data edge and of its model edge clockwise about a known common
@@ -564,9 +564,9 @@ class InterpretationTree:
 
     def poses(self, leaves: Sequence[int], refine: bool = True) -> list[SE3 | None]:
         """Poses ``world_from_model`` of some leaves (None where the data do not determine one yet), least-squares
-        refined unless ``refine`` is False: all of them in one batch (:class:`~haptic.matching.poses.
-        StackedPoses`), from the unrefined ones for a refinement. Poses are kept until the next ``add``, so a
-        leaf is posed once per data update."""
+        refined unless ``refine`` is False: all of them in one batch
+        (:class:`~haptic.matching.poses.StackedPoses`), from the unrefined ones for a refinement. Poses are kept
+        until the next ``add``, so a leaf is posed once per data update."""
         leaves = [int(i) for i in leaves]
         todo = sorted({i for i in leaves if (refine, i) not in self._pose_cache})
         if todo:
