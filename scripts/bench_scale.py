@@ -15,11 +15,12 @@ against library size, log-log, with the fitted growth exponent); prints the tabl
 
     .venv/bin/python scripts/bench_scale.py [--sizes 10,30,100,300,1000] [--episodes 200] [--workers 2]
         [--seed 1] [--library-seed 0] [--libraries out/bench_scale/libraries] [--out out/bench_scale]
-        [--compare-bound SIZE]
+        [--compare-bound SIZE] [--bound N] [--max-posed N]
 
 ``--compare-bound SIZE`` runs the episodes of library SIZE a second time with no bound on the planner's
 hypotheses (``PlannerConfig.max_hypotheses=None``) and reports the change in path cost and outcomes; ``--bound N``
-sets the bound of the first runs (default: ``PlannerConfig``'s).
+sets the bound of the first runs (default: ``PlannerConfig``'s); ``--max-posed N`` sets the largest number of
+interpretations the loop poses into pose classes (``haptic.episode.loop.MAX_POSED``; above it, a random move).
 """
 
 from __future__ import annotations
@@ -58,9 +59,12 @@ class _TimedExecutor:
         return out
 
 
-def _init_worker() -> None:
+def _init_worker(max_posed: int | None = None) -> None:
+    import haptic.episode.loop as loop
     import haptic.episode.worlds as worlds
 
+    if max_posed is not None:
+        loop.MAX_POSED = max_posed
     make = worlds.make_geometric_executor
     worlds.make_geometric_executor = lambda *a, **k: _TimedExecutor(make(*a, **k))
 
@@ -140,10 +144,12 @@ def _build_times(directory: Path) -> dict:
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
-def _run(specs: list[dict], workers: int, bound: int | None) -> tuple[list[dict], float]:
+def _run(
+    specs: list[dict], workers: int, bound: int | None, max_posed: int | None = None
+) -> tuple[list[dict], float]:
     tasks = [{"spec": s, "bound": bound} for s in specs]
     t0 = time.perf_counter()
-    with ProcessPoolExecutor(max_workers=workers, initializer=_init_worker) as pool:
+    with ProcessPoolExecutor(max_workers=workers, initializer=_init_worker, initargs=(max_posed,)) as pool:
         results = list(pool.map(_episode, tasks, chunksize=1))
     return results, time.perf_counter() - t0
 
@@ -240,6 +246,9 @@ def main(argv=None) -> int:
     ap.add_argument("--out", default="out/bench_scale")
     ap.add_argument("--compare-bound", type=int, default=None, metavar="SIZE")
     ap.add_argument("--bound", type=int, default=None, help="PlannerConfig.max_hypotheses (default: its default)")
+    ap.add_argument(
+        "--max-posed", type=int, default=None, help="haptic.episode.loop.MAX_POSED in the workers (default: its value)"
+    )
     args = ap.parse_args(argv)
     if args.bound is None:
         from haptic.planning.predict import PlannerConfig
@@ -262,12 +271,12 @@ def main(argv=None) -> int:
             {"model": s.model, "seed": s.seed, "policy": s.policy, "models": str(lib_dir)}
             for s in plan_sweep(names, args.episodes, args.seed, [args.policy])
         ]
-        results, wall = _run(specs, args.workers, args.bound)
+        results, wall = _run(specs, args.workers, args.bound, args.max_posed)
         row = _summary(size, results, wall, args.workers, build)
         rows.append(row)
         print(json.dumps(row), flush=True)
         if args.compare_bound == size:
-            free, wall_free = _run(specs, args.workers, None)
+            free, wall_free = _run(specs, args.workers, None, args.max_posed)
             paired = [(a, b) for a, b in zip(results, free, strict=True)]
             compare = {
                 "models": size,

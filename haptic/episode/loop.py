@@ -29,8 +29,9 @@ from haptic.planning.moves import Move, MoveResult
 from haptic.planning.policies import Context, Decision, Policy, RandomPolicy
 from haptic.planning.predict import Hypothesis, PlannerConfig
 
-MAX_POSED = 400
-"""Largest number of interpretations whose poses are computed to group them into pose classes."""
+MAX_POSED = 4000
+"""Largest number of interpretations whose poses are computed to group them into pose classes (all of them in one
+batch); above it the loop takes a random move."""
 MAX_FAILED_MOVES = 4
 """Consecutive failed moves after which the episode ends as "failed"."""
 

@@ -137,6 +137,8 @@ class LibraryArrays:
     """``neighbors[(a, b)]``: padded (−1) ascending lists of kind-b neighbours of each kind-a component."""
     members: tuple[np.ndarray, np.ndarray, np.ndarray] = field(init=False)
     """``members[kind]``: padded (−1) global ids of each model's components of that kind, shape (M, max)."""
+    edges_by_length: np.ndarray = field(init=False)
+    """Global edge ids in ascending order of length: the index of a first data edge (:meth:`edges_longer_than`)."""
 
     @classmethod
     def build(cls, library: Mapping[str, Polyhedron] | Sequence[Polyhedron]) -> LibraryArrays:
@@ -232,6 +234,15 @@ class LibraryArrays:
             "members",
             tuple(_ro(_padded_ranges(offsets[k])) for k in range(3)),
         )
+        s(self, "edges_by_length", _ro(np.argsort(self.edge_length, kind="stable")))
+
+    def edges_longer_than(self, length: float) -> np.ndarray:
+        """Global ids (ascending) of the edges longer than ``length`` [m], by bisection in the length index: the
+        candidates of a data edge that starts the tree, whose explored interval ``l_d`` a model edge must exceed
+        less its ε (seed §2.3 step 2)."""
+        lengths = self.edge_length[self.edges_by_length]
+        start = int(np.searchsorted(lengths, length, side="right"))
+        return np.sort(self.edges_by_length[start:])
 
     @property
     def n_models(self) -> int:

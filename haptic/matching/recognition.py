@@ -11,6 +11,7 @@ solid in the world (models congruent by a proper rigid motion), so no further da
 from __future__ import annotations
 
 import weakref
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -23,6 +24,7 @@ from haptic.matching.tree import Interpretation, InterpretationTree
 RECOGNIZED, AMBIGUOUS, NO_MATCH, EXPLORING = "recognized", "ambiguous", "no-match", "exploring"
 
 _SYMMETRY: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+_SYMMETRY_ARRAYS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 _CONGRUENCE: dict[tuple[int, int], list[SE3]] = {}
 
 
@@ -101,21 +103,55 @@ class Recognition:
     """Names of the models with surviving interpretations."""
 
 
+def _symmetry_arrays(model: Polyhedron) -> tuple[np.ndarray, np.ndarray]:
+    """The model's symmetries stacked: rotations (S, 3, 3) and translations (S, 3) (cached per model object)."""
+    if model not in _SYMMETRY_ARRAYS:
+        sym = model_symmetries(model)
+        _SYMMETRY_ARRAYS[model] = (np.stack([s.rotation for s in sym]), np.stack([s.translation for s in sym]))
+    return _SYMMETRY_ARRAYS[model]
+
+
+def _same_pose_as(a: SE3, rotations: np.ndarray, translations: np.ndarray, model: Polyhedron, tol: PoseTolerance):
+    """:func:`equivalent_by_symmetry` of the pose ``a`` and each of N poses ``(rotations, translations)``,
+    vectorised over the poses and the model's symmetries."""
+    c = model.centroid
+    tb = translations + rotations @ c  # the centroid placed by each pose
+    s_rot, s_trans = _symmetry_arrays(model)
+    r_as = a.rotation @ s_rot  # a ∘ S for every symmetry S
+    c_as = r_as @ c + s_trans @ a.rotation.T + a.translation
+    cos = (np.einsum("sij,nij->sn", r_as, rotations) - 1.0) / 2.0
+    near = np.arccos(np.clip(cos, -1.0, 1.0)) <= tol.angle
+    near &= np.linalg.norm(c_as[:, None] - tb[None], axis=2) <= tol.distance
+    return near.any(axis=0)
+
+
+def _group(models: Sequence[Polyhedron], model_index: np.ndarray, poses: Sequence[SE3], tol: PoseTolerance):
+    """Positions of the poses grouped into pose classes, in the order of each class's first member: each pose
+    joins the first earlier class of its model whose first pose it equals up to a symmetry (vectorised over the
+    poses of each model)."""
+    rot = np.stack([p.rotation for p in poses])
+    trans = np.stack([p.translation for p in poses])
+    groups: list[list[int]] = []
+    for m in dict.fromkeys(model_index.tolist()):
+        left = np.flatnonzero(model_index == m)
+        while len(left):
+            rep, rest = int(left[0]), left[1:]
+            same = _same_pose_as(poses[rep], rot[rest], trans[rest], models[rep], tol)
+            groups.append([rep, *rest[same].tolist()])
+            left = rest[~same]
+    return sorted(groups)
+
+
 def group_pose_classes(interpretations: list[Interpretation], tol: PoseTolerance) -> list[PoseClass] | None:
     """Group interpretations into pose classes; None when some interpretation has no pose yet."""
-    reps: list[tuple[Interpretation, list[int]]] = []
-    for it in interpretations:
-        if it.world_from_model is None:
-            return None
-        for rep, members in reps:
-            if rep.model_index == it.model_index and equivalent_by_symmetry(
-                rep.world_from_model, it.world_from_model, it.model, tol
-            ):
-                members.append(it.leaf)
-                break
-        else:
-            reps.append((it, [it.leaf]))
-    return [PoseClass(rep.model, tuple(m), rep.world_from_model) for rep, m in reps]
+    if any(it.world_from_model is None for it in interpretations):
+        return None
+    if not interpretations:
+        return []
+    models = [it.model for it in interpretations]
+    poses = [it.world_from_model for it in interpretations]
+    groups = _group(models, np.array([it.model_index for it in interpretations]), poses, tol)
+    return [PoseClass(models[g[0]], tuple(interpretations[i].leaf for i in g), poses[g[0]]) for g in groups]
 
 
 def same_solid(a: PoseClass, b: PoseClass, tol: PoseTolerance) -> bool:
@@ -138,15 +174,17 @@ def recognize(tree: InterpretationTree, max_interpretations: int = 64, tol: Pose
     if n > max_interpretations:
         return Recognition(EXPLORING, None, None, (), n, models)
     tol = tol if tol is not None else PoseTolerance.from_data(tree.data)
-    interps = [tree.interpretation(i, with_pose=True, refine=False) for i in range(n)]
-    classes = group_pose_classes(interps, tol)
-    if classes is None:
+    poses = tree.poses(range(n), refine=False)
+    if any(p is None for p in poses):
         return Recognition(EXPLORING, None, None, (), n, models)
-    refined = []
-    for c in classes:
-        it = tree.interpretation(c.leaves[0], with_pose=True, refine=True)
-        refined.append(PoseClass(c.model, c.leaves, it.world_from_model or c.world_from_model))
-    classes = refined
+    lib = tree.library
+    model_index = tree.model_indices
+    groups = _group([lib.models[i] for i in model_index], model_index, poses, tol)
+    refined = tree.poses([g[0] for g in groups], refine=True)
+    classes = [
+        PoseClass(lib.models[model_index[g[0]]], tuple(g), r if r is not None else poses[g[0]])
+        for g, r in zip(groups, refined, strict=True)
+    ]
     if len(classes) == 1:
         c = classes[0]
         return Recognition(RECOGNIZED, c.name, c.world_from_model, tuple(classes), n, models)

@@ -6,8 +6,10 @@ each data edge, the *sense* that pairs its direction with the model edge's (``b_
 
 Adding a component extends every leaf (§2.3): (1) candidates from adjacency — for each data component reported
 adjacent to the new one, the model components adjacent to its partner in this leaf, intersected; the first
-component pairs with every model component of its kind in the library; (2) the intrinsic test (edge length);
-(3) geometric relations with the earlier components. Each candidate that passes becomes a child; a leaf without
+component pairs with every model component of its kind in the library (a first edge: every model edge long
+enough, found by bisection in the library's length index,
+:meth:`~haptic.matching.library.LibraryArrays.edges_longer_than`); (2) the intrinsic test (edge length); (3)
+geometric relations with the earlier components. Each candidate that passes becomes a child; a leaf without
 a valid child is pruned. All of it is vectorised over the candidate children.
 
 Senses. Seed §2.4 forces the directions of a data edge and of its model edge clockwise about a known common
@@ -38,6 +40,7 @@ from haptic.geometry.se3 import SE3
 from haptic.matching import constraints as C
 from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex
 from haptic.matching.library import EDGE, FACE, KIND_INDEX, KINDS, VERTEX, LibraryArrays
+from haptic.matching.poses import StackedPoses
 
 PARALLEL_FACES = 1e-6
 """Model face normals closer than this to (anti-)parallel take the plane-distance test [rad]."""
@@ -189,7 +192,8 @@ class InterpretationTree:
         self._sense = np.zeros((0, 0), dtype=np.int8)
         self.counts: list[int] = []
         """Number of interpretations after each ``add`` (re-reported edges included)."""
-        self._pose_cache: dict[bytes, SE3 | None] = {}
+        self._pose_cache: dict[tuple[bool, int], SE3 | None] = {}
+        """Poses by (refined, leaf) of the current leaves, emptied by every ``add``."""
 
     # ------------------------------------------------------------------------------------------ state
 
@@ -256,8 +260,7 @@ class InterpretationTree:
             )
             self._model, self._assign, self._sense = self._model[ok], assign[ok], sense[ok]
         self.counts.append(self.count)
-        if len(self._pose_cache) > 4096:
-            self._pose_cache.clear()
+        self._pose_cache.clear()  # poses are of the data before this add
         return self.count
 
     def add_all(self, components: Iterable[DataComponent]) -> list[int]:
@@ -321,7 +324,11 @@ class InterpretationTree:
         """Seed §2.3 step 1: ``(parent leaf, candidate model component)`` pairs."""
         lib = self.library
         if len(self._data) == 0:
-            cands = np.arange(lib.count(kind))
+            if kind == EDGE:  # the length index; the intrinsic test then decides at the boundary
+                eps = C.edge_length_epsilon(comp.length_bound, comp.position_bound, comp.direction_bound)
+                cands = lib.edges_longer_than(float(comp.length - eps) - 1e-9)
+            else:  # a face or a vertex has no invariant of its own yet: every one of its kind
+                cands = np.arange(lib.count(kind))
             return np.zeros(len(cands), dtype=np.int64), cands
         n = self.count
         if n == 0:
@@ -534,8 +541,6 @@ class InterpretationTree:
 
     def interpretation(self, leaf: int, with_pose: bool = True, refine: bool = True) -> Interpretation:
         """The interpretation at one leaf (with its pose, least-squares refined unless ``refine`` is False)."""
-        from haptic.matching.pose import estimate_pose
-
         lib = self.library
         mi = int(self._model[leaf])
         row, srow = self._assign[leaf], self._sense[leaf]
@@ -545,14 +550,7 @@ class InterpretationTree:
             maps[kind][i] = int(row[i] - lib.offsets[kind, mi])
             if kind == EDGE:
                 senses[i] = int(srow[i])
-        pose = None
-        if with_pose:
-            key = (len(self.counts), refine, bytes(np.concatenate([[mi], row, srow]).astype(np.int64)))
-            if key not in self._pose_cache:
-                self._pose_cache[key] = estimate_pose(
-                    lib.models[mi], self._data.items, maps[FACE], maps[EDGE], senses, maps[VERTEX], refine=refine
-                )
-            pose = self._pose_cache[key]
+        pose = self.poses([leaf], refine)[0] if with_pose else None
         return Interpretation(
             model=lib.models[mi],
             model_index=mi,
@@ -563,6 +561,42 @@ class InterpretationTree:
             world_from_model=pose,
             leaf=leaf,
         )
+
+    def poses(self, leaves: Sequence[int], refine: bool = True) -> list[SE3 | None]:
+        """Poses ``world_from_model`` of some leaves (None where the data do not determine one yet), least-squares
+        refined unless ``refine`` is False: all of them in one batch
+        (:class:`~haptic.matching.poses.StackedPoses`), from the unrefined ones for a refinement. Poses are kept
+        until the next ``add``, so a leaf is posed once per data update."""
+        leaves = [int(i) for i in leaves]
+        todo = sorted({i for i in leaves if (refine, i) not in self._pose_cache})
+        if todo:
+            rows = np.array(todo, dtype=np.int64)
+            prob = self._stacked(rows)
+            if refine:
+                start = self.poses(todo, refine=False)
+                ok = np.array([p is not None for p in start])
+                r = np.stack([p.rotation if p is not None else np.eye(3) for p in start])
+                t = np.stack([p.translation if p is not None else np.zeros(3) for p in start])
+                idx = np.flatnonzero(ok)
+                if len(idx):
+                    r[idx], t[idx] = prob.subset(idx).refine(r[idx], t[idx])
+            else:
+                r, t, ok = prob.initial()
+            for j, leaf in enumerate(todo):
+                self._pose_cache[(refine, leaf)] = SE3(r[j], t[j]) if ok[j] else None
+        return [self._pose_cache[(refine, i)] for i in leaves]
+
+    def _stacked(self, rows: np.ndarray) -> StackedPoses:
+        """The stacked least-squares problems of the leaves ``rows`` (global ids gathered from the library)."""
+        lib, kinds = self.library, np.array(self._data.kinds, dtype=np.int64)
+        fids, eids, vids = (np.flatnonzero(kinds == k) for k in (FACE, EDGE, VERTEX))
+        a = self._assign[rows]
+        f, e, v = a[:, fids], a[:, eids], a[:, vids]
+        return StackedPoses(
+            self._data.items, fids.tolist(), eids.tolist(), vids.tolist(),
+            lib.face_normal[f], lib.face_offset[f], lib.edge_point[e], lib.edge_direction[e],
+            self._sense[rows][:, eids], lib.vertex_position[v],
+        )  # fmt: skip
 
     def interpretations(
         self, with_pose: bool = True, limit: int | None = None, refine: bool = True

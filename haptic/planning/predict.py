@@ -77,8 +77,8 @@ class PlannerConfig:
     max_hypotheses: int | None = 256
     """Most pose classes a policy scores moves against; above it, a reduced set chosen model by model
     (:mod:`haptic.planning.bound`). None: no bound. 256 is above the most pose classes the shipped libraries
-    leave at a planner decision (186, look-alike library), so their decisions are unchanged; the matcher poses
-    at most 400 interpretations (``haptic.episode.loop.MAX_POSED``), so it bounds a decision to under 2/3 of that."""
+    leave at a planner decision (255, look-alike library, with the loop posing up to
+    ``haptic.episode.loop.MAX_POSED`` interpretations), so their decisions are unchanged."""
 
     @property
     def touch_margin(self) -> float:

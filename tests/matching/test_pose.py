@@ -58,3 +58,33 @@ def test_pose_within_1mm_and_half_a_degree_at_default_noise(name):
     errors = np.array(errors)
     assert errors[:, 0].max() < 1e-3, errors
     assert np.degrees(errors[:, 1]).max() < 0.5, errors
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_poses_of_a_batch_equal_the_poses_of_each_interpretation_alone(seed):
+    """The tree poses all its leaves in one stacked problem; each pose is the one the leaf's own problem gives
+    (undetermined ones included), unrefined and refined, and does not depend on the other leaves of the batch."""
+    from haptic.executor.geometric import random_walk
+    from haptic.matching.pose import estimate_pose
+
+    rng = np.random.default_rng(seed)
+    ex = GeometricExecutor(LIB["WEDGE01"], SE3.random(rng, 0.1), SensorNoise(), rng)
+    random_walk(ex, 2, rng)
+    tree = InterpretationTree(LIB)
+    determined = 0
+    for c in ex.components:
+        tree.add(c)
+        n = tree.count
+        for refine in (False, True):
+            batch = tree.poses(range(n), refine=refine)
+            for leaf in range(n):
+                it = tree.interpretation(leaf, with_pose=False)
+                alone = estimate_pose(
+                    it.model, tree.data, it.faces, it.edges, it.edge_senses, it.vertices, refine=refine
+                )
+                assert (batch[leaf] is None) == (alone is None)
+                if alone is not None:
+                    determined += 1
+                    assert np.allclose(batch[leaf].rotation, alone.rotation, atol=1e-8)
+                    assert np.allclose(batch[leaf].translation, alone.translation, atol=1e-9)
+    assert determined > 0

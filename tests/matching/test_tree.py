@@ -128,6 +128,27 @@ def test_first_component_pairs_with_every_model_face():
     assert tree.add(ex.components[0]) == sum(m.n_faces for m in LIB.values())
 
 
+def test_first_edge_pairs_by_the_length_index_as_by_a_scan():
+    """A tree started from an edge takes its candidates from the library's length index: exactly the model
+    edges a scan of the intrinsic test keeps, in global order."""
+    from haptic.matching import constraints as C
+
+    lib = InterpretationTree(LIB).library
+    bounds = {"direction_bound": 0.01, "position_bound": 1e-3, "length_bound": 2e-3}
+    eps = C.edge_length_epsilon(bounds["length_bound"], bounds["position_bound"], bounds["direction_bound"])
+    sizes = []
+    # explored intervals from nothing to longer than any model edge, and right at the boundary of some
+    lengths = [1e-4, *np.quantile(lib.edge_length, [0.25, 0.5, 0.9]), *(lib.edge_length[:5] + eps), 1.0]
+    for length in lengths:
+        first = DataEdge(id=0, direction=(1, 0, 0), point=(0, 0, 0), length=float(length), **bounds)
+        tree = InterpretationTree(lib)
+        tree.add(first)
+        scan = np.flatnonzero(C.edge_length_test(first.length, lib.edge_length, eps))
+        assert np.array_equal(tree.assignments[:, 0], scan)
+        sizes.append(len(scan))
+    assert sizes[0] == lib.count(1) and sizes[-1] == 0 and 0 < sizes[2] < lib.count(1)
+
+
 def test_test_predicts_without_changing_the_tree():
     rng = np.random.default_rng(3)
     ex = GeometricExecutor(LIB["WEDGE01"], SE3.random(rng, 0.1), SensorNoise(), rng)

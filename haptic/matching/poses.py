@@ -1,0 +1,236 @@
+"""Poses of many interpretations at once: their residuals stacked into arrays (seed §2.1, §2.6).
+
+All interpretations of a tree pair the same data components, each with a component of its own model, so their
+least-squares problems have one structure: the same rows (a direction per paired face and per edge of known
+sense, a plane row per touched point, two line rows per edge, a point per vertex), the same data side, and
+model sides that differ only in which model component fills each row. :class:`StackedPoses` holds the model
+side as arrays with a leading axis over interpretations, and every step of
+:func:`~haptic.matching.pose.estimate_pose` — the proper-rotation fit of the directions, the linear least
+squares for the translation, and the Gauss–Newton refinement — runs as one batched array operation over all of
+them. An edge whose sense is not known yet keeps its direction row with weight 0 (it then constrains position
+only, as in the single problem).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from haptic.matching.components import DataComponent
+
+MIN_SPREAD = 0.05
+"""Directions must span at least this sine of an angle to fix a rotation."""
+MIN_CONDITION = 1e-4
+"""Smallest accepted ratio of singular values of the translation system (else the pose is undetermined)."""
+GN_ITERATIONS = 6
+"""Gauss–Newton iterations of the refinement (each stops early once its step is below 1e-12)."""
+
+
+def exp_so3(w: np.ndarray) -> np.ndarray:
+    """Rotation matrices ``exp([w]×)`` of rotation vectors, shape (..., 3) → (..., 3, 3) (Rodrigues)."""
+    w = np.asarray(w, dtype=float)
+    th = np.linalg.norm(w, axis=-1)[..., None, None]
+    k = np.zeros((*w.shape[:-1], 3, 3))
+    k[..., 0, 1], k[..., 0, 2], k[..., 1, 2] = -w[..., 2], w[..., 1], -w[..., 0]
+    k[..., 1, 0], k[..., 2, 0], k[..., 2, 1] = w[..., 2], -w[..., 1], w[..., 0]
+    small = th < 1e-12
+    safe = np.where(small, 1.0, th)
+    a = np.where(small, 1.0, np.sin(safe) / safe)
+    b = np.where(small, 0.0, (1 - np.cos(safe)) / safe**2)
+    return np.eye(3) + a * k + b * (k @ k)
+
+
+def proper_rotations(world: np.ndarray, model: np.ndarray, weights: np.ndarray) -> np.ndarray:
+    """Per interpretation, the proper rotation R minimising ``Σ w ‖a − R c‖²`` (Wahba's problem by SVD).
+
+    ``world`` (K, 3) or (N, K, 3), ``model`` (N, K, 3), ``weights`` (N, K) → (N, 3, 3)."""
+    h = np.swapaxes(world * weights[..., None], -1, -2) @ model
+    u, _, vt = np.linalg.svd(h)
+    d = np.sign(np.linalg.det(u @ vt))
+    d = np.where(d == 0, 1.0, d)
+    u = u.copy()
+    u[..., :, 2] *= d[..., None]
+    return u @ vt
+
+
+def _lstsq(a: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Batched least squares ``a x ≈ y`` (minimum norm) and the singular values of ``a`` (descending)."""
+    u, s, vt = np.linalg.svd(a, full_matrices=False)
+    cutoff = np.finfo(float).eps * max(a.shape[-2:]) * s[..., :1]
+    inv = np.where(s > cutoff, 1.0 / np.where(s > 0, s, 1.0), 0.0)
+    x = np.swapaxes(vt, -1, -2) @ ((np.swapaxes(u, -1, -2) @ y[..., None])[..., 0] * inv)[..., None]
+    return x[..., 0], s
+
+
+def _gauss_newton_step(jac: np.ndarray, f0: np.ndarray) -> np.ndarray:
+    """The steps minimising ``‖J x + f₀‖`` (N, 6): by the normal equations (6 × 6 per problem), or by the SVD
+    least squares where those are singular."""
+    jt = np.swapaxes(jac, -1, -2)
+    try:
+        return np.linalg.solve(jt @ jac, -(jt @ f0[..., None]))[..., 0]
+    except np.linalg.LinAlgError:
+        return _lstsq(jac, -f0)[0]
+
+
+class StackedPoses:
+    """The weighted residuals of N interpretations of the same data, stacked (leading axis N).
+
+    The data side (shared): ``face_ids``, ``edge_ids``, ``vertex_ids`` are the data components paired, in
+    order. The model side (per interpretation): the paired model faces' normals (N, F, 3) and offsets (N, F),
+    edges' source points and directions (N, E, 3) with the senses (N, E) that pair them (+1: ``b_d ≈ R b_m``,
+    −1: ``b_d ≈ −R b_m``, 0 unknown), and vertex positions (N, V, 3), all in the model frame [m].
+    """
+
+    def __init__(
+        self,
+        data: Sequence[DataComponent],
+        face_ids: Sequence[int],
+        edge_ids: Sequence[int],
+        vertex_ids: Sequence[int],
+        face_normal: np.ndarray,
+        face_offset: np.ndarray,
+        edge_point: np.ndarray,
+        edge_direction: np.ndarray,
+        senses: np.ndarray,
+        vertex_position: np.ndarray,
+    ) -> None:
+        n = len(face_normal)
+        self.n = n
+        faces = [data[i] for i in face_ids]
+        edges = [data[i] for i in edge_ids]
+        verts = [data[i] for i in vertex_ids]
+        senses = np.asarray(senses, dtype=float).reshape(n, len(edges))
+        # directions: one row per face, one per edge (weight 0 while its sense is unknown)
+        self.dirs_w = np.array([c.normal for c in faces] + [c.direction for c in edges], dtype=float).reshape(-1, 3)
+        self.dirs_m = np.concatenate(
+            [np.asarray(face_normal, float).reshape(n, -1, 3), senses[..., None] * np.asarray(edge_direction)],
+            axis=1,
+        )
+        wt = np.array(
+            [1.0 / max(c.normal_bound, 1e-6) ** 2 for c in faces]
+            + [1.0 / max(c.direction_bound, 1e-6) ** 2 for c in edges]
+        )
+        known = np.concatenate([np.ones((n, len(faces)), bool), senses != 0], axis=1)
+        self.dirs_wt = np.where(known, wt, 0.0)
+        self.dirs_known = known
+        self._dirs_sw = np.sqrt(self.dirs_wt)
+        # planes: one row per touched point of a paired face
+        k = [len(np.atleast_2d(c.points)) for c in faces]
+        self.plane_n = np.repeat(np.asarray(face_normal, float).reshape(n, -1, 3), k, axis=1)
+        self.plane_d = np.repeat(np.asarray(face_offset, float).reshape(n, -1), k, axis=1)
+        self.plane_q = np.concatenate([np.asarray(c.points, float).reshape(-1, 3) for c in faces] or [np.zeros((0, 3))])
+        self.plane_w = np.repeat([1.0 / max(c.position_bound, 1e-7) for c in faces], k).astype(float)
+        # lines: two rows (the explored interval's ends) per paired edge
+        self.line_p = np.repeat(np.asarray(edge_point, float).reshape(n, -1, 3), 2, axis=1)
+        self.line_b = np.repeat(np.asarray(edge_direction, float).reshape(n, -1, 3), 2, axis=1)
+        self.line_x = np.array([x for c in edges for x in (c.point, c.end_point)], dtype=float).reshape(-1, 3)
+        rho = [max(c.position_bound, 1e-7) for c in edges]
+        self.line_w = np.array(
+            [w for c, r in zip(edges, rho, strict=True) for w in (1.0 / r, 1.0 / (r + c.length * c.direction_bound))]
+        ).reshape(-1)
+        # points: one per paired vertex
+        self.pt_m = np.asarray(vertex_position, float).reshape(n, -1, 3)
+        self.pt_d = np.array([c.position for c in verts], dtype=float).reshape(-1, 3)
+        self.pt_w = np.array([1.0 / max(c.position_bound, 1e-7) for c in verts], dtype=float)
+
+    def subset(self, rows: np.ndarray) -> StackedPoses:
+        """The problems of some interpretations only (``rows`` indexes the leading axis)."""
+        out = object.__new__(StackedPoses)
+        out.__dict__.update(self.__dict__)
+        for name in ("dirs_m", "dirs_wt", "dirs_known", "_dirs_sw", "plane_n", "plane_d", "line_p", "line_b", "pt_m"):
+            setattr(out, name, getattr(self, name)[rows])
+        out.n = len(rows)
+        return out
+
+    def rotations(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(R (N, 3, 3), ok (N,))``: the rotation from all directions, where they span enough (seed §2.6)."""
+        u = np.where(self.dirs_known[..., None], self.dirs_m, 0.0)
+        ok = self.dirs_known.sum(axis=1) >= 2
+        if u.shape[1]:
+            # the largest |u_i × u_j| over pairs, from |u × v|² = |u|² |v|² − (u · v)²
+            gram = u @ np.swapaxes(u, -1, -2)
+            sq = np.einsum("nii->ni", gram)
+            cross2 = sq[:, :, None] * sq[:, None, :] - gram**2
+            ok &= np.sqrt(np.maximum(cross2.max(axis=(1, 2)), 0.0)) >= MIN_SPREAD
+        if not u.shape[1] or not ok.any():
+            return np.broadcast_to(np.eye(3), (self.n, 3, 3)).copy(), ok
+        return proper_rotations(self.dirs_w, self.dirs_m, self.dirs_wt), ok
+
+    def translations(self, r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``(t (N, 3), ok (N,))``: the translation by linear least squares on planes, lines and vertices given
+        the rotations, where that system is well conditioned."""
+        n_rows = len(self.plane_q) + 3 * len(self.line_x) + 3 * len(self.pt_d)
+        if n_rows < 3:
+            return np.zeros((self.n, 3)), np.zeros(self.n, bool)
+        rt = np.swapaxes(r, -1, -2)
+        nrm = self.plane_n @ rt  # rotated normals, one per touched point
+        plane_rows = self.plane_w[:, None] * nrm
+        plane_rhs = self.plane_w * (np.einsum("nij,ij->ni", nrm, self.plane_q) - self.plane_d)
+        b = self.line_b @ rt
+        perp = np.eye(3) - b[..., :, None] * b[..., None, :]  # (N, L, 3, 3)
+        line_rows = (self.line_w[:, None, None] * perp).reshape(self.n, -1, 3)
+        rel = self.line_x - self.line_p @ rt
+        line_rhs = (self.line_w[:, None] * np.einsum("nlij,nlj->nli", perp, rel)).reshape(self.n, -1)
+        pt_rows = (self.pt_w[:, None, None] * np.eye(3)).reshape(-1, 3)
+        pt_rows = np.broadcast_to(pt_rows, (self.n, *pt_rows.shape))
+        pt_rhs = (self.pt_w[:, None] * (self.pt_d - self.pt_m @ rt)).reshape(self.n, -1)
+        a = np.concatenate([plane_rows, line_rows, pt_rows], axis=1)
+        y = np.concatenate([plane_rhs, line_rhs, pt_rhs], axis=1)
+        t, s = _lstsq(a, y)
+        return t, s[:, -1] >= MIN_CONDITION * s[:, 0]
+
+    def residuals(self, r: np.ndarray, t: np.ndarray) -> np.ndarray:
+        """All weighted residuals at poses ``r`` (..., N, 3, 3), ``t`` (..., N, 3): shape (..., N, rows)."""
+        lead = r.shape[:-2]
+        dirs = ((self.dirs_w - self.dirs_m @ np.swapaxes(r, -1, -2)) * self._dirs_sw[..., None]).reshape(*lead, -1)
+        q = (self.plane_q - t[..., None, :]) @ r
+        planes = self.plane_w * (np.einsum("...ij,...ij->...i", q, self.plane_n) - self.plane_d)
+        y = (self.line_x - t[..., None, :]) @ r - self.line_p
+        along = np.einsum("...ij,...ij->...i", y, self.line_b)[..., None] * self.line_b
+        lines = (self.line_w[:, None] * (y - along)).reshape(*lead, -1)
+        pts = (self.pt_w[:, None] * ((self.pt_d - t[..., None, :]) @ r - self.pt_m)).reshape(*lead, -1)
+        return np.concatenate([dirs, planes, lines, pts], axis=-1)
+
+    def initial(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(R, t, ok)``: the closed-form poses (rotation from directions, then translation), unrefined."""
+        r, ok = self.rotations()
+        t = np.zeros((self.n, 3))
+        if ok.any():
+            idx = np.flatnonzero(ok)
+            t_ok, ok_t = self.subset(idx).translations(r[idx])
+            t[idx] = t_ok
+            ok[idx] = ok_t
+        return r, t, ok
+
+    def refine(self, r: np.ndarray, t: np.ndarray, iterations: int = GN_ITERATIONS) -> tuple[np.ndarray, np.ndarray]:
+        """Gauss–Newton on the weighted residuals of every interpretation at once, perturbing each pose on the
+        left (world frame); a problem whose step falls below 1e-12 stops there."""
+        r, t = np.array(r, dtype=float), np.array(t, dtype=float)
+        active = np.arange(len(r))
+        for _ in range(iterations):
+            if not len(active):
+                break
+            prob = self if len(active) == self.n else self.subset(active)
+            ra, ta = r[active], t[active]
+            f0 = prob.residuals(ra, ta)
+            # the six perturbed poses at once, leading axis 6
+            f = prob.residuals(_FD_ROT[:, None] @ ra, np.einsum("jab,nb->jna", _FD_ROT, ta) + _FD_XI[:, None, 3:])
+            jac = np.moveaxis((f - f0) / _FD_STEP, 0, -1)
+            step = _gauss_newton_step(jac, f0)
+            dr = exp_so3(step[:, :3])
+            ra, ta = dr @ ra, (dr @ ta[..., None])[..., 0] + step[:, 3:]
+            u, _, vt = np.linalg.svd(ra)
+            r[active], t[active] = u @ vt, ta
+            active = active[np.linalg.norm(step, axis=1) >= 1e-12]
+        return r, t
+
+
+_FD_STEP = 1e-7
+"""Finite-difference step of the Gauss–Newton Jacobian."""
+_FD_XI = np.eye(6) * _FD_STEP
+_FD_ROT = exp_so3(_FD_XI[:, :3])
+"""The six perturbations of the Jacobian and their rotations, computed once."""
+
+
+__all__ = ["GN_ITERATIONS", "MIN_CONDITION", "MIN_SPREAD", "StackedPoses", "exp_so3", "proper_rotations"]
