@@ -130,14 +130,20 @@ def _moves(
     h: Hypothesis, state: SensorState, components: Mapping[int, DataComponent], noise: SensorNoise,
     config: PlannerConfig, avoid: Sequence[Move],
     missing: tuple[frozenset[int], frozenset[int], frozenset[int]] | None = None,
+    fixed_faces: bool = True,
 ) -> list[tuple[Move, float, float]]:
     """Fresh candidate moves (the planner's, and those aimed at ``missing``) with their predicted cost and risk
-    (as the planner scores them), reliable and not predicted to run into the table (unless no other is left)."""
+    (as the planner scores them), reliable and not predicted to run into the table (unless no other is left).
+    The planner's face moves in fixed directions are left out when moves are aimed at something of the current
+    face, and always with ``fixed_faces`` False (the second move of a look-ahead): what they can measure the
+    aimed moves measure more cheaply, and each costs a prediction."""
     from haptic.planning.policies import refusal, same_move
 
     out = []
     aimed = aimed_face_moves(h, state, components, missing) if missing is not None else []
-    for m in candidate_moves(state, components, config) + aimed:
+    fixed_faces = fixed_faces and not aimed
+    planner = [m for m in candidate_moves(state, components, config) if fixed_faces or m.kind != "face"]
+    for m in planner + aimed:
         if any(same_move(m, bad) for bad in avoid):
             continue
         pred = predict([h], m, state, components, noise, config)
@@ -174,7 +180,7 @@ def choose_verification_move(
         g1 = _gain(_new_features(h, h1), missing)
         score = (1.0 - r) * g1 / max(c, 1e-9)
         left = tuple(x - n for x, n in zip(missing, _new_features(h, h1), strict=True))
-        for m2, c2, r2 in _moves(h1, s1, comps1, noise, config, (), left):
+        for m2, c2, r2 in _moves(h1, s1, comps1, noise, config, (), left, fixed_faces=False):
             sim2 = simulate(h1, m2, s1, comps1, config)
             if sim2 is None:
                 continue
