@@ -321,9 +321,10 @@ def run_loop(
     fallback = RandomPolicy()
     verifier = None
     if spec.verify != "none":
+        from haptic.matching.verify import K_SIGMA, K_SIGMA_PHYSICS
         from haptic.planning.verify import Verifier
 
-        verifier = Verifier(spec.verify, noise, config)
+        verifier = Verifier(spec.verify, noise, config, K_SIGMA_PHYSICS if spec.executor == "physics" else K_SIGMA)
 
     touched: list[tuple[np.ndarray, np.ndarray]] = []
 

@@ -20,7 +20,14 @@ from haptic.geometry.perturb import scale_dimension
 from haptic.matching.components import SensorNoise, from_json
 from haptic.matching.library import LibraryArrays
 from haptic.matching.tree import InterpretationTree
-from haptic.matching.verify import POSE_SAFETY, acceptance, check_verify_mode, coverage, pose_check
+from haptic.matching.verify import (
+    K_SIGMA_PHYSICS,
+    POSE_SAFETY,
+    acceptance,
+    check_verify_mode,
+    coverage,
+    pose_check,
+)
 
 from .helpers import true_leaves
 
@@ -66,7 +73,8 @@ def test_true_interpretation_passes_the_pose_check(name, seed, n_moves, level, a
 
 
 def test_physics_fixture_passes_the_pose_check():
-    """The physics executor's components (its segmenter's bounds) on BOX01: the true interpretation passes."""
+    """The physics executor's components (its segmenter's bounds) on BOX01: the true interpretation passes the
+    pose check and the acceptance test with the physics executor's σ (bound / 6)."""
     data = Path(__file__).parent / "data" / "physics_box01_seed1.json"
     text = data.read_text()
     comps, meta = from_json(text), json.loads(text)
@@ -77,6 +85,8 @@ def test_physics_fixture_passes_the_pose_check():
         it = tree.interpretation(leaf, with_pose=True, refine=True)
         chk = pose_check(LIB[meta["model"]], tree.data, it)
         assert chk.ok, chk
+        acc = acceptance(LIB[meta["model"]], tree.data, it, it.world_from_model, k_sigma=K_SIGMA_PHYSICS)
+        assert acc.ok and acc.statistic < 0.5 * acc.threshold, acc
 
 
 def test_a_longer_object_fails_the_pose_check_or_the_tree():
