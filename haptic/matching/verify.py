@@ -166,9 +166,10 @@ K_SIGMA = 3.0
 K_SIGMA_PHYSICS = 6.0
 """The same for the physics executor's components. Their bounds are ``k √(σ² + floor²)`` with systematic floors
 (pad compliance, detection delay) taken at their worst; what the components actually scatter by is less: on the
-physics executor's library objects (5 episodes and the recorded BOX01 fixture) the statistic at ``K_SIGMA`` summed
-to 0.141 of its degrees of freedom, i.e. the bounds are about 8 σ. 6 keeps a margin of 1.8 in variance over that
-estimate (measured, every one of them then passes with the statistic at most 0.54 of its threshold)."""
+physics executor's library objects (the four episodes of ``scripts/bench_unknown.py --executor physics`` that
+reached the test, PYR01 twice, BOX01, TETRA01L, and the recorded BOX01 fixture) the statistic at ``K_SIGMA`` summed
+to 0.14 of its degrees of freedom (44.2 of 312), i.e. the bounds are about 8 σ. 6 keeps a margin of 1.8 in
+variance over that estimate (every one of them then passes, the statistic at most 0.54 of its threshold)."""
 
 
 @dataclass(frozen=True)
