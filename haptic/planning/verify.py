@@ -73,6 +73,23 @@ def reachable_features(
     return frozenset(faces), frozenset(edges), frozenset(vertices)
 
 
+TABLE_CONTACT = 2e-3
+"""A model vertex within this of the table's plane at the fitted pose rests on the table [m] (the fitted pose is
+off by the noise of its data, about 1 mm on the simulated hand)."""
+
+
+def hidden_vertices(poly: Polyhedron, world_from_model: SE3, cov, config: PlannerConfig) -> list[int]:
+    """Vertices of ``poly`` that the verification can neither measure (not in ``cov``'s reachable vertices) nor
+    take from the table (farther than :data:`TABLE_CONTACT` above it): a vertex under an overhang, or on a face
+    turned to the table that rests on other vertices. An object that differs from the model there (a corner
+    moved 4 mm) is not told apart by anything the hand can touch, so a verification with one is incomplete, not
+    confirmed. Without a table every vertex is reachable and none is hidden."""
+    if config.table_z is None:
+        return []
+    z = world_from_model.apply(poly.vertices)[:, 2] - config.table_z
+    return [v for v in range(poly.n_vertices) if v not in cov.reachable_vertices and z[v] > TABLE_CONTACT]
+
+
 def _new_features(before: Hypothesis, after: Hypothesis) -> tuple[set[int], set[int], set[int]]:
     return (
         set(after.faces.values()) - set(before.faces.values()),
@@ -211,7 +228,7 @@ def _target_points(poly: Polyhedron, missing: tuple[frozenset[int], frozenset[in
     return np.array(pts).reshape(-1, 3)
 
 
-__all__ = ["aimed_face_moves", "choose_verification_move", "reachable_features"]
+__all__ = ["aimed_face_moves", "choose_verification_move", "hidden_vertices", "reachable_features"]
 
 
 class Verifier:
@@ -240,6 +257,8 @@ class Verifier:
         self.accept = None
         self.coverage = None
         self._hyp: Hypothesis | None = None
+        self.hidden: list[int] = []
+        """Model vertices out of the hand's reach and off the table (:func:`hidden_vertices`)."""
         self._model_name: str | None = None
         self._model: Polyhedron | None = None
         self._reach: dict[str, tuple[frozenset[int], frozenset[int], frozenset[int]]] = {}
@@ -275,7 +294,8 @@ class Verifier:
         if not self.check.ok:
             self.status = "mismatch"
         elif self.coverage is not None and self.coverage.met(self.mode):
-            self.status = "confirmed"
+            self.hidden = hidden_vertices(cls.model, self.check.world_from_model, self.coverage, self.config)
+            self.status = "incomplete" if self.mode == "full" and self.hidden else "confirmed"
         else:
             self.status = "verifying"
             got = self.coverage.measured() if self.coverage is not None else 0
@@ -309,6 +329,9 @@ class Verifier:
             a = self.accept
             return (f"verification: residuals {a.statistic:.1f} over the noise model's {a.threshold:.1f} "
                     f"(chi-square, {a.dof} dof)")  # fmt: skip
+        if self.status == "incomplete" and self.hidden:
+            return (f"verification incomplete: {len(self.hidden)} vertices of {self._model_name} out of the hand's "
+                    "reach and off the table (a difference there cannot be measured)")  # fmt: skip
         if self.status == "incomplete" and self.coverage is not None:
             f, e, v = (len(x) for x in self.coverage.missing(self.mode))
             return (f"verification incomplete after {self.moves} moves: {f} faces, {e} edges, {v} vertices of "
@@ -339,4 +362,5 @@ class Verifier:
                        chi2_threshold=round(self.accept.threshold, 3))  # fmt: skip
         if self.coverage is not None:
             out.update(self.coverage.record(self._model))
+            out["vertices_hidden"] = len(self.hidden)
         return out

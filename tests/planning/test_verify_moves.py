@@ -55,3 +55,25 @@ def test_aimed_face_moves_end_beside_a_missing_vertex_and_a_short_edge_move_meas
 def test_nothing_is_aimed_at_when_nothing_is_missing():
     h, state, comps, _ = _on_a_face("BOX01", 0)
     assert aimed_face_moves(h, state, comps, (frozenset(), frozenset(), frozenset())) == []
+
+
+def test_vertices_under_an_overhang_are_hidden_and_the_table_ones_are_not():
+    """LBLOCK01 on the table on its long side (a pose of the simulated hand's benchmark): the inner corner's two
+    vertices, 37 mm up and facing the table, cannot be touched nor taken from the table; lying flat, every
+    vertex is reachable or on the table; without a table none is hidden."""
+    from dataclasses import replace
+
+    from haptic.geometry.se3 import quat_to_matrix
+    from haptic.matching.verify import Coverage
+    from haptic.planning.verify import hidden_vertices, reachable_features
+
+    poly = LIB["LBLOCK01"]
+    table = replace(PlannerConfig(), table_z=0.35)
+    side = SE3(quat_to_matrix(np.array([0.043131444, -0.43720511, -0.555744269, 0.705790109])),
+               np.array([0.513729767, 0.103105708, 0.435697725]))  # fmt: skip
+    flat = SE3(quat_to_matrix(np.array([0.226084105, 0.0, 0.0, -0.974107785])), np.array([0.6057, 0.1243, 0.35]))
+    for pose, hidden in ((side, [3, 9]), (flat, [])):
+        f, e, v = reachable_features(poly, pose, table)
+        cov = Coverage(frozenset(), frozenset(), frozenset(v), f, e, v)
+        assert hidden_vertices(poly, pose, cov, table) == hidden
+        assert hidden_vertices(poly, pose, cov, PlannerConfig()) == []
