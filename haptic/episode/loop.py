@@ -226,9 +226,10 @@ def loop_steps(
     fallback = RandomPolicy()
     verifier = None
     if spec.verify != "none":
+        from haptic.matching.verify import K_SIGMA, K_SIGMA_PHYSICS
         from haptic.planning.verify import Verifier
 
-        verifier = Verifier(spec.verify, noise, config)
+        verifier = Verifier(spec.verify, noise, config, K_SIGMA_PHYSICS if spec.executor == "physics" else K_SIGMA)
 
     touched: list[tuple[np.ndarray, np.ndarray]] = []
 
@@ -271,16 +272,12 @@ def loop_steps(
             if verifying:
                 verdict = verifier.verdict(tree, rec, cost)
                 if verdict != "verifying":
-                    outcome = NO_MATCH if verdict == "mismatch" else RECOGNIZED
-                    if verdict == "mismatch":
-                        chk = verifier.check
-                        detail = (f"verification: data component {chk.component} ({chk.what}) off the recognised "
-                                  f"pose by {chk.worst:.2f} bounds")  # fmt: skip
+                    outcome, detail = verifier.outcome(), verifier.detail()
                     break
             elif rec is not None and rec.status in (RECOGNIZED, AMBIGUOUS, NO_MATCH):
                 outcome = rec.status
                 break
-            if cost > spec.budget or n_moves >= spec.max_moves:
+            if cost > spec.budget or n_moves - (verifier.moves if verifier else 0) >= spec.max_moves:
                 outcome = "budget"
                 break
             move = None

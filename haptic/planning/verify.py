@@ -17,21 +17,26 @@ import numpy as np
 
 from haptic.geometry.polyhedron import Polyhedron
 from haptic.geometry.se3 import SE3
-from haptic.matching.components import DataComponent, SensorNoise
-from haptic.planning.moves import Move, SensorState
+from haptic.matching.components import DataComponent, DataEdge, DataFace, SensorNoise
+from haptic.planning.moves import FaceMove, Move, SensorState
 from haptic.planning.predict import Hypothesis, PlannerConfig, candidate_moves, descent_risk, predict
 
-STALL_MOVES = 6
+STALL_MOVES = 8
 """Verification moves in a row that measure no missing feature after which the verification ends with what it
-has measured (status "incomplete": the episode is recognised, its record says how much was verified)."""
-MAX_VERIFY_MOVES = 24
-"""Verification moves after which the verification ends with what it has measured (status "incomplete"), so
-that an object in the library is not left unrecognised for features the moves reach only slowly (concave
-corners): measured, 5 of 20 seed-library episodes ran out of their 40-move budget without it."""
+has measured (status "incomplete": the episode ends as ambiguous, its record says what was not measured)."""
+MAX_VERIFY_MOVES = 40
+"""Verification moves after which the verification ends with what it has measured (status "incomplete").
+Verification moves do not count against the episode's move budget (``EpisodeSpec.max_moves``, the budget of
+recognition) but against this one: a vertex costs about two moves (an aimed face move and a short edge move, or
+a vertex move and an edge trace), and the seed library's largest models have 16 vertices."""
 MAX_CHECKED_LEAVES = 16
 """Interpretations of the pose class tried by the pose check (the first that passes counts)."""
 MIN_SAMPLES = 3
 """A face counts as reachable on the table when at least this many of its sample points are touchable."""
+AIM_NEAR_VERTEX = 6e-3
+"""An aimed face move (:func:`aimed_face_moves`) ends on an edge of the current face this far from a missing
+vertex [m] (at most a quarter of the edge), so that a short edge move (``c_e`` × 6 mm + ``c_k`` = 1.6 units)
+measures the vertex, instead of tracing the whole edge to it (§3.1: a face costs half an edge per cm)."""
 
 
 def reachable_features(
@@ -68,6 +73,23 @@ def reachable_features(
     return frozenset(faces), frozenset(edges), frozenset(vertices)
 
 
+TABLE_CONTACT = 2e-3
+"""A model vertex within this of the table's plane at the fitted pose rests on the table [m] (the fitted pose is
+off by the noise of its data, about 1 mm on the simulated hand)."""
+
+
+def hidden_vertices(poly: Polyhedron, world_from_model: SE3, cov, config: PlannerConfig) -> list[int]:
+    """Vertices of ``poly`` that the verification can neither measure (not in ``cov``'s reachable vertices) nor
+    take from the table (farther than :data:`TABLE_CONTACT` above it): a vertex under an overhang, or on a face
+    turned to the table that rests on other vertices. An object that differs from the model there (a corner
+    moved 4 mm) is not told apart by anything the hand can touch, so a verification with one is incomplete, not
+    confirmed. Without a table every vertex is reachable and none is hidden."""
+    if config.table_z is None:
+        return []
+    z = world_from_model.apply(poly.vertices)[:, 2] - config.table_z
+    return [v for v in range(poly.n_vertices) if v not in cov.reachable_vertices and z[v] > TABLE_CONTACT]
+
+
 def _new_features(before: Hypothesis, after: Hypothesis) -> tuple[set[int], set[int], set[int]]:
     return (
         set(after.faces.values()) - set(before.faces.values()),
@@ -80,16 +102,65 @@ def _gain(new: tuple[set[int], set[int], set[int]], missing: tuple[frozenset[int
     return sum(len(n & m) for n, m in zip(new, missing, strict=True))
 
 
+def aimed_face_moves(
+    h: Hypothesis,
+    state: SensorState,
+    components: Mapping[int, DataComponent],
+    missing: tuple[frozenset[int], frozenset[int], frozenset[int]],
+) -> list[FaceMove]:
+    """Face moves across the current face aimed, in hypothesis ``h``'s world, at what of it is missing: a point
+    :data:`AIM_NEAR_VERTEX` from each missing vertex of the face on either edge at it, and the midpoint of each
+    missing edge of the face. The planner's fixed directions (§4.1) rarely end near a vertex; these do, so
+    that the vertex costs a short edge move rather than an edge's length."""
+    face = components.get(state.face)
+    f_m = h.faces.get(state.face)
+    if not isinstance(face, DataFace) or f_m is None or h.world_from_model is None:
+        return []
+    poly, t = h.poly, h.world_from_model
+    loop = [int(v) for v in poly.faces[f_m]]
+    targets = []
+    for k, v in enumerate(loop):
+        if v not in missing[2]:
+            continue
+        for nb in (loop[k - 1], loop[(k + 1) % len(loop)]):
+            d = poly.vertices[nb] - poly.vertices[v]
+            length = float(np.linalg.norm(d))
+            if length > 0:
+                targets.append(poly.vertices[v] + min(AIM_NEAR_VERTEX, 0.25 * length) * d / length)
+    for e in poly.face_edges[f_m]:
+        if int(e) in missing[1]:
+            targets.append(poly.edge_points[e] + 0.5 * poly.edge_lengths[e] * poly.edge_directions[e])
+    edge = components.get(state.edge) if state.edge is not None else None
+    along = edge.direction if isinstance(edge, DataEdge) else None
+    out = []
+    for p in targets:
+        d = t.apply(p) - state.position
+        d = d - (d @ face.normal) * face.normal
+        n = float(np.linalg.norm(d))
+        if n < 2 * AIM_NEAR_VERTEX or (along is not None and abs(d @ along) > 0.95 * n):
+            continue  # at hand, or along the edge the sensor is on (an edge move's business)
+        out.append(FaceMove(d / n))
+    return out
+
+
 def _moves(
     h: Hypothesis, state: SensorState, components: Mapping[int, DataComponent], noise: SensorNoise,
     config: PlannerConfig, avoid: Sequence[Move],
+    missing: tuple[frozenset[int], frozenset[int], frozenset[int]] | None = None,
+    fixed_faces: bool = True,
 ) -> list[tuple[Move, float, float]]:
-    """Fresh candidate moves with their predicted cost and risk (as the planner scores them), reliable and not
-    predicted to run into the table (unless no other is left)."""
+    """Fresh candidate moves (the planner's, and those aimed at ``missing``) with their predicted cost and risk
+    (as the planner scores them), reliable and not predicted to run into the table (unless no other is left).
+    The planner's face moves in fixed directions are left out when moves are aimed at something of the current
+    face, and always with ``fixed_faces`` False (the second move of a look-ahead): what they can measure the
+    aimed moves measure more cheaply, and each costs a prediction."""
     from haptic.planning.policies import refusal, same_move
 
     out = []
-    for m in candidate_moves(state, components, config):
+    aimed = aimed_face_moves(h, state, components, missing) if missing is not None else []
+    fixed_faces = fixed_faces and not aimed
+    planner = [m for m in candidate_moves(state, components, config) if fixed_faces or m.kind != "face"]
+    for m in planner + aimed:
         if any(same_move(m, bad) for bad in avoid):
             continue
         pred = predict([h], m, state, components, noise, config)
@@ -112,7 +183,7 @@ def choose_verification_move(
     ``h``'s model per unit of predicted cost, looking two moves ahead; None when no move is admissible."""
     from haptic.planning.search import simulate
 
-    first = _moves(h, state, components, noise, config, avoid)
+    first = _moves(h, state, components, noise, config, avoid, missing)
     if not first:
         return None
     best, best_score = None, 0.0
@@ -126,7 +197,7 @@ def choose_verification_move(
         g1 = _gain(_new_features(h, h1), missing)
         score = (1.0 - r) * g1 / max(c, 1e-9)
         left = tuple(x - n for x, n in zip(missing, _new_features(h, h1), strict=True))
-        for m2, c2, r2 in _moves(h1, s1, comps1, noise, config, ()):
+        for m2, c2, r2 in _moves(h1, s1, comps1, noise, config, (), left, fixed_faces=False):
             sim2 = simulate(h1, m2, s1, comps1, config)
             if sim2 is None:
                 continue
@@ -157,7 +228,7 @@ def _target_points(poly: Polyhedron, missing: tuple[frozenset[int], frozenset[in
     return np.array(pts).reshape(-1, 3)
 
 
-__all__ = ["choose_verification_move", "reachable_features"]
+__all__ = ["aimed_face_moves", "choose_verification_move", "hidden_vertices", "reachable_features"]
 
 
 class Verifier:
@@ -165,22 +236,29 @@ class Verifier:
     once one pose class is left, :meth:`verdict` says whether the data confirm it, contradict it, or must
     go on; :meth:`choose` picks the next verification move; :meth:`record` is what the episode reports."""
 
-    def __init__(self, mode: str, noise: SensorNoise, config: PlannerConfig) -> None:
-        from haptic.matching.verify import check_verify_mode
+    def __init__(self, mode: str, noise: SensorNoise, config: PlannerConfig, k_sigma: float | None = None) -> None:
+        from haptic.matching.verify import K_SIGMA, check_verify_mode
 
         self.mode = check_verify_mode(mode)
         self.noise, self.config = noise, config
+        self.k_sigma = K_SIGMA if k_sigma is None else k_sigma
+        """Bounds over σ of the data components, for the acceptance test."""
         self.started_at: float | None = None
         """Path cost when the verification began [units] (None: not begun)."""
         self.moves = 0
         """Verification moves made."""
         self.status = "not needed"
-        """"confirmed", "mismatch", "incomplete" (no progress in :data:`STALL_MOVES` moves, or
-        :data:`MAX_VERIFY_MOVES` made), "verifying", or
-        "not needed" (no pose class was ever left alone)."""
+        """"confirmed" (recognised), "mismatch" (a component off its hard bounds: no-match), "rejected" (the
+        acceptance test failed: no-match), "incomplete" (no progress in :data:`STALL_MOVES` moves, or
+        :data:`MAX_VERIFY_MOVES` made: ambiguous between the model and an object outside the library),
+        "verifying", or "not needed" (no pose class was ever left alone)."""
         self._progress = (-1, 0)  # (features measured, verification moves then)
         self.check = None
+        self.accept = None
         self.coverage = None
+        self._hyp: Hypothesis | None = None
+        self.hidden: list[int] = []
+        """Model vertices out of the hand's reach and off the table (:func:`hidden_vertices`)."""
         self._model_name: str | None = None
         self._model: Polyhedron | None = None
         self._reach: dict[str, tuple[frozenset[int], frozenset[int], frozenset[int]]] = {}
@@ -188,7 +266,7 @@ class Verifier:
     def verdict(self, tree, rec, cost: float) -> str:
         """"confirmed", "mismatch", "incomplete" or "verifying" for a recognition ``rec`` (status recognized)
         of ``tree``, at path cost ``cost``."""
-        from haptic.matching.verify import coverage, pose_check
+        from haptic.matching.verify import acceptance, coverage, pose_check
 
         cls = rec.classes[0]
         if self.started_at is None:
@@ -204,6 +282,10 @@ class Verifier:
             if chk.ok:
                 break
         it, self.check = best
+        # the moves are chosen in this interpretation's world: the class's others number the model's features
+        # differently (a symmetric model), and the missing ones are this one's
+        self._hyp = Hypothesis(cls.name, cls.model, self.check.world_from_model, it.faces, it.edges, it.vertices,
+                               len(cls.leaves), tuple(cls.leaves))  # fmt: skip
         if self.check.world_from_model is not None:
             if cls.name not in self._reach:
                 self._reach[cls.name] = reachable_features(cls.model, self.check.world_from_model, self.config)
@@ -212,7 +294,8 @@ class Verifier:
         if not self.check.ok:
             self.status = "mismatch"
         elif self.coverage is not None and self.coverage.met(self.mode):
-            self.status = "confirmed"
+            self.hidden = hidden_vertices(cls.model, self.check.world_from_model, self.coverage, self.config)
+            self.status = "incomplete" if self.mode == "full" and self.hidden else "confirmed"
         else:
             self.status = "verifying"
             got = self.coverage.measured() if self.coverage is not None else 0
@@ -222,13 +305,47 @@ class Verifier:
                 self.status = "incomplete"
             if self.moves >= MAX_VERIFY_MOVES:
                 self.status = "incomplete"
+        if self.status in ("confirmed", "incomplete"):  # the final word: the statistical acceptance test
+            self.accept = acceptance(cls.model, tree.data, it, self.check.world_from_model, k_sigma=self.k_sigma)
+            if not self.accept.ok:
+                self.status = "rejected"
         return self.status
+
+    def outcome(self) -> str:
+        """The episode's outcome for a final verdict: recognized (confirmed), no-match (mismatch, rejected),
+        ambiguous (incomplete: the data fit the model and could fit an object that differs where they have not
+        measured)."""
+        from haptic.matching.recognition import AMBIGUOUS, NO_MATCH, RECOGNIZED
+
+        return {"confirmed": RECOGNIZED, "incomplete": AMBIGUOUS}.get(self.status, NO_MATCH)
+
+    def detail(self) -> str:
+        """The episode's detail line for the verdict ("" when confirmed)."""
+        if self.status == "mismatch" and self.check is not None:
+            c = self.check
+            return (f"verification: data component {c.component} ({c.what}) off the recognised pose by "
+                    f"{c.worst:.2f} bounds")  # fmt: skip
+        if self.status == "rejected" and self.accept is not None:
+            a = self.accept
+            return (f"verification: residuals {a.statistic:.1f} over the noise model's {a.threshold:.1f} "
+                    f"(chi-square, {a.dof} dof)")  # fmt: skip
+        if self.status == "incomplete" and self.hidden:
+            return (f"verification incomplete: {len(self.hidden)} vertices of {self._model_name} out of the hand's "
+                    "reach and off the table (a difference there cannot be measured)")  # fmt: skip
+        if self.status == "incomplete" and self.coverage is not None:
+            f, e, v = (len(x) for x in self.coverage.missing(self.mode))
+            return (f"verification incomplete after {self.moves} moves: {f} faces, {e} edges, {v} vertices of "
+                    f"{self._model_name} not measured")  # fmt: skip
+        return ""
 
     def choose(
         self, h: Hypothesis, state: SensorState, components: Mapping[int, DataComponent], avoid: Sequence[Move]
     ) -> Move | None:
-        """The next verification move for hypothesis ``h`` (None: none admissible)."""
+        """The next verification move for hypothesis ``h`` — in the world of the interpretation whose coverage
+        counts, when it has a pose (None: no move admissible)."""
         self.moves += 1
+        if self._hyp is not None and self._hyp.world_from_model is not None:
+            h = self._hyp
         missing = self.coverage.missing(self.mode) if self.coverage is not None else (frozenset(),) * 3
         return choose_verification_move(h, state, components, missing, self.noise, self.config, avoid)
 
@@ -240,6 +357,10 @@ class Verifier:
         if self.check is not None:
             out.update(model=self._model_name, pose_residual=round(float(self.check.worst), 4),
                        pose_component=self.check.component, pose_what=self.check.what)  # fmt: skip
+        if self.accept is not None:
+            out.update(chi2=round(self.accept.statistic, 3), chi2_dof=self.accept.dof,
+                       chi2_threshold=round(self.accept.threshold, 3))  # fmt: skip
         if self.coverage is not None:
             out.update(self.coverage.record(self._model))
+            out["vertices_hidden"] = len(self.hidden)
         return out

@@ -20,7 +20,14 @@ from haptic.geometry.perturb import scale_dimension
 from haptic.matching.components import SensorNoise, from_json
 from haptic.matching.library import LibraryArrays
 from haptic.matching.tree import InterpretationTree
-from haptic.matching.verify import POSE_SAFETY, check_verify_mode, coverage, pose_check
+from haptic.matching.verify import (
+    K_SIGMA_PHYSICS,
+    POSE_SAFETY,
+    acceptance,
+    check_verify_mode,
+    coverage,
+    pose_check,
+)
 
 from .helpers import true_leaves
 
@@ -66,7 +73,8 @@ def test_true_interpretation_passes_the_pose_check(name, seed, n_moves, level, a
 
 
 def test_physics_fixture_passes_the_pose_check():
-    """The physics executor's components (its segmenter's bounds) on BOX01: the true interpretation passes."""
+    """The physics executor's components (its segmenter's bounds) on BOX01: the true interpretation passes the
+    pose check and the acceptance test with the physics executor's σ (bound / 6)."""
     data = Path(__file__).parent / "data" / "physics_box01_seed1.json"
     text = data.read_text()
     comps, meta = from_json(text), json.loads(text)
@@ -77,6 +85,8 @@ def test_physics_fixture_passes_the_pose_check():
         it = tree.interpretation(leaf, with_pose=True, refine=True)
         chk = pose_check(LIB[meta["model"]], tree.data, it)
         assert chk.ok, chk
+        acc = acceptance(LIB[meta["model"]], tree.data, it, it.world_from_model, k_sigma=K_SIGMA_PHYSICS)
+        assert acc.ok and acc.statistic < 0.5 * acc.threshold, acc
 
 
 def test_a_longer_object_fails_the_pose_check_or_the_tree():
@@ -103,7 +113,8 @@ def test_coverage_counts_what_the_interpretation_pairs():
     assert ff == len(set(it.faces.values())) / 6 and fe == len(set(it.edges.values())) / 12
     assert fv == len(set(it.vertices.values())) / 8
     assert cov.met("none")
-    assert cov.met("full") == (ff == fe == fv == 1.0)
+    assert cov.met("full") == (fv == 1.0)  # every vertex: its faces and edges are then fixed too
+    assert cov.met("fast") == (ff == fe == 1.0)
     rec = cov.record(LIB["BOX01"])
     assert rec["faces_total"] == 6 and rec["faces"] == len(cov.faces)
 
@@ -112,3 +123,36 @@ def test_verify_mode_is_checked():
     assert check_verify_mode("fast") == "fast"
     with pytest.raises(HapticError, match="valid: none, fast, full"):
         check_verify_mode("quick")
+
+
+@pytest.mark.parametrize("level", [0.5, 1.0, 4.0, 8.0])
+def test_true_interpretation_passes_the_acceptance_test(level):
+    """Noise drawn from the noise model (not at the bounds: the test is statistical): the true interpretation's
+    residuals are within the χ² threshold in every one of 40 walks (false alarm probability 1e-3 each)."""
+    for k in range(40):
+        name = NAMES[k % len(NAMES)]
+        it, tree, chk = _true_check(name, 1000 + k, 6 + k % 9, level, False)
+        if it.world_from_model is None:
+            continue
+        acc = acceptance(LIB[name], tree.data, it, it.world_from_model)
+        assert acc.ok, (name, k, acc)
+        assert acc.dof > 0 and acc.statistic > 0
+
+
+def test_acceptance_catches_a_systematic_difference_within_every_bound():
+    """A box 0.9 mm (1.5 %) taller than BOX01, random walks of 30 moves: where a BOX01 interpretation survives the
+    tree and passes the pose check (every residual within twice its bound), the residuals together are mostly
+    far off the noise model and the acceptance test turns it away."""
+    box = LIB["BOX01"]
+    taller = scale_dimension(box, 2, 1.015)
+    passed = caught = 0
+    for seed in range(20):
+        ex = _walk(taller, seed, 30, 1.0, at_bounds=False)
+        tree = InterpretationTree({"BOX01": box})
+        tree.add_all(ex.components)
+        its = [tree.interpretation(i, with_pose=True, refine=True) for i in range(min(tree.count, 16))]
+        ok = [it for it in its if it.world_from_model is not None and pose_check(box, tree.data, it).ok]
+        if ok:
+            passed += 1
+            caught += not any(acceptance(box, tree.data, it, it.world_from_model).ok for it in ok)
+    assert passed >= 3 and caught >= 3, (passed, caught)
