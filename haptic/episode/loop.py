@@ -25,9 +25,11 @@ from haptic.geometry.se3 import matrix_to_quat
 from haptic.matching.components import DataComponent, SensorNoise
 from haptic.matching.recognition import AMBIGUOUS, EXPLORING, NO_MATCH, RECOGNIZED, Recognition, recognize
 from haptic.matching.tree import InterpretationTree
+from haptic.matching.verify import K_SIGMA, K_SIGMA_PHYSICS
 from haptic.planning.moves import Move, MoveResult
 from haptic.planning.policies import Context, Decision, Policy, RandomPolicy
 from haptic.planning.predict import Hypothesis, PlannerConfig
+from haptic.planning.verify import Verifier
 
 MAX_POSED = 4000
 """Largest number of interpretations whose poses are computed to group them into pose classes (all of them in one
@@ -226,9 +228,6 @@ def loop_steps(
     fallback = RandomPolicy()
     verifier = None
     if spec.verify != "none":
-        from haptic.matching.verify import K_SIGMA, K_SIGMA_PHYSICS
-        from haptic.planning.verify import Verifier
-
         verifier = Verifier(spec.verify, noise, config, K_SIGMA_PHYSICS if spec.executor == "physics" else K_SIGMA)
 
     touched: list[tuple[np.ndarray, np.ndarray]] = []
