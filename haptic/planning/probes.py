@@ -14,13 +14,18 @@ eliminated if ``i`` is true, and the efficiency is computed as for the tracing m
 (:func:`~haptic.planning.efficiency.efficiency_of`: expected pose classes eliminated per expected cost), so one
 planner can rank probes and tracing moves together.
 
-The elimination rule mirrors the matcher (:mod:`haptic.matching.probes`), with the same pose-error margin
-``ε = ρ + δ + a ‖x − c‖`` at the point concerned: if ``i`` predicts a hit, ``j`` is eliminated when it predicts
-a miss, a contact farther along the line than ``ε / |n·u|`` (the incidence turns a plane's offset into a
-distance along the line), or a normal farther than the angle bounds; if ``i`` predicts a miss, ``j`` is
-eliminated when the line runs inside it deeper than ``ε``. The depth is estimated from the first inside chord,
-``½ · chord · min(|n_in·u|, |n_out·u|)`` (the depth of the chord's midpoint below its entry and exit faces):
-like every prediction of §4.1, an expectation, not a guarantee.
+The elimination rule mirrors the matcher (:mod:`haptic.matching.probes`). If ``i`` predicts a miss, ``j`` is
+eliminated when the line runs inside it deeper than the free segment's margin ``ε = ρ + δ_p + a ‖x − c‖``
+(the matcher's, with the pose tolerance ``δ_p``, ``a`` of :class:`~haptic.matching.recognition.PoseTolerance`).
+The depth is estimated from the first inside chord, ``½ · chord · min(|n_in·u|, |n_out·u|)`` (the depth of the
+chord's midpoint below its entry and exit faces). If ``i`` predicts a hit, ``j`` is eliminated when it predicts
+a miss, a contact farther along the line than the two contact margins allow, or a normal farther than the
+angle bound: the matcher refits each pose with the contact and checks it within ``POSE_SAFETY`` times its
+bounds (:func:`~haptic.matching.verify.pose_check`), so a contact margin is ``(1 + POSE_SAFETY) ρ + δ r``
+(``δ`` the normal bound, ``r`` the contact's distance from the centroid), turned into a distance along the
+line by the incidence ``|n·u|`` (at least :data:`MIN_INCIDENCE`), and the angle bound ``(1 + POSE_SAFETY) δ``.
+Like every prediction of §4.1 these are expectations, not guarantees (``scripts/bench_probes.py`` compares
+them with what the matcher then eliminates).
 """
 
 from __future__ import annotations
@@ -34,6 +39,7 @@ import numpy as np
 from haptic.geometry.raycast import line_hits
 from haptic.matching.components import DataComponent, SensorNoise
 from haptic.matching.recognition import PoseTolerance
+from haptic.matching.verify import POSE_SAFETY
 from haptic.planning.efficiency import efficiency_of, expected_eliminated
 from haptic.planning.moves import CostModel, ProbeMove
 
@@ -170,7 +176,11 @@ class ProbePrediction:
     depth: np.ndarray
     """Estimated depth the line runs inside the object (0 for a miss), shape (N,) [m]."""
     margin: np.ndarray
-    """Pose-error margin ``ε`` at the contact, or at the object's centre for a miss, shape (N,) [m]."""
+    """Pose-error margin ``ε`` of a free segment at the contact, or at the object's centre for a miss, shape
+    (N,) [m]."""
+    contact_margin: np.ndarray
+    """How far off a hypothesis's surface a contact may lie and pass the matcher's pose check, at the contact
+    (NaN for a miss), shape (N,) [m]."""
     angle_bound: float
     """Bound on the angle between two predicted normals that one measurement cannot tell apart [rad]."""
     costs: np.ndarray
@@ -187,7 +197,7 @@ class ProbePrediction:
         # i hits: j misses, meets the line elsewhere, or with another normal
         d |= hi & ~hj
         incid = np.maximum(np.abs(np.nan_to_num(self.normal) @ u), MIN_INCIDENCE)
-        along = self.margin / incid
+        along = np.nan_to_num(self.contact_margin) / incid
         with np.errstate(invalid="ignore"):
             far = np.abs(self.distance[:, None] - self.distance[None, :]) > along[:, None] + along[None, :]
             cosang = np.clip(np.nan_to_num(self.normal) @ np.nan_to_num(self.normal).T, -1.0, 1.0)
@@ -223,7 +233,8 @@ def predict_probes(
     comps = list(components.values()) if isinstance(components, Mapping) else list(components)
     tol = PoseTolerance.from_data(comps)
     rho = noise.k * noise.position_sigma
-    ang = noise.k * noise.normal_sigma + tol.angle  # a measurement's error and a pose's
+    delta = noise.k * noise.normal_sigma
+    ang = (1.0 + POSE_SAFETY) * delta
     n, m = len(hypotheses), len(moves)
     if m == 0:
         return []
@@ -280,11 +291,14 @@ def predict_probes(
         hit = t_hit[i] <= lengths[i]
         dist = np.where(hit, t_hit[i], np.nan)
         at = np.where(hit[:, None], starts[i] + np.nan_to_num(dist)[:, None] * dirs[i], centre_w)
-        margin = rho + tol.distance + tol.angle * np.linalg.norm(at - centre_w, axis=1)
+        r = np.linalg.norm(at - centre_w, axis=1)
+        margin = rho + tol.distance + tol.angle * r
+        contact = np.where(hit, (1.0 + POSE_SAFETY) * rho + delta * r, np.nan)
         s = transfer[i] + np.where(hit, np.nan_to_num(dist), lengths[i] + back[i])
         out.append(ProbePrediction(
             move=mv, hit=hit, distance=dist, face=np.where(hit, face[i], -1),
             normal=np.where(hit[:, None], normal[i], np.nan), depth=np.where(hit, depth[i], 0.0), margin=margin,
+            contact_margin=contact,
             angle_bound=float(ang), costs=np.array([costs.probe_move(x) for x in s]),
         ))  # fmt: skip
     return out

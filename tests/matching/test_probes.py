@@ -16,7 +16,7 @@ from haptic.executor.probe import execute_probe
 from haptic.geometry import SE3, load_library, tracing
 from haptic.matching.components import DataFace, SensorNoise
 from haptic.matching.library import LibraryArrays
-from haptic.matching.probes import FreeSegment, apply_probes, free_segment_consistent, probe_face
+from haptic.matching.probes import MAX_POSED, FreeSegment, apply_probes, free_segment_consistent, probe_face
 from haptic.matching.recognition import PoseTolerance
 from haptic.matching.tree import InterpretationTree
 from haptic.planning.moves import CostModel, ProbeMove
@@ -79,7 +79,7 @@ def _check(name: str, seed: int, n_moves: int, n_probes: int, level: float, at_b
 _common = settings(deadline=None, suppress_health_check=[HealthCheck.too_slow], derandomize=True)
 
 
-@settings(_common, max_examples=60)
+@settings(_common, max_examples=40)
 @given(
     name=st.sampled_from(NAMES),
     seed=st.integers(0, 2**31),
@@ -91,7 +91,7 @@ def test_true_interpretation_survives_probes_with_noise_inside_bounds(name, seed
     _check(name, seed, n_moves, n_probes, level, at_bounds=False)
 
 
-@settings(_common, max_examples=50)
+@settings(_common, max_examples=30)
 @given(name=st.sampled_from(NAMES), seed=st.integers(0, 2**31), n_moves=st.integers(1, 6),
        n_probes=st.integers(1, 4))  # fmt: skip
 def test_true_interpretation_survives_probes_with_noise_at_the_bounds(name, seed, n_moves, n_probes):
@@ -101,10 +101,40 @@ def test_true_interpretation_survives_probes_with_noise_at_the_bounds(name, seed
 def test_both_outcomes_occur_in_the_property_runs():
     """The generator does produce misses and hits (else the properties above would test one kind only)."""
     misses = hits = 0
-    for seed in range(6):
-        m, h = _check(NAMES[seed % len(NAMES)], seed, 3, 4, 1.0, at_bounds=True)
+    for seed in range(4):
+        m, h = _check(NAMES[seed % len(NAMES)], seed, 2, 4, 1.0, at_bounds=True)
         misses, hits = misses + m, hits + h
-    assert misses >= 3 and hits >= 3
+    assert misses >= 2 and hits >= 2
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_a_grazing_miss_displaced_into_the_object_by_its_bound_keeps_the_truth(name):
+    """The worst miss: a true path skimming a face 0.05 mm above it, reported displaced by exactly its bound
+    toward the face (into the object), across the middle of the face."""
+    rng = np.random.default_rng(4)
+    ex = GeometricExecutor(LIB[name], SE3.random(rng, 0.1), SensorNoise(), rng,
+                           settings=GeometricSettings(at_bounds=True))  # fmt: skip
+    random_walk(ex, 6, rng)
+    tree = InterpretationTree(ARRAYS)
+    for c in ex.components:
+        tree.add(c)
+    m, t = ex.model, ex.world_from_model
+    rho = ex.noise.k * ex.noise.position_sigma
+    segments = []
+    for f in rng.permutation(m.n_faces)[:4]:
+        n = t.rotate(m.face_normals[f])
+        p = t.apply(tracing.random_face_point(m, f, rng, margin=0.002))
+        u = np.cross(n, rng.normal(size=3))
+        u /= np.linalg.norm(u)
+        start = p + 5e-5 * n - 0.15 * u
+        if execute_probe(ex, ProbeMove(start, u, 0.3)).components:
+            continue  # the path meets another part of the object: not a miss
+        segments.append(FreeSegment(start - rho * n, u, 0.3, rho))
+    assert segments
+    (leaf,) = true_leaves(tree, ex)[:1]
+    assert tree.count <= MAX_POSED and tree.interpretation(int(leaf)).world_from_model is not None  # tested
+    apply_probes(tree, segments)
+    assert len(true_leaves(tree, ex)) >= 1
 
 
 def test_a_segment_through_the_posed_model_contradicts_it():

@@ -89,3 +89,24 @@ def test_probe_cost_counts_free_space_travel():
     (pred,) = predict_probes(hyps, [mv], here, [], SensorNoise(), costs)
     assert pred.hit[0]
     assert pred.costs[0] == pytest.approx(3.0 + 10.0 * (0.1 + pred.distance[0]))
+
+
+def test_bench_probes_at_a_small_size():
+    """scripts/bench_probes.py at a small size: at each decision point the best probe is carried out and
+    matched, the true pose class survives, and the prediction under it is never above what the matcher
+    eliminated by more than a class or two (it is an expectation; the matcher also has the tree's tests)."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "scripts"))
+    try:
+        from bench_probes import run
+    finally:
+        sys.path.pop(0)
+    rows = run(trials=3, seed=1, quiet=True)
+    assert len(rows) == 3
+    for r in rows:
+        assert r["true_survived"]
+        assert r["candidates"] >= 1 and r["probe_eff"] >= 0.0
+        if r["predicted"] is not None and r["eliminated"] is not None:
+            assert r["predicted"] <= r["eliminated"] + 2
