@@ -36,6 +36,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from haptic.errors import PlanningError
 from haptic.geometry.raycast import line_hits
 from haptic.matching.components import DataComponent, SensorNoise
 from haptic.matching.recognition import PoseTolerance
@@ -250,7 +251,8 @@ def predict_probes(
     by_model: dict[int, list[int]] = {}
     for j, h in enumerate(hypotheses):
         if h.world_from_model is None:
-            raise ValueError(f"hypothesis {j} ({h.model}) has no pose: probes are predicted for posed classes only")
+            raise PlanningError(f"hypothesis {j} ({h.model}) has no pose: probes are predicted for posed pose classes "
+                                "only (leave out those without, as candidate_probes does)")
         by_model.setdefault(id(h.poly), []).append(j)
         centre_w[j] = h.world_from_model.apply(h.poly.centroid)
     for js in by_model.values():

@@ -110,3 +110,14 @@ def test_bench_probes_at_a_small_size():
         assert r["candidates"] >= 1 and r["probe_eff"] >= 0.0
         if r["predicted"] is not None and r["eliminated"] is not None:
             assert r["predicted"] <= r["eliminated"] + 2
+
+
+def test_a_hypothesis_without_a_pose_is_refused_by_name():
+    from haptic.errors import PlanningError
+
+    hyps = [_hyp("BOX01", SE3.identity())]
+    mv = candidate_probes(hyps)[0]
+    unposed = Hypothesis(model="PYR01", poly=LIB["PYR01"], world_from_model=None, faces={}, edges={}, vertices={})
+    assert candidate_probes([unposed]) == []
+    with pytest.raises(PlanningError, match="PYR01.*no pose"):
+        predict_probes([hyps[0], unposed], [mv], np.zeros(3), [], SensorNoise())
