@@ -7,7 +7,11 @@ carried out at the true object, its data matched (:mod:`haptic.matching.probes`)
 pose classes the true class's prediction says the probe eliminates against those the matcher then
 eliminated, whether the true class survived, and the time to generate and predict the candidates.
 
-    .venv/bin/python scripts/bench_probes.py [--trials 40] [--seed 0] [--noise 1.0] [--models DIR]
+    .venv/bin/python scripts/bench_probes.py [--trials 40] [--seed 0] [--noise 1.0] [--models DIR] [--c-p 2.0]
+        [--c-s 20.0]
+
+``--c-p``, ``--c-s``: the probe's cost constants (:class:`~haptic.planning.moves.CostModel`); the tracing moves
+keep their defaults.
 """
 
 from __future__ import annotations
@@ -27,6 +31,7 @@ from haptic.matching.probes import apply_probes
 from haptic.matching.recognition import PoseTolerance, equivalent_by_symmetry, recognize
 from haptic.matching.tree import InterpretationTree
 from haptic.planning.efficiency import class_weights
+from haptic.planning.moves import CostModel
 from haptic.planning.policies import Context, PlannerPolicy
 from haptic.planning.predict import PlannerConfig
 from haptic.planning.probes import candidate_probes, predict_probes
@@ -39,7 +44,7 @@ def _true_class(classes, name, truth, tol) -> int | None:
     return None
 
 
-def trial(lib, arrays, rng, noise, max_moves: int = 12) -> dict | None:
+def trial(lib, arrays, rng, noise, costs: CostModel | None = None, max_moves: int = 12) -> dict | None:
     """One decision point; None when the walk recognised the object (or found no pose) first."""
     names = sorted(lib)
     name = names[int(rng.integers(len(names)))]
@@ -69,7 +74,7 @@ def trial(lib, arrays, rng, noise, max_moves: int = 12) -> dict | None:
     weights = class_weights([h.model for h in hyps])
     t0 = time.perf_counter()
     moves = candidate_probes(hyps)
-    preds = predict_probes(hyps, moves, ex.state.position, components, noise)
+    preds = predict_probes(hyps, moves, ex.state.position, components, noise, costs)
     scores = [p.score(weights) for p in preds]
     t_probe = time.perf_counter() - t0
     t0 = time.perf_counter()
@@ -98,7 +103,8 @@ def trial(lib, arrays, rng, noise, max_moves: int = 12) -> dict | None:
     }  # fmt: skip
 
 
-def run(trials: int = 40, seed: int = 0, noise: float = 1.0, models: str | None = None, quiet: bool = False):
+def run(trials: int = 40, seed: int = 0, noise: float = 1.0, models: str | None = None, quiet: bool = False,
+        costs: CostModel | None = None):
     lib = load_library(models) if models else load_library()
     arrays = LibraryArrays.build(lib)
     rng = np.random.default_rng(seed)
@@ -106,7 +112,7 @@ def run(trials: int = 40, seed: int = 0, noise: float = 1.0, models: str | None 
     attempts = 0
     while len(rows) < trials and attempts < 10 * trials:
         attempts += 1
-        r = trial(lib, arrays, rng, SensorNoise().scaled(noise))
+        r = trial(lib, arrays, rng, SensorNoise().scaled(noise), costs)
         if r is None:
             continue
         rows.append(r)
@@ -124,8 +130,10 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--noise", type=float, default=1.0)
     ap.add_argument("--models", default=None)
+    ap.add_argument("--c-p", type=float, default=CostModel.c_p, help="cost per probe [units]")
+    ap.add_argument("--c-s", type=float, default=CostModel.c_s, help="cost per metre of free space [units/m]")
     a = ap.parse_args()
-    rows = run(a.trials, a.seed, a.noise, a.models)
+    rows = run(a.trials, a.seed, a.noise, a.models, costs=CostModel(c_p=a.c_p, c_s=a.c_s))
     if not rows:
         print("no decision point reached")
         return
@@ -134,8 +142,8 @@ def main() -> None:
     both = [r for r in rows if r["predicted"] is not None and r["eliminated"] is not None]
     med_classes = np.median([r["classes"] for r in rows])
     med_cands = np.median([r["candidates"] for r in rows])
-    print(f"\n{len(rows)} decision points (seed {a.seed}, noise {a.noise}); classes at decision: median "
-          f"{med_classes:.0f}; candidates: median {med_cands:.0f}")
+    print(f"\n{len(rows)} decision points (seed {a.seed}, noise {a.noise}, c_p {a.c_p:g}, c_s {a.c_s:g}); classes "
+          f"at decision: median {med_classes:.0f}; candidates: median {med_cands:.0f}")
     print(f"true class survived the probe: {sum(r['true_survived'] for r in rows)}/{len(rows)}")
     print(f"best probe hit: {sum(r['hit'] for r in rows)}/{len(rows)}")
     print(f"efficiency, best probe vs best tracing move: median {np.median(pe):.3f} vs {np.median(te):.3f}; "
