@@ -89,7 +89,9 @@ def trial(lib, arrays, rng, noise, costs: CostModel | None = None, max_moves: in
     for c in res.components:
         tree.add(c)
         hits.append(c.id)
+    t0 = time.perf_counter()
     apply_probes(tree, res.free_space, hits)
+    t_match = time.perf_counter() - t0
     after = recognize(tree, max_interpretations=400)
     alive = after.classes or ()
     survived = after.status != "no-match" and (
@@ -99,7 +101,7 @@ def trial(lib, arrays, rng, noise, costs: CostModel | None = None, max_moves: in
         "model": name, "classes": len(rec.classes), "candidates": len(moves), "probe_eff": scores[i][0],
         "trace_eff": best_trace, "hit": bool(res.components), "predicted": predicted,
         "eliminated": len(rec.classes) - len(alive) if alive else None, "true_survived": survived,
-        "t_probe": t_probe, "t_trace": t_trace,
+        "t_probe": t_probe, "t_trace": t_trace, "t_match": t_match, "leaves": tree.count,
     }  # fmt: skip
 
 
@@ -120,7 +122,7 @@ def run(trials: int = 40, seed: int = 0, noise: float = 1.0, models: str | None 
             print(f"{r['model']:>12} classes {r['classes']:3d} cands {r['candidates']:3d} "
                   f"eff probe {r['probe_eff']:.3f} trace {r['trace_eff']:.3f} hit {r['hit']!s:5} "
                   f"elim predicted {r['predicted']} actual {r['eliminated']} true kept {r['true_survived']} "
-                  f"t {r['t_probe']:.3f}s/{r['t_trace']:.3f}s")  # fmt: skip
+                  f"t {r['t_probe']:.3f}s/{r['t_trace']:.3f}s/{r['t_match']:.3f}s")  # fmt: skip
     return rows
 
 
@@ -154,8 +156,10 @@ def main() -> None:
         print(f"classes eliminated (under the true class's prediction vs matcher): mean {p.mean():.2f} vs "
               f"{q.mean():.2f}; equal at {int((p == q).sum())}/{len(both)}")
     t_probe, t_trace = np.median([r["t_probe"] for r in rows]), np.median([r["t_trace"] for r in rows])
+    t_match = np.median([r["t_match"] for r in rows])
     print(f"time to generate and predict the probe candidates: median {t_probe:.3f} s; to score the tracing "
-          f"moves: median {t_trace:.3f} s (shared machine)")
+          f"moves: median {t_trace:.3f} s; to match the probe's data (apply_probes): median {t_match:.3f} s, "
+          f"max {max(r['t_match'] for r in rows):.3f} s (shared machine)")
 
 
 if __name__ == "__main__":
