@@ -267,6 +267,18 @@ class InterpretationTree:
         """Add components in order; the interpretation count after each."""
         return [self.add(c) for c in components]
 
+    def retain(self, keep: np.ndarray) -> int:
+        """Eliminate the leaves where ``keep`` (shape (N,) bool) is False: evidence that is no pairing, such as
+        the free space a probe passed through (:mod:`haptic.matching.probes`). Returns the number left; the
+        count after the last ``add`` is updated to it."""
+        keep = np.asarray(keep, dtype=bool)
+        if keep.shape != (self.count,):
+            raise MatchError(f"retain: expected one flag per leaf, shape ({self.count},), got {keep.shape}")
+        self._model, self._assign, self._sense = self._model[keep], self._assign[keep], self._sense[keep]
+        if self.counts:
+            self.counts[-1] = self.count
+        return self.count
+
     def test(self, component: DataComponent) -> np.ndarray:
         """Which current interpretations would survive ``component`` (a prediction), without changing the tree.
 

@@ -1,5 +1,5 @@
-"""The seed's three admissible moves (§4), the sensor state they start from, their results, and their costs
-(§3.1).
+"""The seed's three admissible moves (§4), the free-space probe of §1.1, the sensor state they start from, their
+results, and their costs (§3.1).
 
 A move is chosen by the planner and carried out by an executor (geometric or physics); both return the same
 :class:`MoveResult`. Distances are in metres; costs are in cost units.
@@ -13,6 +13,7 @@ from enum import StrEnum
 import numpy as np
 
 from haptic.matching.components import DataComponent
+from haptic.matching.probes import FreeSegment
 from haptic.matching.trace import ContactTrace
 
 
@@ -21,6 +22,8 @@ class CostModel:
     """Cost constants of seed §3.1. ``c_f``, ``c_e``, ``c_v`` multiply distance; the rest are per event.
 
     Defaults: 1 unit per cm across a face, 2 per cm along an edge (more care), 1.5 per cm around a vertex.
+    A free-space probe (§1.1) costs a constant ``c_p`` per probe, as in the free-space work that counted
+    probes, plus ``c_s`` per metre travelled through free space (0.2 per cm: free motion needs no care).
     """
 
     c_f: float = 100.0
@@ -37,6 +40,10 @@ class CostModel:
     """Acquiring a face normal (a short 2-D stroke) [units]."""
     c_b: float = 0.5
     """Acquiring an edge direction [units]."""
+    c_p: float = 2.0
+    """Per free-space probe: leaving the surface, the guarded approach and its contact (or its end) [units]."""
+    c_s: float = 20.0
+    """Moving through free space, to a probe's line and along it [units/m]."""
 
     def face_move(self, s: float) -> float:
         """``c_f s + c_j + c_b + c_n`` (§4, face move)."""
@@ -49,6 +56,11 @@ class CostModel:
     def vertex_move(self, s: float) -> float:
         """``c_v s + c_j + c_b + c_n`` (§4, vertex move)."""
         return self.c_v * s + self.c_j + self.c_b + self.c_n
+
+    def probe_move(self, s: float) -> float:
+        """``c_p + c_s s`` (§3.1 in the manner of the tracing moves; ``s``: the distance travelled in free space,
+        to the line's start, along it to contact or its end, and back to the surface after a miss)."""
+        return self.c_p + self.c_s * s
 
 
 @dataclass(frozen=True, eq=False)
@@ -99,6 +111,27 @@ class VertexMove:
     kind = "vertex"
 
 
+@dataclass(frozen=True, eq=False)
+class ProbeMove:
+    """Leave the surface, move through free space to ``start`` and approach along the line until contact (a
+    guarded move) or until ``length`` (a miss): the free-space move of seed §1.1. A hit yields a face data
+    component (a point and a normal, adjacent to nothing known); either way the path is free of the object."""
+
+    start: np.ndarray
+    """Start of the line in the world frame, shape (3,) [m]."""
+    direction: np.ndarray
+    """Unit direction of the approach in the world frame, shape (3,)."""
+    length: float
+    """How far along the line the approach goes before it counts as a miss [m]."""
+
+    kind = "probe"
+
+    @property
+    def end(self) -> np.ndarray:
+        """``start + length · direction`` [m]."""
+        return np.asarray(self.start) + self.length * np.asarray(self.direction)
+
+
 Move = FaceMove | EdgeMove | VertexMove
 
 
@@ -147,6 +180,8 @@ class MoveResult:
     samples count: none from an executor without a contact trace)."""
     trace: ContactTrace | None = None
     """Everything the fingertip sensed during the move (None: the executor keeps no trace)."""
+    free_space: tuple[FreeSegment, ...] = ()
+    """Segments the move found free of the object (a probe's path up to its contact or its end)."""
     info: dict = field(default_factory=dict)
     """Executor-specific extras (the reason of a failure, the hand's link poses, simulated time)."""
 

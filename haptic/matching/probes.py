@@ -1,0 +1,168 @@
+"""Matching with free-space probe data (seed §1.1, §2.6): a contact is a face, a miss is free space.
+
+A probe moves the sensor along a line through free space until it touches the object (Grimson and
+Lozano-Pérez's paradigm). What it yields:
+
+- **A hit** is a face data component (:func:`probe_face`): one point and an outward normal with their error
+  bounds, adjacent to nothing known. The interpretation tree takes it as it is: with no adjacency it pairs
+  with every model face of each leaf (§2.3 step 1), and the geometric relations with every earlier component
+  prune the pairings. Against every other data face that is the face-pair angle, which §2.6 notes needs no
+  adjacency (outward normals have consistent senses); against vertices and edges the tree's height and
+  face–edge angle tests. Once a leaf's pose is known, :func:`consistent_leaves` adds the pose check of
+  :mod:`haptic.matching.verify`: with the pose refitted over every pairing, the hit point must lie on the
+  model face's polygon (plane *and* extent) within its bounds, as every other component must.
+- **A miss**, and the path of a hit up to its contact, is a :class:`FreeSegment`: negative evidence. A leaf
+  whose posed model that segment enters is eliminated, but only when it enters deeper than the segment's
+  error bound plus the error of the leaf's pose at that point (:func:`free_margin`), so the true
+  interpretation is never eliminated by data within their bounds.
+
+The pose error margin is the matcher's own tolerance for "the same pose"
+(:meth:`~haptic.matching.recognition.PoseTolerance.from_data`, from the data's error bounds): a displacement
+``δ`` of the model centroid and a rotation ``a`` move a model point ``x`` by at most ``δ + a ‖x − c‖``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from haptic.geometry.polyhedron import Polyhedron
+from haptic.geometry.raycast import depth_samples
+from haptic.geometry.se3 import SE3
+from haptic.matching.components import DataFace, _vec
+from haptic.matching.recognition import PoseTolerance
+from haptic.matching.tree import InterpretationTree
+from haptic.matching.verify import pose_check
+
+MAX_POSED = 400
+"""Most leaves whose poses :func:`consistent_leaves` computes; above it every leaf is kept (sound, as the
+matcher's recognition does: ``haptic.episode.MAX_POSED``)."""
+
+
+@dataclass(frozen=True, eq=False)
+class FreeSegment:
+    """A straight path the sensor travelled without touching the object: ``{start + t u : 0 ≤ t ≤ length}``."""
+
+    start: np.ndarray
+    """Start of the segment in the world frame, shape (3,) [m]."""
+    direction: np.ndarray
+    """Unit direction ``u`` in the world frame, shape (3,)."""
+    length: float
+    """Length of the segment (≥ 0) [m]."""
+    position_bound: float
+    """Error bound on the position of every point of the segment: the true path lies within this of it [m]."""
+
+    kind = "free"
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "start", _vec(self.start))
+        object.__setattr__(self, "direction", _vec(self.direction))
+        object.__setattr__(self, "length", float(self.length))
+
+    @property
+    def end(self) -> np.ndarray:
+        """``start + length · u`` [m]."""
+        return self.start + self.length * self.direction
+
+    def to_dict(self) -> dict:
+        """A JSON-friendly dict (floats at full precision)."""
+        return {"kind": "free", "start": self.start.tolist(), "direction": self.direction.tolist(),
+                "length": self.length, "position_bound": self.position_bound}  # fmt: skip
+
+    @classmethod
+    def from_dict(cls, d: Mapping) -> FreeSegment:
+        """The inverse of :meth:`to_dict`."""
+        d = {k: v for k, v in d.items() if k != "kind"}
+        return cls(**d)
+
+
+def probe_face(
+    id: int, point: np.ndarray, normal: np.ndarray, normal_bound: float, position_bound: float
+) -> DataFace:
+    """The face data component of a probe's contact: one touched point and the sensed outward normal, adjacent to
+    nothing known (a probe arrives from free space)."""
+    return DataFace(id=id, normal=normal, points=np.atleast_2d(point), normal_bound=normal_bound,
+                    position_bound=position_bound, adjacent=())  # fmt: skip
+
+
+def free_margin(seg: FreeSegment, tol: PoseTolerance, world_from_model: SE3, model: Polyhedron,
+                points_in_world: np.ndarray) -> np.ndarray:  # fmt: skip
+    """How deep a hypothesis's posed model may seem to enter ``seg`` at each point while the true object stays
+    clear of the true path: the segment's bound plus the pose error there,
+    ``ε(x) = ρ + δ + a ‖x − T(c)‖`` (``δ``, ``a``: ``tol.distance``, ``tol.angle``; ``c`` the model centroid),
+    shape (P,) [m]."""
+    c_w = world_from_model.apply(model.centroid)
+    r = np.linalg.norm(np.atleast_2d(points_in_world) - c_w, axis=1)
+    return seg.position_bound + tol.distance + tol.angle * r
+
+
+def free_segment_consistent(
+    model: Polyhedron, world_from_model: SE3, seg: FreeSegment, tol: PoseTolerance
+) -> bool:
+    """Whether the model at ``world_from_model`` leaves ``seg`` free within the bounds: no point of the segment
+    lies inside it deeper than :func:`free_margin` (a ball of that radius about such a point would be inside
+    the true object, and the true path passes through it)."""
+    inv = world_from_model.inverse()
+    pts_m, depth = depth_samples(model, inv.apply(seg.start), inv.rotate(seg.direction), seg.length)
+    if not len(depth):
+        return True
+    margin = free_margin(seg, tol, world_from_model, model, world_from_model.apply(pts_m))
+    return bool((depth <= margin).all())
+
+
+def consistent_leaves(
+    tree: InterpretationTree,
+    free: Sequence[FreeSegment],
+    probe_faces: Iterable[int] = (),
+    tol: PoseTolerance | None = None,
+    max_posed: int = MAX_POSED,
+) -> np.ndarray:
+    """Which leaves of ``tree`` the probe data leave standing, shape (N,) bool.
+
+    A leaf whose pose is not yet determined, and every leaf while there are more than ``max_posed``, is kept.
+    A leaf with a pose is eliminated when one of the ``free`` segments enters its posed model deeper than the
+    bounds allow (:func:`free_segment_consistent`), or when it pairs one of the ``probe_faces`` (data ids of
+    probe hits) and fails the pose check of :func:`~haptic.matching.verify.pose_check` (every component,
+    the hit point included, on its model component within ``POSE_SAFETY`` times its bounds).
+    """
+    n = tree.count
+    keep = np.ones(n, dtype=bool)
+    hits = set(int(i) for i in probe_faces)
+    if n > max_posed or (not free and not hits):
+        return keep
+    tol = tol if tol is not None else PoseTolerance.from_data(tree.data)
+    data = tree.data
+    for leaf in range(n):
+        it = tree.interpretation(leaf, with_pose=True, refine=True)
+        pose = it.world_from_model
+        if pose is None:
+            continue
+        if hits & set(it.faces) and not pose_check(it.model, data, it).ok:
+            keep[leaf] = False
+            continue
+        keep[leaf] = all(free_segment_consistent(it.model, pose, seg, tol) for seg in free)
+    return keep
+
+
+def apply_probes(
+    tree: InterpretationTree,
+    free: Sequence[FreeSegment],
+    probe_faces: Iterable[int] = (),
+    tol: PoseTolerance | None = None,
+    max_posed: int = MAX_POSED,
+) -> int:
+    """Eliminate the leaves the probe data contradict (:func:`consistent_leaves`); the number left."""
+    return tree.retain(consistent_leaves(tree, free, probe_faces, tol, max_posed))
+
+
+__all__ = [
+    "MAX_POSED",
+    "FreeSegment",
+    "apply_probes",
+    "consistent_leaves",
+    "free_margin",
+    "free_segment_consistent",
+    "probe_face",
+]

@@ -1,0 +1,310 @@
+"""Candidate free-space probes and their predicted outcomes under each hypothesis (seed §1.1, §4.1).
+
+A probe is a line (:class:`~haptic.planning.moves.ProbeMove`) the sensor approaches along until contact or the
+line's end. Candidates aim at the hypotheses' surfaces: for every pose class and every face that class puts
+in the world, the face's centre approached from a discrete set of directions within :attr:`ProbeConfig.
+max_incidence` of head-on, each line starting outside every hypothesis and running across the whole region
+they occupy, clear of the table. Lines that nearly coincide (same direction, targets within
+:attr:`ProbeConfig.target_spacing` across it) are one candidate.
+
+Each hypothesis predicts, through its pose, whether the line hits its object, the face hit and the distance
+along the line (one vectorised line–triangle intersection per model over every candidate and pose class), and
+how deep a miss-line would run inside it. From those, ``eliminates[i, j]`` says whether hypothesis ``j`` is
+eliminated if ``i`` is true, and the efficiency is computed as for the tracing moves
+(:func:`~haptic.planning.efficiency.efficiency_of`: expected pose classes eliminated per expected cost), so one
+planner can rank probes and tracing moves together.
+
+The elimination rule mirrors the matcher (:mod:`haptic.matching.probes`). If ``i`` predicts a miss, ``j`` is
+eliminated when the line runs inside it deeper than the free segment's margin ``ε = ρ + δ_p + a ‖x − c‖``
+(the matcher's, with the pose tolerance ``δ_p``, ``a`` of :class:`~haptic.matching.recognition.PoseTolerance`).
+The depth is estimated from the first inside chord, ``½ · chord · min(|n_in·u|, |n_out·u|)`` (the depth of the
+chord's midpoint below its entry and exit faces). If ``i`` predicts a hit, ``j`` is eliminated when it predicts
+a miss, a contact farther along the line than the two contact margins allow, or a normal farther than the
+angle bound: the matcher refits each pose with the contact and checks it within ``POSE_SAFETY`` times its
+bounds (:func:`~haptic.matching.verify.pose_check`), so a contact margin is ``(1 + POSE_SAFETY) ρ + δ r``
+(``δ`` the normal bound, ``r`` the contact's distance from the centroid), turned into a distance along the
+line by the incidence ``|n·u|`` (at least :data:`MIN_INCIDENCE`), and the angle bound ``(1 + POSE_SAFETY) δ``.
+Like every prediction of §4.1 these are expectations, not guarantees (``scripts/bench_probes.py`` compares
+them with what the matcher then eliminates).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from haptic.errors import PlanningError
+from haptic.geometry.raycast import line_hits
+from haptic.matching.components import DataComponent, SensorNoise
+from haptic.matching.recognition import PoseTolerance
+from haptic.matching.verify import POSE_SAFETY
+from haptic.planning.efficiency import efficiency_of, expected_eliminated
+from haptic.planning.moves import CostModel, ProbeMove
+
+if TYPE_CHECKING:
+    from haptic.planning.predict import Hypothesis
+
+MIN_INCIDENCE = 0.2
+"""Smallest ``|n·u|`` used to turn a surface offset into a distance along a line (a grazing approach)."""
+
+
+@dataclass(frozen=True)
+class ProbeConfig:
+    """Options of probe candidate generation."""
+
+    n_directions: int = 26
+    """Approach directions, spread evenly over the sphere (a Fibonacci lattice) (§4.1.3: discrete angles)."""
+    max_incidence: float = np.deg2rad(50.0)
+    """A face is approached from directions within this of its inward normal [rad]."""
+    target_spacing: float = 0.01
+    """Targets closer than this across a common direction make one candidate [m]."""
+    standoff: float = 0.03
+    """Lines start this far outside the sphere that holds every hypothesis's object [m]."""
+    max_candidates: int = 64
+    """Most candidates offered (an even subsample of them beyond it)."""
+    table_z: float | None = None
+    """Height of the table top in the world frame (a workspace prior; None: no table) [m]."""
+    table_clearance: float = 0.004
+    """Every point of a line stays at least this above the table top; lines are cut short there [m]."""
+    max_climb: float = 0.5
+    """With a table, the approach may rise at most this steeply (the z of its unit direction): the hand comes
+    from above or the side, never from under the object."""
+
+
+def fibonacci_directions(n: int) -> np.ndarray:
+    """``n`` unit vectors spread evenly over the sphere, shape (n, 3)."""
+    k = np.arange(n) + 0.5
+    z = 1.0 - 2.0 * k / n
+    phi = np.pi * (1.0 + np.sqrt(5.0)) * k
+    r = np.sqrt(np.clip(1.0 - z * z, 0.0, 1.0))
+    return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=1)
+
+
+def _face_targets(poly) -> np.ndarray:
+    """A point inside each face (model frame): the centroid of its largest triangle, shape (F, 3)."""
+    tri = poly.vertices[poly.triangles]
+    area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+    out = np.zeros((poly.n_faces, 3))
+    best = np.full(poly.n_faces, -1.0)
+    for k, f in enumerate(poly.triangle_faces):
+        if area[k] > best[f]:
+            best[f], out[f] = area[k], tri[k].mean(axis=0)
+    return out
+
+
+def _region(hypotheses: Sequence[Hypothesis]) -> tuple[np.ndarray, float]:
+    """Centre and radius of a sphere holding every hypothesis's posed object [m]."""
+    pts = np.concatenate([h.world_from_model.apply(h.poly.vertices) for h in hypotheses])
+    centre = 0.5 * (pts.min(axis=0) + pts.max(axis=0))
+    return centre, float(np.linalg.norm(pts - centre, axis=1).max())
+
+
+def candidate_probes(hypotheses: Sequence[Hypothesis], config: ProbeConfig | None = None) -> list[ProbeMove]:
+    """Probe lines toward the hypotheses' surfaces (see the module docstring); hypotheses without a pose are
+    skipped, and none are offered when no hypothesis has one."""
+    config = config or ProbeConfig()
+    posed = [h for h in hypotheses if h.world_from_model is not None]
+    if not posed:
+        return []
+    centre, radius = _region(posed)
+    big = radius + config.standoff
+    dirs = fibonacci_directions(config.n_directions)
+    if config.table_z is not None:
+        dirs = dirs[dirs[:, 2] <= config.max_climb]
+    cos_max = np.cos(config.max_incidence)
+    seen: set[tuple] = set()
+    out: list[ProbeMove] = []
+    for h in posed:
+        t = h.world_from_model
+        targets, normals = t.apply(_face_targets(h.poly)), t.rotate(h.poly.face_normals)
+        facing = (dirs @ normals.T) <= -cos_max  # (D, F)
+        for di, fi in zip(*np.nonzero(facing), strict=True):
+            u, p = dirs[di], targets[fi]
+            # the target's position across the direction, snapped to the grid: one candidate per cell
+            across = p - (p @ u) * u
+            key = (int(di), *np.round(across / config.target_spacing).astype(int).tolist())
+            if key in seen:
+                continue
+            seen.add(key)
+            move = _line_through(p, u, centre, big, config)
+            if move is not None:
+                out.append(move)
+    if len(out) > config.max_candidates:
+        pick = np.linspace(0, len(out) - 1, config.max_candidates).round().astype(int)
+        out = [out[i] for i in pick]
+    return out
+
+
+def _line_through(p: np.ndarray, u: np.ndarray, centre: np.ndarray, radius: float, config: ProbeConfig):
+    """The chord along ``u`` through ``p`` of the sphere (``centre``, ``radius``), cut short above the table;
+    None when it would not reach ``p``."""
+    w = p - centre
+    b = float(w @ u)
+    disc = b * b - (float(w @ w) - radius * radius)
+    if disc <= 0.0:
+        return None
+    back = b + np.sqrt(disc)  # from p back to the sphere
+    start = p - back * u
+    length = 2.0 * np.sqrt(disc)
+    if config.table_z is not None:
+        floor = config.table_z + config.table_clearance
+        if start[2] < floor or p[2] < floor:
+            return None
+        if u[2] < 0.0:
+            length = min(length, (start[2] - floor) / -u[2])
+    if length <= back:
+        return None
+    return ProbeMove(start, u, float(length))
+
+
+@dataclass(frozen=True, eq=False)
+class ProbePrediction:
+    """A candidate probe with every hypothesis's predicted outcome and cost."""
+
+    move: ProbeMove
+    """The candidate."""
+    hit: np.ndarray
+    """Per hypothesis: whether the line meets its object before its end, shape (N,) bool."""
+    distance: np.ndarray
+    """Distance along the line to the contact, NaN for a miss, shape (N,) [m]."""
+    face: np.ndarray
+    """Model face hit, −1 for a miss, shape (N,)."""
+    normal: np.ndarray
+    """Outward normal of the face hit in the world frame, NaN for a miss, shape (N, 3)."""
+    depth: np.ndarray
+    """Estimated depth the line runs inside the object (0 for a miss), shape (N,) [m]."""
+    margin: np.ndarray
+    """Pose-error margin ``ε`` of a free segment at the contact, or at the object's centre for a miss, shape
+    (N,) [m]."""
+    contact_margin: np.ndarray
+    """How far off a hypothesis's surface a contact may lie and pass the matcher's pose check, at the contact
+    (NaN for a miss), shape (N,) [m]."""
+    angle_bound: float
+    """Bound on the angle between two predicted normals that one measurement cannot tell apart [rad]."""
+    costs: np.ndarray
+    """Predicted cost per hypothesis, shape (N,) [units]."""
+
+    def eliminates(self) -> np.ndarray:
+        """``D[i, j]``: hypothesis ``j`` is eliminated if ``i`` is true (module docstring), shape (N, N)."""
+        n = len(self.hit)
+        u = np.asarray(self.move.direction)
+        d = np.zeros((n, n), dtype=bool)
+        hi, hj = self.hit[:, None], self.hit[None, :]
+        # i misses: j runs deeper than its margin
+        d |= ~hi & hj & (self.depth[None, :] > self.margin[None, :])
+        # i hits: j misses, meets the line elsewhere, or with another normal
+        d |= hi & ~hj
+        incid = np.maximum(np.abs(np.nan_to_num(self.normal) @ u), MIN_INCIDENCE)
+        along = np.nan_to_num(self.contact_margin) / incid
+        with np.errstate(invalid="ignore"):
+            far = np.abs(self.distance[:, None] - self.distance[None, :]) > along[:, None] + along[None, :]
+            cosang = np.clip(np.nan_to_num(self.normal) @ np.nan_to_num(self.normal).T, -1.0, 1.0)
+            turned = np.arccos(cosang) > self.angle_bound
+        d |= hi & hj & (far | turned)
+        np.fill_diagonal(d, False)
+        return d
+
+    def score(self, weights: np.ndarray | None = None) -> tuple[float, float, float]:
+        """Efficiency (expected eliminations per expected cost, §4.1.1), expected eliminations and expected
+        cost, with ``weights`` over the hypotheses (equal when None)."""
+        d = self.eliminates()
+        eff, _ = efficiency_of(d, self.costs, weights)
+        n = len(self.costs)
+        w = np.full(n, 1.0 / n) if weights is None else np.asarray(weights, dtype=float) / np.sum(weights)
+        return eff, expected_eliminated(d, weights), float(self.costs @ w)
+
+
+def predict_probes(
+    hypotheses: Sequence[Hypothesis],
+    moves: Sequence[ProbeMove],
+    position: np.ndarray,
+    components: Mapping[int, DataComponent] | Sequence[DataComponent],
+    noise: SensorNoise,
+    costs: CostModel | None = None,
+) -> list[ProbePrediction]:
+    """Every hypothesis's predicted outcome and cost for each candidate probe (hypotheses must have poses).
+
+    ``position``: where the sensor is (world) [m], for the free-space distance; ``components``: the data so far,
+    whose error bounds set the pose-error margin (:class:`~haptic.matching.recognition.PoseTolerance`).
+    """
+    costs = costs or CostModel()
+    comps = list(components.values()) if isinstance(components, Mapping) else list(components)
+    tol = PoseTolerance.from_data(comps)
+    rho = noise.k * noise.position_sigma
+    delta = noise.k * noise.normal_sigma
+    ang = (1.0 + POSE_SAFETY) * delta
+    n, m = len(hypotheses), len(moves)
+    if m == 0:
+        return []
+    starts = np.array([mv.start for mv in moves], dtype=float)
+    dirs = np.array([mv.direction for mv in moves], dtype=float)
+    lengths = np.array([mv.length for mv in moves], dtype=float)
+    t_hit = np.full((m, n), np.inf)
+    face = np.full((m, n), -1, dtype=np.int64)
+    normal = np.full((m, n, 3), np.nan)
+    depth = np.zeros((m, n))
+    centre_w = np.zeros((n, 3))
+    # one line–triangle intersection per model, over every candidate and every pose class of that model
+    by_model: dict[int, list[int]] = {}
+    for j, h in enumerate(hypotheses):
+        if h.world_from_model is None:
+            raise PlanningError(f"hypothesis {j} ({h.model}) has no pose: probes are predicted for posed pose classes "
+                                "only (leave out those without, as candidate_probes does)")
+        by_model.setdefault(id(h.poly), []).append(j)
+        centre_w[j] = h.world_from_model.apply(h.poly.centroid)
+    for js in by_model.values():
+        poly = hypotheses[js[0]].poly
+        inv = [hypotheses[j].world_from_model.inverse() for j in js]
+        s_m = np.concatenate([t.apply(starts) for t in inv])  # (len(js) * m, 3), hypothesis-major
+        u_m = np.concatenate([t.rotate(dirs) for t in inv])
+        hits = line_hits(poly, s_m, u_m)
+        first = hits.first.reshape(len(js), m).T
+        fc = hits.face.reshape(len(js), m).T
+        # the exit of the first inside chord: the nearest exit-facing crossing beyond the entry
+        tri_n = poly.face_normals[poly.triangle_faces]  # (T, 3)
+        leaving = (u_m @ tri_n.T) > 0.0
+        with np.errstate(invalid="ignore"):
+            beyond = np.where(leaving & (hits.params > hits.first[:, None]), hits.params, np.inf)
+        k_out = np.argmin(beyond, axis=1) if beyond.shape[1] else np.zeros(len(s_m), dtype=int)
+        t_out = beyond[np.arange(len(s_m)), k_out]
+        n_in = np.where((hits.face >= 0)[:, None], poly.face_normals[np.maximum(hits.face, 0)], 0.0)
+        n_out = tri_n[k_out]
+        finite = np.isfinite(t_out) & np.isfinite(hits.first)
+        chord = np.where(finite, np.where(finite, t_out, 0.0) - np.where(finite, hits.first, 0.0), 0.0)
+        dep = 0.5 * chord * np.minimum(np.abs(np.einsum("rk,rk->r", n_in, u_m)),
+                                       np.abs(np.einsum("rk,rk->r", n_out, u_m)))  # fmt: skip
+        # a chord running past the line's end enters only as far as the end goes
+        reach = np.clip(np.repeat(lengths[None], len(js), axis=0).reshape(-1) - hits.first, 0.0, None)
+        dep = np.minimum(dep, reach)
+        for a, j in enumerate(js):
+            t_hit[:, j] = first[:, a]
+            face[:, j] = fc[:, a]
+            ok = fc[:, a] >= 0
+            normal[ok, j] = hypotheses[j].world_from_model.rotate(poly.face_normals[fc[ok, a]])
+            depth[:, j] = dep[a * m : (a + 1) * m]
+    here = np.asarray(position, dtype=float)
+    transfer = np.linalg.norm(starts - here, axis=1)
+    back = np.linalg.norm(starts + lengths[:, None] * dirs - here, axis=1)
+    out = []
+    for i, mv in enumerate(moves):
+        hit = t_hit[i] <= lengths[i]
+        dist = np.where(hit, t_hit[i], np.nan)
+        at = np.where(hit[:, None], starts[i] + np.nan_to_num(dist)[:, None] * dirs[i], centre_w)
+        r = np.linalg.norm(at - centre_w, axis=1)
+        margin = rho + tol.distance + tol.angle * r
+        contact = np.where(hit, (1.0 + POSE_SAFETY) * rho + delta * r, np.nan)
+        s = transfer[i] + np.where(hit, np.nan_to_num(dist), lengths[i] + back[i])
+        out.append(ProbePrediction(
+            move=mv, hit=hit, distance=dist, face=np.where(hit, face[i], -1),
+            normal=np.where(hit[:, None], normal[i], np.nan), depth=np.where(hit, depth[i], 0.0), margin=margin,
+            contact_margin=contact,
+            angle_bound=float(ang), costs=np.array([costs.probe_move(x) for x in s]),
+        ))  # fmt: skip
+    return out
+
+
+__all__ = ["MIN_INCIDENCE", "ProbeConfig", "ProbePrediction", "candidate_probes", "fibonacci_directions",
+           "predict_probes"]  # fmt: skip

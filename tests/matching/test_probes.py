@@ -1,0 +1,196 @@
+"""Matching with free-space probes: a hit is a face adjacent to nothing, a miss is free space.
+
+Soundness (property, in the manner of ``test_soundness.py``): with noise inside the error bounds, and with
+every draw exactly at its bound, neither probe hits nor misses (grazing ones included) prune the true
+interpretation. And the constraints do prune: a segment through a posed model contradicts it.
+"""
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from haptic.errors import MatchError
+from haptic.executor.geometric import GeometricExecutor, GeometricSettings, random_walk
+from haptic.executor.probe import execute_probe
+from haptic.geometry import SE3, load_library, tracing
+from haptic.matching.components import DataFace, SensorNoise
+from haptic.matching.library import LibraryArrays
+from haptic.matching.probes import MAX_POSED, FreeSegment, apply_probes, free_segment_consistent, probe_face
+from haptic.matching.recognition import PoseTolerance
+from haptic.matching.tree import InterpretationTree
+from haptic.planning.moves import CostModel, ProbeMove
+
+from .helpers import true_leaves
+
+LIB = load_library()
+NAMES = sorted(LIB)
+ARRAYS = LibraryArrays.build(LIB)
+
+
+def random_probe(ex: GeometricExecutor, rng: np.random.Generator) -> ProbeMove:
+    """A line at the true object (evaluation side): aimed at a random surface point from outside its face, or
+    grazing its face's plane at a height of 0-3 mm (a near miss, or a hit on another part)."""
+    m, t = ex.model, ex.world_from_model
+    f = int(rng.choice(m.n_faces, p=m.face_areas / m.face_areas.sum()))
+    p = t.apply(tracing.random_face_point(m, f, rng, margin=0.0))
+    n = t.rotate(m.face_normals[f])
+    v = rng.normal(size=3)
+    v /= np.linalg.norm(v)
+    if rng.random() < 0.5:
+        u = v - max(0.0, float(v @ n) + 0.3) * n
+        u /= np.linalg.norm(u)
+        if u @ n > -0.2:
+            u = -n
+        start = p - 0.15 * u
+    else:
+        u = v - (v @ n) * n
+        u /= np.linalg.norm(u)
+        start = p + rng.uniform(0.0, 0.003) * n - 0.15 * u
+    return ProbeMove(start, u, 0.3)
+
+
+def _check(name: str, seed: int, n_moves: int, n_probes: int, level: float, at_bounds: bool) -> tuple[int, int]:
+    rng = np.random.default_rng(seed)
+    ex = GeometricExecutor(
+        LIB[name], SE3.random(rng, 0.2), SensorNoise().scaled(level), rng,
+        settings=GeometricSettings(at_bounds=at_bounds),
+    )  # fmt: skip
+    random_walk(ex, n_moves, rng)
+    tree = InterpretationTree(ARRAYS)
+    for c in ex.components:
+        tree.add(c)
+    free, hits, outcome = [], [], [0, 0]
+    for _ in range(n_probes):
+        res = execute_probe(ex, random_probe(ex, rng))
+        if not res.ok:
+            continue
+        for c in res.components:
+            tree.add(c)
+            hits.append(c.id)
+            assert len(true_leaves(tree, ex)) >= 1, (name, seed, "tree", c)
+        free.extend(res.free_space)
+        outcome[len(res.components)] += 1
+        apply_probes(tree, free, hits)
+        assert len(true_leaves(tree, ex)) >= 1, (name, seed, "probe filter", len(free), len(hits))
+    return outcome[0], outcome[1]
+
+
+_common = settings(deadline=None, suppress_health_check=[HealthCheck.too_slow], derandomize=True)
+
+
+@settings(_common, max_examples=40)
+@given(
+    name=st.sampled_from(NAMES),
+    seed=st.integers(0, 2**31),
+    n_moves=st.integers(1, 6),
+    n_probes=st.integers(1, 4),
+    level=st.sampled_from([0.0, 0.3, 1.0, 2.0, 4.0]),
+)
+def test_true_interpretation_survives_probes_with_noise_inside_bounds(name, seed, n_moves, n_probes, level):
+    _check(name, seed, n_moves, n_probes, level, at_bounds=False)
+
+
+@settings(_common, max_examples=30)
+@given(name=st.sampled_from(NAMES), seed=st.integers(0, 2**31), n_moves=st.integers(1, 6),
+       n_probes=st.integers(1, 4))  # fmt: skip
+def test_true_interpretation_survives_probes_with_noise_at_the_bounds(name, seed, n_moves, n_probes):
+    _check(name, seed, n_moves, n_probes, 1.0, at_bounds=True)
+
+
+def test_both_outcomes_occur_in_the_property_runs():
+    """The generator does produce misses and hits (else the properties above would test one kind only)."""
+    misses = hits = 0
+    for seed in range(4):
+        m, h = _check(NAMES[seed % len(NAMES)], seed, 2, 4, 1.0, at_bounds=True)
+        misses, hits = misses + m, hits + h
+    assert misses >= 2 and hits >= 2
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_a_grazing_miss_displaced_into_the_object_by_its_bound_keeps_the_truth(name):
+    """The worst miss: a true path skimming a face 0.05 mm above it, reported displaced by exactly its bound
+    toward the face (into the object), across the middle of the face."""
+    rng = np.random.default_rng(4)
+    ex = GeometricExecutor(LIB[name], SE3.random(rng, 0.1), SensorNoise(), rng,
+                           settings=GeometricSettings(at_bounds=True))  # fmt: skip
+    random_walk(ex, 6, rng)
+    tree = InterpretationTree(ARRAYS)
+    for c in ex.components:
+        tree.add(c)
+    m, t = ex.model, ex.world_from_model
+    rho = ex.noise.k * ex.noise.position_sigma
+    segments = []
+    for f in rng.permutation(m.n_faces)[:4]:
+        n = t.rotate(m.face_normals[f])
+        p = t.apply(tracing.random_face_point(m, f, rng, margin=0.002))
+        u = np.cross(n, rng.normal(size=3))
+        u /= np.linalg.norm(u)
+        start = p + 5e-5 * n - 0.15 * u
+        if execute_probe(ex, ProbeMove(start, u, 0.3)).components:
+            continue  # the path meets another part of the object: not a miss
+        segments.append(FreeSegment(start - rho * n, u, 0.3, rho))
+    assert segments
+    (leaf,) = true_leaves(tree, ex)[:1]
+    assert tree.count <= MAX_POSED and tree.interpretation(int(leaf)).world_from_model is not None  # tested
+    apply_probes(tree, segments)
+    assert len(true_leaves(tree, ex)) >= 1
+
+
+def test_a_segment_through_the_posed_model_contradicts_it():
+    poly = LIB["BOX01"]
+    pose = SE3.random(np.random.default_rng(1), 0.1)
+    tol = PoseTolerance.from_data([DataFace(0, [0, 0, 1], [[0, 0, 0]], np.deg2rad(0.9), 0.6e-3)])
+    c = pose.apply(poly.centroid)
+    u = pose.rotate(np.array([1.0, 0.0, 0.0]))
+    half = 0.5 * float(poly.extents[0])
+    through = FreeSegment(c - (half + 0.05) * u, u, 2 * half + 0.1, 0.6e-3)
+    assert not free_segment_consistent(poly, pose, through, tol)
+    stops_short = FreeSegment(c - (half + 0.05) * u, u, 0.05, 0.6e-3)  # ends at the surface
+    assert free_segment_consistent(poly, pose, stops_short, tol)
+    # a segment entering by less than the bounds (the pose error grows with the distance from the centroid)
+    shallow = FreeSegment(c - (half + 0.05) * u, u, 0.05 + 0.002, 0.6e-3)
+    assert free_segment_consistent(poly, pose, shallow, tol)
+
+
+def test_probe_hits_prune_by_the_face_pair_angle_without_adjacency():
+    """A hit pairs with every model face; the face-pair angle with the earlier face (seed §2.6) keeps only the
+    pairings at the right angle."""
+    rng = np.random.default_rng(5)
+    ex = GeometricExecutor(LIB["PYR01"], SE3.random(rng, 0.1), SensorNoise(), rng)
+    ex.start()
+    tree = InterpretationTree(ARRAYS)
+    tree.add(ex.components[0])
+    n_faces = sum(p.n_faces for p in LIB.values())
+    m = ex.model
+    f = int(np.argmax(m.face_areas))
+    p = ex.world_from_model.apply(m.vertices[list(m.faces[f])].mean(axis=0))
+    n = ex.world_from_model.rotate(m.face_normals[f])
+    res = execute_probe(ex, ProbeMove(p + 0.1 * n, -n, 0.2))
+    assert res.ok and len(res.components) == 1 and res.components[0].adjacent == ()
+    before = tree.count
+    tree.add(res.components[0])
+    assert tree.count < before * n_faces / 4
+
+
+def test_probe_face_and_free_segment_records():
+    f = probe_face(3, [0.1, 0.2, 0.3], [0, 0, 1], 0.01, 0.001)
+    assert f.points.shape == (1, 3) and f.adjacent == () and f.id == 3
+    s = FreeSegment([0, 0, 0], [1, 0, 0], 0.2, 1e-3)
+    assert FreeSegment.from_dict(s.to_dict()).end == pytest.approx([0.2, 0.0, 0.0])
+
+
+def test_retain_checks_its_mask():
+    tree = InterpretationTree(ARRAYS)
+    tree.add(DataFace(0, [0, 0, 1], [[0, 0, 0]], 0.01, 0.001))
+    with pytest.raises(MatchError, match="one flag per leaf"):
+        tree.retain(np.ones(tree.count + 1, dtype=bool))
+    keep = np.zeros(tree.count, dtype=bool)
+    keep[:3] = True
+    assert tree.retain(keep) == 3 and tree.counts[-1] == 3
+
+
+def test_probe_cost_is_a_constant_plus_free_space_distance():
+    costs = CostModel(c_p=2.0, c_s=20.0)
+    assert costs.probe_move(0.0) == 2.0
+    assert costs.probe_move(0.1) == pytest.approx(4.0)
