@@ -134,7 +134,10 @@ def main(argv: list[str] | None = None) -> int:
         summary = out.with_suffix(".md")
         summed = summary.exists()
         summary_ok = code not in (130, 143) or kept == (_episodes_in(summary) if summed else 0)
-        exit_ok = code in EXPECTED_EXIT[sig_name] or at != at  # an early end is checked by the resume alone
+        # an early end is checked by the resume alone; so is a sweep that had finished its work when the signal
+        # came (every episode kept, the summary written: it exits 0, as the signal found nothing to interrupt)
+        finished = code == 0 and summed and kept == len(reference)
+        exit_ok = code in EXPECTED_EXIT[sig_name] or at != at or finished
         resumed = subprocess.Popen(bench_command(args, out, "--resume"), env=env, start_new_session=True,
                                    stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)  # fmt: skip
         stdout, _ = resumed.communicate(timeout=600)

@@ -25,7 +25,7 @@ BEFORE = [
     ["LBLOCK01", 7, 0.5, None, "recognized", 6, 29.01837, [76, 210, 210, 132, 25, 9, 1]],
     ["PYR01", 11, 4.0, None, "recognized", 3, 12.431959, [76, 24, 24, 2]],
     # its fifth move is chosen at 488 interpretations: a random move while the loop posed at most 400 (then cost
-    # 48.39866, [.., 488, 78, 72, 24, 4, 2]); a planner decision since it poses up to 4000 (haptic.episode.loop.MAX_POSED)
+    # 48.39866, [.., 488, 78, 72, 24, 4, 2]); a planner decision since it poses up to 4000 (loop.MAX_POSED)
     ["LA_NOTCH_30x20", 9, 1.0, LOOKALIKE, "recognized", 8, 33.750422, [219, 700, 692, 488, 19, 8, 4, 4, 2]],
 ]
 
