@@ -16,6 +16,7 @@ from haptic.errors import HapticError, RecordingError
 def add_parser(sub: argparse._SubParsersAction) -> None:
     from haptic.matching.verify import DEFAULT_VERIFY, VERIFY_MODES
     from haptic.options import noise_level, positive_int, seed_int
+    from haptic.planning.moves import MOVE_SETS
     from haptic.planning.registry import POLICY_NAMES
 
     p = sub.add_parser(
@@ -37,6 +38,11 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "--verify", choices=VERIFY_MODES, default=DEFAULT_VERIFY,
         help=f"verification before recognition (default {DEFAULT_VERIFY}): none, fast (pose check; every face "
         "and edge measured) or full (also every vertex)",
+    )  # fmt: skip
+    p.add_argument(
+        "--moves", choices=MOVE_SETS, default="tracing",
+        help="admissible kinds of move (default tracing): tracing (face, edge, vertex moves) or all (free-space "
+        "probes too, one planner ranking them; geometric executor); probing is not available yet",
     )  # fmt: skip
     p.add_argument("--json", metavar="OUT", help="write the episode's JSON record here")
     p.add_argument("--record", metavar="OUT.rrd", help="write a rerun recording here")
@@ -108,6 +114,7 @@ def run(args: argparse.Namespace) -> int:
         model=args.object, seed=args.seed, policy=args.policy, executor=args.executor, noise=args.noise,
         models=args.models, max_moves=args.max_moves, record=args.record, skip_invalid=args.skip_invalid,
         verify=args.verify,
+        moves=args.moves,
     )
     observer = None
     recorder = None

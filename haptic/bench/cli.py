@@ -22,6 +22,7 @@ EXIT_SIGINT, EXIT_SIGTERM = 130, 143
 def add_parser(sub: argparse._SubParsersAction) -> None:
     from haptic.matching.verify import DEFAULT_VERIFY, VERIFY_MODES
     from haptic.options import noise_levels, positive_int, seed_int
+    from haptic.planning.moves import MOVE_SETS
     from haptic.planning.registry import POLICY_NAMES
 
     p = sub.add_parser(
@@ -49,6 +50,11 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "--verify", choices=VERIFY_MODES, default=DEFAULT_VERIFY,
         help=f"verification before recognition (default {DEFAULT_VERIFY}): none, fast or full",
     )
+    p.add_argument(
+        "--moves", choices=MOVE_SETS, default="tracing",
+        help="admissible kinds of move (default tracing): tracing (face, edge, vertex moves) or all (free-space "
+        "probes too, one planner ranking them; geometric executor); probing is not available yet",
+    )  # fmt: skip
     p.add_argument("--out", default="out/bench/results.jsonl", help="results file (JSON lines)")
     p.add_argument("--workers", type=positive_int, default=1,
                    help="worker processes (local backend); CPUs of a Ray started here (ray backend)")
@@ -93,6 +99,7 @@ def _run(args: argparse.Namespace, held: DeferredInterrupts) -> int:
         sorted(library), args.episodes, args.seed, policies, args.noise,
         executor=args.executor, models=args.models, max_moves=args.max_moves, skip_invalid=args.skip_invalid,
         verify=args.verify,
+        moves=args.moves,
     )
     has_results = out.is_file() and out.stat().st_size > 0
     if has_results and not (args.resume or args.force):
@@ -175,7 +182,9 @@ def _write_summary(out: Path, no_plot: bool, quiet: bool = False) -> None:
     from haptic.geometry.io import atomic_write
 
     records = read_results(out) if out.exists() else []
-    table = markdown_table(summary_rows(records, ("library", "executor", "noise", "verify", "policy")))
+    probing = any(r.get("move_set", "tracing") != "tracing" for r in records)  # a column only where it tells
+    keys = ("library", "executor", "noise", "verify", *(("move_set",) if probing else ()), "policy")
+    table = markdown_table(summary_rows(records, keys))
     atomic_write(out.with_suffix(".md"), table)
     if not quiet:
         print(table, end="")

@@ -76,7 +76,9 @@ def markdown_table(rows: Sequence[dict]) -> str:
     """The summary rows as a markdown table."""
     if not rows:
         return "(no episodes)\n"
-    group_keys = [k for k in rows[0] if k in ("library", "policy", "executor", "noise", "verify", "model")]
+    group_keys = [
+        k for k in rows[0] if k in ("library", "policy", "executor", "noise", "verify", "move_set", "model")
+    ]
     cols = [*group_keys, "episodes", "correct %", "wrong model", "wrong pose", "ambig.", "no-match", "budget",
             "failed", "moves mean", "moves median", "cost mean", "cost median", "cost mean (all)", "decide ms",
             "pose mm", "pose deg"]

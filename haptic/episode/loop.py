@@ -23,6 +23,7 @@ from haptic.errors import HapticError
 from haptic.geometry import SE3, Polyhedron
 from haptic.geometry.se3 import matrix_to_quat
 from haptic.matching.components import DataComponent, SensorNoise
+from haptic.matching.probes import FreeSegment, apply_probes
 from haptic.matching.recognition import AMBIGUOUS, EXPLORING, NO_MATCH, RECOGNIZED, Recognition, recognize
 from haptic.matching.tree import InterpretationTree
 from haptic.matching.verify import K_SIGMA, K_SIGMA_PHYSICS
@@ -70,6 +71,12 @@ class EpisodeRecord:
     detail: str = ""
     verify: str = "none"
     verified: dict | None = None
+    move_set: str = "tracing"
+    """Admissible kinds of move (``EpisodeSpec.moves``)."""
+    probes: int = 0
+    """Free-space probes carried out."""
+    probe_misses: int = 0
+    """Of those, probes that met nothing (negative evidence)."""
 
     def to_json(self) -> dict:
         return asdict(self)
@@ -231,6 +238,8 @@ def loop_steps(
         verifier = Verifier(spec.verify, noise, config, K_SIGMA_PHYSICS if spec.executor == "physics" else K_SIGMA)
 
     touched: list[tuple[np.ndarray, np.ndarray]] = []
+    free: list[FreeSegment] = []  # free space the probes travelled (a miss's line, a hit's approach)
+    probe_faces: list[int] = []  # data ids of the faces probes hit
 
     def assess() -> Recognition:
         """The verdict on the data so far (with the table and the touched points, when known)."""
@@ -247,6 +256,11 @@ def loop_steps(
         for c in result.components:
             components[c.id] = c
             tree.add(c)
+        free.extend(result.free_space)
+        if result.move is not None and result.move.kind == "probe":
+            probe_faces.extend(c.id for c in result.components)
+        if free:  # after every add: poses tighten, and leaves unposed or too many before become testable
+            apply_probes(tree, free, probe_faces)
         if config.touch_evidence:
             touched.append(touched_points(result, config))
         cost += result.cost
@@ -339,6 +353,7 @@ def loop_steps(
     in_library = spec.model in library
     err_mm, err_deg, correct = score_outcome(spec, library, true_model, world_from_model, outcome, rec)
     n_by_kind = {k: sum(1 for c in components.values() if c.kind == k) for k in ("face", "edge", "vertex")}
+    n_probes = kinds.count("probe")
     record = EpisodeRecord(
         model=true_model.name if in_library else str(Path(spec.model).name),
         pose={
@@ -369,6 +384,9 @@ def loop_steps(
         detail=detail,
         verify=spec.verify,
         verified=verifier.record(cost) if verifier is not None else None,
+        move_set=spec.moves,
+        probes=n_probes,
+        probe_misses=n_probes - len(probe_faces),
     )
     if obs.on_end:
         obs.on_end(record)

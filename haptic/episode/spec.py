@@ -4,6 +4,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from haptic.errors import HapticError
+from haptic.planning.moves import MOVE_SETS
+
 
 @dataclass(frozen=True)
 class EpisodeSpec:
@@ -31,3 +34,26 @@ class EpisodeSpec:
     """Use the library's valid models when some of its files are bad (else refuse the library)."""
     verify: str = "none"
     """Verification before recognition: "none", "fast" or "full" (:mod:`haptic.matching.verify`)."""
+    moves: str = "tracing"
+    """Admissible kinds of move: "tracing" (face, edge, vertex moves) or "all" (free-space probes too, ranked with
+    them by one planner; geometric executor, planner, greedy and random policies only)."""
+
+    def __post_init__(self) -> None:
+        if self.moves == "tracing":
+            return
+        if self.moves not in MOVE_SETS:
+            raise HapticError(f"unknown --moves {self.moves!r}; valid: tracing, all")
+        if self.moves == "probing":
+            raise HapticError(
+                "--moves probing is not available yet (probes alone do not recognise reliably); valid: tracing, all"
+            )
+        if self.executor != "geometric":
+            raise HapticError(
+                f"--moves {self.moves}: free-space probes run on the geometric executor only; "
+                f"valid with --executor {self.executor}: tracing"
+            )
+        if self.policy == "optimal":
+            raise HapticError(
+                f"--moves {self.moves}: the optimal policy plans tracing moves only; valid with it: "
+                "tracing (or use planner, greedy or random)"
+            )

@@ -84,7 +84,7 @@ class GeometricWorld:
     ) -> Episode:
         library = library if library is not None else cached_library(spec.models, skip_invalid=spec.skip_invalid)
         true_model = resolve_model(spec.model, library)
-        config = config or PlannerConfig()
+        config = replace(config or PlannerConfig(), moves=spec.moves)
         root = np.random.SeedSequence(spec.seed)
         pose_rng, exec_rng, policy_rng = (np.random.default_rng(s) for s in root.spawn(3))
         world_from_model = SE3.random(pose_rng, translation_scale=0.1)

@@ -20,9 +20,11 @@ import numpy as np
 
 from haptic.geometry import tracing
 from haptic.geometry.polyhedron import Polyhedron
+from haptic.geometry.raycast import line_hits
 from haptic.geometry.se3 import SE3, plane_basis
 from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex, SensorNoise
-from haptic.planning.moves import CostModel, EdgeMove, FaceMove, Move, MoveResult, SensorState, VertexMove
+from haptic.matching.probes import FreeSegment
+from haptic.planning.moves import CostModel, EdgeMove, FaceMove, Move, MoveResult, ProbeMove, SensorState, VertexMove
 
 
 @dataclass(frozen=True)
@@ -252,7 +254,48 @@ class GeometricExecutor:
             return self._edge_move(move)
         if isinstance(move, VertexMove):
             return self._vertex_move(move)
+        if isinstance(move, ProbeMove):
+            return self._probe_move(move)
         return MoveResult(move=move, status="invalid", state=self.state, info={"reason": f"unknown move {move!r}"})
+
+    def _probe_move(self, move: ProbeMove) -> MoveResult:
+        """The free-space probe (seed §1.1): cast the line at the posed true model from where the sensor is. A hit
+        is a face data component (the contact point and the face's normal, with the same noise as every face) and the
+        sensor then rests on that face; a miss leaves the sensor where it was (it returns to its last contact, which
+        the cost counts). Either way the path along the line is reported free (:class:`FreeSegment`), displaced as a
+        whole by a position error within its bound. A bad line is "invalid", one that starts inside the object
+        "unreachable"."""
+        start = np.asarray(move.start, dtype=float)
+        u = np.asarray(move.direction, dtype=float)
+        length = float(move.length)
+        if start.shape != (3,) or u.shape != (3,) or not (np.all(np.isfinite(start)) and np.all(np.isfinite(u))):
+            return self._invalid(move, "start and direction must be finite 3-vectors")
+        if abs(float(np.linalg.norm(u)) - 1.0) > 1e-6 or not np.isfinite(length) or length <= 0.0:
+            return self._invalid(move, "direction must be a unit vector and length a positive number of metres")
+        inv = self.world_from_model.inverse()
+        s_m, u_m = inv.apply(start), inv.rotate(u)
+        if bool(self.model.contains(s_m[None])[0]):
+            return MoveResult(move=move, status="unreachable", state=self.state,
+                              info={"reason": "the line starts inside the object"})  # fmt: skip
+        here = np.asarray(self.state.position, dtype=float)
+        transfer = float(np.linalg.norm(start - here))
+        hits = line_hits(self.model, s_m[None], u_m[None])
+        t_hit, face = float(hits.first[0]), int(hits.face[0])
+        rho = self.noise.k * self.noise.position_sigma
+        if t_hit <= length:
+            free = FreeSegment(start + self._vec3(self.noise.position_sigma), u, t_hit, rho)
+            point_m = s_m + t_hit * u_m
+            comp = self._face(face, point_m[None], ())
+            self.components.append(comp)
+            self._pos = point_m
+            self.state = self._state(face=comp.id)
+            s = transfer + t_hit
+            return MoveResult(move=move, status="ok", components=(comp,), distance=s, cost=self.costs.probe_move(s),
+                              state=self.state, free_space=(free,), info={"contact": t_hit})  # fmt: skip
+        free = FreeSegment(start + self._vec3(self.noise.position_sigma), u, length, rho)
+        s = transfer + length + float(np.linalg.norm(move.end - here))
+        return MoveResult(move=move, status="ok", distance=s, cost=self.costs.probe_move(s), state=self.state,
+                          free_space=(free,), info={"contact": None})  # fmt: skip
 
     def _invalid(self, move: Move, reason: str) -> MoveResult:
         return MoveResult(move=move, status="invalid", state=self.state, info={"reason": reason})

@@ -16,6 +16,9 @@ from haptic.matching.components import DataComponent
 from haptic.matching.probes import FreeSegment
 from haptic.matching.trace import ContactTrace
 
+MOVE_SETS = ("tracing", "probing", "all")
+"""The admissible kinds of move a planner may be given: tracing moves, free-space probes, or both."""
+
 
 @dataclass(frozen=True)
 class CostModel:
@@ -132,7 +135,7 @@ class ProbeMove:
         return np.asarray(self.start) + self.length * np.asarray(self.direction)
 
 
-Move = FaceMove | EdgeMove | VertexMove
+Move = FaceMove | EdgeMove | VertexMove | ProbeMove
 
 
 class MoveStatus(StrEnum):

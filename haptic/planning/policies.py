@@ -26,6 +26,7 @@ from haptic.planning.scoring import (  # noqa: F401 -- Context, Decision, refusa
     Decision,
     Scored,
     bounded,
+    probe_moves,
     refusal,
     same_move,
     score_all,
@@ -94,16 +95,20 @@ class GreedyPolicy(_ScoringPolicy):
 
 
 class RandomPolicy(Policy):
-    """A random admissible move: a random move type among those available, then a random one of it."""
+    """A random admissible move: a random move type among those available (free-space probes too when
+    ``config.moves`` admits them and the hypotheses have poses), then a random one of it."""
 
     name = "random"
 
     def choose(self, ctx: Context, rng: np.random.Generator) -> Decision:
-        moves = [
-            m for m in candidate_moves(ctx.state, ctx.components, ctx.config)
-            if not any(same_move(m, bad) for bad in ctx.avoid)
-        ]
-        moves = table_safe_moves(moves, ctx.hypotheses, ctx.state, ctx.components, ctx.config)
+        moves = []
+        if ctx.config.moves != "probing":
+            moves = [
+                m for m in candidate_moves(ctx.state, ctx.components, ctx.config)
+                if not any(same_move(m, bad) for bad in ctx.avoid)
+            ]
+            moves = table_safe_moves(moves, ctx.hypotheses, ctx.state, ctx.components, ctx.config)
+        moves += probe_moves(ctx)
         if not moves:
             raise PlanningError("no admissible move from the current sensor state")
         kinds = sorted({m.kind for m in moves})

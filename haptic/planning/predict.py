@@ -79,6 +79,9 @@ class PlannerConfig:
     (:mod:`haptic.planning.bound`). None: no bound. 256 is above the most pose classes the shipped libraries
     leave at a planner decision (255, look-alike library, with the loop posing up to
     ``haptic.episode.loop.MAX_POSED`` interpretations), so their decisions are unchanged."""
+    moves: str = "tracing"
+    """Admissible kinds of move (``MOVE_SETS``): "tracing" (face, edge and vertex moves), "probing" (free-space
+    probes) or "all" (both, ranked together by one efficiency, seed §1.1)."""
 
     @property
     def touch_margin(self) -> float:

@@ -15,7 +15,7 @@ import numpy as np
 from haptic.matching.components import DataComponent, SensorNoise
 from haptic.planning.bound import reduce_hypotheses
 from haptic.planning.efficiency import class_weights, distinguishable, efficiency_of, expected_eliminated
-from haptic.planning.moves import FaceMove, Move, SensorState
+from haptic.planning.moves import FaceMove, Move, ProbeMove, SensorState
 from haptic.planning.predict import (
     Hypothesis,
     PlannerConfig,
@@ -25,6 +25,7 @@ from haptic.planning.predict import (
     descent_risk,
     predict,
 )
+from haptic.planning.probes import ProbeConfig, ProbePrediction, candidate_probes, predict_probes
 from haptic.planning.simulate import simulate
 
 
@@ -72,16 +73,37 @@ class Decision:
     candidates: tuple[Scored, ...] = ()
 
 
-def score_all(ctx: Context) -> list[tuple[Prediction, float, float, float, float]]:
+def score_all(ctx: Context) -> list[tuple[Prediction | ProbePrediction, float, float, float, float]]:
     """Efficiency, expected eliminations, expected cost and risk of every fresh, reliable candidate move; the
     eliminations come from comparing predicted outcome attributes (§4.1). With a table (``config.table_z``),
-    moves the hypotheses predict to run into it are left out and the rest discounted by that risk."""
+    moves the hypotheses predict to run into it are left out and the rest discounted by that risk.
+    Free-space probes join them when ``config.moves`` admits them, scored in the same form
+    (:meth:`ProbePrediction.score`), so one planner ranks every kind of move together; ``config.moves ==
+    "probing"`` leaves the tracing moves out."""
     weights = class_weights([h.model for h in ctx.hypotheses])
-    preds = [predict(ctx.hypotheses, m, ctx.state, ctx.components, ctx.noise, ctx.config) for m in fresh_moves(ctx)]
-    preds = [p for p in preds if p.reliable(ctx.config)] or preds
-    refused = [(p, refusal(p, ctx.config)) for p in preds]
-    refused = [(p, r) for p, r in refused if r < ctx.config.table_risk] or refused
-    return [(pred, *score_prediction(pred, weights, r, ctx.config)) for pred, r in refused]
+    out: list = []
+    if ctx.config.moves != "probing":
+        preds = [predict(ctx.hypotheses, m, ctx.state, ctx.components, ctx.noise, ctx.config) for m in fresh_moves(ctx)]
+        preds = [p for p in preds if p.reliable(ctx.config)] or preds
+        refused = [(p, refusal(p, ctx.config)) for p in preds]
+        refused = [(p, r) for p, r in refused if r < ctx.config.table_risk] or refused
+        out = [(pred, *score_prediction(pred, weights, r, ctx.config)) for pred, r in refused]
+    return out + [(pred, *pred.score(weights), 0.0) for pred in predict_probe_moves(ctx)]
+
+
+def probe_moves(ctx: Context) -> list[ProbeMove]:
+    """Candidate free-space probes (:func:`~haptic.planning.probes.candidate_probes`) when the configuration admits
+    them (``config.moves``) and every hypothesis has a pose to predict from, less those that failed from here."""
+    if ctx.config.moves == "tracing" or not ctx.hypotheses or any(h.world_from_model is None for h in ctx.hypotheses):
+        return []
+    cfg = ProbeConfig(table_z=ctx.config.table_z, table_clearance=ctx.config.table_clearance)
+    return [m for m in candidate_probes(ctx.hypotheses, cfg) if not any(same_move(m, bad) for bad in ctx.avoid)]
+
+
+def predict_probe_moves(ctx: Context) -> list[ProbePrediction]:
+    """Every hypothesis's predicted outcome of each candidate probe (:func:`probe_moves`)."""
+    moves = probe_moves(ctx)
+    return predict_probes(ctx.hypotheses, moves, ctx.state.position, ctx.components, ctx.noise, ctx.config.costs)
 
 
 def score_prediction(
@@ -176,11 +198,17 @@ def _same_crossing(a: FaceMove, b: FaceMove, ctx: Context) -> bool:
 
 
 def same_move(a: Move, b: Move) -> bool:
-    """Two moves are the same when of one kind with the same parameter (face directions within ~8°)."""
+    """Two moves are the same when of one kind with the same parameter (face directions within ~8°; probes along
+    nearly one line)."""
     if a.kind != b.kind:
         return False
     if a.kind == "face":
         return float(np.dot(a.direction, b.direction)) > 0.99
     if a.kind == "edge":
         return a.sense == b.sense
+    if a.kind == "probe":  # one line: the same direction, starts within a probe target's spacing
+        return (
+            float(np.dot(a.direction, b.direction)) > 0.99
+            and float(np.linalg.norm(np.asarray(a.start) - np.asarray(b.start))) < ProbeConfig.target_spacing
+        )
     return a.across_face == b.across_face
