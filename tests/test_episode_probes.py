@@ -1,0 +1,82 @@
+"""Free-space probes in the episode loop (geometric executor): one planner ranks them with the tracing moves."""
+
+import numpy as np
+import pytest
+
+from haptic.cli import main
+from haptic.episode.spec import EpisodeSpec
+from haptic.episode.worlds import run_episode
+from haptic.errors import HapticError
+from haptic.executor.geometric import GeometricExecutor, random_walk
+from haptic.geometry import SE3, load_library
+from haptic.matching.components import SensorNoise
+from haptic.matching.tree import InterpretationTree
+from haptic.planning.moves import CostModel
+from haptic.planning.predict import PlannerConfig
+
+CHEAP = PlannerConfig(costs=CostModel(c_p=0.5))
+
+
+@pytest.mark.parametrize(("model", "seed"), [("BOX01", 1), ("LBLOCK01", 2), ("WEDGE01", 1)])
+def test_cheap_probes_are_chosen_and_the_episode_recognises_correctly(model, seed):
+    rec = run_episode(EpisodeSpec(model=model, seed=seed, moves="all"), config=CHEAP)
+    assert rec.outcome == "recognized" and rec.correct, rec
+    assert rec.probes >= 1 and rec.move_kinds.count("probe") == rec.probes
+    assert rec.move_set == "all" and 0 <= rec.probe_misses <= rec.probes
+
+
+def test_tracing_admits_no_probes_whatever_they_cost():
+    rec = run_episode(EpisodeSpec(model="BOX01", seed=1), config=CHEAP)
+    assert rec.correct and rec.probes == 0 and "probe" not in rec.move_kinds and rec.move_set == "tracing"
+
+
+def test_random_policy_takes_probes_too():
+    kinds = set()
+    for seed in range(4):
+        rec = run_episode(EpisodeSpec(model="BOX01", seed=seed, policy="random", moves="all"), config=CHEAP)
+        kinds |= set(rec.move_kinds)
+    assert "probe" in kinds
+
+
+@pytest.mark.parametrize(
+    ("fields", "words"),
+    [
+        ({"moves": "probing"}, ("probing", "tracing, all")),
+        ({"moves": "sometimes"}, ("sometimes", "tracing, all")),
+        ({"moves": "all", "executor": "physics"}, ("geometric", "tracing")),
+        ({"moves": "all", "policy": "optimal"}, ("optimal", "tracing")),
+    ],
+)
+def test_move_sets_not_available_are_refused_by_name(fields, words):
+    with pytest.raises(HapticError) as err:
+        EpisodeSpec(model="BOX01", seed=0, **fields)
+    assert all(w in str(err.value) for w in words)
+
+
+def test_cli_refuses_probing_in_one_line(tmp_path, capsys):
+    assert main(["explore", "--object", "BOX01", "--moves", "probing"]) == 1
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "probing" in err and "tracing, all" in err
+
+
+def test_retain_keeps_the_cached_poses_of_the_kept_leaves():
+    """Poses are cached by leaf index: after ``retain`` a leaf's pose is its own, not that of the leaf that had
+    its index before."""
+    lib = load_library(None)
+    rng = np.random.default_rng(3)
+    ex = GeometricExecutor(lib["LBLOCK01"], SE3.random(rng, 0.1), SensorNoise(), rng)
+    random_walk(ex, 3, rng)
+    tree = InterpretationTree(lib)
+    for c in ex.components:
+        tree.add(c)
+    assert tree.count >= 4
+    before = tree.poses(list(range(tree.count)))
+    keep = np.zeros(tree.count, dtype=bool)
+    keep[1::2] = True
+    tree.retain(keep)
+    cached = tree.poses(list(range(tree.count)))
+    kept = [p for p, k in zip(before, keep, strict=True) if k]
+    for a, b in zip(cached, kept, strict=True):
+        assert (a is None) == (b is None)
+        if a is not None:
+            assert np.allclose(a.rotation, b.rotation) and np.allclose(a.translation, b.translation)
