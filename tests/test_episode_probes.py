@@ -80,3 +80,21 @@ def test_retain_keeps_the_cached_poses_of_the_kept_leaves():
         assert (a is None) == (b is None)
         if a is not None:
             assert np.allclose(a.rotation, b.rotation) and np.allclose(a.translation, b.translation)
+
+
+def test_bench_moves_at_a_small_size():
+    """scripts/bench_moves.py at a small size: every setting recognises its draws correctly, tracing uses no
+    probe, and the cheapest probes are used."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "scripts"))
+    try:
+        from bench_moves import markdown, run
+    finally:
+        sys.path.pop(0)
+    rows = run(episodes=6, seed=0, probe_costs=(0.5,))
+    assert [r["setting"] for r in rows] == ["tracing", "all, c_p 0.5"]
+    assert all(r["correct %"] == 100.0 for r in rows)
+    assert rows[0]["probes"] == 0 and rows[1]["probes"] >= 1
+    assert markdown(rows).count("\n") == 3
