@@ -240,6 +240,7 @@ def loop_steps(
     touched: list[tuple[np.ndarray, np.ndarray]] = []
     free: list[FreeSegment] = []  # free space the probes travelled (a miss's line, a hit's approach)
     probe_faces: list[int] = []  # data ids of the faces probes hit
+    probed: list[Move] = []  # probes carried out: the same line again would tell nothing new, so it is not offered
 
     def assess() -> Recognition:
         """The verdict on the data so far (with the table and the touched points, when known)."""
@@ -259,6 +260,7 @@ def loop_steps(
         free.extend(result.free_space)
         if result.move is not None and result.move.kind == "probe":
             probe_faces.extend(c.id for c in result.components)
+            probed.append(result.move)
         if free:  # after every add: poses tighten, and leaves unposed or too many before become testable
             apply_probes(tree, free, probe_faces)
         if config.touch_evidence:
@@ -305,7 +307,7 @@ def loop_steps(
             if move is None:
                 t_dec = time.perf_counter()
                 hyps = hypotheses_from(tree, rec) if rec is not None and rec.classes else []
-                ctx = Context(hyps, state, components, noise, config, avoid=tuple(failed_here), tree=tree)
+                ctx = Context(hyps, state, components, noise, config, avoid=(*failed_here, *probed), tree=tree)
                 try:
                     if len(hyps) >= 2 and not verifying:
                         decision = yield DecisionPoint(ctx, rng)

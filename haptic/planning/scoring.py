@@ -44,7 +44,8 @@ class Context:
     config: PlannerConfig = field(default_factory=PlannerConfig)
     """Candidate generation and cost options."""
     avoid: tuple[Move, ...] = ()
-    """Moves that failed from the current state (they are not offered again until a move succeeds)."""
+    """Moves that failed from the current state (they are not offered again until a move succeeds), and the
+    probes carried out so far (a line probed again tells nothing new)."""
     tree: object | None = None
     """The matcher's interpretation tree (an ``InterpretationTree``), when a policy or a check wants to ask
     the matcher itself which hypotheses a predicted outcome would eliminate."""
