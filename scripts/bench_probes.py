@@ -21,7 +21,7 @@ import time
 
 import numpy as np
 
-from haptic.episode import hypotheses_from
+from haptic.episode.loop import hypotheses_from
 from haptic.executor.geometric import GeometricExecutor
 from haptic.executor.probe import execute_probe
 from haptic.geometry import SE3, load_library
