@@ -1,16 +1,11 @@
 """Free-space probes in the episode loop (geometric executor): one planner ranks them with the tracing moves."""
 
-import numpy as np
 import pytest
 
 from haptic.cli import main
 from haptic.episode.spec import EpisodeSpec
 from haptic.episode.worlds import run_episode
 from haptic.errors import HapticError
-from haptic.executor.geometric import GeometricExecutor, random_walk
-from haptic.geometry import SE3, load_library
-from haptic.matching.components import SensorNoise
-from haptic.matching.tree import InterpretationTree
 from haptic.planning.moves import CostModel
 from haptic.planning.predict import PlannerConfig
 
@@ -57,29 +52,6 @@ def test_cli_refuses_probing_in_one_line(tmp_path, capsys):
     assert main(["explore", "--object", "BOX01", "--moves", "probing"]) == 1
     err = capsys.readouterr().err.strip()
     assert "\n" not in err and "probing" in err and "tracing, all" in err
-
-
-def test_retain_keeps_the_cached_poses_of_the_kept_leaves():
-    """Poses are cached by leaf index: after ``retain`` a leaf's pose is its own, not that of the leaf that had
-    its index before."""
-    lib = load_library(None)
-    rng = np.random.default_rng(3)
-    ex = GeometricExecutor(lib["LBLOCK01"], SE3.random(rng, 0.1), SensorNoise(), rng)
-    random_walk(ex, 3, rng)
-    tree = InterpretationTree(lib)
-    for c in ex.components:
-        tree.add(c)
-    assert tree.count >= 4
-    before = tree.poses(list(range(tree.count)))
-    keep = np.zeros(tree.count, dtype=bool)
-    keep[1::2] = True
-    tree.retain(keep)
-    cached = tree.poses(list(range(tree.count)))
-    kept = [p for p, k in zip(before, keep, strict=True) if k]
-    for a, b in zip(cached, kept, strict=True):
-        assert (a is None) == (b is None)
-        if a is not None:
-            assert np.allclose(a.rotation, b.rotation) and np.allclose(a.translation, b.translation)
 
 
 def test_bench_moves_at_a_small_size():

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import re
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -414,3 +415,17 @@ def test_link_geoms_are_drawn_where_mujoco_puts_them(tmp_path):
     assert palm.series("Transform3D:translation", "sim_time")[1][0] == [[0.0, 0.0, 1.0]]
     moves, quats = palm.series("Transform3D:quaternion")
     assert sorted(moves, key=str) == [1, None] and quats == [[[0.0, 0.0, 0.0, 1.0]]] * 2  # rerun's (x, y, z, w)
+
+
+def test_verification_moves_are_labelled_as_such(tmp_path):
+    out = tmp_path / "verified.rrd"
+    recorder = EpisodeRecorder(out)
+    record = run_episode(replace(SPEC, verify="full"), observer=recorder.observer())
+    recorder.close()
+    assert record.verified and record.verified["moves"] > 0
+    _, texts = load_recording(out)["decision/scores"].series("TextDocument:text")
+    texts = [t[0] for t in texts]
+    verifying = [t for t in texts if "a verification" in t]
+    assert len(verifying) == record.verified["moves"], "one label per verification move"
+    first = texts.index(verifying[0])
+    assert not any("an opening" in t for t in texts[first:]), "no verification move called an opening move"

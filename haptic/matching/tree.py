@@ -193,7 +193,7 @@ class InterpretationTree:
         self.counts: list[int] = []
         """Number of interpretations after each ``add`` (re-reported edges included)."""
         self._pose_cache: dict[tuple[bool, int], SE3 | None] = {}
-        """Poses by (refined, leaf) of the current leaves, emptied by every ``add``."""
+        """Poses by (refined, leaf) of the current leaves, emptied by every ``add`` and renumbered by ``retain``."""
 
     # ------------------------------------------------------------------------------------------ state
 
@@ -275,9 +275,8 @@ class InterpretationTree:
         if keep.shape != (self.count,):
             raise MatchError(f"retain: expected one flag per leaf, shape ({self.count},), got {keep.shape}")
         self._model, self._assign, self._sense = self._model[keep], self._assign[keep], self._sense[keep]
-        # the cached poses are by leaf index: carry those of the kept leaves over to their new indices
-        new_index = np.cumsum(keep) - 1
-        self._pose_cache = {(r, int(new_index[i])): p for (r, i), p in self._pose_cache.items() if keep[i]}
+        renumber = np.cumsum(keep) - 1  # a kept leaf's new index; its pose (same data) stays valid
+        self._pose_cache = {(r, int(renumber[i])): p for (r, i), p in self._pose_cache.items() if keep[i]}
         if self.counts:
             self.counts[-1] = self.count
         return self.count

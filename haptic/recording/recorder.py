@@ -138,6 +138,8 @@ class _State:
     move: int = 0
     """The move being logged."""
     counts: tuple[float, float | None] = (math.nan, None)
+    status: str = "-"
+    """The matcher's status after the last move ("recognized" while a verification runs)."""
     """Latest log10 interpretations and pose classes plotted."""
 
 
@@ -360,6 +362,7 @@ class EpisodeRecorder:
             self._no_decision(i, kind)
 
         status = recognition.status if recognition is not None else "-"
+        s.status = status
         comps = ", ".join(f"{c.kind} {c.id}" for c in result.components) or "none"
         rec.log(
             "log/moves",
@@ -532,12 +535,18 @@ class EpisodeRecorder:
         self._s.counts = (interpretations, classes)
 
     def _no_decision(self, i: int, kind: str) -> None:
-        """The candidate table at a move the planner did not choose (the start, an opening move)."""
+        """The candidate table at a move the planner did not choose (the start, an opening move, a verification
+        move: one chosen while the matcher had recognised the object)."""
         s = self._s
         if s.decision_shown:
             self.stream.log("world/decision", rr.Clear(recursive=True))
             s.decision_shown = False
-        what = "the start" if i == 0 else f"an opening {kind} move"
+        if i == 0:
+            what = "the start"
+        elif s.status == "recognized":
+            what = f"a verification {kind} move (what the recognised model predicts and is not measured yet)"
+        else:
+            what = f"an opening {kind} move"
         self.stream.log("decision/scores", rr.TextDocument(f"**move {i}**: {what}, not a planner decision",
                                                            media_type=rr.MediaType.MARKDOWN))  # fmt: skip
 

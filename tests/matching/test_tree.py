@@ -205,3 +205,24 @@ def test_vertex_move_data_are_consistent():
     feed(tree, ex)
     assert len(true_leaves(tree, ex)) >= 1
     assert set(tree.summary()) <= {"HEXPRISM01", "FRAME01", "BOX01", "BOX01N", "BOX01P", "LBLOCK01", "WEDGE01"}
+
+
+def test_retain_keeps_each_kept_leaf_with_its_own_pose():
+    # poses are kept per leaf between adds: after leaves are eliminated, a leaf's pose must still be its own
+    rng = np.random.default_rng(4)
+    ex = GeometricExecutor(LIB["BOX01"], SE3.random(rng, 0.1), SensorNoise(), rng)
+    random_walk(ex, 3, rng)
+    posed, fresh = InterpretationTree(LIB), InterpretationTree(LIB)
+    for c in ex.components:
+        posed.add(c)
+        fresh.add(c)
+    n = posed.count
+    assert n > 4
+    posed.poses(range(n))  # kept for the leaves as they are numbered now
+    keep = np.arange(n) % 3 == 1
+    posed.retain(keep)
+    fresh.retain(keep)
+    for a, b in zip(posed.poses(range(posed.count)), fresh.poses(range(fresh.count)), strict=True):
+        assert (a is None) == (b is None)
+        if a is not None:
+            assert np.allclose(a.as_matrix(), b.as_matrix(), atol=1e-12)
