@@ -18,7 +18,7 @@ from haptic.episode.loop import EpisodeObserver, EpisodeRecord, Executor, Observ
 from haptic.episode.spec import EpisodeSpec
 from haptic.errors import HapticError
 from haptic.executor.geometric import GeometricExecutor
-from haptic.geometry import SE3, Polyhedron, load_library, resolve_model
+from haptic.geometry import SE3, Polyhedron, resolve_model
 from haptic.geometry.library_cache import cached_library
 from haptic.matching.components import SensorNoise, check_noise_level
 from haptic.planning.moves import CostModel, MoveResult
@@ -71,6 +71,17 @@ def make_geometric_executor(model: Polyhedron, world_from_model: SE3, noise: Sen
     return GeometricExecutor(model, world_from_model, noise=noise, rng=rng, costs=costs)
 
 
+def _setup(
+    spec: EpisodeSpec, library: dict[str, Polyhedron] | None
+) -> tuple[dict[str, Polyhedron], Polyhedron, list[np.random.Generator]]:
+    """What every world starts from: the library (loaded once per process unless given), the true model, and
+    the one split of the episode's seed into the generators of the pose, the executor, the policy and the
+    simulator (children 0-3 of ``SeedSequence(spec.seed)``; a world uses those it needs)."""
+    library = library if library is not None else cached_library(spec.models, skip_invalid=spec.skip_invalid)
+    rngs = [np.random.default_rng(s) for s in np.random.SeedSequence(spec.seed).spawn(4)]
+    return library, resolve_model(spec.model, library), rngs
+
+
 class GeometricWorld:
     """The ideal sensor: the object floats at a random pose; moves are computed from the true model, with noise."""
 
@@ -82,11 +93,8 @@ class GeometricWorld:
         library: dict[str, Polyhedron] | None = None,
         config: PlannerConfig | None = None,
     ) -> Episode:
-        library = library if library is not None else cached_library(spec.models, skip_invalid=spec.skip_invalid)
-        true_model = resolve_model(spec.model, library)
+        library, true_model, (pose_rng, exec_rng, policy_rng, _) = _setup(spec, library)
         config = replace(config or PlannerConfig(), moves=spec.moves)
-        root = np.random.SeedSequence(spec.seed)
-        pose_rng, exec_rng, policy_rng = (np.random.default_rng(s) for s in root.spawn(3))
         world_from_model = SE3.random(pose_rng, translation_scale=0.1)
         noise = SensorNoise().scaled(check_noise_level(spec.noise))
         executor = make_geometric_executor(true_model, world_from_model, noise, exec_rng, config.costs)
@@ -133,11 +141,8 @@ class PhysicsWorld:
         from haptic.sim import RobotInterface, Simulation, compose_scene, random_object_pose
         from haptic.sim.scene import scene_object_from_polyhedron
 
-        library = library if library is not None else load_library(spec.models, skip_invalid=spec.skip_invalid)
-        true_model = resolve_model(spec.model, library)
+        library, true_model, (pose_rng, exec_rng, policy_rng, sim_seq) = _setup(spec, library)
         config = config or PlannerConfig()
-        root = np.random.SeedSequence(spec.seed)
-        pose_rng, exec_rng, policy_rng, sim_seq = (np.random.default_rng(s) for s in root.spawn(4))
         obj = scene_object_from_polyhedron(true_model)
         pose = random_object_pose(obj, pose_rng)
         scene = compose_scene(obj, pose)

@@ -287,12 +287,7 @@ class EpisodeRecorder:
     ) -> None:
         """One successful move (``i`` = 0 for the start): path, contacts, components, counts."""
         rec, s = self.stream, self._s
-        trace = _trace_of(result)
-        if trace is not None and len(trace.time):
-            s.sim_time = float(trace.time[-1])
-        if not s.blueprint_sent:
-            self._send_blueprint(trace)
-        self._set_time(i)
+        trace = self._begin_move(i, result)
         for c in result.components:
             s.components[c.id] = c
         kind = getattr(result.move, "kind", "start") if i > 0 else "start"
@@ -374,17 +369,24 @@ class EpisodeRecorder:
             ),
         )
 
-    def on_failed_move(self, i: int, result: MoveResult) -> None:
-        """A move that failed (no components): its trace, when there is one, in ``world/trace/failed``, a cross
-        on the interpretation plot (the counts unchanged) and a warning in ``log/moves``. (Called by the loop
-        when :class:`~haptic.episode.loop.EpisodeObserver` has an ``on_failed_move`` hook.)"""
-        rec, s = self.stream, self._s
+    def _begin_move(self, i: int, result: MoveResult) -> Any:
+        """Move ``i``'s contact trace (None without one), after setting the clocks to it and sending the
+        blueprint with the first move."""
+        s = self._s
         trace = _trace_of(result)
         if trace is not None and len(trace.time):
             s.sim_time = float(trace.time[-1])
         if not s.blueprint_sent:
             self._send_blueprint(trace)
         self._set_time(i)
+        return trace
+
+    def on_failed_move(self, i: int, result: MoveResult) -> None:
+        """A move that failed (no components): its trace, when there is one, in ``world/trace/failed``, a cross
+        on the interpretation plot (the counts unchanged) and a warning in ``log/moves``. (Called by the loop
+        when :class:`~haptic.episode.loop.EpisodeObserver` has an ``on_failed_move`` hook.)"""
+        rec, s = self.stream, self._s
+        trace = self._begin_move(i, result)
         if trace is not None and len(trace.time):
             self._log_trace(trace)
         self._log_hand(result, trace)
