@@ -42,9 +42,10 @@ from haptic.geometry.library_cache import cached_library
 from haptic.matching.components import DataComponent, DataEdge, DataFace
 from haptic.matching.recognition import AMBIGUOUS, NO_MATCH, RECOGNIZED
 from haptic.matching.verify import DEFAULT_VERIFY
+from haptic.planning.config import PlannerConfig
 from haptic.planning.moves import EdgeMove, FaceMove, Move, MoveResult, VertexMove
 from haptic.planning.policies import Decision, Policy, same_move
-from haptic.planning.predict import PlannerConfig, candidate_moves
+from haptic.planning.predict import candidate_moves
 from haptic.planning.registry import make_policy
 
 MAX_COMPONENTS = 8

@@ -22,8 +22,8 @@ import numpy as np
 from haptic.bench.runner import library_name, plan_sweep
 from haptic.episode.worlds import run_episode
 from haptic.geometry.library_cache import cached_library
+from haptic.planning.config import PlannerConfig
 from haptic.planning.moves import CostModel
-from haptic.planning.predict import PlannerConfig
 
 COLUMNS = ("library", "setting", "episodes", "correct %", "cost mean", "cost median", "moves mean", "moves median",
            "probes", "with a probe", "misses", "outcomes", "wall s")  # fmt: skip

@@ -30,10 +30,10 @@ from haptic.matching.library import LibraryArrays
 from haptic.matching.probes import apply_probes
 from haptic.matching.recognition import PoseTolerance, equivalent_by_symmetry, recognize
 from haptic.matching.tree import InterpretationTree
+from haptic.planning.config import PlannerConfig
 from haptic.planning.efficiency import class_weights
 from haptic.planning.moves import CostModel
 from haptic.planning.policies import Context, PlannerPolicy
-from haptic.planning.predict import PlannerConfig
 from haptic.planning.probes import candidate_probes, predict_probes
 
 

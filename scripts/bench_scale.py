@@ -74,7 +74,7 @@ def _episode(task: dict) -> dict:
     from haptic.episode.loop import EpisodeObserver
     from haptic.episode.spec import EpisodeSpec
     from haptic.episode.worlds import run_episode
-    from haptic.planning.predict import PlannerConfig
+    from haptic.planning.config import PlannerConfig
 
     decisions: list[tuple[float, float, float, float]] = []
     fallback = [0]  # decisions taken by the loop's random fallback (no pose classes yet: too many or unposed)
@@ -251,7 +251,7 @@ def main(argv=None) -> int:
     )
     args = ap.parse_args(argv)
     if args.bound is None:
-        from haptic.planning.predict import PlannerConfig
+        from haptic.planning.config import PlannerConfig
 
         args.bound = PlannerConfig().max_hypotheses
 

@@ -44,7 +44,7 @@ def test_touched_points_lie_on_the_true_surface():
     # the evidence the episode checks pose classes against: every touched point on a face of the object that
     # faces the way the sensed normal does
     from haptic.episode.perception import touched_points
-    from haptic.planning.predict import PlannerConfig
+    from haptic.planning.config import PlannerConfig
     from haptic.planning.reach import touch_distance
     from haptic.sim.scene import TABLE_TOP_Z
 

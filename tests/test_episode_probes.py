@@ -6,8 +6,8 @@ from haptic.cli import main
 from haptic.episode.spec import EpisodeSpec
 from haptic.episode.worlds import run_episode
 from haptic.errors import HapticError
+from haptic.planning.config import PlannerConfig
 from haptic.planning.moves import CostModel
-from haptic.planning.predict import PlannerConfig
 
 CHEAP = PlannerConfig(costs=CostModel(c_p=0.5))
 

@@ -20,7 +20,8 @@ from haptic.episode.worlds import GeometricWorld
 from haptic.geometry import Polyhedron, load_library
 from haptic.matching.recognition import RECOGNIZED, model_symmetries, recognize
 from haptic.matching.tree import InterpretationTree
-from haptic.planning.predict import PlannerConfig, candidate_moves
+from haptic.planning.config import PlannerConfig
+from haptic.planning.predict import candidate_moves
 
 
 def _may_be_recognized(tree: InterpretationTree) -> bool:

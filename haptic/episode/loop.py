@@ -27,9 +27,10 @@ from haptic.matching.probes import FreeSegment, apply_probes
 from haptic.matching.recognition import AMBIGUOUS, EXPLORING, NO_MATCH, RECOGNIZED, Recognition, recognize
 from haptic.matching.tree import InterpretationTree
 from haptic.matching.verify import K_SIGMA, K_SIGMA_PHYSICS
+from haptic.planning.config import PlannerConfig
+from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import Move, MoveResult
 from haptic.planning.policies import Context, Decision, Policy, RandomPolicy
-from haptic.planning.predict import Hypothesis, PlannerConfig
 from haptic.planning.verify import Verifier
 
 MAX_POSED = 4000

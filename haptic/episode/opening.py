@@ -5,9 +5,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from haptic.planning.config import PlannerConfig
 from haptic.planning.moves import Move
 from haptic.planning.policies import same_move
-from haptic.planning.predict import PlannerConfig, candidate_moves, table_safe_moves, vertex_sweep_off_table
+from haptic.planning.predict import candidate_moves
+from haptic.planning.table import table_safe_moves, vertex_sweep_off_table
 
 
 def opening_move(

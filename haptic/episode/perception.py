@@ -7,9 +7,10 @@ import numpy as np
 
 from haptic.matching.recognition import AMBIGUOUS, EXPLORING, RECOGNIZED, PoseTolerance, Recognition, same_solid
 from haptic.matching.tree import InterpretationTree
+from haptic.planning.config import PlannerConfig
 from haptic.planning.moves import MoveResult
-from haptic.planning.predict import PlannerConfig, pose_fixed_by, rests_on_table
 from haptic.planning.reach import indistinguishable, touch_distance
+from haptic.planning.table import pose_fixed_by, rests_on_table
 
 TOUCH_CONE = np.deg2rad(8.0)
 """Within a group of touches, those whose sensed normal is farther than this from the group's median normal are

@@ -21,9 +21,9 @@ from haptic.executor.geometric import GeometricExecutor
 from haptic.geometry import SE3, Polyhedron, resolve_model
 from haptic.geometry.library_cache import cached_library
 from haptic.matching.components import SensorNoise, check_noise_level
+from haptic.planning.config import PlannerConfig
 from haptic.planning.moves import CostModel, MoveResult
 from haptic.planning.policies import Policy
-from haptic.planning.predict import PlannerConfig
 from haptic.planning.registry import make_policy
 
 STEEP_DESCENT_RISK = 0.5

@@ -23,7 +23,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from haptic.planning.predict import Hypothesis
+from haptic.planning.hypothesis import Hypothesis
 
 
 def reduce_hypotheses(hypotheses: Sequence[Hypothesis], bound: int | None) -> list[Hypothesis]:

@@ -32,9 +32,9 @@ import numpy as np
 from haptic.errors import PlanningError
 from haptic.matching.components import DataComponent
 from haptic.planning.efficiency import class_weights
+from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import Move, SensorState
 from haptic.planning.policies import PlannerPolicy, Policy
-from haptic.planning.predict import Hypothesis
 from haptic.planning.scoring import Context, Decision, Scored, score_all
 from haptic.planning.search import Branch, branches
 

@@ -20,7 +20,7 @@ import numpy as np
 
 from haptic.errors import PlanningError
 from haptic.planning.moves import Move
-from haptic.planning.predict import candidate_moves, table_safe_moves
+from haptic.planning.predict import candidate_moves
 from haptic.planning.scoring import (  # noqa: F401 -- Context, Decision, refusal, same_move: re-exported
     Context,
     Decision,
@@ -32,6 +32,7 @@ from haptic.planning.scoring import (  # noqa: F401 -- Context, Decision, refusa
     score_all,
 )
 from haptic.planning.search import lookahead_choice
+from haptic.planning.table import table_safe_moves
 
 
 class Policy:

@@ -1,120 +1,27 @@
 """Candidate moves and their predicted outcomes under each hypothesis (seed §4.1).
 
-A hypothesis is one pose class of one model: a model, its pose ``world_from_model`` and the correspondence of
-data components to model components. Through the pose, each hypothesis predicts what a candidate move would
-yield "in its world": the distance travelled, the new edge's angle, the new face's angle; and what the move
-would cost there. The planner compares these predictions (:mod:`haptic.planning.efficiency`).
+Through its pose, each hypothesis (:class:`~haptic.planning.hypothesis.Hypothesis`: one pose class of one
+model) predicts what a candidate move would yield "in its world": the distance travelled, the new edge's angle,
+the new face's angle; and what the move would cost there. The planner compares these predictions
+(:mod:`haptic.planning.efficiency`).
 """
 
 from __future__ import annotations
 
 import weakref
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
-from functools import cached_property
+from dataclasses import dataclass
 
 import numpy as np
 
 from haptic.geometry.polyhedron import Polyhedron
-from haptic.geometry.se3 import SE3, plane_basis
-from haptic.geometry.tracing import FaceHit, circle_vertex, trace_edge, trace_face
+from haptic.geometry.se3 import plane_basis
+from haptic.geometry.tracing import FaceHit, circle_vertex, trace_edge
 from haptic.matching.components import DataComponent, DataEdge, DataFace, SensorNoise
-from haptic.planning.moves import CostModel, EdgeMove, FaceMove, Move, SensorState, VertexMove
-
-
-@dataclass(frozen=True)
-class PlannerConfig:
-    """Options of candidate generation and prediction."""
-
-    n_directions: int = 8
-    """Face-move directions sampled over the half-plane into the face (§4.1.3: discrete angles)."""
-    vertex_radius: float = 0.008
-    """Radius of the circular path of a vertex move [m]."""
-    costs: CostModel = field(default_factory=CostModel)
-    """Cost constants (§3.1)."""
-    min_face_travel: float = 0.006
-    """Face moves predicted (median over hypotheses) to meet an edge sooner than this are not offered: a
-    finger that starts that close to an edge cannot settle on the face first [m]."""
-    min_vertex_clearance: float = 0.004
-    """Face moves predicted to meet their edge closer than this to a vertex are not offered: a fingertip
-    crossing there touches two edges at once [m]."""
-    table_z: float | None = None
-    """Height of the table top in the world frame, a workspace prior the robot knows (set for the physics
-    executor's scene, never from the object) [m]. None: no table (the geometric executor), no table checks."""
-    pad_radius: float = 0.012
-    """Radius of the fingertip pad (the robot's own geometry), for the table checks [m]."""
-    table_clearance: float = 0.004
-    """A pad position whose lowest point would come closer than this to the table top counts as on the table:
-    the executor's own limit (2 mm) plus a margin for the hypotheses' pose error [m]."""
-    steep_descent: float = 0.5
-    """A face move whose direction points down more steeply than this (the sine of its descent) is "steep"."""
-    steep_descent_risk: float = 0.0
-    """Failure risk charged to steep face moves (their efficiency is discounted by it): the physics hand,
-    fingers pointing down, often loses the surface rolling down over the edge such a trace meets. 0: none."""
-    table_rest_tol: float = 0.003
-    """With a table, a pose class whose model would reach more than this below the table top, or whose lowest
-    point would float more than this above it, is not a pose the object can rest in [m]."""
-    max_undercut: float | None = None
-    """With a table, how far a face's outward normal may lean back under, past horizontal, for the pad of the
-    downward-pointing fingers to roll onto it over a convex edge (the robot's own reach, set for the physics
-    executor) [rad]. A face move predicted to roll over an edge onto a face leaning further ends there and
-    reports the edge alone (:attr:`Prediction.edge_only`); a vertex move doing so counts as refused like one
-    running into the table. None: no limit."""
-    touch_evidence: bool = False
-    """Every touched point is checked against each pose class's surface (the episode does so with the
-    physics executor's traces), so a face move that cannot step onto its next face still tells how far its
-    face reaches; scored so."""
-    touch_tol: float = 0.0025
-    """A touched point farther than this from every face of a pose class whose normal agrees with the sensed
-    one contradicts the class [m]."""
-    touch_outliers: int = 3
-    """Contradicting points it takes to set a pose class aside (a stray reading is not enough)."""
-    touch_spacing: float = 0.001
-    """Touched points are thinned to about one per this much of the trace [m]."""
-    table_risk: float = 0.5
-    """Candidate moves that at least this fraction of the hypotheses predict to bring the pad onto the table
-    are not offered (the executor would refuse or abort them); the rest are discounted by their risk."""
-    max_hypotheses: int | None = 256
-    """Most pose classes a policy scores moves against; above it, a reduced set chosen model by model
-    (:mod:`haptic.planning.bound`). None: no bound. 256 is above the most pose classes the shipped libraries
-    leave at a planner decision (255, look-alike library, with the loop posing up to
-    ``haptic.episode.loop.MAX_POSED`` interpretations), so their decisions are unchanged."""
-    moves: str = "tracing"
-    """Admissible kinds of move (``MOVE_SETS``): "tracing" (face, edge and vertex moves), "probing" (free-space
-    probes) or "all" (both, ranked together by one efficiency, seed §1.1)."""
-
-    @property
-    def touch_margin(self) -> float:
-        """How far past a pose class's edge a trace must touch its face for the touched points to set the
-        class aside (``touch_outliers`` points beyond ``touch_tol``) [m]."""
-        return self.touch_tol + self.touch_outliers * self.touch_spacing
-
-
-@dataclass(frozen=True, eq=False)
-class Hypothesis:
-    """One pose class of one model, as the planner sees it."""
-
-    model: str
-    """Model name."""
-    poly: Polyhedron
-    """The model."""
-    world_from_model: SE3 | None
-    """Pose (None until the data fix it)."""
-    faces: Mapping[int, int]
-    """Data face id → model face id."""
-    edges: Mapping[int, int]
-    """Data edge id → model edge id."""
-    vertices: Mapping[int, int]
-    """Data vertex id → model vertex id."""
-    size: int = 1
-    """Interpretations in this pose class."""
-    leaves: tuple[int, ...] = ()
-    """The matcher's leaf indices of this pose class's interpretations (when known)."""
-
-    @cached_property
-    def model_from_world(self) -> SE3 | None:
-        """The inverse pose (computed once)."""
-        return None if self.world_from_model is None else self.world_from_model.inverse()
+from haptic.planning.config import PlannerConfig
+from haptic.planning.hypothesis import FaceTrace, Hypothesis, trace_in
+from haptic.planning.moves import EdgeMove, FaceMove, Move, SensorState, VertexMove
+from haptic.planning.table import data_table_conflict, table_prediction
 
 
 @dataclass(frozen=True, eq=False)
@@ -243,41 +150,6 @@ def _signed_dihedral(poly: Polyhedron, f_from: int, f_to: int, edge: int) -> flo
 def _line_angle(a: np.ndarray, b: np.ndarray) -> float:
     """Angle between two lines (unsigned directions), in [0, π/2] [rad]."""
     return float(np.arccos(np.clip(abs(a @ b) / (np.linalg.norm(a) * np.linalg.norm(b)), 0.0, 1.0)))
-
-
-@dataclass(frozen=True, eq=False)
-class FaceTrace:
-    """A face move traced in one hypothesis's world (model frame)."""
-
-    face: int
-    """The model face traced."""
-    start: np.ndarray
-    """The sensor's position projected onto it."""
-    direction: np.ndarray
-    """The move's direction."""
-    hit: FaceHit
-    """Where it meets the face's boundary."""
-
-    def clearance(self, poly: Polyhedron) -> float:
-        """Distance of the crossing point from the nearer end of the edge met [m]."""
-        e = self.hit.edge
-        s_hit = float((self.hit.point - poly.edge_points[e]) @ poly.edge_directions[e])
-        return min(s_hit, float(poly.edge_lengths[e]) - s_hit)
-
-
-def trace_in(h: Hypothesis, move: FaceMove, state: SensorState) -> FaceTrace | None:
-    """Face move ``move`` from ``state`` traced in hypothesis ``h``'s world; None when ``h`` cannot say (no
-    pose, the current face not matched, no single edge met)."""
-    f_m = h.faces.get(state.face)
-    if h.world_from_model is None or f_m is None:
-        return None
-    model_from_world = h.model_from_world
-    poly, p_m = h.poly, model_from_world.apply(state.position)
-    n = poly.face_normals[f_m]
-    p_m = p_m - (p_m @ n - poly.face_offsets[f_m]) * n
-    d_m = model_from_world.rotate(move.direction)
-    hit = trace_face(poly, f_m, p_m, d_m)
-    return None if hit is None else FaceTrace(f_m, p_m, d_m, hit)
 
 
 _LOOPS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
@@ -445,7 +317,7 @@ def predict(
         if data_table_conflict(move, state, components, config):
             table = np.ones(len(hypotheses))
         else:
-            got = np.array([_table_conflict(h, move, state, components, config) for h in hypotheses], dtype=float)
+            got = np.array([table_prediction(h, move, state, components, config) for h in hypotheses], dtype=float)
             table = got[:, 0]
             if isinstance(move, FaceMove):
                 reach = got[:, 1]
@@ -459,239 +331,3 @@ def predict(
         move, np.array(rows), outcome_bounds(noise)[move.kind], costs_arr, np.array(clear, dtype=float), table,
         reach, edge_only,
     )
-
-
-# ------------------------------------------------------------------------------------------- the table
-
-EDGE_ROLL = np.deg2rad(12.0)
-"""How far the pad's normal must turn over an edge, before it leans under past ``max_undercut``, for the
-executor to measure the edge from the roll alone (its segmenter wants 10°): from a face leaning under
-within this of the limit, a move ending at an edge onto a face out of reach tells nothing [rad]."""
-EDGE_ONLY_CLEARANCE = 0.008
-"""A face move ends at its edge with the next face out of reach, reporting the edge alone, only where it meets
-the edge at least this far from both its ends: the pad rolls some 40° over it, its centre as far past the
-edge's line as ``pad_radius · sin 40°``, and nearer an end it touches the faces round the vertex [m]."""
-TABLE_STEP_ONTO = 0.003
-"""How far onto the next face a face or vertex move strokes for its normal (for the table check) [m]."""
-
-
-def pad_clearance(point: np.ndarray, normal: np.ndarray, config: PlannerConfig) -> float:
-    """Height above the table top of the pad's lowest point when it touches ``point`` of a surface of outward
-    ``normal`` (the fingers point down) [m]; +inf without a table."""
-    if config.table_z is None:
-        return float("inf")
-    r = config.pad_radius
-    return float(point[2] + r * normal[2] - r - config.table_z)
-
-
-def _inward(poly: Polyhedron, edge: int, face: int) -> np.ndarray:
-    """Unit vector in ``face``'s plane, perpendicular to ``edge``, pointing into the face (model frame)."""
-    w = np.cross(poly.face_normals[face], poly.edge_directions[edge])
-    return w if poly.edge_left_face[edge] == face else -w
-
-
-def circle_points(
-    vertex: np.ndarray, u: np.ndarray, w: np.ndarray, radius: float, start: float, stop: float, step: float
-) -> np.ndarray:
-    """Points of the circle of a vertex move: ``vertex + radius (−cos θ u + sin θ w)`` for θ from ``start`` to
-    ``stop`` (``u`` along the current edge toward the vertex, ``w`` into the crossed face), shape (K, 3)."""
-    th = np.arange(start, stop + 1e-9, step) if stop > start else np.array([start])
-    return vertex + radius * (-np.cos(th)[:, None] * u + np.sin(th)[:, None] * w)
-
-
-VERTEX_START_ANGLE = np.deg2rad(25.0)
-"""The physics executor's vertex circle starts this far from the current edge [rad]."""
-
-
-def table_conflict(
-    h: Hypothesis, move: Move, state: SensorState, components: Mapping[int, DataComponent], config: PlannerConfig
-) -> float:
-    """Whether hypothesis ``h`` predicts ``move`` to bring the pad onto the table (1.0), not (0.0), or cannot
-    say (NaN): a face move sliding down to an edge within the pad's reach of the table or stepping onto a face
-    the table hides; a vertex move whose circle, before it meets the next edge, would put the pad on the table,
-    or whose next face the table hides. Edge moves are never refused (one running down to the table ends at
-    the vertex the table blocks, which the executor finds). A workspace prior (``config.table_z``) with the
-    hypothesis's own pose; 0.0 without a table. With ``config.max_undercut``, a vertex move stepping over a
-    convex edge onto a face that leans under further than the pad reaches counts too (a face move doing so
-    ends at the edge instead: :attr:`Prediction.edge_only`)."""
-    return _table_conflict(h, move, state, components, config)[0]
-
-
-def _table_conflict(
-    h: Hypothesis, move: Move, state: SensorState, components: Mapping[int, DataComponent], config: PlannerConfig
-) -> tuple[float, float]:
-    """:func:`table_conflict`; for a face move, how far its trace touches the face (:attr:`Prediction.reach`)
-    and whether it ends at its edge, the next face out of reach (:attr:`Prediction.edge_only`); NaN, NaN for
-    other moves."""
-    if config.table_z is None:
-        return 0.0, np.nan, np.nan
-    t = h.world_from_model
-    if t is None:
-        return np.nan, np.nan, np.nan
-    poly, lim = h.poly, config.table_clearance
-
-    def leans_under(e_m: int, g_m: int) -> bool:
-        """Whether the pad cannot roll over convex edge ``e_m`` onto ``g_m``: it leans under, out of reach."""
-        if config.max_undercut is None or poly.edge_convexity[e_m] <= 0:
-            return False
-        return float(t.rotate(poly.face_normals[g_m])[2]) < -np.sin(config.max_undercut)
-
-    def onto_hidden(e_m: int, g_m: int, at_m: np.ndarray) -> bool:
-        q = t.apply(at_m + TABLE_STEP_ONTO * _inward(poly, e_m, g_m))
-        return leans_under(e_m, g_m) or pad_clearance(q, t.rotate(poly.face_normals[g_m]), config) < lim
-
-    if isinstance(move, FaceMove):
-        tr = trace_in(h, move, state)
-        if tr is None:
-            return np.nan, np.nan, np.nan
-        hit = tr.hit
-        n_w = t.rotate(poly.face_normals[tr.face])
-        d_z = float(np.asarray(move.direction)[2])
-        if d_z < 0.0 and pad_clearance(t.apply(hit.point), n_w, config) < lim:
-            # the slide stops where the pad comes too close to the table
-            start = pad_clearance(t.apply(tr.start), n_w, config)
-            return 1.0, float(np.clip((start - lim) / -d_z, 0.0, hit.distance)), 0.0
-        if leans_under(hit.edge, hit.next_face):
-            near_end = tr.clearance(poly) < EDGE_ONLY_CLEARANCE
-            if near_end or float(n_w[2]) < -np.sin(config.max_undercut - EDGE_ROLL):
-                return 1.0, float(hit.distance), 0.0  # no room to roll over the edge alone: the move fails there
-            return 0.0, float(hit.distance), 1.0
-        return float(onto_hidden(hit.edge, hit.next_face, hit.point)), float(hit.distance), 0.0
-    if isinstance(move, EdgeMove):
-        # an edge running down to the table ends at a vertex on it, where the table blocks the finger: the
-        # executor finds that vertex (the only way to measure such an edge), so an edge move is never refused
-        return 0.0, np.nan, np.nan
-    if isinstance(move, VertexMove):
-        e_m = h.edges.get(state.edge) if state.edge is not None else None
-        v_m = h.vertices.get(state.vertex) if state.vertex is not None else None
-        a_m = h.faces.get(move.across_face)
-        if e_m is None or v_m is None or a_m is None:
-            return np.nan, np.nan, np.nan
-        try:
-            hit = circle_vertex(poly, v_m, e_m, a_m, config.vertex_radius)
-        except ValueError:
-            return np.nan, np.nan, np.nan
-        u = poly.edge_directions[e_m] * (1.0 if poly.edges[e_m, 1] == v_m else -1.0)
-        pts = circle_points(poly.vertices[v_m], u, _inward(poly, e_m, a_m), config.vertex_radius,
-                            VERTEX_START_ANGLE, hit.angle, np.deg2rad(3.0))  # fmt: skip
-        n_w = t.rotate(poly.face_normals[a_m])
-        if min(pad_clearance(q, n_w, config) for q in t.apply(pts)) < lim:
-            return 1.0, np.nan, np.nan
-        away = poly.edge_directions[hit.edge] * (1.0 if poly.edges[hit.edge, 0] == v_m else -1.0)
-        at = poly.vertices[v_m] + config.vertex_radius * away
-        return float(onto_hidden(hit.edge, hit.next_face, at)), np.nan, np.nan
-    raise TypeError(f"unknown move {move!r}")
-
-
-def _vertex_frame(
-    state: SensorState, components: Mapping[int, DataComponent], face: int
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
-    """From the data: the current vertex, the unit vector along the current edge toward it, the unit vector
-    into data face ``face`` perpendicular to the edge, and that face's normal. None when the data lack one."""
-    edge = components.get(state.edge) if state.edge is not None else None
-    vertex = components.get(state.vertex) if state.vertex is not None else None
-    f = components.get(face)
-    if not isinstance(edge, DataEdge) or vertex is None or not isinstance(f, DataFace):
-        return None
-    b, n = edge.direction, f.normal
-    mid = edge.point + 0.5 * edge.length * b
-    u = b if (vertex.position - mid) @ b >= 0 else -b
-    w = np.cross(n, b)
-    w /= max(float(np.linalg.norm(w)), 1e-12)
-    side = dict(edge.side_points).get(face) if edge.side_points else None
-    ref = side if side is not None else f.points.mean(axis=0)
-    if (ref - edge.point) @ w < 0:
-        w = -w
-    return vertex.position, u, w, n
-
-
-def vertex_sweep_off_table(
-    state: SensorState, components: Mapping[int, DataComponent], face: int, config: PlannerConfig
-) -> float:
-    """From the data alone: the angle the circle of a vertex move across data face ``face`` can sweep from its
-    start before the pad would come onto the table (2π: never; 0: its start is out of reach) [rad]."""
-    if config.table_z is None:
-        return 2 * np.pi
-    frame = _vertex_frame(state, components, face)
-    if frame is None:
-        return 2 * np.pi
-    vtx, u, w, n = frame
-    step = np.deg2rad(2.0)
-    pts = circle_points(vtx, u, w, config.vertex_radius, VERTEX_START_ANGLE, 2 * np.pi - VERTEX_START_ANGLE, step)
-    low = [i for i, q in enumerate(pts) if pad_clearance(q, n, config) < config.table_clearance]
-    return float(low[0] * step) if low else 2 * np.pi
-
-
-def data_table_conflict(
-    move: Move, state: SensorState, components: Mapping[int, DataComponent], config: PlannerConfig
-) -> bool:
-    """What the data alone say about the table, whatever the model: a face move heading down from a point
-    already within the pad's reach of the table, or a vertex move whose circle cannot even start off it."""
-    if config.table_z is None:
-        return False
-    if isinstance(move, FaceMove):
-        face = components.get(state.face)
-        if not isinstance(face, DataFace) or float(np.asarray(move.direction)[2]) >= 0.0:
-            return False
-        return pad_clearance(state.position, face.normal, config) < config.table_clearance
-    if isinstance(move, VertexMove):
-        return vertex_sweep_off_table(state, components, move.across_face, config) <= 0.0
-    return False
-
-
-def move_table_risk(
-    move: Move,
-    hypotheses: Sequence[Hypothesis],
-    state: SensorState,
-    components: Mapping[int, DataComponent],
-    config: PlannerConfig,
-) -> float:
-    """Fraction of the hypotheses (that can say) predicting ``move`` to run into the table; 1 when the data
-    alone say so; 0 without a table or a prediction."""
-    if config.table_z is None:
-        return 0.0
-    if data_table_conflict(move, state, components, config):
-        return 1.0
-    vals = np.array([table_conflict(h, move, state, components, config) for h in hypotheses], dtype=float)
-    return 0.0 if not len(vals) or np.isnan(vals).all() else float(np.nanmean(vals))
-
-
-def table_safe_moves(
-    moves: Sequence[Move],
-    hypotheses: Sequence[Hypothesis],
-    state: SensorState,
-    components: Mapping[int, DataComponent],
-    config: PlannerConfig,
-) -> list[Move]:
-    """``moves`` less those predicted to run into the table (risk ≥ ``config.table_risk``); all of them when
-    that leaves none (the executor then says so). Unchanged without a table."""
-    if config.table_z is None:
-        return list(moves)
-    safe = [m for m in moves if move_table_risk(m, hypotheses, state, components, config) < config.table_risk]
-    return safe or list(moves)
-
-
-def descent_risk(move: Move, config: PlannerConfig) -> float:
-    """``config.steep_descent_risk`` for a face move heading down more steeply than ``config.steep_descent``,
-    else 0."""
-    if move.kind != "face" or config.steep_descent_risk <= 0.0:
-        return 0.0
-    return config.steep_descent_risk if float(np.asarray(move.direction)[2]) < -config.steep_descent else 0.0
-
-
-def rests_on_table(poly: Polyhedron, world_from_model: SE3, config: PlannerConfig) -> bool:
-    """Whether ``poly`` at ``world_from_model`` rests on the table: its lowest vertex at the table top within
-    ``config.table_rest_tol`` (neither through it nor floating). True without a table."""
-    if config.table_z is None:
-        return True
-    low = float(world_from_model.apply(poly.vertices)[:, 2].min()) - config.table_z
-    return abs(low) <= config.table_rest_tol
-
-
-def pose_fixed_by(components: Mapping[int, DataComponent]) -> bool:
-    """Whether the data fix every interpretation's translation: a data vertex, or faces whose normals span
-    space. (Until then a pose class's pose is one of many and says nothing about where the table is.)"""
-    if any(c.kind == "vertex" for c in components.values()):
-        return True
-    normals = np.array([c.normal for c in components.values() if isinstance(c, DataFace)])
-    return len(normals) >= 3 and float(np.linalg.svd(normals, compute_uv=False)[2]) > 0.3

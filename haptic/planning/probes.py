@@ -45,7 +45,7 @@ from haptic.planning.efficiency import efficiency_of, expected_eliminated
 from haptic.planning.moves import CostModel, ProbeMove
 
 if TYPE_CHECKING:
-    from haptic.planning.predict import Hypothesis
+    from haptic.planning.hypothesis import Hypothesis
 
 MIN_INCIDENCE = 0.2
 """Smallest ``|n·u|`` used to turn a surface offset into a distance along a line (a grazing approach)."""

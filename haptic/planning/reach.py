@@ -9,10 +9,10 @@ normal ``n`` is *reachable* when the pad touching it, centred at ``c = p + r n``
 - can be lowered there from above (the vertical line over ``c`` stays outside the object), and
 - meets a face it can press on (the normal leans under by no more than ``config.max_undercut``).
 
-A convex edge between a face the pad reaches (with room to roll :data:`~haptic.planning.predict.EDGE_ROLL`
+A convex edge between a face the pad reaches (with room to roll :data:`~haptic.planning.table.EDGE_ROLL`
 before the limit) and one leaning under past ``config.max_undercut`` is *observable* where the pad can slide
 to it on the first face and roll over it to that limit clear of the table, away from its ends
-(:data:`~haptic.planning.predict.EDGE_ONLY_CLEARANCE`): a face move there reports the edge alone.
+(:data:`~haptic.planning.table.EDGE_ONLY_CLEARANCE`): a face move there reports the edge alone.
 
 Two hypotheses (model and pose) that agree on every reachable point and observable edge -- each one's
 reachable surface lies on the other's surface, and its observable edges on the other's edges, within
@@ -26,7 +26,8 @@ import numpy as np
 
 from haptic.geometry import SE3, Polyhedron
 from haptic.geometry.distance import point_triangle_distance, surface_distance
-from haptic.planning.predict import EDGE_ONLY_CLEARANCE, EDGE_ROLL, PlannerConfig
+from haptic.planning.config import PlannerConfig
+from haptic.planning.table import EDGE_ONLY_CLEARANCE, EDGE_ROLL
 
 SPACING = 0.004
 """Spacing of the sample points over the faces [m]."""

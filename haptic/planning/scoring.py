@@ -14,19 +14,14 @@ import numpy as np
 
 from haptic.matching.components import DataComponent, SensorNoise
 from haptic.planning.bound import reduce_hypotheses
+from haptic.planning.config import PlannerConfig
 from haptic.planning.efficiency import class_weights, distinguishable, efficiency_of, expected_eliminated
+from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import FaceMove, Move, ProbeMove, SensorState
-from haptic.planning.predict import (
-    Hypothesis,
-    PlannerConfig,
-    Prediction,
-    candidate_moves,
-    crossed_edge,
-    descent_risk,
-    predict,
-)
+from haptic.planning.predict import Prediction, candidate_moves, crossed_edge, predict
 from haptic.planning.probes import ProbeConfig, ProbePrediction, candidate_probes, predict_probes
 from haptic.planning.simulate import simulate
+from haptic.planning.table import descent_risk
 
 
 @dataclass(frozen=True, eq=False)

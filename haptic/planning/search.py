@@ -14,9 +14,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from haptic.matching.components import DataComponent, SensorNoise
+from haptic.planning.config import PlannerConfig
 from haptic.planning.efficiency import class_weights, outcome_groups
+from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import Move, SensorState
-from haptic.planning.predict import Hypothesis, PlannerConfig, candidate_moves, predict
+from haptic.planning.predict import candidate_moves, predict
 from haptic.planning.scoring import Context, refusal, same_move, score_prediction
 from haptic.planning.simulate import simulate
 

@@ -12,8 +12,9 @@ import numpy as np
 
 from haptic.geometry.tracing import circle_vertex, trace_edge
 from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex, SensorNoise
+from haptic.planning.config import PlannerConfig
+from haptic.planning.hypothesis import Hypothesis, trace_in
 from haptic.planning.moves import EdgeMove, FaceMove, Move, SensorState, VertexMove
-from haptic.planning.predict import Hypothesis, PlannerConfig, trace_in
 
 STEP_ONTO = 0.003
 """How far onto the next face a simulated face or vertex move steps for its normal [m]."""

@@ -18,8 +18,11 @@ import numpy as np
 from haptic.geometry.polyhedron import Polyhedron
 from haptic.geometry.se3 import SE3
 from haptic.matching.components import DataComponent, DataEdge, DataFace, SensorNoise
+from haptic.planning.config import PlannerConfig
+from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import FaceMove, Move, SensorState
-from haptic.planning.predict import Hypothesis, PlannerConfig, candidate_moves, descent_risk, predict
+from haptic.planning.predict import candidate_moves, predict
+from haptic.planning.table import descent_risk
 
 STALL_MOVES = 8
 """Verification moves in a row that measure no missing feature after which the verification ends with what it

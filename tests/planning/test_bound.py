@@ -4,7 +4,7 @@ import pytest
 
 from haptic.geometry import load_library
 from haptic.planning.bound import reduce_hypotheses
-from haptic.planning.predict import Hypothesis
+from haptic.planning.hypothesis import Hypothesis
 
 LIB = load_library()
 

@@ -6,8 +6,10 @@ import numpy as np
 
 from haptic.geometry import SE3, load_library
 from haptic.matching.components import DataFace, SensorNoise
+from haptic.planning.config import PlannerConfig
+from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import FaceMove, SensorState
-from haptic.planning.predict import Hypothesis, PlannerConfig, predict
+from haptic.planning.predict import predict
 from haptic.planning.scoring import Context, eliminates, fresh_moves
 
 LIB = load_library()

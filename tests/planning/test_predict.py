@@ -5,8 +5,10 @@ import numpy as np
 from haptic.executor.geometric import GeometricExecutor
 from haptic.geometry import SE3, load_library
 from haptic.matching.components import SensorNoise
+from haptic.planning.config import PlannerConfig
+from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import CostModel
-from haptic.planning.predict import Hypothesis, PlannerConfig, candidate_moves, predict_one
+from haptic.planning.predict import candidate_moves, predict_one
 
 LIB = load_library()
 
@@ -86,8 +88,9 @@ def test_trace_all_equals_trace_in_for_each_hypothesis():
     """The batched face trace gives each hypothesis the trace of its own world."""
     from haptic.geometry import tracing
     from haptic.geometry.generate import generate_library
+    from haptic.planning.hypothesis import trace_in
     from haptic.planning.moves import FaceMove, SensorState
-    from haptic.planning.predict import trace_all, trace_in
+    from haptic.planning.predict import trace_all
 
     models = generate_library(12, seed=4)
     rng = np.random.default_rng(0)

@@ -8,8 +8,8 @@ from haptic.executor.probe import execute_probe
 from haptic.geometry import SE3, load_library
 from haptic.matching.components import SensorNoise
 from haptic.planning.efficiency import class_weights
+from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import CostModel
-from haptic.planning.predict import Hypothesis
 from haptic.planning.probes import ProbeConfig, candidate_probes, predict_probes
 
 LIB = load_library()

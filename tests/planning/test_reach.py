@@ -3,7 +3,7 @@
 import numpy as np
 
 from haptic.geometry import SE3, Polyhedron, load_library
-from haptic.planning.predict import PlannerConfig
+from haptic.planning.config import PlannerConfig
 from haptic.planning.reach import indistinguishable, observable_edges, reachable
 
 LIB = load_library()

@@ -8,14 +8,10 @@ import numpy as np
 from haptic.executor.geometric import GeometricExecutor
 from haptic.geometry import SE3, load_library
 from haptic.matching.components import SensorNoise
+from haptic.planning.config import PlannerConfig
+from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import CostModel, FaceMove
-from haptic.planning.predict import (
-    Hypothesis,
-    PlannerConfig,
-    rests_on_table,
-    table_conflict,
-    table_safe_moves,
-)
+from haptic.planning.table import rests_on_table, table_conflict, table_safe_moves
 
 LIB = load_library()
 TABLE_Z = 0.35

@@ -5,8 +5,9 @@ import numpy as np
 from haptic.executor.geometric import GeometricExecutor
 from haptic.geometry import SE3, load_library
 from haptic.matching.components import SensorNoise
+from haptic.planning.config import PlannerConfig
+from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import CostModel, EdgeMove
-from haptic.planning.predict import Hypothesis, PlannerConfig
 from haptic.planning.search import simulate
 from haptic.planning.verify import AIM_NEAR_VERTEX, aimed_face_moves
 

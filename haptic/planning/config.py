@@ -1,0 +1,76 @@
+"""The planner's settings: candidate generation, prediction, the table and the bound on pose classes scored."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from haptic.planning.moves import CostModel
+
+
+@dataclass(frozen=True)
+class PlannerConfig:
+    """Options of candidate generation and prediction."""
+
+    n_directions: int = 8
+    """Face-move directions sampled over the half-plane into the face (§4.1.3: discrete angles)."""
+    vertex_radius: float = 0.008
+    """Radius of the circular path of a vertex move [m]."""
+    costs: CostModel = field(default_factory=CostModel)
+    """Cost constants (§3.1)."""
+    min_face_travel: float = 0.006
+    """Face moves predicted (median over hypotheses) to meet an edge sooner than this are not offered: a
+    finger that starts that close to an edge cannot settle on the face first [m]."""
+    min_vertex_clearance: float = 0.004
+    """Face moves predicted to meet their edge closer than this to a vertex are not offered: a fingertip
+    crossing there touches two edges at once [m]."""
+    table_z: float | None = None
+    """Height of the table top in the world frame, a workspace prior the robot knows (set for the physics
+    executor's scene, never from the object) [m]. None: no table (the geometric executor), no table checks."""
+    pad_radius: float = 0.012
+    """Radius of the fingertip pad (the robot's own geometry), for the table checks [m]."""
+    table_clearance: float = 0.004
+    """A pad position whose lowest point would come closer than this to the table top counts as on the table:
+    the executor's own limit (2 mm) plus a margin for the hypotheses' pose error [m]."""
+    steep_descent: float = 0.5
+    """A face move whose direction points down more steeply than this (the sine of its descent) is "steep"."""
+    steep_descent_risk: float = 0.0
+    """Failure risk charged to steep face moves (their efficiency is discounted by it): the physics hand,
+    fingers pointing down, often loses the surface rolling down over the edge such a trace meets. 0: none."""
+    table_rest_tol: float = 0.003
+    """With a table, a pose class whose model would reach more than this below the table top, or whose lowest
+    point would float more than this above it, is not a pose the object can rest in [m]."""
+    max_undercut: float | None = None
+    """With a table, how far a face's outward normal may lean back under, past horizontal, for the pad of the
+    downward-pointing fingers to roll onto it over a convex edge (the robot's own reach, set for the physics
+    executor) [rad]. A face move predicted to roll over an edge onto a face leaning further ends there and
+    reports the edge alone (:attr:`~haptic.planning.predict.Prediction.edge_only`); a vertex move doing so
+    counts as refused like one running into the table. None: no limit."""
+    touch_evidence: bool = False
+    """Every touched point is checked against each pose class's surface (the episode does so with the
+    physics executor's traces), so a face move that cannot step onto its next face still tells how far its
+    face reaches; scored so."""
+    touch_tol: float = 0.0025
+    """A touched point farther than this from every face of a pose class whose normal agrees with the sensed
+    one contradicts the class [m]."""
+    touch_outliers: int = 3
+    """Contradicting points it takes to set a pose class aside (a stray reading is not enough)."""
+    touch_spacing: float = 0.001
+    """Touched points are thinned to about one per this much of the trace [m]."""
+    table_risk: float = 0.5
+    """Candidate moves that at least this fraction of the hypotheses predict to bring the pad onto the table
+    are not offered (the executor would refuse or abort them); the rest are discounted by their risk."""
+    max_hypotheses: int | None = 256
+    """Most pose classes a policy scores moves against; above it, a reduced set chosen model by model
+    (:mod:`haptic.planning.bound`). None: no bound. 256 is above the most pose classes the shipped libraries
+    leave at a planner decision (255, look-alike library, with the loop posing up to
+    ``haptic.episode.loop.MAX_POSED`` interpretations), so their decisions are unchanged."""
+    moves: str = "tracing"
+    """Admissible kinds of move (``MOVE_SETS``): "tracing" (face, edge and vertex moves), "probing" (free-space
+    probes) or "all" (both, ranked together by one efficiency, seed §1.1)."""
+
+    @property
+    def touch_margin(self) -> float:
+        """How far past a pose class's edge a trace must touch its face for the touched points to set the
+        class aside (``touch_outliers`` points beyond ``touch_tol``) [m]."""
+        return self.touch_tol + self.touch_outliers * self.touch_spacing
+

@@ -1,0 +1,280 @@
+"""The table as a workspace prior: which moves would bring the fingertip pad onto it, and which poses rest on it.
+
+The fingers point down and end in a pad of radius ``config.pad_radius``; the table top is at ``config.table_z``
+(the robot's workspace, never the object). Each hypothesis predicts through its own pose whether a move runs
+into the table (:func:`table_conflict`); the data alone say so for some moves whatever the model
+(:func:`data_table_conflict`). Without a table (``config.table_z`` None, the geometric executor) nothing here
+refuses a move or a pose.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+
+from haptic.geometry.polyhedron import Polyhedron
+from haptic.geometry.se3 import SE3
+from haptic.geometry.tracing import circle_vertex
+from haptic.matching.components import DataComponent, DataEdge, DataFace
+from haptic.planning.config import PlannerConfig
+from haptic.planning.hypothesis import Hypothesis, trace_in
+from haptic.planning.moves import EdgeMove, FaceMove, Move, SensorState, VertexMove
+
+EDGE_ROLL = np.deg2rad(12.0)
+"""How far the pad's normal must turn over an edge, before it leans under past ``max_undercut``, for the
+executor to measure the edge from the roll alone (its segmenter wants 10°): from a face leaning under
+within this of the limit, a move ending at an edge onto a face out of reach tells nothing [rad]."""
+EDGE_ONLY_CLEARANCE = 0.008
+"""A face move ends at its edge with the next face out of reach, reporting the edge alone, only where it meets
+the edge at least this far from both its ends: the pad rolls some 40° over it, its centre as far past the
+edge's line as ``pad_radius · sin 40°``, and nearer an end it touches the faces round the vertex [m]."""
+TABLE_STEP_ONTO = 0.003
+"""How far onto the next face a face or vertex move strokes for its normal (for the table check) [m]."""
+
+
+def pad_height(point: np.ndarray, normal: np.ndarray, pad_radius: float, table_z: float) -> float:
+    """Height above the table top (at ``table_z``) of the lowest point of a pad of radius ``pad_radius`` when it
+    touches ``point`` of a surface of outward ``normal``, the fingers pointing down [m]."""
+    return float(point[2] + pad_radius * normal[2] - pad_radius - table_z)
+
+
+def pad_clearance(point: np.ndarray, normal: np.ndarray, config: PlannerConfig) -> float:
+    """:func:`pad_height` with the planner's pad and table; +inf without a table."""
+    if config.table_z is None:
+        return float("inf")
+    return pad_height(point, normal, config.pad_radius, config.table_z)
+
+
+def _inward(poly: Polyhedron, edge: int, face: int) -> np.ndarray:
+    """Unit vector in ``face``'s plane, perpendicular to ``edge``, pointing into the face (model frame)."""
+    w = np.cross(poly.face_normals[face], poly.edge_directions[edge])
+    return w if poly.edge_left_face[edge] == face else -w
+
+
+def circle_points(
+    vertex: np.ndarray, u: np.ndarray, w: np.ndarray, radius: float, start: float, stop: float, step: float
+) -> np.ndarray:
+    """Points of the circle of a vertex move: ``vertex + radius (−cos θ u + sin θ w)`` for θ from ``start`` to
+    ``stop`` (``u`` along the current edge toward the vertex, ``w`` into the crossed face), shape (K, 3)."""
+    th = np.arange(start, stop + 1e-9, step) if stop > start else np.array([start])
+    return vertex + radius * (-np.cos(th)[:, None] * u + np.sin(th)[:, None] * w)
+
+
+VERTEX_START_ANGLE = np.deg2rad(25.0)
+"""A vertex move's circle starts this far from the current edge (the physics executor's start) [rad]."""
+SWEEP_STEP = np.deg2rad(2.0)
+"""Spacing of the points of a vertex circle checked against the table [rad]."""
+
+
+def circle_sweep_off_table(
+    vertex: np.ndarray,
+    u: np.ndarray,
+    w: np.ndarray,
+    normal: np.ndarray,
+    radius: float,
+    table_z: float,
+    pad_radius: float,
+    clearance: float,
+    start: float = VERTEX_START_ANGLE,
+) -> float:
+    """The angle the circle of a vertex move (:func:`circle_points` from ``start``) can sweep before the pad,
+    touching the circle's face of outward ``normal``, comes closer than ``clearance`` to the table top (2π:
+    never; 0: not even its start is that far from it) [rad]. The planner checks the circle from the data with
+    its margin, the physics executor with its own limit."""
+    pts = circle_points(vertex, u, w, radius, start, 2 * np.pi - start, SWEEP_STEP)
+    low = [i for i, q in enumerate(pts) if pad_height(q, normal, pad_radius, table_z) < clearance]
+    return float(low[0] * SWEEP_STEP) if low else 2 * np.pi
+
+
+def table_conflict(
+    h: Hypothesis, move: Move, state: SensorState, components: Mapping[int, DataComponent], config: PlannerConfig
+) -> float:
+    """Whether hypothesis ``h`` predicts ``move`` to bring the pad onto the table (1.0), not (0.0), or cannot
+    say (NaN): a face move sliding down to an edge within the pad's reach of the table or stepping onto a face
+    the table hides; a vertex move whose circle, before it meets the next edge, would put the pad on the table,
+    or whose next face the table hides. Edge moves are never refused (one running down to the table ends at
+    the vertex the table blocks, which the executor finds). A workspace prior (``config.table_z``) with the
+    hypothesis's own pose; 0.0 without a table. With ``config.max_undercut``, a vertex move stepping over a
+    convex edge onto a face that leans under further than the pad reaches counts too (a face move doing so
+    ends at the edge instead: :attr:`~haptic.planning.predict.Prediction.edge_only`)."""
+    return table_prediction(h, move, state, components, config)[0]
+
+
+def table_prediction(
+    h: Hypothesis, move: Move, state: SensorState, components: Mapping[int, DataComponent], config: PlannerConfig
+) -> tuple[float, float, float]:
+    """:func:`table_conflict`; for a face move, how far its trace touches the face
+    (:attr:`~haptic.planning.predict.Prediction.reach`) and whether it ends at its edge, the next face out of
+    reach (:attr:`~haptic.planning.predict.Prediction.edge_only`); NaN, NaN for other moves."""
+    if config.table_z is None:
+        return 0.0, np.nan, np.nan
+    t = h.world_from_model
+    if t is None:
+        return np.nan, np.nan, np.nan
+    poly, lim = h.poly, config.table_clearance
+
+    def leans_under(e_m: int, g_m: int) -> bool:
+        """Whether the pad cannot roll over convex edge ``e_m`` onto ``g_m``: it leans under, out of reach."""
+        if config.max_undercut is None or poly.edge_convexity[e_m] <= 0:
+            return False
+        return float(t.rotate(poly.face_normals[g_m])[2]) < -np.sin(config.max_undercut)
+
+    def onto_hidden(e_m: int, g_m: int, at_m: np.ndarray) -> bool:
+        q = t.apply(at_m + TABLE_STEP_ONTO * _inward(poly, e_m, g_m))
+        return leans_under(e_m, g_m) or pad_clearance(q, t.rotate(poly.face_normals[g_m]), config) < lim
+
+    if isinstance(move, FaceMove):
+        tr = trace_in(h, move, state)
+        if tr is None:
+            return np.nan, np.nan, np.nan
+        hit = tr.hit
+        n_w = t.rotate(poly.face_normals[tr.face])
+        d_z = float(np.asarray(move.direction)[2])
+        if d_z < 0.0 and pad_clearance(t.apply(hit.point), n_w, config) < lim:
+            # the slide stops where the pad comes too close to the table
+            start = pad_clearance(t.apply(tr.start), n_w, config)
+            return 1.0, float(np.clip((start - lim) / -d_z, 0.0, hit.distance)), 0.0
+        if leans_under(hit.edge, hit.next_face):
+            near_end = tr.clearance(poly) < EDGE_ONLY_CLEARANCE
+            if near_end or float(n_w[2]) < -np.sin(config.max_undercut - EDGE_ROLL):
+                return 1.0, float(hit.distance), 0.0  # no room to roll over the edge alone: the move fails there
+            return 0.0, float(hit.distance), 1.0
+        return float(onto_hidden(hit.edge, hit.next_face, hit.point)), float(hit.distance), 0.0
+    if isinstance(move, EdgeMove):
+        # an edge running down to the table ends at a vertex on it, where the table blocks the finger: the
+        # executor finds that vertex (the only way to measure such an edge), so an edge move is never refused
+        return 0.0, np.nan, np.nan
+    if isinstance(move, VertexMove):
+        e_m = h.edges.get(state.edge) if state.edge is not None else None
+        v_m = h.vertices.get(state.vertex) if state.vertex is not None else None
+        a_m = h.faces.get(move.across_face)
+        if e_m is None or v_m is None or a_m is None:
+            return np.nan, np.nan, np.nan
+        try:
+            hit = circle_vertex(poly, v_m, e_m, a_m, config.vertex_radius)
+        except ValueError:
+            return np.nan, np.nan, np.nan
+        u = poly.edge_directions[e_m] * (1.0 if poly.edges[e_m, 1] == v_m else -1.0)
+        pts = circle_points(poly.vertices[v_m], u, _inward(poly, e_m, a_m), config.vertex_radius,
+                            VERTEX_START_ANGLE, hit.angle, np.deg2rad(3.0))  # fmt: skip
+        n_w = t.rotate(poly.face_normals[a_m])
+        if min(pad_clearance(q, n_w, config) for q in t.apply(pts)) < lim:
+            return 1.0, np.nan, np.nan
+        away = poly.edge_directions[hit.edge] * (1.0 if poly.edges[hit.edge, 0] == v_m else -1.0)
+        at = poly.vertices[v_m] + config.vertex_radius * away
+        return float(onto_hidden(hit.edge, hit.next_face, at)), np.nan, np.nan
+    raise TypeError(f"unknown move {move!r}")
+
+
+def _vertex_frame(
+    state: SensorState, components: Mapping[int, DataComponent], face: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
+    """From the data: the current vertex, the unit vector along the current edge toward it, the unit vector
+    into data face ``face`` perpendicular to the edge, and that face's normal. None when the data lack one."""
+    edge = components.get(state.edge) if state.edge is not None else None
+    vertex = components.get(state.vertex) if state.vertex is not None else None
+    f = components.get(face)
+    if not isinstance(edge, DataEdge) or vertex is None or not isinstance(f, DataFace):
+        return None
+    b, n = edge.direction, f.normal
+    mid = edge.point + 0.5 * edge.length * b
+    u = b if (vertex.position - mid) @ b >= 0 else -b
+    w = np.cross(n, b)
+    w /= max(float(np.linalg.norm(w)), 1e-12)
+    side = dict(edge.side_points).get(face) if edge.side_points else None
+    ref = side if side is not None else f.points.mean(axis=0)
+    if (ref - edge.point) @ w < 0:
+        w = -w
+    return vertex.position, u, w, n
+
+
+def vertex_sweep_off_table(
+    state: SensorState, components: Mapping[int, DataComponent], face: int, config: PlannerConfig
+) -> float:
+    """From the data alone: the angle the circle of a vertex move across data face ``face`` can sweep from its
+    start before the pad would come onto the table (2π: never; 0: its start is out of reach) [rad]."""
+    if config.table_z is None:
+        return 2 * np.pi
+    frame = _vertex_frame(state, components, face)
+    if frame is None:
+        return 2 * np.pi
+    vtx, u, w, n = frame
+    return circle_sweep_off_table(
+        vtx, u, w, n, config.vertex_radius, config.table_z, config.pad_radius, config.table_clearance
+    )
+
+
+def data_table_conflict(
+    move: Move, state: SensorState, components: Mapping[int, DataComponent], config: PlannerConfig
+) -> bool:
+    """What the data alone say about the table, whatever the model: a face move heading down from a point
+    already within the pad's reach of the table, or a vertex move whose circle cannot even start off it."""
+    if config.table_z is None:
+        return False
+    if isinstance(move, FaceMove):
+        face = components.get(state.face)
+        if not isinstance(face, DataFace) or float(np.asarray(move.direction)[2]) >= 0.0:
+            return False
+        return pad_clearance(state.position, face.normal, config) < config.table_clearance
+    if isinstance(move, VertexMove):
+        return vertex_sweep_off_table(state, components, move.across_face, config) <= 0.0
+    return False
+
+
+def move_table_risk(
+    move: Move,
+    hypotheses: Sequence[Hypothesis],
+    state: SensorState,
+    components: Mapping[int, DataComponent],
+    config: PlannerConfig,
+) -> float:
+    """Fraction of the hypotheses (that can say) predicting ``move`` to run into the table; 1 when the data
+    alone say so; 0 without a table or a prediction."""
+    if config.table_z is None:
+        return 0.0
+    if data_table_conflict(move, state, components, config):
+        return 1.0
+    vals = np.array([table_conflict(h, move, state, components, config) for h in hypotheses], dtype=float)
+    return 0.0 if not len(vals) or np.isnan(vals).all() else float(np.nanmean(vals))
+
+
+def table_safe_moves(
+    moves: Sequence[Move],
+    hypotheses: Sequence[Hypothesis],
+    state: SensorState,
+    components: Mapping[int, DataComponent],
+    config: PlannerConfig,
+) -> list[Move]:
+    """``moves`` less those predicted to run into the table (risk ≥ ``config.table_risk``); all of them when
+    that leaves none (the executor then says so). Unchanged without a table."""
+    if config.table_z is None:
+        return list(moves)
+    safe = [m for m in moves if move_table_risk(m, hypotheses, state, components, config) < config.table_risk]
+    return safe or list(moves)
+
+
+def descent_risk(move: Move, config: PlannerConfig) -> float:
+    """``config.steep_descent_risk`` for a face move heading down more steeply than ``config.steep_descent``,
+    else 0."""
+    if move.kind != "face" or config.steep_descent_risk <= 0.0:
+        return 0.0
+    return config.steep_descent_risk if float(np.asarray(move.direction)[2]) < -config.steep_descent else 0.0
+
+
+def rests_on_table(poly: Polyhedron, world_from_model: SE3, config: PlannerConfig) -> bool:
+    """Whether ``poly`` at ``world_from_model`` rests on the table: its lowest vertex at the table top within
+    ``config.table_rest_tol`` (neither through it nor floating). True without a table."""
+    if config.table_z is None:
+        return True
+    low = float(world_from_model.apply(poly.vertices)[:, 2].min()) - config.table_z
+    return abs(low) <= config.table_rest_tol
+
+
+def pose_fixed_by(components: Mapping[int, DataComponent]) -> bool:
+    """Whether the data fix every interpretation's translation: a data vertex, or faces whose normals span
+    space. (Until then a pose class's pose is one of many and says nothing about where the table is.)"""
+    if any(c.kind == "vertex" for c in components.values()):
+        return True
+    normals = np.array([c.normal for c in components.values() if isinstance(c, DataFace)])
+    return len(normals) >= 3 and float(np.linalg.svd(normals, compute_uv=False)[2]) > 0.3
