@@ -3,10 +3,12 @@
 :class:`PhysicsExecutor` has the interface of the geometric executor -- ``start()`` and ``execute(move)``
 returning :class:`~haptic.planning.moves.MoveResult` records with the same components, ids, adjacency and
 sensor states -- so the matcher and the planner do not know which executor they talk to. It is built on the
-primitives of :mod:`haptic.executor.primitives` and the segmenter of :mod:`haptic.executor.segment`, and
-it is given a :class:`~haptic.sim.robot.RobotInterface` only: joint encoders / forward kinematics and the
-fingertip's sensed contact. It never sees the simulation, the scene, the object or its pose; the only prior
-it uses is the workspace (the table's height and the region where objects are placed).
+primitives of :mod:`haptic.executor.primitives` and the segmenter of :mod:`haptic.executor.segment`, starts
+with the landing search of :mod:`haptic.executor.landing` and checks its workspace (the table) with
+:mod:`haptic.executor.workspace`; and it is given a :class:`~haptic.sim.robot.RobotInterface` only: joint
+encoders / forward kinematics and the fingertip's sensed contact. It never sees the simulation, the scene, the
+object or its pose; the only prior it uses is the workspace (the table's height and the region where objects
+are placed).
 
 Costs are computed from the distances actually travelled by each move's main trace (seed §3.1). Faults --
 contact lost, joint limit / unreachable target, blocked motion, timeout, simulation instability -- end the
@@ -22,14 +24,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from haptic.errors import HapticError
-from haptic.executor.primitives import (
-    PrimitiveResult,
-    TouchConfig,
-    Toucher,
-    angle,
-    perpendicular,
-    unit,
-)
+from haptic.executor.landing import LandingSearch
+from haptic.executor.primitives import PrimitiveResult, TouchConfig, Toucher, angle, unit
 from haptic.executor.segment import (
     FaceFit,
     LineFit,
@@ -38,17 +34,15 @@ from haptic.executor.segment import (
     face_rows,
     fit_face,
     line_from_points,
-    normal_turn_rate,
 )
+from haptic.executor.workspace import Workspace, admissible_moves, toward_vertex
 from haptic.matching.components import DataComponent
 from haptic.matching.trace import PHASES, ContactTrace
 from haptic.planning.moves import CostModel, EdgeMove, FaceMove, Move, MoveResult, SensorState, Touches, VertexMove
+from haptic.planning.table import VERTEX_START_ANGLE
 from haptic.sim.robot import RobotInterface
-from haptic.sim.scene import OBJECT_REGION, TABLE_TOP_Z
+from haptic.sim.scene import TABLE_TOP_Z
 
-MAX_STUCK = 4
-"""Start: moves across above the object region, at the highest approach, that may time out in a row before
-the start gives up (the arm is held back: every further landing would be too)."""
 RIDGE_PROBE = 0.004
 """An edge measured from a roll alone is followed this far each way from where the roll ended [m] ..."""
 RIDGE_MIN_SPAN = 0.003
@@ -103,7 +97,7 @@ class PhysicsSettings:
     """Longest trace along an edge [m]."""
     vertex_radius: float = 0.008
     """Radius of the circle around a vertex (contact point) [m]."""
-    vertex_start_angle: float = math.radians(25.0)
+    vertex_start_angle: float = VERTEX_START_ANGLE
     """The circle starts this far from the current edge [rad]."""
     vertex_standoff: float = 0.004
     """After an edge move the pad rests on the current face this far back along the edge and in from it [m]."""
@@ -123,7 +117,7 @@ class _FaceData:
     anchor: np.ndarray  # a contact point known to be on the face
 
 
-class PhysicsExecutor:
+class PhysicsExecutor(LandingSearch):
     """Executes face, edge and vertex moves with the simulated hand and segments what it senses."""
 
     def __init__(
@@ -152,6 +146,8 @@ class PhysicsExecutor:
         self.settings = s
         self.toucher = Toucher(robot, s.touch, finger)
         self.toucher.floor_z = TABLE_TOP_Z + s.pad_clearance
+        self.workspace = Workspace(self.toucher, s.table_margin, s.pad_clearance, s.vertex_radius,
+                                   s.vertex_start_angle)  # fmt: skip
         self.segmenter = Segmenter(self.bounds)
         self.state: SensorState | None = None
         """Sensor state after the last move (None before :meth:`start`)."""
@@ -248,21 +244,9 @@ class PhysicsExecutor:
         pts, nrm = trace.point_in_world[mask], trace.normal_in_world[mask]
         self._faces[fid] = _FaceData(pts, nrm, pts[-1].copy())
 
-    def _touching_table(self) -> bool:
-        k = self.robot.fingers.index(self._finger)
-        for c in self.robot.read().contacts[k]:
-            if c.point_in_world[2] < TABLE_TOP_Z + self.settings.table_margin and c.normal_in_world[2] > 0.95:
-                return True
-        return False
-
-    def _is_table(self, normal: np.ndarray, point: np.ndarray | None) -> bool:
-        return point is not None and normal[2] > 0.99 and point[2] < TABLE_TOP_Z + self.settings.table_margin
-
-    def _pad_clearance(self, point: np.ndarray, normal: np.ndarray) -> float:
-        """Height above the table top of the pad's lowest point when it touches ``point`` of a face of
-        ``normal`` (fingers pointing down; the workspace prior is the table's height) [m]."""
-        r = self.toucher.pad_radius
-        return float(point[2] + r * normal[2] - r - TABLE_TOP_Z)
+    def _finger_contacts(self):
+        """The exploring fingertip's sensed contacts now."""
+        return self.robot.read().contacts[self.robot.fingers.index(self._finger)]
 
     def _contact_point(self) -> np.ndarray:
         t = self.toucher
@@ -275,137 +259,6 @@ class PhysicsExecutor:
         then acquire the touched face's normal with a short L stroke. Reports one data face."""
         move = FaceMove(np.zeros(3))
         return self._run(move, lambda pieces: self._start(move, pieces))
-
-    def _landing_points(self) -> list[np.ndarray]:
-        s = self.settings
-        (x0, x1), (y0, y1) = OBJECT_REGION
-        xs = np.arange(x0 - s.search_margin, x1 + s.search_margin + 1e-9, s.search_spacing)
-        ys = np.arange(y0 - s.search_margin, y1 + s.search_margin + 1e-9, s.search_spacing)
-        centre = np.array([(x0 + x1) / 2, (y0 + y1) / 2])
-        pts = np.array([[x, y] for x in xs for y in ys])
-        pts = pts + self.rng.uniform(-0.3, 0.3, pts.shape) * s.search_spacing
-        order = np.argsort(np.linalg.norm(pts - centre, axis=1) + self.rng.uniform(0, 0.01, len(pts)))
-        return [pts[i] for i in order]
-
-    def _start(self, move: Move, pieces: list[PrimitiveResult]) -> MoveResult:
-        s, t = self.settings, self.toucher
-        z_top = TABLE_TOP_Z + s.approach_height
-        z_max = TABLE_TOP_Z + max(s.max_approach_height, s.approach_height)
-        last = "no-contact"
-        landings = self._landing_points()
-        budget = s.max_landings if s.max_landings is not None else len(landings) + s.edge_retries
-        i = -1
-        stuck = 0  # moves across, at the highest approach, that timed out in a row
-        while i + 1 < min(len(landings), budget):
-            i += 1
-            xy = landings[i]
-            above = np.array([xy[0], xy[1], z_top])
-            if t.tip[2] < z_top - 0.01:  # lift straight up first
-                up = t.tip.copy()
-                up[2] = z_top
-                pieces.append(t.move_free(up, timeout=3.0, tol=3e-3))
-            r = t.move_free(above, timeout=4.0, tol=3e-3)
-            pieces.append(r)
-            can_raise = z_top < z_max - 1e-6
-            if r.status == "timeout" and can_raise:
-                # blocked on the way across: the object stands taller than the approach height. Go higher
-                z_top, i = min(z_top + s.approach_raise, z_max), i - 1
-                continue
-            stuck = stuck + 1 if r.status == "timeout" else 0
-            if stuck >= MAX_STUCK:
-                return MoveResult(move=move, status="unreachable", state=None,
-                                  info={"reason": f"the hand cannot move across the object region: {stuck} moves "
-                                                  "above it in a row did not get there"})  # fmt: skip
-            if not r.ok:
-                last = r.status
-                if r.status == "unstable":
-                    break
-                continue
-            # fast guarded descent to just above the table, then back off and touch again slowly
-            r = t.approach(
-                np.array([0.0, 0.0, -1.0]), z_top - TABLE_TOP_Z - s.search_floor, speed=s.search_speed, settle=False
-            )
-            pieces.append(r)
-            if r.ok and r.info["point"][2] > z_top - 0.006 - t.pad_radius and can_raise:
-                # touched at once (the side of something reaching up to the approach height): go higher
-                z_top, i = min(z_top + s.approach_raise, z_max), i - 1
-                continue
-            if r.ok:
-                back = t.tip + np.array([0.0, 0.0, 0.005])
-                pieces.append(t.move_free(back, timeout=1.0, tol=1e-3))
-                r = t.approach(np.array([0.0, 0.0, -1.0]), 0.015)
-                pieces.append(r)
-            if not r.ok:
-                last = r.status
-                if r.status == "unstable":
-                    break
-                continue
-            if self._is_table(r.info["normal"], r.info["point"]):
-                continue
-            fit, trace = self._normal_stroke(r.info["normal"], pieces)
-            if fit is None:  # touched the object near an edge: try close by first
-                near = r.info["point"][:2] + self.rng.normal(0.0, 0.012, (2, 2))
-                landings[i + 1 : i + 1] = list(near)
-                continue
-            face = self.segmenter.add_face(fit, ())
-            self._store_face(face.id, trace, fit)
-            self._on_face = face.id
-            self.state = SensorState(position=self._contact_point(), face=face.id)
-            return MoveResult(move=move, status="ok", components=(face,), state=self.state,
-                              info={"travel": sum(p.distance for p in pieces)})  # fmt: skip
-        return MoveResult(move=move, status=last if last != "ok" else "no-contact", state=None,
-                          info={"reason": "no face found over the object region"})  # fmt: skip
-
-    def _normal_stroke(self, n0: np.ndarray, pieces: list[PrimitiveResult]) -> tuple[FaceFit | None, ContactTrace]:
-        """An L stroke from the landing point for the face's normal; tries other headings when it meets an edge."""
-        s, t = self.settings, self.toucher
-        a = perpendicular(n0)
-        phi0 = self.rng.uniform(0, 2 * np.pi)
-        for k in range(4):
-            phi = phi0 + k * np.pi / 2
-            d1 = math.cos(phi) * a + math.sin(phi) * np.cross(n0, a)
-            d2 = np.cross(n0, d1)
-            legs = []
-            for d in (d1, d2):
-                r = t.trace_face(d, n0, s.normal_stroke, phase="stroke")
-                legs.append(r)
-                pieces.append(r)
-                if not r.ok or r.event != "done":
-                    break
-            if all(r.ok and r.event == "done" for r in legs) and len(legs) == 2:
-                trace = ContactTrace.concatenate([r.trace for r in legs])
-                if not self._on_one_face(trace):
-                    return None, trace  # the pad rolled on an edge or a vertex: land again elsewhere
-                fit = self.segmenter.fit_face_trace(trace, legs[-1].info["face_normal"], two_d=True)
-                return fit, trace
-            if legs[-1].status == "unstable":
-                return None, ContactTrace.concatenate([])
-            # met an edge: back off the way it came and turn
-            back = (
-                t.trace_face(-legs[-1].info.get("direction", d1), n0, s.normal_stroke, phase="stroke")
-                if (legs[-1].ok)
-                else None
-            )
-            if back is not None:
-                pieces.append(back)
-            if t.contact[1] is None:
-                return None, ContactTrace.concatenate([])
-            n0 = t.normal.copy()
-        return None, ContactTrace.concatenate([])
-
-    def _on_one_face(self, trace: ContactTrace) -> bool:
-        """Whether every contact row of the start's L stroke lies on one face. On a face the sensed normal does
-        not turn as the pad slides; landed on (or next to) an edge or a vertex, the pad rolls on it and the
-        normal turns by 1/r along the stroke -- slowly enough for the edge detector not to fire, and the rows
-        within the face cone of the turning normals then fit a wrong plane. Every contact row counts here, not
-        only those in the cone."""
-        ok = trace.in_contact
-        if ok.sum() < self.bounds.min_face_rows:
-            return False
-        tips = trace.tip_in_world[ok]
-        q = tips - tips.mean(axis=0)
-        _, _, vt = np.linalg.svd(q, full_matrices=False)
-        return normal_turn_rate(q @ vt[:2].T, trace.normal_in_world[ok]) <= self.bounds.max_face_curvature
 
     # ------------------------------------------------------------------------------------------ moves
     def execute(self, move: Move) -> MoveResult:
@@ -431,7 +284,7 @@ class PhysicsExecutor:
                 and angle(t.normal, n) < math.radians(5.0)):  # fmt: skip
             return "ok"
         target = self._faces[fid].anchor if near is None else near
-        if self._pad_clearance(target, n) < self.settings.pad_clearance:
+        if self.workspace.pad_clearance(target, n) < self.settings.pad_clearance:
             self._why = "the touch would put the pad on the table"
             return "unreachable"
         r = t.lift_and_approach(target, n, floor_z=TABLE_TOP_Z + t.pad_radius + self.settings.table_margin)
@@ -451,7 +304,7 @@ class PhysicsExecutor:
         """Roll over / climb out of the edge just met, then stroke on the next face. Returns (status, reason,
         roll trace, stroke trace, next face fit)."""
         t = self.toucher
-        if kind == "concave" and self._touching_table():
+        if kind == "concave" and self.workspace.touching_table(self._finger_contacts()):
             return "unreachable", "the finger met the table", None, None, None
         r = t.cross_edge(kind, n_a, direction)
         pieces.append(r)
@@ -461,7 +314,7 @@ class PhysicsExecutor:
                     r.trace, None, None
             return r.status, f"crossing the {kind} edge: {r.event}", None, None, None
         n_b = r.info["normal"]
-        if self._is_table(n_b, t.contact[2]):
+        if self.workspace.is_table(n_b, t.contact[2]):
             return "unreachable", "the edge lies on the table", None, None, None
         along = r.info["edge_direction"]
         if away_from is not None and float((t.tip - away_from) @ along) < 0:
@@ -611,7 +464,8 @@ class PhysicsExecutor:
         )
         if self._on_face not in rec.faces or self._line_distance(rec, t.tip) > 0.03 or not on_clean:
             fid = st.face if st.face in rec.faces else rec.faces[1]
-            near = self._reentry_point(rec, fid, u)
+            near = self.workspace.reentry_point(rec, seg.faces[fid].component.normal, rec.inward[fid],
+                                                rec.param(self._contact_point()), u, s.edge_reentry)  # fmt: skip
             if near is None:
                 return self._fail(move, "unreachable", "the edge next to the table is out of the pad's reach")
             status = self._ensure_on_face(fid, pieces, near=near)
@@ -650,23 +504,6 @@ class PhysicsExecutor:
                           cost=self.costs.edge_move(r.distance), state=self.state,
                           info={"vertex_event": r.info.get("event_sign", 1)})  # fmt: skip
 
-    def _reentry_point(self, rec, fid: int, u: np.ndarray) -> np.ndarray | None:
-        """Where an edge move touches face ``fid`` again next to edge ``rec`` before following it along
-        ``u``: beside the last contact, or -- when that is within the pad's reach of the table -- the
-        nearest point further along ``u`` (inside the explored interval) that is not. None: no such point."""
-        n = self.segmenter.faces[fid].component.normal
-        s0 = rec.param(self._contact_point())
-        lo, hi = rec.interval
-        sense = 1.0 if float(u @ rec.direction) > 0 else -1.0
-        for shift in np.arange(0.0, 0.0301, 0.002):
-            s_k = s0 + sense * shift
-            if shift > 0 and not (lo - 1e-3 <= s_k <= hi + 1e-3):
-                break
-            p = rec.at(s_k) + self.settings.edge_reentry * rec.inward[fid]
-            if self._pad_clearance(p, n) >= self.settings.pad_clearance + 0.001:
-                return p
-        return None
-
     @staticmethod
     def _line_distance(rec, w: np.ndarray) -> float:
         q = w - rec.at(rec.param(w))
@@ -690,8 +527,7 @@ class PhysicsExecutor:
                 return None, 0.0
             s = (rows.point_in_world[at_v] - rec.point) @ rec.direction
             return float(np.median(s)), max(float(np.std(s)), b.point_sigma) / math.sqrt(len(s))
-        k = self.robot.fingers.index(self._finger)
-        contacts = self.robot.read().contacts[k]
+        contacts = self._finger_contacts()
         if not contacts:
             return None, 0.0
         blk = min(contacts, key=lambda cc: float(cc.normal_in_world @ u))
@@ -713,14 +549,12 @@ class PhysicsExecutor:
         if f not in rec.inward or st.vertex not in rec.vertices:
             return self._invalid(move, "the current edge does not know that face or vertex")
         vtx = seg.vertices[st.vertex].position
-        s_v = rec.vertices[st.vertex]
-        lo, hi = rec.interval
-        u = rec.direction if s_v >= 0.5 * (lo + hi) else -rec.direction  # along the edge, towards the vertex
+        u = toward_vertex(rec, rec.vertices[st.vertex])
         w_f = rec.inward[f]
         n_f = seg.faces[f].component.normal
         rho, beta = s.vertex_radius, s.vertex_start_angle
         p0 = vtx + rho * (-math.cos(beta) * u + math.sin(beta) * w_f)
-        sweep = self._circle_sweep_off_table(vtx, n_f, u, w_f)
+        sweep = self.workspace.circle_sweep_off_table(vtx, n_f, u, w_f)
         if sweep <= 0.0:
             return self._fail(move, "unreachable", "the vertex is next to the table: the circle around it would "
                                                    "put the pad on the table")  # fmt: skip
@@ -756,48 +590,10 @@ class PhysicsExecutor:
         return MoveResult(move=move, status="ok", components=(edge, face), distance=r.distance,
                           cost=self.costs.vertex_move(r.distance), state=self.state, info={"kind": kind})  # fmt: skip
 
-    def _circle_sweep_off_table(self, vtx: np.ndarray, n_f: np.ndarray, u: np.ndarray, w_f: np.ndarray) -> float:
-        """Angle [rad] the vertex circle can sweep from its start before the pad would come onto the table
-        (2π: never; 0: not even its start is reachable)."""
-        s = self.settings
-        rho, beta = s.vertex_radius, s.vertex_start_angle
-        for th in np.arange(beta, 2.0 * math.pi - beta + 1e-9, math.radians(2.0)):
-            p = vtx + rho * (-math.cos(th) * u + math.sin(th) * w_f)
-            if self._pad_clearance(p, n_f) < s.pad_clearance:
-                return float(th - beta)
-        return 2.0 * math.pi
-
     # ------------------------------------------------------------------------------------------ helpers
     def admissible_moves(self, rng: np.random.Generator, n_directions: int = 8) -> list[Move]:
-        """Candidate moves from the current state (as the geometric executor's): face moves in random
-        in-plane directions, edge moves both ways on an edge, vertex moves across either face at a vertex."""
-        st = self.state
-        if st is None:
-            return []
-        n = self.segmenter.faces[st.face].component.normal
-        a = perpendicular(n)
-        b = np.cross(n, a)
-        moves: list[Move] = [
-            FaceMove(math.cos(x) * a + math.sin(x) * b) for x in rng.uniform(0, 2 * np.pi, n_directions)
-        ]
-        if st.edge is not None:
-            moves.extend([EdgeMove(1), EdgeMove(-1)])
-        if st.vertex is not None:
-            moves.extend(VertexMove(f) for f in st.edge_faces if self._vertex_move_off_table(f))
-        return moves
-
-    def _vertex_move_off_table(self, f: int) -> bool:
-        """Whether the circle of a vertex move across face ``f`` can start off the table (else the move
-        fails at once with status ``unreachable``)."""
-        st, seg = self.state, self.segmenter
-        rec = seg.edges.get(st.edge) if st.edge is not None else None
-        if rec is None or f not in rec.inward or st.vertex not in rec.vertices:
-            return True
-        s_v = rec.vertices[st.vertex]
-        lo, hi = rec.interval
-        u = rec.direction if s_v >= 0.5 * (lo + hi) else -rec.direction
-        vtx = seg.vertices[st.vertex].position
-        return self._circle_sweep_off_table(vtx, seg.faces[f].component.normal, u, rec.inward[f]) > 0.0
+        """Candidate moves from the current state (:func:`~haptic.executor.workspace.admissible_moves`)."""
+        return admissible_moves(self.state, self.segmenter, self.workspace, rng, n_directions)
 
 
 __all__ = ["PhysicsExecutor", "PhysicsSettings"]

@@ -27,12 +27,12 @@ def test_vertex_circle_is_limited_by_the_table():
 
     def sweep(height: float) -> float:
         vtx = np.array([0.5, 0.0, TABLE_TOP_Z + height])
-        return ex._circle_sweep_off_table(vtx, n, -up, w)
+        return ex.workspace.circle_sweep_off_table(vtx, n, -up, w)
 
     assert sweep(0.0) == 0.0  # a vertex on the table: not even the circle's start is reachable
     assert sweep(0.06) == 2 * math.pi  # a top vertex: the whole circle is clear
     part = sweep(0.018)  # low: the circle may start but must stop before it dips to the table
     assert 0.0 < part < math.pi
     # a horizontal face at table-vertex height is still clear (the pad rests on it from above)
-    assert ex._pad_clearance(np.array([0.5, 0.0, TABLE_TOP_Z + 0.005]), up) > 0.004
-    assert ex._pad_clearance(np.array([0.5, 0.0, TABLE_TOP_Z + 0.005]), n) < 0.0
+    assert ex.workspace.pad_clearance(np.array([0.5, 0.0, TABLE_TOP_Z + 0.005]), up) > 0.004
+    assert ex.workspace.pad_clearance(np.array([0.5, 0.0, TABLE_TOP_Z + 0.005]), n) < 0.0

@@ -1,0 +1,152 @@
+"""The start of the physics executor: the landing search for a first face.
+
+The object rests somewhere over the object region (a workspace prior; its pose is unknown). The pad descends
+from above the region at the points of a landing grid, nearest its centre first, raising its approach when the
+object stands taller, until it touches something that is not the table; then a short L stroke acquires the
+touched face's normal. :class:`LandingSearch` is that part of :class:`~haptic.executor.physics.PhysicsExecutor`
+(its methods use the executor's toucher, segmenter, settings and generator).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from haptic.executor.primitives import PrimitiveResult, perpendicular
+from haptic.executor.segment import FaceFit, normal_turn_rate
+from haptic.executor.workspace import landing_points
+from haptic.matching.trace import ContactTrace
+from haptic.planning.moves import Move, MoveResult, SensorState
+from haptic.sim.scene import TABLE_TOP_Z
+
+MAX_STUCK = 4
+"""Start: moves across above the object region, at the highest approach, that may time out in a row before
+the start gives up (the arm is held back: every further landing would be too)."""
+
+
+class LandingSearch:
+    """The start's landing search and first face, a part of the physics executor."""
+
+    def _start(self, move: Move, pieces: list[PrimitiveResult]) -> MoveResult:
+        s, t = self.settings, self.toucher
+        z_top = TABLE_TOP_Z + s.approach_height
+        z_max = TABLE_TOP_Z + max(s.max_approach_height, s.approach_height)
+        last = "no-contact"
+        landings = landing_points(s.search_spacing, s.search_margin, self.rng)
+        budget = s.max_landings if s.max_landings is not None else len(landings) + s.edge_retries
+        i = -1
+        stuck = 0  # moves across, at the highest approach, that timed out in a row
+        while i + 1 < min(len(landings), budget):
+            i += 1
+            xy = landings[i]
+            above = np.array([xy[0], xy[1], z_top])
+            if t.tip[2] < z_top - 0.01:  # lift straight up first
+                up = t.tip.copy()
+                up[2] = z_top
+                pieces.append(t.move_free(up, timeout=3.0, tol=3e-3))
+            r = t.move_free(above, timeout=4.0, tol=3e-3)
+            pieces.append(r)
+            can_raise = z_top < z_max - 1e-6
+            if r.status == "timeout" and can_raise:
+                # blocked on the way across: the object stands taller than the approach height. Go higher
+                z_top, i = min(z_top + s.approach_raise, z_max), i - 1
+                continue
+            stuck = stuck + 1 if r.status == "timeout" else 0
+            if stuck >= MAX_STUCK:
+                return MoveResult(move=move, status="unreachable", state=None,
+                                  info={"reason": f"the hand cannot move across the object region: {stuck} moves "
+                                                  "above it in a row did not get there"})  # fmt: skip
+            if not r.ok:
+                last = r.status
+                if r.status == "unstable":
+                    break
+                continue
+            # fast guarded descent to just above the table, then back off and touch again slowly
+            r = t.approach(
+                np.array([0.0, 0.0, -1.0]), z_top - TABLE_TOP_Z - s.search_floor, speed=s.search_speed, settle=False
+            )
+            pieces.append(r)
+            if r.ok and r.info["point"][2] > z_top - 0.006 - t.pad_radius and can_raise:
+                # touched at once (the side of something reaching up to the approach height): go higher
+                z_top, i = min(z_top + s.approach_raise, z_max), i - 1
+                continue
+            if r.ok:
+                back = t.tip + np.array([0.0, 0.0, 0.005])
+                pieces.append(t.move_free(back, timeout=1.0, tol=1e-3))
+                r = t.approach(np.array([0.0, 0.0, -1.0]), 0.015)
+                pieces.append(r)
+            if not r.ok:
+                last = r.status
+                if r.status == "unstable":
+                    break
+                continue
+            if self.workspace.is_table(r.info["normal"], r.info["point"]):
+                continue
+            fit, trace = self._normal_stroke(r.info["normal"], pieces)
+            if fit is None:  # touched the object near an edge: try close by first
+                near = r.info["point"][:2] + self.rng.normal(0.0, 0.012, (2, 2))
+                landings[i + 1 : i + 1] = list(near)
+                continue
+            face = self.segmenter.add_face(fit, ())
+            self._store_face(face.id, trace, fit)
+            self._on_face = face.id
+            self.state = SensorState(position=self._contact_point(), face=face.id)
+            return MoveResult(move=move, status="ok", components=(face,), state=self.state,
+                              info={"travel": sum(p.distance for p in pieces)})  # fmt: skip
+        return MoveResult(move=move, status=last if last != "ok" else "no-contact", state=None,
+                          info={"reason": "no face found over the object region"})  # fmt: skip
+
+    def _normal_stroke(self, n0: np.ndarray, pieces: list[PrimitiveResult]) -> tuple[FaceFit | None, ContactTrace]:
+        """An L stroke from the landing point for the face's normal; tries other headings when it meets an edge."""
+        s, t = self.settings, self.toucher
+        a = perpendicular(n0)
+        phi0 = self.rng.uniform(0, 2 * np.pi)
+        for k in range(4):
+            phi = phi0 + k * np.pi / 2
+            d1 = math.cos(phi) * a + math.sin(phi) * np.cross(n0, a)
+            d2 = np.cross(n0, d1)
+            legs = []
+            for d in (d1, d2):
+                r = t.trace_face(d, n0, s.normal_stroke, phase="stroke")
+                legs.append(r)
+                pieces.append(r)
+                if not r.ok or r.event != "done":
+                    break
+            if all(r.ok and r.event == "done" for r in legs) and len(legs) == 2:
+                trace = ContactTrace.concatenate([r.trace for r in legs])
+                if not self._on_one_face(trace):
+                    return None, trace  # the pad rolled on an edge or a vertex: land again elsewhere
+                fit = self.segmenter.fit_face_trace(trace, legs[-1].info["face_normal"], two_d=True)
+                return fit, trace
+            if legs[-1].status == "unstable":
+                return None, ContactTrace.concatenate([])
+            # met an edge: back off the way it came and turn
+            back = (
+                t.trace_face(-legs[-1].info.get("direction", d1), n0, s.normal_stroke, phase="stroke")
+                if (legs[-1].ok)
+                else None
+            )
+            if back is not None:
+                pieces.append(back)
+            if t.contact[1] is None:
+                return None, ContactTrace.concatenate([])
+            n0 = t.normal.copy()
+        return None, ContactTrace.concatenate([])
+
+    def _on_one_face(self, trace: ContactTrace) -> bool:
+        """Whether every contact row of the start's L stroke lies on one face. On a face the sensed normal does
+        not turn as the pad slides; landed on (or next to) an edge or a vertex, the pad rolls on it and the
+        normal turns by 1/r along the stroke -- slowly enough for the edge detector not to fire, and the rows
+        within the face cone of the turning normals then fit a wrong plane. Every contact row counts here, not
+        only those in the cone."""
+        ok = trace.in_contact
+        if ok.sum() < self.bounds.min_face_rows:
+            return False
+        tips = trace.tip_in_world[ok]
+        q = tips - tips.mean(axis=0)
+        _, _, vt = np.linalg.svd(q, full_matrices=False)
+        return normal_turn_rate(q @ vt[:2].T, trace.normal_in_world[ok]) <= self.bounds.max_face_curvature
+
+
+__all__ = ["MAX_STUCK", "LandingSearch"]
