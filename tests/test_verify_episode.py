@@ -101,11 +101,14 @@ def test_noise_out_of_range_is_one_line_and_no_episode(bad, capsys):
 def test_physics_noise_level_sets_sensor_segmenter_and_planner_bounds():
     from haptic.episode.worlds import noise_models
     from haptic.executor.segment import SegmentBounds
+    from haptic.matching.components import NoiseModel, SensorNoise
+    from haptic.sim import SimulatedSensorNoise
 
-    sim1, seg1, plan1 = noise_models(1.0)
-    sim4, seg4, plan4 = noise_models(4.0)
+    sim1, seg1, plan1 = noise_models(NoiseModel(1.0))
+    sim4, seg4, plan4 = noise_models(NoiseModel(4.0))
     assert seg1 == SegmentBounds()  # level 1 is the executor's default
-    sim0, seg0, plan0 = noise_models(0.0)
+    assert sim1 == SimulatedSensorNoise.from_notes() and plan1 == SensorNoise()  # and the sensors' and planner's
+    sim0, seg0, plan0 = noise_models(NoiseModel(0.0))
     assert sim0.normal_std == 0 and seg0 == seg1 and plan0 == plan1  # bounds never below the default level
     assert np.isclose(sim4.normal_std, 4 * sim1.normal_std) and np.isclose(sim4.point_std, 4 * sim1.point_std)
     assert np.isclose(seg4.normal_sigma, 4 * seg1.normal_sigma) and np.isclose(seg4.point_sigma, 4 * seg1.point_sigma)

@@ -20,7 +20,7 @@ from haptic.errors import HapticError
 from haptic.executor.geometric import GeometricExecutor
 from haptic.geometry import SE3, Polyhedron, resolve_model
 from haptic.geometry.library_cache import cached_library
-from haptic.matching.components import SensorNoise, check_noise_level
+from haptic.matching.components import NoiseModel, SensorNoise, check_noise_level
 from haptic.planning.config import PlannerConfig
 from haptic.planning.moves import CostModel, MoveResult
 from haptic.planning.policies import Policy
@@ -96,29 +96,27 @@ class GeometricWorld:
         library, true_model, (pose_rng, exec_rng, policy_rng, _) = _setup(spec, library)
         config = replace(config or PlannerConfig(), moves=spec.moves)
         world_from_model = SE3.random(pose_rng, translation_scale=0.1)
-        noise = SensorNoise().scaled(check_noise_level(spec.noise))
+        noise = NoiseModel(check_noise_level(spec.noise)).fitted
         executor = make_geometric_executor(true_model, world_from_model, noise, exec_rng, config.costs)
         return Episode(spec, library, true_model, world_from_model, executor, noise, config, policy_rng)
 
 
-def noise_models(level: float):
-    """One noise level for the simulated hand: the simulated sensors' noise (PHYSICS_NOTES levels x ``level``),
-    the segmenter's bounds (its σ x ``level``, the systematic floors unchanged), hence the matcher's bounds
-    (the segmented components carry them), and the planner's outcome bounds (:class:`SensorNoise` x ``level``).
-    The bounds do not shrink below the default level (``max(level, 1)``): the simulated contacts scatter by
-    about that much with ideal sensors (contact discretisation, pad compliance; noiseless, normals beside a
-    seam of the simulated pieces read 1.5° off), and a segmenter fitting with σ = 0 fails. Returns ``(sim
-    noise, segment bounds, planner noise)``; ``level`` must be within
-    :data:`~haptic.matching.components.NOISE_LEVELS`."""
-    from haptic.executor.segment import SegmentBounds  # the simulated hand's modules load only for its episodes
-    from haptic.sim import SimulatedSensorNoise as SimNoise
+BOUND_FLOOR = 1.0
+"""On the simulated hand the bounds do not shrink below this noise level: the simulated contacts scatter by
+about that much with ideal sensors (contact discretisation, pad compliance; noiseless, normals beside a seam of
+the simulated pieces read 1.5° off), and a segmenter fitting with σ = 0 fails."""
 
-    level = check_noise_level(level)
-    n = SimNoise.from_notes()
-    sim_noise = SimNoise(n.force_std * level, n.normal_std * level, n.point_std * level, n.joint_std * level)
-    bounded = max(level, 1.0)
-    bounds = SegmentBounds.from_noise(n.force_std, n.normal_std, n.point_std).scaled(bounded)
-    return sim_noise, bounds, SensorNoise().scaled(bounded)
+
+def noise_models(noise: NoiseModel):
+    """One noise model for the simulated hand: the simulated sensors' noise (its per-sample σ at its level),
+    the segmenter's bounds (the same σ, the systematic floors unchanged), hence the matcher's bounds (the
+    segmented components carry them), and the planner's outcome bounds (its fitted σ); the bounds at no less
+    than :data:`BOUND_FLOOR`. Returns ``(sim noise, segment bounds, planner noise)``."""
+    from haptic.executor.segment import SegmentBounds  # the simulated hand's modules load only for its episodes
+    from haptic.sim import SimulatedSensorNoise
+
+    bounded = noise.at_least(BOUND_FLOOR)
+    return SimulatedSensorNoise.from_model(noise), SegmentBounds.from_model(bounded), bounded.fitted
 
 
 class PhysicsWorld:
@@ -152,7 +150,7 @@ class PhysicsWorld:
                 config, table_z=ws.table_top_z, pad_radius=ws.pad_radius, vertex_radius=PhysicsSettings().vertex_radius,
                 steep_descent_risk=STEEP_DESCENT_RISK, max_undercut=TouchConfig().max_undercut, touch_evidence=True,
             )  # fmt: skip
-        sim_noise, bounds, noise = noise_models(spec.noise)
+        sim_noise, bounds, noise = noise_models(NoiseModel(check_noise_level(spec.noise)))
         sim = Simulation(scene, noise=sim_noise, seed=int(sim_seq.integers(2**31 - 1)))
         executor = PhysicsExecutor(RobotInterface(sim), bounds=bounds, costs=config.costs, rng=exec_rng)
         results: list[MoveResult] = []  # every move's result, for scoring perception

@@ -21,7 +21,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from haptic.executor.primitives import perpendicular, unit
-from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex
+from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex, NoiseModel
 from haptic.matching.trace import ContactTrace
 
 
@@ -78,6 +78,11 @@ class SegmentBounds:
     def from_noise(cls, force_std: float, normal_std: float, point_std: float, **kw) -> SegmentBounds:
         """Bounds for a sensor with these standard deviations [N, rad, m]."""
         return cls(normal_sigma=normal_std, point_sigma=point_std, force_sigma=force_std, **kw)
+
+    @classmethod
+    def from_model(cls, model: NoiseModel, **kw) -> SegmentBounds:
+        """Bounds for the per-sample noise of ``model``: its σ at level 1 scaled by its level (:meth:`scaled`)."""
+        return cls.from_noise(model.force_std, model.normal_std, model.point_std, **kw).scaled(model.level)
 
     def scaled(self, level: float) -> SegmentBounds:
         """The bounds for a sensor whose noise is ``level`` times this one's (the statistical σ scale; the

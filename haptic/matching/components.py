@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import json
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -161,6 +161,45 @@ class SensorNoise:
             self.length_sigma * level,
             self.k,
         )
+
+
+@dataclass(frozen=True)
+class NoiseModel:
+    """The one sensor-noise model of an episode: a noise level times the fingertip's sensor noise, from which
+    every noise an episode knows is derived, at two scales of one sensor:
+
+    - per sample (``force_std``, ``normal_std``, ``point_std``, ``joint_std`` at level 1: the levels of
+      PHYSICS_NOTES): what the simulated sensors add to each reading
+      (:meth:`haptic.sim.physics.SimulatedSensorNoise.from_model`) and what the segmenter's σ start from
+      (:meth:`haptic.executor.segment.SegmentBounds.from_model`);
+    - per fitted component (``component`` at level 1): the σ, hence the error bounds, of a face, edge or vertex
+      fitted over many samples (:attr:`fitted`): the geometric executor's noise and the planner's outcome
+      bounds.
+
+    ``level`` multiplies every σ (0: noiseless). :func:`haptic.episode.worlds.noise_models` builds the
+    simulated hand's from one model."""
+
+    level: float = 1.0
+    """Multiplies every standard deviation (``--noise``)."""
+    force_std: float = 0.02
+    """σF per sample at level 1: touch / contact normal force [N]."""
+    normal_std: float = np.deg2rad(1.0)
+    """σn per sample at level 1: contact normal direction, per tangent axis [rad]."""
+    point_std: float = 2e-4
+    """σp per sample at level 1: contact point, per axis [m]."""
+    joint_std: float = 0.0
+    """Joint encoder σ per sample at level 1 [rad]."""
+    component: SensorNoise = field(default_factory=SensorNoise)
+    """The σ of fitted components at level 1."""
+
+    @property
+    def fitted(self) -> SensorNoise:
+        """The fitted components' noise at this level."""
+        return self.component.scaled(self.level)
+
+    def at_least(self, level: float) -> NoiseModel:
+        """The same model at ``max(self.level, level)``."""
+        return replace(self, level=max(self.level, level))
 
 
 NOISE_LEVELS = (0.0, 10.0)

@@ -17,6 +17,7 @@ import mujoco
 import numpy as np
 
 from haptic.errors import SceneError
+from haptic.matching.components import NoiseModel
 from haptic.sim.scene import (
     ARM_HOME,
     ARM_JOINTS,
@@ -57,9 +58,9 @@ def merge_patches(points: np.ndarray, normals: np.ndarray, forces: np.ndarray) -
 
 @dataclass(frozen=True)
 class SimulatedSensorNoise:
-    """Zero-mean Gaussian noise of the simulated sensors, per sample (all zero: ideal sensors). The matcher and
-    planner work with the bounds of segmented components instead (:class:`haptic.matching.components.SensorNoise`;
-    :func:`haptic.episode.worlds.noise_models` derives both from one noise level)."""
+    """Zero-mean Gaussian noise of the simulated sensors, per sample (all zero: ideal sensors): the per-sample
+    part of :class:`~haptic.matching.components.NoiseModel` at its level (:meth:`from_model`). The matcher and
+    planner work with the bounds of segmented components instead (the model's fitted part)."""
 
     force_std: float = 0.0
     """σF: touch / contact normal force [N]."""
@@ -76,9 +77,15 @@ class SimulatedSensorNoise:
         return self.force_std > 0 or self.normal_std > 0 or self.point_std > 0 or self.joint_std > 0
 
     @classmethod
+    def from_model(cls, model: NoiseModel) -> SimulatedSensorNoise:
+        """The per-sample noise of ``model`` at its level."""
+        k = model.level
+        return cls(model.force_std * k, model.normal_std * k, model.point_std * k, model.joint_std * k)
+
+    @classmethod
     def from_notes(cls) -> SimulatedSensorNoise:
-        """The levels of PHYSICS_NOTES: σF 0.02 N, σn 1°, σp 0.2 mm."""
-        return cls(force_std=0.02, normal_std=np.deg2rad(1.0), point_std=2e-4)
+        """The levels of PHYSICS_NOTES (σF 0.02 N, σn 1°, σp 0.2 mm): :meth:`from_model` at level 1."""
+        return cls.from_model(NoiseModel())
 
 
 @dataclass(frozen=True)
