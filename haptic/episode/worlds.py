@@ -98,6 +98,7 @@ class GeometricWorld:
         world_from_model = SE3.random(pose_rng, translation_scale=0.1)
         noise = NoiseModel(check_noise_level(spec.noise)).fitted
         executor = make_geometric_executor(true_model, world_from_model, noise, exec_rng, config.costs)
+        config = replace(config, vertex_radius=executor.settings.vertex_radius)  # the circle the executor makes
         return Episode(spec, library, true_model, world_from_model, executor, noise, config, policy_rng)
 
 
@@ -134,7 +135,7 @@ class PhysicsWorld:
     ) -> Episode:
         # MuJoCo and the physics executor load only for physics episodes (geometric sweeps never import them)
         from haptic.episode.evaluate import score_components
-        from haptic.executor.physics import PhysicsExecutor, PhysicsSettings
+        from haptic.executor.physics import PhysicsExecutor
         from haptic.executor.primitives import TouchConfig
         from haptic.sim import RobotInterface, Simulation, compose_scene, random_object_pose
         from haptic.sim.scene import scene_object_from_polyhedron
@@ -147,12 +148,13 @@ class PhysicsWorld:
         if config.table_z is None:  # the robot knows its workspace from the scene (never the object)
             ws = scene.workspace
             config = replace(
-                config, table_z=ws.table_top_z, pad_radius=ws.pad_radius, vertex_radius=PhysicsSettings().vertex_radius,
-                steep_descent_risk=STEEP_DESCENT_RISK, max_undercut=TouchConfig().max_undercut, touch_evidence=True,
+                config, table_z=ws.table_top_z, pad_radius=ws.pad_radius, steep_descent_risk=STEEP_DESCENT_RISK,
+                max_undercut=TouchConfig().max_undercut, touch_evidence=True,
             )  # fmt: skip
         sim_noise, bounds, noise = noise_models(NoiseModel(check_noise_level(spec.noise)))
         sim = Simulation(scene, noise=sim_noise, seed=int(sim_seq.integers(2**31 - 1)))
         executor = PhysicsExecutor(RobotInterface(sim), bounds=bounds, costs=config.costs, rng=exec_rng)
+        config = replace(config, vertex_radius=executor.settings.vertex_radius)  # the circle the executor makes
         results: list[MoveResult] = []  # every move's result, for scoring perception
 
         def keep(*args) -> None:

@@ -24,7 +24,17 @@ from haptic.geometry.raycast import line_hits
 from haptic.geometry.se3 import SE3, plane_basis
 from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex, SensorNoise
 from haptic.matching.probes import FreeSegment
-from haptic.planning.moves import CostModel, EdgeMove, FaceMove, Move, MoveResult, ProbeMove, SensorState, VertexMove
+from haptic.planning.moves import (
+    VERTEX_RADIUS,
+    CostModel,
+    EdgeMove,
+    FaceMove,
+    Move,
+    MoveResult,
+    ProbeMove,
+    SensorState,
+    VertexMove,
+)
 
 
 @dataclass(frozen=True)
@@ -35,8 +45,8 @@ class GeometricSettings:
     """Half-length of the interval explored on an edge to acquire its direction [m]."""
     step_onto_face: float = 0.008
     """How far the sensor moves onto a new face to acquire its normal [m]."""
-    vertex_radius: float = 0.006
-    """Radius of the circular path around a vertex [m]."""
+    vertex_radius: float = VERTEX_RADIUS
+    """Radius of the circular path around a vertex [m] (the hand's)."""
     start_margin: float = 0.004
     """Smallest distance of the landing point from the boundary of its face [m]."""
     vertex_standoff: float = 0.002

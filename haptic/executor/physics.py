@@ -38,7 +38,17 @@ from haptic.executor.segment import (
 from haptic.executor.workspace import Workspace, admissible_moves, toward_vertex
 from haptic.matching.components import DataComponent
 from haptic.matching.trace import PHASES, ContactTrace
-from haptic.planning.moves import CostModel, EdgeMove, FaceMove, Move, MoveResult, SensorState, Touches, VertexMove
+from haptic.planning.moves import (
+    VERTEX_RADIUS,
+    CostModel,
+    EdgeMove,
+    FaceMove,
+    Move,
+    MoveResult,
+    SensorState,
+    Touches,
+    VertexMove,
+)
 from haptic.planning.table import VERTEX_START_ANGLE
 from haptic.sim.robot import RobotInterface
 from haptic.sim.scene import TABLE_TOP_Z
@@ -95,7 +105,7 @@ class PhysicsSettings:
     """Longest trace across a face before a face move gives up [m]."""
     max_edge_trace: float = 0.25
     """Longest trace along an edge [m]."""
-    vertex_radius: float = 0.008
+    vertex_radius: float = VERTEX_RADIUS
     """Radius of the circle around a vertex (contact point) [m]."""
     vertex_start_angle: float = VERTEX_START_ANGLE
     """The circle starts this far from the current edge [rad]."""

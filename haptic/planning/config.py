@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from haptic.planning.moves import CostModel
+from haptic.planning.moves import VERTEX_RADIUS, CostModel
 
 
 @dataclass(frozen=True)
@@ -13,8 +13,8 @@ class PlannerConfig:
 
     n_directions: int = 8
     """Face-move directions sampled over the half-plane into the face (§4.1.3: discrete angles)."""
-    vertex_radius: float = 0.008
-    """Radius of the circular path of a vertex move [m]."""
+    vertex_radius: float = VERTEX_RADIUS
+    """Radius of the circular path of a vertex move [m]: the executor's, which the episode's world sets."""
     costs: CostModel = field(default_factory=CostModel)
     """Cost constants (§3.1)."""
     min_face_travel: float = 0.006

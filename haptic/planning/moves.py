@@ -114,6 +114,12 @@ class VertexMove:
     kind = "vertex"
 
 
+VERTEX_RADIUS = 0.008
+"""Radius of a vertex move's circle round the vertex [m], the hand's: the physics executor circles the contact
+point this far from the vertex (its pad, of 12 mm radius, touching the face there, not the edges round the
+vertex). Both executors' settings default to it, and each world gives its executor's to the planner."""
+
+
 @dataclass(frozen=True, eq=False)
 class ProbeMove:
     """Leave the surface, move through free space to ``start`` and approach along the line until contact (a
