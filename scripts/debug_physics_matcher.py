@@ -44,7 +44,7 @@ def on_move(i, res, n, rec):
 
 
 def on_failed(i, res):
-    print("FAILED", i, res.move, res.status, res.info.get("reason"))
+    print("FAILED", i, res.move, res.status, res.reason)
 
 
 spec = EpisodeSpec(model=args.model, seed=args.seed, executor="physics")

@@ -53,7 +53,7 @@ def _edge_sense(ex: PhysicsExecutor, rng: np.random.Generator) -> int | None:
 
 
 def _is_table(r) -> bool:
-    return "table" in str(r.info.get("reason", ""))
+    return "table" in r.reason
 
 
 def explore(poly, seed: int, plan=PLAN, retries: int = 4):
@@ -175,7 +175,7 @@ def main(argv=None) -> int:
                 if r.status == "invalid":
                     continue
                 if r.move.kind == "face" and r.ok:
-                    all_rates.append((r.info["sim_time"], r.info["wall_time"]))
+                    all_rates.append((r.sim_time, r.wall_time))
                 c[f"{r.move.kind}_asked"] += 1
                 c[f"{r.move.kind}_ok"] += r.ok
                 c["table"] += (not r.ok) and _is_table(r)

@@ -165,7 +165,7 @@ def test_physics_trace_and_hand_links_are_recorded(tmp_path):
     from haptic.geometry import SE3, load_library
     from haptic.matching.components import DataFace
     from haptic.matching.trace import ContactTrace
-    from haptic.planning.moves import FaceMove, MoveResult, SensorState
+    from haptic.planning.moves import FaceMove, HandLinks, MoveResult, SensorState
 
     n = 50
     t = 1.0 + 0.002 * np.arange(n)
@@ -179,7 +179,7 @@ def test_physics_trace_and_hand_links_are_recorded(tmp_path):
     links = {"palm": tip + [0, 0, 0.1], "index_tip": np.tile(np.eye(4), (n, 1, 1)), "bad": np.zeros((n, 2))}
     result = MoveResult(
         move=FaceMove(np.zeros(3)), status="ok", components=(face,), cost=1.0,
-        state=SensorState(position=pts[-1], face=0), trace=trace, info={"hand_links": links, "sim_time": 0.1},
+        state=SensorState(position=pts[-1], face=0), trace=trace, links=HandLinks(links), sim_time=0.1,
     )  # fmt: skip
     out = tmp_path / "physics.rrd"
     recorder = EpisodeRecorder(out)
@@ -189,7 +189,7 @@ def test_physics_trace_and_hand_links_are_recorded(tmp_path):
     later = ContactTrace(*(a[:20] for a in trace._arrays()))
     later = ContactTrace(later.time + 1.0, *later._arrays()[1:])
     failed = MoveResult(move=FaceMove(np.array([1.0, 0, 0])), status="timeout", cost=0.5,
-                        state=result.state, trace=later, info={"reason": "no edge"})  # fmt: skip
+                        state=result.state, trace=later, reason="no edge")  # fmt: skip
     recorder.on_failed_move(1, failed)
     recorder.close(keep=True)
 
@@ -305,12 +305,12 @@ def test_physics_episode_opens_framed_with_readable_plots(physics_recorded):
 
 
 def test_hand_links_time_must_match_the_rows(tmp_path):
-    from haptic.planning.moves import FaceMove, MoveResult
+    from haptic.planning.moves import FaceMove, HandLinks, MoveResult
 
     links = {"palm": np.zeros((4, 3)), "index_tip": np.ones((4, 3))}
     result = MoveResult(move=FaceMove(np.zeros(3)), status="timeout",
-                        info={"hand_links": links, "hand_links_time": [0.1, 0.2],
-                              "hand_link_chains": (("palm", "index_tip"), ("palm", "nowhere"))})  # fmt: skip
+                        links=HandLinks(links, np.array([0.1, 0.2]),
+                                        (("palm", "index_tip"), ("palm", "nowhere"))))  # fmt: skip
     out = tmp_path / "x.rrd"
     recorder = EpisodeRecorder(out)
     with pytest.warns(UserWarning, match="hand_links_time"):
@@ -392,10 +392,10 @@ def test_link_geoms_are_drawn_where_mujoco_puts_them(tmp_path):
         LinkGeom(None, "table_top", "box", (0.3, 0.4, 0.015), np.r_[[0.6, 0, 0.335], 1, 0, 0, 0], (0.5, 0.5, 0.5, 1)),
     )  # fmt: skip
     poses = {"palm": np.array([[0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0]])}  # 1 m up, no rotation
-    from haptic.planning.moves import FaceMove, MoveResult
+    from haptic.planning.moves import FaceMove, HandLinks, MoveResult
 
     result = MoveResult(move=FaceMove(np.zeros(3)), status="timeout",
-                        info={"link_geoms": geoms, "hand_links": poses, "hand_links_time": [0.5]})  # fmt: skip
+                        links=HandLinks(poses, np.array([0.5]), geoms=geoms))  # fmt: skip
     out = tmp_path / "geoms.rrd"
     recorder = EpisodeRecorder(out)
     with pytest.warns(UserWarning, match="hfield"):

@@ -257,7 +257,7 @@ class GeometricExecutor:
     def execute(self, move: Move) -> MoveResult:
         """Carry out a move from the current state; never raises for an inadmissible move (status "invalid")."""
         if self.state is None:
-            return MoveResult(move=move, status="invalid", info={"reason": "call start() first"})
+            return MoveResult(move=move, status="invalid", reason="call start() first")
         if isinstance(move, FaceMove):
             return self._face_move(move)
         if isinstance(move, EdgeMove):
@@ -266,7 +266,7 @@ class GeometricExecutor:
             return self._vertex_move(move)
         if isinstance(move, ProbeMove):
             return self._probe_move(move)
-        return MoveResult(move=move, status="invalid", state=self.state, info={"reason": f"unknown move {move!r}"})
+        return MoveResult(move=move, status="invalid", state=self.state, reason=f"unknown move {move!r}")
 
     def _probe_move(self, move: ProbeMove) -> MoveResult:
         """The free-space probe (seed §1.1): cast the line at the posed true model from where the sensor is. A hit
@@ -286,7 +286,7 @@ class GeometricExecutor:
         s_m, u_m = inv.apply(start), inv.rotate(u)
         if bool(self.model.contains(s_m[None])[0]):
             return MoveResult(move=move, status="unreachable", state=self.state,
-                              info={"reason": "the line starts inside the object"})  # fmt: skip
+                              reason="the line starts inside the object")  # fmt: skip
         here = np.asarray(self.state.position, dtype=float)
         transfer = float(np.linalg.norm(start - here))
         hits = line_hits(self.model, s_m[None], u_m[None])
@@ -308,7 +308,7 @@ class GeometricExecutor:
                           free_space=(free,), info={"contact": None})  # fmt: skip
 
     def _invalid(self, move: Move, reason: str) -> MoveResult:
-        return MoveResult(move=move, status="invalid", state=self.state, info={"reason": reason})
+        return MoveResult(move=move, status="invalid", state=self.state, reason=reason)
 
     def _face_move(self, move: FaceMove) -> MoveResult:
         m, st = self.model, self.state
@@ -323,7 +323,7 @@ class GeometricExecutor:
             return self._invalid(move, "direction is not in the plane of the current face")
         hit = tracing.trace_face(m, f, self._pos, inplane)
         if hit is None:
-            return MoveResult(move=move, status="unreachable", state=st, info={"reason": "trace met a vertex"})
+            return MoveResult(move=move, status="unreachable", state=st, reason="trace met a vertex")
         e, g = hit.edge, hit.next_face
         s_hit = float((hit.point - m.edge_points[e]) @ m.edge_directions[e])
         eid, rec = self._new_edge(e, s_hit, 0.0, float(m.edge_lengths[e]))

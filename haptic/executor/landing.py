@@ -55,8 +55,8 @@ class LandingSearch:
             stuck = stuck + 1 if r.status == "timeout" else 0
             if stuck >= MAX_STUCK:
                 return MoveResult(move=move, status="unreachable", state=None,
-                                  info={"reason": f"the hand cannot move across the object region: {stuck} moves "
-                                                  "above it in a row did not get there"})  # fmt: skip
+                                  reason=f"the hand cannot move across the object region: {stuck} moves "
+                                         "above it in a row did not get there")  # fmt: skip
             if not r.ok:
                 last = r.status
                 if r.status == "unstable":
@@ -95,7 +95,7 @@ class LandingSearch:
             return MoveResult(move=move, status="ok", components=(face,), state=self.state,
                               info={"travel": sum(p.distance for p in pieces)})  # fmt: skip
         return MoveResult(move=move, status=last if last != "ok" else "no-contact", state=None,
-                          info={"reason": "no face found over the object region"})  # fmt: skip
+                          reason="no face found over the object region")  # fmt: skip
 
     def _normal_stroke(self, n0: np.ndarray, pieces: list[PrimitiveResult]) -> tuple[FaceFit | None, ContactTrace]:
         """An L stroke from the landing point for the face's normal; tries other headings when it meets an edge."""

@@ -43,6 +43,7 @@ from haptic.planning.moves import (
     CostModel,
     EdgeMove,
     FaceMove,
+    HandLinks,
     Move,
     MoveResult,
     SensorState,
@@ -185,35 +186,28 @@ class PhysicsExecutor(LandingSearch):
             res = body(pieces)
         except (HapticError, FloatingPointError, ValueError, np.linalg.LinAlgError) as exc:
             self._on_face = None
-            res = MoveResult(move=move, status="unstable", state=self.state, info={"reason": str(exc)})
+            res = MoveResult(move=move, status="unstable", state=self.state, reason=str(exc))
         except Exception as exc:  # noqa: BLE001 -- mujoco raises plain exceptions on a diverged state
             self._on_face = None
             res = MoveResult(move=move, status="unstable", state=self.state,
-                             info={"reason": f"{type(exc).__name__}: {exc}"})  # fmt: skip
+                             reason=f"{type(exc).__name__}: {exc}")  # fmt: skip
         trace = ContactTrace.concatenate([p.trace for p in pieces])
         self.traces.append(trace)
-        info = dict(res.info)
-        info.update(**self._hand_links())
-        info.update(sim_time=self.robot.time - t0, wall_time=time.perf_counter() - w0)
+        links = self._hand_links()
         return MoveResult(move=res.move, status=res.status, components=res.components, distance=res.distance,
-                          cost=res.cost, state=res.state, touches=touches_of(trace), trace=trace,
-                          info=info)  # fmt: skip
+                          cost=res.cost, state=res.state, touches=touches_of(trace), trace=trace, reason=res.reason,
+                          links=links, sim_time=self.robot.time - t0, wall_time=time.perf_counter() - w0,
+                          info=res.info)  # fmt: skip
 
-    def _hand_links(self) -> dict:
+    def _hand_links(self) -> HandLinks:
         """The hand's link poses sampled during the move (the robot's own forward kinematics), for
-        recordings: ``hand_links`` (name -> (n, 7): position [m], quaternion (w, x, y, z)), ``hand_links_time``
-        (n,) [s], ``hand_link_chains`` (the skeleton's polylines of link names) and ``link_geoms`` (the robot's
-        collision geometry per link, and the table top)."""
+        recordings, with the skeleton's chains and the robot's collision geometry per link (and the table top)."""
         self.toucher.sample_links()  # the pose at the end of the move
         times, pos = self.toucher.take_links()
         self._links_until = float(times[-1]) if len(times) else self._links_until
         names = self.robot.link_names
-        return {
-            "hand_links": {name: pos[:, j] for j, name in enumerate(names)},
-            "hand_links_time": times,
-            "hand_link_chains": self.robot.link_chains,
-            "link_geoms": self.robot.link_geoms(),
-        }
+        return HandLinks({name: pos[:, j] for j, name in enumerate(names)}, times, self.robot.link_chains,
+                         self.robot.link_geoms())  # fmt: skip
 
     def _edge_between(self, face: int, trace: ContactTrace, phase: str, roll: ContactTrace, fit_b: FaceFit,
                       kind: str, corner: np.ndarray) -> tuple[FaceFit, LineFit | None, str]:  # fmt: skip
@@ -233,7 +227,7 @@ class PhysicsExecutor(LandingSearch):
         if status == "ok":
             status = "unreachable"
         self._on_face = None
-        return MoveResult(move=move, status=status, state=self.state, info={"reason": reason})
+        return MoveResult(move=move, status=status, state=self.state, reason=reason)
 
     def _face_fit(self, fid: int, extra: ContactTrace | None = None) -> FaceFit:
         """The fit of a data face from all rows recorded on it (plus rows of ``extra`` that agree with it)."""
@@ -274,17 +268,17 @@ class PhysicsExecutor(LandingSearch):
     def execute(self, move: Move) -> MoveResult:
         """Carry out a move from the current state; a failure is a status, never an exception."""
         if self.state is None:
-            return MoveResult(move=move, status="invalid", info={"reason": "call start() first"})
+            return MoveResult(move=move, status="invalid", reason="call start() first")
         if isinstance(move, FaceMove):
             return self._run(move, lambda pieces: self._face_move(move, pieces))
         if isinstance(move, EdgeMove):
             return self._run(move, lambda pieces: self._edge_move(move, pieces))
         if isinstance(move, VertexMove):
             return self._run(move, lambda pieces: self._vertex_move(move, pieces))
-        return MoveResult(move=move, status="invalid", state=self.state, info={"reason": f"unknown move {move!r}"})
+        return MoveResult(move=move, status="invalid", state=self.state, reason=f"unknown move {move!r}")
 
     def _invalid(self, move: Move, reason: str) -> MoveResult:
-        return MoveResult(move=move, status="invalid", state=self.state, info={"reason": reason})
+        return MoveResult(move=move, status="invalid", state=self.state, reason=reason)
 
     def _ensure_on_face(self, fid: int, pieces: list[PrimitiveResult], near: np.ndarray | None = None) -> str:
         """Put the pad on data face ``fid`` (at ``near`` when given, else where it last touched it)."""

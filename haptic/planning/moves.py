@@ -7,6 +7,7 @@ A move is chosen by the planner and carried out by an executor (geometric or phy
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from enum import StrEnum
 
@@ -169,6 +170,22 @@ class Touches:
 
 
 @dataclass(frozen=True, eq=False)
+class HandLinks:
+    """The hand's link poses sampled during a move (the robot's own forward kinematics, never the object), as
+    a recording draws them."""
+
+    poses: Mapping[str, np.ndarray]
+    """Link name -> its poses, one row per sample: (n, 7) position [m] and quaternion (w, x, y, z); a
+    recording also takes (n, 3) positions or (n, 4, 4) transforms."""
+    time: np.ndarray | None = None
+    """Time of each sample, shape (n,) [s] (None: unknown)."""
+    chains: tuple[tuple[str, ...], ...] = ()
+    """The skeleton's polylines of link names (drawn when there is no geometry)."""
+    geoms: tuple = ()
+    """The robot's collision geometry per link and the table top (:class:`haptic.sim.physics.LinkGeom`)."""
+
+
+@dataclass(frozen=True, eq=False)
 class MoveResult:
     """What a move yielded."""
 
@@ -191,8 +208,18 @@ class MoveResult:
     """Everything the fingertip sensed during the move (None: the executor keeps no trace)."""
     free_space: tuple[FreeSegment, ...] = ()
     """Segments the move found free of the object (a probe's path up to its contact or its end)."""
+    reason: str = ""
+    """Why the move failed, in words ("" when it did not, or the executor does not say)."""
+    links: HandLinks | None = None
+    """The hand's link poses during the move, for recordings (None: the executor has no hand)."""
+    sim_time: float | None = None
+    """Simulated time the move took [s] (None: the executor does not simulate)."""
+    wall_time: float | None = None
+    """Wall time the move took [s] (None: not measured)."""
     info: dict = field(default_factory=dict)
-    """Executor-specific extras (the reason of a failure, the hand's link poses, simulated time)."""
+    """Executor-specific details no one downstream relies on: the physics executor's sensed edge ``kind``
+    ("convex"/"concave"), ``next_face`` ("out of reach" for an edge reported alone), ``vertex_event`` and the
+    start's ``travel``; the geometric executor's probe ``contact`` (distance along the line, or None)."""
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "status", MoveStatus(self.status))

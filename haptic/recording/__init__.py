@@ -22,10 +22,10 @@ default framing; labels show on hover):
 - ``world/truth/object``: the true model's mesh, model frame (static; the ground-truth layer)
 - ``world/truth/edges``: its edges as line strips (static)
 - ``world/estimate``, ``.../edges``: the recognised model at its estimated pose, once recognised
-- ``world/robot/<link>``: Transform3D of each robot link (``info["hand_links"]`` poses), per sampled tick
+- ``world/robot/<link>``: Transform3D of each robot link (``MoveResult.links`` poses), per sampled tick
   (``sim_time``) and at the end of each move (``move``)
 - ``world/robot/<link>/<kind>s``: the link's collision geoms (capsules, spheres, cylinders, boxes, ellipsoids,
-  meshes) in the link frame, static (``info["link_geoms"]``); ``world/table``: the table top
+  meshes) in the link frame, static (``MoveResult.links.geoms``); ``world/table``: the table top
 - ``world/hand/pad``: Transform3D (a translation) to the active fingertip pad's centre (the trace's tip), per
   tick and at the end of each move (without traces: the sensor's position after each move): the origin of the
   ``fingertip`` view, which so follows the pad
@@ -44,7 +44,7 @@ default framing; labels show on hover):
 - ``world/hand/fingertip``: pad centre per control tick (physics only)
 - ``world/hand/contact/points``, ``/normals``: sensed contact per control tick (physics only)
 - ``world/hand/links``, ``world/hand/skeleton``: link origins and the links joined as line strips
-  (``info["hand_link_chains"]``), drawn only when a result reports links without their geometry
+  (``MoveResult.links.chains``), drawn only when a result reports links without their geometry
 - ``plots/interpretations``, ``plots/pose_classes``: log10 of the surviving interpretations and pose classes
   after each move (-1 stands for none); a failed move repeats the count
 - ``plots/moves/<kind>``: a marker per move on the interpretation plot, coloured by move kind (``start``,

@@ -405,7 +405,7 @@ class EpisodeRecorder:
             self._log_counts(*s.counts, "failed")
         if i not in s.decided:
             self._no_decision(i, getattr(result.move, "kind", "?"))
-        reason = result.info.get("reason", "") if isinstance(result.info, dict) else ""
+        reason = result.reason
         rec.log(
             "log/moves",
             rr.TextLog(
@@ -633,17 +633,17 @@ class EpisodeRecorder:
             self._s.trace_style_logged = True
 
     def _log_hand(self, result: MoveResult, trace: Any) -> None:
-        info = result.info if isinstance(result.info, dict) else {}
-        geoms = info.get("link_geoms")
-        if geoms and self._s.geom_links is None:
-            self._log_geoms(geoms)
-        links = info.get("hand_links")
-        if not links:
+        hand = result.links
+        if hand is None:
+            return
+        if hand.geoms and self._s.geom_links is None:
+            self._log_geoms(hand.geoms)
+        if not hand.poses:
             return
         if self._s.geom_links:
-            self._log_link_poses(links, info.get("hand_links_time"))
+            self._log_link_poses(hand.poses, hand.time)
         else:
-            self._log_links(links, trace, info.get("hand_links_time"), info.get("hand_link_chains"))
+            self._log_links(hand.poses, trace, hand.time, hand.chains)
 
     def _log_geoms(self, geoms: Any) -> None:
         """The robot's collision geometry, static, in its links' frames (``world/robot/<link>/<kind>s``), and the
@@ -685,7 +685,7 @@ class EpisodeRecorder:
             rec.log(path, rr.Transform3D(translation=a[-1, :3], quaternion=quat[-1]))
 
     def _log_links(self, links: dict, trace: Any, times: Any = None, chains: Any = None) -> None:
-        """``info["hand_links"]``: link name -> (n, 3) positions, (n, 4, 4) poses or (n, 7) position +
+        """``links`` (:attr:`HandLinks.poses`): link name -> (n, 3) positions, (n, 4, 4) poses or (n, 7) position +
         quaternion (w, x, y, z), world frame; n rows at the sim times ``times`` (n,) [s] when given, else
         aligned with the trace's ticks (or 1: the pose at the end of the move). ``chains``: polylines of link
         names, drawn as line strips in ``world/hand/skeleton``. Malformed entries are skipped with a

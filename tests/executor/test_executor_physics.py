@@ -32,7 +32,7 @@ def _setup(name: str, seed: int):
 def _start_and_face_move(sim: Simulation, seed: int):
     ex = PhysicsExecutor(RobotInterface(sim), rng=np.random.default_rng(seed))
     results = [ex.start()]
-    assert results[0].ok, results[0].info
+    assert results[0].ok, results[0].reason
     rng = np.random.default_rng(seed + 1)
     for _ in range(FACE_DIRECTIONS):
         r = ex.execute(ex.admissible_moves(rng, 1)[0])
@@ -51,7 +51,7 @@ def box_run():
 
 def test_start_and_face_move_report_accurate_components(box_run):
     poly, sim, ex, results = box_run
-    assert results[-1].ok, [r.info.get("reason") for r in results]
+    assert results[-1].ok, [r.reason for r in results]
     kinds = [c.kind for c in results[-1].components]
     assert kinds == ["edge", "face"]
     edge, face = results[-1].components
@@ -94,7 +94,7 @@ def test_invalid_moves_are_statuses_not_exceptions(box_run):
 
 
 def test_moves_report_the_hand_links_from_the_robot_bodies_only(box_run):
-    """``info["hand_links"]``: the robot's own links (forward kinematics of robot bodies, never the object),
+    """``MoveResult.links``: the robot's own links (forward kinematics of robot bodies, never the object),
     sampled through every move on one continuous sim-time axis."""
     _, sim, _, results = box_run
     m = sim.model
@@ -102,12 +102,12 @@ def test_moves_report_the_hand_links_from_the_robot_bodies_only(box_run):
     assert all(m.body_rootid[b] == robot_root != m.body_rootid[m.body("object").id] for b in sim.link_body)
     last = -1.0
     for r in results:
-        t, links = r.info["hand_links_time"], r.info["hand_links"]
+        t, links = r.links.time, r.links.poses
         assert list(links) == list(RobotInterface.link_names)
         assert len(t) >= 2 and np.all(np.diff(t) > 0) and t[0] > last
         last = t[-1]
         assert all(v.shape == (len(t), 7) and np.isfinite(v).all() for v in links.values())  # position, quaternion
-        geoms = r.info["link_geoms"]  # the robot's own collision geometry and the table top, never the object
+        geoms = r.links.geoms  # the robot's own collision geometry and the table top, never the object
         assert {g.link for g in geoms} - {None} <= set(RobotInterface.link_names)
         assert [g.name for g in geoms if g.link is None] == ["table_top"]
         assert not any("object" in g.name for g in geoms)
@@ -202,8 +202,8 @@ def test_start_finds_an_object_taller_than_the_approach_height():
     assert PhysicsSettings().approach_height < 0.12
     ex = PhysicsExecutor(RobotInterface(sim), rng=np.random.default_rng(3))
     r = ex.start()
-    assert r.ok, r.info
-    assert r.info["sim_time"] < 60.0
+    assert r.ok, r.reason
+    assert r.sim_time < 60.0
     assert r.state.position[2] > TABLE_TOP_Z + PhysicsSettings().approach_height, r.state.position  # on the top
 
 
@@ -222,7 +222,7 @@ def test_start_finds_an_object_at_a_corner_of_the_region(corner):
     pose[:2, 3] += target - 0.5 * (v.min(axis=0) + v.max(axis=0))[:2]  # bounding-box centre on the corner
     sim = Simulation(compose_scene(obj, pose), noise=SimulatedSensorNoise.from_notes(), seed=5)
     r = PhysicsExecutor(RobotInterface(sim), rng=np.random.default_rng(5)).start()
-    assert r.ok, r.info.get("reason")
+    assert r.ok, r.reason
 
 
 def test_start_lands_again_when_the_l_stroke_rolled_on_an_edge():
@@ -238,7 +238,7 @@ def test_start_lands_again_when_the_l_stroke_rolled_on_an_edge():
     noise = SimulatedSensorNoise.from_notes()
     sim = Simulation(compose_scene(obj, pose), noise=noise, seed=int(sim_seq.integers(2**31 - 1)))
     r = PhysicsExecutor(RobotInterface(sim), rng=exec_rng).start()
-    assert r.ok, r.info.get("reason")
+    assert r.ok, r.reason
     n = r.components[0].normal
     truth = ConvexHull(obj.vertices @ pose[:3, :3].T + pose[:3, 3]).equations[:, :3]
     err = np.degrees(np.arccos(np.clip(truth @ n, -1.0, 1.0))).min()
