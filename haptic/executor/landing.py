@@ -13,9 +13,10 @@ import math
 
 import numpy as np
 
-from haptic.executor.primitives import PrimitiveResult, perpendicular
+from haptic.executor.primitives import PrimitiveResult
 from haptic.executor.segment import FaceFit, normal_turn_rate
 from haptic.executor.workspace import landing_points
+from haptic.geometry.se3 import perpendicular
 from haptic.matching.trace import ContactTrace
 from haptic.planning.moves import Move, MoveResult, SensorState
 from haptic.sim.scene import TABLE_TOP_Z

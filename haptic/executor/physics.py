@@ -25,7 +25,7 @@ import numpy as np
 
 from haptic.errors import HapticError
 from haptic.executor.landing import LandingSearch
-from haptic.executor.primitives import PrimitiveResult, TouchConfig, Toucher, angle, unit
+from haptic.executor.primitives import PrimitiveResult, TouchConfig, Toucher
 from haptic.executor.segment import (
     FaceFit,
     LineFit,
@@ -36,6 +36,7 @@ from haptic.executor.segment import (
     line_from_points,
 )
 from haptic.executor.workspace import Workspace, admissible_moves, toward_vertex
+from haptic.geometry.se3 import angle, unit
 from haptic.matching.components import DataComponent
 from haptic.matching.trace import PHASES, ContactTrace
 from haptic.planning.moves import (

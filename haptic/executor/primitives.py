@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from haptic.geometry.se3 import plane_basis
+from haptic.geometry.se3 import angle, perpendicular, unit
 from haptic.matching.trace import PHASES, ContactTrace, empty_trace
 from haptic.sim.robot import RobotInterface
 from haptic.sim.scene import PAD_RADIUS
@@ -34,10 +34,10 @@ DOWN = np.diag([-1.0, 1.0, -1.0])
 """Hand rotation ``world_from_hand`` with the fingers pointing down (the tracing posture)."""
 
 FAILURES = ("no-contact", "unreachable", "timeout", "unstable")
+"""Failure statuses of a primitive (the move statuses of :class:`~haptic.planning.moves.MoveResult`)."""
 UNDERCUT_SLACK = math.radians(3.0)
 """Rolling off a face that itself leans under near the limit, the roll ends for the undercut only once the
 normal leans this much further than the face's (not on a noisy first reading) [rad]."""
-"""Failure statuses of a primitive (the move statuses of :class:`~haptic.planning.moves.MoveResult`)."""
 
 @dataclass(frozen=True)
 class TouchConfig:
@@ -138,21 +138,6 @@ class PrimitiveResult:
     @property
     def ok(self) -> bool:
         return self.status == "ok"
-
-
-def unit(v: np.ndarray) -> np.ndarray:
-    n = math.sqrt(float(v @ v))
-    return v / n if n > 0 else v
-
-
-def angle(a: np.ndarray, b: np.ndarray) -> float:
-    """Angle between unit vectors [rad]."""
-    return math.acos(max(-1.0, min(1.0, float(a @ b))))
-
-
-def perpendicular(v: np.ndarray) -> np.ndarray:
-    """A unit vector perpendicular to ``v``."""
-    return plane_basis(v, assume_unit=True)[0]
 
 
 class Toucher:

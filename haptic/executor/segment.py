@@ -20,7 +20,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from haptic.executor.primitives import perpendicular, unit
+from haptic.geometry.se3 import perpendicular, unit
 from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex, NoiseModel
 from haptic.matching.trace import ContactTrace
 

@@ -16,8 +16,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from haptic.executor.primitives import Toucher, perpendicular
+from haptic.executor.primitives import Toucher
 from haptic.executor.segment import EdgeRecord, Segmenter
+from haptic.geometry.se3 import perpendicular
 from haptic.planning.moves import EdgeMove, FaceMove, Move, SensorState, VertexMove
 from haptic.planning.table import circle_sweep_off_table, pad_height
 from haptic.sim.physics import FingertipContact

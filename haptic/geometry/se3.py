@@ -5,6 +5,7 @@ A transform named ``a_from_b`` maps coordinates in frame b to frame a.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -130,3 +131,19 @@ def plane_basis(normal: np.ndarray, assume_unit: bool = False) -> tuple[np.ndarr
         u = np.cross(n, [0.0, 1.0, 0.0])
     u /= np.linalg.norm(u)
     return u, np.cross(n, u)
+
+
+def perpendicular(v: np.ndarray) -> np.ndarray:
+    """A unit vector perpendicular to unit vector ``v`` (the first of :func:`plane_basis`)."""
+    return plane_basis(v, assume_unit=True)[0]
+
+
+def unit(v: np.ndarray) -> np.ndarray:
+    """``v`` normalised (``v`` itself when it is zero)."""
+    n = math.sqrt(float(v @ v))
+    return v / n if n > 0 else v
+
+
+def angle(a: np.ndarray, b: np.ndarray) -> float:
+    """Angle between unit vectors [rad]."""
+    return math.acos(max(-1.0, min(1.0, float(a @ b))))

@@ -6,8 +6,8 @@ import math
 
 import numpy as np
 
-from haptic.executor.primitives import unit
 from haptic.executor.segment import FaceFit, LineFit, SegmentBounds, Segmenter, fit_face, normal_turn_rate
+from haptic.geometry.se3 import unit
 from haptic.matching.trace import ContactTrace
 
 R_PAD = 0.012
