@@ -18,6 +18,7 @@ from haptic.episode.loop import EpisodeObserver, EpisodeRecord, Executor, Observ
 from haptic.episode.spec import EpisodeSpec
 from haptic.errors import HapticError
 from haptic.executor.geometric import GeometricExecutor
+from haptic.executor.segment import SegmentBounds
 from haptic.geometry import SE3, Polyhedron, resolve_model
 from haptic.geometry.library_cache import cached_library
 from haptic.matching.components import NoiseModel, SensorNoise, check_noise_level
@@ -113,8 +114,7 @@ def noise_models(noise: NoiseModel):
     the segmenter's bounds (the same σ, the systematic floors unchanged), hence the matcher's bounds (the
     segmented components carry them), and the planner's outcome bounds (its fitted σ); the bounds at no less
     than :data:`BOUND_FLOOR`. Returns ``(sim noise, segment bounds, planner noise)``."""
-    from haptic.executor.segment import SegmentBounds  # the simulated hand's modules load only for its episodes
-    from haptic.sim import SimulatedSensorNoise
+    from haptic.sim import SimulatedSensorNoise  # MuJoCo loads only for the simulated hand's episodes
 
     bounded = noise.at_least(BOUND_FLOOR)
     return SimulatedSensorNoise.from_model(noise), SegmentBounds.from_model(bounded), bounded.fitted

@@ -32,7 +32,6 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -42,10 +41,8 @@ from haptic.matching.components import DataComponent, SensorNoise
 from haptic.matching.recognition import PoseTolerance
 from haptic.matching.verify import POSE_SAFETY
 from haptic.planning.efficiency import efficiency_of, expected_eliminated
+from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import CostModel, ProbeMove
-
-if TYPE_CHECKING:
-    from haptic.planning.hypothesis import Hypothesis
 
 MIN_INCIDENCE = 0.2
 """Smallest ``|n·u|`` used to turn a surface offset into a distance along a line (a grazing approach)."""
