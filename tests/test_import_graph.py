@@ -98,6 +98,21 @@ def test_the_pure_core_imports_no_outer_layer_and_no_simulator(graph):
     assert not heavy, f"the pure core imports a simulator, viewer or environment package: {heavy}"
 
 
+def test_planning_settings_hypotheses_and_table_checks_sit_below_prediction(graph):
+    """Inside planning: ``config`` and ``hypothesis`` below ``table``, and ``table`` below ``predict`` and
+    ``reach`` (the workspace side needs neither prediction nor reach)."""
+    g, _ = graph
+    below = {
+        "haptic.planning.config": ("haptic.planning.table", "haptic.planning.predict"),
+        "haptic.planning.hypothesis": ("haptic.planning.table", "haptic.planning.predict"),
+        "haptic.planning.table": ("haptic.planning.predict", "haptic.planning.reach"),
+    }
+    for low, highs in below.items():
+        for high in highs:
+            assert nx.has_path(g, high, low), f"{high} does not build on {low}"
+            assert not nx.has_path(g, low, high), f"{low} imports {high}, above it"
+
+
 def test_the_graph_sees_function_level_and_relative_imports(tmp_path):
     """The checks could fail: a cycle hidden in a function, and an upward relative import, are found."""
     pkg = tmp_path / "pkg"
