@@ -17,7 +17,7 @@ import numpy as np
 from haptic.episode.loop import EpisodeObserver, EpisodeRecord, Executor, Observer, chain_observers, run_loop
 from haptic.episode.spec import EpisodeSpec
 from haptic.errors import HapticError
-from haptic.executor.geometric import GeometricExecutor
+from haptic.executor.geometric import GeometricExecutor, GeometricSettings
 from haptic.executor.segment import SegmentBounds
 from haptic.geometry import SE3, Polyhedron, resolve_model
 from haptic.geometry.library_cache import cached_library
@@ -68,8 +68,11 @@ class Episode:
         return record
 
 
-def make_geometric_executor(model: Polyhedron, world_from_model: SE3, noise: SensorNoise, rng, costs: CostModel):
-    return GeometricExecutor(model, world_from_model, noise=noise, rng=rng, costs=costs)
+def make_geometric_executor(
+    model: Polyhedron, world_from_model: SE3, noise: SensorNoise, rng, costs: CostModel,
+    settings: GeometricSettings | None = None,
+):  # fmt: skip
+    return GeometricExecutor(model, world_from_model, noise=noise, rng=rng, costs=costs, settings=settings)
 
 
 def _setup(
@@ -98,8 +101,9 @@ class GeometricWorld:
         config = replace(config or PlannerConfig(), moves=spec.moves)
         world_from_model = SE3.random(pose_rng, translation_scale=0.1)
         noise = NoiseModel(check_noise_level(spec.noise)).fitted
-        executor = make_geometric_executor(true_model, world_from_model, noise, exec_rng, config.costs)
-        config = replace(config, vertex_radius=executor.settings.vertex_radius)  # the circle the executor makes
+        settings = GeometricSettings()
+        executor = make_geometric_executor(true_model, world_from_model, noise, exec_rng, config.costs, settings)
+        config = replace(config, vertex_radius=settings.vertex_radius)  # the circle the executor makes
         return Episode(spec, library, true_model, world_from_model, executor, noise, config, policy_rng)
 
 
@@ -135,7 +139,7 @@ class PhysicsWorld:
     ) -> Episode:
         # MuJoCo and the physics executor load only for physics episodes (geometric sweeps never import them)
         from haptic.episode.evaluate import score_components
-        from haptic.executor.physics import PhysicsExecutor
+        from haptic.executor.physics import PhysicsExecutor, PhysicsSettings
         from haptic.executor.primitives import TouchConfig
         from haptic.sim import RobotInterface, Simulation, compose_scene, random_object_pose
         from haptic.sim.scene import scene_object_from_polyhedron
@@ -153,8 +157,10 @@ class PhysicsWorld:
             )  # fmt: skip
         sim_noise, bounds, noise = noise_models(NoiseModel(check_noise_level(spec.noise)))
         sim = Simulation(scene, noise=sim_noise, seed=int(sim_seq.integers(2**31 - 1)))
-        executor = PhysicsExecutor(RobotInterface(sim), bounds=bounds, costs=config.costs, rng=exec_rng)
-        config = replace(config, vertex_radius=executor.settings.vertex_radius)  # the circle the executor makes
+        settings = PhysicsSettings()
+        executor = PhysicsExecutor(RobotInterface(sim), bounds=bounds, costs=config.costs, rng=exec_rng,
+                                   settings=settings)  # fmt: skip
+        config = replace(config, vertex_radius=settings.vertex_radius)  # the circle the executor makes
         results: list[MoveResult] = []  # every move's result, for scoring perception
 
         def keep(*args) -> None:
