@@ -27,7 +27,9 @@ the start gives up (the arm is held back: every further landing would be too).""
 
 
 class LandingSearch:
-    """The start's landing search and first face, a part of the physics executor."""
+    """The start's landing search and first face, a part of the physics executor: it uses the executor's
+    ``settings``, ``toucher``, ``segmenter``, ``workspace``, ``bounds`` and ``rng``, stores the first face with
+    ``_store_face`` and sets ``state`` and ``_on_face``."""
 
     def _start(self, move: Move, pieces: list[PrimitiveResult]) -> MoveResult:
         s, t = self.settings, self.toucher
