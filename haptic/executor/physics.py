@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from haptic.errors import HapticError
+from haptic.executor.physics_probe import probe_move
 from haptic.executor.primitives import (
     PrimitiveResult,
     TouchConfig,
@@ -42,7 +43,17 @@ from haptic.executor.segment import (
 )
 from haptic.matching.components import DataComponent
 from haptic.matching.trace import PHASES, ContactTrace
-from haptic.planning.moves import CostModel, EdgeMove, FaceMove, Move, MoveResult, SensorState, Touches, VertexMove
+from haptic.planning.moves import (
+    CostModel,
+    EdgeMove,
+    FaceMove,
+    Move,
+    MoveResult,
+    ProbeMove,
+    SensorState,
+    Touches,
+    VertexMove,
+)
 from haptic.sim.robot import RobotInterface
 from haptic.sim.scene import OBJECT_REGION, TABLE_TOP_Z
 
@@ -191,7 +202,7 @@ class PhysicsExecutor:
         info.update(sim_time=self.robot.time - t0, wall_time=time.perf_counter() - w0)
         return MoveResult(move=res.move, status=res.status, components=res.components, distance=res.distance,
                           cost=res.cost, state=res.state, touches=touches_of(trace), trace=trace,
-                          info=info)  # fmt: skip
+                          free_space=res.free_space, info=info)  # fmt: skip
 
     def _hand_links(self) -> dict:
         """The hand's link poses sampled during the move (the robot's own forward kinematics), for
@@ -418,6 +429,8 @@ class PhysicsExecutor:
             return self._run(move, lambda pieces: self._edge_move(move, pieces))
         if isinstance(move, VertexMove):
             return self._run(move, lambda pieces: self._vertex_move(move, pieces))
+        if isinstance(move, ProbeMove):  # the free-space probe: haptic.executor.physics_probe
+            return self._run(move, lambda pieces: probe_move(self, move, pieces))
         return MoveResult(move=move, status="invalid", state=self.state, info={"reason": f"unknown move {move!r}"})
 
     def _invalid(self, move: Move, reason: str) -> MoveResult:
