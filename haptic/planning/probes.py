@@ -72,6 +72,15 @@ class ProbeConfig:
     max_climb: float = 0.5
     """With a table, the approach may rise at most this steeply (the z of its unit direction): the hand comes
     from above or the side, never from under the object."""
+    pad_radius: float = 0.0
+    """Radius of a fingertip pad whose leading point (its centre plus the radius along the line) travels the
+    line (0: a point sensor). With a table, the pad's lowest point -- up to a radius below the line -- stays
+    ``table_clearance`` above the top, and the line's start can be reached from above: the pad centre there is
+    outside the sphere holding every hypothesis's object by the radius, and so is the vertical column above it
+    (the hand descends to the start from over the object) [m]."""
+    max_undercut: float | None = None
+    """Faces whose outward normal leans under (points down) by more than this are not aimed at: the pad of a
+    finger pointing down cannot press on them (its phalanx meets the object first) [rad]. None: no limit."""
 
 
 def fibonacci_directions(n: int) -> np.ndarray:
@@ -121,6 +130,8 @@ def candidate_probes(hypotheses: Sequence[Hypothesis], config: ProbeConfig | Non
         t = h.world_from_model
         targets, normals = t.apply(_face_targets(h.poly)), t.rotate(h.poly.face_normals)
         facing = (dirs @ normals.T) <= -cos_max  # (D, F)
+        if config.max_undercut is not None:
+            facing &= (normals[:, 2] >= -np.sin(config.max_undercut))[None, :]
         for di, fi in zip(*np.nonzero(facing), strict=True):
             u, p = dirs[di], targets[fi]
             # the target's position across the direction, snapped to the grid: one candidate per cell
@@ -129,7 +140,7 @@ def candidate_probes(hypotheses: Sequence[Hypothesis], config: ProbeConfig | Non
             if key in seen:
                 continue
             seen.add(key)
-            move = _line_through(p, u, centre, big, config)
+            move = _line_through(p, u, centre, big, config, radius)
             if move is not None:
                 out.append(move)
     if len(out) > config.max_candidates:
@@ -138,9 +149,12 @@ def candidate_probes(hypotheses: Sequence[Hypothesis], config: ProbeConfig | Non
     return out
 
 
-def _line_through(p: np.ndarray, u: np.ndarray, centre: np.ndarray, radius: float, config: ProbeConfig):
+def _line_through(
+    p: np.ndarray, u: np.ndarray, centre: np.ndarray, radius: float, config: ProbeConfig, hold: float = 0.0
+):
     """The chord along ``u`` through ``p`` of the sphere (``centre``, ``radius``), cut short above the table;
-    None when it would not reach ``p``."""
+    None when it would not reach ``p``, or (with a pad and a table) when the pad could not come down to its
+    start clear of the sphere of radius ``hold`` that holds every hypothesis's object."""
     w = p - centre
     b = float(w @ u)
     disc = b * b - (float(w @ w) - radius * radius)
@@ -150,11 +164,19 @@ def _line_through(p: np.ndarray, u: np.ndarray, centre: np.ndarray, radius: floa
     start = p - back * u
     length = 2.0 * np.sqrt(disc)
     if config.table_z is not None:
-        floor = config.table_z + config.table_clearance
+        r = config.pad_radius
+        floor = config.table_z + config.table_clearance + r * (1.0 + u[2])  # the line's lowest point allowed
         if start[2] < floor or p[2] < floor:
             return None
         if u[2] < 0.0:
             length = min(length, (start[2] - floor) / -u[2])
+        if r > 0.0:
+            c0 = start - r * u  # the pad centre at the line's start
+            w0 = c0 - centre
+            if float(np.linalg.norm(w0)) < hold + r:
+                return None
+            if w0[2] < 0.0 and float(np.hypot(w0[0], w0[1])) < hold + r:  # under the sphere's side
+                return None
     if length <= back:
         return None
     return ProbeMove(start, u, float(length))
