@@ -38,7 +38,6 @@ def test_random_policy_takes_probes_too():
     [
         ({"moves": "probing"}, ("probing", "tracing, all")),
         ({"moves": "sometimes"}, ("sometimes", "tracing, all")),
-        ({"moves": "all", "executor": "physics"}, ("geometric", "tracing")),
         ({"moves": "all", "policy": "optimal"}, ("optimal", "tracing")),
     ],
 )
@@ -46,6 +45,13 @@ def test_move_sets_not_available_are_refused_by_name(fields, words):
     with pytest.raises(HapticError) as err:
         EpisodeSpec(model="BOX01", seed=0, **fields)
     assert all(w in str(err.value) for w in words)
+
+
+def test_probes_are_admitted_on_the_simulated_hand():
+    spec = EpisodeSpec(model="BOX01", seed=0, moves="all", executor="physics")
+    assert spec.moves == "all"
+    with pytest.raises(HapticError):
+        EpisodeSpec(model="BOX01", seed=0, moves="all", executor="physics", policy="optimal")
 
 
 def test_cli_refuses_probing_in_one_line(tmp_path, capsys):
