@@ -36,8 +36,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from haptic.executor.primitives import PrimitiveResult, angle, unit
+from haptic.executor.primitives import PrimitiveResult, angle, perpendicular, unit
+from haptic.executor.segment import FaceFit
 from haptic.matching.probes import FreeSegment
+from haptic.matching.trace import ContactTrace
 from haptic.planning.moves import MoveResult, ProbeMove, SensorState
 from haptic.sim.scene import TABLE_TOP_Z
 
@@ -131,13 +133,17 @@ def probe_move(ex: PhysicsExecutor, move: ProbeMove, pieces: list[PrimitiveResul
             return ex._fail(move, res, f"leaving the surface: {res.event}")
     lifted = t.tip.copy()
     ex._on_face = None
+    went_along = False  # the pad has been on the line (the way back may follow it)
 
     def fail(res, reason: str) -> MoveResult:
         """The failed move's result, after going back the way it came (off the object first, when touching)."""
         out = ex._fail(move, res, reason)
         if t.contact[1] is not None and t.normal is not None:
             pieces.append(t.move_free(t.tip + settings.lift * t.normal, timeout=2.0, tol=2e-3))
-        _return(ex, lifted, z_safe, n_left, was_on, settings, pieces, [])
+        if went_along:
+            _return(ex, lifted, z_safe, n_left, was_on, settings, pieces, [], centre0)
+        else:
+            _return(ex, lifted, z_safe, n_left, was_on, settings, pieces, [])
         return out
     # 2. up, across, down to the line's start
     for name, w in (("rising", np.array([lifted[0], lifted[1], z_safe])),
@@ -150,6 +156,7 @@ def probe_move(ex: PhysicsExecutor, move: ProbeMove, pieces: list[PrimitiveResul
             why = f"touched the object {name} (finger {res.info['finger']})" if res.event == "contact" else res.event
             return fail("unreachable" if res.ok else res, f"transfer to the probe's line: {why}")
     # 3. the guarded approach along the line
+    went_along = True
     approach = leg(centre1, settings.probe_speed, settings.probe_lag, phase="approach")
     bound = ex.bounds.bound(ex.bounds.point_sigma, ex.bounds.position_floor)
     tips = approach.trace.tip_in_world
@@ -159,7 +166,7 @@ def probe_move(ex: PhysicsExecutor, move: ProbeMove, pieces: list[PrimitiveResul
         return fail(approach, f"approach along the line: {approach.event}")
     if approach.event == "done":  # a miss: the whole line is free
         segment = _leading_segment(tips, u, r, 0.0, bound)
-        back = _return(ex, lifted, z_safe, n_left, was_on, settings, pieces, free)
+        back = _return(ex, lifted, z_safe, n_left, was_on, settings, pieces, free, centre0)
         s = _free_distance(free)
         return MoveResult(move=move, status="ok", distance=s, cost=ex.costs.probe_move(s), state=st,
                           free_space=(segment,) if segment is not None else (),
@@ -176,7 +183,7 @@ def probe_move(ex: PhysicsExecutor, move: ProbeMove, pieces: list[PrimitiveResul
         return fail(touch, f"touching the contact again: {touch.event}")
     if ex._is_table(touch.info["normal"], touch.info["point"]):
         return fail("unreachable", "the probe touched the table")
-    fit, trace = ex._normal_stroke(touch.info["normal"], pieces)
+    fit, trace = _measure_face(ex, touch.info["point"], touch.info["normal"], pieces)
     if fit is None:
         return fail("unreachable", "the probe touched an edge or a vertex: no face normal there")
     face = seg.add_face(fit, ())
@@ -187,6 +194,42 @@ def probe_move(ex: PhysicsExecutor, move: ProbeMove, pieces: list[PrimitiveResul
                       cost=ex.costs.probe_move(s) + ex.costs.c_n, state=ex.state,
                       free_space=(segment,) if segment is not None else (),
                       info={"contact": travel, "hit_point": touch.info["point"].tolist()})  # fmt: skip
+
+
+def _measure_face(ex: PhysicsExecutor, point: np.ndarray, n0: np.ndarray,
+                  pieces: list[PrimitiveResult]) -> tuple[FaceFit | None, ContactTrace]:  # fmt: skip
+    """The face under the contact at ``point`` (sensed normal ``n0``): an L stroke from it (legs of
+    ``normal_stroke``), in up to four headings a quarter turn apart -- touching ``point`` again between tries --
+    until one stays on one face (its normal does not turn as the pad slides: not rolling on an edge or a vertex
+    nearby) and fits a plane. (None, trace) when none does."""
+    t, s, seg = ex.toucher, ex.settings, ex.segmenter
+    a = perpendicular(n0)
+    phi0 = ex.rng.uniform(0.0, 2.0 * math.pi)
+    floor = TABLE_TOP_Z + t.pad_radius + s.table_margin
+    trace = ContactTrace.concatenate([])
+    for k in range(4):
+        if k > 0:
+            again = t.lift_and_approach(point, n0, floor_z=floor)
+            pieces.append(again)
+            if not again.ok or angle(again.info["normal"], n0) > math.radians(6.0):
+                return None, trace
+        phi = phi0 + k * math.pi / 2.0
+        d1 = math.cos(phi) * a + math.sin(phi) * np.cross(n0, a)
+        legs = []
+        for d in (d1, np.cross(n0, d1)):
+            r = t.trace_face(d, n0, s.normal_stroke, phase="stroke")
+            legs.append(r)
+            pieces.append(r)
+            if not r.ok or r.event != "done":
+                break
+        if legs[-1].status == "unstable":
+            return None, trace
+        trace = ContactTrace.concatenate([r.trace for r in legs])
+        if len(legs) == 2 and all(r.ok and r.event == "done" for r in legs) and ex._on_one_face(trace):
+            fit = seg.fit_face_trace(trace, legs[-1].info["face_normal"], two_d=True)
+            if fit is not None:
+                return fit, trace
+    return None, trace
 
 
 def _highest_contact(ex: PhysicsExecutor) -> float:
@@ -203,16 +246,37 @@ def _highest_contact(ex: PhysicsExecutor) -> float:
 
 
 def _return(ex: PhysicsExecutor, lifted: np.ndarray, z_safe: float, n_left: np.ndarray, was_on: int | None,
-            settings: ProbeSettings, pieces: list[PrimitiveResult], free: list[PrimitiveResult]) -> bool:  # fmt: skip
-    """After a miss: up from the line's end, across and down to where the pad left the surface, and touch the
-    face it left again (when it was on one). Whether the pad rests on that face again."""
+            settings: ProbeSettings, pieces: list[PrimitiveResult], free: list[PrimitiveResult],
+            line_start: np.ndarray | None = None) -> bool:  # fmt: skip
+    """After a miss (or a failure): up from where the pad is -- when that is blocked (under an overhang), back to
+    the pad centre's place at the line's start ``line_start`` first --, across and down to where the pad left
+    the surface, and touch the face it left again (when it was on one). Whether the pad rests on that face
+    again."""
     t = ex.toucher
-    for w in (np.array([t.tip[0], t.tip[1], z_safe]), np.array([lifted[0], lifted[1], z_safe]), lifted):
-        if float(np.linalg.norm(w - t.tip)) < 1e-3:
-            continue
+
+    def go(w: np.ndarray) -> PrimitiveResult:
         res = t.move_guarded(w, settings.transfer_speed, max_lag=settings.transfer_lag)
         pieces.append(res)
         free.append(res)
+        return res
+
+    up = go(np.array([t.tip[0], t.tip[1], z_safe]))
+    if (not up.ok or up.event != "done") and line_start is not None:
+        # under an overhang: off the object, back along the line (free: the pad came that way), then up
+        if t.contact[1] is not None and t.normal is not None:
+            off = t.move_free(t.tip + settings.lift * t.normal, timeout=2.0, tol=2e-3)
+            pieces.append(off)
+            free.append(off)
+        for w in (line_start, np.array([line_start[0], line_start[1], z_safe])):
+            up = go(w)
+            if not up.ok or up.event != "done":
+                return False
+    elif not up.ok or up.event != "done":
+        return False
+    for w in (np.array([lifted[0], lifted[1], z_safe]), lifted):
+        if float(np.linalg.norm(w - t.tip)) < 1e-3:
+            continue
+        res = go(w)
         if not res.ok or res.event != "done":
             return False
     if was_on is None:
