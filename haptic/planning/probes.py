@@ -49,6 +49,9 @@ if TYPE_CHECKING:
 
 MIN_INCIDENCE = 0.2
 """Smallest ``|n·u|`` used to turn a surface offset into a distance along a line (a grazing approach)."""
+FINGER_LIFT = 0.08
+"""Height above the pad's centre through which the finger above it must be free [m] (as
+:data:`haptic.planning.reach.LIFT`)."""
 
 
 @dataclass(frozen=True)
@@ -77,7 +80,8 @@ class ProbeConfig:
     line (0: a point sensor). With a table, the pad's lowest point -- up to a radius below the line -- stays
     ``table_clearance`` above the top, and the line's start can be reached from above: the pad centre there is
     outside the sphere holding every hypothesis's object by the radius, and so is the vertical column above it
-    (the hand descends to the start from over the object) [m]."""
+    (the hand descends to the start from over the object); the finger above the pad stays clear of every
+    hypothesis's object along the line (:func:`finger_clear`) [m]."""
     max_undercut: float | None = None
     """Faces whose outward normal leans under (points down) by more than this are not aimed at: the pad of a
     finger pointing down cannot press on them (its phalanx meets the object first) [rad]. None: no limit."""
@@ -146,7 +150,43 @@ def candidate_probes(hypotheses: Sequence[Hypothesis], config: ProbeConfig | Non
     if len(out) > config.max_candidates:
         pick = np.linspace(0, len(out) - 1, config.max_candidates).round().astype(int)
         out = [out[i] for i in pick]
+    if out and config.pad_radius > 0.0 and config.table_z is not None:
+        clear = finger_clear(posed, out, config.pad_radius)
+        out = [mv for mv, ok in zip(out, clear, strict=True) if ok]
     return out
+
+
+FINGER_SAMPLES = 8
+"""Points along a line's pad path at which :func:`finger_clear` checks the finger above the pad."""
+
+
+def finger_clear(hypotheses: Sequence[Hypothesis], moves: Sequence[ProbeMove], pad_radius: float,
+                 lift: float = FINGER_LIFT) -> np.ndarray:  # fmt: skip
+    """Whether the finger above the pad -- pointing down, the column from the pad's top to ``lift`` above its
+    centre -- stays clear of every hypothesis's object while the pad travels each line up to where that
+    hypothesis predicts its contact (or to the line's end), shape (M,) bool. A line passing under an overhang
+    of a hypothesis (a slot's ceiling, a ledge) would have the finger's phalanx meet the object before the pad:
+    a blocked move, no contact sensed."""
+    m = len(moves)
+    ok = np.ones(m, dtype=bool)
+    if m == 0:
+        return ok
+    r = pad_radius
+    starts = np.array([mv.start for mv in moves], dtype=float)
+    dirs = np.array([mv.direction for mv in moves], dtype=float)
+    lengths = np.array([mv.length for mv in moves], dtype=float)
+    frac = np.linspace(0.0, 1.0, FINGER_SAMPLES)
+    up = np.array([0.0, 0.0, 1.0])
+    for h in hypotheses:
+        inv = h.model_from_world
+        t_end = np.minimum(line_hits(h.poly, inv.apply(starts), inv.rotate(dirs)).first, lengths)  # (M,)
+        centres = (starts - r * dirs)[:, None, :] + (frac[None, :] * t_end[:, None])[..., None] * dirs[:, None, :]
+        tops = inv.apply((centres + lift * up).reshape(-1, 3))
+        down = np.broadcast_to(inv.rotate(-up), tops.shape)
+        hit = line_hits(h.poly, tops, down).first <= lift - r
+        blocked = hit | h.poly.contains(tops)
+        ok &= ~blocked.reshape(m, FINGER_SAMPLES).any(axis=1)
+    return ok
 
 
 def _line_through(
@@ -328,5 +368,5 @@ def predict_probes(
     return out
 
 
-__all__ = ["MIN_INCIDENCE", "ProbeConfig", "ProbePrediction", "candidate_probes", "fibonacci_directions",
-           "predict_probes"]  # fmt: skip
+__all__ = ["FINGER_LIFT", "MIN_INCIDENCE", "ProbeConfig", "ProbePrediction", "candidate_probes",
+           "fibonacci_directions", "finger_clear", "predict_probes"]  # fmt: skip
