@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import Any
 
 import numpy as np
 
@@ -43,8 +43,9 @@ from haptic.matching.trace import ContactTrace
 from haptic.planning.moves import MoveResult, ProbeMove, SensorState
 from haptic.sim.scene import TABLE_TOP_Z
 
-if TYPE_CHECKING:
-    from haptic.executor.physics import PhysicsExecutor
+PhysicsExecutor = Any
+"""The :class:`~haptic.executor.physics.PhysicsExecutor` whose hand carries out the probe (its toucher, segmenter,
+bounds, costs and state); the type is not imported here, since that module dispatches to this one."""
 
 
 @dataclass(frozen=True)
