@@ -2,8 +2,8 @@
 moves, path cost, wall and simulated time, pose error and perception errors per episode, then a summary per object.
 
     .venv/bin/python scripts/physics_episodes.py [--poses 3] [--first-seed 1] [--objects BOX01,WEDGE01]
-                                                 [--policy planner] [--moves tracing|all] [--jobs 2]
-                                                 [--json episodes.json]
+                                                 [--policy planner] [--moves tracing|all]
+                                                 [--verify none|fast|full] [--jobs 2] [--json episodes.json]
 
 Pose ``k`` of an object is episode seed ``first-seed + k`` (the seed places the object and drives the planner's
 random choices), so any row can be replayed with ``haptic explore --object NAME --executor physics --seed S``
@@ -34,7 +34,7 @@ SEED_OBJECTS = ("BOX01", "WEDGE01", "BOX01N", "BOX01P", "PYR01", "TETRA01L", "TE
                 "FRAME01")
 
 
-def one(model: str, seed: int, policy: str, moves: str = "tracing") -> dict:
+def one(model: str, seed: int, policy: str, moves: str = "tracing", verify: str = "none") -> dict:
     """One physics episode's record as JSON (an ``error`` entry when it could not run), with the probes that
     failed (``probes_failed``) and why (``probe_failures``)."""
     failed: list[str] = []
@@ -44,7 +44,7 @@ def one(model: str, seed: int, policy: str, moves: str = "tracing") -> dict:
             failed.append(f"{result.status}: {result.info.get('reason', '')}")
 
     try:
-        spec = EpisodeSpec(model=model, seed=seed, policy=policy, executor="physics", moves=moves)
+        spec = EpisodeSpec(model=model, seed=seed, policy=policy, executor="physics", moves=moves, verify=verify)
         rec = run_episode(spec, observer=EpisodeObserver(on_failed_move=on_failed)).to_json()
     except HapticError as exc:
         return {"model": model, "seed": seed, "outcome": "error", "correct": False, "detail": str(exc)}
@@ -73,12 +73,14 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--objects", default=",".join(SEED_OBJECTS))
     ap.add_argument("--policy", default="planner")
     ap.add_argument("--moves", default="tracing", choices=("tracing", "all"), help="admissible kinds of move")
+    ap.add_argument("--verify", default="none", choices=("none", "fast", "full"),
+                    help="verification before recognition (default none: the matcher's verdict)")
     ap.add_argument("--jobs", type=int, default=1, help="episodes run in parallel (processes)")
     ap.add_argument("--json", default=None, help="write every episode record here")
     args = ap.parse_args(argv)
 
     objects = [o for o in args.objects.split(",") if o]
-    jobs = [(o, args.first_seed + k, args.policy, args.moves) for o in objects for k in range(args.poses)]
+    jobs = [(o, args.first_seed + k, args.policy, args.moves, args.verify) for o in objects for k in range(args.poses)]
     t0 = time.perf_counter()
     if args.jobs > 1:
         with ProcessPoolExecutor(args.jobs) as pool:
