@@ -42,7 +42,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--moves", choices=MOVE_SETS, default="tracing",
         help="admissible kinds of move (default tracing): tracing (face, edge, vertex moves) or all (free-space "
-        "probes too, one planner ranking them; geometric executor); probing is not available yet",
+        "probes too, one planner ranking them); probing is not available yet",
     )  # fmt: skip
     p.add_argument("--json", metavar="OUT", help="write the episode's JSON record here")
     p.add_argument("--record", metavar="OUT.rrd", help="write a rerun recording here")

@@ -2,10 +2,13 @@
 moves, path cost, wall and simulated time, pose error and perception errors per episode, then a summary per object.
 
     .venv/bin/python scripts/physics_episodes.py [--poses 3] [--first-seed 1] [--objects BOX01,WEDGE01]
-                                                 [--policy planner] [--jobs 2] [--json episodes.json]
+                                                 [--policy planner] [--moves tracing|all]
+                                                 [--verify none|fast|full] [--jobs 2] [--json episodes.json]
 
 Pose ``k`` of an object is episode seed ``first-seed + k`` (the seed places the object and drives the planner's
-random choices), so any row can be replayed with ``haptic explore --object NAME --executor physics --seed S``.
+random choices), so any row can be replayed with ``haptic explore --object NAME --executor physics --seed S``
+(and ``--moves all`` for free-space probes too: the probes used, those that missed and those that failed are
+counted per episode).
 Copy and adapt: one episode is ``run_episode(EpisodeSpec(model=..., seed=..., executor="physics"))``.
 """
 
@@ -21,6 +24,7 @@ from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
+from haptic.episode.loop import EpisodeObserver
 from haptic.episode.spec import EpisodeSpec
 from haptic.episode.worlds import run_episode
 from haptic.errors import HapticError
@@ -30,12 +34,22 @@ SEED_OBJECTS = ("BOX01", "WEDGE01", "BOX01N", "BOX01P", "PYR01", "TETRA01L", "TE
                 "FRAME01")
 
 
-def one(model: str, seed: int, policy: str) -> dict:
-    """One physics episode's record as JSON (an ``error`` entry when it could not run)."""
+def one(model: str, seed: int, policy: str, moves: str = "tracing", verify: str = "none") -> dict:
+    """One physics episode's record as JSON (an ``error`` entry when it could not run), with the probes that
+    failed (``probes_failed``) and why (``probe_failures``)."""
+    failed: list[str] = []
+
+    def on_failed(n, result) -> None:
+        if result.move is not None and result.move.kind == "probe":
+            failed.append(f"{result.status}: {result.info.get('reason', '')}")
+
     try:
-        return run_episode(EpisodeSpec(model=model, seed=seed, policy=policy, executor="physics")).to_json()
+        spec = EpisodeSpec(model=model, seed=seed, policy=policy, executor="physics", moves=moves, verify=verify)
+        rec = run_episode(spec, observer=EpisodeObserver(on_failed_move=on_failed)).to_json()
     except HapticError as exc:
         return {"model": model, "seed": seed, "outcome": "error", "correct": False, "detail": str(exc)}
+    rec.update(probes_failed=len(failed), probe_failures=failed)
+    return rec
 
 
 def _f(x, fmt: str = ".1f") -> str:
@@ -58,12 +72,15 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--first-seed", type=int, default=1)
     ap.add_argument("--objects", default=",".join(SEED_OBJECTS))
     ap.add_argument("--policy", default="planner")
+    ap.add_argument("--moves", default="tracing", choices=("tracing", "all"), help="admissible kinds of move")
+    ap.add_argument("--verify", default="none", choices=("none", "fast", "full"),
+                    help="verification before recognition (default none: the matcher's verdict)")
     ap.add_argument("--jobs", type=int, default=1, help="episodes run in parallel (processes)")
     ap.add_argument("--json", default=None, help="write every episode record here")
     args = ap.parse_args(argv)
 
     objects = [o for o in args.objects.split(",") if o]
-    jobs = [(o, args.first_seed + k, args.policy) for o in objects for k in range(args.poses)]
+    jobs = [(o, args.first_seed + k, args.policy, args.moves, args.verify) for o in objects for k in range(args.poses)]
     t0 = time.perf_counter()
     if args.jobs > 1:
         with ProcessPoolExecutor(args.jobs) as pool:
@@ -71,11 +88,12 @@ def main(argv: list[str] | None = None) -> int:
     else:
         records = [one(*j) for j in jobs]
 
-    print(f"{'object':<10} {'seed':>4} {'outcome':<10} {'ok':<3} {'moves':>5} {'fail':>4} {'cost':>6} "
-          f"{'wall s':>6} {'sim s':>6} {'err mm':>6} {'err °':>5}  perception (medians)")  # fmt: skip
+    print(f"{'object':<10} {'seed':>4} {'outcome':<10} {'ok':<3} {'moves':>5} {'fail':>4} {'probes':>6} "
+          f"{'cost':>6} {'wall s':>6} {'sim s':>6} {'err mm':>6} {'err °':>5}  perception (medians)")  # fmt: skip
     for r in records:
+        probes = f"{r.get('probes', 0)}/{r.get('probe_misses', 0)}/{r.get('probes_failed', 0)}"
         print(f"{r['model']:<10} {r['seed']:>4} {r['outcome']:<10} {'yes' if r['correct'] else 'no':<3} "
-              f"{r.get('moves', 0):>5} {r.get('failed_moves', 0):>4} {_f(r.get('path_cost')):>6} "
+              f"{r.get('moves', 0):>5} {r.get('failed_moves', 0):>4} {probes:>6} {_f(r.get('path_cost')):>6} "
               f"{_f(r.get('wall_time_s')):>6} {_f(r.get('sim_time_s')):>6} {_f(r.get('pose_error_mm'), '.2f'):>6} "
               f"{_f(r.get('pose_error_deg'), '.2f'):>5}  {_perception(r)}")  # fmt: skip
         if r["outcome"] not in ("recognized",) and r.get("detail"):
@@ -83,7 +101,7 @@ def main(argv: list[str] | None = None) -> int:
 
     print()
     print(f"{'object':<10} {'correct':>7} {'wrong':>5} {'moves':>6} {'cost':>6} {'wall s':>6} {'sim s':>6} "
-          f"{'err mm':>6}  (medians over the correctly recognised episodes)")  # fmt: skip
+          f"{'err mm':>6}  (medians over the correctly recognised episodes; probes: used/missed/failed)")  # fmt: skip
     wrong_total = 0
     for o in objects:
         rs = [r for r in records if r["model"] == o]

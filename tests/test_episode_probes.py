@@ -38,7 +38,6 @@ def test_random_policy_takes_probes_too():
     [
         ({"moves": "probing"}, ("probing", "tracing, all")),
         ({"moves": "sometimes"}, ("sometimes", "tracing, all")),
-        ({"moves": "all", "executor": "physics"}, ("geometric", "tracing")),
         ({"moves": "all", "policy": "optimal"}, ("optimal", "tracing")),
     ],
 )
@@ -46,6 +45,13 @@ def test_move_sets_not_available_are_refused_by_name(fields, words):
     with pytest.raises(HapticError) as err:
         EpisodeSpec(model="BOX01", seed=0, **fields)
     assert all(w in str(err.value) for w in words)
+
+
+def test_probes_are_admitted_on_the_simulated_hand():
+    spec = EpisodeSpec(model="BOX01", seed=0, moves="all", executor="physics")
+    assert spec.moves == "all"
+    with pytest.raises(HapticError):
+        EpisodeSpec(model="BOX01", seed=0, moves="all", executor="physics", policy="optimal")
 
 
 def test_cli_refuses_probing_in_one_line(tmp_path, capsys):
@@ -70,3 +76,33 @@ def test_bench_moves_at_a_small_size():
     assert all(r["correct %"] == 100.0 for r in rows)
     assert rows[0]["probes"] == 0 and rows[1]["probes"] >= 1
     assert markdown(rows).count("\n") == 3
+
+
+def test_a_failed_probe_is_not_tried_again_and_tracing_moves_follow_it():
+    """An executor whose probes all fail (as the hand's do when it cannot get along a line): each line is tried
+    once, and the move after a failed probe is a tracing move; the episode still recognises by tracing."""
+    from haptic.episode.worlds import build_episode
+    from haptic.planning.moves import MoveResult
+    from haptic.planning.scoring import same_move
+
+    episode = build_episode(EpisodeSpec(model="BOX01", seed=1, moves="all"), config=CHEAP)
+    inner = episode.executor
+    kinds, lines = [], []
+
+    class FailingProbes:
+        def start(self):
+            return inner.start()
+
+        def execute(self, move):
+            kinds.append(move.kind)
+            if move.kind == "probe":
+                assert not any(same_move(move, m) for m in lines), "a failed line was offered again"
+                lines.append(move)
+                return MoveResult(move=move, status="unreachable", state=inner.state, info={"reason": "blocked"})
+            return inner.execute(move)
+
+    episode.executor = FailingProbes()
+    rec = episode.run()
+    assert "probe" in kinds and rec.outcome == "recognized" and rec.correct
+    after = [kinds[i + 1] for i, k in enumerate(kinds[:-1]) if k == "probe"]
+    assert after and all(k != "probe" for k in after)

@@ -53,7 +53,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--moves", choices=MOVE_SETS, default="tracing",
         help="admissible kinds of move (default tracing): tracing (face, edge, vertex moves) or all (free-space "
-        "probes too, one planner ranking them; geometric executor); probing is not available yet",
+        "probes too, one planner ranking them); probing is not available yet",
     )  # fmt: skip
     p.add_argument("--out", default="out/bench/results.jsonl", help="results file (JSON lines)")
     p.add_argument("--workers", type=positive_int, default=1,

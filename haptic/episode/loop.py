@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Generator
-from dataclasses import asdict, dataclass, field, fields
+from dataclasses import asdict, dataclass, field, fields, replace
 from pathlib import Path
 from typing import Protocol
 
@@ -241,7 +241,7 @@ def loop_steps(
     touched: list[tuple[np.ndarray, np.ndarray]] = []
     free: list[FreeSegment] = []  # free space the probes travelled (a miss's line, a hit's approach)
     probe_faces: list[int] = []  # data ids of the faces probes hit
-    probed: list[Move] = []  # probes carried out: the same line again would tell nothing new, so it is not offered
+    probed: list[Move] = []  # probes carried out or failed: the same line again would tell nothing new (or fail again)
 
     def assess() -> Recognition:
         """The verdict on the data so far (with the table and the touched points, when known)."""
@@ -308,7 +308,11 @@ def loop_steps(
             if move is None:
                 t_dec = time.perf_counter()
                 hyps = hypotheses_from(tree, rec) if rec is not None and rec.classes else []
-                ctx = Context(hyps, state, components, noise, config, avoid=(*failed_here, *probed), tree=tree)
+                # after a probe failed from here (the hand could not get along its line), tracing moves until one
+                # succeeds: probes aimed at the same region would fail the same way
+                cfg = replace(config, moves="tracing") if config.moves == "all" and any(
+                    m.kind == "probe" for m in failed_here) else config  # fmt: skip
+                ctx = Context(hyps, state, components, noise, cfg, avoid=(*failed_here, *probed), tree=tree)
                 try:
                     if len(hyps) >= 2 and not verifying:
                         decision = yield DecisionPoint(ctx, rng)
@@ -327,6 +331,8 @@ def loop_steps(
                 failed_total += 1
                 failed_in_a_row += 1
                 failed_here.append(move)
+                if move.kind == "probe":  # its line is where it is, whatever the state: not offered again
+                    probed.append(move)
                 cost += result.cost
                 if obs.on_failed_move:
                     obs.on_failed_move(n_moves, result)

@@ -36,7 +36,7 @@ class EpisodeSpec:
     """Verification before recognition: "none", "fast" or "full" (:mod:`haptic.matching.verify`)."""
     moves: str = "tracing"
     """Admissible kinds of move: "tracing" (face, edge, vertex moves) or "all" (free-space probes too, ranked with
-    them by one planner; geometric executor, planner, greedy and random policies only)."""
+    them by one planner; planner, greedy and random policies only)."""
 
     def __post_init__(self) -> None:
         if self.moves == "tracing":
@@ -46,11 +46,6 @@ class EpisodeSpec:
         if self.moves == "probing":
             raise HapticError(
                 "--moves probing is not available yet (probes alone do not recognise reliably); valid: tracing, all"
-            )
-        if self.executor != "geometric":
-            raise HapticError(
-                f"--moves {self.moves}: free-space probes run on the geometric executor only; "
-                f"valid with --executor {self.executor}: tracing"
             )
         if self.policy == "optimal":
             raise HapticError(

@@ -145,7 +145,7 @@ class PhysicsWorld:
         from haptic.sim.scene import scene_object_from_polyhedron
 
         library, true_model, (pose_rng, exec_rng, policy_rng, sim_seq) = _setup(spec, library)
-        config = config or PlannerConfig()
+        config = replace(config or PlannerConfig(), moves=spec.moves)
         obj = scene_object_from_polyhedron(true_model)
         pose = random_object_pose(obj, pose_rng)
         scene = compose_scene(obj, pose)

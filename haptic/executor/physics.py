@@ -25,6 +25,7 @@ import numpy as np
 
 from haptic.errors import HapticError
 from haptic.executor.landing import LandingSearch
+from haptic.executor.physics_probe import probe_move
 from haptic.executor.primitives import PrimitiveResult, TouchConfig, Toucher
 from haptic.executor.segment import (
     FaceFit,
@@ -47,6 +48,7 @@ from haptic.planning.moves import (
     HandLinks,
     Move,
     MoveResult,
+    ProbeMove,
     SensorState,
     Touches,
     VertexMove,
@@ -198,7 +200,7 @@ class PhysicsExecutor(LandingSearch):
         return MoveResult(move=res.move, status=res.status, components=res.components, distance=res.distance,
                           cost=res.cost, state=res.state, touches=touches_of(trace), trace=trace, reason=res.reason,
                           links=links, sim_time=self.robot.time - t0, wall_time=time.perf_counter() - w0,
-                          info=res.info)  # fmt: skip
+                          free_space=res.free_space, info=res.info)  # fmt: skip
 
     def _hand_links(self) -> HandLinks:
         """The hand's link poses sampled during the move (the robot's own forward kinematics), for
@@ -276,6 +278,8 @@ class PhysicsExecutor(LandingSearch):
             return self._run(move, lambda pieces: self._edge_move(move, pieces))
         if isinstance(move, VertexMove):
             return self._run(move, lambda pieces: self._vertex_move(move, pieces))
+        if isinstance(move, ProbeMove):  # the free-space probe: haptic.executor.physics_probe
+            return self._run(move, lambda pieces: probe_move(self, move, pieces))
         return MoveResult(move=move, status="invalid", state=self.state, reason=f"unknown move {move!r}")
 
     def _invalid(self, move: Move, reason: str) -> MoveResult:

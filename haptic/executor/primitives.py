@@ -33,6 +33,8 @@ from haptic.sim.scene import PAD_RADIUS
 DOWN = np.diag([-1.0, 1.0, -1.0])
 """Hand rotation ``world_from_hand`` with the fingers pointing down (the tracing posture)."""
 
+SERVO_LAG = 0.13
+"""The position servo trails a moving command by about this much time [s] (measured: 15 mm at 0.15 m/s)."""
 FAILURES = ("no-contact", "unreachable", "timeout", "unstable")
 """Failure statuses of a primitive (the move statuses of :class:`~haptic.planning.moves.MoveResult`)."""
 UNDERCUT_SLACK = math.radians(3.0)
@@ -295,6 +297,57 @@ class Toucher:
                 return self._result("unstable", "nan", 0.0)
             if s >= 1.0 and np.linalg.norm(self.tip - point) < tol:
                 return self._result("ok", "done", 0.0)
+        return self._result("timeout", "limit", 0.0)
+
+    def move_guarded(
+        self, point: np.ndarray, speed: float, phase: str = "free", max_lag: float = 0.004, timeout: float | None = None
+    ) -> PrimitiveResult:
+        """Move the pad centre to ``point`` [m] along a straight line at ``speed`` [m/s] (position control) in
+        free space, stopping at the first touch anywhere on the hand's fingertips: the active pad's debounced
+        contact, or any other fingertip's sensed contact force above the threshold. Event ``"done"`` (status
+        ok) when it got there; ``"contact"`` (status ok; ``info``: ``finger``, ``point``, ``normal`` sensed,
+        ``travel`` of the pad centre along the line [m]) at a touch; ``"blocked"`` (``unreachable``) when the pad
+        lags its commanded point by more than ``max_lag`` beyond the servo's own lag (about 0.1 s of travel:
+        :data:`SERVO_LAG`) -- something unsensed, a phalanx or the palm, holds the hand back; ``"limit"``
+        (``unreachable``) when the arm cannot reach ``point``."""
+        cfg = self.config
+        target = np.asarray(point, dtype=float)
+        start = self.tip.copy()
+        self.hybrid = False
+        self.normal = None
+        self.contact_ticks = 0
+        if not self.robot.reachable(self.finger, target, cfg.hand_rotation).reachable:
+            return self._result("unreachable", "limit", 0.0, target=target)
+        dist = float(np.linalg.norm(target - start))
+        u = (target - start) / dist if dist > 0 else np.zeros(3)
+        n_ticks = max(1, int(math.ceil(dist / speed / self.dt)))
+        others = [f for f in self.robot.fingers if f != self.finger]
+        settle_ticks = int(0.5 / self.dt)
+        max_lag = max_lag + SERVO_LAG * speed
+        timeout = timeout if timeout is not None else dist / speed + 2.0
+        for k in range(1, int(timeout / self.dt)):
+            s = min(1.0, k / n_ticks)
+            command = start + s * (target - start)
+            self.robot.move_fingertip(command, cfg.hand_rotation)
+            self.tick(phase)
+            if self._unhealthy:
+                return self._result("unstable", "nan", 0.0)
+            travel = float((self.tip - start) @ u)
+            if self.touching:
+                self.robot.move_fingertip(self.tip.copy(), cfg.hand_rotation)
+                return self._result("ok", "contact", 0.0, finger=self.finger, point=self.contact[2].copy(),
+                                    normal=self.normal.copy(), travel=travel)  # fmt: skip
+            for f in others:
+                c = self.robot.sense_contact(f)
+                if c.normal_force > self.threshold and c.normal_in_world is not None:
+                    self.robot.move_fingertip(self.tip.copy(), cfg.hand_rotation)
+                    return self._result("ok", "contact", 0.0, finger=f, point=c.point_in_world.copy(),
+                                        normal=c.normal_in_world.copy(), travel=travel)  # fmt: skip
+            if float(np.linalg.norm(self.tip - command)) > max_lag and s < 1.0:
+                self.robot.move_fingertip(self.tip.copy(), cfg.hand_rotation)
+                return self._result("unreachable", "blocked", 0.0, travel=travel)
+            if s >= 1.0 and (np.linalg.norm(self.tip - target) < 7e-4 or k > n_ticks + settle_ticks):
+                return self._result("ok", "done", 0.0, travel=travel)
         return self._result("timeout", "limit", 0.0)
 
     def approach(

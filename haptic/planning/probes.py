@@ -46,6 +46,9 @@ from haptic.planning.moves import CostModel, ProbeMove
 
 MIN_INCIDENCE = 0.2
 """Smallest ``|n·u|`` used to turn a surface offset into a distance along a line (a grazing approach)."""
+FINGER_LIFT = 0.08
+"""Height above the pad's centre through which the finger above it must be free [m] (as
+:data:`haptic.planning.reach.LIFT`)."""
 
 
 @dataclass(frozen=True)
@@ -69,6 +72,16 @@ class ProbeConfig:
     max_climb: float = 0.5
     """With a table, the approach may rise at most this steeply (the z of its unit direction): the hand comes
     from above or the side, never from under the object."""
+    pad_radius: float = 0.0
+    """Radius of a fingertip pad whose leading point (its centre plus the radius along the line) travels the
+    line (0: a point sensor). With a table, the pad's lowest point -- up to a radius below the line -- stays
+    ``table_clearance`` above the top, and the line's start can be reached from above: the pad centre there is
+    outside the sphere holding every hypothesis's object by the radius, and so is the vertical column above it
+    (the hand descends to the start from over the object); the finger above the pad stays clear of every
+    hypothesis's object along the line (:func:`finger_clear`) [m]."""
+    max_undercut: float | None = None
+    """Faces whose outward normal leans under (points down) by more than this are not aimed at: the pad of a
+    finger pointing down cannot press on them (its phalanx meets the object first) [rad]. None: no limit."""
 
 
 def fibonacci_directions(n: int) -> np.ndarray:
@@ -118,6 +131,8 @@ def candidate_probes(hypotheses: Sequence[Hypothesis], config: ProbeConfig | Non
         t = h.world_from_model
         targets, normals = t.apply(_face_targets(h.poly)), t.rotate(h.poly.face_normals)
         facing = (dirs @ normals.T) <= -cos_max  # (D, F)
+        if config.max_undercut is not None:
+            facing &= (normals[:, 2] >= -np.sin(config.max_undercut))[None, :]
         for di, fi in zip(*np.nonzero(facing), strict=True):
             u, p = dirs[di], targets[fi]
             # the target's position across the direction, snapped to the grid: one candidate per cell
@@ -126,18 +141,57 @@ def candidate_probes(hypotheses: Sequence[Hypothesis], config: ProbeConfig | Non
             if key in seen:
                 continue
             seen.add(key)
-            move = _line_through(p, u, centre, big, config)
+            move = _line_through(p, u, centre, big, config, radius)
             if move is not None:
                 out.append(move)
     if len(out) > config.max_candidates:
         pick = np.linspace(0, len(out) - 1, config.max_candidates).round().astype(int)
         out = [out[i] for i in pick]
+    if out and config.pad_radius > 0.0 and config.table_z is not None:
+        clear = finger_clear(posed, out, config.pad_radius)
+        out = [mv for mv, ok in zip(out, clear, strict=True) if ok]
     return out
 
 
-def _line_through(p: np.ndarray, u: np.ndarray, centre: np.ndarray, radius: float, config: ProbeConfig):
+FINGER_SAMPLES = 8
+"""Points along a line's pad path at which :func:`finger_clear` checks the finger above the pad."""
+
+
+def finger_clear(hypotheses: Sequence[Hypothesis], moves: Sequence[ProbeMove], pad_radius: float,
+                 lift: float = FINGER_LIFT) -> np.ndarray:  # fmt: skip
+    """Whether the finger above the pad -- pointing down, the column from the pad's top to ``lift`` above its
+    centre -- stays clear of every hypothesis's object while the pad travels each line up to where that
+    hypothesis predicts its contact (or to the line's end), shape (M,) bool. A line passing under an overhang
+    of a hypothesis (a slot's ceiling, a ledge) would have the finger's phalanx meet the object before the pad:
+    a blocked move, no contact sensed."""
+    m = len(moves)
+    ok = np.ones(m, dtype=bool)
+    if m == 0:
+        return ok
+    r = pad_radius
+    starts = np.array([mv.start for mv in moves], dtype=float)
+    dirs = np.array([mv.direction for mv in moves], dtype=float)
+    lengths = np.array([mv.length for mv in moves], dtype=float)
+    frac = np.linspace(0.0, 1.0, FINGER_SAMPLES)
+    up = np.array([0.0, 0.0, 1.0])
+    for h in hypotheses:
+        inv = h.model_from_world
+        t_end = np.minimum(line_hits(h.poly, inv.apply(starts), inv.rotate(dirs)).first, lengths)  # (M,)
+        centres = (starts - r * dirs)[:, None, :] + (frac[None, :] * t_end[:, None])[..., None] * dirs[:, None, :]
+        tops = inv.apply((centres + lift * up).reshape(-1, 3))
+        down = np.broadcast_to(inv.rotate(-up), tops.shape)
+        hit = line_hits(h.poly, tops, down).first <= lift - r
+        blocked = hit | h.poly.contains(tops)
+        ok &= ~blocked.reshape(m, FINGER_SAMPLES).any(axis=1)
+    return ok
+
+
+def _line_through(
+    p: np.ndarray, u: np.ndarray, centre: np.ndarray, radius: float, config: ProbeConfig, hold: float = 0.0
+):
     """The chord along ``u`` through ``p`` of the sphere (``centre``, ``radius``), cut short above the table;
-    None when it would not reach ``p``."""
+    None when it would not reach ``p``, or (with a pad and a table) when the pad could not come down to its
+    start clear of the sphere of radius ``hold`` that holds every hypothesis's object."""
     w = p - centre
     b = float(w @ u)
     disc = b * b - (float(w @ w) - radius * radius)
@@ -147,11 +201,19 @@ def _line_through(p: np.ndarray, u: np.ndarray, centre: np.ndarray, radius: floa
     start = p - back * u
     length = 2.0 * np.sqrt(disc)
     if config.table_z is not None:
-        floor = config.table_z + config.table_clearance
+        r = config.pad_radius
+        floor = config.table_z + config.table_clearance + r * (1.0 + u[2])  # the line's lowest point allowed
         if start[2] < floor or p[2] < floor:
             return None
         if u[2] < 0.0:
             length = min(length, (start[2] - floor) / -u[2])
+        if r > 0.0:
+            c0 = start - r * u  # the pad centre at the line's start
+            w0 = c0 - centre
+            if float(np.linalg.norm(w0)) < hold + r:
+                return None
+            if w0[2] < 0.0 and float(np.hypot(w0[0], w0[1])) < hold + r:  # under the sphere's side
+                return None
     if length <= back:
         return None
     return ProbeMove(start, u, float(length))
@@ -303,5 +365,5 @@ def predict_probes(
     return out
 
 
-__all__ = ["MIN_INCIDENCE", "ProbeConfig", "ProbePrediction", "candidate_probes", "fibonacci_directions",
-           "predict_probes"]  # fmt: skip
+__all__ = ["FINGER_LIFT", "MIN_INCIDENCE", "ProbeConfig", "ProbePrediction", "candidate_probes",
+           "fibonacci_directions", "finger_clear", "predict_probes"]  # fmt: skip

@@ -92,7 +92,9 @@ def probe_moves(ctx: Context) -> list[ProbeMove]:
     them (``config.moves``) and every hypothesis has a pose to predict from, less those that failed from here."""
     if ctx.config.moves == "tracing" or not ctx.hypotheses or any(h.world_from_model is None for h in ctx.hypotheses):
         return []
-    cfg = ProbeConfig(table_z=ctx.config.table_z, table_clearance=ctx.config.table_clearance)
+    c = ctx.config
+    pad = c.pad_radius if c.table_z is not None else 0.0  # the simulated hand's pad (a point sensor without a table)
+    cfg = ProbeConfig(table_z=c.table_z, table_clearance=c.table_clearance, pad_radius=pad, max_undercut=c.max_undercut)
     return [m for m in candidate_probes(ctx.hypotheses, cfg) if not any(same_move(m, bad) for bad in ctx.avoid)]
 
 

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import haptic.executor.physics as physics_module
+import haptic.executor.physics_probe as probe_module
 import haptic.executor.primitives as primitives_module
 import haptic.executor.segment as segment_module
 from haptic.episode.evaluate import score_components
@@ -120,7 +121,7 @@ def test_no_peeking_constructor_refuses_the_simulation():
         PhysicsExecutor(sim)
 
 
-@pytest.mark.parametrize("module", [physics_module, primitives_module, segment_module])
+@pytest.mark.parametrize("module", [physics_module, probe_module, primitives_module, segment_module])
 def test_no_peeking_sources_never_touch_ground_truth(module):
     src = inspect.getsource(module)
     for name in ("ground_truth", "GroundTruth", "world_from_object", "Simulation(", "._sim", "compose_scene",

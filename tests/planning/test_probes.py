@@ -63,6 +63,38 @@ def test_candidates_aim_at_surfaces_and_stay_clear_of_the_table():
         assert pred.hit.any()  # aimed at some hypothesis's surface
 
 
+def test_candidates_for_a_pad_keep_it_off_the_table_and_reachable_from_above():
+    """With the hand's pad: its lowest point (up to a radius below the line) clears the table, the pad centre at
+    the start and the column above it lie outside the sphere holding every hypothesis by the radius, and no
+    face leaning under past the limit is aimed at -- while the point sensor's candidates include such lines."""
+    from haptic.planning.probes import _region
+
+    rng = np.random.default_rng(2)
+    poly = LIB["LBLOCK01"]
+    pose = SE3.random(rng, 0.0)
+    table = float(pose.apply(poly.vertices)[:, 2].min())
+    hyps = [_hyp("LBLOCK01", pose), _hyp("PYR01", SE3.random(rng, 0.01))]
+    r, lean = 0.012, np.deg2rad(30.0)
+    point = candidate_probes(hyps, ProbeConfig(table_z=table, max_candidates=1000))
+    config = ProbeConfig(table_z=table, pad_radius=r, max_undercut=lean, max_candidates=1000)
+    moves = candidate_probes(hyps, config)
+    assert 8 <= len(moves) < len(point)
+    centre, hold = _region(hyps)
+    for mv in moves:
+        u = mv.direction
+        for p in (mv.start, mv.end):
+            assert p[2] - r * u[2] - r >= table + config.table_clearance - 1e-9
+        c0 = mv.start - r * u
+        w = c0 - centre
+        assert np.linalg.norm(w) >= hold + r
+        assert w[2] >= 0.0 or np.hypot(w[0], w[1]) >= hold + r
+    preds = predict_probes(hyps, moves, np.zeros(3), [], SensorNoise())
+    for pred in preds:
+        hit = pred.hit
+        # the face a line was aimed at leans under by at most the limit, in some hypothesis that it hits
+        assert (pred.normal[hit, 2] >= -np.sin(lean) - 1e-9).any()
+
+
 def test_efficiency_ranks_probes_that_separate_hypotheses():
     """Two models at one pose: probes that tell them apart have positive efficiency; the same hypothesis twice
     cannot be told apart by any probe."""
@@ -121,3 +153,20 @@ def test_a_hypothesis_without_a_pose_is_refused_by_name():
     assert candidate_probes([unposed]) == []
     with pytest.raises(PlanningError, match="PYR01.*no pose"):
         predict_probes([hyps[0], unposed], [mv], np.zeros(3), [], SensorNoise())
+
+
+def test_the_finger_above_the_pad_must_clear_every_hypothesis():
+    """A line running under a hypothesis's object (a ledge over the pad) is blocked for the finger above the pad,
+    up to where that hypothesis is met; one running beside it, or stopping at its face, is clear."""
+    from haptic.planning.moves import ProbeMove
+    from haptic.planning.probes import finger_clear
+
+    poly = LIB["BOX01"]
+    lo, hi = poly.vertices.min(axis=0), poly.vertices.max(axis=0)
+    pose = SE3.from_matrix(np.eye(4))
+    hyps = [_hyp("BOX01", pose)]
+    under = ProbeMove(np.array([lo[0] - 0.03, 0.5 * (lo[1] + hi[1]), lo[2] - 0.03]), np.array([1.0, 0.0, 0.0]), 0.2)
+    beside = ProbeMove(np.array([lo[0] - 0.03, hi[1] + 0.03, lo[2] - 0.03]), np.array([1.0, 0.0, 0.0]), 0.2)
+    at_face = ProbeMove(np.array([lo[0] - 0.03, 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])]),
+                        np.array([1.0, 0.0, 0.0]), 0.2)  # fmt: skip
+    assert finger_clear(hyps, [under, beside, at_face], 0.012).tolist() == [False, True, True]

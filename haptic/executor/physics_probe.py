@@ -1,0 +1,296 @@
+"""The free-space probe (seed §1.1) on the simulated hand: :meth:`PhysicsExecutor.execute` of a
+:class:`~haptic.planning.moves.ProbeMove` (:func:`probe_move`).
+
+The index pad's *leading point* -- its centre plus the pad radius along the line's direction -- travels the
+line, so the planner's line-cast predictions hold for a head-on contact and the line itself is free wherever
+the pad passed. Step by step, every motion guarded (any fingertip's touch, or the pad held back from its
+command, ends it):
+
+1. *Leave the surface*: lift along the sensed normal (``ProbeSettings.lift``).
+2. *Transfer, up and over*: rise straight up to a safe height -- the highest contact sensed so far plus the pad
+   radius and ``ProbeSettings.clearance`` (the object rests on the table and was touched only below it), at
+   least the line's start; never above the hand's reach over the region --, across, and straight down to the
+   pad centre's place at the line's start. A touch on the way is a failed move (``unreachable``), never a hit.
+3. *Guarded approach* along the line at ``ProbeSettings.probe_speed`` until the index pad touches, or to the
+   line's end (a miss). A touch by another fingertip, or the hand held back, fails the move.
+4. *A hit*: back off, touch again slowly and settle, then an L stroke from the contact for the face's normal
+   (the start's stroke, :meth:`PhysicsExecutor._normal_stroke`): the segmenter's plane fit of those contacts,
+   with bounds from their scatter. The face is reported adjacent to nothing; the sensor rests on it. A contact
+   the stroke finds on an edge or a vertex, or the table, fails the move.
+5. *A miss*: back the way it came, over the top to where the pad left the surface, and touch the face it
+   left again (the sensor state is the one before the probe, as the geometric executor's).
+
+Either way the leading point's path up to the first touch (cut short by ``ProbeSettings.free_margin``: the
+pad's compliance and the detection delay) or the whole line is reported free (:class:`FreeSegment`): the
+measured pad centres (forward kinematics) plus the pad radius along the line, with a bound of the segmenter's
+position bound plus the largest sideways deviation of the measured path from its straight line. The cost is
+``c_p + c_s s`` over the distance ``s`` travelled in free space (lift, transfer, approach, and the way back
+after a miss), plus ``c_n`` for the normal stroke of a hit.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from haptic.executor.primitives import PrimitiveResult
+from haptic.executor.segment import FaceFit
+from haptic.geometry.se3 import angle, perpendicular, unit
+from haptic.matching.probes import FreeSegment
+from haptic.matching.trace import ContactTrace
+from haptic.planning.moves import MoveResult, ProbeMove, SensorState
+from haptic.sim.scene import TABLE_TOP_Z
+
+PhysicsExecutor = Any
+"""The :class:`~haptic.executor.physics.PhysicsExecutor` whose hand carries out the probe (its toucher, segmenter,
+bounds, costs and state); the type is not imported here, since that module dispatches to this one."""
+
+
+@dataclass(frozen=True)
+class ProbeSettings:
+    """Geometry and speeds of the probe on the hand."""
+
+    lift: float = 0.008
+    """Lift off the surface along its normal before the transfer [m]."""
+    clearance: float = 0.03
+    """The transfer passes this far above the highest contact sensed so far (plus the pad radius) [m]."""
+    transfer_speed: float = 0.15
+    """Speed of the transfer [m/s]."""
+    probe_speed: float = 0.05
+    """Speed of the guarded approach along the line [m/s]."""
+    back_off: float = 0.004
+    """After the first touch the pad backs off this far and touches again slowly [m]."""
+    free_margin: float = 0.0015
+    """A hit's free segment ends this far before the leading point's place at the first touch (pad compliance,
+    detection delay) [m]."""
+    transfer_lag: float = 0.012
+    """The transfer is blocked when the pad lags its command by more than this [m] ..."""
+    probe_lag: float = 0.004
+    """... the approach along the line by more than this [m]."""
+
+
+SETTINGS = ProbeSettings()
+
+
+def _free_distance(pieces: list[PrimitiveResult]) -> float:
+    return float(sum(p.distance for p in pieces))
+
+
+def _leading_segment(tips: np.ndarray, u: np.ndarray, radius: float, cut: float, bound: float) -> FreeSegment | None:
+    """The free segment of the leading point for the pad centres ``tips`` (n, 3) measured along a line of
+    direction ``u``: from the first centre plus ``radius`` along ``u``, as far as they went less ``cut``; its
+    bound is ``bound`` plus the largest sideways deviation of the centres from that line. None when too short."""
+    if len(tips) < 2:
+        return None
+    p0 = tips[0]
+    s = (tips - p0) @ u
+    length = float(s.max()) - cut
+    if length <= 1e-4:
+        return None
+    side = tips - p0 - s[:, None] * u[None, :]
+    dev = float(np.linalg.norm(side, axis=1).max())
+    return FreeSegment(p0 + radius * u, u, length, bound + dev)
+
+
+def probe_move(ex: PhysicsExecutor, move: ProbeMove, pieces: list[PrimitiveResult],
+               settings: ProbeSettings = SETTINGS) -> MoveResult:  # fmt: skip
+    """Carry out ``move`` with ``ex``'s hand (module docstring); a failure is a status, never an exception."""
+    t, st, seg = ex.toucher, ex.state, ex.segmenter
+    start = np.asarray(move.start, dtype=float)
+    u = np.asarray(move.direction, dtype=float)
+    length = float(move.length)
+    if start.shape != (3,) or u.shape != (3,) or not (np.all(np.isfinite(start)) and np.all(np.isfinite(u))):
+        return ex._invalid(move, "start and direction must be finite 3-vectors")
+    if abs(float(np.linalg.norm(u)) - 1.0) > 1e-6 or not math.isfinite(length) or length <= 0.0:
+        return ex._invalid(move, "direction must be a unit vector and length a positive number of metres")
+    r = t.pad_radius
+    centre0 = start - r * u  # the pad centre when its leading point is at the line's start
+    centre1 = centre0 + length * u
+    floor = TABLE_TOP_Z + ex.settings.pad_clearance
+    if min(centre0[2], centre1[2]) - r < floor:
+        return ex._invalid(move, "the line would bring the pad onto the table")
+    z_reach = TABLE_TOP_Z + ex.settings.max_approach_height
+    z_safe = max(_highest_contact(ex) + r + settings.clearance, float(centre0[2]), float(t.tip[2]))
+    if z_safe > z_reach:
+        return ex._fail(move, "unreachable", "the line's start is above the hand's reach over the region")
+    was_on = ex._on_face if (ex._on_face == st.face and t.contact[1] is not None) else None
+    free: list[PrimitiveResult] = []  # the pieces through free space, for the distance
+
+    def leg(point: np.ndarray, speed: float, lag: float, phase: str = "free") -> PrimitiveResult:
+        res = t.move_guarded(point, speed, phase=phase, max_lag=lag)
+        pieces.append(res)
+        free.append(res)
+        return res
+
+    # 1. leave the surface
+    n_left = t.normal.copy() if t.contact[1] is not None and t.normal is not None else np.array([0.0, 0.0, 1.0])
+    if t.contact[1] is not None:
+        res = t.move_free(t.tip + settings.lift * n_left, timeout=2.0, tol=2e-3)
+        pieces.append(res)
+        free.append(res)
+        if not res.ok:
+            return ex._fail(move, res, f"leaving the surface: {res.event}")
+    lifted = t.tip.copy()
+    ex._on_face = None
+    went_along = False  # the pad has been on the line (the way back may follow it)
+
+    def fail(res, reason: str) -> MoveResult:
+        """The failed move's result, after going back the way it came (off the object first, when touching)."""
+        out = ex._fail(move, res, reason)
+        if t.contact[1] is not None and t.normal is not None:
+            pieces.append(t.move_free(t.tip + settings.lift * t.normal, timeout=2.0, tol=2e-3))
+        if went_along:
+            _return(ex, lifted, z_safe, n_left, was_on, settings, pieces, [], centre0)
+        else:
+            _return(ex, lifted, z_safe, n_left, was_on, settings, pieces, [])
+        return out
+    # 2. up, across, down to the line's start
+    for name, w in (("rising", np.array([lifted[0], lifted[1], z_safe])),
+                    ("moving across", np.array([centre0[0], centre0[1], z_safe])),
+                    ("descending to the line", centre0)):  # fmt: skip
+        if float(np.linalg.norm(w - t.tip)) < 1e-3:
+            continue
+        res = leg(w, settings.transfer_speed, settings.transfer_lag)
+        if not res.ok or res.event != "done":
+            why = f"touched the object {name} (finger {res.info['finger']})" if res.event == "contact" else res.event
+            return fail("unreachable" if res.ok else res, f"transfer to the probe's line: {why}")
+    # 3. the guarded approach along the line
+    went_along = True
+    approach = leg(centre1, settings.probe_speed, settings.probe_lag, phase="approach")
+    bound = ex.bounds.bound(ex.bounds.point_sigma, ex.bounds.position_floor)
+    tips = approach.trace.tip_in_world
+    if approach.ok and approach.event == "contact" and approach.info["finger"] != t.finger:
+        return fail("unreachable", f"the {approach.info['finger']} fingertip touched the object first")
+    if not approach.ok:
+        return fail(approach, f"approach along the line: {approach.event}")
+    if approach.event == "done":  # a miss: the whole line is free
+        segment = _leading_segment(tips, u, r, 0.0, bound)
+        back = _return(ex, lifted, z_safe, n_left, was_on, settings, pieces, free, centre0)
+        s = _free_distance(free)
+        return MoveResult(move=move, status="ok", distance=s, cost=ex.costs.probe_move(s), state=st,
+                          free_space=(segment,) if segment is not None else (),
+                          info={"contact": None, "returned": back})  # fmt: skip
+    # 4. a hit: the path to the first touch is free; touch again slowly, settle, stroke for the normal
+    segment = _leading_segment(tips, u, r, settings.free_margin, bound)
+    travel = float(approach.info["travel"])
+    s = _free_distance(free)
+    retreat = t.move_free(t.tip - settings.back_off * u, timeout=1.0, tol=1e-3)
+    pieces.append(retreat)
+    touch = t.approach(u, settings.back_off + 0.004)
+    pieces.append(touch)
+    if not touch.ok:
+        return fail(touch, f"touching the contact again: {touch.event}")
+    if ex.workspace.is_table(touch.info["normal"], touch.info["point"]):
+        return fail("unreachable", "the probe touched the table")
+    fit, trace = _measure_face(ex, touch.info["point"], touch.info["normal"], pieces)
+    if fit is None:
+        return fail("unreachable", "the probe touched an edge or a vertex: no face normal there")
+    face = seg.add_face(fit, ())
+    ex._store_face(face.id, trace, fit)
+    ex._on_face = face.id
+    ex.state = SensorState(position=ex._contact_point(), face=face.id)
+    return MoveResult(move=move, status="ok", components=(face,), distance=s,
+                      cost=ex.costs.probe_move(s) + ex.costs.c_n, state=ex.state,
+                      free_space=(segment,) if segment is not None else (),
+                      info={"contact": travel, "hit_point": touch.info["point"].tolist()})  # fmt: skip
+
+
+def _measure_face(ex: PhysicsExecutor, point: np.ndarray, n0: np.ndarray,
+                  pieces: list[PrimitiveResult]) -> tuple[FaceFit | None, ContactTrace]:  # fmt: skip
+    """The face under the contact at ``point`` (sensed normal ``n0``): an L stroke from it (legs of
+    ``normal_stroke``), in up to four headings a quarter turn apart -- touching ``point`` again between tries --
+    until one stays on one face (its normal does not turn as the pad slides: not rolling on an edge or a vertex
+    nearby) and fits a plane. (None, trace) when none does."""
+    t, s, seg = ex.toucher, ex.settings, ex.segmenter
+    a = perpendicular(n0)
+    phi0 = ex.rng.uniform(0.0, 2.0 * math.pi)
+    floor = TABLE_TOP_Z + t.pad_radius + s.table_margin
+    trace = ContactTrace.concatenate([])
+    for k in range(4):
+        if k > 0:
+            again = t.lift_and_approach(point, n0, floor_z=floor)
+            pieces.append(again)
+            if not again.ok or angle(again.info["normal"], n0) > math.radians(6.0):
+                return None, trace
+        phi = phi0 + k * math.pi / 2.0
+        d1 = math.cos(phi) * a + math.sin(phi) * np.cross(n0, a)
+        legs = []
+        for d in (d1, np.cross(n0, d1)):
+            r = t.trace_face(d, n0, s.normal_stroke, phase="stroke")
+            legs.append(r)
+            pieces.append(r)
+            if not r.ok or r.event != "done":
+                break
+        if legs[-1].status == "unstable":
+            return None, trace
+        trace = ContactTrace.concatenate([r.trace for r in legs])
+        if len(legs) == 2 and all(r.ok and r.event == "done" for r in legs) and ex._on_one_face(trace):
+            fit = seg.fit_face_trace(trace, legs[-1].info["face_normal"], two_d=True)
+            if fit is not None:
+                return fit, trace
+    return None, trace
+
+
+def _highest_contact(ex: PhysicsExecutor) -> float:
+    """The highest contact point sensed in any move so far [m] (the table top when none)."""
+    z = TABLE_TOP_Z
+    for tr in ex.traces:
+        ok = tr.in_contact
+        if ok.any():
+            z = max(z, float(tr.point_in_world[ok, 2].max()))
+    t = ex.toucher
+    if t.contact[2] is not None:
+        z = max(z, float(t.contact[2][2]))
+    return z
+
+
+def _return(ex: PhysicsExecutor, lifted: np.ndarray, z_safe: float, n_left: np.ndarray, was_on: int | None,
+            settings: ProbeSettings, pieces: list[PrimitiveResult], free: list[PrimitiveResult],
+            line_start: np.ndarray | None = None) -> bool:  # fmt: skip
+    """After a miss (or a failure): up from where the pad is -- when that is blocked (under an overhang), back to
+    the pad centre's place at the line's start ``line_start`` first --, across and down to where the pad left
+    the surface, and touch the face it left again (when it was on one). Whether the pad rests on that face
+    again."""
+    t = ex.toucher
+
+    def go(w: np.ndarray) -> PrimitiveResult:
+        res = t.move_guarded(w, settings.transfer_speed, max_lag=settings.transfer_lag)
+        pieces.append(res)
+        free.append(res)
+        return res
+
+    up = go(np.array([t.tip[0], t.tip[1], z_safe]))
+    if (not up.ok or up.event != "done") and line_start is not None:
+        # under an overhang: off the object, back along the line (free: the pad came that way), then up
+        if t.contact[1] is not None and t.normal is not None:
+            off = t.move_free(t.tip + settings.lift * t.normal, timeout=2.0, tol=2e-3)
+            pieces.append(off)
+            free.append(off)
+        for w in (line_start, np.array([line_start[0], line_start[1], z_safe])):
+            up = go(w)
+            if not up.ok or up.event != "done":
+                return False
+    elif not up.ok or up.event != "done":
+        return False
+    for w in (np.array([lifted[0], lifted[1], z_safe]), lifted):
+        if float(np.linalg.norm(w - t.tip)) < 1e-3:
+            continue
+        res = go(w)
+        if not res.ok or res.event != "done":
+            return False
+    if was_on is None:
+        return False
+    res = t.approach(-n_left, 2 * settings.lift + 0.004)
+    pieces.append(res)
+    free.append(res)
+    n_face = ex.segmenter.faces[was_on].component.normal
+    if not res.ok or angle(unit(res.info["normal"]), n_face) > math.radians(6.0):
+        return False
+    ex._on_face = was_on
+    return True
+
+
+__all__ = ["SETTINGS", "ProbeSettings", "probe_move"]

@@ -1,0 +1,80 @@
+"""The free-space probe on the simulated hand: a line aimed at a face of an object placed by the test hits it,
+with the sensed point on the true face plane and the normal within their bounds; a line aimed past the object
+misses and reports its path free. Ground truth is read here, by the test, never by the executor."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from haptic.executor.physics import PhysicsExecutor
+from haptic.geometry import SE3, load_library
+from haptic.geometry.raycast import depth_samples
+from haptic.planning.moves import ProbeMove
+from haptic.sim import RobotInterface, SimulatedSensorNoise, Simulation, compose_scene, random_object_pose
+from haptic.sim.scene import PAD_RADIUS, TABLE_TOP_Z, scene_object_from_polyhedron
+
+
+@pytest.fixture(scope="module")
+def probed():
+    poly = load_library()["BOX01"]
+    obj = scene_object_from_polyhedron(poly)
+    pose = random_object_pose(obj, np.random.default_rng(4))
+    sim = Simulation(compose_scene(obj, pose), noise=SimulatedSensorNoise.from_notes(), seed=4)
+    ex = PhysicsExecutor(RobotInterface(sim), rng=np.random.default_rng(4))
+    first = ex.start()
+    assert first.ok, first.info
+    truth = SE3.from_matrix(sim.ground_truth().world_from_object)
+    normals = truth.rotate(poly.face_normals)
+    # a side face (horizontal normal) facing away from the robot's base, approached head-on at mid-height
+    side = [f for f in range(poly.n_faces) if abs(normals[f, 2]) < 0.1]
+    f = max(side, key=lambda k: normals[k, 0])
+    n = normals[f]
+    verts = truth.apply(poly.vertices[list(poly.faces[f])])
+    target = verts.mean(axis=0)
+    target[2] = max(target[2], TABLE_TOP_Z + PAD_RADIUS + 0.008)
+    hit = ex.execute(ProbeMove(target + 0.05 * n, -n, 0.08))
+    # the same direction, shifted sideways past the object's extent
+    across = np.cross(n, [0.0, 0.0, 1.0])
+    width = float(np.ptp(truth.apply(poly.vertices) @ across))
+    miss_move = ProbeMove(target + 0.05 * n + (width + 0.03) * across, -n, 0.10)
+    state_before = hit.state
+    miss = ex.execute(miss_move)
+    return poly, truth, f, hit, state_before, miss, ex
+
+
+def test_a_probe_at_a_face_hits_it_within_the_bounds(probed):
+    poly, truth, f, hit, _, _, ex = probed
+    assert hit.ok, hit.reason
+    assert hit.move.kind == "probe"
+    (face,) = hit.components
+    assert face.kind == "face" and face.adjacent == ()
+    n_true = truth.rotate(poly.face_normals[f])
+    d_true = float(n_true @ truth.apply(poly.vertices[poly.faces[f][0]]))
+    off = np.abs(face.points @ n_true - d_true)
+    assert off.max() <= face.position_bound, (off.max(), face.position_bound)
+    err = np.arccos(np.clip(face.normal @ n_true, -1.0, 1.0))
+    assert err <= face.normal_bound, (np.degrees(err), np.degrees(face.normal_bound))
+    assert hit.state.face == face.id
+    # the approach's path up to the contact is free of the object, and ends next to the face
+    (seg,) = hit.free_space
+    inv = truth.inverse()
+    _, depth = depth_samples(poly, inv.apply(seg.start), inv.rotate(seg.direction), seg.length)
+    assert len(depth) == 0 or depth.max() <= seg.position_bound
+    out = float(n_true @ seg.end) - d_true  # how far outside the face the free path ends
+    assert -seg.position_bound <= out < 0.005, out
+    assert hit.cost == pytest.approx(ex.costs.probe_move(hit.distance) + ex.costs.c_n)
+
+
+def test_a_probe_past_the_object_misses_and_returns_to_the_face(probed):
+    poly, truth, _, hit, state_before, miss, _ = probed
+    assert miss.ok, miss.reason
+    assert miss.components == () and miss.info["contact"] is None
+    (seg,) = miss.free_space
+    assert seg.length == pytest.approx(miss.move.length, abs=0.002)
+    inv = truth.inverse()
+    _, depth = depth_samples(poly, inv.apply(seg.start), inv.rotate(seg.direction), seg.length)
+    assert len(depth) == 0
+    # the sensor is back on the face the probe left, as the state says
+    assert miss.state.face == state_before.face and miss.info["returned"]
+    assert miss.distance > 2 * seg.length
