@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from haptic.errors import HapticError
-from haptic.planning.moves import MOVE_SETS
+from haptic.planning.moves import DEFAULT_MOVES, MOVE_SETS
 
 
 @dataclass(frozen=True)
@@ -34,19 +34,16 @@ class EpisodeSpec:
     """Use the library's valid models when some of its files are bad (else refuse the library)."""
     verify: str = "none"
     """Verification before recognition: "none", "fast" or "full" (:mod:`haptic.matching.verify`)."""
-    moves: str = "tracing"
-    """Admissible kinds of move: "tracing" (face, edge, vertex moves) or "all" (free-space probes too, ranked with
-    them by one planner; geometric executor, planner, greedy and random policies only)."""
+    moves: str = DEFAULT_MOVES
+    """Admissible kinds of move: "tracing" (face, edge, vertex moves), "probing" (free-space probes alone) or
+    "all" (both, ranked by one planner); probes on the geometric executor, with the planner, greedy and random
+    policies only."""
 
     def __post_init__(self) -> None:
-        if self.moves == "tracing":
+        if self.moves == "tracing":  # the tracing moves run everywhere
             return
         if self.moves not in MOVE_SETS:
-            raise HapticError(f"unknown --moves {self.moves!r}; valid: tracing, all")
-        if self.moves == "probing":
-            raise HapticError(
-                "--moves probing is not available yet (probes alone do not recognise reliably); valid: tracing, all"
-            )
+            raise HapticError(f"unknown --moves {self.moves!r}; valid: {', '.join(MOVE_SETS)}")
         if self.executor != "geometric":
             raise HapticError(
                 f"--moves {self.moves}: free-space probes run on the geometric executor only; "

@@ -19,7 +19,7 @@ from haptic.geometry.polyhedron import Polyhedron
 from haptic.geometry.se3 import SE3, plane_basis
 from haptic.geometry.tracing import FaceHit, circle_vertex, trace_edge, trace_face
 from haptic.matching.components import DataComponent, DataEdge, DataFace, SensorNoise
-from haptic.planning.moves import CostModel, EdgeMove, FaceMove, Move, SensorState, VertexMove
+from haptic.planning.moves import DEFAULT_MOVES, CostModel, EdgeMove, FaceMove, Move, SensorState, VertexMove
 
 
 @dataclass(frozen=True)
@@ -79,7 +79,7 @@ class PlannerConfig:
     (:mod:`haptic.planning.bound`). None: no bound. 256 is above the most pose classes the shipped libraries
     leave at a planner decision (255, look-alike library, with the loop posing up to
     ``haptic.episode.loop.MAX_POSED`` interpretations), so their decisions are unchanged."""
-    moves: str = "tracing"
+    moves: str = DEFAULT_MOVES
     """Admissible kinds of move (``MOVE_SETS``): "tracing" (face, edge and vertex moves), "probing" (free-space
     probes) or "all" (both, ranked together by one efficiency, seed §1.1)."""
 

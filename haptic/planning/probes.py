@@ -3,9 +3,9 @@
 A probe is a line (:class:`~haptic.planning.moves.ProbeMove`) the sensor approaches along until contact or the
 line's end. Candidates aim at the hypotheses' surfaces: for every pose class and every face that class puts
 in the world, the face's centre approached from a discrete set of directions within :attr:`ProbeConfig.
-max_incidence` of head-on, each line starting outside every hypothesis and running across the whole region
-they occupy, clear of the table. Lines that nearly coincide (same direction, targets within
-:attr:`ProbeConfig.target_spacing` across it) are one candidate.
+max_incidence` of head-on, each line starting just before the first ball holding a hypothesis's object that it
+meets and ending just past the last (:attr:`ProbeConfig.standoff`), clear of the table. Lines that nearly
+coincide (same direction, targets within :attr:`ProbeConfig.target_spacing` across it) are one candidate.
 
 Each hypothesis predicts, through its pose, whether the line hits its object, the face hit and the distance
 along the line (one vectorised line–triangle intersection per model over every candidate and pose class), and
@@ -30,15 +30,16 @@ them with what the matcher then eliminates).
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from haptic.errors import PlanningError
+from haptic.geometry.polyhedron import Polyhedron
 from haptic.geometry.raycast import line_hits
-from haptic.matching.components import DataComponent, SensorNoise
+from haptic.matching.components import DataComponent, DataFace, SensorNoise
 from haptic.matching.recognition import PoseTolerance
 from haptic.matching.verify import POSE_SAFETY
 from haptic.planning.efficiency import efficiency_of, expected_eliminated
@@ -61,8 +62,10 @@ class ProbeConfig:
     """A face is approached from directions within this of its inward normal [rad]."""
     target_spacing: float = 0.01
     """Targets closer than this across a common direction make one candidate [m]."""
-    standoff: float = 0.03
-    """Lines start this far outside the sphere that holds every hypothesis's object [m]."""
+    standoff: float = 0.01
+    """Lines start this far before the first sphere they meet that holds a hypothesis's posed object (at its
+    centroid, through its farthest vertex), and a miss runs this far past the last one: free space farther out
+    tells nothing and costs ``c_s`` per metre [m]."""
     max_candidates: int = 64
     """Most candidates offered (an even subsample of them beyond it)."""
     table_z: float | None = None
@@ -115,6 +118,7 @@ def candidate_probes(hypotheses: Sequence[Hypothesis], config: ProbeConfig | Non
     if config.table_z is not None:
         dirs = dirs[dirs[:, 2] <= config.max_climb]
     cos_max = np.cos(config.max_incidence)
+    balls = _hypothesis_balls(posed)
     seen: set[tuple] = set()
     out: list[ProbeMove] = []
     for h in posed:
@@ -131,11 +135,45 @@ def candidate_probes(hypotheses: Sequence[Hypothesis], config: ProbeConfig | Non
             seen.add(key)
             move = _line_through(p, u, centre, big, config)
             if move is not None:
+                move = _clip_to_balls(move, balls, config.standoff, union=True)
+            if move is not None:
                 out.append(move)
     if len(out) > config.max_candidates:
         pick = np.linspace(0, len(out) - 1, config.max_candidates).round().astype(int)
         out = [out[i] for i in pick]
     return out
+
+
+def _hypothesis_balls(hypotheses: Sequence[Hypothesis]) -> tuple[np.ndarray, np.ndarray]:
+    """Centre (posed centroid) and radius (to the farthest vertex) of each hypothesis's object, (N, 3), (N,)."""
+    centres = np.array([h.world_from_model.apply(h.poly.centroid) for h in hypotheses])
+    radii = np.array([float(np.linalg.norm(h.poly.vertices - h.poly.centroid, axis=1).max()) for h in hypotheses])
+    return centres, radii
+
+
+def _clip_to_balls(move: ProbeMove, balls: tuple[np.ndarray, np.ndarray], margin: float, union: bool):
+    """``move`` shortened to the part of its line within ``margin`` of the balls (``union``: of any of them,
+    where one of several objects may be; else of all of them, where one object within each must be); None when
+    that part is empty. The start moves forward, the end back; the line is never lengthened."""
+    centres, radii = balls
+    s, u = np.asarray(move.start, dtype=float), np.asarray(move.direction, dtype=float)
+    w = centres - s
+    b = w @ u
+    disc = b * b - (np.einsum("ij,ij->i", w, w) - (radii + margin) ** 2)
+    meets = disc > 0.0
+    root = np.sqrt(np.where(meets, disc, 0.0))
+    if union:
+        if not meets.any():
+            return None
+        t0, t1 = float((b - root)[meets].min()), float((b + root)[meets].max())
+    else:
+        if not meets.all():
+            return None
+        t0, t1 = float((b - root).max()), float((b + root).min())
+    t0, t1 = max(t0, 0.0), min(t1, float(move.length))
+    if t1 <= t0:
+        return None
+    return ProbeMove(s + t0 * u, u, t1 - t0)
 
 
 def _line_through(p: np.ndarray, u: np.ndarray, centre: np.ndarray, radius: float, config: ProbeConfig):
@@ -158,6 +196,61 @@ def _line_through(p: np.ndarray, u: np.ndarray, centre: np.ndarray, radius: floa
     if length <= back:
         return None
     return ProbeMove(start, u, float(length))
+
+
+@dataclass(frozen=True)
+class LibraryExtent:
+    """How large the library's objects are, for aiming probes before any hypothesis has a pose."""
+
+    reach: float
+    """The largest distance between two vertices of one model: every point of the object lies within this of
+    every contact [m]."""
+    depth: float
+    """The smallest distance from a model's centroid to its nearest face plane, over the library: a point this
+    far behind a contact, against its normal, lies inside or near every model touched there [m]."""
+
+    @classmethod
+    def of(cls, models: Iterable[Polyhedron]) -> LibraryExtent:
+        """The extent of a library's models."""
+        reach, depth = 0.0, np.inf
+        for poly in models:
+            v = poly.vertices
+            reach = max(reach, float(np.sqrt(((v[:, None] - v[None]) ** 2).sum(-1)).max()))
+            depth = min(depth, float(np.abs(poly.face_offsets - poly.face_normals @ poly.centroid).min()))
+        return cls(reach, depth if np.isfinite(depth) else 0.0)
+
+
+def opening_probes(
+    faces: Sequence[DataFace], extent: LibraryExtent, config: ProbeConfig | None = None
+) -> list[ProbeMove]:
+    """Probe lines toward the object's region before hypotheses have poses (the opening of ``--moves probing``),
+    best first: a fixed spread of approach directions (:attr:`ProbeConfig.n_directions`, a Fibonacci lattice),
+    each line through the region's estimated centre ``c = mean(q_i − depth · n_i)`` over the data faces (their
+    contact points ``q_i`` and outward normals ``n_i``), running across the region that must hold the object:
+    the intersection of the balls of radius ``reach`` about the contacts (plus the standoff). Ranked by how
+    nearly the face each would hit is perpendicular to every normal measured so far (smallest
+    ``max_i |u · n_i|``): a face whose normal is independent of the known ones is what fixes the rotation (two
+    normals) and the translation (three planes), hence the poses."""
+    config = config or ProbeConfig()
+    if not faces:
+        return []
+    q = np.array([np.mean(np.atleast_2d(f.points), axis=0) for f in faces])
+    n = np.array([f.normal for f in faces])
+    centre = (q - extent.depth * n).mean(axis=0)
+    radius = extent.reach + extent.depth + config.standoff
+    dirs = fibonacci_directions(config.n_directions)
+    if config.table_z is not None:
+        dirs = dirs[dirs[:, 2] <= config.max_climb]
+    order = np.argsort(np.abs(dirs @ n.T).max(axis=1), kind="stable")
+    within = (q, np.full(len(q), extent.reach))  # every point of the object is within reach of every contact
+    out = []
+    for u in dirs[order]:
+        move = _line_through(centre, u, centre, radius, config)
+        if move is not None:
+            move = _clip_to_balls(move, within, config.standoff, union=False)
+        if move is not None:
+            out.append(move)
+    return out
 
 
 @dataclass(frozen=True, eq=False)
@@ -306,5 +399,5 @@ def predict_probes(
     return out
 
 
-__all__ = ["MIN_INCIDENCE", "ProbeConfig", "ProbePrediction", "candidate_probes", "fibonacci_directions",
-           "predict_probes"]  # fmt: skip
+__all__ = ["MIN_INCIDENCE", "LibraryExtent", "ProbeConfig", "ProbePrediction", "candidate_probes",
+           "fibonacci_directions", "opening_probes", "predict_probes"]  # fmt: skip
