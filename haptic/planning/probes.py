@@ -48,6 +48,8 @@ from haptic.planning.moves import CostModel, ProbeMove
 if TYPE_CHECKING:
     from haptic.planning.predict import Hypothesis
 
+BEHIND = 0.05
+"""Opening probes head along every known face's normal, or across it within this (``u · n ≥ −0.05``)."""
 MIN_INCIDENCE = 0.2
 """Smallest ``|n·u|`` used to turn a surface offset into a distance along a line (a grazing approach)."""
 
@@ -206,18 +208,18 @@ class LibraryExtent:
     """The largest distance between two vertices of one model: every point of the object lies within this of
     every contact [m]."""
     depth: float
-    """The smallest distance from a model's centroid to its nearest face plane, over the library: a point this
-    far behind a contact, against its normal, lies inside or near every model touched there [m]."""
+    """The median over the library of a model's centroid's distance to its nearest face plane: how far behind
+    a contact, against its normal, the object's inside is aimed at [m]."""
 
     @classmethod
     def of(cls, models: Iterable[Polyhedron]) -> LibraryExtent:
         """The extent of a library's models."""
-        reach, depth = 0.0, np.inf
+        reach, depths = 0.0, []
         for poly in models:
             v = poly.vertices
             reach = max(reach, float(np.sqrt(((v[:, None] - v[None]) ** 2).sum(-1)).max()))
-            depth = min(depth, float(np.abs(poly.face_offsets - poly.face_normals @ poly.centroid).min()))
-        return cls(reach, depth if np.isfinite(depth) else 0.0)
+            depths.append(float(np.abs(poly.face_offsets - poly.face_normals @ poly.centroid).min()))
+        return cls(reach, float(np.median(depths)) if depths else 0.0)
 
 
 def opening_probes(
@@ -230,7 +232,9 @@ def opening_probes(
     the intersection of the balls of radius ``reach`` about the contacts (plus the standoff). Ranked by how
     nearly the face each would hit is perpendicular to every normal measured so far (smallest
     ``max_i |u · n_i|``): a face whose normal is independent of the known ones is what fixes the rotation (two
-    normals) and the translation (three planes), hence the poses."""
+    normals) and the translation (three planes), hence the poses. Directions heading against a known face's
+    normal (``u · n_i < −``:data:`BEHIND`) are left out while others remain: such a line may enter through that
+    face again, and a convex object's face is never met from behind."""
     config = config or ProbeConfig()
     if not faces:
         return []
@@ -241,6 +245,9 @@ def opening_probes(
     dirs = fibonacci_directions(config.n_directions)
     if config.table_z is not None:
         dirs = dirs[dirs[:, 2] <= config.max_climb]
+    behind = (dirs @ n.T >= -BEHIND).all(axis=1)  # from behind every known face: no line enters through one again
+    if behind.any():
+        dirs = dirs[behind]
     order = np.argsort(np.abs(dirs @ n.T).max(axis=1), kind="stable")
     within = (q, np.full(len(q), extent.reach))  # every point of the object is within reach of every contact
     out = []
@@ -399,5 +406,5 @@ def predict_probes(
     return out
 
 
-__all__ = ["MIN_INCIDENCE", "LibraryExtent", "ProbeConfig", "ProbePrediction", "candidate_probes",
+__all__ = ["BEHIND", "MIN_INCIDENCE", "LibraryExtent", "ProbeConfig", "ProbePrediction", "candidate_probes",
            "fibonacci_directions", "opening_probes", "predict_probes"]  # fmt: skip
