@@ -311,12 +311,13 @@ class EpisodeRecorder:
             path = np.vstack([path, path])
         if len(path):
             s.strips.append(path)
-            s.strip_kinds.append(kind)
+            s.strip_kinds.append("probe miss" if kind == "probe" and not result.components else kind)
             rec.log(
                 "world/trace/path",
                 rr.LineStrips3D(
                     s.strips,
-                    colors=[KIND_COLORS.get(k, KIND_COLORS["start"]) for k in s.strip_kinds],
+                    colors=[PROBE_MISS_COLOR if k == "probe miss" else KIND_COLORS.get(k, KIND_COLORS["start"])
+                            for k in s.strip_kinds],
                     radii=TRACE_RADIUS,
                     labels=[f"move {j}: {k}" for j, k in enumerate(s.strip_kinds)],
                     show_labels=False,
