@@ -17,8 +17,11 @@ planner can rank probes and tracing moves together.
 The elimination rule mirrors the matcher (:mod:`haptic.matching.probes`). If ``i`` predicts a miss, ``j`` is
 eliminated when the line runs inside it deeper than the free segment's margin ``ε = ρ + δ_p + a ‖x − c‖``
 (the matcher's, with the pose tolerance ``δ_p``, ``a`` of :class:`~haptic.matching.recognition.PoseTolerance`).
-The depth is estimated from the first inside chord, ``½ · chord · min(|n_in·u|, |n_out·u|)`` (the depth of the
-chord's midpoint below its entry and exit faces). If ``i`` predicts a hit, ``j`` is eliminated when it predicts
+The depth is the matcher's measure, the largest distance from the surface of points of the first inside chord
+(three, at its quarters; the matcher samples more, so the prediction never says deeper than it finds). The
+depth of the chord's midpoint below its entry and exit faces, ``½ · chord · min(|n_in·u|, |n_out·u|)``, would
+overstate it wherever a third face runs near the chord (a line past a corner), predicting a miss to eliminate
+poses the matcher keeps. If ``i`` predicts a hit, ``j`` is eliminated when it predicts
 a miss, a contact farther along the line than the two contact margins allow, or a normal farther than the
 angle bound: the matcher refits each pose with the contact and checks it within ``POSE_SAFETY`` times its
 bounds (:func:`~haptic.matching.verify.pose_check`), so a contact margin is ``(1 + POSE_SAFETY) ρ + δ r``
@@ -37,6 +40,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from haptic.errors import PlanningError
+from haptic.geometry.distance import surface_distance
 from haptic.geometry.polyhedron import Polyhedron
 from haptic.geometry.raycast import line_hits
 from haptic.matching.components import DataComponent, DataFace, SensorNoise
@@ -50,6 +54,8 @@ if TYPE_CHECKING:
 
 BEHIND = 0.05
 """Opening probes head along every known face's normal, or across it within this (``u · n ≥ −0.05``)."""
+DEPTH_FRACTIONS = np.array([0.25, 0.5, 0.75])
+"""Where along a predicted miss-line's first inside chord its depth is sampled (fractions of the chord)."""
 MIN_INCIDENCE = 0.2
 """Smallest ``|n·u|`` used to turn a surface offset into a distance along a line (a grazing approach)."""
 
@@ -370,15 +376,16 @@ def predict_probes(
             beyond = np.where(leaving & (hits.params > hits.first[:, None]), hits.params, np.inf)
         k_out = np.argmin(beyond, axis=1) if beyond.shape[1] else np.zeros(len(s_m), dtype=int)
         t_out = beyond[np.arange(len(s_m)), k_out]
-        n_in = np.where((hits.face >= 0)[:, None], poly.face_normals[np.maximum(hits.face, 0)], 0.0)
-        n_out = tri_n[k_out]
-        finite = np.isfinite(t_out) & np.isfinite(hits.first)
-        chord = np.where(finite, np.where(finite, t_out, 0.0) - np.where(finite, hits.first, 0.0), 0.0)
-        dep = 0.5 * chord * np.minimum(np.abs(np.einsum("rk,rk->r", n_in, u_m)),
-                                       np.abs(np.einsum("rk,rk->r", n_out, u_m)))  # fmt: skip
-        # a chord running past the line's end enters only as far as the end goes
-        reach = np.clip(np.repeat(lengths[None], len(js), axis=0).reshape(-1) - hits.first, 0.0, None)
-        dep = np.minimum(dep, reach)
+        # the depth as the matcher measures it: distances from the surface of points of the chord (up to the
+        # line's end), the largest of DEPTH_FRACTIONS samples
+        lens = np.repeat(lengths[None], len(js), axis=0).reshape(-1)
+        fin = np.flatnonzero(np.isfinite(t_out) & np.isfinite(hits.first) & (hits.first < lens))
+        dep = np.zeros(len(s_m))
+        if len(fin):
+            lo, hi = hits.first[fin], np.minimum(t_out[fin], lens[fin])
+            ts = lo[:, None] + (hi - lo)[:, None] * DEPTH_FRACTIONS
+            pts = s_m[fin, None, :] + ts[..., None] * u_m[fin, None, :]
+            dep[fin] = surface_distance(poly, pts.reshape(-1, 3)).reshape(len(fin), -1).max(axis=1)
         for a, j in enumerate(js):
             t_hit[:, j] = first[:, a]
             face[:, j] = fc[:, a]
@@ -406,5 +413,5 @@ def predict_probes(
     return out
 
 
-__all__ = ["BEHIND", "MIN_INCIDENCE", "LibraryExtent", "ProbeConfig", "ProbePrediction", "candidate_probes",
-           "fibonacci_directions", "opening_probes", "predict_probes"]  # fmt: skip
+__all__ = ["BEHIND", "DEPTH_FRACTIONS", "MIN_INCIDENCE", "LibraryExtent", "ProbeConfig", "ProbePrediction",
+           "candidate_probes", "fibonacci_directions", "opening_probes", "predict_probes"]  # fmt: skip

@@ -194,3 +194,47 @@ def test_probe_cost_is_a_constant_plus_free_space_distance():
     costs = CostModel(c_p=2.0, c_s=20.0)
     assert costs.probe_move(0.0) == 2.0
     assert costs.probe_move(0.1) == pytest.approx(4.0)
+
+
+def _check_probes_alone(name: str, seed: int, n_probes: int, level: float, at_bounds: bool) -> int:
+    """The start, then probes only: the opening's lines toward the region the contacts leave (as under ``--moves
+    probing``, before poses), every few a random line at the object; returns how many hits."""
+    from haptic.planning.probes import LibraryExtent, opening_probes
+
+    rng = np.random.default_rng(seed)
+    ex = GeometricExecutor(
+        LIB[name], SE3.random(rng, 0.2), SensorNoise().scaled(level), rng,
+        settings=GeometricSettings(at_bounds=at_bounds),
+    )  # fmt: skip
+    extent = LibraryExtent.of(LIB.values())
+    tree = InterpretationTree(ARRAYS)
+    tree.add(ex.start().components[0])
+    free, hits = [], []
+    for k in range(n_probes):
+        faces = [c for c in ex.components if isinstance(c, DataFace)]
+        lines = opening_probes(faces, extent)
+        move = random_probe(ex, rng) if k % 3 == 2 or not lines else lines[int(rng.integers(min(3, len(lines))))]
+        res = execute_probe(ex, move)
+        if not res.ok:
+            continue
+        for c in res.components:
+            tree.add(c)
+            hits.append(c.id)
+            assert len(true_leaves(tree, ex)) >= 1, (name, seed, "tree", c)
+        free.extend(res.free_space)
+        apply_probes(tree, free, hits)
+        assert len(true_leaves(tree, ex)) >= 1, (name, seed, "probe filter", len(free), len(hits))
+    return len(hits)
+
+
+@settings(_common, max_examples=30)
+@given(name=st.sampled_from(NAMES), seed=st.integers(0, 2**31), n_probes=st.integers(2, 6),
+       level=st.sampled_from([0.0, 1.0, 3.0]), at_bounds=st.booleans())  # fmt: skip
+def test_true_interpretation_survives_probes_alone(name, seed, n_probes, level, at_bounds):
+    _check_probes_alone(name, seed, n_probes, level, at_bounds)
+
+
+def test_opening_probes_hit_the_object():
+    """The opening's lines do reach the object: most of them hit (else the property above tests misses only)."""
+    hits = sum(_check_probes_alone(name, seed, 3, 1.0, False) for seed, name in enumerate(NAMES))
+    assert hits >= 2 * len(NAMES)
