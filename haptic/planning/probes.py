@@ -239,8 +239,8 @@ def opening_probes(
     nearly the face each would hit is perpendicular to every normal measured so far (smallest
     ``max_i |u · n_i|``): a face whose normal is independent of the known ones is what fixes the rotation (two
     normals) and the translation (three planes), hence the poses. Directions heading against a known face's
-    normal (``u · n_i < −``:data:`BEHIND`) are left out while others remain: such a line may enter through that
-    face again, and a convex object's face is never met from behind."""
+    normal (``u · n_i < −``:data:`BEHIND`) come after all the others: such a line may enter through that face
+    again, and a convex object's face is never met from behind."""
     config = config or ProbeConfig()
     if not faces:
         return []
@@ -251,10 +251,9 @@ def opening_probes(
     dirs = fibonacci_directions(config.n_directions)
     if config.table_z is not None:
         dirs = dirs[dirs[:, 2] <= config.max_climb]
-    behind = (dirs @ n.T >= -BEHIND).all(axis=1)  # from behind every known face: no line enters through one again
-    if behind.any():
-        dirs = dirs[behind]
-    order = np.argsort(np.abs(dirs @ n.T).max(axis=1), kind="stable")
+    # from behind every known face first (no such line enters through one again), then the rest
+    ahead = ~(dirs @ n.T >= -BEHIND).all(axis=1)
+    order = np.lexsort((np.abs(dirs @ n.T).max(axis=1), ahead))
     within = (q, np.full(len(q), extent.reach))  # every point of the object is within reach of every contact
     out = []
     for u in dirs[order]:
