@@ -16,7 +16,7 @@ from haptic.errors import HapticError, RecordingError
 def add_parser(sub: argparse._SubParsersAction) -> None:
     from haptic.matching.verify import DEFAULT_VERIFY, VERIFY_MODES
     from haptic.options import noise_level, positive_int, seed_int
-    from haptic.planning.moves import MOVE_SETS
+    from haptic.planning.moves import DEFAULT_MOVES, MOVE_SETS
     from haptic.planning.registry import POLICY_NAMES
 
     p = sub.add_parser(
@@ -40,9 +40,10 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "and edge measured) or full (also every vertex)",
     )  # fmt: skip
     p.add_argument(
-        "--moves", choices=MOVE_SETS, default="tracing",
-        help="admissible kinds of move (default tracing): tracing (face, edge, vertex moves) or all (free-space "
-        "probes too, one planner ranking them); probing is not available yet",
+        "--moves", choices=MOVE_SETS, default=DEFAULT_MOVES,
+        help=f"admissible kinds of move (default {DEFAULT_MOVES}): tracing (face, edge, vertex moves), probing "
+        "(free-space probes alone, geometric executor; verification, if any, by tracing moves) or all (both, one "
+        "planner ranking them)",
     )  # fmt: skip
     p.add_argument("--json", metavar="OUT", help="write the episode's JSON record here")
     p.add_argument("--record", metavar="OUT.rrd", help="write a rerun recording here")

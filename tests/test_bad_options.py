@@ -195,3 +195,23 @@ def test_scene_export_to_a_directory(tmp_path, capsys):
 
 def test_scene_negative_seed(capsys):
     one_line_error(capsys, main(["scene", "--object", "WEDGE01", "--seed", "-1"]), 2, "--seed", "at least 0")
+
+
+@pytest.mark.parametrize(
+    "extra, words",
+    [
+        (["--moves", "probing", "--policy", "optimal"], ["--moves probing", "optimal", "planner, greedy or random"]),
+        (["--moves", "all", "--policy", "optimal"], ["--moves all", "optimal", "tracing"]),
+        (["--moves", "probing", "--executor", "physics"], ["--moves probing", "geometric", "tracing"]),
+    ],
+    ids=["probing-optimal", "all-optimal", "probing-physics"],
+)
+def test_explore_move_set_not_available_with(capsys, extra, words):
+    one_line_error(capsys, main(["explore", "--object", "WEDGE01", *extra]), 1, *words)
+
+
+def test_bench_move_set_not_available_with(tmp_path, capsys):
+    out = tmp_path / "r.jsonl"
+    one_line_error(capsys, main(["bench", "--moves", "probing", "--policy", "planner,optimal", "--episodes", "1",
+                                 "--out", str(out)]), 1, "optimal", "planner, greedy or random")  # fmt: skip
+    assert not out.exists()

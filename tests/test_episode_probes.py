@@ -36,8 +36,8 @@ def test_random_policy_takes_probes_too():
 @pytest.mark.parametrize(
     ("fields", "words"),
     [
-        ({"moves": "probing"}, ("probing", "tracing, all")),
-        ({"moves": "sometimes"}, ("sometimes", "tracing, all")),
+        ({"moves": "sometimes"}, ("sometimes", "tracing, probing, all")),
+        ({"moves": "probing", "executor": "physics"}, ("geometric", "tracing, all")),
         ({"moves": "all", "policy": "optimal"}, ("optimal", "tracing")),
     ],
 )
@@ -54,10 +54,35 @@ def test_probes_are_admitted_on_the_simulated_hand():
         EpisodeSpec(model="BOX01", seed=0, moves="all", executor="physics", policy="optimal")
 
 
-def test_cli_refuses_probing_in_one_line(tmp_path, capsys):
-    assert main(["explore", "--object", "BOX01", "--moves", "probing"]) == 1
-    err = capsys.readouterr().err.strip()
-    assert "\n" not in err and "probing" in err and "tracing, all" in err
+@pytest.mark.parametrize(("model", "seed"), [("BOX01", 1), ("WEDGE01", 1), ("LBLOCK01", 2), ("TETRA01L", 3)])
+@pytest.mark.parametrize("policy", ["planner", "greedy", "random"])
+def test_probes_alone_recognise_correctly(model, seed, policy):
+    rec = run_episode(EpisodeSpec(model=model, seed=seed, policy=policy, moves="probing"))
+    assert rec.outcome == "recognized" and rec.correct, rec
+    assert rec.move_set == "probing" and set(rec.move_kinds[1:]) == {"probe"}  # [0]: the start
+    assert rec.probes == rec.moves and rec.probes >= 2
+
+
+def test_probes_alone_on_the_look_alike_library():
+    from haptic.geometry.library_cache import cached_library
+
+    models = "assets/libraries/lookalike"
+    lib = cached_library(models)
+    for name in sorted(lib)[:2]:
+        rec = run_episode(EpisodeSpec(model=name, seed=0, moves="probing", models=models), lib)
+        assert rec.outcome == "recognized" and rec.correct, rec
+
+
+def test_probes_alone_are_verified_with_the_tracing_moves():
+    rec = run_episode(EpisodeSpec(model="WEDGE01", seed=1, moves="probing", verify="fast"))
+    assert rec.correct and rec.verified["status"] == "confirmed"
+    recognising = rec.move_kinds[1 : 1 + rec.moves - rec.verified["moves"]]
+    assert recognising and set(recognising) == {"probe"}
+
+
+def test_cli_explores_with_probes_alone(tmp_path, capsys):
+    assert main(["explore", "--object", "WEDGE01", "--seed", "1", "--moves", "probing", "--verify", "none"]) == 0
+    assert "probe" in capsys.readouterr().out
 
 
 def test_bench_moves_at_a_small_size():
@@ -68,14 +93,16 @@ def test_bench_moves_at_a_small_size():
 
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "scripts"))
     try:
-        from bench_moves import markdown, run
+        from bench_moves import markdown, ratios, run
     finally:
         sys.path.pop(0)
     rows = run(episodes=6, seed=0, probe_costs=(0.5,))
-    assert [r["setting"] for r in rows] == ["tracing", "all, c_p 0.5"]
+    assert [r["setting"] for r in rows] == ["tracing", "probing, c_p 0.5", "all, c_p 0.5"]
     assert all(r["correct %"] == 100.0 for r in rows)
-    assert rows[0]["probes"] == 0 and rows[1]["probes"] >= 1
-    assert markdown(rows).count("\n") == 3
+    assert rows[0]["probes"] == 0 and rows[2]["probes"] >= 1
+    assert rows[1]["with a probe"] == 6 and rows[1]["probes"] >= 2 * 6
+    assert markdown(rows).count("\n") == 4
+    assert len(ratios(rows)) == 1 and "c_p 0.5" in ratios(rows)[0]
 
 
 def test_a_failed_probe_is_not_tried_again_and_tracing_moves_follow_it():
@@ -98,7 +125,7 @@ def test_a_failed_probe_is_not_tried_again_and_tracing_moves_follow_it():
             if move.kind == "probe":
                 assert not any(same_move(move, m) for m in lines), "a failed line was offered again"
                 lines.append(move)
-                return MoveResult(move=move, status="unreachable", state=inner.state, info={"reason": "blocked"})
+                return MoveResult(move=move, status="unreachable", state=inner.state, reason="blocked")
             return inner.execute(move)
 
     episode.executor = FailingProbes()

@@ -429,3 +429,65 @@ def test_verification_moves_are_labelled_as_such(tmp_path):
     assert len(verifying) == record.verified["moves"], "one label per verification move"
     first = texts.index(verifying[0])
     assert not any("an opening" in t for t in texts[first:]), "no verification move called an opening move"
+
+
+def test_probes_are_drawn_hits_and_misses_apart(tmp_path):
+    from haptic.geometry import SE3, load_library
+    from haptic.matching.probes import FreeSegment, probe_face
+    from haptic.planning.moves import FaceMove, MoveResult, ProbeMove, SensorState
+    from haptic.recording.style import KIND_COLORS, PROBE_HIT_COLOR, PROBE_MISS_COLOR
+
+    box = load_library()["BOX01"]
+    out = tmp_path / "probes.rrd"
+    recorder = EpisodeRecorder(out)
+    obs = recorder.observer()
+    obs.on_start(box, SE3.identity())
+    top = float(box.vertices[:, 2].max())
+    first = probe_face(0, np.array([0.0, 0.0, top]), np.array([0.0, 0.0, 1.0]), 0.01, 0.0005)
+    obs.on_move(0, MoveResult(FaceMove(np.zeros(3)), "ok", (first,), state=SensorState(first.points[0], 0)), 76)
+    side = float(box.vertices[:, 0].max())
+    hit_move = ProbeMove(np.array([side + 0.05, 0.0, 0.0]), np.array([-1.0, 0.0, 0.0]), 0.1)
+    hit = probe_face(1, np.array([side, 0.0, 0.0]), np.array([1.0, 0.0, 0.0]), 0.01, 0.0005)
+    obs.on_move(1, MoveResult(hit_move, "ok", (hit,), cost=3.0, state=SensorState(hit.points[0], 1),
+                              free_space=(FreeSegment(hit_move.start, hit_move.direction, 0.05, 0.0005),)), 40)
+    miss_move = ProbeMove(np.array([side + 0.05, 0.0, top + 0.05]), np.array([-1.0, 0.0, 0.0]), 0.2)
+    obs.on_move(2, MoveResult(miss_move, "ok", (), cost=6.0, state=SensorState(hit.points[0], 1),
+                              free_space=(FreeSegment(miss_move.start, miss_move.direction, 0.2, 0.0005),)), 12)
+    assert recorder.close(keep=True) == out
+
+    ents = load_recording(out)
+    _, hits = ents["world/probes/hits"].series("LineStrips3D:strips")
+    assert np.allclose(hits[-1], [[hit_move.start, hit.points[0]]]), "a hit: its line from the start to the contact"
+    _, misses = ents["world/probes/misses"].series("LineStrips3D:strips")
+    assert np.allclose(misses[-1], [[miss_move.start, miss_move.end]]), "a miss: its whole line"
+    _, contacts = ents["world/probes/contacts"].series("Points3D:positions")
+    _, normals = ents["world/probes/normals"].series("Arrows3D:vectors")
+    assert np.allclose(contacts[-1], [hit.points[0]]) and np.allclose(np.cross(normals[-1][0], hit.normal), 0.0)
+
+    def rgb(ent: str, comp: str) -> tuple[int, ...]:
+        packed = int(ents[ent].series(comp)[1][-1][0])
+        return tuple((packed >> s) & 255 for s in (24, 16, 8))
+
+    assert rgb("world/probes/hits", "LineStrips3D:colors") == PROBE_HIT_COLOR
+    assert rgb("world/probes/misses", "LineStrips3D:colors") == PROBE_MISS_COLOR != PROBE_HIT_COLOR
+    assert ents["world/probes/misses"].timelines["move"] == [2], "no miss before the miss"
+    assert [len(v) for v in ents["world/probes/normals"].series("Arrows3D:vectors")[1]] == [1, 1], "one hit, kept"
+    # the move markers on the interpretations plot, in the probe's own colour
+    assert ents["plots/moves/probe"].series("Scalars:scalars")[0] == [1, 2]
+    assert ents["plots/moves/probe"].static["SeriesPoints:names"] == ["probe move"]
+    assert KIND_COLORS["probe"] == PROBE_HIT_COLOR
+
+
+def test_candidate_probes_are_named_as_probes(tmp_path):
+    out = tmp_path / "all.rrd"
+    recorder = EpisodeRecorder(out)
+    record = run_episode(EpisodeSpec(model="WEDGE01", seed=1, moves="all"), observer=recorder.observer())
+    recorder.close()
+    assert record.probes >= 1
+    ents = load_recording(out)
+    _, tables = ents["decision/scores"].series("TextDocument:text")
+    chosen = [t[0] for t in tables if "chose **probe (" in t[0]]
+    assert len(chosen) == record.probes, "every probe the planner chose, named as a probe in its table"
+    assert all(re.search(r"\| probe \([+-]\d\.\d\d, [+-]\d\.\d\d, [+-]\d\.\d\d\) \d+ cm", t) for t in chosen)
+    _, lines = ents["world/decision/probes"].series("LineStrips3D:strips")
+    assert lines and all(1 <= len(ls) <= 5 for ls in lines)

@@ -22,7 +22,7 @@ EXIT_SIGINT, EXIT_SIGTERM = 130, 143
 def add_parser(sub: argparse._SubParsersAction) -> None:
     from haptic.matching.verify import DEFAULT_VERIFY, VERIFY_MODES
     from haptic.options import noise_levels, positive_int, seed_int
-    from haptic.planning.moves import MOVE_SETS
+    from haptic.planning.moves import DEFAULT_MOVES, MOVE_SETS
     from haptic.planning.registry import POLICY_NAMES
 
     p = sub.add_parser(
@@ -51,9 +51,10 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         help=f"verification before recognition (default {DEFAULT_VERIFY}): none, fast or full",
     )
     p.add_argument(
-        "--moves", choices=MOVE_SETS, default="tracing",
-        help="admissible kinds of move (default tracing): tracing (face, edge, vertex moves) or all (free-space "
-        "probes too, one planner ranking them); probing is not available yet",
+        "--moves", choices=MOVE_SETS, default=DEFAULT_MOVES,
+        help=f"admissible kinds of move (default {DEFAULT_MOVES}): tracing (face, edge, vertex moves), probing "
+        "(free-space probes alone, geometric executor; verification, if any, by tracing moves) or all (both, one "
+        "planner ranking them)",
     )  # fmt: skip
     p.add_argument("--out", default="out/bench/results.jsonl", help="results file (JSON lines)")
     p.add_argument("--workers", type=positive_int, default=1,

@@ -15,7 +15,7 @@ from typing import Protocol
 
 import numpy as np
 
-from haptic.episode.opening import opening_move
+from haptic.episode.opening import opening_move, opening_probe
 from haptic.episode.perception import on_the_table, touched_points
 from haptic.episode.scoring import score_outcome
 from haptic.episode.spec import EpisodeSpec
@@ -31,6 +31,7 @@ from haptic.planning.config import PlannerConfig
 from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import Move, MoveResult
 from haptic.planning.policies import Context, Decision, Policy, RandomPolicy
+from haptic.planning.probes import LibraryExtent
 from haptic.planning.verify import Verifier
 
 MAX_POSED = 4000
@@ -73,7 +74,7 @@ class EpisodeRecord:
     verify: str = "none"
     verified: dict | None = None
     move_set: str = "tracing"
-    """Admissible kinds of move (``EpisodeSpec.moves``)."""
+    """Admissible kinds of move (``EpisodeSpec.moves``; a record written before it existed: "tracing")."""
     probes: int = 0
     """Free-space probes carried out."""
     probe_misses: int = 0
@@ -282,7 +283,9 @@ def loop_steps(
         state = first.state
         if obs.on_move:
             obs.on_move(0, first, tree.count, rec)
-        fixed = ["face", "edge", "vertex"]
+        probing = config.moves == "probing"
+        fixed = [] if probing else ["face", "edge", "vertex"]
+        extent = LibraryExtent.of(library.values()) if probing else None
         while True:
             verifying = verifier is not None and rec is not None and rec.status == RECOGNIZED
             if verifying:
@@ -305,6 +308,8 @@ def loop_steps(
                     if config.table_z is not None and rec is not None and rec.classes else ()
                 )  # fmt: skip
                 move = opening_move(fixed.pop(0), state, components, config, rng, tuple(failed_here), hyps)
+            if probing and move is None and not verifying and not (rec is not None and rec.classes):
+                move = opening_probe(components, extent, config, rng, (*failed_here, *probed))
             if move is None:
                 t_dec = time.perf_counter()
                 hyps = hypotheses_from(tree, rec) if rec is not None and rec.classes else []

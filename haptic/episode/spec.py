@@ -35,17 +35,20 @@ class EpisodeSpec:
     verify: str = "none"
     """Verification before recognition: "none", "fast" or "full" (:mod:`haptic.matching.verify`)."""
     moves: str = "tracing"
-    """Admissible kinds of move: "tracing" (face, edge, vertex moves) or "all" (free-space probes too, ranked with
-    them by one planner; planner, greedy and random policies only)."""
+    """Admissible kinds of move: "tracing" (face, edge, vertex moves), "probing" (free-space probes alone,
+    geometric executor) or "all" (both, ranked by one planner); probes with the planner, greedy and random
+    policies only. The command line's default is ``haptic.planning.moves.DEFAULT_MOVES``; this one is what a
+    record written before the field existed was run with."""
 
     def __post_init__(self) -> None:
-        if self.moves == "tracing":
+        if self.moves == "tracing":  # the tracing moves run everywhere
             return
         if self.moves not in MOVE_SETS:
-            raise HapticError(f"unknown --moves {self.moves!r}; valid: tracing, all")
-        if self.moves == "probing":
+            raise HapticError(f"unknown --moves {self.moves!r}; valid: {', '.join(MOVE_SETS)}")
+        if self.moves == "probing" and self.executor != "geometric":
             raise HapticError(
-                "--moves probing is not available yet (probes alone do not recognise reliably); valid: tracing, all"
+                f"--moves probing: probes alone run on the geometric executor only; "
+                f"valid with --executor {self.executor}: tracing, all"
             )
         if self.policy == "optimal":
             raise HapticError(

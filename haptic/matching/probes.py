@@ -36,6 +36,12 @@ from haptic.matching.recognition import PoseTolerance
 from haptic.matching.tree import InterpretationTree
 from haptic.matching.verify import pose_check
 
+MIN_SPAN = 0.3
+"""Smallest ratio of singular values of the directions that fix the data's position (face normals, per touched
+point; the two across each edge; all three at a vertex) for the probe data to be tested against posed leaves
+(:func:`consistent_leaves`): below it, as with a few probe contacts on faces of nearly coplanar normals, a pose
+fitted to the data is off along the weak direction by more than the pose check's factor and the pose tolerance
+allow, and the truth could be eliminated."""
 MAX_POSED = 400
 """Most leaves whose poses :func:`consistent_leaves` computes; above it every leaf is kept (sound, as the
 matcher's recognition does: ``haptic.episode.MAX_POSED``)."""
@@ -121,7 +127,8 @@ def consistent_leaves(
 ) -> np.ndarray:
     """Which leaves of ``tree`` the probe data leave standing, shape (N,) bool.
 
-    A leaf whose pose is not yet determined, and every leaf while there are more than ``max_posed``, is kept.
+    A leaf whose pose is not yet determined, and every leaf while there are more than ``max_posed`` or while the
+    data fix a position only weakly (:func:`position_span` below :data:`MIN_SPAN`), is kept.
     A leaf with a pose is eliminated when one of the ``free`` segments enters its posed model deeper than the
     bounds allow (:func:`free_segment_consistent`), or when it pairs one of the ``probe_faces`` (data ids of
     probe hits) and fails the pose check of :func:`~haptic.matching.verify.pose_check` (every component,
@@ -130,7 +137,7 @@ def consistent_leaves(
     n = tree.count
     keep = np.ones(n, dtype=bool)
     hits = set(int(i) for i in probe_faces)
-    if n > max_posed or (not free and not hits):
+    if n > max_posed or (not free and not hits) or position_span(tree.data) < MIN_SPAN:
         return keep
     tol = tol if tol is not None else PoseTolerance.from_data(tree.data)
     data = tree.data
@@ -146,6 +153,25 @@ def consistent_leaves(
     return keep
 
 
+def position_span(data: Sequence) -> float:
+    """How well the data fix a position: the smallest over the largest singular value of the unit directions
+    along which they constrain it (a face's normal once per touched point, the two directions across an edge,
+    the three axes at a vertex); 0 when they constrain fewer than three."""
+    rows = []
+    for c in data:
+        if isinstance(c, DataFace):
+            rows.extend([c.normal] * len(np.atleast_2d(c.points)))
+        elif getattr(c, "kind", None) == "edge":
+            b = np.asarray(c.direction, dtype=float)
+            rows.extend(np.linalg.svd(np.eye(3) - np.outer(b, b))[0][:, :2].T)
+        elif getattr(c, "kind", None) == "vertex":
+            rows.extend(np.eye(3))
+    if len(rows) < 3:
+        return 0.0
+    sv = np.linalg.svd(np.asarray(rows, dtype=float), compute_uv=False)
+    return float(sv[-1] / sv[0]) if sv[0] > 0 else 0.0
+
+
 def apply_probes(
     tree: InterpretationTree,
     free: Sequence[FreeSegment],
@@ -159,10 +185,12 @@ def apply_probes(
 
 __all__ = [
     "MAX_POSED",
+    "MIN_SPAN",
     "FreeSegment",
     "apply_probes",
     "consistent_leaves",
     "free_margin",
     "free_segment_consistent",
+    "position_span",
     "probe_face",
 ]

@@ -19,6 +19,9 @@ from haptic.matching.trace import ContactTrace
 
 MOVE_SETS = ("tracing", "probing", "all")
 """The admissible kinds of move a planner may be given: tracing moves, free-space probes, or both."""
+DEFAULT_MOVES = "tracing"
+"""The move set of an episode unless one is asked for (``EpisodeSpec.moves``, ``PlannerConfig.moves``, the command
+line's ``--moves``)."""
 
 
 @dataclass(frozen=True)

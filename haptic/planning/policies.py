@@ -119,6 +119,8 @@ class RandomPolicy(Policy):
 
 
 def _further(ctx: Context, cands: Sequence[Scored], rng: np.random.Generator, depth: int) -> Move:
+    if ctx.config.moves == "probing":  # the look-ahead simulates tracing moves only
+        return _cheapest_exploring(cands, rng)
     for d in range(2, depth + 1):
         move = lookahead_choice(ctx, depth=d)
         if move is not None:

@@ -3,9 +3,9 @@
 A probe is a line (:class:`~haptic.planning.moves.ProbeMove`) the sensor approaches along until contact or the
 line's end. Candidates aim at the hypotheses' surfaces: for every pose class and every face that class puts
 in the world, the face's centre approached from a discrete set of directions within :attr:`ProbeConfig.
-max_incidence` of head-on, each line starting outside every hypothesis and running across the whole region
-they occupy, clear of the table. Lines that nearly coincide (same direction, targets within
-:attr:`ProbeConfig.target_spacing` across it) are one candidate.
+max_incidence` of head-on, each line starting just before the first ball holding a hypothesis's object that it
+meets and ending just past the last (:attr:`ProbeConfig.standoff`), clear of the table. Lines that nearly
+coincide (same direction, targets within :attr:`ProbeConfig.target_spacing` across it) are one candidate.
 
 Each hypothesis predicts, through its pose, whether the line hits its object, the face hit and the distance
 along the line (one vectorised line–triangle intersection per model over every candidate and pose class), and
@@ -17,8 +17,11 @@ planner can rank probes and tracing moves together.
 The elimination rule mirrors the matcher (:mod:`haptic.matching.probes`). If ``i`` predicts a miss, ``j`` is
 eliminated when the line runs inside it deeper than the free segment's margin ``ε = ρ + δ_p + a ‖x − c‖``
 (the matcher's, with the pose tolerance ``δ_p``, ``a`` of :class:`~haptic.matching.recognition.PoseTolerance`).
-The depth is estimated from the first inside chord, ``½ · chord · min(|n_in·u|, |n_out·u|)`` (the depth of the
-chord's midpoint below its entry and exit faces). If ``i`` predicts a hit, ``j`` is eliminated when it predicts
+The depth is the matcher's measure, the largest distance from the surface of points of the first inside chord
+(three, at its quarters; the matcher samples more, so the prediction never says deeper than it finds). The
+depth of the chord's midpoint below its entry and exit faces, ``½ · chord · min(|n_in·u|, |n_out·u|)``, would
+overstate it wherever a third face runs near the chord (a line past a corner), predicting a miss to eliminate
+poses the matcher keeps. If ``i`` predicts a hit, ``j`` is eliminated when it predicts
 a miss, a contact farther along the line than the two contact margins allow, or a normal farther than the
 angle bound: the matcher refits each pose with the contact and checks it within ``POSE_SAFETY`` times its
 bounds (:func:`~haptic.matching.verify.pose_check`), so a contact margin is ``(1 + POSE_SAFETY) ρ + δ r``
@@ -30,20 +33,26 @@ them with what the matcher then eliminates).
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from haptic.errors import PlanningError
+from haptic.geometry.distance import surface_distance
+from haptic.geometry.polyhedron import Polyhedron
 from haptic.geometry.raycast import line_hits
-from haptic.matching.components import DataComponent, SensorNoise
+from haptic.matching.components import DataComponent, DataFace, SensorNoise
 from haptic.matching.recognition import PoseTolerance
 from haptic.matching.verify import POSE_SAFETY
 from haptic.planning.efficiency import efficiency_of, expected_eliminated
 from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import CostModel, ProbeMove
 
+BEHIND = 0.05
+"""Opening probes head along every known face's normal, or across it within this (``u · n ≥ −0.05``)."""
+DEPTH_FRACTIONS = np.array([0.25, 0.5, 0.75])
+"""Where along a predicted miss-line's first inside chord its depth is sampled (fractions of the chord)."""
 MIN_INCIDENCE = 0.2
 """Smallest ``|n·u|`` used to turn a surface offset into a distance along a line (a grazing approach)."""
 FINGER_LIFT = 0.08
@@ -61,8 +70,10 @@ class ProbeConfig:
     """A face is approached from directions within this of its inward normal [rad]."""
     target_spacing: float = 0.01
     """Targets closer than this across a common direction make one candidate [m]."""
-    standoff: float = 0.03
-    """Lines start this far outside the sphere that holds every hypothesis's object [m]."""
+    standoff: float = 0.01
+    """Lines start this far before the first sphere they meet that holds a hypothesis's posed object (at its
+    centroid, through its farthest vertex), and a miss runs this far past the last one: free space farther out
+    tells nothing and costs ``c_s`` per metre [m]."""
     max_candidates: int = 64
     """Most candidates offered (an even subsample of them beyond it)."""
     table_z: float | None = None
@@ -125,6 +136,7 @@ def candidate_probes(hypotheses: Sequence[Hypothesis], config: ProbeConfig | Non
     if config.table_z is not None:
         dirs = dirs[dirs[:, 2] <= config.max_climb]
     cos_max = np.cos(config.max_incidence)
+    balls = _hypothesis_balls(posed)
     seen: set[tuple] = set()
     out: list[ProbeMove] = []
     for h in posed:
@@ -142,6 +154,8 @@ def candidate_probes(hypotheses: Sequence[Hypothesis], config: ProbeConfig | Non
                 continue
             seen.add(key)
             move = _line_through(p, u, centre, big, config, radius)
+            if move is not None:
+                move = _clip_to_balls(move, balls, config.standoff, union=True)
             if move is not None:
                 out.append(move)
     if len(out) > config.max_candidates:
@@ -186,6 +200,38 @@ def finger_clear(hypotheses: Sequence[Hypothesis], moves: Sequence[ProbeMove], p
     return ok
 
 
+def _hypothesis_balls(hypotheses: Sequence[Hypothesis]) -> tuple[np.ndarray, np.ndarray]:
+    """Centre (posed centroid) and radius (to the farthest vertex) of each hypothesis's object, (N, 3), (N,)."""
+    centres = np.array([h.world_from_model.apply(h.poly.centroid) for h in hypotheses])
+    radii = np.array([float(np.linalg.norm(h.poly.vertices - h.poly.centroid, axis=1).max()) for h in hypotheses])
+    return centres, radii
+
+
+def _clip_to_balls(move: ProbeMove, balls: tuple[np.ndarray, np.ndarray], margin: float, union: bool):
+    """``move`` shortened to the part of its line within ``margin`` of the balls (``union``: of any of them,
+    where one of several objects may be; else of all of them, where one object within each must be); None when
+    that part is empty. The start moves forward, the end back; the line is never lengthened."""
+    centres, radii = balls
+    s, u = np.asarray(move.start, dtype=float), np.asarray(move.direction, dtype=float)
+    w = centres - s
+    b = w @ u
+    disc = b * b - (np.einsum("ij,ij->i", w, w) - (radii + margin) ** 2)
+    meets = disc > 0.0
+    root = np.sqrt(np.where(meets, disc, 0.0))
+    if union:
+        if not meets.any():
+            return None
+        t0, t1 = float((b - root)[meets].min()), float((b + root)[meets].max())
+    else:
+        if not meets.all():
+            return None
+        t0, t1 = float((b - root).max()), float((b + root).min())
+    t0, t1 = max(t0, 0.0), min(t1, float(move.length))
+    if t1 <= t0:
+        return None
+    return ProbeMove(s + t0 * u, u, t1 - t0)
+
+
 def _line_through(
     p: np.ndarray, u: np.ndarray, centre: np.ndarray, radius: float, config: ProbeConfig, hold: float = 0.0
 ):
@@ -217,6 +263,65 @@ def _line_through(
     if length <= back:
         return None
     return ProbeMove(start, u, float(length))
+
+
+@dataclass(frozen=True)
+class LibraryExtent:
+    """How large the library's objects are, for aiming probes before any hypothesis has a pose."""
+
+    reach: float
+    """The largest distance between two vertices of one model: every point of the object lies within this of
+    every contact [m]."""
+    depth: float
+    """The median over the library of a model's centroid's distance to its nearest face plane: how far behind
+    a contact, against its normal, the object's inside is aimed at [m]."""
+
+    @classmethod
+    def of(cls, models: Iterable[Polyhedron]) -> LibraryExtent:
+        """The extent of a library's models."""
+        reach, depths = 0.0, []
+        for poly in models:
+            v = poly.vertices
+            reach = max(reach, float(np.sqrt(((v[:, None] - v[None]) ** 2).sum(-1)).max()))
+            depths.append(float(np.abs(poly.face_offsets - poly.face_normals @ poly.centroid).min()))
+        return cls(reach, float(np.median(depths)) if depths else 0.0)
+
+
+def opening_probes(
+    faces: Sequence[DataFace], extent: LibraryExtent, config: ProbeConfig | None = None
+) -> list[ProbeMove]:
+    """Probe lines toward the object's region before hypotheses have poses (the opening of ``--moves probing``),
+    best first: a fixed spread of approach directions (:attr:`ProbeConfig.n_directions`, a Fibonacci lattice),
+    each line through the region's estimated centre ``c = mean(q_i − depth · n_i)`` over the data faces (their
+    contact points ``q_i`` and outward normals ``n_i``), running across the region that must hold the object:
+    the intersection of the balls of radius ``reach`` about the contacts (plus the standoff). Ranked by how
+    nearly the face each would hit is perpendicular to every normal measured so far (smallest
+    ``max_i |u · n_i|``): a face whose normal is independent of the known ones is what fixes the rotation (two
+    normals) and the translation (three planes), hence the poses. Directions heading against a known face's
+    normal (``u · n_i < −``:data:`BEHIND`) come after all the others: such a line may enter through that face
+    again, and a convex object's face is never met from behind."""
+    config = config or ProbeConfig()
+    if not faces:
+        return []
+    q = np.array([np.mean(np.atleast_2d(f.points), axis=0) for f in faces])
+    n = np.array([f.normal for f in faces])
+    centre = (q - extent.depth * n).mean(axis=0)
+    radius = extent.reach + extent.depth + config.standoff
+    dirs = fibonacci_directions(config.n_directions)
+    if config.table_z is not None:
+        dirs = dirs[dirs[:, 2] <= config.max_climb]
+    # from behind every known face first (no such line enters through one again), then the rest
+    ahead = ~(dirs @ n.T >= -BEHIND).all(axis=1)
+    order = np.lexsort((np.abs(dirs @ n.T).max(axis=1), ahead))
+    within = (q, np.full(len(q), extent.reach))  # every point of the object is within reach of every contact
+    out = []
+    for u in dirs[order]:
+        move = _line_through(centre, u, centre, radius, config)
+        if move is not None:
+            move = _clip_to_balls(move, within, config.standoff, union=False)
+        if move is not None:
+            out.append(move)
+    return out
 
 
 @dataclass(frozen=True, eq=False)
@@ -329,15 +434,16 @@ def predict_probes(
             beyond = np.where(leaving & (hits.params > hits.first[:, None]), hits.params, np.inf)
         k_out = np.argmin(beyond, axis=1) if beyond.shape[1] else np.zeros(len(s_m), dtype=int)
         t_out = beyond[np.arange(len(s_m)), k_out]
-        n_in = np.where((hits.face >= 0)[:, None], poly.face_normals[np.maximum(hits.face, 0)], 0.0)
-        n_out = tri_n[k_out]
-        finite = np.isfinite(t_out) & np.isfinite(hits.first)
-        chord = np.where(finite, np.where(finite, t_out, 0.0) - np.where(finite, hits.first, 0.0), 0.0)
-        dep = 0.5 * chord * np.minimum(np.abs(np.einsum("rk,rk->r", n_in, u_m)),
-                                       np.abs(np.einsum("rk,rk->r", n_out, u_m)))  # fmt: skip
-        # a chord running past the line's end enters only as far as the end goes
-        reach = np.clip(np.repeat(lengths[None], len(js), axis=0).reshape(-1) - hits.first, 0.0, None)
-        dep = np.minimum(dep, reach)
+        # the depth as the matcher measures it: distances from the surface of points of the chord (up to the
+        # line's end), the largest of DEPTH_FRACTIONS samples
+        lens = np.repeat(lengths[None], len(js), axis=0).reshape(-1)
+        fin = np.flatnonzero(np.isfinite(t_out) & np.isfinite(hits.first) & (hits.first < lens))
+        dep = np.zeros(len(s_m))
+        if len(fin):
+            lo, hi = hits.first[fin], np.minimum(t_out[fin], lens[fin])
+            ts = lo[:, None] + (hi - lo)[:, None] * DEPTH_FRACTIONS
+            pts = s_m[fin, None, :] + ts[..., None] * u_m[fin, None, :]
+            dep[fin] = surface_distance(poly, pts.reshape(-1, 3)).reshape(len(fin), -1).max(axis=1)
         for a, j in enumerate(js):
             t_hit[:, j] = first[:, a]
             face[:, j] = fc[:, a]
@@ -365,5 +471,6 @@ def predict_probes(
     return out
 
 
-__all__ = ["FINGER_LIFT", "MIN_INCIDENCE", "ProbeConfig", "ProbePrediction", "candidate_probes",
-           "fibonacci_directions", "finger_clear", "predict_probes"]  # fmt: skip
+__all__ = ["BEHIND", "DEPTH_FRACTIONS", "FINGER_LIFT", "MIN_INCIDENCE", "LibraryExtent", "ProbeConfig",
+           "ProbePrediction", "candidate_probes", "fibonacci_directions", "finger_clear", "opening_probes",
+           "predict_probes"]  # fmt: skip

@@ -68,6 +68,11 @@ def _waypoints(prev: np.ndarray | None, result: MoveResult, new: np.ndarray | No
     one: the geometric executor's path (it has no fingertip trajectory)."""
     pts: list[np.ndarray] = [prev] if prev is not None else []
     move = result.move
+    if getattr(move, "kind", None) == "probe":  # through free space to the line, along it, back after a miss
+        start = np.asarray(move.start, dtype=float)
+        if result.components:
+            return np.array([*pts, start, *(p for c in result.components for p in np.atleast_2d(c.points))])
+        return np.array([*pts, start, move.end, *pts])
     for c in result.components:
         if isinstance(c, DataFace):
             pts.extend(c.points)
@@ -238,7 +243,7 @@ def _decision_table(i: int, decision: Decision) -> str:
 
 def _move_name(move: Move) -> str:
     """The move's kind and direction: ``face (+0.92, +0.33, -0.22)`` (a world direction), ``edge +``,
-    ``vertex across f2``."""
+    ``vertex across f2``, ``probe (+0.00, -0.71, -0.71) 12 cm`` (the approach direction and the line's length)."""
     kind = getattr(move, "kind", "?")
     if kind == "face":
         d = np.asarray(move.direction, dtype=float)
@@ -247,4 +252,7 @@ def _move_name(move: Move) -> str:
         return f"edge {'+' if move.sense > 0 else '-'}"
     if kind == "vertex":
         return f"vertex across f{move.across_face}"
+    if kind == "probe":
+        d = np.asarray(move.direction, dtype=float)
+        return f"probe ({d[0]:+.2f}, {d[1]:+.2f}, {d[2]:+.2f}) {100 * float(move.length):.0f} cm"
     return str(move)

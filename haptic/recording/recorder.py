@@ -42,6 +42,7 @@ from haptic.recording.drawing import (
 from haptic.recording.style import (
     APPLICATION_ID,
     ARROW_RADIUS,
+    CANDIDATE_PROBES,
     CANDIDATE_SCALE,
     CONTACT_COLOR,
     CONTACT_NORMAL_SCALE,
@@ -60,6 +61,9 @@ from haptic.recording.style import (
     NORMAL_SCALE,
     OBJECT_VIEW_DISTANCE,
     POSE_CLASSES_COLOR,
+    PROBE_HIT_COLOR,
+    PROBE_MISS_COLOR,
+    PROBE_RADIUS,
     ROBOT_ALPHA,
     START_TEXT,
     TRACE_MAX_POINTS,
@@ -119,6 +123,10 @@ class _State:
     strips: list[np.ndarray] = field(default_factory=list)
     strip_kinds: list[str] = field(default_factory=list)
     failed_strips: list[np.ndarray] = field(default_factory=list)
+    probe_hits: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = field(default_factory=list)
+    """Probes that met the object: line start, contact and sensed normal (world) [m]."""
+    probe_misses: list[np.ndarray] = field(default_factory=list)
+    """Probes that met nothing: their whole line, (2, 3) [m]."""
     position: np.ndarray | None = None
     sim_time: float | None = None
     cost: float = 0.0
@@ -303,12 +311,13 @@ class EpisodeRecorder:
             path = np.vstack([path, path])
         if len(path):
             s.strips.append(path)
-            s.strip_kinds.append(kind)
+            s.strip_kinds.append("probe miss" if kind == "probe" and not result.components else kind)
             rec.log(
                 "world/trace/path",
                 rr.LineStrips3D(
                     s.strips,
-                    colors=[KIND_COLORS.get(k, KIND_COLORS["start"]) for k in s.strip_kinds],
+                    colors=[PROBE_MISS_COLOR if k == "probe miss" else KIND_COLORS.get(k, KIND_COLORS["start"])
+                            for k in s.strip_kinds],
                     radii=TRACE_RADIUS,
                     labels=[f"move {j}: {k}" for j, k in enumerate(s.strip_kinds)],
                     show_labels=False,
@@ -339,6 +348,8 @@ class EpisodeRecorder:
                         radii=ARROW_RADIUS),
         )  # fmt: skip
         self._log_hand(result, trace)
+        if kind == "probe":
+            self._log_probe(result)
 
         self._log_components()
 
@@ -368,6 +379,37 @@ class EpisodeRecorder:
                 level=rr.TextLogLevel.INFO,
             ),
         )
+
+    def _log_probe(self, result: MoveResult) -> None:
+        """Every probe so far: a hit as its line from the start to the contact, the contact and its normal
+        (``world/probes/hits``, ``.../contacts``, ``.../normals``); a miss as its whole line
+        (``world/probes/misses``), in another colour."""
+        rec, s = self.stream, self._s
+        move = result.move
+        start = np.asarray(move.start, dtype=float)
+        face = next((c for c in result.components if isinstance(c, DataFace)), None)
+        if face is not None:
+            s.probe_hits.append((start, np.atleast_2d(face.points)[0], np.asarray(face.normal, dtype=float)))
+        else:
+            s.probe_misses.append(np.array([start, move.end]))
+        n = len(s.probe_hits) + len(s.probe_misses)
+        if s.probe_hits:
+            starts, pts, nrm = (np.array(x) for x in zip(*s.probe_hits, strict=True))
+            labels = [f"probe hit {j}" for j in range(len(pts))]
+            lines = np.stack([starts, pts], axis=1)
+            rec.log("world/probes/hits", rr.LineStrips3D(lines, colors=[PROBE_HIT_COLOR], radii=PROBE_RADIUS,
+                                                         labels=labels, show_labels=False))  # fmt: skip
+            rec.log("world/probes/contacts", rr.Points3D(pts, radii=CONTACT_RADIUS, colors=[PROBE_HIT_COLOR],
+                                                         labels=labels, show_labels=False))  # fmt: skip
+            rec.log("world/probes/normals", rr.Arrows3D(origins=pts, vectors=nrm * NORMAL_SCALE * s.radius,
+                                                        colors=[PROBE_HIT_COLOR], radii=ARROW_RADIUS))  # fmt: skip
+        if s.probe_misses:
+            labels = [f"probe miss {j}" for j in range(len(s.probe_misses))]
+            rec.log("world/probes/misses", rr.LineStrips3D(s.probe_misses, colors=[PROBE_MISS_COLOR],
+                                                           radii=PROBE_RADIUS, labels=labels,
+                                                           show_labels=False))  # fmt: skip
+        rec.log("log/moves", rr.TextLog(f"probe {n}: {'hit' if face is not None else 'miss'}",
+                                        level=rr.TextLogLevel.INFO))  # fmt: skip
 
     def _begin_move(self, i: int, result: MoveResult) -> Any:
         """Move ``i``'s contact trace (None without one), after setting the clocks to it and sending the
@@ -435,6 +477,16 @@ class EpisodeRecorder:
                 vectors.append(d * CANDIDATE_SCALE * s.radius * (0.5 + 0.5 * r))
                 colors.append(_score_color(r))
                 labels.append(f"{_move_name(c.move)} {c.score:.3g}")
+            probes = [(c, r) for c, r in zip(cands, rel, strict=True) if getattr(c.move, "kind", None) == "probe"]
+            probes = sorted(probes, key=lambda cr: -cr[1])[:CANDIDATE_PROBES]  # the best lines only: dozens hide all
+            if probes:
+                rec.log(
+                    "world/decision/probes",
+                    rr.LineStrips3D([np.array([c.move.start, c.move.end]) for c, _ in probes],
+                                    colors=[_score_color(r) for _, r in probes], radii=ARROW_RADIUS,
+                                    labels=[f"{_move_name(c.move)} {c.score:.3g}" for c, _ in probes],
+                                    show_labels=False),
+                )  # fmt: skip
             if origins:
                 rec.log(
                     "world/decision/candidates",
@@ -448,6 +500,13 @@ class EpisodeRecorder:
             ]
         else:
             lines = []
+        if getattr(decision.move, "kind", None) == "probe":
+            rec.log(
+                "world/decision/chosen",
+                rr.Arrows3D(origins=[decision.move.start], vectors=[decision.move.end - decision.move.start],
+                            colors=[(255, 255, 255)], radii=rr.components.Radius.ui_points(2.5),
+                            labels=[_move_name(decision.move)], show_labels=False),
+            )  # fmt: skip
         d = self._move_direction(decision.move)
         if d is not None and s.position is not None:
             rec.log(

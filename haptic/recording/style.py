@@ -25,6 +25,8 @@ CONTACT_NORMAL_SCALE = 0.25
 CANDIDATE_SCALE = 0.5
 """Length of the best candidate move's arrow, as a fraction of the object's radius (the others scale down
 with their score, to half of it)."""
+CANDIDATE_PROBES = 5
+"""Most candidate probes drawn as lines at a decision (the best-scoring; the table lists more)."""
 DEFAULT_RADIUS = 0.04
 """Object radius assumed before the episode's object is known [m]."""
 MOVE_CONTACTS = 60
@@ -64,9 +66,15 @@ KIND_COLORS: dict[str, tuple[int, int, int]] = {
     "face": (70, 130, 230),
     "edge": (240, 150, 40),
     "vertex": (190, 90, 220),
+    "probe": (235, 60, 160),
     "failed": (230, 50, 50),
 }
 """Colour of each move kind (path strips, move markers on the interpretation plot, candidates)."""
+PROBE_HIT_COLOR = KIND_COLORS["probe"]
+"""A probe that met the object: its line from its start to the contact, the contact and its normal."""
+PROBE_MISS_COLOR = (40, 40, 40)
+"""A probe that met nothing: its whole line (free space)."""
+PROBE_RADIUS = rr.components.Radius.ui_points(2.5)
 FACE_COLOR = (70, 130, 230, 140)
 EDGE_COLOR = (240, 150, 40)
 VERTEX_COLOR = (220, 40, 60)

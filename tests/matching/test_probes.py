@@ -62,18 +62,26 @@ def _check(name: str, seed: int, n_moves: int, n_probes: int, level: float, at_b
         tree.add(c)
     free, hits, outcome = [], [], [0, 0]
     for _ in range(n_probes):
-        res = execute_probe(ex, random_probe(ex, rng))
-        if not res.ok:
-            continue
-        for c in res.components:
-            tree.add(c)
-            hits.append(c.id)
-            assert len(true_leaves(tree, ex)) >= 1, (name, seed, "tree", c)
-        free.extend(res.free_space)
-        outcome[len(res.components)] += 1
-        apply_probes(tree, free, hits)
-        assert len(true_leaves(tree, ex)) >= 1, (name, seed, "probe filter", len(free), len(hits))
+        res = _probe_and_check(ex, tree, random_probe(ex, rng), free, hits, (name, seed))
+        if res is not None:
+            outcome[len(res.components)] += 1
     return outcome[0], outcome[1]
+
+
+def _probe_and_check(ex, tree, move, free: list, hits: list, label: tuple):
+    """Carry out ``move``, match its data (hits in the tree, then the probe filter over all the probe data so
+    far), asserting after each step that the true interpretation is left; the result, None when it failed."""
+    res = execute_probe(ex, move)
+    if not res.ok:
+        return None
+    for c in res.components:
+        tree.add(c)
+        hits.append(c.id)
+        assert len(true_leaves(tree, ex)) >= 1, (*label, "tree", c)
+    free.extend(res.free_space)
+    apply_probes(tree, free, hits)
+    assert len(true_leaves(tree, ex)) >= 1, (*label, "probe filter", len(free), len(hits))
+    return res
 
 
 _common = settings(deadline=None, suppress_health_check=[HealthCheck.too_slow], derandomize=True)
@@ -194,3 +202,51 @@ def test_probe_cost_is_a_constant_plus_free_space_distance():
     costs = CostModel(c_p=2.0, c_s=20.0)
     assert costs.probe_move(0.0) == 2.0
     assert costs.probe_move(0.1) == pytest.approx(4.0)
+
+
+def _check_probes_alone(name: str, seed: int, n_probes: int, level: float, at_bounds: bool) -> int:
+    """The start, then probes only: the opening's lines toward the region the contacts leave (as under ``--moves
+    probing``, before poses), every few a random line at the object; returns how many hits."""
+    from haptic.planning.probes import LibraryExtent, opening_probes
+
+    rng = np.random.default_rng(seed)
+    ex = GeometricExecutor(
+        LIB[name], SE3.random(rng, 0.2), SensorNoise().scaled(level), rng,
+        settings=GeometricSettings(at_bounds=at_bounds),
+    )  # fmt: skip
+    extent = LibraryExtent.of(LIB.values())
+    tree = InterpretationTree(ARRAYS)
+    tree.add(ex.start().components[0])
+    free, hits = [], []
+    for k in range(n_probes):
+        faces = [c for c in ex.components if isinstance(c, DataFace)]
+        lines = opening_probes(faces, extent)
+        move = random_probe(ex, rng) if k % 3 == 2 or not lines else lines[int(rng.integers(min(3, len(lines))))]
+        _probe_and_check(ex, tree, move, free, hits, (name, seed))
+    return len(hits)
+
+
+@settings(_common, max_examples=30)
+@given(name=st.sampled_from(NAMES), seed=st.integers(0, 2**31), n_probes=st.integers(2, 6),
+       level=st.sampled_from([0.0, 1.0, 3.0]), at_bounds=st.booleans())  # fmt: skip
+def test_true_interpretation_survives_probes_alone(name, seed, n_probes, level, at_bounds):
+    _check_probes_alone(name, seed, n_probes, level, at_bounds)
+
+
+def test_opening_probes_hit_the_object():
+    """The opening's lines do reach the object: most of them hit (else the property above tests misses only)."""
+    hits = sum(_check_probes_alone(name, seed, 3, 1.0, False) for seed, name in enumerate(NAMES))
+    assert hits >= 2 * len(NAMES)
+
+
+def test_position_span_says_when_the_data_fix_a_position_in_every_direction():
+    from haptic.matching.probes import MIN_SPAN, position_span
+
+    def face(i, n):
+        return probe_face(i, np.zeros(3), np.asarray(n, dtype=float) / np.linalg.norm(n), 0.01, 0.0005)
+
+    axes = [face(0, [1, 0, 0]), face(1, [0, 1, 0]), face(2, [0, 0, 1])]
+    assert position_span(axes) == pytest.approx(1.0)
+    assert position_span(axes[:2]) == 0.0  # two planes leave a line
+    flat = [face(0, [1, 0, 0]), face(1, [0, 1, 0]), face(2, [1, 1, 0.1])]  # nearly coplanar normals
+    assert position_span(flat) < MIN_SPAN <= position_span(axes)
