@@ -155,7 +155,12 @@ def candidate_probes(hypotheses: Sequence[Hypothesis], config: ProbeConfig | Non
             seen.add(key)
             move = _line_through(p, u, centre, big, config, radius)
             if move is not None:
-                move = _clip_to_balls(move, balls, config.standoff, union=True)
+                clipped = _clip_to_balls(move, balls, config.standoff, union=True)
+                if clipped is not None and config.pad_radius > 0.0:
+                    # the hand comes down to the line's start from above, clear of every hypothesis's object:
+                    # the start stays there, only the end is cut
+                    clipped = ProbeMove(move.start, u, float((clipped.end - move.start) @ u))
+                move = clipped
             if move is not None:
                 out.append(move)
     if len(out) > config.max_candidates:
