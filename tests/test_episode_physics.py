@@ -68,3 +68,20 @@ def test_faces_beside_a_seam_of_the_simulated_pieces_read_true():
     rec = run_episode(EpisodeSpec(model="BOX01P", seed=22, executor="physics", noise=0.0))
     assert rec.outcome == "recognized" and rec.correct, rec.outcome
     assert rec.perception["face_normal_deg"]["max"] < 0.3, rec.perception["face_normal_deg"]
+
+
+def test_a_pad_lifted_off_a_valley_reports_no_vertex():
+    # FRAME01 standing on its side: following a concave valley of its sloped faces down toward the hole, the
+    # finger's distal link meets the frame's rim and lifts the pad off the valley with the normal still across
+    # it; that is no vertex (the surface did not fall away), and the library object is not rejected
+    lost = []
+
+    def on_failed(n, r) -> None:
+        if r.move.kind == "edge" and r.reason.endswith("lost"):
+            lost.append(r)
+
+    spec = EpisodeSpec(model="FRAME01", seed=1, executor="physics", verify="full", budget=40.0)
+    rec = run_episode(spec, observer=EpisodeObserver(on_failed_move=on_failed))
+    assert rec.outcome != "no-match", rec.detail
+    assert rec.perception["spurious"] == 0
+    assert lost and lost[0].status == "no-contact"

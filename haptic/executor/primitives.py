@@ -13,7 +13,8 @@ with a valid normal (pitfall 5); an edge when the filtered normal leaves the run
 than 10° for 3 samples (convex when it tilts towards the direction of travel -- the surface falls away --,
 concave when it tilts against it -- the finger is blocked) or, as a backup, when the force stays below
 0.3 F for 20 ms (the surface fell away) or progress stalls (blocked); a vertex while following an edge when
-the filtered normal gains a component along the edge above sin 15°, or contact is lost (pitfall 8).
+the filtered normal gains a component along the edge above sin 15°, or contact is lost once the normal leaned
+along the edge (pitfall 8; lost before, the pad was lifted off the edge, and the move fails).
 Ridge following presses along the sensed normal and servos sideways to keep it on the bisector of the two
 face normals.
 """
@@ -77,6 +78,11 @@ class TouchConfig:
     """... the fingertip advanced less than this fraction of the commanded travel [-]."""
     vertex_sin: float = math.sin(math.radians(15.0))
     """Vertex: the filtered normal's component along the edge exceeds this [-]."""
+    loss_lean_sin: float = math.sin(math.radians(5.0))
+    """Contact lost while following a ridge is its vertex (the surface fell away) only when the filtered normal
+    had leaned at least this far along the edge: the pad cannot leave the end of an edge without rolling on to
+    the vertex. Lost with the normal still across the edge, the pad was lifted off it -- another part of the
+    finger met the object (a frame's rim above a valley) -- and the edge goes on [-]."""
     roll_window: float = 0.001
     """A roll is over when the normal turned less than ``roll_settled`` over this much travel [m] ..."""
     roll_settled: float = math.radians(1.5)
@@ -630,8 +636,10 @@ class Toucher:
     ) -> PrimitiveResult:
         """Ridge following: press along the sensed normal, servo sideways to keep it on the bisector of
         ``n_a`` and ``n_b``, move along ``along`` until a vertex (the normal gains a component along the edge
-        above sin 15°, or contact is lost, or progress stalls). ``toward_a``: the sideways direction that turns
-        the normal towards ``n_a``. With ``acquire_only`` it stops once the normal is on the bisector.
+        above sin 15°, or contact is lost once it leaned along it, or progress stalls). ``toward_a``: the sideways
+        direction that turns the normal towards ``n_a``. With ``acquire_only`` it stops once the normal is on
+        the bisector. Contact lost before the normal leaned along the edge (:attr:`TouchConfig.loss_lean_sin`)
+        is no vertex: ``no-contact``, event ``lost``.
 
         ``info``: ``event_sign`` (+1 the surface fell away at the vertex, −1 the finger was blocked)."""
         cfg = self.config
@@ -651,6 +659,7 @@ class Toucher:
         # line: starting beyond the end of the edge behind it (rolling on the vertex there), the normal leans
         # back until the pad has moved onto the ridge
         on_line = False
+        lean = -1.0  # the filtered normal's largest component along ``along`` on the ridge
         progress: list[float] = []
         window = max(2, int(cfg.stall_time / self.dt))
         timeout = (max_distance / cfg.edge_speed if not acquire_only else 0.0) * 2.0 + 3.0
@@ -685,9 +694,13 @@ class Toucher:
                     return self._result("timeout", "limit", 0.0, error=err)
                 continue
             if self.weak_ticks * self.dt >= cfg.loss_time:
+                if lean < cfg.loss_lean_sin:
+                    return self._result("no-contact", "lost", 0.0, lean=lean)
                 return self._result("ok", "vertex", 0.0, event_sign=1, lost=True)
             if self.normal is not None:
                 c = float(self.normal @ u)
+                if self.contact[1] is not None:
+                    lean = max(lean, c)
                 if abs(c) > cfg.vertex_sin and (c > 0 or on_line):
                     over += 1
                     if over >= cfg.debounce:
