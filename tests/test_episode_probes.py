@@ -133,3 +133,18 @@ def test_a_failed_probe_is_not_tried_again_and_tracing_moves_follow_it():
     assert "probe" in kinds and rec.outcome == "recognized" and rec.correct
     after = [kinds[i + 1] for i, k in enumerate(kinds[:-1]) if k == "probe"]
     assert after and all(k != "probe" for k in after)
+
+
+def test_an_episode_whose_tree_outgrows_the_bound_fails_instead_of_exhausting_memory(monkeypatch):
+    """Probes alone on a look-alike box whose hits meet faces of few distinct normals: the tree doubles with every
+    hit (to 2 million interpretations, and gigabytes, at c_p 0.5). With a bound, the episode
+    ends "failed", naming it, with the tree held below twice the bound plus one add."""
+    import haptic.episode.loop as loop
+    from haptic.geometry.library_cache import cached_library
+
+    monkeypatch.setattr(loop, "MAX_INTERPRETATIONS", 1500)
+    models = "assets/libraries/lookalike"
+    spec = EpisodeSpec(model="LA_BOX_100x80x60", seed=299909236, models=models, verify="none", moves="probing")
+    rec = run_episode(spec, cached_library(models), config=PlannerConfig(costs=CostModel(c_p=0.5)))
+    assert rec.outcome == "failed" and "more than the matcher holds (1500)" in rec.detail
+    assert 1500 < rec.interpretations[-1] and not rec.correct

@@ -39,6 +39,10 @@ MAX_POSED = 4000
 batch); above it the loop takes a random move."""
 MAX_FAILED_MOVES = 4
 """Consecutive failed moves after which the episode ends as "failed"."""
+MAX_INTERPRETATIONS = 200_000
+"""Most interpretations the loop lets the tree hold: past it the episode ends as "failed" before another
+component is added (the next add tests each interpretation against every model face and would need gigabytes;
+probes that hit faces of few distinct normals can double the tree with every hit)."""
 
 
 @dataclass
@@ -299,6 +303,10 @@ def loop_steps(
             if cost > spec.budget or n_moves - (verifier.moves if verifier else 0) >= spec.max_moves:
                 outcome = "budget"
                 break
+            if tree.count > MAX_INTERPRETATIONS:
+                outcome = "failed"
+                detail = f"{tree.count} interpretations, more than the matcher holds ({MAX_INTERPRETATIONS})"
+                break
             move = None
             if verifying:
                 move = verifier.choose(hypotheses_from(tree, rec)[0], state, components, tuple(failed_here))
@@ -362,7 +370,6 @@ def loop_steps(
 
     if verifier is not None and outcome == NO_MATCH and verifier.status == "verifying":
         verifier.status = "mismatch"  # the matcher itself left no interpretation during the verification
-    recognized = rec.model if rec is not None and outcome == RECOGNIZED else None
     recognized = rec.model if rec is not None and outcome == RECOGNIZED else None
     in_library = spec.model in library
     err_mm, err_deg, correct = score_outcome(spec, library, true_model, world_from_model, outcome, rec)
