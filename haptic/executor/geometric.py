@@ -275,13 +275,11 @@ class GeometricExecutor:
         the cost counts). Either way the path along the line is reported free (:class:`FreeSegment`), displaced as a
         whole by a position error within its bound. A bad line is "invalid", one that starts inside the object
         "unreachable"."""
+        if (problem := move.problem()) is not None:
+            return self._invalid(move, problem)
         start = np.asarray(move.start, dtype=float)
         u = np.asarray(move.direction, dtype=float)
         length = float(move.length)
-        if start.shape != (3,) or u.shape != (3,) or not (np.all(np.isfinite(start)) and np.all(np.isfinite(u))):
-            return self._invalid(move, "start and direction must be finite 3-vectors")
-        if abs(float(np.linalg.norm(u)) - 1.0) > 1e-6 or not np.isfinite(length) or length <= 0.0:
-            return self._invalid(move, "direction must be a unit vector and length a positive number of metres")
         inv = self.world_from_model.inverse()
         s_m, u_m = inv.apply(start), inv.rotate(u)
         if bool(self.model.contains(s_m[None])[0]):

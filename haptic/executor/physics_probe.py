@@ -99,13 +99,11 @@ def probe_move(ex: PhysicsExecutor, move: ProbeMove, pieces: list[PrimitiveResul
                settings: ProbeSettings = SETTINGS) -> MoveResult:  # fmt: skip
     """Carry out ``move`` with ``ex``'s hand (module docstring); a failure is a status, never an exception."""
     t, st, seg = ex.toucher, ex.state, ex.segmenter
+    if (problem := move.problem()) is not None:
+        return ex._invalid(move, problem)
     start = np.asarray(move.start, dtype=float)
     u = np.asarray(move.direction, dtype=float)
     length = float(move.length)
-    if start.shape != (3,) or u.shape != (3,) or not (np.all(np.isfinite(start)) and np.all(np.isfinite(u))):
-        return ex._invalid(move, "start and direction must be finite 3-vectors")
-    if abs(float(np.linalg.norm(u)) - 1.0) > 1e-6 or not math.isfinite(length) or length <= 0.0:
-        return ex._invalid(move, "direction must be a unit vector and length a positive number of metres")
     r = t.pad_radius
     centre0 = start - r * u  # the pad centre when its leading point is at the line's start
     centre1 = centre0 + length * u

@@ -144,6 +144,16 @@ class ProbeMove:
         """``start + length · direction`` [m]."""
         return np.asarray(self.start) + self.length * np.asarray(self.direction)
 
+    def problem(self) -> str | None:
+        """Why the line cannot be carried out as given (an executor's "invalid" reason), or None."""
+        start, u = np.asarray(self.start, dtype=float), np.asarray(self.direction, dtype=float)
+        if start.shape != (3,) or u.shape != (3,) or not (np.all(np.isfinite(start)) and np.all(np.isfinite(u))):
+            return "start and direction must be finite 3-vectors"
+        length = float(self.length)
+        if abs(float(np.linalg.norm(u)) - 1.0) > 1e-6 or not np.isfinite(length) or length <= 0.0:
+            return "direction must be a unit vector and length a positive number of metres"
+        return None
+
 
 Move = FaceMove | EdgeMove | VertexMove | ProbeMove
 
