@@ -15,8 +15,9 @@ taken over every candidate move (face-move directions discretised as the planner
 the :data:`MAX_PROBES` free-space probes of highest planner efficiency when ``config.moves`` admits probes, to
 ``depth`` moves. A probe branches on its outcomes (:func:`~haptic.planning.search.probe_branches`): a hit
 leaves the sensor on a new face, a miss leaves it where it was and the branch without the pose classes the
-free line rules out; the probes carried out on the way to a node are not offered there again. Below that depth a node is valued by *rolling out* the efficiency planner in the same model
-(its move over every candidate, probes too, every branch, to ``rollout_moves`` moves; what is still unresolved then is charged
+free line rules out; the probes carried out on the way to a node are not offered there again. Below that
+depth a node is valued by *rolling out* the efficiency planner in the same model (its move over every
+candidate, probes too, every branch, to ``rollout_moves`` moves; what is still unresolved then is charged
 ``unresolved_cost``). With the roll-out as the leaf value the search is a policy improvement over the
 planner: in the model, its expected cost is never above the planner's.
 
