@@ -7,7 +7,11 @@ noise):
   knowing the truth (``--hindsight-depth`` moves after the fixed sequence; :mod:`haptic.bench.oracle`), a
   lower bound for every policy.
 
-    .venv/bin/python scripts/bench_optimal.py [--episodes 60] [--seed 7] [--jobs 2] [--json out/optimal.jsonl]
+    .venv/bin/python scripts/bench_optimal.py [--episodes 60] [--seed 7] [--moves tracing] [--jobs 2]
+        [--json out/optimal.jsonl]
+
+``--moves`` sets the policies' admissible moves (as ``haptic bench --moves``); the hindsight optimum searches
+tracing moves whatever it is. ``--hindsight-depth 0`` leaves the hindsight optimum out.
 """
 
 from __future__ import annotations
@@ -22,6 +26,7 @@ from tqdm import tqdm
 
 from haptic.bench.runner import plan_sweep
 from haptic.episode.spec import EpisodeSpec
+from haptic.planning.moves import MOVE_SETS
 
 SMALL = ["BOX01", "WEDGE01", "BOX01N", "BOX01P", "PYR01", "TETRA01L", "TETRA01R"]
 
@@ -58,12 +63,13 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--depth", type=int, default=2, help="moves searched exhaustively by the optimal policy")
     ap.add_argument("--hindsight-depth", type=int, default=3, help="moves after the fixed sequence, hindsight search")
     ap.add_argument("--policies", default="optimal,planner,greedy,random")
+    ap.add_argument("--moves", choices=MOVE_SETS, default="tracing", help="admissible moves of the policies")
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--json", help="write one JSON line per episode and policy here")
     args = ap.parse_args(argv)
     policies = args.policies.split(",")
-    specs = plan_sweep(SMALL, args.episodes, args.seed, policies)
-    draws = {s.seed: s for s in specs}
+    specs = plan_sweep(SMALL, args.episodes, args.seed, policies, moves=args.moves)
+    draws = {s.seed: s for s in specs} if args.hindsight_depth > 0 else {}
     t0 = time.perf_counter()
     rows: list[dict] = []
     with ProcessPoolExecutor(max_workers=args.jobs) as pool:
@@ -78,11 +84,11 @@ def main(argv: list[str] | None = None) -> int:
         atomic_write(args.json, "".join(json.dumps(r) + "\n" for r in rows))
 
     by = {(r["policy"], r["seed"]): r for r in rows}
-    seeds = sorted(draws)
-    hind_ok = [k for k in seeds if by[("hindsight", k)]["cost"] is not None]
-    print(f"library: {', '.join(SMALL)}; {args.episodes} episodes, seed {args.seed}; optimal search depth "
-          f"{args.depth}; hindsight depth {args.hindsight_depth} after the fixed sequence; {wall:.0f} s wall, "
-          f"{args.jobs} jobs")
+    seeds = sorted({s.seed for s in specs})
+    hind_ok = [k for k in seeds if ("hindsight", k) in by and by[("hindsight", k)]["cost"] is not None]
+    print(f"library: {', '.join(SMALL)}; {args.episodes} episodes, seed {args.seed}; --moves {args.moves}; optimal "
+          f"search depth {args.depth}; hindsight depth {args.hindsight_depth} after the fixed sequence; {wall:.0f} s "
+          f"wall, {args.jobs} jobs")
     print(f"hindsight optimum found for {len(hind_ok)}/{len(seeds)} episodes (its column uses those)")
     print()
     print("| policy | correct | mean cost | median cost | mean moves | median moves | wall s/episode | "
@@ -92,7 +98,7 @@ def main(argv: list[str] | None = None) -> int:
     def mean_cost(p, ks):
         return float(np.mean([by[(p, k)]["cost"] for k in ks]))
 
-    for p in policies + ["hindsight"]:
+    for p in policies + (["hindsight"] if hind_ok else []):
         ks = hind_ok if p == "hindsight" else seeds
         rs = [by[(p, k)] for k in ks]
         c = np.array([r["cost"] for r in rs])
@@ -100,7 +106,7 @@ def main(argv: list[str] | None = None) -> int:
         vs_opt = "-"
         if "optimal" in policies and p != "hindsight":
             vs_opt = f"{mean_cost(p, seeds) / mean_cost('optimal', seeds):.3f}"
-        vs_hind = f"{mean_cost(p, hind_ok) / mean_cost('hindsight', hind_ok):.3f}"
+        vs_hind = f"{mean_cost(p, hind_ok) / mean_cost('hindsight', hind_ok):.3f}" if hind_ok else "-"
         wall_ep = "-" if p == "hindsight" else f"{np.mean([r['wall_s'] for r in rs]):.2f}"
         correct = "-" if p == "hindsight" else f"{sum(r['correct'] for r in rs)}/{len(rs)}"
         print(f"| {p} | {correct} | {c.mean():.2f} | {np.median(c):.2f} | {m.mean():.2f} | {np.median(m):.1f} | "

@@ -200,11 +200,10 @@ def test_scene_negative_seed(capsys):
 @pytest.mark.parametrize(
     "extra, words",
     [
-        (["--moves", "probing", "--policy", "optimal"], ["--moves probing", "optimal", "planner, greedy or random"]),
-        (["--moves", "all", "--policy", "optimal"], ["--moves all", "optimal", "tracing"]),
         (["--moves", "probing", "--executor", "physics"], ["--moves probing", "geometric", "tracing"]),
+        (["--moves", "probing", "--executor", "physics", "--policy", "optimal"], ["--moves probing", "geometric"]),
     ],
-    ids=["probing-optimal", "all-optimal", "probing-physics"],
+    ids=["probing-physics", "probing-physics-optimal"],
 )
 def test_explore_move_set_not_available_with(capsys, extra, words):
     one_line_error(capsys, main(["explore", "--object", "WEDGE01", *extra]), 1, *words)
@@ -212,6 +211,6 @@ def test_explore_move_set_not_available_with(capsys, extra, words):
 
 def test_bench_move_set_not_available_with(tmp_path, capsys):
     out = tmp_path / "r.jsonl"
-    one_line_error(capsys, main(["bench", "--moves", "probing", "--policy", "planner,optimal", "--episodes", "1",
-                                 "--out", str(out)]), 1, "optimal", "planner, greedy or random")  # fmt: skip
+    one_line_error(capsys, main(["bench", "--moves", "probing", "--policy", "planner,optimal", "--executor", "physics",
+                                 "--episodes", "1", "--out", str(out)]), 1, "geometric", "tracing, all")  # fmt: skip
     assert not out.exists()

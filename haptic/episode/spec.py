@@ -36,9 +36,9 @@ class EpisodeSpec:
     """Verification before recognition: "none", "fast" or "full" (:mod:`haptic.matching.verify`)."""
     moves: str = "tracing"
     """Admissible kinds of move: "tracing" (face, edge, vertex moves), "probing" (free-space probes alone,
-    geometric executor) or "all" (both, ranked by one planner); probes with the planner, greedy and random
-    policies only. The command line's default is ``haptic.planning.moves.DEFAULT_MOVES``; this one is what a
-    record written before the field existed was run with."""
+    geometric executor) or "all" (both, ranked by one planner; every policy plans them). The command line's
+    default is ``haptic.planning.moves.DEFAULT_MOVES``; this one is what a record written before the field
+    existed was run with."""
 
     def __post_init__(self) -> None:
         if self.moves == "tracing":  # the tracing moves run everywhere
@@ -49,9 +49,4 @@ class EpisodeSpec:
             raise HapticError(
                 f"--moves probing: probes alone run on the geometric executor only; "
                 f"valid with --executor {self.executor}: tracing, all"
-            )
-        if self.policy == "optimal":
-            raise HapticError(
-                f"--moves {self.moves}: the optimal policy plans tracing moves only; valid with it: "
-                "tracing (or use planner, greedy or random)"
             )

@@ -11,9 +11,13 @@ recognised. So the expected cost to recognition of a node is
     V(node) = 0                                                    one pose class left
             = min over moves m of  sum_b p_b (cost_b + V(b))        otherwise
 
-taken over every candidate move (face-move directions discretised as the planner's, ``PlannerConfig``) to
-``depth`` moves. Below that depth a node is valued by *rolling out* the efficiency planner in the same model
-(its move, every branch, to ``rollout_moves`` moves; what is still unresolved then is charged
+taken over every candidate move (face-move directions discretised as the planner's, ``PlannerConfig``), and
+the :data:`MAX_PROBES` free-space probes of highest planner efficiency when ``config.moves`` admits probes, to
+``depth`` moves. A probe branches on its outcomes (:func:`~haptic.planning.search.probe_branches`): a hit
+leaves the sensor on a new face, a miss leaves it where it was and the branch without the pose classes the
+free line rules out; the probes carried out on the way to a node are not offered there again. Below that
+depth a node is valued by *rolling out* the efficiency planner in the same model (its move over every
+candidate, probes too, every branch, to ``rollout_moves`` moves; what is still unresolved then is charged
 ``unresolved_cost``). With the roll-out as the leaf value the search is a policy improvement over the
 planner: in the model, its expected cost is never above the planner's.
 
@@ -26,6 +30,7 @@ efficiencies, not expected costs).
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
+from dataclasses import replace
 
 import numpy as np
 
@@ -33,10 +38,18 @@ from haptic.errors import PlanningError
 from haptic.matching.components import DataComponent
 from haptic.planning.efficiency import class_weights
 from haptic.planning.hypothesis import Hypothesis
-from haptic.planning.moves import Move, SensorState
+from haptic.planning.moves import Move, ProbeMove, SensorState
 from haptic.planning.policies import PlannerPolicy, Policy
-from haptic.planning.scoring import Context, Decision, Scored, score_all
-from haptic.planning.search import Branch, branches
+from haptic.planning.predict import Prediction
+from haptic.planning.probes import ProbePrediction
+from haptic.planning.scoring import Context, Decision, Scored, same_move, score_all
+from haptic.planning.search import Branch, branches, probe_branches
+
+MAX_PROBES = 4
+"""Free-space probes a node of the search expands: those of highest planner efficiency. Tracing moves are
+few (eight face directions, two edge senses, two vertex moves) and all are expanded; probe candidates are
+up to 64, and expanding each at each of two levels multiplies the search by hundreds. Roll-outs still follow
+the planner over every candidate."""
 
 
 class OptimalPolicy(Policy):
@@ -50,13 +63,17 @@ class OptimalPolicy(Policy):
         rollout_moves: int = 6,
         unresolved_cost: float = 20.0,
         max_hypotheses: int = 60,
+        max_probes: int = MAX_PROBES,
     ) -> None:
         if depth < 1:
             raise PlanningError(f"optimal policy: depth must be at least 1, got {depth}")
+        if max_probes < 0:
+            raise PlanningError(f"optimal policy: max_probes must be 0 or more, got {max_probes}")
         self.depth = depth
         self.rollout_moves = rollout_moves
         self.unresolved_cost = unresolved_cost
         self.max_hypotheses = max_hypotheses
+        self.max_probes = max_probes
         self._planner = PlannerPolicy()
 
     def choose(self, ctx: Context, rng: np.random.Generator) -> Decision:
@@ -64,10 +81,12 @@ class OptimalPolicy(Policy):
         if len(hyps) > self.max_hypotheses or any(h.world_from_model is None for h in hyps):
             return self._planner.choose(ctx, rng)
         weights = class_weights([h.model for h in hyps])
-        search = _Search(ctx, self.rollout_moves, self.unresolved_cost)
+        probed = tuple(m for m in ctx.avoid if isinstance(m, ProbeMove))
+        root = score_all(ctx)
+        search = _Search(ctx, self.rollout_moves, self.unresolved_cost, self.max_probes, root)
         scored = []
-        for pred, _eff, elim, cost, risk in score_all(ctx):
-            q = search.q(hyps, weights, pred.move, ctx.state, ctx.components, self.depth)
+        for pred, _eff, elim, cost, risk in search.expanded(root):
+            q = search.q(hyps, weights, pred, ctx.state, ctx.components, self.depth, probed)
             if q is not None:
                 scored.append(Scored(pred.move, -q, cost, elim, risk))
         if not scored:
@@ -80,76 +99,125 @@ class OptimalPolicy(Policy):
 class _Search:
     """Expected cost to recognition within the planner's model, from one decision's context."""
 
-    def __init__(self, ctx: Context, rollout_moves: int, unresolved_cost: float) -> None:
+    def __init__(
+        self, ctx: Context, rollout_moves: int, unresolved_cost: float, max_probes: int = MAX_PROBES, root=None
+    ) -> None:
         self.ctx = ctx
         self.rollout_moves = rollout_moves
         self.unresolved_cost = unresolved_cost
+        self.max_probes = max_probes
         self.nodes = 0
+        # the decision's probe candidates, predicted once over its hypotheses; a node below predicts them for
+        # its own by subsetting (ProbePrediction.subset): its hypotheses are the root's, poses unchanged
+        root = score_all(ctx) if root is None and ctx.config.moves != "tracing" else (root or [])
+        self._probes = [c[0] for c in root if isinstance(c[0], ProbePrediction)]
+        self._index = {id(h.world_from_model): k for k, h in enumerate(ctx.hypotheses)}
 
-    def _branches(self, hyps, weights, move, state, components) -> list[Branch]:
+    def expanded(self, scored: list) -> list:
+        """The candidates a node expands: every tracing move, and the ``max_probes`` probes of highest planner
+        efficiency (first best on ties), in their order."""
+        probes = [k for k, c in enumerate(scored) if isinstance(c[0], ProbePrediction)]
+        if len(probes) <= self.max_probes:
+            return scored
+        keep = set(sorted(probes, key=lambda k: -scored[k][1])[: self.max_probes])
+        return [c for k, c in enumerate(scored) if k not in probes or k in keep]
+
+    def _branches(self, hyps, weights, pred, state, components) -> list[Branch]:
         self.nodes += 1
-        return branches(hyps, weights, move, state, components, self.ctx.noise, self.ctx.config)
+        if isinstance(pred, ProbePrediction):
+            return probe_branches(hyps, weights, pred, state, components, self.ctx.noise)
+        return branches(hyps, weights, pred.move, state, components, self.ctx.noise, self.ctx.config)
 
-    def _moves(self, hyps, state, components) -> list[tuple[Move, float, float]]:
-        """Candidate moves from a node with the planner's score (efficiency) and expected cost."""
-        sub = Context(hyps, state, components, self.ctx.noise, self.ctx.config)
-        return [(p.move, eff, cost) for p, eff, _elim, cost, _risk in score_all(sub)]
+    def _moves(self, hyps, state, components, probed) -> list[tuple]:
+        """Candidate moves from a node, as :func:`score_all` scores them (the planner's efficiency, expected
+        eliminations, cost, risk), less the probes carried out on the way there. The probes are the decision's
+        own candidates, predicted for the node's hypotheses (:meth:`ProbePrediction.subset`: the costs from the
+        node's sensor position, the free segment's margins of the decision's data): regenerating and
+        predicting them at every node of the search would take most of its time."""
+        config = self.ctx.config
+        if config.moves == "tracing":
+            return score_all(Context(hyps, state, components, self.ctx.noise, config, avoid=probed))
+        idx = [self._index.get(id(h.world_from_model)) for h in hyps]
+        if any(k is None for k in idx):  # not the decision's hypotheses: predict afresh
+            return score_all(Context(hyps, state, components, self.ctx.noise, config, avoid=probed))
+        out = []
+        if config.moves != "probing":
+            tracing = replace(config, moves="tracing")
+            out = score_all(Context(hyps, state, components, self.ctx.noise, tracing))
+        weights = class_weights([h.model for h in hyps])
+        for root in self._probes:
+            if any(same_move(root.move, done) for done in probed):
+                continue
+            pred = root.subset(idx, state.position, config.costs)
+            out.append((pred, *pred.score(weights), 0.0))
+        return out
 
     def q(
         self,
         hyps: Sequence[Hypothesis],
         weights: np.ndarray,
-        move: Move,
+        pred: Prediction | ProbePrediction,
         state: SensorState,
         components: Mapping[int, DataComponent],
         depth: int,
+        probed: tuple[ProbeMove, ...] = (),
     ) -> float | None:
-        """Expected cost of ``move`` and of the best continuation ``depth - 1`` moves deep (then roll-outs);
-        None when the move cannot be simulated in any hypothesis's world."""
-        brs = self._branches(hyps, weights, move, state, components)
+        """Expected cost of the predicted move and of the best continuation ``depth - 1`` moves deep (then
+        roll-outs); None when the move cannot be simulated in any hypothesis's world. ``probed``: the probes
+        carried out so far (not offered again below)."""
+        brs = self._branches(hyps, weights, pred, state, components)
         if not brs:
             return None
-        return _expected(brs, lambda b: self.value(list(b.hypotheses), b.weights, b.state, b.components, depth - 1))
+        after = _after(probed, pred.move)
+        return _expected(
+            brs, lambda b: self.value(list(b.hypotheses), b.weights, b.state, b.components, depth - 1, after)
+        )
 
-    def value(self, hyps, weights, state, components, depth: int) -> float:
+    def value(self, hyps, weights, state, components, depth: int, probed: tuple[ProbeMove, ...] = ()) -> float:
         """Least expected cost to recognition from a node."""
         if len(hyps) <= 1:
             return 0.0
         if depth <= 0:
-            return self.rollout(hyps, weights, state, components, self.rollout_moves)
+            return self.rollout(hyps, weights, state, components, self.rollout_moves, probed)
         best = np.inf
-        for move, _eff, _cost in self._moves(hyps, state, components):
-            q = self.q(hyps, weights, move, state, components, depth)
+        for cand in self.expanded(self._moves(hyps, state, components, probed)):
+            q = self.q(hyps, weights, cand[0], state, components, depth, probed)
             if q is not None and q < best:
                 best = q
         if not np.isfinite(best):
             return self.unresolved_cost
         return best
 
-    def rollout(self, hyps, weights, state, components, moves_left: int) -> float:
-        """Expected cost to recognition following the efficiency planner (deterministic ties: first best;
-        with nothing to eliminate, the cheapest face or vertex move)."""
+    def rollout(self, hyps, weights, state, components, moves_left: int, probed: tuple[ProbeMove, ...] = ()) -> float:
+        """Expected cost to recognition following the efficiency planner over every candidate, probes too
+        (deterministic ties: first best; with nothing to eliminate, the cheapest face or vertex move)."""
         if len(hyps) <= 1:
             return 0.0
         if moves_left <= 0:
             return self.unresolved_cost
-        cands = self._moves(hyps, state, components)
+        cands = self._moves(hyps, state, components, probed)
         if not cands:
             return self.unresolved_cost
-        effs = np.array([e for _, e, _ in cands])
+        effs = np.array([c[1] for c in cands])
         if effs.max() > 0:
-            move = cands[int(np.argmax(effs))][0]
+            pred = cands[int(np.argmax(effs))][0]
         else:
-            pool = [c for c in cands if c[0].kind in ("face", "vertex")] or cands
-            costs = np.array([c[2] for c in pool])
+            pool = [c for c in cands if c[0].move.kind in ("face", "vertex")] or cands
+            costs = np.array([c[3] for c in pool])
             costs = np.where(np.isfinite(costs), costs, np.inf)
-            move = pool[int(np.argmin(costs))][0]
-        brs = self._branches(hyps, weights, move, state, components)
+            pred = pool[int(np.argmin(costs))][0]
+        brs = self._branches(hyps, weights, pred, state, components)
         if not brs:
             return self.unresolved_cost
+        after = _after(probed, pred.move)
         return _expected(
-            brs, lambda b: self.rollout(list(b.hypotheses), b.weights, b.state, b.components, moves_left - 1)
+            brs, lambda b: self.rollout(list(b.hypotheses), b.weights, b.state, b.components, moves_left - 1, after)
         )
+
+
+def _after(probed: tuple[ProbeMove, ...], move: Move) -> tuple[ProbeMove, ...]:
+    """The probes carried out once ``move`` is."""
+    return (*probed, move) if isinstance(move, ProbeMove) else probed
 
 
 def _expected(brs: Sequence[Branch], rest: Callable[[Branch], float]) -> float:

@@ -3,8 +3,8 @@
 - ``planner``: the candidate of highest efficiency (expected pose classes eliminated per expected cost).
 - ``greedy``: the candidate of most expected eliminations, whatever it costs.
 - ``random``: a random admissible move (a random move type, then a random move of that type).
-- ``optimal``: the least expected path cost to recognition by exhaustive search over move sequences, for
-  small libraries (:mod:`haptic.planning.optimal`).
+- ``optimal``: the least expected path cost to recognition by exhaustive search over move sequences (tracing
+  moves and free-space probes alike), for small libraries (:mod:`haptic.planning.optimal`).
 
 The best possible cost of an episode is measured from outside, in hindsight: :mod:`haptic.bench.oracle`.
 

@@ -355,9 +355,32 @@ class ProbePrediction:
     """Bound on the angle between two predicted normals that one measurement cannot tell apart [rad]."""
     costs: np.ndarray
     """Predicted cost per hypothesis, shape (N,) [units]."""
+    known: np.ndarray | None = None
+    """:meth:`eliminates` when already computed (a :meth:`subset` carries its share of the whole's), else None."""
+
+    def subset(self, idx: Sequence[int], position: np.ndarray, costs: CostModel | None = None) -> ProbePrediction:
+        """The prediction for hypotheses ``idx`` alone, with the sensor at ``position`` (the costs of getting to
+        the line and back from there): what :func:`predict_probes` would predict for them, but for the margins,
+        which keep the pose tolerance of the data this prediction was made with."""
+        idx = np.asarray(idx, dtype=int)
+        costs = costs or CostModel()
+        here = np.asarray(position, dtype=float)
+        start = np.asarray(self.move.start, dtype=float)
+        transfer = float(np.linalg.norm(start - here))
+        back = float(np.linalg.norm(self.move.end - here))
+        hit = self.hit[idx]
+        s = transfer + np.where(hit, np.nan_to_num(self.distance[idx]), float(self.move.length) + back)
+        return ProbePrediction(
+            move=self.move, hit=hit, distance=self.distance[idx], face=self.face[idx], normal=self.normal[idx],
+            depth=self.depth[idx], margin=self.margin[idx], contact_margin=self.contact_margin[idx],
+            angle_bound=self.angle_bound, costs=np.array([costs.probe_move(x) for x in s]),
+            known=self.eliminates()[np.ix_(idx, idx)],
+        )  # fmt: skip
 
     def eliminates(self) -> np.ndarray:
         """``D[i, j]``: hypothesis ``j`` is eliminated if ``i`` is true (module docstring), shape (N, N)."""
+        if self.known is not None:
+            return self.known
         n = len(self.hit)
         u = np.asarray(self.move.direction)
         d = np.zeros((n, n), dtype=bool)
@@ -374,7 +397,40 @@ class ProbePrediction:
             turned = np.arccos(cosang) > self.angle_bound
         d |= hi & hj & (far | turned)
         np.fill_diagonal(d, False)
+        object.__setattr__(self, "known", d)
         return d
+
+    def outcome_groups(self) -> list[tuple[np.ndarray, np.ndarray]]:
+        """The outcomes one measurement can tell apart, as ``(producers, alive)`` index pairs: ``producers`` the
+        hypotheses whose world gives that outcome, ``alive`` every hypothesis it leaves (by :meth:`eliminates`).
+
+        A hit and a miss are always told apart (contact or none). Every predicted miss is one outcome; it
+        eliminates the hypotheses it runs deeper than their margin into, and leaves the rest, with the
+        hypotheses that predict a hit but too shallow a chord for a miss to rule them out. The hits form groups
+        as the tracing outcomes do (:func:`~haptic.planning.efficiency.outcome_groups`): the transitive closure
+        of "one does not eliminate the other" (between two hits :meth:`eliminates` is symmetric); no hit leaves
+        a hypothesis outside its group alive."""
+        d = self.eliminates()
+        out = []
+        miss = np.flatnonzero(~self.hit)
+        if len(miss):
+            out.append((miss, np.flatnonzero(~d[miss].any(axis=0))))
+        hit = np.flatnonzero(self.hit)
+        label = -np.ones(len(self.hit), dtype=int)
+        for i in hit:
+            if label[i] >= 0:
+                continue
+            label[i] = i
+            stack = [i]
+            while stack:
+                k = stack.pop()
+                near = self.hit & (label < 0) & ~(d[k] & d[:, k])
+                for j in np.flatnonzero(near):
+                    label[j] = i
+                    stack.append(j)
+            group = np.flatnonzero(label == i)
+            out.append((group, group))
+        return out
 
     def score(self, weights: np.ndarray | None = None) -> tuple[float, float, float]:
         """Efficiency (expected eliminations per expected cost, §4.1.1), expected eliminations and expected

@@ -2,8 +2,13 @@
 the data it would produce and the sensor state it would end in; from there the next moves are predicted.
 
 Used by the planner when no single move is expected to eliminate anything (the discriminating features are
-more than one move away), and to check predictions against the matcher itself
-(:func:`matcher_eliminations`).
+more than one move away), by the optimal policy's search (:mod:`haptic.planning.optimal`), and to check
+predictions against the matcher itself (:func:`matcher_eliminations`).
+
+A free-space probe branches on its predicted outcomes (:func:`probe_branches`): a miss leaves no data, so
+what it tells is carried as the hypotheses it leaves. Those that predict a hit too shallow for the miss to
+rule out stay in the miss's branch with weight zero: in the (noiseless) model they cannot give it, but the
+matcher keeps them, so the branch is not recognised until something else eliminates them.
 """
 
 from __future__ import annotations
@@ -17,10 +22,11 @@ from haptic.matching.components import DataComponent, SensorNoise
 from haptic.planning.config import PlannerConfig
 from haptic.planning.efficiency import class_weights, outcome_groups
 from haptic.planning.hypothesis import Hypothesis
-from haptic.planning.moves import Move, SensorState
+from haptic.planning.moves import Move, ProbeMove, SensorState
 from haptic.planning.predict import candidate_moves, predict
+from haptic.planning.probes import ProbePrediction, predict_probes
 from haptic.planning.scoring import Context, refusal, same_move, score_prediction
-from haptic.planning.simulate import simulate
+from haptic.planning.simulate import simulate, simulate_probe
 
 
 @dataclass(frozen=True, eq=False)
@@ -30,7 +36,8 @@ class Branch:
     hypotheses: tuple[Hypothesis, ...]
     """The group's hypotheses with correspondences extended by the move's new components."""
     weights: np.ndarray
-    """Their prior weights (not normalised)."""
+    """Their prior weights (not normalised; zero for a hypothesis alive after the outcome that its own world
+    would not give, :func:`probe_branches`)."""
     state: SensorState
     """Sensor state after the move (as the group's first hypothesis simulates it)."""
     components: Mapping[int, DataComponent]
@@ -48,7 +55,13 @@ def branches(
     noise: SensorNoise,
     config: PlannerConfig,
 ) -> list[Branch]:
-    """Split the hypotheses by what ``move`` would show, and simulate each group onward."""
+    """Split the hypotheses by what ``move`` would show, and simulate each group onward (a probe:
+    :func:`probe_branches`). Groups of no weight are left out: in the model they never occur."""
+    if isinstance(move, ProbeMove):
+        if any(h.world_from_model is None for h in hyps):
+            return []
+        (pp,) = predict_probes(hyps, [move], state.position, components, noise, config.costs)
+        return probe_branches(hyps, weights, pp, state, components, noise)
     pred = predict(hyps, move, state, components, noise, config)
     if not pred.reliable(config) or pred.table_risk >= config.table_risk:
         return []
@@ -62,10 +75,41 @@ def branches(
             continue
         idx = [i for i, _ in sims]
         w = weights[idx]
+        if not w.sum() > 0.0:
+            continue
         _, st, comps = sims[0][1]
         out.append(
             Branch(tuple(s[0] for _, s in sims), w, st, comps, float(pred.costs[idx] @ (w / w.sum())))
         )
+    return out
+
+
+def probe_branches(
+    hyps: Sequence[Hypothesis],
+    weights: np.ndarray,
+    pred: ProbePrediction,
+    state: SensorState,
+    components: Mapping[int, DataComponent],
+    noise: SensorNoise,
+) -> list[Branch]:
+    """The branches of a probe by its predicted outcomes (:meth:`ProbePrediction.outcome_groups`), each with
+    the weighted mean of its producers' predicted costs. A hit's branch: its hypotheses with correspondences
+    extended by the face each hits, the data face and sensor state of the first one's world
+    (:func:`~haptic.planning.simulate.simulate_probe`). The miss's: every hypothesis it leaves, unchanged, the
+    sensor back where it was and the data as they were; those that would not miss weigh nothing in it."""
+    out = []
+    for producers, alive in pred.outcome_groups():
+        w_p = weights[producers]
+        if not w_p.sum() > 0.0:
+            continue
+        cost = float(pred.costs[producers] @ (w_p / w_p.sum()))
+        if pred.hit[producers[0]]:
+            sims = [simulate_probe(hyps[i], pred.move, state, components, noise) for i in producers]
+            _, st, comps = sims[0]
+            out.append(Branch(tuple(s[0] for s in sims), w_p, st, comps, cost))
+        else:
+            w = np.where(pred.hit[alive], 0.0, weights[alive])
+            out.append(Branch(tuple(hyps[i] for i in alive), w, state, dict(components), cost))
     return out
 
 

@@ -1,6 +1,12 @@
 """A move carried out exactly in one hypothesis's world (noiseless): the data it would produce and the sensor
 state it would end in. The look-ahead (:mod:`haptic.planning.search`) predicts the next moves from there; the
 candidate filter of :mod:`haptic.planning.scoring` asks it which vertex moves only circle back.
+
+A free-space probe (:func:`simulate_probe`) ends as the executors end one: a hit is a face touched at the
+contact, adjacent to nothing known, with the sensor resting on it; a miss adds no component and leaves the
+sensor where it was (it returns to the face it left). What a miss tells -- the line is free of the object --
+is no component: the search carries it as the hypotheses it eliminates
+(:func:`~haptic.planning.search.probe_branches`).
 """
 
 from __future__ import annotations
@@ -10,17 +16,17 @@ from dataclasses import replace
 
 import numpy as np
 
+from haptic.geometry.raycast import line_hits
 from haptic.geometry.tracing import circle_vertex, trace_edge
 from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex, SensorNoise
 from haptic.planning.config import PlannerConfig
 from haptic.planning.hypothesis import Hypothesis, trace_in
-from haptic.planning.moves import EdgeMove, FaceMove, Move, SensorState, VertexMove
+from haptic.planning.moves import EdgeMove, FaceMove, Move, ProbeMove, SensorState, VertexMove
 
 STEP_ONTO = 0.003
 """How far onto the next face a simulated face or vertex move steps for its normal [m]."""
 EDGE_PROBE = 0.004
 """Length of edge explored when an edge is first met [m]."""
-
 
 
 def simulate(
@@ -33,9 +39,12 @@ def simulate(
 ) -> tuple[Hypothesis, SensorState, dict[int, DataComponent]] | None:
     """The move carried out exactly in hypothesis ``h``'s world: its extended correspondence, the new sensor
     state and the new (noiseless) data components; None when ``h`` cannot say (no pose, meets a vertex) or
-    when a vertex move would only circle back to an edge and face already explored."""
+    when a vertex move would only circle back to an edge and face already explored. A probe:
+    :func:`simulate_probe`."""
     if h.world_from_model is None:
         return None
+    if isinstance(move, ProbeMove):
+        return simulate_probe(h, move, state, components, noise)
     t = h.world_from_model
     poly = h.poly
     p_m = t.inverse().apply(state.position)
@@ -118,3 +127,37 @@ def simulate(
     merged = dict(components)
     merged.update(new)
     return replace(h, faces=faces, edges=edges, vertices=vertices), new_state, merged
+
+
+def simulate_probe(
+    h: Hypothesis,
+    move: ProbeMove,
+    state: SensorState,
+    components: Mapping[int, DataComponent],
+    noise: SensorNoise | None = None,
+) -> tuple[Hypothesis, SensorState, dict[int, DataComponent]] | None:
+    """Probe ``move`` carried out exactly in hypothesis ``h``'s world (the line cast at its posed model, as
+    :func:`~haptic.planning.probes.predict_probes` casts it). A hit: a new data face at the contact with the
+    outward normal of the model face hit (bounds from ``noise``, as every simulated face), adjacent to nothing;
+    the correspondence extended by it; the sensor on it, at no edge or vertex. A miss: ``h``, ``state`` and the
+    components unchanged. None when ``h`` has no pose."""
+    t = h.world_from_model
+    if t is None:
+        return None
+    inv = h.model_from_world
+    s_m = inv.apply(np.asarray(move.start, dtype=float))
+    u_m = inv.rotate(np.asarray(move.direction, dtype=float))
+    hits = line_hits(h.poly, s_m[None], u_m[None])
+    t_hit, g = float(hits.first[0]), int(hits.face[0])
+    merged = dict(components)
+    if not t_hit <= float(move.length) or g < 0:
+        return h, state, merged
+    fid = max(components) + 1 if components else 0
+    k = noise.k if noise is not None else 0.0
+    nb = k * noise.normal_sigma if noise is not None else 0.0
+    pb = k * noise.position_sigma if noise is not None else 0.0
+    contact = t.apply(s_m + t_hit * u_m)
+    merged[fid] = DataFace(fid, t.rotate(h.poly.face_normals[g]), contact[None, :], nb, pb, ())
+    faces = dict(h.faces)
+    faces[fid] = g
+    return replace(h, faces=faces), SensorState(contact, fid), merged
