@@ -46,6 +46,7 @@ from haptic.matching.components import DataComponent, DataFace, SensorNoise
 from haptic.matching.recognition import PoseTolerance
 from haptic.matching.verify import POSE_SAFETY
 from haptic.planning.efficiency import efficiency_of, expected_eliminated
+from haptic.planning.handpath import HandStart
 from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import CostModel, ProbeMove
 
@@ -393,11 +394,16 @@ def predict_probes(
     components: Mapping[int, DataComponent] | Sequence[DataComponent],
     noise: SensorNoise,
     costs: CostModel | None = None,
+    hand: HandStart | None = None,
 ) -> list[ProbePrediction]:
     """Every hypothesis's predicted outcome and cost for each candidate probe (hypotheses must have poses).
 
     ``position``: where the sensor is (world) [m], for the free-space distance; ``components``: the data so far,
     whose error bounds set the pose-error margin (:class:`~haptic.matching.recognition.PoseTolerance`).
+    ``hand``: where the simulated hand's pad is, when the probe is the hand's: the free-space distance is then
+    that of its path up and over the object (:mod:`haptic.planning.handpath`) and a hit adds ``c_n`` for the
+    stroke measuring the face's normal; None (a point sensor): a straight transfer to the line's start and,
+    after a miss, straight back from its end.
     """
     costs = costs or CostModel()
     comps = list(components.values()) if isinstance(components, Mapping) else list(components)
@@ -456,8 +462,13 @@ def predict_probes(
             normal[ok, j] = hypotheses[j].world_from_model.rotate(poly.face_normals[fc[ok, a]])
             depth[:, j] = dep[a * m : (a + 1) * m]
     here = np.asarray(position, dtype=float)
-    transfer = np.linalg.norm(starts - here, axis=1)
-    back = np.linalg.norm(starts + lengths[:, None] * dirs - here, axis=1)
+    if hand is None:
+        transfer = np.linalg.norm(starts - here, axis=1)
+        back = np.linalg.norm(starts + lengths[:, None] * dirs - here, axis=1)
+        normal_cost = 0.0
+    else:
+        transfer, back = hand.distances(starts, dirs, lengths)
+        normal_cost = costs.c_n
     out = []
     for i, mv in enumerate(moves):
         hit = t_hit[i] <= lengths[i]
@@ -467,11 +478,12 @@ def predict_probes(
         margin = rho + tol.distance + tol.angle * r
         contact = np.where(hit, (1.0 + POSE_SAFETY) * rho + delta * r, np.nan)
         s = transfer[i] + np.where(hit, np.nan_to_num(dist), lengths[i] + back[i])
+        c = np.array([costs.probe_move(x) for x in s])
         out.append(ProbePrediction(
             move=mv, hit=hit, distance=dist, face=np.where(hit, face[i], -1),
             normal=np.where(hit[:, None], normal[i], np.nan), depth=np.where(hit, depth[i], 0.0), margin=margin,
             contact_margin=contact,
-            angle_bound=float(ang), costs=np.array([costs.probe_move(x) for x in s]),
+            angle_bound=float(ang), costs=c if hand is None else c + np.where(hit, normal_cost, 0.0),
         ))  # fmt: skip
     return out
 

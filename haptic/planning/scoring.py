@@ -12,10 +12,11 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from haptic.matching.components import DataComponent, SensorNoise
+from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex, SensorNoise
 from haptic.planning.bound import reduce_hypotheses
 from haptic.planning.config import PlannerConfig
 from haptic.planning.efficiency import class_weights, distinguishable, efficiency_of, expected_eliminated
+from haptic.planning.handpath import HandStart
 from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import FaceMove, Move, ProbeMove, SensorState
 from haptic.planning.predict import Prediction, candidate_moves, crossed_edge, predict
@@ -98,10 +99,31 @@ def probe_moves(ctx: Context) -> list[ProbeMove]:
     return [m for m in candidate_probes(ctx.hypotheses, cfg) if not any(same_move(m, bad) for bad in ctx.avoid)]
 
 
-def predict_probe_moves(ctx: Context) -> list[ProbePrediction]:
-    """Every hypothesis's predicted outcome of each candidate probe (:func:`probe_moves`)."""
-    moves = probe_moves(ctx)
-    return predict_probes(ctx.hypotheses, moves, ctx.state.position, ctx.components, ctx.noise, ctx.config.costs)
+def predict_probe_moves(ctx: Context, moves: Sequence[ProbeMove] | None = None) -> list[ProbePrediction]:
+    """Every hypothesis's predicted outcome of each candidate probe (:func:`probe_moves`, or ``moves``), its cost
+    along the simulated hand's path (:func:`hand_start`) when the configuration has a pad and a table."""
+    moves = probe_moves(ctx) if moves is None else list(moves)
+    return predict_probes(ctx.hypotheses, moves, ctx.state.position, ctx.components, ctx.noise, ctx.config.costs,
+                          hand_start(ctx))  # fmt: skip
+
+
+def hand_start(ctx: Context) -> HandStart | None:
+    """Where the simulated hand's pad is, from the data (:class:`~haptic.planning.handpath.HandStart`): touching
+    the sensor's position on its face (that face's normal), below the highest contact point of the data
+    components; None without a pad and a table (a point sensor)."""
+    c = ctx.config
+    face = ctx.components.get(ctx.state.face)
+    if c.table_z is None or c.pad_radius <= 0.0 or not isinstance(face, DataFace):
+        return None
+    points = [np.atleast_2d(ctx.state.position)]
+    for comp in ctx.components.values():
+        if isinstance(comp, DataFace):
+            points.append(np.atleast_2d(comp.points))
+        elif isinstance(comp, DataEdge):
+            points.append(np.atleast_2d(comp.point))
+        elif isinstance(comp, DataVertex):
+            points.append(np.atleast_2d(comp.position))
+    return HandStart.at(ctx.state.position, face.normal, np.concatenate(points), c.pad_radius)
 
 
 def score_prediction(
