@@ -24,6 +24,11 @@ from haptic.planning.probes import ProbeConfig, ProbePrediction, candidate_probe
 from haptic.planning.simulate import simulate
 from haptic.planning.table import descent_risk
 
+PROBE_RISK = 0.25
+"""Probes the hand's pad is predicted to fail in this share of the hypotheses' weight or more are not offered
+(:meth:`~haptic.planning.probes.ProbePrediction.risk`): a failed probe tells the matcher nothing, and the loop
+then falls back to tracing moves; the rest are discounted by their risk."""
+
 
 @dataclass(frozen=True, eq=False)
 class Context:
@@ -75,8 +80,8 @@ def score_all(ctx: Context) -> list[tuple[Prediction | ProbePrediction, float, f
     eliminations come from comparing predicted outcome attributes (§4.1). With a table (``config.table_z``),
     moves the hypotheses predict to run into it are left out and the rest discounted by that risk.
     Free-space probes join them when ``config.moves`` admits them, scored in the same form
-    (:meth:`ProbePrediction.score`), so one planner ranks every kind of move together; ``config.moves ==
-    "probing"`` leaves the tracing moves out."""
+    (:meth:`ProbePrediction.score`, on the simulated hand discounted by :meth:`ProbePrediction.risk`), so one
+    planner ranks every kind of move together; ``config.moves == "probing"`` leaves the tracing moves out."""
     weights = class_weights([h.model for h in ctx.hypotheses])
     out: list = []
     if ctx.config.moves != "probing":
@@ -85,7 +90,13 @@ def score_all(ctx: Context) -> list[tuple[Prediction | ProbePrediction, float, f
         refused = [(p, refusal(p, ctx.config)) for p in preds]
         refused = [(p, r) for p, r in refused if r < ctx.config.table_risk] or refused
         out = [(pred, *score_prediction(pred, weights, r, ctx.config)) for pred, r in refused]
-    return out + [(pred, *pred.score(weights), 0.0) for pred in predict_probe_moves(ctx)]
+    for pred in predict_probe_moves(ctx):
+        eff, elim, cost = pred.score(weights)
+        risk = pred.risk(weights)  # the hand's pad touching what the line-cast does not predict (0: a point sensor)
+        if risk >= PROBE_RISK:
+            continue
+        out.append((pred, eff * (1.0 - risk), elim * (1.0 - risk), cost, risk))
+    return out
 
 
 def probe_moves(ctx: Context) -> list[ProbeMove]:
@@ -123,7 +134,7 @@ def hand_start(ctx: Context) -> HandStart | None:
             points.append(np.atleast_2d(comp.point))
         elif isinstance(comp, DataVertex):
             points.append(np.atleast_2d(comp.position))
-    return HandStart.at(ctx.state.position, face.normal, np.concatenate(points), c.pad_radius)
+    return HandStart.at(ctx.state.position, face.normal, np.concatenate(points), c.pad_radius, c.max_undercut)
 
 
 def score_prediction(
