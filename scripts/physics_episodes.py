@@ -142,8 +142,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--first-seed", type=int, default=1)
     ap.add_argument("--objects", default=",".join(SEED_OBJECTS))
     ap.add_argument("--policy", default="planner")
-    ap.add_argument("--moves", default="tracing", choices=("tracing", "probing", "all"),
-                    help="admissible kinds of move")
+    ap.add_argument("--moves", default="tracing", choices=("tracing", "all"), help="admissible kinds of move")
     ap.add_argument("--probe-costs", action="store_true",
                     help="list each probe the planner chose: predicted against actual cost")
     ap.add_argument("--verify", default="none", choices=("none", "fast", "full"),
