@@ -4,11 +4,15 @@ moves, path cost, wall and simulated time, pose error and perception errors per 
     .venv/bin/python scripts/physics_episodes.py [--poses 3] [--first-seed 1] [--objects BOX01,WEDGE01]
                                                  [--policy planner] [--moves tracing|all]
                                                  [--verify none|fast|full] [--jobs 2] [--json episodes.json]
+                                                 [--probe-costs]
 
 Pose ``k`` of an object is episode seed ``first-seed + k`` (the seed places the object and drives the planner's
 random choices), so any row can be replayed with ``haptic explore --object NAME --executor physics --seed S``
 (and ``--moves all`` for free-space probes too: the probes used, those that missed and those that failed are
 counted per episode).
+``--probe-costs`` lists every probe the planner chose with its predicted cost -- the expected one it was ranked
+by, and the mean over the hypotheses that predicted the outcome it had (hit or miss) -- beside the cost the hand
+reported, and sums up their differences.
 Copy and adapt: one episode is ``run_episode(EpisodeSpec(model=..., seed=..., executor="physics"))``.
 """
 
@@ -24,31 +28,74 @@ from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
-from haptic.episode.loop import EpisodeObserver
+from haptic.episode.loop import EpisodeObserver, chain_observers
 from haptic.episode.spec import EpisodeSpec
 from haptic.episode.worlds import run_episode
 from haptic.errors import HapticError
 from haptic.geometry.io import atomic_write
+from haptic.planning.efficiency import class_weights
+from haptic.planning.registry import make_policy
+from haptic.planning.scoring import bounded, predict_probe_moves
 
 SEED_OBJECTS = ("BOX01", "WEDGE01", "BOX01N", "BOX01P", "PYR01", "TETRA01L", "TETRA01R", "HEXPRISM01", "LBLOCK01",
                 "FRAME01")
 
 
-def one(model: str, seed: int, policy: str, moves: str = "tracing", verify: str = "none") -> dict:
+class ProbeCosts:
+    """A policy that is ``policy`` but keeps, for each probe it chooses, the predicted costs; with :meth:`observer`,
+    beside the cost the hand then reported (``rows``: one dict per probe)."""
+
+    def __init__(self, policy) -> None:
+        self.policy, self.name = policy, policy.name
+        self.pending: tuple | None = None
+        self.rows: list[dict] = []
+
+    def choose(self, ctx, rng):
+        decision = self.policy.choose(ctx, rng)
+        self.pending = None
+        if decision.move.kind == "probe":
+            b = bounded(ctx)
+            pred = predict_probe_moves(b, [decision.move])[0]
+            self.pending = (decision.move, pred, class_weights([h.model for h in b.hypotheses]))
+        return decision
+
+    def _result(self, n, result, *rest) -> None:
+        if self.pending is None or result.move is not self.pending[0]:
+            return
+        _, pred, w = self.pending
+        self.pending = None
+        hit = bool(result.ok and result.components)
+        same = pred.hit == hit
+        row = {"status": str(result.status), "hit": hit if result.ok else None, "actual": float(result.cost),
+               "expected": float(pred.costs @ w),
+               "predicted": float(pred.costs[same] @ w[same] / w[same].sum()) if same.any() else None}  # fmt: skip
+        self.rows.append(row)
+
+    def observer(self) -> EpisodeObserver:
+        return EpisodeObserver(on_move=self._result, on_failed_move=self._result)
+
+
+def one(model: str, seed: int, policy: str, moves: str = "tracing", verify: str = "none",
+        probe_costs: bool = False) -> dict:  # fmt: skip
     """One physics episode's record as JSON (an ``error`` entry when it could not run), with the probes that
-    failed (``probes_failed``) and why (``probe_failures``)."""
+    failed (``probes_failed``) and why (``probe_failures``), and with ``probe_costs`` their predicted and
+    actual costs (``probe_costs``, :class:`ProbeCosts`)."""
     failed: list[str] = []
 
     def on_failed(n, result) -> None:
         if result.move is not None and result.move.kind == "probe":
-            failed.append(f"{result.status}: {result.info.get('reason', '')}")
+            failed.append(f"{result.status}: {result.reason or result.info.get('reason', '')}")
 
+    watch = ProbeCosts(make_policy(policy)) if probe_costs else None
     try:
         spec = EpisodeSpec(model=model, seed=seed, policy=policy, executor="physics", moves=moves, verify=verify)
-        rec = run_episode(spec, observer=EpisodeObserver(on_failed_move=on_failed)).to_json()
+        obs = chain_observers(EpisodeObserver(on_failed_move=on_failed), watch.observer() if watch else None)
+        rec = run_episode(spec, observer=obs, policy=watch).to_json()
     except HapticError as exc:
         return {"model": model, "seed": seed, "outcome": "error", "correct": False, "detail": str(exc)}
     rec.update(probes_failed=len(failed), probe_failures=failed)
+    if watch is not None:
+        rec["probe_costs"] = watch.rows
     return rec
 
 
@@ -66,6 +113,29 @@ def _perception(r: dict) -> str:
             f"sp {p.get('spurious', '-')} mi {p.get('missed', '-')}")  # fmt: skip
 
 
+def _print_probe_costs(records: list[dict]) -> None:
+    """Each probe the planner chose, predicted against actual cost, then the differences' mean and range."""
+    print()
+    print(f"{'object':<10} {'seed':>4} {'status':<12} {'hit':<4} {'expected':>8} {'predicted':>9} {'actual':>6} "
+          f"{'act−pred':>8}")  # fmt: skip
+    diffs, diffs_exp = [], []
+    for r in records:
+        for p in r.get("probe_costs", []):
+            d = None if p["predicted"] is None or p["hit"] is None else p["actual"] - p["predicted"]
+            hit = "-" if p["hit"] is None else ("hit" if p["hit"] else "miss")
+            print(f"{r['model']:<10} {r['seed']:>4} {p['status']:<12} {hit:<4} {p['expected']:>8.2f} "
+                  f"{_f(p['predicted'], '.2f'):>9} {p['actual']:>6.2f} {_f(d, '+.2f'):>8}")  # fmt: skip
+            if d is not None:
+                diffs.append(d)
+            if p["hit"] is not None:
+                diffs_exp.append(p["actual"] - p["expected"])
+    if diffs:
+        a, e = np.array(diffs), np.array(diffs_exp)
+        print(f"probes carried out {len(a)}: actual − predicted (for the outcome) mean {a.mean():+.2f}, "
+              f"mean |·| {np.abs(a).mean():.2f}, range {a.min():+.2f} … {a.max():+.2f}; actual − expected mean "
+              f"{e.mean():+.2f}, range {e.min():+.2f} … {e.max():+.2f} [units]")  # fmt: skip
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--poses", type=int, default=3, help="random resting poses (episodes) per object")
@@ -73,6 +143,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--objects", default=",".join(SEED_OBJECTS))
     ap.add_argument("--policy", default="planner")
     ap.add_argument("--moves", default="tracing", choices=("tracing", "all"), help="admissible kinds of move")
+    ap.add_argument("--probe-costs", action="store_true",
+                    help="list each probe the planner chose: predicted against actual cost")
     ap.add_argument("--verify", default="none", choices=("none", "fast", "full"),
                     help="verification before recognition (default none: the matcher's verdict)")
     ap.add_argument("--jobs", type=int, default=1, help="episodes run in parallel (processes)")
@@ -80,7 +152,8 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
 
     objects = [o for o in args.objects.split(",") if o]
-    jobs = [(o, args.first_seed + k, args.policy, args.moves, args.verify) for o in objects for k in range(args.poses)]
+    jobs = [(o, args.first_seed + k, args.policy, args.moves, args.verify, args.probe_costs)
+            for o in objects for k in range(args.poses)]
     t0 = time.perf_counter()
     if args.jobs > 1:
         with ProcessPoolExecutor(args.jobs) as pool:
@@ -123,6 +196,8 @@ def main(argv: list[str] | None = None) -> int:
     print(f"correct {len(good)}/{len(records)}, wrong recognitions {wrong_total}; outcomes: "
           f"{', '.join(f'{k} {v}' for k, v in sorted(outcomes.items()))}; median wall time to recognition "
           f"{_f(float(np.median(walls)) if walls else None)} s; total {time.perf_counter() - t0:.0f} s")  # fmt: skip
+    if args.probe_costs:
+        _print_probe_costs(records)
     if args.json:
         atomic_write(args.json, json.dumps(records, indent=1))
         print(f"wrote {args.json}")

@@ -11,6 +11,8 @@ command, ends it):
    radius and ``ProbeSettings.clearance`` (the object rests on the table and was touched only below it), at
    least the line's start; never above the hand's reach over the region --, across, and straight down to the
    pad centre's place at the line's start. A touch on the way is a failed move (``unreachable``), never a hit.
+   The path is the planner's (:mod:`haptic.planning.handpath`: :func:`~haptic.planning.handpath.safe_height`,
+   :func:`~haptic.planning.handpath.over_the_top`), so its cost prediction follows the hand.
 3. *Guarded approach* along the line at ``ProbeSettings.probe_speed`` until the index pad touches, or to the
    line's end (a miss). A touch by another fingertip, or the hand held back, fails the move.
 4. *A hit*: back off, touch again slowly and settle, then an L stroke from the contact for the face's normal
@@ -41,6 +43,7 @@ from haptic.executor.segment import FaceFit
 from haptic.geometry.se3 import angle, perpendicular, unit
 from haptic.matching.probes import FreeSegment
 from haptic.matching.trace import ContactTrace
+from haptic.planning.handpath import CLEARANCE, LIFT, over_the_top, safe_height
 from haptic.planning.moves import MoveResult, ProbeMove, SensorState
 from haptic.sim.scene import TABLE_TOP_Z
 
@@ -53,9 +56,9 @@ bounds, costs and state); the type is not imported here, since that module dispa
 class ProbeSettings:
     """Geometry and speeds of the probe on the hand."""
 
-    lift: float = 0.008
+    lift: float = LIFT
     """Lift off the surface along its normal before the transfer [m]."""
-    clearance: float = 0.03
+    clearance: float = CLEARANCE
     """The transfer passes this far above the highest contact sensed so far (plus the pad radius) [m]."""
     transfer_speed: float = 0.15
     """Speed of the transfer [m/s]."""
@@ -111,7 +114,7 @@ def probe_move(ex: PhysicsExecutor, move: ProbeMove, pieces: list[PrimitiveResul
     if min(centre0[2], centre1[2]) - r < floor:
         return ex._invalid(move, "the line would bring the pad onto the table")
     z_reach = TABLE_TOP_Z + ex.settings.max_approach_height
-    z_safe = max(_highest_contact(ex) + r + settings.clearance, float(centre0[2]), float(t.tip[2]))
+    z_safe = safe_height(_highest_contact(ex), r, centre0, t.tip, settings.clearance)
     if z_safe > z_reach:
         return ex._fail(move, "unreachable", "the line's start is above the hand's reach over the region")
     was_on = ex._on_face if (ex._on_face == st.face and t.contact[1] is not None) else None
@@ -146,9 +149,8 @@ def probe_move(ex: PhysicsExecutor, move: ProbeMove, pieces: list[PrimitiveResul
             _return(ex, lifted, z_safe, n_left, was_on, settings, pieces, [])
         return out
     # 2. up, across, down to the line's start
-    for name, w in (("rising", np.array([lifted[0], lifted[1], z_safe])),
-                    ("moving across", np.array([centre0[0], centre0[1], z_safe])),
-                    ("descending to the line", centre0)):  # fmt: skip
+    for name, w in zip(("rising", "moving across", "descending to the line"), over_the_top(lifted, z_safe, centre0),
+                       strict=True):  # fmt: skip
         if float(np.linalg.norm(w - t.tip)) < 1e-3:
             continue
         res = leg(w, settings.transfer_speed, settings.transfer_lag)
@@ -260,7 +262,8 @@ def _return(ex: PhysicsExecutor, lifted: np.ndarray, z_safe: float, n_left: np.n
         free.append(res)
         return res
 
-    up = go(np.array([t.tip[0], t.tip[1], z_safe]))
+    way = over_the_top(t.tip, z_safe, lifted)
+    up = go(way[0])
     if (not up.ok or up.event != "done") and line_start is not None:
         # under an overhang: off the object, back along the line (free: the pad came that way), then up
         if t.contact[1] is not None and t.normal is not None:
@@ -273,7 +276,7 @@ def _return(ex: PhysicsExecutor, lifted: np.ndarray, z_safe: float, n_left: np.n
                 return False
     elif not up.ok or up.event != "done":
         return False
-    for w in (np.array([lifted[0], lifted[1], z_safe]), lifted):
+    for w in way[1:]:
         if float(np.linalg.norm(w - t.tip)) < 1e-3:
             continue
         res = go(w)

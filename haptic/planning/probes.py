@@ -46,6 +46,7 @@ from haptic.matching.components import DataComponent, DataFace, SensorNoise
 from haptic.matching.recognition import PoseTolerance
 from haptic.matching.verify import POSE_SAFETY
 from haptic.planning.efficiency import efficiency_of, expected_eliminated
+from haptic.planning.handpath import HandStart, foot_near_boundary, pad_touches_first, pad_touches_path
 from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import CostModel, ProbeMove
 
@@ -173,15 +174,20 @@ def candidate_probes(hypotheses: Sequence[Hypothesis], config: ProbeConfig | Non
 
 
 FINGER_SAMPLES = 8
-"""Points along a line's pad path at which :func:`finger_clear` checks the finger above the pad."""
+"""Points along a line's pad path at which :func:`finger_clear` checks the finger above the pad (and points up
+the finger at each)."""
+FINGER_RADIUS = 0.0085
+"""Radius of the finger's links above the pad (the index finger's capsules) [m]: a line into a slot the pad
+fits in but the finger slanting after it does not is blocked."""
 
 
 def finger_clear(hypotheses: Sequence[Hypothesis], moves: Sequence[ProbeMove], pad_radius: float,
-                 lift: float = FINGER_LIFT) -> np.ndarray:  # fmt: skip
+                 lift: float = FINGER_LIFT, finger_radius: float = FINGER_RADIUS) -> np.ndarray:  # fmt: skip
     """Whether the finger above the pad -- pointing down, the column from the pad's top to ``lift`` above its
-    centre -- stays clear of every hypothesis's object while the pad travels each line up to where that
-    hypothesis predicts its contact (or to the line's end), shape (M,) bool. A line passing under an overhang
-    of a hypothesis (a slot's ceiling, a ledge) would have the finger's phalanx meet the object before the pad:
+    centre, ``finger_radius`` thick -- stays clear of every hypothesis's object while the pad travels each line
+    up to where that hypothesis predicts its contact (or to the line's end), shape (M,) bool. A line passing
+    under an overhang of a hypothesis (a slot's ceiling, a ledge), or slanting into a slot the pad fits in and
+    the finger after it does not, would have the finger's phalanx meet the object before the pad:
     a blocked move, no contact sensed."""
     m = len(moves)
     ok = np.ones(m, dtype=bool)
@@ -200,7 +206,10 @@ def finger_clear(hypotheses: Sequence[Hypothesis], moves: Sequence[ProbeMove], p
         tops = inv.apply((centres + lift * up).reshape(-1, 3))
         down = np.broadcast_to(inv.rotate(-up), tops.shape)
         hit = line_hits(h.poly, tops, down).first <= lift - r
-        blocked = hit | h.poly.contains(tops)
+        # the finger is a capsule about the column: its points stay a finger's radius off the surface
+        column = tops[:, None, :] + np.linspace(0.0, lift - r, FINGER_SAMPLES)[None, :, None] * down[:1, None, :]
+        thick = surface_distance(h.poly, column.reshape(-1, 3)).reshape(len(tops), -1).min(axis=1) < finger_radius
+        blocked = hit | thick | h.poly.contains(tops)
         ok &= ~blocked.reshape(m, FINGER_SAMPLES).any(axis=1)
     return ok
 
@@ -355,13 +364,29 @@ class ProbePrediction:
     """Bound on the angle between two predicted normals that one measurement cannot tell apart [rad]."""
     costs: np.ndarray
     """Predicted cost per hypothesis, shape (N,) [units]."""
+    fails: np.ndarray | None = None
+    """Per hypothesis, for the simulated hand's pad: whether it would touch something before the head-on contact
+    predicted (an edge or a slot's rim beside the line, a face grazed on a miss,
+    :func:`~haptic.planning.handpath.pad_touches_first`) or hit a face leaning under past its reach -- a failed
+    move, not the outcome predicted --, shape (N,) bool; None for a point sensor."""
+
+    def risk(self, weights: np.ndarray | None = None) -> float:
+        """The weighted share of hypotheses in which the move fails (:attr:`fails`; 0 without)."""
+        if self.fails is None:
+            return 0.0
+        n = len(self.fails)
+        w = np.full(n, 1.0 / n) if weights is None else np.asarray(weights, dtype=float) / np.sum(weights)
+        return float(self.fails @ w)
+
     known: np.ndarray | None = None
     """:meth:`eliminates` when already computed (a :meth:`subset` carries its share of the whole's), else None."""
 
     def subset(self, idx: Sequence[int], position: np.ndarray, costs: CostModel | None = None) -> ProbePrediction:
         """The prediction for hypotheses ``idx`` alone, with the sensor at ``position`` (the costs of getting to
         the line and back from there): what :func:`predict_probes` would predict for them, but for the margins,
-        which keep the pose tolerance of the data this prediction was made with."""
+        which keep the pose tolerance of the data this prediction was made with, and, for the simulated hand
+        (:attr:`fails` set), the costs, which keep those of its path from where this prediction was made (the
+        climb over the object, most of the path, changes little with where on the object the pad starts)."""
         idx = np.asarray(idx, dtype=int)
         costs = costs or CostModel()
         here = np.asarray(position, dtype=float)
@@ -373,12 +398,14 @@ class ProbePrediction:
         return ProbePrediction(
             move=self.move, hit=hit, distance=self.distance[idx], face=self.face[idx], normal=self.normal[idx],
             depth=self.depth[idx], margin=self.margin[idx], contact_margin=self.contact_margin[idx],
-            angle_bound=self.angle_bound, costs=np.array([costs.probe_move(x) for x in s]),
-            known=self.eliminates()[np.ix_(idx, idx)],
+            angle_bound=self.angle_bound,
+            costs=np.array([costs.probe_move(x) for x in s]) if self.fails is None else self.costs[idx],
+            fails=None if self.fails is None else self.fails[idx], known=self.eliminates()[np.ix_(idx, idx)],
         )  # fmt: skip
 
     def eliminates(self) -> np.ndarray:
-        """``D[i, j]``: hypothesis ``j`` is eliminated if ``i`` is true (module docstring), shape (N, N)."""
+        """``D[i, j]``: hypothesis ``j`` is eliminated if ``i`` is true (module docstring), shape (N, N); never
+        where the hand's move fails in ``i``'s world or ``j``'s (:attr:`fails`)."""
         if self.known is not None:
             return self.known
         n = len(self.hit)
@@ -396,6 +423,8 @@ class ProbePrediction:
             cosang = np.clip(np.nan_to_num(self.normal) @ np.nan_to_num(self.normal).T, -1.0, 1.0)
             turned = np.arccos(cosang) > self.angle_bound
         d |= hi & hj & (far | turned)
+        if self.fails is not None:  # where the hand's move fails, its outcome is not the one predicted
+            d &= ~self.fails[:, None] & ~self.fails[None, :]
         np.fill_diagonal(d, False)
         object.__setattr__(self, "known", d)
         return d
@@ -449,11 +478,16 @@ def predict_probes(
     components: Mapping[int, DataComponent] | Sequence[DataComponent],
     noise: SensorNoise,
     costs: CostModel | None = None,
+    hand: HandStart | None = None,
 ) -> list[ProbePrediction]:
     """Every hypothesis's predicted outcome and cost for each candidate probe (hypotheses must have poses).
 
     ``position``: where the sensor is (world) [m], for the free-space distance; ``components``: the data so far,
     whose error bounds set the pose-error margin (:class:`~haptic.matching.recognition.PoseTolerance`).
+    ``hand``: where the simulated hand's pad is, when the probe is the hand's: the free-space distance is then
+    that of its path up and over the object (:mod:`haptic.planning.handpath`) and a hit adds ``c_n`` for the
+    stroke measuring the face's normal; None (a point sensor): a straight transfer to the line's start and,
+    after a miss, straight back from its end.
     """
     costs = costs or CostModel()
     comps = list(components.values()) if isinstance(components, Mapping) else list(components)
@@ -471,6 +505,7 @@ def predict_probes(
     face = np.full((m, n), -1, dtype=np.int64)
     normal = np.full((m, n, 3), np.nan)
     depth = np.zeros((m, n))
+    fails = np.zeros((m, n), dtype=bool)
     centre_w = np.zeros((n, 3))
     # one line–triangle intersection per model, over every candidate and every pose class of that model
     by_model: dict[int, list[int]] = {}
@@ -505,15 +540,37 @@ def predict_probes(
             ts = lo[:, None] + (hi - lo)[:, None] * DEPTH_FRACTIONS
             pts = s_m[fin, None, :] + ts[..., None] * u_m[fin, None, :]
             dep[fin] = surface_distance(poly, pts.reshape(-1, 3)).reshape(len(fin), -1).max(axis=1)
+        if hand is not None:  # where the pad would touch before its leading point meets the face
+            hit_m = hits.first <= lens
+            inc = np.ones(len(s_m))
+            inc[hit_m] = np.abs(np.einsum("ij,ij->i", u_m[hit_m], poly.face_normals[hits.face[hit_m]]))
+            early = pad_touches_first(poly, s_m, u_m, np.where(hit_m, hits.first, lens), inc, hand.pad_radius)
+            # the pad's contact on the face (its centre where it meets the plane, less the radius along the normal)
+            r = hand.pad_radius
+            k = np.flatnonzero(hit_m)
+            tc = hits.first[k] - r * (1.0 / np.clip(inc[k], MIN_INCIDENCE, 1.0) - 1.0)
+            feet = s_m[k] + (tc - r)[:, None] * u_m[k] - r * poly.face_normals[hits.face[k]]
+            early[k] |= foot_near_boundary(poly, hits.face[k], feet)
+            rise = hand.rise()  # the pad's way up from the surface it leaves, the same for every line
+            for a, t in enumerate(inv):
+                if pad_touches_path(poly, t.apply(rise), hand.pad_radius):
+                    early[a * m : (a + 1) * m] = True
         for a, j in enumerate(js):
+            if hand is not None:
+                fails[:, j] = early[a * m : (a + 1) * m]
             t_hit[:, j] = first[:, a]
             face[:, j] = fc[:, a]
             ok = fc[:, a] >= 0
             normal[ok, j] = hypotheses[j].world_from_model.rotate(poly.face_normals[fc[ok, a]])
             depth[:, j] = dep[a * m : (a + 1) * m]
     here = np.asarray(position, dtype=float)
-    transfer = np.linalg.norm(starts - here, axis=1)
-    back = np.linalg.norm(starts + lengths[:, None] * dirs - here, axis=1)
+    if hand is None:
+        transfer = np.linalg.norm(starts - here, axis=1)
+        back = np.linalg.norm(starts + lengths[:, None] * dirs - here, axis=1)
+        normal_cost = 0.0
+    else:
+        transfer, back = hand.distances(starts, dirs, lengths)
+        normal_cost = costs.c_n
     out = []
     for i, mv in enumerate(moves):
         hit = t_hit[i] <= lengths[i]
@@ -523,15 +580,21 @@ def predict_probes(
         margin = rho + tol.distance + tol.angle * r
         contact = np.where(hit, (1.0 + POSE_SAFETY) * rho + delta * r, np.nan)
         s = transfer[i] + np.where(hit, np.nan_to_num(dist), lengths[i] + back[i])
+        c = np.array([costs.probe_move(x) for x in s])
+        fail = None
+        if hand is not None:
+            fail = fails[i].copy()
+            if hand.max_undercut is not None:
+                fail |= hit & (np.nan_to_num(normal[i, :, 2]) < -np.sin(hand.max_undercut))
         out.append(ProbePrediction(
             move=mv, hit=hit, distance=dist, face=np.where(hit, face[i], -1),
             normal=np.where(hit[:, None], normal[i], np.nan), depth=np.where(hit, depth[i], 0.0), margin=margin,
             contact_margin=contact,
-            angle_bound=float(ang), costs=np.array([costs.probe_move(x) for x in s]),
+            angle_bound=float(ang), costs=c if hand is None else c + np.where(hit, normal_cost, 0.0), fails=fail,
         ))  # fmt: skip
     return out
 
 
 __all__ = ["BEHIND", "DEPTH_FRACTIONS", "FINGER_LIFT", "MIN_INCIDENCE", "LibraryExtent", "ProbeConfig",
-           "ProbePrediction", "candidate_probes", "fibonacci_directions", "finger_clear", "opening_probes",
-           "predict_probes"]  # fmt: skip
+           "ProbePrediction", "FINGER_RADIUS", "candidate_probes", "fibonacci_directions", "finger_clear",
+           "opening_probes", "predict_probes"]  # fmt: skip

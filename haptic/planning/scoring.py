@@ -12,16 +12,22 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from haptic.matching.components import DataComponent, SensorNoise
+from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex, SensorNoise
 from haptic.planning.bound import reduce_hypotheses
 from haptic.planning.config import PlannerConfig
 from haptic.planning.efficiency import class_weights, distinguishable, efficiency_of, expected_eliminated
+from haptic.planning.handpath import HandStart
 from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import FaceMove, Move, ProbeMove, SensorState
 from haptic.planning.predict import Prediction, candidate_moves, crossed_edge, predict
 from haptic.planning.probes import ProbeConfig, ProbePrediction, candidate_probes, predict_probes
 from haptic.planning.simulate import simulate
 from haptic.planning.table import descent_risk
+
+PROBE_RISK = 0.25
+"""Probes the hand's pad is predicted to fail in this share of the hypotheses' weight or more are not offered
+(:meth:`~haptic.planning.probes.ProbePrediction.risk`): a failed probe tells the matcher nothing, and the loop
+then falls back to tracing moves; the rest are discounted by their risk."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -74,8 +80,8 @@ def score_all(ctx: Context) -> list[tuple[Prediction | ProbePrediction, float, f
     eliminations come from comparing predicted outcome attributes (§4.1). With a table (``config.table_z``),
     moves the hypotheses predict to run into it are left out and the rest discounted by that risk.
     Free-space probes join them when ``config.moves`` admits them, scored in the same form
-    (:meth:`ProbePrediction.score`), so one planner ranks every kind of move together; ``config.moves ==
-    "probing"`` leaves the tracing moves out."""
+    (:meth:`ProbePrediction.score`, on the simulated hand discounted by :meth:`ProbePrediction.risk`), so one
+    planner ranks every kind of move together; ``config.moves == "probing"`` leaves the tracing moves out."""
     weights = class_weights([h.model for h in ctx.hypotheses])
     out: list = []
     if ctx.config.moves != "probing":
@@ -84,7 +90,13 @@ def score_all(ctx: Context) -> list[tuple[Prediction | ProbePrediction, float, f
         refused = [(p, refusal(p, ctx.config)) for p in preds]
         refused = [(p, r) for p, r in refused if r < ctx.config.table_risk] or refused
         out = [(pred, *score_prediction(pred, weights, r, ctx.config)) for pred, r in refused]
-    return out + [(pred, *pred.score(weights), 0.0) for pred in predict_probe_moves(ctx)]
+    for pred in predict_probe_moves(ctx):
+        eff, elim, cost = pred.score(weights)
+        risk = pred.risk(weights)  # the hand's pad touching what the line-cast does not predict (0: a point sensor)
+        if risk >= PROBE_RISK:
+            continue
+        out.append((pred, eff * (1.0 - risk), elim * (1.0 - risk), cost, risk))
+    return out
 
 
 def probe_moves(ctx: Context) -> list[ProbeMove]:
@@ -98,10 +110,31 @@ def probe_moves(ctx: Context) -> list[ProbeMove]:
     return [m for m in candidate_probes(ctx.hypotheses, cfg) if not any(same_move(m, bad) for bad in ctx.avoid)]
 
 
-def predict_probe_moves(ctx: Context) -> list[ProbePrediction]:
-    """Every hypothesis's predicted outcome of each candidate probe (:func:`probe_moves`)."""
-    moves = probe_moves(ctx)
-    return predict_probes(ctx.hypotheses, moves, ctx.state.position, ctx.components, ctx.noise, ctx.config.costs)
+def predict_probe_moves(ctx: Context, moves: Sequence[ProbeMove] | None = None) -> list[ProbePrediction]:
+    """Every hypothesis's predicted outcome of each candidate probe (:func:`probe_moves`, or ``moves``), its cost
+    along the simulated hand's path (:func:`hand_start`) when the configuration has a pad and a table."""
+    moves = probe_moves(ctx) if moves is None else list(moves)
+    return predict_probes(ctx.hypotheses, moves, ctx.state.position, ctx.components, ctx.noise, ctx.config.costs,
+                          hand_start(ctx))  # fmt: skip
+
+
+def hand_start(ctx: Context) -> HandStart | None:
+    """Where the simulated hand's pad is, from the data (:class:`~haptic.planning.handpath.HandStart`): touching
+    the sensor's position on its face (that face's normal), below the highest contact point of the data
+    components; None without a pad and a table (a point sensor)."""
+    c = ctx.config
+    face = ctx.components.get(ctx.state.face)
+    if c.table_z is None or c.pad_radius <= 0.0 or not isinstance(face, DataFace):
+        return None
+    points = [np.atleast_2d(ctx.state.position)]
+    for comp in ctx.components.values():
+        if isinstance(comp, DataFace):
+            points.append(np.atleast_2d(comp.points))
+        elif isinstance(comp, DataEdge):
+            points.append(np.atleast_2d(comp.point))
+        elif isinstance(comp, DataVertex):
+            points.append(np.atleast_2d(comp.position))
+    return HandStart.at(ctx.state.position, face.normal, np.concatenate(points), c.pad_radius, c.max_undercut)
 
 
 def score_prediction(

@@ -10,7 +10,11 @@ import pytest
 from haptic.executor.physics import PhysicsExecutor
 from haptic.geometry import SE3, load_library
 from haptic.geometry.raycast import depth_samples
+from haptic.matching.components import DataFace, SensorNoise
+from haptic.planning.handpath import HandStart
+from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import ProbeMove
+from haptic.planning.probes import predict_probes
 from haptic.sim import RobotInterface, SimulatedSensorNoise, Simulation, compose_scene, random_object_pose
 from haptic.sim.scene import PAD_RADIUS, TABLE_TOP_Z, scene_object_from_polyhedron
 
@@ -33,14 +37,42 @@ def probed():
     verts = truth.apply(poly.vertices[list(poly.faces[f])])
     target = verts.mean(axis=0)
     target[2] = max(target[2], TABLE_TOP_Z + PAD_RADIUS + 0.008)
+    before_hit = (first.state, list(ex.components))
     hit = ex.execute(ProbeMove(target + 0.05 * n, -n, 0.08))
     # the same direction, shifted sideways past the object's extent
     across = np.cross(n, [0.0, 0.0, 1.0])
     width = float(np.ptp(truth.apply(poly.vertices) @ across))
     miss_move = ProbeMove(target + 0.05 * n + (width + 0.03) * across, -n, 0.10)
     state_before = hit.state
+    ex.before = (before_hit, (hit.state, list(ex.components)))  # for the cost predictions
     miss = ex.execute(miss_move)
     return poly, truth, f, hit, state_before, miss, ex
+
+
+def _predicted_cost(ex, poly, truth, state, components, move) -> tuple[bool, float]:
+    """The planner's predicted outcome and cost of ``move`` on the hand, from the data before it (the true
+    pose as the one hypothesis: the test may read it)."""
+    face = next(c for c in components if c.id == state.face)
+    assert isinstance(face, DataFace)
+    contacts = np.concatenate([np.atleast_2d(c.points) for c in components if isinstance(c, DataFace)])
+    hand = HandStart.at(state.position, face.normal, contacts, PAD_RADIUS)
+    hyp = Hypothesis("BOX01", poly, truth, {}, {}, {})
+    (pred,) = predict_probes([hyp], [move], state.position, components, SensorNoise(), ex.costs, hand)
+    return bool(pred.hit[0]), float(pred.costs[0])
+
+
+def test_the_planner_predicts_the_hands_probe_cost(probed):
+    """The prediction follows the hand's path up and over the object (haptic.planning.handpath), a hit's normal
+    stroke included: within a unit of the cost the executor reports (a straight transfer would fall short by
+    the climb over the object, several units)."""
+    poly, truth, _, hit, _, miss, ex = probed
+    for result, (state, comps) in zip((hit, miss), ex.before, strict=True):
+        assert result.ok, result.reason
+        would_hit, cost = _predicted_cost(ex, poly, truth, state, comps, result.move)
+        assert would_hit == bool(result.components)
+        assert cost == pytest.approx(result.cost, abs=1.0), (result.move, cost, result.cost)
+        straight = float(np.linalg.norm(np.asarray(result.move.start) - state.position))
+        assert result.cost > ex.costs.probe_move(straight) + 1.0  # the path rule matters here
 
 
 def test_a_probe_at_a_face_hits_it_within_the_bounds(probed):
