@@ -24,8 +24,8 @@ from haptic.planning.efficiency import class_weights, outcome_groups
 from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import Move, ProbeMove, SensorState
 from haptic.planning.predict import candidate_moves, predict
-from haptic.planning.probes import ProbePrediction, predict_probes
-from haptic.planning.scoring import Context, refusal, same_move, score_prediction
+from haptic.planning.probes import ProbePrediction
+from haptic.planning.scoring import Context, predict_probe_moves, refusal, same_move, score_prediction
 from haptic.planning.simulate import simulate, simulate_probe
 
 
@@ -60,7 +60,7 @@ def branches(
     if isinstance(move, ProbeMove):
         if any(h.world_from_model is None for h in hyps):
             return []
-        (pp,) = predict_probes(hyps, [move], state.position, components, noise, config.costs)
+        (pp,) = predict_probe_moves(Context(hyps, state, components, noise, config), [move])
         return probe_branches(hyps, weights, pp, state, components, noise)
     pred = predict(hyps, move, state, components, noise, config)
     if not pred.reliable(config) or pred.table_risk >= config.table_risk:
