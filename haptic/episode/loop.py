@@ -15,7 +15,13 @@ from typing import Protocol
 
 import numpy as np
 
-from haptic.episode.opening import opening_move, opening_probe
+from haptic.episode.opening import (
+    cheaper_opening,
+    edge_run_of,
+    opening_move,
+    opening_probe,
+    tracing_remainder,
+)
 from haptic.episode.perception import on_the_table, touched_points
 from haptic.episode.scoring import score_outcome
 from haptic.episode.spec import EpisodeSpec
@@ -287,9 +293,10 @@ def loop_steps(
         state = first.state
         if obs.on_move:
             obs.on_move(0, first, tree.count, rec)
-        probing = config.moves == "probing"
+        probing = config.moves == "probing"  # probes until the hypotheses have poses: the opening is probes
+        choosing = config.moves == "all"  # each new face of the opening by a tracing move or a probe
         fixed = [] if probing else ["face", "edge", "vertex"]
-        extent = LibraryExtent.of(library.values()) if probing else None
+        extent = LibraryExtent.of(library.values()) if probing or choosing else None
         while True:
             verifying = verifier is not None and rec is not None and rec.status == RECOGNIZED
             if verifying:
@@ -310,6 +317,17 @@ def loop_steps(
             move = None
             if verifying:
                 move = verifier.choose(hypotheses_from(tree, rec)[0], state, components, tuple(failed_here))
+            posed = rec is not None and bool(rec.classes)
+            probe_failed = any(m.kind == "probe" for m in failed_here)
+            if choosing and move is None and not posed and not verifying:
+                # the tracing opening from where the sensor is, or a probe when it measures the next face for less
+                # (not after a probe failed from here: probes aimed at the same region would fail the same way)
+                fixed = tracing_remainder(state)
+                if not probe_failed:
+                    run = edge_run_of(tree, state.edge) if state.edge is not None else None
+                    move = cheaper_opening(fixed, state, components, extent, config, rng, (*failed_here, *probed), run)
+                if move is not None:
+                    fixed = []
             if fixed and move is None:
                 hyps = (
                     tuple(hypotheses_from(tree, rec))
@@ -323,8 +341,7 @@ def loop_steps(
                 hyps = hypotheses_from(tree, rec) if rec is not None and rec.classes else []
                 # after a probe failed from here (the hand could not get along its line), tracing moves until one
                 # succeeds: probes aimed at the same region would fail the same way
-                cfg = replace(config, moves="tracing") if config.moves == "all" and any(
-                    m.kind == "probe" for m in failed_here) else config  # fmt: skip
+                cfg = replace(config, moves="tracing") if config.moves == "all" and probe_failed else config
                 ctx = Context(hyps, state, components, noise, cfg, avoid=(*failed_here, *probed), tree=tree)
                 try:
                     if len(hyps) >= 2 and not verifying:

@@ -272,7 +272,8 @@ def _line_through(
 
 @dataclass(frozen=True)
 class LibraryExtent:
-    """How large the library's objects are, for aiming probes before any hypothesis has a pose."""
+    """How large the library's objects are, for aiming probes before any hypothesis has a pose, and what the
+    opening's tracing moves travel on them on average (for choosing between those and a probe)."""
 
     reach: float
     """The largest distance between two vertices of one model: every point of the object lies within this of
@@ -280,16 +281,55 @@ class LibraryExtent:
     depth: float
     """The median over the library of a model's centroid's distance to its nearest face plane: how far behind
     a contact, against its normal, the object's inside is aimed at [m]."""
+    face_run: float = 0.0
+    """Expected length of a face move from a point of a face to its boundary: half the mean chord of a
+    uniform random line across a face, ``π A / (2 P)`` (area ``A``, perimeter ``P``), averaged over the
+    library's faces weighted by area (the sensor lands on a face with chance in proportion to it) [m]."""
+    edge_run: float = 0.0
+    """Expected length of an edge move from where a face move met an edge to the edge's end: half an edge,
+    edges weighted by length (a face move meets an edge with chance in proportion to it), ``E[l²] / (2 E[l])``
+    over the library's edges [m]."""
+    corner_angle: float = 0.0
+    """Mean interior angle of the library's face corners: the turn of a vertex move from the edge it starts on
+    to the next edge of the face [rad]."""
 
     @classmethod
     def of(cls, models: Iterable[Polyhedron]) -> LibraryExtent:
         """The extent of a library's models."""
         reach, depths = 0.0, []
+        runs, areas, lengths, corners = [], [], [], []
         for poly in models:
             v = poly.vertices
             reach = max(reach, float(np.sqrt(((v[:, None] - v[None]) ** 2).sum(-1)).max()))
             depths.append(float(np.abs(poly.face_offsets - poly.face_normals @ poly.centroid).min()))
-        return cls(reach, float(np.median(depths)) if depths else 0.0)
+            edge_l = poly.edge_lengths
+            lengths.extend(edge_l.tolist())
+            for f, fe in enumerate(poly.face_edges):
+                area = float(poly.face_areas[f])
+                runs.append(np.pi * area / (2.0 * float(edge_l[list(fe)].sum())))
+                areas.append(area)
+                ring = v[list(poly.face_vertices(f))]
+                a, b = np.roll(ring, 1, axis=0) - ring, np.roll(ring, -1, axis=0) - ring
+                cos = np.einsum("ij,ij->i", a, b) / (np.linalg.norm(a, axis=1) * np.linalg.norm(b, axis=1))
+                corners.extend(np.arccos(np.clip(cos, -1.0, 1.0)).tolist())
+        if not depths:
+            return cls(0.0, 0.0)
+        lengths = np.array(lengths)
+        return cls(
+            reach,
+            float(np.median(depths)),
+            face_run=float(np.average(runs, weights=areas)),
+            edge_run=float((lengths**2).sum() / (2.0 * lengths.sum())),
+            corner_angle=float(np.mean(corners)),
+        )
+
+
+def region_centre(faces: Sequence[DataFace], extent: LibraryExtent) -> np.ndarray:
+    """The estimated centre of the object's region before any pose, ``c = mean(q_i − depth · n_i)`` over the
+    data faces (contact points ``q_i``, outward normals ``n_i``) [m]; the opening probes' lines run through it."""
+    q = np.array([np.mean(np.atleast_2d(f.points), axis=0) for f in faces])
+    n = np.array([f.normal for f in faces])
+    return (q - extent.depth * n).mean(axis=0)
 
 
 def opening_probes(
@@ -310,7 +350,7 @@ def opening_probes(
         return []
     q = np.array([np.mean(np.atleast_2d(f.points), axis=0) for f in faces])
     n = np.array([f.normal for f in faces])
-    centre = (q - extent.depth * n).mean(axis=0)
+    centre = region_centre(faces, extent)
     radius = extent.reach + extent.depth + config.standoff
     dirs = fibonacci_directions(config.n_directions)
     if config.table_z is not None:
@@ -478,4 +518,4 @@ def predict_probes(
 
 __all__ = ["BEHIND", "DEPTH_FRACTIONS", "FINGER_LIFT", "MIN_INCIDENCE", "LibraryExtent", "ProbeConfig",
            "ProbePrediction", "candidate_probes", "fibonacci_directions", "finger_clear", "opening_probes",
-           "predict_probes"]  # fmt: skip
+           "predict_probes", "region_centre"]  # fmt: skip
