@@ -29,6 +29,7 @@ from haptic.errors import HapticError
 from haptic.geometry import SE3, Polyhedron
 from haptic.geometry.se3 import matrix_to_quat
 from haptic.matching.components import DataComponent, SensorNoise
+from haptic.matching.probes import MAX_POSED as PROBES_MAX_POSED
 from haptic.matching.probes import FreeSegment, apply_probes
 from haptic.matching.recognition import AMBIGUOUS, EXPLORING, NO_MATCH, RECOGNIZED, Recognition, recognize
 from haptic.matching.tree import InterpretationTree
@@ -334,8 +335,8 @@ def loop_steps(
                     if config.table_z is not None and rec is not None and rec.classes else ()
                 )  # fmt: skip
                 move = opening_move(fixed.pop(0), state, components, config, rng, tuple(failed_here), hyps)
-            if probing and move is None and not verifying and not (rec is not None and rec.classes):
-                move = opening_probe(components, extent, config, rng, (*failed_here, *probed))
+            if probing and move is None and not verifying and (not posed or tree.count > PROBES_MAX_POSED):
+                move = opening_probe(components, extent, config, rng, (*failed_here, *probed), unmeasured=posed)
             if move is None:
                 t_dec = time.perf_counter()
                 hyps = hypotheses_from(tree, rec) if rec is not None and rec.classes else []

@@ -70,21 +70,24 @@ def opening_probe(
     config: PlannerConfig,
     rng: np.random.Generator,
     avoid: tuple = (),
+    unmeasured: bool = False,
 ) -> ProbeMove | None:
     """A probe of the opening while the hypotheses have no poses yet (the tree pairs each hit with model faces
     by the face-pair angle, §2.6, and the distance of parallel faces, until three independent normals fix the
     poses): a random one of :func:`opening_choices`; None when none is left."""
-    lines = opening_choices(components, extent, config, avoid)
+    lines = opening_choices(components, extent, config, avoid, unmeasured)
     return lines[int(rng.integers(len(lines)))] if lines else None
 
 
-def opening_choices(components, extent: LibraryExtent, config: PlannerConfig, avoid: tuple = ()) -> list[ProbeMove]:
+def opening_choices(
+    components, extent: LibraryExtent, config: PlannerConfig, avoid: tuple = (), unmeasured: bool = False
+) -> list[ProbeMove]:
     """The :data:`OPENING_PROBE_CHOICES` best lines of :func:`~haptic.planning.probes.opening_probes` toward the
     region the data faces leave for the object, less the lines already probed or failed (``avoid``)."""
     comps = components.values() if hasattr(components, "values") else components
     faces = [c for c in comps if isinstance(c, DataFace)]
     cfg = ProbeConfig(table_z=config.table_z, table_clearance=config.table_clearance)
-    lines = [m for m in opening_probes(faces, extent, cfg) if not any(same_move(m, bad) for bad in avoid)]
+    lines = [m for m in opening_probes(faces, extent, cfg, unmeasured) if not any(same_move(m, bad) for bad in avoid)]
     return lines[:OPENING_PROBE_CHOICES]
 
 

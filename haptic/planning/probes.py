@@ -333,7 +333,7 @@ def region_centre(faces: Sequence[DataFace], extent: LibraryExtent) -> np.ndarra
 
 
 def opening_probes(
-    faces: Sequence[DataFace], extent: LibraryExtent, config: ProbeConfig | None = None
+    faces: Sequence[DataFace], extent: LibraryExtent, config: ProbeConfig | None = None, unmeasured: bool = False
 ) -> list[ProbeMove]:
     """Probe lines toward the object's region before hypotheses have poses (the opening of ``--moves probing``),
     best first: a fixed spread of approach directions (:attr:`ProbeConfig.n_directions`, a Fibonacci lattice),
@@ -356,8 +356,11 @@ def opening_probes(
     if config.table_z is not None:
         dirs = dirs[dirs[:, 2] <= config.max_climb]
     # from behind every known face first (no such line enters through one again), then the rest
-    ahead = ~(dirs @ n.T >= -BEHIND).all(axis=1)
-    order = np.lexsort((np.abs(dirs @ n.T).max(axis=1), ahead))
+    if unmeasured:
+        order = np.argsort((-(dirs @ n.T)).max(axis=1), kind="stable")
+    else:
+        ahead = ~(dirs @ n.T >= -BEHIND).all(axis=1)
+        order = np.lexsort((np.abs(dirs @ n.T).max(axis=1), ahead))
     within = (q, np.full(len(q), extent.reach))  # every point of the object is within reach of every contact
     out = []
     for u in dirs[order]:
