@@ -121,3 +121,30 @@ def test_with_dear_probes_the_opening_is_the_seeds(model, seed):
     assert rec.outcome == "recognized" and rec.correct, rec
     assert rec.move_kinds[1:4] == ["face", "edge", "vertex"] == traced.move_kinds[1:4]
     assert rec.cum_cost[:4] == traced.cum_cost[:4]  # the same moves: the opening drew what tracing draws
+
+
+def test_once_posed_the_opening_probes_aim_away_from_every_measured_normal():
+    """Three perpendicular faces measured: the best lines head along the known normals' sum, toward the faces
+    opposite them (each approach away from every measured normal), never back at a measured face."""
+    from haptic.planning.probes import opening_probes
+
+    normals = np.eye(3)
+    faces = [DataFace(i, normals[i], [0.03 * normals[i]], 0.02, 0.0005) for i in range(3)]
+    lines = opening_probes(faces, EXTENT, unmeasured=True)
+    assert lines
+    best = np.array(lines[0].direction)
+    assert (normals @ best > 0.3).all()
+    first = np.array([m.direction for m in opening_probes(faces, EXTENT)[:3]])
+    assert (first @ normals.T).min() < 0.3  # the ranking before poses seeks independent normals instead
+
+
+@pytest.mark.parametrize("c_p", [0.5, 2.0])
+def test_probes_alone_recognise_the_look_alike_box_whose_tree_outgrew_the_bound(c_p):
+    """LA_BOX_100x80x60, seed 299909236: after the third normal the planner's probes met the same faces again
+    and the tree (above the probe matcher's MAX_POSED, tested by normals only) grew to the bound; the opening
+    going on toward unmeasured faces recognises it, the tree staying small."""
+    models = "assets/libraries/lookalike"
+    spec = EpisodeSpec(model="LA_BOX_100x80x60", seed=299909236, models=models, verify="none", moves="probing")
+    rec = run_episode(spec, cached_library(models), config=PlannerConfig(costs=CostModel(c_p=c_p)))
+    assert rec.outcome == "recognized" and rec.correct, rec
+    assert max(rec.interpretations) < 4000 and set(rec.move_kinds[1:]) == {"probe"}

@@ -1,6 +1,9 @@
 """The opening sequence of an episode (seed §4.1): a face move, an edge move, a vertex move, each in a random
 admissible direction, away from the table when there is one; with free-space probes alone (``--moves probing``),
-probes from a spread of directions toward the object's region until the hypotheses have poses."""
+probes from a spread of directions toward the object's region until the hypotheses have poses (and on, toward the
+faces not measured yet, while the tree is too large for the probe matcher to test hits by position); with both
+(``--moves all``), until the hypotheses have poses, each new face by the cheaper way (:func:`cheaper_opening`):
+the tracing opening from where the sensor is, up to its next move that measures a face, or a probe."""
 
 from __future__ import annotations
 

@@ -344,7 +344,11 @@ def opening_probes(
     ``max_i |u · n_i|``): a face whose normal is independent of the known ones is what fixes the rotation (two
     normals) and the translation (three planes), hence the poses. Directions heading against a known face's
     normal (``u · n_i < −``:data:`BEHIND`) come after all the others: such a line may enter through that face
-    again, and a convex object's face is never met from behind."""
+    again, and a convex object's face is never met from behind. With ``unmeasured`` (once the rotation is
+    known, under ``--moves probing`` while the tree is too large for the probe matcher to test hits by their
+    position) they are ranked instead by how far the approach is from every measured normal (smallest
+    ``max_i (−u · n_i)``): the faces not met yet, those opposite the known ones first (whose distance from
+    them the tree tests, §2.6)."""
     config = config or ProbeConfig()
     if not faces:
         return []
