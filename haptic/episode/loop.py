@@ -295,7 +295,9 @@ def loop_steps(
         if obs.on_move:
             obs.on_move(0, first, tree.count, rec)
         probing = config.moves == "probing"  # probes until the hypotheses have poses: the opening is probes
-        choosing = config.moves == "all"  # each new face of the opening by a tracing move or a probe
+        # each new face of the opening by a tracing move or a probe; the simulated hand (a table) keeps the seed's
+        # tracing opening: its probes cost more than predicted, and failed ones more again
+        choosing = config.moves == "all" and config.table_z is None
         fixed = [] if probing else ["face", "edge", "vertex"]
         extent = LibraryExtent.of(library.values()) if probing or choosing else None
         while True:
