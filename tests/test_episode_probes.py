@@ -134,9 +134,10 @@ def test_a_failed_probe_is_not_tried_again_and_tracing_moves_follow_it():
 
 
 def test_an_episode_whose_tree_outgrows_the_bound_fails_instead_of_exhausting_memory(monkeypatch):
-    """Probes alone on a look-alike box whose hits meet faces of few distinct normals: the tree doubles with every
-    hit (to 2 million interpretations, and gigabytes, at c_p 0.5). With a bound, the episode
-    ends "failed", naming it, with the tree held below twice the bound plus one add."""
+    """Probes alone on a look-alike box: the tree holds 1 800 interpretations after the third normal (before the
+    opening went on toward unmeasured faces, hits on the same faces grew it to millions, and gigabytes). With a
+    bound below that, the episode ends "failed", naming it, with the tree held below twice the bound plus one
+    add."""
     import haptic.episode.loop as loop
     from haptic.geometry.library_cache import cached_library
 

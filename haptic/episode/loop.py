@@ -15,7 +15,13 @@ from typing import Protocol
 
 import numpy as np
 
-from haptic.episode.opening import opening_move, opening_probe
+from haptic.episode.opening import (
+    cheaper_opening,
+    edge_run_of,
+    opening_move,
+    opening_probe,
+    tracing_remainder,
+)
 from haptic.episode.perception import on_the_table, touched_points
 from haptic.episode.scoring import score_outcome
 from haptic.episode.spec import EpisodeSpec
@@ -23,6 +29,7 @@ from haptic.errors import HapticError
 from haptic.geometry import SE3, Polyhedron
 from haptic.geometry.se3 import matrix_to_quat
 from haptic.matching.components import DataComponent, SensorNoise
+from haptic.matching.probes import MAX_POSED as PROBES_MAX_POSED
 from haptic.matching.probes import FreeSegment, apply_probes
 from haptic.matching.recognition import AMBIGUOUS, EXPLORING, NO_MATCH, RECOGNIZED, Recognition, recognize
 from haptic.matching.tree import InterpretationTree
@@ -287,9 +294,12 @@ def loop_steps(
         state = first.state
         if obs.on_move:
             obs.on_move(0, first, tree.count, rec)
-        probing = config.moves == "probing"
+        probing = config.moves == "probing"  # probes until the hypotheses have poses: the opening is probes
+        # each new face of the opening by a tracing move or a probe; the simulated hand (a table) keeps the seed's
+        # tracing opening: its probes cost more than predicted, and failed ones more again
+        choosing = config.moves == "all" and config.table_z is None
         fixed = [] if probing else ["face", "edge", "vertex"]
-        extent = LibraryExtent.of(library.values()) if probing else None
+        extent = LibraryExtent.of(library.values()) if probing or choosing else None
         while True:
             verifying = verifier is not None and rec is not None and rec.status == RECOGNIZED
             if verifying:
@@ -310,21 +320,31 @@ def loop_steps(
             move = None
             if verifying:
                 move = verifier.choose(hypotheses_from(tree, rec)[0], state, components, tuple(failed_here))
+            posed = rec is not None and bool(rec.classes)
+            probe_failed = any(m.kind == "probe" for m in failed_here)
+            if choosing and move is None and not posed and not verifying:
+                # the tracing opening from where the sensor is, or a probe when it measures the next face for less
+                # (not after a probe failed from here: probes aimed at the same region would fail the same way)
+                fixed = tracing_remainder(state)
+                if not probe_failed:
+                    run = edge_run_of(tree, state.edge) if state.edge is not None else None
+                    move = cheaper_opening(fixed, state, components, extent, config, rng, (*failed_here, *probed), run)
+                if move is not None:
+                    fixed = []
             if fixed and move is None:
                 hyps = (
                     tuple(hypotheses_from(tree, rec))
                     if config.table_z is not None and rec is not None and rec.classes else ()
                 )  # fmt: skip
                 move = opening_move(fixed.pop(0), state, components, config, rng, tuple(failed_here), hyps)
-            if probing and move is None and not verifying and not (rec is not None and rec.classes):
-                move = opening_probe(components, extent, config, rng, (*failed_here, *probed))
+            if probing and move is None and not verifying and (not posed or tree.count > PROBES_MAX_POSED):
+                move = opening_probe(components, extent, config, rng, (*failed_here, *probed), unmeasured=posed)
             if move is None:
                 t_dec = time.perf_counter()
                 hyps = hypotheses_from(tree, rec) if rec is not None and rec.classes else []
                 # after a probe failed from here (the hand could not get along its line), tracing moves until one
                 # succeeds: probes aimed at the same region would fail the same way
-                cfg = replace(config, moves="tracing") if config.moves == "all" and any(
-                    m.kind == "probe" for m in failed_here) else config  # fmt: skip
+                cfg = replace(config, moves="tracing") if config.moves == "all" and probe_failed else config
                 ctx = Context(hyps, state, components, noise, cfg, avoid=(*failed_here, *probed), tree=tree)
                 try:
                     if len(hyps) >= 2 and not verifying:
