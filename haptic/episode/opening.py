@@ -87,11 +87,16 @@ def opening_choices(
 ) -> list[ProbeMove]:
     """The :data:`OPENING_PROBE_CHOICES` best lines of :func:`~haptic.planning.probes.opening_probes` toward the
     region the data faces leave for the object, less the lines already probed or failed (``avoid``)."""
-    comps = components.values() if hasattr(components, "values") else components
-    faces = [c for c in comps if isinstance(c, DataFace)]
+    faces = _data_faces(components)
     cfg = ProbeConfig(table_z=config.table_z, table_clearance=config.table_clearance)
     lines = [m for m in opening_probes(faces, extent, cfg, unmeasured) if not any(same_move(m, bad) for bad in avoid)]
     return lines[:OPENING_PROBE_CHOICES]
+
+
+def _data_faces(components) -> list[DataFace]:
+    """The data faces among ``components`` (a mapping by id or a sequence)."""
+    comps = components.values() if hasattr(components, "values") else components
+    return [c for c in comps if isinstance(c, DataFace)]
 
 
 def tracing_opening_cost(
@@ -121,8 +126,7 @@ def opening_probe_cost(move: ProbeMove, position: np.ndarray, components, extent
     """Expected cost of an opening probe from the sensor at ``position``: ``c_p + c_s s``, ``s`` the transfer to
     the line's start and the run along it to the expected contact, ``depth`` before the point of the line
     nearest the region's estimated centre (:func:`~haptic.planning.probes.region_centre`) [units]."""
-    comps = components.values() if hasattr(components, "values") else components
-    faces = [c for c in comps if isinstance(c, DataFace)]
+    faces = _data_faces(components)
     start, u = np.asarray(move.start, dtype=float), np.asarray(move.direction, dtype=float)
     run = float((region_centre(faces, extent) - start) @ u) - extent.depth
     run = min(max(run, 0.0), float(move.length))

@@ -1,4 +1,4 @@
-"""The path of a free-space probe on the simulated hand (issue 15 item 4): the one rule the physics executor
+"""The path of a free-space probe on the simulated hand: the one rule the physics executor
 follows (:mod:`haptic.executor.physics_probe`) and the planner predicts its cost by
 (:func:`~haptic.planning.probes.predict_probes`).
 
@@ -125,11 +125,13 @@ def pad_touches_path(poly, centres: np.ndarray, pad_radius: float) -> bool:
 
 
 def safe_height(highest: float, pad_radius: float, line_start_centre: np.ndarray, tip: np.ndarray,
-                clearance: float = CLEARANCE) -> float:  # fmt: skip
+                clearance: float = CLEARANCE):  # fmt: skip
     """``z_safe``: the height of the transfer over the object (module docstring, step 2) [m]; ``highest`` is the
-    highest contact sensed so far, ``line_start_centre`` the pad centre at the line's start ``c_0``, ``tip``
-    the pad centre before the lift."""
-    return max(highest + pad_radius + clearance, float(line_start_centre[2]), float(tip[2]))
+    highest contact sensed so far, ``line_start_centre`` the pad centre at the line's start ``c_0`` (3,), or at
+    each line's start (M, 3) (then one height per line, (M,)), ``tip`` the pad centre before the lift."""
+    z0 = np.asarray(line_start_centre, dtype=float)[..., 2]
+    z = np.maximum(np.maximum(highest + pad_radius + clearance, z0), float(np.asarray(tip)[2]))
+    return float(z) if z.ndim == 0 else z
 
 
 def over_the_top(frm: np.ndarray, z_safe: float, to: np.ndarray) -> np.ndarray:
@@ -137,12 +139,6 @@ def over_the_top(frm: np.ndarray, z_safe: float, to: np.ndarray) -> np.ndarray:
     straight down to ``to``, shape (3, 3) (``frm`` itself left out)."""
     frm, to = np.asarray(frm, dtype=float), np.asarray(to, dtype=float)
     return np.array([[frm[0], frm[1], z_safe], [to[0], to[1], z_safe], to])
-
-
-def path_length(points: np.ndarray) -> float:
-    """Length of the polyline through ``points`` (n, 3) [m]."""
-    p = np.asarray(points, dtype=float)
-    return float(np.linalg.norm(np.diff(p, axis=0), axis=1).sum()) if len(p) > 1 else 0.0
 
 
 def probe_distances(tip: np.ndarray, normal: np.ndarray, highest: float, pad_radius: float, starts: np.ndarray,
@@ -157,7 +153,7 @@ def probe_distances(tip: np.ndarray, normal: np.ndarray, highest: float, pad_rad
     lifted = tip + lift * np.asarray(normal, dtype=float)
     c0 = np.asarray(starts, dtype=float) - pad_radius * np.asarray(dirs, dtype=float)
     c1 = c0 + np.asarray(lengths, dtype=float)[:, None] * np.asarray(dirs, dtype=float)
-    z_safe = np.maximum(np.maximum(highest + pad_radius + clearance, c0[:, 2]), tip[2])
+    z_safe = safe_height(highest, pad_radius, c0, tip, clearance)
     across_to = np.hypot(c0[:, 0] - lifted[0], c0[:, 1] - lifted[1])
     across_back = np.hypot(c1[:, 0] - lifted[0], c1[:, 1] - lifted[1])
     to_start = lift + np.abs(z_safe - lifted[2]) + across_to + (z_safe - c0[:, 2])
@@ -166,5 +162,5 @@ def probe_distances(tip: np.ndarray, normal: np.ndarray, highest: float, pad_rad
 
 
 __all__ = ["CLEARANCE", "LIFT", "PAD_SAMPLES", "PAD_TOLERANCE", "STROKE_ROOM", "HandStart", "foot_near_boundary",
-           "over_the_top", "pad_touches_first", "pad_touches_path", "path_length", "probe_distances",
+           "over_the_top", "pad_touches_first", "pad_touches_path", "probe_distances",
            "safe_height"]  # fmt: skip

@@ -42,7 +42,7 @@ from haptic.planning.moves import Move, ProbeMove, SensorState
 from haptic.planning.policies import PlannerPolicy, Policy
 from haptic.planning.predict import Prediction
 from haptic.planning.probes import ProbePrediction
-from haptic.planning.scoring import Context, Decision, Scored, same_move, score_all
+from haptic.planning.scoring import Context, Decision, Scored, same_move, score_all, score_probe
 from haptic.planning.search import Branch, branches, probe_branches
 
 MAX_PROBES = 4
@@ -148,8 +148,9 @@ class _Search:
         for root in self._probes:
             if any(same_move(root.move, done) for done in probed):
                 continue
-            pred = root.subset(idx, state.position, config.costs)
-            out.append((pred, *pred.score(weights), 0.0))
+            scored = score_probe(root.subset(idx, state.position, config.costs), weights)
+            if scored is not None:
+                out.append(scored)
         return out
 
     def q(

@@ -90,13 +90,18 @@ def score_all(ctx: Context) -> list[tuple[Prediction | ProbePrediction, float, f
         refused = [(p, refusal(p, ctx.config)) for p in preds]
         refused = [(p, r) for p, r in refused if r < ctx.config.table_risk] or refused
         out = [(pred, *score_prediction(pred, weights, r, ctx.config)) for pred, r in refused]
-    for pred in predict_probe_moves(ctx):
-        eff, elim, cost = pred.score(weights)
-        risk = pred.risk(weights)  # the hand's pad touching what the line-cast does not predict (0: a point sensor)
-        if risk >= PROBE_RISK:
-            continue
-        out.append((pred, eff * (1.0 - risk), elim * (1.0 - risk), cost, risk))
-    return out
+    return out + [s for s in (score_probe(pred, weights) for pred in predict_probe_moves(ctx)) if s is not None]
+
+
+def score_probe(pred: ProbePrediction, weights: np.ndarray) -> tuple | None:
+    """A probe scored as :func:`score_all` scores it, ``(pred, efficiency, eliminations, cost, risk)``, both
+    discounted by the risk that the hand's pad touches what the line-cast does not predict (0: a point sensor);
+    None when that risk is :data:`PROBE_RISK` or more."""
+    eff, elim, cost = pred.score(weights)
+    risk = pred.risk(weights)
+    if risk >= PROBE_RISK:
+        return None
+    return pred, eff * (1.0 - risk), elim * (1.0 - risk), cost, risk
 
 
 def probe_moves(ctx: Context) -> list[ProbeMove]:
