@@ -16,7 +16,7 @@ from haptic.errors import HapticError, RecordingError
 def add_parser(sub: argparse._SubParsersAction) -> None:
     from haptic.matching.verify import DEFAULT_VERIFY, VERIFY_MODES
     from haptic.options import noise_level, positive_int, seed_int
-    from haptic.planning.moves import DEFAULT_MOVES, MOVE_SETS
+    from haptic.planning.moves import DEFAULT_MOVES, HAND_DEFAULT_MOVES, MOVE_SETS
     from haptic.planning.registry import POLICY_NAMES
 
     p = sub.add_parser(
@@ -40,9 +40,10 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "and edge measured) or full (also every vertex)",
     )  # fmt: skip
     p.add_argument(
-        "--moves", choices=MOVE_SETS, default=DEFAULT_MOVES,
-        help=f"admissible kinds of move (default {DEFAULT_MOVES}): tracing (face, edge, vertex moves), probing "
-        "(free-space probes alone, geometric executor; verification, if any, by tracing moves) or all (both, one "
+        "--moves", choices=MOVE_SETS, default=None,
+        help=f"admissible kinds of move (default {DEFAULT_MOVES}; {HAND_DEFAULT_MOVES} with --executor physics): "
+        "tracing (face, edge, vertex moves), probing "
+        "(free-space probes alone, geometric executor; a verification traces too) or all (both, one "
         "planner ranking them)",
     )  # fmt: skip
     p.add_argument("--json", metavar="OUT", help="write the episode's JSON record here")
@@ -103,6 +104,7 @@ def run(args: argparse.Namespace) -> int:
     from haptic.geometry import load_library
     from haptic.geometry.io import atomic_write
     from haptic.options import check_output_file
+    from haptic.planning.moves import default_moves
 
     # output paths are checked before the episode runs, so that its result cannot be lost at the end
     if args.json:
@@ -115,7 +117,7 @@ def run(args: argparse.Namespace) -> int:
         model=args.object, seed=args.seed, policy=args.policy, executor=args.executor, noise=args.noise,
         models=args.models, max_moves=args.max_moves, record=args.record, skip_invalid=args.skip_invalid,
         verify=args.verify,
-        moves=args.moves,
+        moves=args.moves or default_moves(args.executor),
     )
     observer = None
     recorder = None

@@ -66,7 +66,7 @@ def test_resume_runs_only_the_missing_episodes(tmp_path, capsys):
     assert "unfinished last line" in captured.err
     assert untimed(read_results(cut)) == untimed(read_results(full))
     table = cut.with_suffix(".md").read_text()
-    assert "| seed | geometric | 1.0 | full | planner | 3 |" in table  # the summary is of the whole file
+    assert "| seed | geometric | 1.0 | full | all | planner | 3 |" in table  # the summary is of the whole file
     assert bench(cut, "--resume") == 0  # nothing left to do
     assert "running 0" in capsys.readouterr().out
     assert len(read_results(cut)) == 6
@@ -114,7 +114,7 @@ def test_sigterm_keeps_finished_lines_and_writes_the_summary(tmp_path):
     records = read_results(out)
     assert 1 <= len(records) < 40
     table = out.with_suffix(".md").read_text()
-    assert f"| seed | geometric | 1.0 | full | planner | {len(records)} |" in table
+    assert f"| seed | geometric | 1.0 | full | all | planner | {len(records)} |" in table
     time.sleep(0.5)
     assert not _live_in_group(proc.pid)
 

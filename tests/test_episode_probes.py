@@ -147,3 +147,29 @@ def test_an_episode_whose_tree_outgrows_the_bound_fails_instead_of_exhausting_me
     rec = run_episode(spec, cached_library(models), config=PlannerConfig(costs=CostModel(c_p=0.5)))
     assert rec.outcome == "failed" and "more than the matcher holds (1500)" in rec.detail
     assert 1500 < rec.interpretations[-1] and not rec.correct
+
+
+@pytest.mark.parametrize(
+    ("argv", "expected"),
+    [
+        ([], "all"),
+        (["--executor", "physics"], "tracing"),
+        (["--executor", "physics", "--moves", "all"], "all"),
+        (["--moves", "tracing"], "tracing"),
+    ],
+)
+def test_the_command_lines_default_move_set_is_all_and_tracing_on_the_hand(argv, expected, monkeypatch, capsys):
+    """``explore`` without ``--moves``: every kind of move on the geometric executor, the tracing moves on the
+    simulated hand (``default_moves``); an explicit ``--moves`` is taken as given."""
+    import haptic.episode.worlds as worlds
+
+    seen = []
+
+    def fake(spec, library=None, observer=None, config=None, policy=None):
+        seen.append(spec.moves)
+        raise HapticError("stopped before the episode")
+
+    monkeypatch.setattr(worlds, "run_episode", fake)
+    assert main(["explore", "--object", "BOX01", *argv]) != 0
+    assert seen == [expected]
+    assert "stopped before the episode" in capsys.readouterr().err

@@ -75,7 +75,7 @@ def test_an_incomplete_verification_is_not_a_recognition(monkeypatch):
     that differs where they have not measured, so the episode ends ambiguous and says what is missing."""
     import haptic.planning.verify as verify
 
-    monkeypatch.setattr(verify, "MAX_VERIFY_MOVES", 1)
+    monkeypatch.setattr(verify, "verify_move_budget", lambda n_target: 1)
     r = run_episode(EpisodeSpec(model="BOX01", seed=3, verify="full"), library=LIB).to_json()
     assert r["outcome"] == "ambiguous" and r["recognized"] is None and not r["correct"]
     assert r["verified"]["status"] == "incomplete" and r["verified"]["vertices_fraction"] < 1.0

@@ -22,7 +22,7 @@ EXIT_SIGINT, EXIT_SIGTERM = 130, 143
 def add_parser(sub: argparse._SubParsersAction) -> None:
     from haptic.matching.verify import DEFAULT_VERIFY, VERIFY_MODES
     from haptic.options import noise_levels, positive_int, seed_int
-    from haptic.planning.moves import DEFAULT_MOVES, MOVE_SETS
+    from haptic.planning.moves import DEFAULT_MOVES, HAND_DEFAULT_MOVES, MOVE_SETS
     from haptic.planning.registry import POLICY_NAMES
 
     p = sub.add_parser(
@@ -51,9 +51,10 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         help=f"verification before recognition (default {DEFAULT_VERIFY}): none, fast or full",
     )
     p.add_argument(
-        "--moves", choices=MOVE_SETS, default=DEFAULT_MOVES,
-        help=f"admissible kinds of move (default {DEFAULT_MOVES}): tracing (face, edge, vertex moves), probing "
-        "(free-space probes alone, geometric executor; verification, if any, by tracing moves) or all (both, one "
+        "--moves", choices=MOVE_SETS, default=None,
+        help=f"admissible kinds of move (default {DEFAULT_MOVES}; {HAND_DEFAULT_MOVES} with --executor physics): "
+        "tracing (face, edge, vertex moves), probing "
+        "(free-space probes alone, geometric executor; a verification traces too) or all (both, one "
         "planner ranking them)",
     )  # fmt: skip
     p.add_argument("--out", default="out/bench/results.jsonl", help="results file (JSON lines)")
@@ -81,6 +82,7 @@ def _run(args: argparse.Namespace, held: DeferredInterrupts) -> int:
     from haptic.cli import report_skipped
     from haptic.geometry import load_library
     from haptic.options import check_output_file
+    from haptic.planning.moves import default_moves
     from haptic.planning.registry import POLICY_NAMES
 
     # Everything is checked before any episode runs or any file is touched.
@@ -100,7 +102,7 @@ def _run(args: argparse.Namespace, held: DeferredInterrupts) -> int:
         sorted(library), args.episodes, args.seed, policies, args.noise,
         executor=args.executor, models=args.models, max_moves=args.max_moves, skip_invalid=args.skip_invalid,
         verify=args.verify,
-        moves=args.moves,
+        moves=args.moves or default_moves(args.executor),
     )
     has_results = out.is_file() and out.stat().st_size > 0
     if has_results and not (args.resume or args.force):

@@ -319,7 +319,7 @@ def loop_steps(
                 break
             move = None
             if verifying:
-                move = verifier.choose(hypotheses_from(tree, rec)[0], state, components, tuple(failed_here))
+                move = verifier.choose(hypotheses_from(tree, rec)[0], state, components, tuple(failed_here), probed)
             posed = rec is not None and bool(rec.classes)
             probe_failed = any(m.kind == "probe" for m in failed_here)
             if choosing and move is None and not posed and not verifying:

@@ -277,6 +277,13 @@ class Coverage:
             self.reachable_vertices - self.vertices if tv > 0 else frozenset(),
         )
 
+    def target_size(self, mode: str) -> int:
+        """Number of reachable features ``mode``'s target asks for (the vertices under ``full``; the faces and
+        edges under ``fast``)."""
+        tf, te, tv = TARGETS[mode]
+        return ((len(self.reachable_faces) if tf > 0 else 0) + (len(self.reachable_edges) if te > 0 else 0)
+                + (len(self.reachable_vertices) if tv > 0 else 0))  # fmt: skip
+
     def measured(self) -> int:
         """Number of reachable features measured (faces, edges and vertices together)."""
         return (len(self.faces & self.reachable_faces) + len(self.edges & self.reachable_edges)

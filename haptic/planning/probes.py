@@ -154,14 +154,7 @@ def candidate_probes(hypotheses: Sequence[Hypothesis], config: ProbeConfig | Non
             if key in seen:
                 continue
             seen.add(key)
-            move = _line_through(p, u, centre, big, config, radius)
-            if move is not None:
-                clipped = _clip_to_balls(move, balls, config.standoff, union=True)
-                if clipped is not None and config.pad_radius > 0.0:
-                    # the hand comes down to the line's start from above, clear of every hypothesis's object:
-                    # the start stays there, only the end is cut
-                    clipped = ProbeMove(move.start, u, float((clipped.end - move.start) @ u))
-                move = clipped
+            move = _probe_line(p, u, centre, big, radius, balls, config)
             if move is not None:
                 out.append(move)
     if len(out) > config.max_candidates:
@@ -170,6 +163,64 @@ def candidate_probes(hypotheses: Sequence[Hypothesis], config: ProbeConfig | Non
     if out and config.pad_radius > 0.0 and config.table_z is not None:
         clear = finger_clear(posed, out, config.pad_radius)
         out = [mv for mv, ok in zip(out, clear, strict=True) if ok]
+    return out
+
+
+def _probe_line(p: np.ndarray, u: np.ndarray, centre: np.ndarray, big: float, radius: float, balls,
+                config: ProbeConfig) -> ProbeMove | None:  # fmt: skip
+    """The candidate line along ``u`` through ``p`` (:func:`_line_through` the region's sphere), cut to the balls
+    that hold the hypotheses' objects; None when there is none."""
+    move = _line_through(p, u, centre, big, config, radius)
+    if move is None:
+        return None
+    clipped = _clip_to_balls(move, balls, config.standoff, union=True)
+    if clipped is not None and config.pad_radius > 0.0:
+        # the hand comes down to the line's start from above, clear of every hypothesis's object: the start stays
+        # there, only the end is cut
+        clipped = ProbeMove(move.start, u, float((clipped.end - move.start) @ u))
+    return clipped
+
+
+def aimed_probes(
+    h: Hypothesis, targets: Sequence[tuple[np.ndarray, int]], config: ProbeConfig | None = None
+) -> list[tuple[ProbeMove, int]]:
+    """Probe lines at chosen points of hypothesis ``h``'s posed model: for each ``(point, face)`` (model frame,
+    the point on that face), the line through the point head-on (along the face's inward normal) or, where that
+    one is not admissible (the table, the hand's way down, the finger above the pad, :func:`candidate_probes`'
+    rules), along the admissible one of the discrete directions within ``max_incidence`` of head-on nearest to
+    it; at most one line per target, with its target's index. A verification uses them to carry the sensor to
+    a part of the model still to be measured (:mod:`haptic.planning.verify`)."""
+    config = config or ProbeConfig()
+    if h.world_from_model is None or not len(targets):
+        return []
+    t = h.world_from_model
+    centre, radius = _region([h])
+    big = radius + config.standoff
+    balls = _hypothesis_balls([h])
+    dirs = fibonacci_directions(config.n_directions)
+    cos_max = np.cos(config.max_incidence)
+    lines: list[tuple[ProbeMove, int]] = []
+    for k, (point, f) in enumerate(targets):
+        n = t.rotate(h.poly.face_normals[f])
+        if config.max_undercut is not None and n[2] < -np.sin(config.max_undercut):
+            continue
+        p = t.apply(point)
+        near = dirs[dirs @ -n >= cos_max]
+        near = near[np.argsort(-(near @ -n))]
+        for u in (-n, *near):
+            if config.table_z is not None and u[2] > config.max_climb:
+                continue
+            move = _probe_line(p, u, centre, big, radius, balls, config)
+            if move is not None:
+                lines.append((move, k))
+    if lines and config.pad_radius > 0.0 and config.table_z is not None:
+        clear = finger_clear([h], [mv for mv, _ in lines], config.pad_radius)
+        lines = [x for x, ok in zip(lines, clear, strict=True) if ok]
+    out, seen = [], set()
+    for mv, k in lines:  # the first admissible line of each target (head-on first)
+        if k not in seen:
+            seen.add(k)
+            out.append((mv, k))
     return out
 
 
@@ -643,5 +694,5 @@ def predict_probes(
 
 
 __all__ = ["BEHIND", "DEPTH_FRACTIONS", "FINGER_LIFT", "MIN_INCIDENCE", "LibraryExtent", "ProbeConfig",
-           "FINGER_RADIUS", "ProbePrediction", "candidate_probes", "fibonacci_directions", "finger_clear",
-           "opening_probes", "predict_probes", "region_centre"]  # fmt: skip
+           "FINGER_RADIUS", "ProbePrediction", "aimed_probes", "candidate_probes", "fibonacci_directions",
+           "finger_clear", "opening_probes", "predict_probes", "region_centre"]  # fmt: skip

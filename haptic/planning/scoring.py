@@ -109,10 +109,16 @@ def probe_moves(ctx: Context) -> list[ProbeMove]:
     them (``config.moves``) and every hypothesis has a pose to predict from, less those that failed from here."""
     if ctx.config.moves == "tracing" or not ctx.hypotheses or any(h.world_from_model is None for h in ctx.hypotheses):
         return []
-    c = ctx.config
-    pad = c.pad_radius if c.table_z is not None else 0.0  # the simulated hand's pad (a point sensor without a table)
-    cfg = ProbeConfig(table_z=c.table_z, table_clearance=c.table_clearance, pad_radius=pad, max_undercut=c.max_undercut)
+    cfg = probe_config(ctx.config)
     return [m for m in candidate_probes(ctx.hypotheses, cfg) if not any(same_move(m, bad) for bad in ctx.avoid)]
+
+
+def probe_config(config: PlannerConfig) -> ProbeConfig:
+    """The probe lines' options for a planner configuration: its table, and the simulated hand's pad when there is
+    a table (a point sensor without one)."""
+    pad = config.pad_radius if config.table_z is not None else 0.0
+    return ProbeConfig(table_z=config.table_z, table_clearance=config.table_clearance, pad_radius=pad,
+                       max_undercut=config.max_undercut)  # fmt: skip
 
 
 def predict_probe_moves(ctx: Context, moves: Sequence[ProbeMove] | None = None) -> list[ProbePrediction]:

@@ -7,6 +7,11 @@ the hypothesis's world (:func:`~haptic.planning.search.simulate`), per unit of p
 same risks as the planner's moves (the table, a steep descent). A move that measures nothing new now is scored
 by the best two-move sequence it starts (the look-ahead of :mod:`haptic.planning.search`), and, when no such
 sequence measures anything, the move that ends nearest a missing feature is taken.
+
+Where the move set admits probes (``--moves probing|all``) and the sensor is a point (no table: the geometric
+executor), a free-space probe may carry the sensor to a face beside what is still missing
+(:func:`verification_probes`); it measures no edge or vertex itself, so it is scored with the two tracing moves
+after it. The verification's move budget follows the model (:func:`verify_move_budget`).
 """
 
 from __future__ import annotations
@@ -27,11 +32,22 @@ from haptic.planning.table import descent_risk
 STALL_MOVES = 8
 """Verification moves in a row that measure no missing feature after which the verification ends with what it
 has measured (status "incomplete": the episode ends as ambiguous, its record says what was not measured)."""
-MAX_VERIFY_MOVES = 40
-"""Verification moves after which the verification ends with what it has measured (status "incomplete").
-Verification moves do not count against the episode's move budget (``EpisodeSpec.max_moves``, the budget of
-recognition) but against this one: a vertex costs about two moves (an aimed face move and a short edge move, or
-a vertex move and an edge trace), and the seed library's largest models have 16 vertices."""
+MOVES_PER_FEATURE = 3
+"""Verification moves allowed per feature of the coverage target (:func:`verify_move_budget`): a vertex costs about
+two moves (an aimed face move and a short edge move, or a vertex move and an edge trace), and getting from one to
+the next about one more."""
+
+
+def verify_move_budget(n_target: int) -> int:
+    """The verification moves after which the verification ends with what it has measured (status "incomplete"),
+    for a model with ``n_target`` reachable features in its coverage target (the vertices under ``full``, the faces
+    and edges under ``fast``): :data:`STALL_MOVES` plus :data:`MOVES_PER_FEATURE` per feature, so that the budget
+    follows the model (a fixed one is sized to some library's largest model and cuts a larger one short).
+    Verification moves do not count against the episode's move budget (``EpisodeSpec.max_moves``, the budget of
+    recognition) but against this one."""
+    return STALL_MOVES + MOVES_PER_FEATURE * max(int(n_target), 0)
+
+
 MAX_CHECKED_LEAVES = 16
 """Interpretations of the pose class tried by the pose check (the first that passes counts)."""
 MIN_SAMPLES = 3
@@ -173,6 +189,147 @@ def _moves(
     return good or [(m, c, r) for m, c, r, _ in out]
 
 
+def _sequence_score(
+    h: Hypothesis, state: SensorState, components: Mapping[int, DataComponent],
+    missing: tuple[frozenset[int], frozenset[int], frozenset[int]], noise: SensorNoise, config: PlannerConfig,
+    depth: int, gain: int, cost: float, ok: float, fixed_faces: bool,
+) -> float:
+    """The best ``ok · (gain + g) / (cost + c)`` over the sequences of one to ``depth`` fresh tracing moves from
+    here, each move's gain ``g`` (missing features measured, in ``h``'s world), cost ``c`` and success ``ok``
+    (one less its risk) added to those of the moves before (``gain``, ``cost``, ``ok``); 0 when none is
+    admissible."""
+    from haptic.planning.search import simulate
+
+    best = 0.0
+    for m, c, r in _moves(h, state, components, noise, config, (), missing, fixed_faces=fixed_faces):
+        sim = simulate(h, m, state, components, config)
+        if sim is None:
+            continue
+        h1, s1, comps1 = sim
+        new = _new_features(h, h1)
+        g, c1, ok1 = gain + _gain(new, missing), cost + c, ok * (1.0 - r)
+        best = max(best, ok1 * g / max(c1, 1e-9))
+        if depth > 1:
+            left = tuple(x - n for x, n in zip(missing, new, strict=True))
+            best = max(best, _sequence_score(h1, s1, comps1, left, noise, config, depth - 1, g, c1, ok1, False))
+    return best
+
+
+MAX_VERIFY_PROBES = 2
+"""Probes a verification decision weighs (:func:`verification_probes`), the nearest targets first."""
+PROBE_INSET = 0.01
+"""A verification probe aims at a point of a face this far from both edges at the missing vertex [m]: the hand's
+contact stays clear of the face's boundary (:func:`~haptic.planning.handpath.foot_near_boundary`), and an aimed
+face move then reaches an edge :data:`AIM_NEAR_VERTEX` from the vertex."""
+MIN_PROBE_TRANSFER = 0.02
+"""Targets nearer the sensor than this are left to tracing moves [m]: a probe's constant cost alone buys 2 cm
+across a face."""
+
+
+_CORNERS: dict[int, tuple[Polyhedron, dict[tuple[int, int], np.ndarray]]] = {}
+
+
+def _corner_points(poly: Polyhedron) -> dict[tuple[int, int], np.ndarray]:
+    """For each corner ``(vertex, face)`` of ``poly`` that has one, the point of the face :data:`PROBE_INSET`
+    from both edges at the vertex, on the corner's bisector (model frame); none at a straight or reflex corner,
+    or where the face is too narrow there. Computed once per model."""
+    from haptic.geometry.distance import point_triangle_distance
+
+    got = _CORNERS.get(id(poly))
+    if got is not None and got[0] is poly:
+        return got[1]
+    out: dict[tuple[int, int], np.ndarray] = {}
+    for f in range(poly.n_faces):
+        loop = [int(x) for x in poly.faces[f]]
+        tri = poly.vertices[poly.triangles[poly.triangle_faces == f]]
+        for k, v in enumerate(loop):
+            e1 = poly.vertices[loop[k - 1]] - poly.vertices[v]
+            e2 = poly.vertices[loop[(k + 1) % len(loop)]] - poly.vertices[v]
+            e1, e2 = e1 / np.linalg.norm(e1), e2 / np.linalg.norm(e2)
+            w = e1 + e2
+            if np.linalg.norm(w) < 1e-9 or np.cross(e1, e2) @ poly.face_normals[f] > 0:
+                continue  # a straight or reflex corner (the loop runs counter-clockwise about the normal)
+            w /= np.linalg.norm(w)
+            sin_half = float(np.linalg.norm(np.cross(e1, w)))
+            p = poly.vertices[v] + PROBE_INSET / max(sin_half, 1e-3) * w
+            if float(point_triangle_distance(p[None], tri).min()) < 1e-9:
+                out[(v, f)] = p
+    _CORNERS[id(poly)] = (poly, out)
+    return out
+
+
+def _probe_targets(
+    poly: Polyhedron, missing: tuple[frozenset[int], frozenset[int], frozenset[int]], faces_ok: frozenset[int] | None
+) -> list[tuple[np.ndarray, int]]:
+    """Points (model frame) on the faces at the missing features, each with its face, that a probe may land on to
+    measure them next: for a missing vertex, the point of each face at it :data:`PROBE_INSET` from both edges at
+    the vertex (:func:`_corner_points`); for a missing edge, a point that far in from its midpoint on each face
+    along it; for a missing face, the centroid of its largest triangle. Only faces of ``faces_ok`` (None: all)."""
+    from haptic.geometry.distance import point_triangle_distance
+
+    mf, me, mv = missing
+    corners = _corner_points(poly)
+    out: list[tuple[np.ndarray, int]] = []
+    for v in sorted(mv):
+        for f in poly.vertex_faces[v]:
+            p = corners.get((int(v), int(f)))
+            if p is not None and (faces_ok is None or f in faces_ok):
+                out.append((p, int(f)))
+    for e in sorted(me):
+        mid = poly.edge_points[e] + 0.5 * poly.edge_lengths[e] * poly.edge_directions[e]
+        for f in (int(poly.edge_left_face[e]), int(poly.edge_right_face[e])):
+            if faces_ok is not None and f not in faces_ok:
+                continue
+            tri = poly.vertices[poly.triangles[poly.triangle_faces == f]]
+            inward = np.cross(poly.face_normals[f], poly.edge_directions[e])
+            for sign in (1.0, -1.0):
+                p = mid + sign * PROBE_INSET * inward
+                if float(point_triangle_distance(p[None], tri).min()) < 1e-9:
+                    out.append((p, f))
+                    break
+    if mf:
+        from haptic.planning.probes import _face_targets
+
+        centres = _face_targets(poly)
+        out += [(centres[f], int(f)) for f in sorted(mf) if faces_ok is None or f in faces_ok]
+    return out
+
+
+def verification_probes(
+    h: Hypothesis, state: SensorState, components: Mapping[int, DataComponent],
+    missing: tuple[frozenset[int], frozenset[int], frozenset[int]], noise: SensorNoise, config: PlannerConfig,
+    avoid: Sequence[Move] = (), probed: Sequence[Move] = (), faces_ok: frozenset[int] | None = None,
+) -> list[tuple[Move, float, float]]:
+    """Free-space probes that carry the sensor to what of hypothesis ``h``'s model is still missing, with their
+    predicted cost and risk, when the configuration admits probes (``config.moves``): a probe measures no edge
+    or vertex, but it lands on a face beside one for ``c_p`` plus ``c_s`` per metre of free space, where tracing
+    there costs ``c_f`` per metre of face and ``c_e`` per metre of edge. Lines (:func:`~haptic.planning.probes.
+    aimed_probes`) at the targets of :func:`_probe_targets` at least :data:`MIN_PROBE_TRANSFER` from the sensor,
+    the :data:`MAX_VERIFY_PROBES` nearest, predicted to hit their face in ``h``'s world and not to fail there (the
+    hand's checks); none after a probe failed from here (``avoid``), nor along a line probed before (``probed``)."""
+    from haptic.planning.probes import aimed_probes
+    from haptic.planning.scoring import Context, predict_probe_moves, probe_config, same_move
+
+    if config.moves == "tracing" or config.table_z is not None or h.world_from_model is None:
+        return []
+    if any(m.kind == "probe" for m in avoid):
+        return []
+    here = h.model_from_world.apply(state.position)
+    targets = [(p, f) for p, f in _probe_targets(h.poly, missing, faces_ok)
+               if float(np.linalg.norm(p - here)) >= MIN_PROBE_TRANSFER]  # fmt: skip
+    targets.sort(key=lambda pf: float(np.linalg.norm(pf[0] - here)))
+    lines = aimed_probes(h, targets, probe_config(config))
+    moves = [mv for mv, _ in lines if not any(same_move(mv, done) for done in probed)][:MAX_VERIFY_PROBES]
+    faces = {id(mv): targets[k][1] for mv, k in lines}
+    preds = predict_probe_moves(Context((h,), state, components, noise, config), moves)
+    out = []
+    for pred in preds:
+        if not bool(pred.hit[0]) or int(pred.face[0]) != faces[id(pred.move)] or pred.risk() > 0.0:
+            continue
+        out.append((pred.move, float(pred.costs[0]), 0.0))
+    return out
+
+
 def choose_verification_move(
     h: Hypothesis,
     state: SensorState,
@@ -181,31 +338,37 @@ def choose_verification_move(
     noise: SensorNoise,
     config: PlannerConfig,
     avoid: Sequence[Move] = (),
+    probed: Sequence[Move] = (),
+    faces_ok: frozenset[int] | None = None,
 ) -> Move | None:
     """The move that measures the most missing features (faces, edges, vertices of ``missing``) of hypothesis
-    ``h``'s model per unit of predicted cost, looking two moves ahead; None when no move is admissible."""
+    ``h``'s model per unit of predicted cost, looking two tracing moves ahead, or, where the configuration
+    admits probes, a probe (:func:`verification_probes`, not along a line of ``probed``) and the two tracing
+    moves after it; None when no move is admissible. ``avoid``: moves that failed from here."""
     from haptic.planning.search import simulate
+    from haptic.planning.simulate import simulate_probe
 
     first = _moves(h, state, components, noise, config, avoid, missing)
-    if not first:
+    probes = verification_probes(h, state, components, missing, noise, config, avoid, probed, faces_ok)
+    if not first and not probes:
         return None
     best, best_score = None, 0.0
     ends: list[tuple[Move, np.ndarray | None, float]] = []
-    for m, c, r in first:
-        sim = simulate(h, m, state, components, config)
+    for m, c, r in [*first, *probes]:
+        sim = (simulate_probe(h, m, state, components, noise) if m.kind == "probe"
+               else simulate(h, m, state, components, config))  # fmt: skip
         if sim is None:
             ends.append((m, None, c))
             continue
         h1, s1, comps1 = sim
-        g1 = _gain(_new_features(h, h1), missing)
+        new = _new_features(h, h1)
+        g1 = _gain(new, missing)
         score = (1.0 - r) * g1 / max(c, 1e-9)
-        left = tuple(x - n for x, n in zip(missing, _new_features(h, h1), strict=True))
-        for m2, c2, r2 in _moves(h1, s1, comps1, noise, config, (), left, fixed_faces=False):
-            sim2 = simulate(h1, m2, s1, comps1, config)
-            if sim2 is None:
-                continue
-            g2 = _gain(_new_features(h1, sim2[0]), left)
-            score = max(score, (1.0 - r) * (1.0 - r2) * (g1 + g2) / max(c + c2, 1e-9))
+        left = tuple(x - n for x, n in zip(missing, new, strict=True))
+        # after a tracing move one more; after a probe, which measures at most a face, two more
+        depth = 2 if m.kind == "probe" else 1
+        score = max(score, _sequence_score(h1, s1, comps1, left, noise, config, depth, g1, c, 1.0 - r,
+                                           m.kind == "probe"))  # fmt: skip
         if score > best_score:
             best, best_score = m, score
         ends.append((m, h.world_from_model.inverse().apply(s1.position), c))
@@ -214,7 +377,7 @@ def choose_verification_move(
     # nothing within two moves: head for the nearest missing feature
     targets = _target_points(h.poly, missing)
     if not len(targets):
-        return first[0][0]
+        return ends[0][0]
     scored = [
         (float(np.linalg.norm(targets - p, axis=1).min()) if p is not None else np.inf, c, k)
         for k, (m, p, c) in enumerate(ends)
@@ -231,7 +394,8 @@ def _target_points(poly: Polyhedron, missing: tuple[frozenset[int], frozenset[in
     return np.array(pts).reshape(-1, 3)
 
 
-__all__ = ["aimed_face_moves", "choose_verification_move", "hidden_vertices", "reachable_features"]
+__all__ = ["aimed_face_moves", "choose_verification_move", "hidden_vertices", "reachable_features",
+           "verification_probes", "verify_move_budget"]
 
 
 class Verifier:
@@ -253,7 +417,7 @@ class Verifier:
         self.status = "not needed"
         """"confirmed" (recognised), "mismatch" (a component off its hard bounds: no-match), "rejected" (the
         acceptance test failed: no-match), "incomplete" (no progress in :data:`STALL_MOVES` moves, or
-        :data:`MAX_VERIFY_MOVES` made: ambiguous between the model and an object outside the library),
+        :func:`verify_move_budget` made: ambiguous between the model and an object outside the library),
         "verifying", or "not needed" (no pose class was ever left alone)."""
         self._progress = (-1, 0)  # (features measured, verification moves then)
         self.check = None
@@ -306,13 +470,19 @@ class Verifier:
                 self._progress = (got, self.moves)
             elif self.moves - self._progress[1] >= STALL_MOVES:
                 self.status = "incomplete"
-            if self.moves >= MAX_VERIFY_MOVES:
+            if self.moves >= self.move_budget():
                 self.status = "incomplete"
         if self.status in ("confirmed", "incomplete"):  # the final word: the statistical acceptance test
             self.accept = acceptance(cls.model, tree.data, it, self.check.world_from_model, k_sigma=self.k_sigma)
             if not self.accept.ok:
                 self.status = "rejected"
         return self.status
+
+    def move_budget(self) -> int:
+        """The verification moves this verification may make (:func:`verify_move_budget` of the recognised
+        model's coverage target; :data:`STALL_MOVES` while no pose gives one)."""
+        n = self.coverage.target_size(self.mode) if self.coverage is not None else 0
+        return verify_move_budget(n)
 
     def outcome(self) -> str:
         """The episode's outcome for a final verdict: recognized (confirmed), no-match (mismatch, rejected),
@@ -342,15 +512,19 @@ class Verifier:
         return ""
 
     def choose(
-        self, h: Hypothesis, state: SensorState, components: Mapping[int, DataComponent], avoid: Sequence[Move]
+        self, h: Hypothesis, state: SensorState, components: Mapping[int, DataComponent], avoid: Sequence[Move],
+        probed: Sequence[Move] = (),
     ) -> Move | None:
         """The next verification move for hypothesis ``h`` — in the world of the interpretation whose coverage
-        counts, when it has a pose (None: no move admissible)."""
+        counts, when it has a pose (None: no move admissible). ``avoid``: moves that failed from here;
+        ``probed``: the probes' lines so far (not probed again)."""
         self.moves += 1
         if self._hyp is not None and self._hyp.world_from_model is not None:
             h = self._hyp
         missing = self.coverage.missing(self.mode) if self.coverage is not None else (frozenset(),) * 3
-        return choose_verification_move(h, state, components, missing, self.noise, self.config, avoid)
+        faces_ok = self._reach[self._model_name][0] if self._model_name in self._reach else None
+        return choose_verification_move(h, state, components, missing, self.noise, self.config, avoid, probed,
+                                        faces_ok)  # fmt: skip
 
     def record(self, cost: float) -> dict:
         """What was verified: the mode, the verdict, the verification's moves and cost, the pose check's worst
@@ -364,6 +538,7 @@ class Verifier:
             out.update(chi2=round(self.accept.statistic, 3), chi2_dof=self.accept.dof,
                        chi2_threshold=round(self.accept.threshold, 3))  # fmt: skip
         if self.coverage is not None:
+            out["move_budget"] = self.move_budget()
             out.update(self.coverage.record(self._model))
             out["vertices_hidden"] = len(self.hidden)
         return out

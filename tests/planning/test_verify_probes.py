@@ -1,0 +1,138 @@
+"""Verification with free-space probes (haptic.planning.verify): where probes are admitted, a probe carries the
+sensor to a face beside a vertex still to be measured; and the verification's move budget follows the model."""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from haptic.episode.spec import EpisodeSpec
+from haptic.episode.worlds import run_episode
+from haptic.geometry import load_library
+from haptic.planning.config import PlannerConfig
+from haptic.planning.moves import ProbeMove
+from haptic.planning.search import simulate
+from haptic.planning.simulate import simulate_probe
+from haptic.planning.verify import (
+    MIN_PROBE_TRANSFER,
+    MOVES_PER_FEATURE,
+    PROBE_INSET,
+    STALL_MOVES,
+    _probe_targets,
+    choose_verification_move,
+    verification_probes,
+    verify_move_budget,
+)
+from tests.planning.test_verify_moves import _on_a_face
+
+LIB = load_library()
+ALL = PlannerConfig(moves="all")
+
+
+def _far_vertices(h, state) -> frozenset[int]:
+    """The model's vertices off the face the sensor is on."""
+    on = {int(v) for v in h.poly.faces[h.faces[state.face]]}
+    return frozenset(v for v in range(h.poly.n_vertices) if v not in on)
+
+
+def test_targets_lie_on_their_face_inset_from_both_edges_at_the_vertex():
+    box = LIB["BOX01"]
+    targets = _probe_targets(box, (frozenset(), frozenset(), frozenset({0})), None)
+    assert len(targets) == 3  # one on each face at the corner
+    for p, f in targets:
+        assert abs(box.face_normals[f] @ p - box.face_offsets[f]) < 1e-12
+        # a box's corner is square: the point is the inset from both edges, along each of the face's axes
+        d = np.abs(p - box.vertices[0])
+        assert np.sort(d)[1:] == pytest.approx([PROBE_INSET, PROBE_INSET])
+    only = _probe_targets(box, (frozenset(), frozenset(), frozenset({0})), frozenset({targets[0][1]}))
+    assert [f for _, f in only] == [targets[0][1]]
+
+
+def test_no_target_at_a_reflex_corner():
+    lb = LIB["LBLOCK01"]
+    for f in range(lb.n_faces):
+        loop = [int(v) for v in lb.faces[f]]
+        for k, v in enumerate(loop):
+            a = lb.vertices[loop[k - 1]] - lb.vertices[v]
+            b = lb.vertices[loop[(k + 1) % len(loop)]] - lb.vertices[v]
+            if np.cross(a, b) @ lb.face_normals[f] > 1e-12:  # reflex at v in face f
+                targets = _probe_targets(lb, (frozenset(), frozenset(), frozenset({v})), frozenset({f}))
+                assert targets == [], (f, v)
+
+
+def test_probes_land_on_the_face_they_aim_at_far_from_the_sensor():
+    for name, seed in [("BOX01", 0), ("HEXPRISM01", 1), ("LBLOCK01", 2), ("WEDGE01", 3)]:
+        h, state, comps, ex = _on_a_face(name, seed)
+        missing = (frozenset(), frozenset(), _far_vertices(h, state))
+        probes = verification_probes(h, state, comps, missing, ex.noise, ALL)
+        assert probes, name
+        here = h.model_from_world.apply(state.position)
+        for move, cost, risk in probes:
+            assert isinstance(move, ProbeMove) and cost > ALL.costs.c_p and risk == 0.0
+            h1, s1, c1 = simulate_probe(h, move, state, comps, ex.noise)
+            landed = h.model_from_world.apply(s1.position)
+            assert np.linalg.norm(landed - here) >= MIN_PROBE_TRANSFER - 1e-9
+            # the face it lands on is at a missing vertex
+            (f_new,) = set(h1.faces.values()) - set(h.faces.values()) or {h1.faces[s1.face]}
+            assert set(int(v) for v in h.poly.faces[f_new]) & missing[2], name
+
+
+def test_no_probes_for_tracing_on_the_hand_or_after_a_probe_failed_here():
+    h, state, comps, ex = _on_a_face("BOX01", 0)
+    missing = (frozenset(), frozenset(), _far_vertices(h, state))
+    assert verification_probes(h, state, comps, missing, ex.noise, PlannerConfig()) == []
+    hand = replace(ALL, table_z=-0.2)
+    assert verification_probes(h, state, comps, missing, ex.noise, hand) == []
+    probes = verification_probes(h, state, comps, missing, ex.noise, ALL)
+    failed = probes[0][0]
+    assert verification_probes(h, state, comps, missing, ex.noise, ALL, avoid=(failed,)) == []
+    # a line probed before is not offered again
+    again = verification_probes(h, state, comps, missing, ex.noise, ALL, probed=(failed,))
+    assert all(np.linalg.norm(m.start - failed.start) > 0 for m, _, _ in again)
+
+
+def test_a_probe_is_chosen_when_what_is_missing_is_far_and_tracing_when_it_is_near():
+    h, state, comps, ex = _on_a_face("BOX01", 0)
+    far = (frozenset(), frozenset(), _far_vertices(h, state))
+    assert choose_verification_move(h, state, comps, far, ex.noise, ALL).kind == "probe"
+    # under tracing the same verification traces
+    assert choose_verification_move(h, state, comps, far, ex.noise, PlannerConfig()).kind != "probe"
+    # a vertex of the face the sensor is on: an aimed face move, no probe
+    near = (frozenset(), frozenset(), frozenset(int(v) for v in h.poly.faces[h.faces[state.face]]))
+    move = choose_verification_move(h, state, comps, near, ex.noise, ALL)
+    assert move.kind == "face" and simulate(h, move, state, comps, ALL) is not None
+
+
+def test_the_move_budget_follows_the_model():
+    assert verify_move_budget(0) == STALL_MOVES
+    assert verify_move_budget(16) - verify_move_budget(8) == 8 * MOVES_PER_FEATURE
+    # the seed library's largest models (16 vertices) get more than the fixed 40 they were cut off at
+    assert verify_move_budget(16) > 40
+
+
+def test_a_large_model_is_verified_past_forty_moves_and_the_record_gives_its_budget(monkeypatch):
+    """BOX01N (16 vertices) under --moves all with its verification tracing only: 46 verification moves, beyond
+    the fixed 40 that once ended this episode as ambiguous with 3 vertices unmeasured."""
+    import haptic.planning.verify as verify
+
+    monkeypatch.setattr(verify, "MAX_VERIFY_PROBES", 0)
+    r = run_episode(EpisodeSpec(model="BOX01N", seed=634010735, verify="full", moves="all")).to_json()
+    v = r["verified"]
+    assert r["outcome"] == "recognized" and r["correct"], r["detail"]
+    assert v["moves"] > 40 and v["move_budget"] == verify_move_budget(16)
+    assert v["vertices_fraction"] == 1.0
+    assert "probe" not in r["move_kinds"][len(r["move_kinds"]) - v["moves"]:]
+
+
+def test_probes_in_an_all_verification_and_none_under_tracing():
+    """The same episode, verified with probes under --moves all and without under tracing: both confirm the
+    model; with probes for less path cost."""
+    spec = EpisodeSpec(model="BOX01", seed=165636437, verify="full", moves="all")
+    probed = run_episode(spec).to_json()
+    traced = run_episode(replace(spec, moves="tracing")).to_json()
+    for r in (probed, traced):
+        assert r["outcome"] == "recognized" and r["correct"], r["detail"]
+    verifying = probed["move_kinds"][len(probed["move_kinds"]) - probed["verified"]["moves"]:]
+    assert verifying.count("probe") >= 2
+    assert "probe" not in traced["move_kinds"]
+    assert probed["verified"]["cost"] < traced["verified"]["cost"]
