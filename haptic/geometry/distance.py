@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from haptic.geometry.polyhedron import Polyhedron
+from haptic.geometry.se3 import cross
 
 
 def surface_distance(poly: Polyhedron, points: np.ndarray) -> np.ndarray:
@@ -24,7 +25,7 @@ def point_triangle_distance(p: np.ndarray, tri: np.ndarray) -> np.ndarray:
     a, b, c = tri[None, :, 0], tri[None, :, 1], tri[None, :, 2]
     q = p[:, None, :]
     ab, ac = b - a, c - a
-    n = np.cross(ab, ac)
+    n = cross(ab, ac)
     nn = np.einsum("ptk,ptk->pt", n, n) + 1e-30
     # projection onto the plane and its barycentric coordinates
     w = q - a

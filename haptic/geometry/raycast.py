@@ -16,6 +16,7 @@ import numpy as np
 
 from haptic.geometry.distance import surface_distance
 from haptic.geometry.polyhedron import Polyhedron
+from haptic.geometry.se3 import cross
 
 BARYCENTRIC_SLACK = 1e-9
 """Relative slack on the barycentric coordinates: a line through a triangle's edge (a diagonal of a face's
@@ -44,13 +45,13 @@ def line_hits(poly: Polyhedron, starts: np.ndarray, directions: np.ndarray) -> L
     tri = poly.vertices[poly.triangles]  # (T, 3, 3)
     a = tri[:, 0]
     e1, e2 = tri[:, 1] - a, tri[:, 2] - a
-    pvec = np.cross(u[:, None, :], e2[None])  # (R, T, 3)
+    pvec = cross(u[:, None, :], e2[None])  # (R, T, 3)
     det = np.einsum("tk,rtk->rt", e1, pvec)
     ok = np.abs(det) > 1e-18
     inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
     s = o[:, None, :] - a[None]
     bu = np.einsum("rtk,rtk->rt", s, pvec) * inv
-    qvec = np.cross(s, e1[None])
+    qvec = cross(s, e1[None])
     bv = np.einsum("rk,rtk->rt", u, qvec) * inv
     t = np.einsum("tk,rtk->rt", e2, qvec) * inv
     slack = BARYCENTRIC_SLACK

@@ -67,6 +67,19 @@ class SE3:
         return rotation_angle(self.rotation.T @ other.rotation)
 
 
+def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``np.cross`` of 3-vectors along the last axis, broadcast, with the same arithmetic (so the same bits) and
+    without its axis handling, which dominates on the small arrays of the planner's inner loops."""
+    a, b = np.asarray(a), np.asarray(b)
+    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
+    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape), dtype=np.result_type(a, b))
+    out[..., 0] = a1 * b2 - a2 * b1
+    out[..., 1] = a2 * b0 - a0 * b2
+    out[..., 2] = a0 * b1 - a1 * b0
+    return out
+
+
 def rotation_angle(r: np.ndarray) -> float:
     """Angle of a rotation matrix [rad]."""
     return float(np.arccos(np.clip((np.trace(r) - 1.0) / 2.0, -1.0, 1.0)))

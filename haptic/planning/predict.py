@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from haptic.geometry.polyhedron import Polyhedron
-from haptic.geometry.se3 import plane_basis
+from haptic.geometry.se3 import cross, plane_basis
 from haptic.geometry.tracing import FaceHit, circle_vertex, trace_edge
 from haptic.matching.components import DataComponent, DataEdge, DataFace, SensorNoise
 from haptic.planning.config import PlannerConfig
@@ -206,10 +206,10 @@ def trace_all(hypotheses: Sequence[Hypothesis], move: FaceMove, state: SensorSta
         a[j, : len(lp[2])], seg[j, : len(lp[2])], real[j, : len(lp[2])] = lp[0], lp[1], True
     start, d, n = np.array(starts), np.array(dirs), np.array(normals)
     r = a - start[:, None]
-    den = np.einsum("mkc,mc->mk", np.cross(d[:, None], seg), n)
+    den = np.einsum("mkc,mc->mk", cross(d[:, None], seg), n)
     safe = np.where(np.abs(den) > 1e-15, den, 1.0)
-    t = np.einsum("mkc,mc->mk", np.cross(r, seg), n) / safe
-    u = np.einsum("mkc,mkc->mk", np.cross(r, d[:, None]), n[:, None].repeat(k, axis=1)) / safe
+    t = np.einsum("mkc,mc->mk", cross(r, seg), n) / safe
+    u = np.einsum("mkc,mkc->mk", cross(r, d[:, None]), n[:, None].repeat(k, axis=1)) / safe
     miss = start[:, None] + t[..., None] * d[:, None] - (a + u[..., None] * seg)
     ok = real & (np.abs(den) > 1e-15) & (t > 1e-12) & (u >= -1e-12) & (u <= 1 + 1e-12)
     ok &= np.linalg.norm(miss, axis=2) <= 1e-7
