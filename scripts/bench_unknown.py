@@ -35,7 +35,7 @@ from haptic.errors import HapticError, ModelError
 from haptic.geometry import Polyhedron, are_congruent, load_library, save_model
 from haptic.geometry.io import atomic_write
 from haptic.geometry.perturb import chamfer_edge, move_vertex, scale_dimension
-from haptic.planning.moves import CostModel
+from haptic.planning.moves import MOVE_SETS, CostModel, default_moves
 
 SCALES = (0.97, 1.03, 1.05, 1.10)
 VERTEX_MM = (2.0, 4.0, 8.0)
@@ -152,8 +152,11 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--max-moves", type=int, default=40)
+    ap.add_argument("--moves", choices=MOVE_SETS, default=None,
+                    help="admissible kinds of move (default: the command line's for the executor)")
     ap.add_argument("--out", default="out/unknown", help="output directory")
     args = ap.parse_args(argv)
+    moves = args.moves or default_moves(args.executor)
     try:
         library = load_library(args.models)
         lib_name = Path(args.models).name if args.models else "seed"
@@ -179,14 +182,14 @@ def main(argv: list[str] | None = None) -> int:
                     for s in seeds:
                         specs.append(EpisodeSpec(
                             model=str(path), seed=int(s), executor=args.executor, noise=args.noise,
-                            models=args.models, max_moves=args.max_moves, verify=mode,
+                            models=args.models, max_moves=args.max_moves, verify=mode, moves=moves,
                         ))  # fmt: skip
                         meta.append((name, kind, size))
         if args.baseline:
             for mode in [m for m in args.baseline_verify.split(",") if m] or modes:
                 for s in plan_sweep(names, args.baseline, args.seed + 1, ["planner"], (args.noise,),
                                     executor=args.executor, models=args.models, max_moves=args.max_moves,
-                                    verify=mode):  # fmt: skip
+                                    verify=mode, moves=moves):  # fmt: skip
                     specs.append(s)
                     meta.append((s.model, "library", "-"))
         results = out / f"{lib_name}_{args.executor}.jsonl"
@@ -205,7 +208,8 @@ def main(argv: list[str] | None = None) -> int:
                 atomic_write(results, "\n".join(lines) + "\n")
         atomic_write(results, "\n".join(lines) + "\n")
         wall = time.perf_counter() - t0
-        text = (f"# {lib_name} library, {args.executor} executor, noise {args.noise:g}\n\n" + table(records) + "\n"
+        text = (f"# {lib_name} library, {args.executor} executor, --moves {moves}, noise {args.noise:g}\n\n"
+                + table(records) + "\n"
                 + cost_ratios(records, library))  # fmt: skip
         atomic_write(results.with_suffix(".md"), text)
         print(text)
