@@ -16,6 +16,7 @@ after it. The verification's move budget follows the model (:func:`verify_move_b
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Mapping, Sequence
 
 import numpy as np
@@ -226,7 +227,7 @@ MIN_PROBE_TRANSFER = 0.02
 across a face."""
 
 
-_CORNERS: dict[int, tuple[Polyhedron, dict[tuple[int, int], np.ndarray]]] = {}
+_CORNERS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 def _corner_points(poly: Polyhedron) -> dict[tuple[int, int], np.ndarray]:
@@ -235,9 +236,8 @@ def _corner_points(poly: Polyhedron) -> dict[tuple[int, int], np.ndarray]:
     or where the face is too narrow there. Computed once per model."""
     from haptic.geometry.distance import point_triangle_distance
 
-    got = _CORNERS.get(id(poly))
-    if got is not None and got[0] is poly:
-        return got[1]
+    if poly in _CORNERS:
+        return _CORNERS[poly]
     out: dict[tuple[int, int], np.ndarray] = {}
     for f in range(poly.n_faces):
         loop = [int(x) for x in poly.faces[f]]
@@ -254,7 +254,7 @@ def _corner_points(poly: Polyhedron) -> dict[tuple[int, int], np.ndarray]:
             p = poly.vertices[v] + PROBE_INSET / max(sin_half, 1e-3) * w
             if float(point_triangle_distance(p[None], tri).min()) < 1e-9:
                 out[(v, f)] = p
-    _CORNERS[id(poly)] = (poly, out)
+    _CORNERS[poly] = out
     return out
 
 
@@ -310,24 +310,18 @@ def verification_probes(
     from haptic.planning.probes import aimed_probes
     from haptic.planning.scoring import Context, predict_probe_moves, probe_config, same_move
 
-    if config.moves == "tracing" or config.table_z is not None or h.world_from_model is None:
-        return []
-    if any(m.kind == "probe" for m in avoid):
+    no_probes = config.moves == "tracing" or config.table_z is not None  # the hand verifies by tracing
+    if no_probes or h.world_from_model is None or any(m.kind == "probe" for m in avoid):
         return []
     here = h.model_from_world.apply(state.position)
     targets = [(p, f) for p, f in _probe_targets(h.poly, missing, faces_ok)
                if float(np.linalg.norm(p - here)) >= MIN_PROBE_TRANSFER]  # fmt: skip
     targets.sort(key=lambda pf: float(np.linalg.norm(pf[0] - here)))
-    lines = aimed_probes(h, targets, probe_config(config))
-    moves = [mv for mv, _ in lines if not any(same_move(mv, done) for done in probed)][:MAX_VERIFY_PROBES]
-    faces = {id(mv): targets[k][1] for mv, k in lines}
-    preds = predict_probe_moves(Context((h,), state, components, noise, config), moves)
-    out = []
-    for pred in preds:
-        if not bool(pred.hit[0]) or int(pred.face[0]) != faces[id(pred.move)] or pred.risk() > 0.0:
-            continue
-        out.append((pred.move, float(pred.costs[0]), 0.0))
-    return out
+    lines = [(mv, targets[k][1]) for mv, k in aimed_probes(h, targets, probe_config(config))
+             if not any(same_move(mv, done) for done in probed)][:MAX_VERIFY_PROBES]  # fmt: skip
+    preds = predict_probe_moves(Context((h,), state, components, noise, config), [mv for mv, _ in lines])
+    return [(pred.move, float(pred.costs[0]), 0.0) for pred, (_, face) in zip(preds, lines, strict=True)
+            if bool(pred.hit[0]) and int(pred.face[0]) == face and pred.risk() == 0.0]  # fmt: skip
 
 
 def choose_verification_move(

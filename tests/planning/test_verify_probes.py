@@ -50,6 +50,7 @@ def test_targets_lie_on_their_face_inset_from_both_edges_at_the_vertex():
 
 def test_no_target_at_a_reflex_corner():
     lb = LIB["LBLOCK01"]
+    reflex = 0
     for f in range(lb.n_faces):
         loop = [int(v) for v in lb.faces[f]]
         for k, v in enumerate(loop):
@@ -58,6 +59,8 @@ def test_no_target_at_a_reflex_corner():
             if np.cross(a, b) @ lb.face_normals[f] > 1e-12:  # reflex at v in face f
                 targets = _probe_targets(lb, (frozenset(), frozenset(), frozenset({v})), frozenset({f}))
                 assert targets == [], (f, v)
+                reflex += 1
+    assert reflex == 2  # the inner corner of each L-shaped face
 
 
 def test_probes_land_on_the_face_they_aim_at_far_from_the_sensor():
