@@ -54,7 +54,7 @@ probes that hit faces of few distinct normals can double the tree with every hit
 
 @dataclass
 class EpisodeRecord:
-    """What one episode did and how it scored (the JSON record of DESIGN.md, plus traces)."""
+    """What one episode did and how it scored (the JSON record of docs/design.md and the README, plus traces)."""
 
     model: str
     pose: dict

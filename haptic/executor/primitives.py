@@ -8,7 +8,7 @@ ends with an *event* (why it stopped: ``"contact"``, ``"convex-edge"``, ``"conca
 (``"no-contact"``, ``"unreachable"``, ``"timeout"``, ``"unstable"``), and returns the contact trace it
 recorded (time, fingertip pose, contact point, normal, force, phase) and the distance the fingertip travelled.
 
-Detection follows ``PHYSICS_NOTES.md``: contact when the sensed force exceeds max(0.1 F, 5 σF) for 3 samples
+Detection follows ``docs/physics-notes.md``: contact when the sensed force exceeds max(0.1 F, 5 σF) for 3 samples
 with a valid normal (pitfall 5); an edge when the filtered normal leaves the running face normal by more
 than 10° for 3 samples (convex when it tilts towards the direction of travel -- the surface falls away --,
 concave when it tilts against it -- the finger is blocked) or, as a backup, when the force stays below

@@ -2,7 +2,7 @@
 
 A face is the set of trace rows whose sensed normals agree (within a few σ): its normal combines the mean of the
 sensed normals with a plane fit of the contact points (inverse-variance weights, the plane fit counting only
-when the points span two dimensions -- PHYSICS_NOTES pitfall 6); its points are the contact points projected
+when the points span two dimensions -- docs/physics-notes.md, pitfall 6); its points are the contact points projected
 onto the fitted plane. An edge is the line ``n_a × n_b`` through (convex) the contact points recorded while the
 pad rolled over it -- they stay on the edge -- or (concave, where the pad cannot reach the corner) the
 intersection of the two face planes; a long ridge trace refines both by a line fit. A vertex is the point of

@@ -169,7 +169,7 @@ class NoiseModel:
     every noise an episode knows is derived, at two scales of one sensor:
 
     - per sample (``force_std``, ``normal_std``, ``point_std``, ``joint_std`` at level 1: the levels of
-      PHYSICS_NOTES): what the simulated sensors add to each reading
+      docs/physics-notes.md): what the simulated sensors add to each reading
       (:meth:`haptic.sim.physics.SimulatedSensorNoise.from_model`) and what the segmenter's σ start from
       (:meth:`haptic.executor.segment.SegmentBounds.from_model`);
     - per fitted component (``component`` at level 1): the σ, hence the error bounds, of a face, edge or vertex

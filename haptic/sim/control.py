@@ -13,7 +13,7 @@ Modes (one active finger, a parameter; the index by default):
 - ``hybrid``: regulates the normal force along the SENSED contact normal (feed-forward + PI on the force
   error + normal damping) while moving tangentially; the tangential reference is re-anchored on the
   tangent plane through the tip every tick and its lead is capped, and tangential motion stops after
-  contact has been lost for a while (PHYSICS_NOTES pitfalls 3-5). Before the first contact it approaches
+  contact has been lost for a while (docs/physics-notes.md, pitfalls 3-5). Before the first contact it approaches
   along ``-normal_hint`` at ``approach_speed``.
 
 Only robot-side quantities enter the control law: joint state, the robot's own dynamics and kinematics,

@@ -84,7 +84,7 @@ class SimulatedSensorNoise:
 
     @classmethod
     def from_notes(cls) -> SimulatedSensorNoise:
-        """The levels of PHYSICS_NOTES (σF 0.02 N, σn 1°, σp 0.2 mm): :meth:`from_model` at level 1."""
+        """The levels of docs/physics-notes.md (σF 0.02 N, σn 1°, σp 0.2 mm): :meth:`from_model` at level 1."""
         return cls.from_model(NoiseModel())
 
 
