@@ -6,7 +6,7 @@ STAMP  := $(VENV)/.installed-stamp
 RAY_STAMP := $(VENV)/.ray-stamp
 export MUJOCO_GL ?= disable
 
-.PHONY: demo test bench bench-ci lint models ray clean
+.PHONY: demo test check bench bench-ci lint models ray clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -28,6 +28,12 @@ demo: $(STAMP)
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -n 2 -p no:cacheprovider
+
+# The quick check while editing: ruff and the pure core's tests (geometry, matching, planning) but those marked
+# slow (whole episodes, searches); `make test` runs everything.
+check: $(STAMP)
+	$(BIN)/ruff check haptic tests scripts
+	$(BIN)/python -m pytest -n 2 -p no:cacheprovider -m "not slow" tests/geometry tests/matching tests/planning
 
 bench: $(STAMP)
 	$(BIN)/haptic bench --episodes 200 --policy planner,greedy,random --seed 1 --workers 2 --force --out out/bench/seed.jsonl
