@@ -128,7 +128,7 @@ def test_explore_and_bench_refuse_a_library_with_bad_files_naming_all(mixed_libr
 
 def test_skip_invalid_uses_the_valid_models(mixed_library, tmp_path, capsys):
     out_file = tmp_path / "r.jsonl"
-    args = ["--models", str(mixed_library), "--seed", "3", "--skip-invalid", "--policy", "planner"]
+    args = ["--models", str(mixed_library), "--seed", "3", "--skip-invalid", "--policy", "planner", "--verify", "none"]
     assert main(["bench", *args, "--episodes", "3", "--out", str(out_file), "--no-plot"]) == 0
     out, err = capsys.readouterr()
     assert err.count("skipped invalid model file") == 2

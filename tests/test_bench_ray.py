@@ -72,7 +72,8 @@ def private_ray():
 @pytest.mark.skipif(not Path("/proc/self/environ").exists(), reason="needs /proc to find Ray's processes")
 def test_ray_resumes_a_local_sweep_with_the_same_records_and_leaves_no_process(tmp_path):
     local, mixed = tmp_path / "local.jsonl", tmp_path / "mixed.jsonl"
-    args = ["bench", "--episodes", "3", "--policy", "planner,random", "--seed", "6", "--no-plot"]
+    # without verification: the records the two backends must agree on are the same, in a tenth of the time
+    args = ["bench", "--episodes", "3", "--policy", "planner,random", "--seed", "6", "--verify", "none", "--no-plot"]
     assert main([*args, "--workers", "2", "--out", str(local)]) == 0
     lines = local.read_text().splitlines(keepends=True)
     mixed.write_text("".join(lines[:2]))  # the local backend did two; Ray resumes the other four

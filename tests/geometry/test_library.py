@@ -122,6 +122,7 @@ def test_round_trip_export_import(name, suffix, tmp_path):
     assert are_congruent(m, back)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", sorted(EXPECTED))
 def test_convex_decomposition_is_exact(name):
     from scipy.spatial import ConvexHull

@@ -14,6 +14,8 @@ from haptic.geometry.shapes import box
 LIB = load_library()
 SEED_OBJECTS = ["BOX01", "WEDGE01", "BOX01N", "BOX01P", "PYR01", "TETRA01L", "TETRA01R"]
 
+pytestmark = pytest.mark.slow  # whole episodes and sweeps
+
 
 @pytest.mark.parametrize("name", SEED_OBJECTS)
 def test_planner_recognizes_every_seed_object(name):

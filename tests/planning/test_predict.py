@@ -1,6 +1,7 @@
 """Predictions of move outcomes agree with what the geometric executor then measures."""
 
 import numpy as np
+import pytest
 
 from haptic.executor.geometric import GeometricExecutor
 from haptic.geometry import SE3, load_library
@@ -50,6 +51,7 @@ def test_true_hypothesis_predicts_the_executed_distance():
     assert checked >= 40
 
 
+@pytest.mark.slow
 def test_predicted_eliminations_agree_with_the_matcher():
     """The planner's attribute predictions (seed §4.1) against the matcher given each hypothesis's simulated
     data: over real decision points, the two agree on nearly every (true, eliminated) pair."""

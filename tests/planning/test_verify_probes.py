@@ -113,6 +113,7 @@ def test_the_move_budget_follows_the_model():
     assert verify_move_budget(16) > 40
 
 
+@pytest.mark.slow
 def test_a_large_model_is_verified_past_forty_moves_and_the_record_gives_its_budget(monkeypatch):
     """BOX01N (16 vertices) under --moves all with its verification tracing only: 46 verification moves, beyond
     the fixed 40 that once ended this episode as ambiguous with 3 vertices unmeasured."""
@@ -127,6 +128,7 @@ def test_a_large_model_is_verified_past_forty_moves_and_the_record_gives_its_bud
     assert "probe" not in r["move_kinds"][len(r["move_kinds"]) - v["moves"]:]
 
 
+@pytest.mark.slow
 def test_probes_in_an_all_verification_and_none_under_tracing():
     """The same episode, verified with probes under --moves all and without under tracing: both confirm the
     model; with probes for less path cost."""
