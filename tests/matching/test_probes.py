@@ -87,6 +87,7 @@ def _probe_and_check(ex, tree, move, free: list, hits: list, label: tuple):
 _common = settings(deadline=None, suppress_health_check=[HealthCheck.too_slow], derandomize=True)
 
 
+@pytest.mark.slow  # a property over many random episodes: make test, not make check
 @settings(_common, max_examples=40)
 @given(
     name=st.sampled_from(NAMES),
@@ -99,6 +100,7 @@ def test_true_interpretation_survives_probes_with_noise_inside_bounds(name, seed
     _check(name, seed, n_moves, n_probes, level, at_bounds=False)
 
 
+@pytest.mark.slow  # a property over many random episodes: make test, not make check
 @settings(_common, max_examples=30)
 @given(name=st.sampled_from(NAMES), seed=st.integers(0, 2**31), n_moves=st.integers(1, 6),
        n_probes=st.integers(1, 4))  # fmt: skip
@@ -226,6 +228,7 @@ def _check_probes_alone(name: str, seed: int, n_probes: int, level: float, at_bo
     return len(hits)
 
 
+@pytest.mark.slow  # a property over many random episodes: make test, not make check
 @settings(_common, max_examples=30)
 @given(name=st.sampled_from(NAMES), seed=st.integers(0, 2**31), n_probes=st.integers(2, 6),
        level=st.sampled_from([0.0, 1.0, 3.0]), at_bounds=st.booleans())  # fmt: skip

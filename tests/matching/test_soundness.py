@@ -5,6 +5,7 @@ drawn inside the bounds and once with every draw exactly at its bound (the worst
 """
 
 import numpy as np
+import pytest
 from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
@@ -41,6 +42,7 @@ def _check(name: str, seed: int, n_moves: int, level: float, at_bounds: bool) ->
 _common = settings(deadline=None, suppress_health_check=[HealthCheck.too_slow], derandomize=True)
 
 
+@pytest.mark.slow  # a property over many random episodes: make test, not make check
 @settings(_common, max_examples=700)
 @given(
     name=st.sampled_from(NAMES),
@@ -52,6 +54,7 @@ def test_true_interpretation_survives_noise_inside_bounds(name, seed, n_moves, l
     _check(name, seed, n_moves, level, at_bounds=False)
 
 
+@pytest.mark.slow  # a property over many random episodes: make test, not make check
 @settings(_common, max_examples=400)
 @given(name=st.sampled_from(NAMES), seed=st.integers(0, 2**31), n_moves=st.integers(1, 8))
 # skew (non-adjacent) edge pair: the closest approach moves with the tilt of either line times the skew distance
