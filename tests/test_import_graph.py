@@ -16,7 +16,7 @@ import haptic
 
 CORE = ("haptic.geometry", "haptic.matching", "haptic.planning")
 OUTER = ("haptic.sim", "haptic.executor", "haptic.episode", "haptic.bench", "haptic.recording", "haptic.env")
-HEAVY = ("mujoco", "dm_control", "rerun", "gymnasium")
+HEAVY = ("mujoco", "dm_control", "mink", "rerun", "gymnasium")
 """Third-party packages the pure core must not import."""
 
 

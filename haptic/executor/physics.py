@@ -48,6 +48,7 @@ from haptic.planning.moves import (
     HandLinks,
     Move,
     MoveResult,
+    MoveStatus,
     ProbeMove,
     SensorState,
     Touches,
@@ -56,6 +57,9 @@ from haptic.planning.moves import (
 from haptic.planning.table import VERTEX_START_ANGLE
 from haptic.sim.robot import RobotInterface
 from haptic.sim.scene import TABLE_TOP_Z
+
+MOVE_STATUSES = frozenset(MoveStatus)
+"""The statuses a move result may carry."""
 
 RIDGE_PROBE = 0.004
 """An edge measured from a roll alone is followed this far each way from where the roll ended [m] ..."""
@@ -226,8 +230,11 @@ class PhysicsExecutor(LandingSearch):
         return fit_a, seg.edge_line(fit_a, fit_b, kind == "convex", roll_all, corner), ""
 
     def _fail(self, move: Move, res: PrimitiveResult | str, reason: str) -> MoveResult:
+        """The move failed with ``reason``: its status is the primitive's failure, or "unreachable" for an
+        outcome that is no :class:`MoveStatus` (a primitive that ended "ok" short of the move, an event such as
+        "undercut" that one move recovers from and another cannot)."""
         status = res if isinstance(res, str) else res.status
-        if status == "ok":
+        if status == "ok" or status not in MOVE_STATUSES:
             status = "unreachable"
         self._on_face = None
         return MoveResult(move=move, status=status, state=self.state, reason=reason)

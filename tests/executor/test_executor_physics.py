@@ -244,3 +244,24 @@ def test_start_lands_again_when_the_l_stroke_rolled_on_an_edge():
     truth = ConvexHull(obj.vertices @ pose[:3, :3].T + pose[:3, 3]).equations[:, :3]
     err = np.degrees(np.arccos(np.clip(truth @ n, -1.0, 1.0))).min()
     assert err < 1.0, err
+
+
+def test_a_vertex_move_whose_next_face_leans_under_fails_as_unreachable(monkeypatch):
+    """Crossing an edge onto a face that leans under the pad's reach ends a face move with the edge alone; a
+    vertex move circling onto such a face fails cleanly, naming it, with a move status (not the primitive's
+    "undercut" event)."""
+    from haptic.executor.primitives import PrimitiveResult
+    from haptic.matching.trace import empty_trace
+
+    poly, sim = _setup("BOX01", 3)
+    ex, results = _start_and_face_move(sim, 3)
+    for sense in (1, -1):
+        if ex.execute(EdgeMove(sense)).ok:
+            break
+    assert ex.state.vertex is not None
+    undercut = PrimitiveResult("unreachable", "undercut", empty_trace(), 0.0)
+    monkeypatch.setattr(ex.toucher, "cross_edge", lambda *args, **kwargs: undercut)
+    r = ex.execute(VertexMove(ex.state.edge_faces[0]))
+    assert not r.ok
+    assert r.status == "unreachable"
+    assert "leans under" in r.reason and "MoveStatus" not in r.reason
