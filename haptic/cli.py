@@ -49,16 +49,6 @@ def _add_models(sub: argparse._SubParsersAction) -> None:
     gp.set_defaults(run=_models_generate)
 
 
-def report_skipped(models: str | None, skipped: bool) -> None:
-    """Name on stderr, one line each, the library files ``--skip-invalid`` left out."""
-    if not skipped:
-        return
-    from haptic.geometry.io import scan_library
-
-    for msg in scan_library(models).errors.values():
-        print(f"haptic: skipped invalid model file: {msg}", file=sys.stderr)
-
-
 def _models_list(args: argparse.Namespace) -> int:
     from tqdm import tqdm
 

@@ -98,12 +98,11 @@ def verdict_line(rec: dict) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    from haptic.cli import report_skipped
     from haptic.episode.spec import EpisodeSpec
     from haptic.episode.worlds import run_episode
     from haptic.geometry import load_library
     from haptic.geometry.io import atomic_write
-    from haptic.options import check_output_file
+    from haptic.options import check_output_file, report_skipped
     from haptic.planning.moves import default_moves
 
     # output paths are checked before the episode runs, so that its result cannot be lost at the end

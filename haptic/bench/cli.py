@@ -79,9 +79,8 @@ def run(args: argparse.Namespace) -> int:
 def _run(args: argparse.Namespace, held: DeferredInterrupts) -> int:
     from haptic.bench.results import ResultsWriter, drop_partial_line, iter_results
     from haptic.bench.runner import episode_key, key_id, plan_sweep, ray_available
-    from haptic.cli import report_skipped
     from haptic.geometry import load_library
-    from haptic.options import check_output_file
+    from haptic.options import check_output_file, report_skipped
     from haptic.planning.moves import default_moves
     from haptic.planning.registry import POLICY_NAMES
 
