@@ -440,13 +440,6 @@ class PhysicsExecutor(LandingSearch):
             return f"no edge along the roll's axis (the ridge spans {span * 1e3:.1f} mm: a vertex?)"
         return pts
 
-    @staticmethod
-    def _last_on(trace: ContactTrace, normal: np.ndarray) -> np.ndarray:
-        ok = trace.in_contact
-        on = ok & (np.where(ok[:, None], trace.normal_in_world, 0.0) @ normal > math.cos(math.radians(4.0)))
-        idx = np.flatnonzero(on)
-        return trace.point_in_world[idx[-1]].copy() if len(idx) else trace.point_in_world[np.flatnonzero(ok)[0]]
-
     def _edge_frame(self, eid: int):
         rec = self.segmenter.edges[eid]
         fa, fb = rec.faces

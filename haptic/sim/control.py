@@ -205,10 +205,7 @@ class Controller:
         self._jacp, self._jacr = self._jac[:3], self._jac[3:]
         self._jac_arm = self._jac[:, :N_ARM]
         self._mfull = np.zeros((m.nv, m.nv))
-        self._tau_lo = m.actuator_ctrlrange[sim.arm, 0].copy()
-        self._tau_hi = m.actuator_ctrlrange[sim.arm, 1].copy()
         self._hand_lo = m.actuator_ctrlrange[sim.hand, 0].copy()
-        self._hand_hi = m.actuator_ctrlrange[sim.hand, 1].copy()
         self._hand_kp = sim.hand_kp
         self._eye3 = np.eye(3)
         self._hand_site = int(sim.flange_site)
