@@ -28,6 +28,7 @@ from haptic.executor.landing import LandingSearch
 from haptic.executor.physics_probe import probe_move
 from haptic.executor.primitives import PrimitiveResult, TouchConfig, Toucher
 from haptic.executor.segment import (
+    AT_END,
     FaceFit,
     LineFit,
     SegmentBounds,
@@ -36,7 +37,7 @@ from haptic.executor.segment import (
     fit_face,
     line_from_points,
 )
-from haptic.executor.workspace import Workspace, admissible_moves, toward_vertex
+from haptic.executor.workspace import ReentrySearch, Workspace, admissible_moves, toward_vertex
 from haptic.geometry.se3 import angle, unit
 from haptic.matching.components import DataComponent
 from haptic.matching.trace import PHASES, ContactTrace
@@ -122,6 +123,45 @@ class PhysicsSettings:
     point would come closer than this to the table top; a slide heading down stops there [m]."""
     edge_reentry: float = 0.004
     """An edge move that must first return next to its edge touches the face this far in from the edge [m]."""
+    reentry: ReentrySearch = field(default_factory=ReentrySearch)
+    """... and, when that is within the pad's reach of the table, searches further along the edge."""
+    edge_reach: float = 0.03
+    """An edge move starts where the pad is when it rests on one of the edge's faces within this of its line;
+    farther, it returns next to the edge first [m]."""
+    vertex_hold: float = 0.05
+    """At the end of an edge the pad presses in place this long before the vertex is located [s]."""
+    min_vertex_rows: int = 3
+    """The vertex is located from the rows whose normal leans along the edge (at least this many) ..."""
+    lost_vertex_rows: int = 5
+    """... or, contact lost, from this many last contacts [-]."""
+    min_block_cos: float = 0.2
+    """A blocking contact locates a vertex only when its normal has at least this component along the edge [-]."""
+    roll_lead_rows: int = 8
+    """The last rows of a trace on a face before a roll count with the roll (for the edge between) [-]."""
+    stroke_headings: int = 4
+    """An L stroke for a face's normal is tried in up to this many headings, a quarter turn apart."""
+    approach_slack: float = 0.01
+    """Start: a pad more than this below the approach height lifts straight up first [m]."""
+    touched_at_once: float = 0.006
+    """Start: a landing touch within this (plus the pad radius) below the approach height touched the side of
+    something reaching up to it [m]."""
+    landing_back_off: float = 0.005
+    """Start: after the fast descent the pad backs off this far up ...[m]"""
+    landing_touch: float = 0.015
+    """... and touches again slowly, over at most this [m]."""
+    landing_jitter: float = 0.012
+    """Start: after touching near an edge, landings are tried again this close by (σ) [m] ..."""
+    near_landings: int = 2
+    """... this many of them."""
+    search_jitter: float = 0.3
+    """Start: the landing grid's points are jittered by up to this fraction of its spacing [-] ..."""
+    search_order_jitter: float = 0.01
+    """... and their order (nearest the region's centre first) by up to this distance [m]."""
+    table_normal_cos: float = 0.99
+    """A contact is the table when its normal's vertical component exceeds this (and it is below the table top
+    plus ``table_margin``) [-] ..."""
+    table_contact_cos: float = 0.95
+    """... a fingertip's contact, as sensed during a move, when it exceeds this [-]."""
 
 
 @dataclass
@@ -153,15 +193,12 @@ class PhysicsExecutor(LandingSearch):
         self.costs = costs or CostModel()
         self.rng = rng if rng is not None else np.random.default_rng(0)
         s = settings or PhysicsSettings()
-        if s.touch.force_sigma != self.bounds.force_sigma:
-            s = PhysicsSettings(
-                **{**s.__dict__, "touch": TouchConfig(**{**s.touch.__dict__, "force_sigma": self.bounds.force_sigma})}
-            )
         self.settings = s
-        self.toucher = Toucher(robot, s.touch, finger)
+        self.toucher = Toucher(robot, s.touch, finger, self.bounds)
         self.toucher.floor_z = TABLE_TOP_Z + s.pad_clearance
         self.workspace = Workspace(self.toucher, s.table_margin, s.pad_clearance, s.vertex_radius,
-                                   s.vertex_start_angle)  # fmt: skip
+                                   s.vertex_start_angle, table_normal_cos=s.table_normal_cos,
+                                   table_contact_cos=s.table_contact_cos)  # fmt: skip
         self.segmenter = Segmenter(self.bounds)
         self.state: SensorState | None = None
         """Sensor state after the last move (None before :meth:`start`)."""
@@ -219,7 +256,8 @@ class PhysicsExecutor(LandingSearch):
         when the roll cannot have been over an edge between the two faces."""
         seg = self.segmenter
         fit_a = self._face_fit(face, trace)
-        roll_all = ContactTrace.concatenate([trace.select(trace.phase == PHASES.index(phase)).tail(8), roll])
+        lead = trace.select(trace.phase == PHASES.index(phase)).tail(self.settings.roll_lead_rows)
+        roll_all = ContactTrace.concatenate([lead, roll])
         why = seg.edge_inconsistency(fit_a, fit_b, kind == "convex", roll_all)
         if why is not None:
             return fit_a, None, f"no edge between the faces: {why}"
@@ -247,7 +285,7 @@ class PhysicsExecutor(LandingSearch):
         return fit_face(pts, nrm, self.bounds)
 
     def _store_face(self, fid: int, trace: ContactTrace, fit: FaceFit) -> None:
-        mask = face_rows(trace, fit.normal, self.bounds.face_cone)
+        mask = face_rows(trace, fit.normal, self.bounds.face_cone, self.bounds.min_refine_rows)
         pts, nrm = trace.point_in_world[mask], trace.normal_in_world[mask]
         self._faces[fid] = _FaceData(pts, nrm, pts[-1].copy())
 
@@ -290,7 +328,7 @@ class PhysicsExecutor(LandingSearch):
         t = self.toucher
         n = self.segmenter.faces[fid].component.normal
         if (near is None and self._on_face == fid and t.contact[1] is not None
-                and angle(t.normal, n) < math.radians(5.0)):  # fmt: skip
+                and angle(t.normal, n) < self.bounds.resting_cone):  # fmt: skip
             return "ok"
         target = self._faces[fid].anchor if near is None else near
         if self.workspace.pad_clearance(target, n) < self.settings.pad_clearance:
@@ -301,7 +339,7 @@ class PhysicsExecutor(LandingSearch):
         if not r.ok:
             self._why = f"{r.status}/{r.event}"
             return r.status
-        if angle(r.info["normal"], n) > math.radians(6.0):
+        if angle(r.info["normal"], n) > self.bounds.retouch_cone:
             self._why = f"touched a normal {math.degrees(angle(r.info['normal'], n)):.0f}° off the face"
             return "unreachable"
         self._on_face = fid
@@ -388,8 +426,8 @@ class PhysicsExecutor(LandingSearch):
         it traced."""
         st, seg = self.state, self.segmenter
         fit_a = self._face_fit(st.face, r.trace)
-        got = seg.edge_from_roll(fit_a, ContactTrace.concatenate([r.trace.select(r.trace.phase ==
-                                                                                 PHASES.index("face")).tail(8), roll]))
+        lead = r.trace.select(r.trace.phase == PHASES.index("face")).tail(self.settings.roll_lead_rows)
+        got = seg.edge_from_roll(fit_a, ContactTrace.concatenate([lead, roll]))
         if isinstance(got, str):
             return self._fail(move, "unreachable", f"{reason}; no edge from the roll: {got}")
         line, n_last = got
@@ -404,13 +442,12 @@ class PhysicsExecutor(LandingSearch):
                           cost=self.costs.face_move(r.distance), state=self.state,
                           info={"kind": "convex", "next_face": "out of reach"})  # fmt: skip
 
-    @staticmethod
-    def _on_ridge(rows: ContactTrace, u: np.ndarray) -> np.ndarray:
-        """Rows of a ridge-following trace in contact on the ridge itself: the sensed normal within 4° of
-        perpendicular to the edge direction ``u`` (not rolling on a vertex at its end)."""
+    def _on_ridge(self, rows: ContactTrace, u: np.ndarray) -> np.ndarray:
+        """Rows of a ridge-following trace in contact on the ridge itself: the sensed normal within
+        ``ridge_row_cone`` of perpendicular to the edge direction ``u`` (not rolling on a vertex at its end)."""
         ok = rows.in_contact & (rows.phase == PHASES.index("ridge"))
         along = np.where(ok[:, None], rows.normal_in_world, 0.0) @ u
-        return ok & (np.abs(along) < math.sin(math.radians(4.0)))
+        return ok & (np.abs(along) < math.sin(self.bounds.ridge_row_cone))
 
     def _probe_ridge(
         self, e: np.ndarray, n_a: np.ndarray, n_b: np.ndarray, pieces: list[PrimitiveResult]
@@ -436,7 +473,7 @@ class PhysicsExecutor(LandingSearch):
                 return f"following the edge: {f.event}"
         pts = np.concatenate(pts)
         span = float(np.ptp(pts @ e)) if len(pts) else 0.0
-        if len(pts) < 10 or span < RIDGE_MIN_SPAN:
+        if len(pts) < self.bounds.min_line_points or span < RIDGE_MIN_SPAN:
             return f"no edge along the roll's axis (the ridge spans {span * 1e3:.1f} mm: a vertex?)"
         return pts
 
@@ -458,16 +495,17 @@ class PhysicsExecutor(LandingSearch):
         if st.vertex is not None and st.vertex in rec.vertices:
             s_v = rec.vertices[st.vertex]
             lo, hi = rec.interval
-            if (move.sense > 0 and s_v >= hi - 1e-9) or (move.sense < 0 and s_v <= lo + 1e-9):
+            if (move.sense > 0 and s_v >= hi - AT_END) or (move.sense < 0 and s_v <= lo + AT_END):
                 return self._invalid(move, "the sensor is already at the vertex in that sense")
         u = move.sense * rec.direction
         on_clean = t.normal is not None and any(
-            angle(t.normal, seg.faces[f].component.normal) < math.radians(4.0) for f in rec.faces
+            angle(t.normal, seg.faces[f].component.normal) < self.bounds.face_cone for f in rec.faces
         )
-        if self._on_face not in rec.faces or self._line_distance(rec, t.tip) > 0.03 or not on_clean:
+        if self._on_face not in rec.faces or self._line_distance(rec, t.tip) > s.edge_reach or not on_clean:
             fid = st.face if st.face in rec.faces else rec.faces[1]
             near = self.workspace.reentry_point(rec, seg.faces[fid].component.normal, rec.inward[fid],
-                                                rec.param(self._contact_point()), u, s.edge_reentry)  # fmt: skip
+                                                rec.param(self._contact_point()), u, s.edge_reentry,
+                                                s.reentry)  # fmt: skip
             if near is None:
                 return self._fail(move, "unreachable", "the edge next to the table is out of the pad's reach")
             status = self._ensure_on_face(fid, pieces, near=near)
@@ -482,7 +520,7 @@ class PhysicsExecutor(LandingSearch):
         pieces.append(r)
         if not r.ok:
             return self._fail(move, r, f"following the edge: {r.event}")
-        hold = t.hold(0.05)
+        hold = t.hold(s.vertex_hold)
         pieces.append(hold)
         rows = ContactTrace.concatenate([r.trace, hold.trace])
         s_v, s_sigma = self._vertex_param(rec, rows, u, r.info.get("event_sign", 1))
@@ -491,7 +529,7 @@ class PhysicsExecutor(LandingSearch):
         # refine the line with the ridge contacts (convex edges), then extend it to the vertex
         ridge = self._on_ridge(rows, u)
         w_v, w_from = rec.at(s_v), rec.at(s_from)
-        seg.refine_edge(st.edge, rows.point_in_world[ridge] if ridge.sum() >= 10 else None,
+        seg.refine_edge(st.edge, rows.point_in_world[ridge] if ridge.sum() >= seg.bounds.min_line_points else None,
                         (self._face_fit(rec.faces[0]), self._face_fit(rec.faces[1])))  # fmt: skip
         s_v, s_from = rec.param(w_v), rec.param(w_from)
         edge, vertex = seg.extend_edge(st.edge, s_from, s_v, s_sigma, 1 if float(u @ rec.direction) > 0 else -1)
@@ -518,26 +556,26 @@ class PhysicsExecutor(LandingSearch):
         ok = rows.in_contact
         n = np.where(ok[:, None], rows.normal_in_world, 0.0)
         c = n @ u
-        b = self.bounds
+        b, s = self.bounds, self.settings
         if event_sign > 0:
-            at_v = ok & (c > math.sin(math.radians(5.0)))
-            if at_v.sum() < 3:  # contact was lost: the last contacts
-                idx = np.flatnonzero(ok)[-5:]
+            at_v = ok & (c > s.touch.loss_lean_sin)  # the pad rolls on the vertex
+            if at_v.sum() < s.min_vertex_rows:  # contact was lost: the last contacts
+                idx = np.flatnonzero(ok)[-s.lost_vertex_rows :]
                 at_v = np.zeros(len(rows), bool)
                 at_v[idx] = True
             if not at_v.any():
                 return None, 0.0
-            s = (rows.point_in_world[at_v] - rec.point) @ rec.direction
-            return float(np.median(s)), max(float(np.std(s)), b.point_sigma) / math.sqrt(len(s))
+            along = (rows.point_in_world[at_v] - rec.point) @ rec.direction
+            return float(np.median(along)), max(float(np.std(along)), b.point_sigma) / math.sqrt(len(along))
         contacts = self._finger_contacts()
         if not contacts:
             return None, 0.0
         blk = min(contacts, key=lambda cc: float(cc.normal_in_world @ u))
         denom = float(blk.normal_in_world @ rec.direction)
-        if abs(denom) < 0.2:
+        if abs(denom) < s.min_block_cos:
             return None, 0.0
-        s = float((blk.point_in_world - rec.point) @ blk.normal_in_world) / denom
-        return s, b.point_sigma / abs(denom)
+        s_v = float((blk.point_in_world - rec.point) @ blk.normal_in_world) / denom
+        return s_v, b.point_sigma / abs(denom)
 
     def _vertex_move(self, move: VertexMove, pieces: list[PrimitiveResult]) -> MoveResult:
         st, t, seg, s = self.state, self.toucher, self.segmenter, self.settings

@@ -60,6 +60,17 @@ TABLE_TOP_Z = _table_top_z(mjcf.from_path(str(TABLETOP_XML)))
 """Height of the table's top surface in the world frame [m], read from scenes/tabletop.xml."""
 PAD_RADIUS = _pad_radius(mjcf.from_path(str(HAND_XML)))
 """Radius of the tracing (index) fingertip's pad [m], read from assets/mjcf/hand/hand.xml."""
+ROTATION_ATOL = 1e-6
+"""A (3, 3) matrix is a rotation when ``RᵀR`` is the identity within this (absolute, per entry) [-]."""
+ZERO_VECTOR = 1e-9
+"""A vector shorter than this has no direction (round-off) [-]."""
+MIN_PART_VOLUME = 1e-9
+"""Smallest volume of a convex part of an object [m^3]."""
+STABLE_MARGIN = 0.002
+"""A resting facet is stable when the solid's centroid projects into it at least this far from its border [m]."""
+OBJECT_RGBA = (0.25, 0.6, 0.35, 1.0)
+"""Colour of the object's geoms (red, green, blue, alpha)."""
+
 OBJECT_REGION = ((0.46, 0.62), (-0.10, 0.10))
 """Where a random object centre is placed on the table: ((x_min, x_max), (y_min, y_max)) in world [m]."""
 
@@ -151,8 +162,9 @@ def scene_object_from_parts(name: str, parts: Sequence[np.ndarray]) -> SceneObje
             hull = ConvexHull(arr)
         except QhullError as exc:
             raise SceneError(f"object {name!r}, part {i}: the vertices span no volume (flat or degenerate)") from exc
-        if hull.volume < 1e-9:
-            raise SceneError(f"object {name!r}, part {i}: volume {hull.volume:.3g} m^3 is below 1e-9 m^3")
+        if hull.volume < MIN_PART_VOLUME:
+            raise SceneError(f"object {name!r}, part {i}: volume {hull.volume:.3g} m^3 is below "
+                             f"{MIN_PART_VOLUME:.0e} m^3")
         checked.append(arr[hull.vertices])
     if not checked:
         raise SceneError(f"object {name!r}: no convex parts; give at least one (n>=4, 3) vertex array")
@@ -201,7 +213,7 @@ def _rotation_taking(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.eye(3) + vx + vx @ vx / (1 + c)
 
 
-def stable_resting_rotations(obj: SceneObject, margin: float = 0.002) -> list[np.ndarray]:
+def stable_resting_rotations(obj: SceneObject, margin: float = STABLE_MARGIN) -> list[np.ndarray]:
     """Rotations (3, 3) ``world_from_object`` that rest the object on a hull facet, stably.
 
     A facet is stable when the solid's centroid projects into it at least ``margin`` [m] from its border.
@@ -249,7 +261,7 @@ def _check_pose(world_from_object: np.ndarray) -> np.ndarray:
     if t.shape != (4, 4) or not np.all(np.isfinite(t)):
         raise SceneError(f"world_from_object: expected a finite (4, 4) transform, got shape {t.shape}")
     r = t[:3, :3]
-    if not np.allclose(r.T @ r, np.eye(3), atol=1e-6) or np.linalg.det(r) < 0:
+    if not np.allclose(r.T @ r, np.eye(3), atol=ROTATION_ATOL) or np.linalg.det(r) < 0:
         raise SceneError("world_from_object: the upper-left (3, 3) block must be a proper rotation")
     return t
 
@@ -310,14 +322,14 @@ def compose_scene(
                 type="mesh",
                 mesh=mesh_name,
                 dclass="scene",
-                rgba=(0.25, 0.6, 0.35, 1.0),
+                rgba=OBJECT_RGBA,
                 group=0,
             )
     scene.model = f"haptic_{obj.name}" if obj is not None else "haptic_empty"
 
-    n_act = 6 + len(HAND_JOINTS)
-    ctrl = np.zeros(n_act)
-    ctrl[6:] = HAND_TRACE
+    n_arm = len(ARM_JOINTS)
+    ctrl = np.zeros(n_arm + len(HAND_JOINTS))
+    ctrl[n_arm:] = HAND_TRACE
     scene.keyframe.add("key", name="home", qpos=np.concatenate([ARM_HOME, HAND_TRACE]), ctrl=ctrl)
     return ComposedScene(mjcf_model=scene, object=obj, world_from_object=pose)
 
