@@ -29,6 +29,7 @@ from haptic.executor.physics_probe import probe_move
 from haptic.executor.primitives import PrimitiveResult, TouchConfig, Toucher
 from haptic.executor.segment import (
     AT_END,
+    MM,
     FaceFit,
     LineFit,
     SegmentBounds,
@@ -53,6 +54,7 @@ from haptic.planning.moves import (
     SensorState,
     Touches,
     VertexMove,
+    in_plane,
 )
 from haptic.planning.table import VERTEX_START_ANGLE
 from haptic.sim.robot import RobotInterface
@@ -381,8 +383,8 @@ class PhysicsExecutor(LandingSearch):
         if d.shape != (3,) or not np.all(np.isfinite(d)):
             return self._invalid(move, "direction must be a finite 3-vector")
         n_a = seg.faces[st.face].component.normal
-        inplane = d - (d @ n_a) * n_a
-        if np.linalg.norm(inplane) < 0.1 * max(np.linalg.norm(d), 1e-12):
+        inplane = in_plane(d, n_a)
+        if inplane is None:
             return self._invalid(move, "direction is not in the plane of the current face")
         status = self._ensure_on_face(st.face, pieces)
         if status != "ok":
@@ -474,7 +476,7 @@ class PhysicsExecutor(LandingSearch):
         pts = np.concatenate(pts)
         span = float(np.ptp(pts @ e)) if len(pts) else 0.0
         if len(pts) < self.bounds.min_line_points or span < RIDGE_MIN_SPAN:
-            return f"no edge along the roll's axis (the ridge spans {span * 1e3:.1f} mm: a vertex?)"
+            return f"no edge along the roll's axis (the ridge spans {span * MM:.1f} mm: a vertex?)"
         return pts
 
     def _edge_frame(self, eid: int):

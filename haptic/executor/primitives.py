@@ -42,6 +42,10 @@ DOWN = np.diag([-1.0, 1.0, -1.0])
 
 SERVO_LAG = 0.13
 """The position servo trails a moving command by about this much time [s] (measured: 15 mm at 0.15 m/s)."""
+OPPOSED = 1e-6
+"""Two unit normals whose sum is shorter than this (squared) are opposed: they have no bisector [-]."""
+AT_CENTRE = 1e-6
+"""A contact this close to the vertex circle's centre has no radial direction [m]."""
 FAILURES = ("no-contact", "unreachable", "timeout", "unstable")
 """Failure statuses of a primitive (the move statuses of :class:`~haptic.planning.moves.MoveResult`)."""
 
@@ -521,7 +525,7 @@ class Toucher:
         above = q_t + clear * n_t
         mid = 0.5 * (lifted + above)
         bis = n_c + n_t
-        bis = unit(bis) if bis @ bis > 1e-6 else np.array([0.0, 0.0, 1.0])
+        bis = unit(bis) if bis @ bis > OPPOSED else np.array([0.0, 0.0, 1.0])
         deficit = max(clear - float((mid - q_c) @ n_c), clear - float((mid - q_t) @ n_t), 0.0)
         waypoint = mid + deficit / max(float(bis @ n_c), cfg.min_bisector_cos) * bis
         points = [lifted, waypoint, above]
@@ -850,7 +854,7 @@ class Toucher:
             r = p - vtx
             r = r - (r @ n_f) * n_f
             rad = math.sqrt(float(r @ r))
-            rh = r / rad if rad > 1e-6 else r0
+            rh = r / rad if rad > AT_CENTRE else r0
             t = unit(np.cross(axis, rh))
             v = cfg.face_speed * t + cfg.circle_gain * (radius - rad) * rh
             self._press(v)

@@ -69,7 +69,9 @@ class SegmentBounds:
     something else [rad]."""
     roll_axis_slack: float = math.radians(3.0)
     """Rolling over an edge whose next face is out of reach, the sensed normals stay this close (beyond the
-    noise) to the plane perpendicular to the edge; a roll round a vertex turns them out of any one plane [rad]."""
+    noise) to the plane perpendicular to the edge; a roll round a vertex turns them out of any one plane [rad] ..."""
+    roll_axis_quantile: float = 0.9
+    """... this quantile of them [-]."""
     min_refine_rows: int = 3
     """A face's rows are picked again about their own mean normal when at least this many agree with the guess."""
     min_roll_rows: int = 3
@@ -287,6 +289,8 @@ def line_from_points(
     return LineFit(c, b, s_b, s_pos, (float(s.min()), float(s.max())))
 
 
+MM = 1e3
+"""Millimetres per metre (the unit of lengths in messages)."""
 AT_END = 1e-9
 """A vertex's parameter within this of an end of an edge's explored interval is at that end (round-off) [m]."""
 
@@ -442,7 +446,7 @@ class Segmenter:
             return "the normal turned too little over the edge"
         off = float(np.median(np.abs(pts @ n_a - fit_a.offset)))
         if off > b.max_roll_offset:
-            return f"the roll lies {off * 1e3:.1f} mm off the face's plane"
+            return f"the roll lies {off * MM:.1f} mm off the face's plane"
         # the edge direction e ⊥ n_a: e = cos φ u + sin φ w; each rolling normal gives n·e = 0
         u = perpendicular(n_a)
         w = np.cross(n_a, u)
@@ -451,7 +455,7 @@ class Segmenter:
         e = unit(vt[-1, 0] * u + vt[-1, 1] * w)
         resid = n @ e
         # with no second face to check the edge against, every rolling normal must have turned about it
-        if float(np.quantile(np.abs(resid), 0.9)) > math.sin(b.roll_axis_slack) + b.k * b.normal_sigma:
+        if float(np.quantile(np.abs(resid), b.roll_axis_quantile)) > math.sin(b.roll_axis_slack) + b.k * b.normal_sigma:
             return "the roll turned about more than one axis (round a vertex?)"
         sigma_n = max(float(np.sqrt(np.mean(resid**2))), b.normal_sigma)
         s_e = math.hypot(sigma_n / math.sqrt(float(sin2.sum())), fit_a.normal_sigma)
@@ -482,7 +486,7 @@ class Segmenter:
             off = max(float(np.median(np.abs(q @ fit_a.normal - fit_a.offset))),
                       float(np.median(np.abs(q @ fit_b.normal - fit_b.offset))))  # fmt: skip
             if off > b.max_roll_offset:
-                return f"the roll lies {off * 1e3:.1f} mm off the faces' planes"
+                return f"the roll lies {off * MM:.1f} mm off the faces' planes"
         return None
 
     def add_edge(
@@ -606,6 +610,7 @@ class Segmenter:
 
 __all__ = [
     "AT_END",
+    "MM",
     "EdgeRecord",
     "FaceFit",
     "FaceRecord",

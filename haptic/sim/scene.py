@@ -64,6 +64,15 @@ ROTATION_ATOL = 1e-6
 """A (3, 3) matrix is a rotation when ``RᵀR`` is the identity within this (absolute, per entry) [-]."""
 ZERO_VECTOR = 1e-9
 """A vector shorter than this has no direction (round-off) [-]."""
+ANTIPARALLEL = 1e-12
+"""Two unit vectors whose dot product is within this of −1 are opposite (round-off) [-]."""
+PARALLEL = 1e-6
+"""Two unit vectors whose dot product is within this of 1 are the same direction (hull facets of one plane);
+a cross product shorter than this has no direction [-]."""
+PLANE_DECIMALS = 9
+"""Hull facet equations are rounded to this many decimals before duplicates are merged."""
+MIN_PART_POINTS = 4
+"""Fewest vertices of a convex part of an object (a tetrahedron's)."""
 MIN_PART_VOLUME = 1e-9
 """Smallest volume of a convex part of an object [m^3]."""
 STABLE_MARGIN = 0.002
@@ -156,7 +165,7 @@ def scene_object_from_parts(name: str, parts: Sequence[np.ndarray]) -> SceneObje
     checked = []
     for i, p in enumerate(parts):
         arr = np.asarray(p, dtype=float)
-        if arr.ndim != 2 or arr.shape[1] != 3 or len(arr) < 4 or not np.all(np.isfinite(arr)):
+        if arr.ndim != 2 or arr.shape[1] != 3 or len(arr) < MIN_PART_POINTS or not np.all(np.isfinite(arr)):
             raise SceneError(f"object {name!r}, part {i}: expected an (n>=4, 3) finite vertex array, got {arr.shape}")
         try:
             hull = ConvexHull(arr)
@@ -203,9 +212,9 @@ def _rotation_taking(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """The smallest rotation (3, 3) taking unit vector a to unit vector b."""
     v = np.cross(a, b)
     c = float(np.dot(a, b))
-    if c < -1 + 1e-12:  # antiparallel: half turn about any axis perpendicular to a
+    if c < -1 + ANTIPARALLEL:  # antiparallel: half turn about any axis perpendicular to a
         axis = np.cross(a, [1.0, 0.0, 0.0])
-        if np.linalg.norm(axis) < 1e-6:
+        if np.linalg.norm(axis) < PARALLEL:
             axis = np.cross(a, [0.0, 1.0, 0.0])
         axis /= np.linalg.norm(axis)
         return 2 * np.outer(axis, axis) - np.eye(3)
@@ -221,16 +230,16 @@ def stable_resting_rotations(obj: SceneObject, margin: float = STABLE_MARGIN) ->
     points = obj.vertices
     hull = ConvexHull(points)
     centroid = _solid_centroid(obj.parts)
-    planes = np.unique(np.round(hull.equations, 9), axis=0)
+    planes = np.unique(np.round(hull.equations, PLANE_DECIMALS), axis=0)
     out = []
     seen: list[np.ndarray] = []
     for n_d in planes:
         n, d = n_d[:3], n_d[3]
-        if any(np.dot(n, s) > 1 - 1e-6 for s in seen):
+        if any(np.dot(n, s) > 1 - PARALLEL for s in seen):
             continue
         seen.append(n)
         p = centroid - (np.dot(n, centroid) + d) * n  # projection on the facet plane
-        others = planes[np.einsum("ij,j->i", planes[:, :3], n) < 1 - 1e-6]
+        others = planes[np.einsum("ij,j->i", planes[:, :3], n) < 1 - PARALLEL]
         if np.all(others[:, :3] @ p + others[:, 3] <= -margin):
             out.append(_rotation_taking(n, np.array([0.0, 0.0, -1.0])))
     if not out:  # no facet is stable by the margin: fall back to the largest-area support
