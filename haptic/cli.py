@@ -12,13 +12,17 @@ import json
 import os
 import sys
 from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING
 
 from haptic.errors import HapticError
+
+if TYPE_CHECKING:
+    from haptic.options import Subcommands
 
 Runner = Callable[[argparse.Namespace], int]
 
 
-def _add_models(sub: argparse._SubParsersAction) -> None:
+def _add_models(sub: Subcommands) -> None:
     p = sub.add_parser("models", help="list, show and check polyhedral models")
     msub = p.add_subparsers(dest="models_cmd", required=True, metavar="{list,show,check,generate}")
 
@@ -151,7 +155,7 @@ def _models_generate(args: argparse.Namespace) -> int:
     return 0
 
 
-def _optional_subcommands() -> list[Callable[[argparse._SubParsersAction], None]]:
+def _optional_subcommands() -> list[Callable[[Subcommands], None]]:
     """Subcommands whose modules may pull in heavy dependencies are imported only when present."""
     out = []
     for module in ("haptic.sim.cli", "haptic.episode_cli", "haptic.bench.cli"):

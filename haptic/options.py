@@ -15,9 +15,17 @@ import sys
 import tempfile
 import threading
 from pathlib import Path
+from typing import Any, Protocol
 
 from haptic.errors import HapticError
 from haptic.matching.components import NOISE_LEVELS
+
+
+class Subcommands(Protocol):
+    """What a subcommand's ``add_parser`` is given: the ``haptic`` command's subparsers (the object
+    ``ArgumentParser.add_subparsers`` returns)."""
+
+    def add_parser(self, name: str, **kwargs: Any) -> argparse.ArgumentParser: ...
 
 
 def report_skipped(models: str | None, skipped: bool) -> None:

@@ -13,13 +13,13 @@ import time
 from pathlib import Path
 
 from haptic.errors import BenchError, HapticError
-from haptic.options import DeferredInterrupts, Terminated
+from haptic.options import DeferredInterrupts, Subcommands, Terminated
 
 EXIT_SIGINT, EXIT_SIGTERM = 130, 143
 """Exit codes of a sweep ended by SIGINT (Ctrl-C) or SIGTERM: 128 + the signal's number."""
 
 
-def add_parser(sub: argparse._SubParsersAction) -> None:
+def add_parser(sub: Subcommands) -> None:
     from haptic.matching.verify import DEFAULT_VERIFY, VERIFY_MODES
     from haptic.options import noise_levels, positive_int, seed_int
     from haptic.planning.moves import DEFAULT_MOVES, HAND_DEFAULT_MOVES, MOVE_SETS

@@ -94,9 +94,9 @@ class LandingSearch:
                 landings[i + 1 : i + 1] = list(near)
                 continue
             face = self.segmenter.add_face(fit, ())
-            self._store_face(face.id, trace, fit)
-            self._on_face = face.id
-            self.state = SensorState(position=self._contact_point(), face=face.id)
+            self.store_face(face.id, trace, fit)
+            self.on_face = face.id
+            self.state = SensorState(position=self.contact_point(), face=face.id)
             return MoveResult(move=move, status="ok", components=(face,), state=self.state,
                               info={"travel": sum(p.distance for p in pieces)})  # fmt: skip
         return MoveResult(move=move, status=last if last != "ok" else "no-contact", state=None,
@@ -120,7 +120,7 @@ class LandingSearch:
                     break
             if all(r.ok and r.event == "done" for r in legs) and len(legs) == 2:
                 trace = ContactTrace.concatenate([r.trace for r in legs])
-                if not self._on_one_face(trace):
+                if not self.on_one_face(trace):
                     return None, trace  # the pad rolled on an edge or a vertex: land again elsewhere
                 fit = self.segmenter.fit_face_trace(trace, legs[-1].info["face_normal"], two_d=True)
                 return fit, trace
@@ -139,7 +139,7 @@ class LandingSearch:
             n0 = t.normal.copy()
         return None, ContactTrace.concatenate([])
 
-    def _on_one_face(self, trace: ContactTrace) -> bool:
+    def on_one_face(self, trace: ContactTrace) -> bool:
         """Whether every contact row of the start's L stroke lies on one face. On a face the sensed normal does
         not turn as the pad slides; landed on (or next to) an edge or a vertex, the pad rolls on it and the
         normal turns by 1/r along the stroke -- slowly enough for the edge detector not to fire, and the rows

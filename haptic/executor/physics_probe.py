@@ -107,7 +107,7 @@ def probe_move(ex: PhysicsExecutor, move: ProbeMove, pieces: list[PrimitiveResul
     """Carry out ``move`` with ``ex``'s hand (module docstring); a failure is a status, never an exception."""
     t, st, seg = ex.toucher, ex.state, ex.segmenter
     if (problem := move.problem()) is not None:
-        return ex._invalid(move, problem)
+        return ex.invalid_result(move, problem)
     start = np.asarray(move.start, dtype=float)
     u = np.asarray(move.direction, dtype=float)
     length = float(move.length)
@@ -116,12 +116,12 @@ def probe_move(ex: PhysicsExecutor, move: ProbeMove, pieces: list[PrimitiveResul
     centre1 = centre0 + length * u
     floor = TABLE_TOP_Z + ex.settings.pad_clearance
     if min(centre0[2], centre1[2]) - r < floor:
-        return ex._invalid(move, "the line would bring the pad onto the table")
+        return ex.invalid_result(move, "the line would bring the pad onto the table")
     z_reach = TABLE_TOP_Z + ex.settings.max_approach_height
     z_safe = safe_height(_highest_contact(ex), r, centre0, t.tip, settings.clearance)
     if z_safe > z_reach:
-        return ex._fail(move, "unreachable", "the line's start is above the hand's reach over the region")
-    was_on = ex._on_face if (ex._on_face == st.face and t.contact[1] is not None) else None
+        return ex.failed_result(move, "unreachable", "the line's start is above the hand's reach over the region")
+    was_on = ex.on_face if (ex.on_face == st.face and t.contact[1] is not None) else None
     free: list[PrimitiveResult] = []  # the pieces through free space, for the distance
 
     def leg(point: np.ndarray, speed: float, lag: float, phase: str = "free") -> PrimitiveResult:
@@ -137,14 +137,14 @@ def probe_move(ex: PhysicsExecutor, move: ProbeMove, pieces: list[PrimitiveResul
         pieces.append(res)
         free.append(res)
         if not res.ok:
-            return ex._fail(move, res, f"leaving the surface: {res.event}")
+            return ex.failed_result(move, res, f"leaving the surface: {res.event}")
     lifted = t.tip.copy()
-    ex._on_face = None
+    ex.on_face = None
     went_along = False  # the pad has been on the line (the way back may follow it)
 
     def fail(res, reason: str) -> MoveResult:
         """The failed move's result, after going back the way it came (off the object first, when touching)."""
-        out = ex._fail(move, res, reason)
+        out = ex.failed_result(move, res, reason)
         if t.contact[1] is not None and t.normal is not None:
             pieces.append(t.move_free(t.tip + settings.lift * t.normal, timeout=t.config.lift_timeout,
                                       tol=t.config.lift_tol))  # fmt: skip
@@ -194,9 +194,9 @@ def probe_move(ex: PhysicsExecutor, move: ProbeMove, pieces: list[PrimitiveResul
     if fit is None:
         return fail("unreachable", "the probe touched an edge or a vertex: no face normal there")
     face = seg.add_face(fit, ())
-    ex._store_face(face.id, trace, fit)
-    ex._on_face = face.id
-    ex.state = SensorState(position=ex._contact_point(), face=face.id)
+    ex.store_face(face.id, trace, fit)
+    ex.on_face = face.id
+    ex.state = SensorState(position=ex.contact_point(), face=face.id)
     return MoveResult(move=move, status="ok", components=(face,), distance=s,
                       cost=ex.costs.probe_move(s) + ex.costs.c_n, state=ex.state,
                       free_space=(segment,) if segment is not None else (),
@@ -232,7 +232,7 @@ def _measure_face(ex: PhysicsExecutor, point: np.ndarray, n0: np.ndarray,
         if legs[-1].status == "unstable":
             return None, trace
         trace = ContactTrace.concatenate([r.trace for r in legs])
-        if len(legs) == 2 and all(r.ok and r.event == "done" for r in legs) and ex._on_one_face(trace):
+        if len(legs) == 2 and all(r.ok and r.event == "done" for r in legs) and ex.on_one_face(trace):
             fit = seg.fit_face_trace(trace, legs[-1].info["face_normal"], two_d=True)
             if fit is not None:
                 return fit, trace
@@ -295,7 +295,7 @@ def _return(ex: PhysicsExecutor, lifted: np.ndarray, z_safe: float, n_left: np.n
     n_face = ex.segmenter.faces[was_on].component.normal
     if not res.ok or angle(unit(res.info["normal"]), n_face) > ex.bounds.retouch_cone:
         return False
-    ex._on_face = was_on
+    ex.on_face = was_on
     return True
 
 

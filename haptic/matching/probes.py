@@ -31,7 +31,7 @@ import numpy as np
 from haptic.geometry.polyhedron import Polyhedron
 from haptic.geometry.raycast import depth_samples
 from haptic.geometry.se3 import SE3
-from haptic.matching.components import DataFace, _vec
+from haptic.matching.components import DataFace, readonly_vector
 from haptic.matching.recognition import PoseTolerance
 from haptic.matching.tree import InterpretationTree
 from haptic.matching.verify import pose_check
@@ -63,8 +63,8 @@ class FreeSegment:
     kind = "free"
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "start", _vec(self.start))
-        object.__setattr__(self, "direction", _vec(self.direction))
+        object.__setattr__(self, "start", readonly_vector(self.start))
+        object.__setattr__(self, "direction", readonly_vector(self.direction))
         object.__setattr__(self, "length", float(self.length))
 
     @property

@@ -105,7 +105,7 @@ def fibonacci_directions(n: int) -> np.ndarray:
     return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=1)
 
 
-def _face_targets(poly) -> np.ndarray:
+def face_targets(poly) -> np.ndarray:
     """A point inside each face (model frame): the centroid of its largest triangle, shape (F, 3)."""
     tri = poly.vertices[poly.triangles]
     area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
@@ -142,7 +142,7 @@ def candidate_probes(hypotheses: Sequence[Hypothesis], config: ProbeConfig | Non
     out: list[ProbeMove] = []
     for h in posed:
         t = h.world_from_model
-        targets, normals = t.apply(_face_targets(h.poly)), t.rotate(h.poly.face_normals)
+        targets, normals = t.apply(face_targets(h.poly)), t.rotate(h.poly.face_normals)
         facing = (dirs @ normals.T) <= -cos_max  # (D, F)
         if config.max_undercut is not None:
             facing &= (normals[:, 2] >= -np.sin(config.max_undercut))[None, :]

@@ -68,7 +68,7 @@ def reachable_features(
     allf = frozenset(range(poly.n_faces))
     if config.table_z is None:
         return allf, frozenset(range(poly.n_edges)), frozenset(range(poly.n_vertices))
-    from haptic.planning.reach import SPACING, TRACE_ROOM, _touchable
+    from haptic.planning.reach import SPACING, TRACE_ROOM, touchable
 
     faces = set()
     for f in range(poly.n_faces):  # interior sample points of the face's triangles
@@ -84,7 +84,7 @@ def reachable_features(
         if not len(p):
             continue
         nrm = np.broadcast_to(poly.face_normals[f], p.shape)
-        ok = _touchable(poly, world_from_model, world_from_model.apply(p), world_from_model.rotate(nrm), config,
+        ok = touchable(poly, world_from_model, world_from_model.apply(p), world_from_model.rotate(nrm), config,
                         TRACE_ROOM)  # fmt: skip
         if int(ok.sum()) >= MIN_SAMPLES:
             faces.add(f)
@@ -288,9 +288,9 @@ def _probe_targets(
                     out.append((p, f))
                     break
     if mf:
-        from haptic.planning.probes import _face_targets
+        from haptic.planning.probes import face_targets
 
-        centres = _face_targets(poly)
+        centres = face_targets(poly)
         out += [(centres[f], int(f)) for f in sorted(mf) if faces_ok is None or f in faces_ok]
     return out
 
