@@ -18,7 +18,7 @@ if TYPE_CHECKING:
 
 
 def add_parser(sub: Subcommands) -> None:
-    from haptic.matching.verify import DEFAULT_VERIFY, VERIFY_MODES
+    from haptic.matching.acceptance import DEFAULT_VERIFY, VERIFY_MODES
     from haptic.options import noise_level, positive_int, seed_int
     from haptic.planning.moves import DEFAULT_MOVES, HAND_DEFAULT_MOVES, MOVE_SETS
     from haptic.planning.registry import POLICY_NAMES

@@ -433,7 +433,7 @@ def test_verification_moves_are_labelled_as_such(tmp_path):
 
 def test_probes_are_drawn_hits_and_misses_apart(tmp_path):
     from haptic.geometry import SE3, load_library
-    from haptic.matching.probes import FreeSegment, probe_face
+    from haptic.matching.free_space import FreeSegment, probe_face
     from haptic.planning.moves import FaceMove, MoveResult, ProbeMove, SensorState
     from haptic.recording.style import KIND_COLORS, PROBE_HIT_COLOR, PROBE_MISS_COLOR
 

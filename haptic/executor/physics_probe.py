@@ -41,7 +41,7 @@ import numpy as np
 from haptic.executor.primitives import PrimitiveResult
 from haptic.executor.segment import FaceFit
 from haptic.geometry.se3 import angle, perpendicular, unit
-from haptic.matching.probes import FreeSegment
+from haptic.matching.free_space import FreeSegment
 from haptic.matching.trace import ContactTrace
 from haptic.planning.handpath import CLEARANCE, LIFT, over_the_top, safe_height
 from haptic.planning.moves import MoveResult, ProbeMove, SensorState

@@ -14,7 +14,7 @@ from enum import StrEnum
 import numpy as np
 
 from haptic.matching.components import DataComponent
-from haptic.matching.probes import FreeSegment
+from haptic.matching.free_space import FreeSegment
 from haptic.matching.trace import ContactTrace
 
 MOVE_SETS = ("tracing", "probing", "all")
