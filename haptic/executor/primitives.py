@@ -65,13 +65,14 @@ class TouchConfig:
     """Guarded-approach speed [m/s]."""
     free_speed: float = 0.20
     """Speed of free-space moves [m/s]."""
-    contact_fraction: float = 0.1
-    """Contact is sensed above max(contact_fraction × force, contact_sigmas × σF) [-] ..."""
+    contact_fraction: float = ControlGains.contact_fraction
+    """Contact is sensed above max(contact_fraction × force, contact_sigmas × σF) [-] (the defaults: the
+    hybrid controller's) ..."""
     contact_sigmas: float = ControlGains.contact_sigmas
     """... [-] (σF: :attr:`SegmentBounds.force_sigma <haptic.executor.segment.SegmentBounds.force_sigma>`)."""
     debounce: int = 3
     """Consecutive samples a detection must hold [ticks]."""
-    normal_filter: float = 0.25
+    normal_filter: float = ControlGains.normal_filter
     """Per-tick low-pass weight of a new normal sample (0..1]."""
     edge_angle: float = math.radians(10.0)
     """Edge: the filtered normal leaves the face normal by more than this [rad]."""

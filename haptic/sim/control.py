@@ -65,8 +65,8 @@ class ControlGains:
     """Largest lead of the tangential reference ahead of the tip [m]."""
     contact_lost_after: float = 0.03
     """Time without contact after which tangential motion stops [s]."""
-    contact_threshold: float = 0.1
-    """Contact is sensed above max(contact_threshold * force target, contact_sigmas * sigma_F,
+    contact_fraction: float = 0.1
+    """Contact is sensed above max(contact_fraction * force target, contact_sigmas * sigma_F,
     min_contact_force) ..."""
     contact_sigmas: float = 5.0
     """... [-] (sigma_F: the simulated force sensor's noise) ..."""
@@ -346,7 +346,7 @@ class Controller:
     def _contact_threshold(self, force: float) -> float:
         """The sensed force above which the hybrid mode counts a contact, for a target ``force`` [N]."""
         g = self.gains
-        return max(g.contact_threshold * float(force), g.contact_sigmas * self.sim.noise.force_std, g.min_contact_force)
+        return max(g.contact_fraction * float(force), g.contact_sigmas * self.sim.noise.force_std, g.min_contact_force)
 
     def hybrid_status(self) -> HybridStatus | None:
         """State of the hybrid mode, or None in another mode."""
