@@ -26,7 +26,7 @@ import numpy as np
 from haptic.errors import HapticError
 from haptic.executor.landing import LandingSearch
 from haptic.executor.physics_probe import probe_move
-from haptic.executor.primitives import PrimitiveResult, TouchConfig, Toucher
+from haptic.executor.primitives import PrimitiveResult, Toucher
 from haptic.executor.segment import (
     AT_END,
     MM,
@@ -38,6 +38,7 @@ from haptic.executor.segment import (
     fit_face,
     line_from_points,
 )
+from haptic.executor.touch_config import TouchConfig
 from haptic.executor.workspace import ReentrySearch, Workspace, admissible_moves, toward_vertex
 from haptic.geometry.se3 import angle, unit
 from haptic.matching.components import DataComponent
