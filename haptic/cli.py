@@ -12,13 +12,17 @@ import json
 import os
 import sys
 from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING
 
 from haptic.errors import HapticError
+
+if TYPE_CHECKING:
+    from haptic.options import Subcommands
 
 Runner = Callable[[argparse.Namespace], int]
 
 
-def _add_models(sub: argparse._SubParsersAction) -> None:
+def _add_models(sub: Subcommands) -> None:
     p = sub.add_parser("models", help="list, show and check polyhedral models")
     msub = p.add_subparsers(dest="models_cmd", required=True, metavar="{list,show,check,generate}")
 
@@ -47,16 +51,6 @@ def _add_models(sub: argparse._SubParsersAction) -> None:
     gp.add_argument("--seed", type=int, default=0, help="seed of the draw (default 0)")
     gp.add_argument("--out", required=True, metavar="DIR", help="new (or empty) library directory to write")
     gp.set_defaults(run=_models_generate)
-
-
-def report_skipped(models: str | None, skipped: bool) -> None:
-    """Name on stderr, one line each, the library files ``--skip-invalid`` left out."""
-    if not skipped:
-        return
-    from haptic.geometry.io import scan_library
-
-    for msg in scan_library(models).errors.values():
-        print(f"haptic: skipped invalid model file: {msg}", file=sys.stderr)
 
 
 def _models_list(args: argparse.Namespace) -> int:
@@ -161,7 +155,7 @@ def _models_generate(args: argparse.Namespace) -> int:
     return 0
 
 
-def _optional_subcommands() -> list[Callable[[argparse._SubParsersAction], None]]:
+def _optional_subcommands() -> list[Callable[[Subcommands], None]]:
     """Subcommands whose modules may pull in heavy dependencies are imported only when present."""
     out = []
     for module in ("haptic.sim.cli", "haptic.episode_cli", "haptic.bench.cli"):

@@ -39,9 +39,9 @@ from haptic.episode.worlds import Episode, build_episode
 from haptic.errors import HapticError
 from haptic.geometry import load_library
 from haptic.geometry.library_cache import cached_library
+from haptic.matching.acceptance import DEFAULT_VERIFY
 from haptic.matching.components import DataComponent, DataEdge, DataFace
 from haptic.matching.recognition import AMBIGUOUS, NO_MATCH, RECOGNIZED
-from haptic.matching.verify import DEFAULT_VERIFY
 from haptic.planning.config import PlannerConfig
 from haptic.planning.moves import EdgeMove, FaceMove, Move, MoveResult, VertexMove
 from haptic.planning.policies import Decision, Policy, same_move

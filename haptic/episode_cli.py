@@ -9,12 +9,16 @@ from __future__ import annotations
 import argparse
 import json
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from haptic.errors import HapticError, RecordingError
 
+if TYPE_CHECKING:
+    from haptic.options import Subcommands
 
-def add_parser(sub: argparse._SubParsersAction) -> None:
-    from haptic.matching.verify import DEFAULT_VERIFY, VERIFY_MODES
+
+def add_parser(sub: Subcommands) -> None:
+    from haptic.matching.acceptance import DEFAULT_VERIFY, VERIFY_MODES
     from haptic.options import noise_level, positive_int, seed_int
     from haptic.planning.moves import DEFAULT_MOVES, HAND_DEFAULT_MOVES, MOVE_SETS
     from haptic.planning.registry import POLICY_NAMES
@@ -98,12 +102,11 @@ def verdict_line(rec: dict) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    from haptic.cli import report_skipped
     from haptic.episode.spec import EpisodeSpec
     from haptic.episode.worlds import run_episode
     from haptic.geometry import load_library
     from haptic.geometry.io import atomic_write
-    from haptic.options import check_output_file
+    from haptic.options import check_output_file, report_skipped
     from haptic.planning.moves import default_moves
 
     # output paths are checked before the episode runs, so that its result cannot be lost at the end

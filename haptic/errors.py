@@ -21,10 +21,6 @@ class MatchError(HapticError):
     """Data components or matcher input are inconsistent (bad adjacency, unknown ids, wrong types)."""
 
 
-class ExecutorError(HapticError):
-    """A move cannot be executed as asked (bad start, unknown move, no contact)."""
-
-
 class PlanningError(HapticError):
     """A planner or policy was configured with invalid options."""
 

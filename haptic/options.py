@@ -11,12 +11,31 @@ import argparse
 import math
 import os
 import signal
+import sys
 import tempfile
 import threading
 from pathlib import Path
+from typing import Any, Protocol
 
 from haptic.errors import HapticError
 from haptic.matching.components import NOISE_LEVELS
+
+
+class Subcommands(Protocol):
+    """What a subcommand's ``add_parser`` is given: the ``haptic`` command's subparsers (the object
+    ``ArgumentParser.add_subparsers`` returns)."""
+
+    def add_parser(self, name: str, **kwargs: Any) -> argparse.ArgumentParser: ...
+
+
+def report_skipped(models: str | None, skipped: bool) -> None:
+    """Name on stderr, one line each, the library files ``--skip-invalid`` left out."""
+    if not skipped:
+        return
+    from haptic.geometry.io import scan_library  # the library scan loads only when files were skipped
+
+    for msg in scan_library(models).errors.values():
+        print(f"haptic: skipped invalid model file: {msg}", file=sys.stderr)
 
 
 def int_at_least(low: int):

@@ -1,9 +1,10 @@
 """Benchmark of free-space probes at the planner's decision points, geometric executor (not a timed test).
 
 For random objects and poses, tracing moves at random until the matcher holds two or more pose classes; then
-at that decision point: the probe candidates and their predictions (:mod:`haptic.planning.probes`), the most
+at that decision point: the probe candidates and their predictions (:mod:`haptic.planning.probe_lines`,
+:mod:`haptic.planning.probe_prediction`), the most
 efficient probe against the most efficient tracing move (the planner's own scoring), and the best probe
-carried out at the true object, its data matched (:mod:`haptic.matching.probes`). Prints per trial and in sum:
+carried out at the true object, its data matched (:mod:`haptic.matching.free_space`). Prints per trial and in sum:
 pose classes the true class's prediction says the probe eliminates against those the matcher then
 eliminated, whether the true class survived, and the time to generate and predict the candidates.
 
@@ -23,18 +24,18 @@ import numpy as np
 
 from haptic.episode.loop import hypotheses_from
 from haptic.executor.geometric import GeometricExecutor
-from haptic.executor.probe import execute_probe
 from haptic.geometry import SE3, load_library
 from haptic.matching.components import SensorNoise
+from haptic.matching.free_space import apply_probes
 from haptic.matching.library import LibraryArrays
-from haptic.matching.probes import apply_probes
 from haptic.matching.recognition import PoseTolerance, equivalent_by_symmetry, recognize
 from haptic.matching.tree import InterpretationTree
 from haptic.planning.config import PlannerConfig
 from haptic.planning.efficiency import class_weights
 from haptic.planning.moves import CostModel
 from haptic.planning.policies import Context, PlannerPolicy
-from haptic.planning.probes import candidate_probes, predict_probes
+from haptic.planning.probe_lines import candidate_probes
+from haptic.planning.probe_prediction import predict_probes
 
 
 def _true_class(classes, name, truth, tol) -> int | None:
@@ -84,7 +85,7 @@ def trial(lib, arrays, rng, noise, costs: CostModel | None = None, max_moves: in
     i = int(np.argmax([s[0] for s in scores]))
     pred = preds[i]
     predicted = int(pred.eliminates()[k_true].sum()) if k_true is not None else None
-    res = execute_probe(ex, pred.move)
+    res = ex.execute(pred.move)
     hits = []
     for c in res.components:
         tree.add(c)

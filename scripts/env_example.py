@@ -21,7 +21,7 @@ import haptic.env  # noqa: F401 -- registers the environments
 from haptic.bench.runner import plan_sweep, run_sweep
 from haptic.env import PolicyAgent
 from haptic.geometry.library_cache import cached_library
-from haptic.matching.verify import DEFAULT_VERIFY, VERIFY_MODES
+from haptic.matching.acceptance import DEFAULT_VERIFY, VERIFY_MODES
 
 
 def play(env: gym.Env, act, model: str, seed: int) -> dict:

@@ -34,8 +34,8 @@ from haptic.episode.worlds import run_episode
 from haptic.errors import HapticError
 from haptic.geometry.io import atomic_write
 from haptic.planning.efficiency import class_weights
+from haptic.planning.move_scores import bounded, predict_probe_moves
 from haptic.planning.registry import make_policy
-from haptic.planning.scoring import bounded, predict_probe_moves
 
 SEED_OBJECTS = ("BOX01", "WEDGE01", "BOX01N", "BOX01P", "PYR01", "TETRA01L", "TETRA01R", "HEXPRISM01", "LBLOCK01",
                 "FRAME01")

@@ -20,8 +20,8 @@ from haptic.matching.components import DataEdge, DataFace
 from haptic.matching.tree import InterpretationTree
 from haptic.planning.config import PlannerConfig
 from haptic.planning.moves import CostModel, SensorState
+from haptic.planning.opening_probes import LibraryExtent
 from haptic.planning.policies import same_move
-from haptic.planning.probes import LibraryExtent
 
 LIB = cached_library(None)
 EXTENT = LibraryExtent.of(LIB.values())
@@ -126,7 +126,7 @@ def test_with_dear_probes_the_opening_is_the_seeds(model, seed):
 def test_once_posed_the_opening_probes_aim_away_from_every_measured_normal():
     """Three perpendicular faces measured: the best lines head along the known normals' sum, toward the faces
     opposite them (each approach away from every measured normal), never back at a measured face."""
-    from haptic.planning.probes import opening_probes
+    from haptic.planning.opening_probes import opening_probes
 
     normals = np.eye(3)
     faces = [DataFace(i, normals[i], [0.03 * normals[i]], 0.02, 0.0005) for i in range(3)]

@@ -109,8 +109,8 @@ def test_a_failed_probe_is_not_tried_again_and_tracing_moves_follow_it():
     """An executor whose probes all fail (as the hand's do when it cannot get along a line): each line is tried
     once, and the move after a failed probe is a tracing move; the episode still recognises by tracing."""
     from haptic.episode.worlds import build_episode
+    from haptic.planning.move_scores import same_move
     from haptic.planning.moves import MoveResult
-    from haptic.planning.scoring import same_move
 
     episode = build_episode(EpisodeSpec(model="BOX01", seed=1, moves="all"), config=CHEAP)
     inner = episode.executor

@@ -1,4 +1,5 @@
-"""The import graph of ``haptic``: module-level and function-level imports, read with ``ast``.
+"""The import graph of ``haptic``: module-level and function-level imports, and imports of modules named by
+string literals (``__import__``, ``importlib.import_module``), read with ``ast``.
 
 It has no cycle, between modules or between layers, and the pure core (geometry, matching, planning) imports
 nothing of the layers built on it, nor a simulator or a viewer.
@@ -31,9 +32,41 @@ def _modules(root: Path) -> dict[str, Path]:
     return out
 
 
+DYNAMIC_IMPORTS = ("__import__", "import_module")
+"""Functions that import a module named by a string: ``__import__(name)``, ``importlib.import_module(name)``."""
+
+
+def _dynamic_import(call: ast.Call) -> bool:
+    f = call.func
+    name = f.id if isinstance(f, ast.Name) else f.attr if isinstance(f, ast.Attribute) else None
+    return name in DYNAMIC_IMPORTS and bool(call.args)
+
+
+def _literal_loops(tree: ast.AST) -> dict[str, list[str]]:
+    """Loop variables that run over a tuple or list of string literals: name -> the strings."""
+    out: dict[str, list[str]] = {}
+    for node in ast.walk(tree):
+        over = isinstance(node, ast.For) and isinstance(node.iter, ast.Tuple | ast.List)
+        if over and isinstance(node.target, ast.Name):
+            names = [e.value for e in node.iter.elts if isinstance(e, ast.Constant) and isinstance(e.value, str)]
+            out.setdefault(node.target.id, []).extend(names)
+    return out
+
+
+def _literal_names(arg: ast.expr, loops: dict[str, list[str]]) -> list[str]:
+    """The module names a dynamic import's argument can hold: a string literal, or a loop variable over
+    string literals."""
+    if isinstance(arg, ast.Constant) and isinstance(arg.value, str):
+        return [arg.value]
+    if isinstance(arg, ast.Name):
+        return loops.get(arg.id, [])
+    return []
+
+
 def import_graph(root: Path) -> tuple[nx.DiGraph, dict[str, set[str]]]:
     """The package's modules and the imports between them (every ``import`` and ``from ... import``, at module
-    level or inside functions), and the top-level third-party packages each module imports."""
+    level or inside functions, and every ``__import__`` / ``importlib.import_module`` of a string literal or of
+    a loop variable over string literals), and the top-level third-party packages each module imports."""
     mods = _modules(root)
     pkg = root.name
     graph, external = nx.DiGraph(), {}
@@ -46,9 +79,13 @@ def import_graph(root: Path) -> tuple[nx.DiGraph, dict[str, set[str]]]:
     for mod, path in mods.items():
         graph.add_node(mod)
         external[mod] = set()
-        for node in ast.walk(ast.parse(path.read_text(), filename=str(path))):
+        tree = ast.parse(path.read_text(), filename=str(path))
+        loops = _literal_loops(tree)
+        for node in ast.walk(tree):
             if isinstance(node, ast.Import):
                 targets = [a.name for a in node.names]
+            elif isinstance(node, ast.Call) and _dynamic_import(node):
+                targets = _literal_names(node.args[0], loops)
             elif isinstance(node, ast.ImportFrom):
                 base = node.module or ""
                 if node.level:
@@ -126,3 +163,31 @@ def test_the_graph_sees_function_level_and_relative_imports(tmp_path):
     assert [sorted(c) for c in nx.simple_cycles(g)] == [["pkg.core.a", "pkg.core.b"]]
     assert g.has_edge("pkg.core.b", "pkg.sim")
     assert external["pkg.core.b"] == {"mujoco"}
+
+
+def test_the_graph_sees_imports_of_modules_named_by_strings(tmp_path):
+    """A cycle closed through ``__import__`` or ``importlib.import_module`` (of a literal, or of a loop variable
+    over literals) is found; a name computed at run time is not guessed at."""
+    pkg = tmp_path / "pkg"
+    pkg.mkdir()
+    (pkg / "__init__.py").write_text("")
+    (pkg / "cli.py").write_text(
+        "def commands():\n"
+        "    for module in ('pkg.sub', 'pkg.other'):\n"
+        "        __import__(module, fromlist=['add_parser'])\n"
+    )
+    (pkg / "sub.py").write_text("def run():\n    from pkg.cli import commands\n")
+    (pkg / "other.py").write_text("import importlib\n\ndef f():\n    importlib.import_module('pkg.leaf')\n")
+    (pkg / "leaf.py").write_text("def g(name):\n    return __import__(name)\n")
+    g, _ = import_graph(pkg)
+    assert [sorted(c) for c in nx.simple_cycles(g)] == [["pkg.cli", "pkg.sub"]]
+    assert g.has_edge("pkg.cli", "pkg.other") and g.has_edge("pkg.other", "pkg.leaf")
+    assert list(g.successors("pkg.leaf")) == []
+
+
+def test_the_command_reaches_its_subcommands_one_way(graph):
+    """``haptic.cli`` loads its subcommands by name; none of them imports it back."""
+    g, _ = graph
+    for sub in ("haptic.sim.cli", "haptic.episode_cli", "haptic.bench.cli"):
+        assert g.has_edge("haptic.cli", sub)
+        assert not nx.has_path(g, sub, "haptic.cli"), f"{sub} imports haptic.cli back"

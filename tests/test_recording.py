@@ -186,8 +186,8 @@ def test_physics_trace_and_hand_links_are_recorded(tmp_path):
     recorder.on_start(load_library()["WEDGE01"], SE3.identity())
     with pytest.warns(UserWarning, match="bad"):
         recorder.on_move(0, result, 12, None)
-    later = ContactTrace(*(a[:20] for a in trace._arrays()))
-    later = ContactTrace(later.time + 1.0, *later._arrays()[1:])
+    later = ContactTrace(*(a[:20] for a in trace.columns()))
+    later = ContactTrace(later.time + 1.0, *later.columns()[1:])
     failed = MoveResult(move=FaceMove(np.array([1.0, 0, 0])), status="timeout", cost=0.5,
                         state=result.state, trace=later, reason="no edge")  # fmt: skip
     recorder.on_failed_move(1, failed)
@@ -433,7 +433,7 @@ def test_verification_moves_are_labelled_as_such(tmp_path):
 
 def test_probes_are_drawn_hits_and_misses_apart(tmp_path):
     from haptic.geometry import SE3, load_library
-    from haptic.matching.probes import FreeSegment, probe_face
+    from haptic.matching.free_space import FreeSegment, probe_face
     from haptic.planning.moves import FaceMove, MoveResult, ProbeMove, SensorState
     from haptic.recording.style import KIND_COLORS, PROBE_HIT_COLOR, PROBE_MISS_COLOR
 

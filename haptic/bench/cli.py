@@ -13,14 +13,14 @@ import time
 from pathlib import Path
 
 from haptic.errors import BenchError, HapticError
-from haptic.options import DeferredInterrupts, Terminated
+from haptic.options import DeferredInterrupts, Subcommands, Terminated
 
 EXIT_SIGINT, EXIT_SIGTERM = 130, 143
 """Exit codes of a sweep ended by SIGINT (Ctrl-C) or SIGTERM: 128 + the signal's number."""
 
 
-def add_parser(sub: argparse._SubParsersAction) -> None:
-    from haptic.matching.verify import DEFAULT_VERIFY, VERIFY_MODES
+def add_parser(sub: Subcommands) -> None:
+    from haptic.matching.acceptance import DEFAULT_VERIFY, VERIFY_MODES
     from haptic.options import noise_levels, positive_int, seed_int
     from haptic.planning.moves import DEFAULT_MOVES, HAND_DEFAULT_MOVES, MOVE_SETS
     from haptic.planning.registry import POLICY_NAMES
@@ -79,9 +79,8 @@ def run(args: argparse.Namespace) -> int:
 def _run(args: argparse.Namespace, held: DeferredInterrupts) -> int:
     from haptic.bench.results import ResultsWriter, drop_partial_line, iter_results
     from haptic.bench.runner import episode_key, key_id, plan_sweep, ray_available
-    from haptic.cli import report_skipped
     from haptic.geometry import load_library
-    from haptic.options import check_output_file
+    from haptic.options import check_output_file, report_skipped
     from haptic.planning.moves import default_moves
     from haptic.planning.registry import POLICY_NAMES
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 import json
 import os
 import signal
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterator
 from pathlib import Path
 
 from haptic.errors import BenchError
@@ -103,9 +103,3 @@ def drop_partial_line(path: str | os.PathLike) -> int:
         keep = data.rfind(b"\n") + 1
         fh.truncate(keep)
         return len(data) - keep
-
-
-def write_lines(path: str | os.PathLike, records: Iterable[dict]) -> None:
-    with ResultsWriter(path, overwrite=True) as w:
-        for r in records:
-            w.write(r)

@@ -291,7 +291,3 @@ def _run_ray(payload: list[dict], workers: int) -> Iterator[dict]:
         if started:
             ray.shutdown()
         held.release()
-
-
-def with_models(specs: Sequence[EpisodeSpec], models: str | None) -> list[EpisodeSpec]:
-    return [replace(s, models=models) for s in specs]

@@ -120,7 +120,7 @@ def _outside_distance(model: Polyhedron, face: int, points_m: np.ndarray) -> flo
     loop = model.vertices[list(model.faces[face])]
     uv = np.column_stack([loop @ u, loop @ w])
     q = np.column_stack([points_m @ u, points_m @ w])
-    return float(np.mean([0.0 if tracing._inside_polygon(x, uv) else tracing._boundary_distance(x, uv) for x in q]))
+    return float(np.mean([0.0 if tracing.inside_polygon(x, uv) else tracing.boundary_distance(x, uv) for x in q]))
 
 
 def score_face(c: DataFace, model: Polyhedron, rot: np.ndarray, trans: np.ndarray, tol: EvaluationTolerances):
@@ -256,10 +256,10 @@ def _first_exit_felt(model: Polyhedron, face: int, start_m: np.ndarray, d_m: np.
         for s in np.arange(step, float(np.linalg.norm(model.extents)) + step, step):
             q = hit.point + s * d
             x = np.array([q @ u, q @ w])
-            if tracing._inside_polygon(x, uv):
+            if tracing.inside_polygon(x, uv):
                 p = q
                 break  # back on the face: a corner the pad bridges; trace on from here
-            if tracing._boundary_distance(x, uv) > depth:
+            if tracing.boundary_distance(x, uv) > depth:
                 return hit
         else:
             return hit

@@ -22,23 +22,23 @@ from haptic.episode.opening import (
     opening_probe,
     tracing_remainder,
 )
+from haptic.episode.outcome import score_outcome
 from haptic.episode.perception import on_the_table, touched_points
-from haptic.episode.scoring import score_outcome
 from haptic.episode.spec import EpisodeSpec
 from haptic.errors import HapticError
 from haptic.geometry import SE3, Polyhedron
 from haptic.geometry.se3 import matrix_to_quat
+from haptic.matching.acceptance import K_SIGMA, K_SIGMA_PHYSICS
 from haptic.matching.components import DataComponent, SensorNoise
-from haptic.matching.probes import MAX_POSED as PROBES_MAX_POSED
-from haptic.matching.probes import FreeSegment, apply_probes
+from haptic.matching.free_space import MAX_POSED as PROBES_MAX_POSED
+from haptic.matching.free_space import FreeSegment, apply_probes
 from haptic.matching.recognition import AMBIGUOUS, EXPLORING, NO_MATCH, RECOGNIZED, Recognition, recognize
 from haptic.matching.tree import InterpretationTree
-from haptic.matching.verify import K_SIGMA, K_SIGMA_PHYSICS
 from haptic.planning.config import PlannerConfig
 from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import Move, MoveResult
+from haptic.planning.opening_probes import LibraryExtent
 from haptic.planning.policies import Context, Decision, Policy, RandomPolicy
-from haptic.planning.probes import LibraryExtent
 from haptic.planning.verify import Verifier
 
 MAX_POSED = 4000

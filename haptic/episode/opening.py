@@ -14,14 +14,15 @@ import numpy as np
 from haptic.matching.components import DataFace
 from haptic.planning.config import PlannerConfig
 from haptic.planning.moves import CostModel, Move, ProbeMove
+from haptic.planning.opening_probes import LibraryExtent, opening_probes, region_centre
 from haptic.planning.policies import same_move
 from haptic.planning.predict import candidate_moves
-from haptic.planning.probes import LibraryExtent, ProbeConfig, opening_probes, region_centre
+from haptic.planning.probe_lines import ProbeConfig
 from haptic.planning.table import table_safe_moves, vertex_sweep_off_table
 
 OPENING_PROBE_CHOICES = 3
 """The opening probe is drawn from this many of the best-ranked lines not yet tried
-(:func:`~haptic.planning.probes.opening_probes`)."""
+(:func:`~haptic.planning.opening_probes.opening_probes`)."""
 
 
 def opening_move(
@@ -85,7 +86,7 @@ def opening_probe(
 def opening_choices(
     components, extent: LibraryExtent, config: PlannerConfig, avoid: tuple = (), unmeasured: bool = False
 ) -> list[ProbeMove]:
-    """The :data:`OPENING_PROBE_CHOICES` best lines of :func:`~haptic.planning.probes.opening_probes` toward the
+    """The :data:`OPENING_PROBE_CHOICES` best lines of :func:`~haptic.planning.opening_probes.opening_probes` toward the
     region the data faces leave for the object, less the lines already probed or failed (``avoid``)."""
     faces = _data_faces(components)
     cfg = ProbeConfig(table_z=config.table_z, table_clearance=config.table_clearance)
@@ -104,7 +105,7 @@ def tracing_opening_cost(
 ) -> float:
     """Expected cost of the opening's tracing moves ``kinds`` up to and including the first that measures a new
     face (a face move or a vertex move: §4, each ends acquiring a normal; an edge move measures a vertex only),
-    from the library's averages (:class:`~haptic.planning.probes.LibraryExtent`): a face move
+    from the library's averages (:class:`~haptic.planning.opening_probes.LibraryExtent`): a face move
     ``c_f · face_run + c_j + c_b + c_n``, an edge move ``c_e · edge_run + c_k`` (``edge_run`` the one given,
     :func:`edge_run_of` the edge the sensor is on, else the library's), a vertex move
     ``c_v · r_v · corner_angle + c_j + c_b + c_n`` (``r_v`` the vertex circle's radius) [units]."""
@@ -125,7 +126,7 @@ def opening_probe_cost(move: ProbeMove, position: np.ndarray, components, extent
                        config: PlannerConfig) -> float:  # fmt: skip
     """Expected cost of an opening probe from the sensor at ``position``: ``c_p + c_s s``, ``s`` the transfer to
     the line's start and the run along it to the expected contact, ``depth`` before the point of the line
-    nearest the region's estimated centre (:func:`~haptic.planning.probes.region_centre`) [units]."""
+    nearest the region's estimated centre (:func:`~haptic.planning.opening_probes.region_centre`) [units]."""
     faces = _data_faces(components)
     start, u = np.asarray(move.start, dtype=float), np.asarray(move.direction, dtype=float)
     run = float((region_centre(faces, extent) - start) @ u) - extent.depth

@@ -33,7 +33,7 @@ class EpisodeSpec:
     skip_invalid: bool = False
     """Use the library's valid models when some of its files are bad (else refuse the library)."""
     verify: str = "none"
-    """Verification before recognition: "none", "fast" or "full" (:mod:`haptic.matching.verify`)."""
+    """Verification before recognition: "none", "fast" or "full" (:mod:`haptic.matching.acceptance`)."""
     moves: str = "tracing"
     """Admissible kinds of move: "tracing" (face, edge, vertex moves), "probing" (free-space probes alone,
     geometric executor) or "all" (both, ranked by one planner; every policy plans them). The command line's

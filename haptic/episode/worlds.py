@@ -140,7 +140,7 @@ class PhysicsWorld:
         # MuJoCo and the physics executor load only for physics episodes (geometric sweeps never import them)
         from haptic.episode.evaluate import score_components
         from haptic.executor.physics import PhysicsExecutor, PhysicsSettings
-        from haptic.executor.primitives import TouchConfig
+        from haptic.executor.touch_config import TouchConfig
         from haptic.sim import RobotInterface, Simulation, compose_scene, random_object_pose
         from haptic.sim.scene import scene_object_from_polyhedron
 

@@ -23,9 +23,10 @@ from haptic.geometry.polyhedron import Polyhedron
 from haptic.geometry.raycast import line_hits
 from haptic.geometry.se3 import SE3, plane_basis
 from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex, SensorNoise
-from haptic.matching.probes import FreeSegment
+from haptic.matching.free_space import FreeSegment
 from haptic.planning.moves import (
     VERTEX_RADIUS,
+    ZERO_LENGTH,
     CostModel,
     EdgeMove,
     FaceMove,
@@ -34,7 +35,13 @@ from haptic.planning.moves import (
     ProbeMove,
     SensorState,
     VertexMove,
+    in_plane,
 )
+
+INSIDE = 1e-7
+"""A trace onto a new face starts this far in from the edge, off it (round-off) [m]."""
+AT_VERTEX = 1e-9
+"""An edge trace shorter than this started at its vertex (round-off) [m]."""
 
 
 @dataclass(frozen=True)
@@ -50,8 +57,15 @@ class GeometricSettings:
     start_margin: float = 0.004
     """Smallest distance of the landing point from the boundary of its face [m]."""
     vertex_standoff: float = 0.002
-    """After an edge move the sensor rests this far back from the vertex along the edge (and a quarter of it in
-    on the current face) [m]."""
+    """After an edge move the sensor rests this far back from the vertex along the edge ... [m]"""
+    standoff_inward: float = 0.25
+    """... and this fraction of that in on the current face [-] ..."""
+    standoff_edge_fraction: float = 0.25
+    """... at most this fraction of the edge's length back [-]."""
+    step_room_fraction: float = 0.45
+    """Stepping onto a new face, the sensor goes at most this fraction of the way to the face's far boundary [-]."""
+    circle_clear: float = 0.3
+    """A vertex move's new edge is explored from this fraction of the circle's radius from the vertex [-]."""
     truncate: bool = True
     """Truncate every noise draw to the error bound k σ (data always inside their bounds)."""
     at_bounds: bool = False
@@ -183,7 +197,7 @@ class GeometricExecutor:
         src, dst = int(m.edges[e, 0]), int(m.edges[e, 1])
 
         def at(s: float) -> int | None:
-            v = src if s <= 1e-12 else dst if s >= length - 1e-12 else None
+            v = src if s <= ZERO_LENGTH else dst if s >= length - ZERO_LENGTH else None
             return rec.vertices.get(v) if v is not None else None
 
         return DataEdge(
@@ -224,9 +238,9 @@ class GeometricExecutor:
     def _step_onto(self, face: int, edge: int, point: np.ndarray) -> np.ndarray:
         """Points on ``face`` reached by stepping in from ``point`` on ``edge`` (to acquire the normal)."""
         w = self._inward(face, edge)
-        hit = tracing.trace_face(self.model, face, point + 1e-7 * w, w)
+        hit = tracing.trace_face(self.model, face, point + INSIDE * w, w)
         room = hit.distance if hit is not None else self.settings.step_onto_face
-        s = min(self.settings.step_onto_face, 0.45 * room)
+        s = min(self.settings.step_onto_face, self.settings.step_room_fraction * room)
         return np.array([point + 0.5 * s * w, point + s * w])
 
     def _arc_point(self, face: int, vertex: int, edge: int, angle: float, radius: float) -> np.ndarray:
@@ -315,9 +329,8 @@ class GeometricExecutor:
         if d.shape != (3,) or not np.all(np.isfinite(d)):
             return self._invalid(move, "direction must be a finite 3-vector")
         d_m = self.world_from_model.inverse().rotate(d)
-        n = m.face_normals[f]
-        inplane = d_m - (d_m @ n) * n
-        if np.linalg.norm(inplane) < 0.1 * max(np.linalg.norm(d_m), 1e-12):
+        inplane = in_plane(d_m, m.face_normals[f])
+        if inplane is None:
             return self._invalid(move, "direction is not in the plane of the current face")
         hit = tracing.trace_face(m, f, self._pos, inplane)
         if hit is None:
@@ -356,7 +369,7 @@ class GeometricExecutor:
         s_pos = float(np.clip((self._pos - p_m) @ b_m, 0.0, length))
         ms = move.sense * rec.sense
         hit = tracing.trace_edge(m, e, p_m + s_pos * b_m, ms)
-        if hit.distance < 1e-9 or (st.vertex is not None and rec.vertices.get(hit.vertex) == st.vertex):
+        if hit.distance < AT_VERTEX or (st.vertex is not None and rec.vertices.get(hit.vertex) == st.vertex):
             return self._invalid(move, "the sensor is already at the vertex in that sense")
         lo, hi = rec.interval
         rec.interval = (0.0, max(hi, s_pos)) if ms < 0 else (min(lo, s_pos), length)
@@ -375,8 +388,9 @@ class GeometricExecutor:
             comps.append(new_vertex)
         # stop at the vertex, on the current face: a little back along the edge and in from it
         f = self._true_face[st.face]
-        back = min(self.settings.vertex_standoff, 0.25 * length)
-        self._pos = m.vertices[hit.vertex] - ms * back * b_m + 0.25 * back * self._inward(f, e)
+        s = self.settings
+        back = min(s.vertex_standoff, s.standoff_edge_fraction * length)
+        self._pos = m.vertices[hit.vertex] - ms * back * b_m + s.standoff_inward * back * self._inward(f, e)
         self.state = self._state(face=st.face, edge=st.edge, vertex=rec.vertices[hit.vertex], edge_faces=st.edge_faces)
         self.components.extend(comps)
         return MoveResult(
@@ -406,7 +420,8 @@ class GeometricExecutor:
         from_src = int(m.edges[e2, 0]) == v
         rr = min(r, 0.5 * length2)
         s_hit = rr if from_src else length2 - rr
-        lo_lim, hi_lim = (0.3 * rr, length2) if from_src else (0.0, length2 - 0.3 * rr)
+        clear = self.settings.circle_clear
+        lo_lim, hi_lim = (clear * rr, length2) if from_src else (0.0, length2 - clear * rr)
         eid, rec2 = self._new_edge(e2, s_hit, lo_lim, hi_lim)
         h = m.edge_points[e2] + s_hit * m.edge_directions[e2]
         pts = self._step_onto(g2, e2, h)
@@ -450,19 +465,27 @@ class GeometricExecutor:
         return moves
 
 
+WALK_ATTEMPTS = 20
+"""A random walk tries up to this many moves for each move it makes."""
+WALK_FACE_SHARE = 0.4
+"""A random walk makes a face move with this probability when an edge or vertex move is possible."""
+
+
 def random_walk(executor: GeometricExecutor, n_moves: int, rng: np.random.Generator) -> list[MoveResult]:
-    """Start on a random face and make ``n_moves`` random admissible moves (face moves half the time when an
-    edge or vertex move is possible). Returns the results of the start and every successful move."""
+    """Start on a random face and make ``n_moves`` random admissible moves (face moves with probability
+    :data:`WALK_FACE_SHARE` when an edge or vertex move is possible). Returns the results of the start and every
+    successful move."""
     results = [executor.start()]
     for _ in range(n_moves):
-        for _attempt in range(20):
+        for _attempt in range(WALK_ATTEMPTS):
             st = executor.state
             kinds = ["face"]
             if st.edge is not None:
                 kinds.append("edge")
             if st.vertex is not None:
                 kinds.append("vertex")
-            kind = kinds[0] if len(kinds) == 1 or rng.random() < 0.4 else kinds[int(rng.integers(1, len(kinds)))]
+            face_move = len(kinds) == 1 or rng.random() < WALK_FACE_SHARE
+            kind = kinds[0] if face_move else kinds[int(rng.integers(1, len(kinds)))]
             if kind == "face":
                 move: Move = executor.admissible_moves(rng, n_directions=1)[0]
             elif kind == "edge":

@@ -21,6 +21,8 @@ from haptic.matching.trace import ContactTrace
 from haptic.planning.moves import Move, MoveResult, SensorState
 from haptic.sim.scene import TABLE_TOP_Z
 
+RAISE_ROUND_OFF = 1e-6
+"""The approach can still be raised while it is more than this below its highest [m] (round-off)."""
 MAX_STUCK = 4
 """Start: moves across above the object region, at the highest approach, that may time out in a row before
 the start gives up (the arm is held back: every further landing would be too)."""
@@ -36,7 +38,7 @@ class LandingSearch:
         z_top = TABLE_TOP_Z + s.approach_height
         z_max = TABLE_TOP_Z + max(s.max_approach_height, s.approach_height)
         last = "no-contact"
-        landings = landing_points(s.search_spacing, s.search_margin, self.rng)
+        landings = landing_points(s.search_spacing, s.search_margin, self.rng, s.search_jitter, s.search_order_jitter)
         budget = s.max_landings if s.max_landings is not None else len(landings) + s.edge_retries
         i = -1
         stuck = 0  # moves across, at the highest approach, that timed out in a row
@@ -44,13 +46,13 @@ class LandingSearch:
             i += 1
             xy = landings[i]
             above = np.array([xy[0], xy[1], z_top])
-            if t.tip[2] < z_top - 0.01:  # lift straight up first
+            if t.tip[2] < z_top - s.approach_slack:  # lift straight up first
                 up = t.tip.copy()
                 up[2] = z_top
-                pieces.append(t.move_free(up, timeout=3.0, tol=3e-3))
-            r = t.move_free(above, timeout=4.0, tol=3e-3)
+                pieces.append(t.move_free(up, timeout=t.config.via_timeout, tol=t.config.via_tol))
+            r = t.move_free(above, timeout=t.config.free_timeout, tol=t.config.via_tol)
             pieces.append(r)
-            can_raise = z_top < z_max - 1e-6
+            can_raise = z_top < z_max - RAISE_ROUND_OFF
             if r.status == "timeout" and can_raise:
                 # blocked on the way across: the object stands taller than the approach height. Go higher
                 z_top, i = min(z_top + s.approach_raise, z_max), i - 1
@@ -70,14 +72,14 @@ class LandingSearch:
                 np.array([0.0, 0.0, -1.0]), z_top - TABLE_TOP_Z - s.search_floor, speed=s.search_speed, settle=False
             )
             pieces.append(r)
-            if r.ok and r.info["point"][2] > z_top - 0.006 - t.pad_radius and can_raise:
+            if r.ok and r.info["point"][2] > z_top - s.touched_at_once - t.pad_radius and can_raise:
                 # touched at once (the side of something reaching up to the approach height): go higher
                 z_top, i = min(z_top + s.approach_raise, z_max), i - 1
                 continue
             if r.ok:
-                back = t.tip + np.array([0.0, 0.0, 0.005])
-                pieces.append(t.move_free(back, timeout=1.0, tol=1e-3))
-                r = t.approach(np.array([0.0, 0.0, -1.0]), 0.015)
+                back = t.tip + np.array([0.0, 0.0, s.landing_back_off])
+                pieces.append(t.move_free(back, timeout=t.config.back_off_timeout, tol=t.config.target_tol))
+                r = t.approach(np.array([0.0, 0.0, -1.0]), s.landing_touch)
                 pieces.append(r)
             if not r.ok:
                 last = r.status
@@ -88,13 +90,13 @@ class LandingSearch:
                 continue
             fit, trace = self._normal_stroke(r.info["normal"], pieces)
             if fit is None:  # touched the object near an edge: try close by first
-                near = r.info["point"][:2] + self.rng.normal(0.0, 0.012, (2, 2))
+                near = r.info["point"][:2] + self.rng.normal(0.0, s.landing_jitter, (s.near_landings, 2))
                 landings[i + 1 : i + 1] = list(near)
                 continue
             face = self.segmenter.add_face(fit, ())
-            self._store_face(face.id, trace, fit)
-            self._on_face = face.id
-            self.state = SensorState(position=self._contact_point(), face=face.id)
+            self.store_face(face.id, trace, fit)
+            self.on_face = face.id
+            self.state = SensorState(position=self.contact_point(), face=face.id)
             return MoveResult(move=move, status="ok", components=(face,), state=self.state,
                               info={"travel": sum(p.distance for p in pieces)})  # fmt: skip
         return MoveResult(move=move, status=last if last != "ok" else "no-contact", state=None,
@@ -105,7 +107,7 @@ class LandingSearch:
         s, t = self.settings, self.toucher
         a = perpendicular(n0)
         phi0 = self.rng.uniform(0, 2 * np.pi)
-        for k in range(4):
+        for k in range(s.stroke_headings):
             phi = phi0 + k * np.pi / 2
             d1 = math.cos(phi) * a + math.sin(phi) * np.cross(n0, a)
             d2 = np.cross(n0, d1)
@@ -118,7 +120,7 @@ class LandingSearch:
                     break
             if all(r.ok and r.event == "done" for r in legs) and len(legs) == 2:
                 trace = ContactTrace.concatenate([r.trace for r in legs])
-                if not self._on_one_face(trace):
+                if not self.on_one_face(trace):
                     return None, trace  # the pad rolled on an edge or a vertex: land again elsewhere
                 fit = self.segmenter.fit_face_trace(trace, legs[-1].info["face_normal"], two_d=True)
                 return fit, trace
@@ -137,7 +139,7 @@ class LandingSearch:
             n0 = t.normal.copy()
         return None, ContactTrace.concatenate([])
 
-    def _on_one_face(self, trace: ContactTrace) -> bool:
+    def on_one_face(self, trace: ContactTrace) -> bool:
         """Whether every contact row of the start's L stroke lies on one face. On a face the sensed normal does
         not turn as the pad slides; landed on (or next to) an edge or a vertex, the pad rolls on it and the
         normal turns by 1/r along the stroke -- slowly enough for the edge detector not to fire, and the rows

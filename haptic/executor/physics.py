@@ -26,8 +26,10 @@ import numpy as np
 from haptic.errors import HapticError
 from haptic.executor.landing import LandingSearch
 from haptic.executor.physics_probe import probe_move
-from haptic.executor.primitives import PrimitiveResult, TouchConfig, Toucher
+from haptic.executor.primitives import PrimitiveResult, Toucher
 from haptic.executor.segment import (
+    AT_END,
+    MM,
     FaceFit,
     LineFit,
     SegmentBounds,
@@ -36,7 +38,8 @@ from haptic.executor.segment import (
     fit_face,
     line_from_points,
 )
-from haptic.executor.workspace import Workspace, admissible_moves, toward_vertex
+from haptic.executor.touch_config import TouchConfig
+from haptic.executor.workspace import ReentrySearch, Workspace, admissible_moves, toward_vertex
 from haptic.geometry.se3 import angle, unit
 from haptic.matching.components import DataComponent
 from haptic.matching.trace import PHASES, ContactTrace
@@ -53,6 +56,7 @@ from haptic.planning.moves import (
     SensorState,
     Touches,
     VertexMove,
+    in_plane,
 )
 from haptic.planning.table import VERTEX_START_ANGLE
 from haptic.sim.robot import RobotInterface
@@ -126,6 +130,45 @@ class PhysicsSettings:
     point would come closer than this to the table top; a slide heading down stops there [m]."""
     edge_reentry: float = 0.004
     """An edge move that must first return next to its edge touches the face this far in from the edge [m]."""
+    reentry: ReentrySearch = field(default_factory=ReentrySearch)
+    """... and, when that is within the pad's reach of the table, searches further along the edge."""
+    edge_reach: float = 0.03
+    """An edge move starts where the pad is when it rests on one of the edge's faces within this of its line;
+    farther, it returns next to the edge first [m]."""
+    vertex_hold: float = 0.05
+    """At the end of an edge the pad presses in place this long before the vertex is located [s]."""
+    min_vertex_rows: int = 3
+    """The vertex is located from the rows whose normal leans along the edge (at least this many) ..."""
+    lost_vertex_rows: int = 5
+    """... or, contact lost, from this many last contacts [-]."""
+    min_block_cos: float = 0.2
+    """A blocking contact locates a vertex only when its normal has at least this component along the edge [-]."""
+    roll_lead_rows: int = 8
+    """The last rows of a trace on a face before a roll count with the roll (for the edge between) [-]."""
+    stroke_headings: int = 4
+    """An L stroke for a face's normal is tried in up to this many headings, a quarter turn apart."""
+    approach_slack: float = 0.01
+    """Start: a pad more than this below the approach height lifts straight up first [m]."""
+    touched_at_once: float = 0.006
+    """Start: a landing touch within this (plus the pad radius) below the approach height touched the side of
+    something reaching up to it [m]."""
+    landing_back_off: float = 0.005
+    """Start: after the fast descent the pad backs off this far up ...[m]"""
+    landing_touch: float = 0.015
+    """... and touches again slowly, over at most this [m]."""
+    landing_jitter: float = 0.012
+    """Start: after touching near an edge, landings are tried again this close by (σ) [m] ..."""
+    near_landings: int = 2
+    """... this many of them."""
+    search_jitter: float = 0.3
+    """Start: the landing grid's points are jittered by up to this fraction of its spacing [-] ..."""
+    search_order_jitter: float = 0.01
+    """... and their order (nearest the region's centre first) by up to this distance [m]."""
+    table_normal_cos: float = 0.99
+    """A contact is the table when its normal's vertical component exceeds this (and it is below the table top
+    plus ``table_margin``) [-] ..."""
+    table_contact_cos: float = 0.95
+    """... a fingertip's contact, as sensed during a move, when it exceeds this [-]."""
 
 
 @dataclass
@@ -157,22 +200,20 @@ class PhysicsExecutor(LandingSearch):
         self.costs = costs or CostModel()
         self.rng = rng if rng is not None else np.random.default_rng(0)
         s = settings or PhysicsSettings()
-        if s.touch.force_sigma != self.bounds.force_sigma:
-            s = PhysicsSettings(
-                **{**s.__dict__, "touch": TouchConfig(**{**s.touch.__dict__, "force_sigma": self.bounds.force_sigma})}
-            )
         self.settings = s
-        self.toucher = Toucher(robot, s.touch, finger)
+        self.toucher = Toucher(robot, s.touch, finger, self.bounds)
         self.toucher.floor_z = TABLE_TOP_Z + s.pad_clearance
         self.workspace = Workspace(self.toucher, s.table_margin, s.pad_clearance, s.vertex_radius,
-                                   s.vertex_start_angle)  # fmt: skip
+                                   s.vertex_start_angle, table_normal_cos=s.table_normal_cos,
+                                   table_contact_cos=s.table_contact_cos)  # fmt: skip
         self.segmenter = Segmenter(self.bounds)
         self.state: SensorState | None = None
         """Sensor state after the last move (None before :meth:`start`)."""
         self.traces: list[ContactTrace] = []
         """Every contact trace recorded, one per move (start included)."""
         self._faces: dict[int, _FaceData] = {}
-        self._on_face: int | None = None  # data face the pad is known to rest on
+        self.on_face: int | None = None
+        """The data face the pad is known to rest on (None: not known)."""
         self._finger = finger
         self._why = ""  # detail of the last repositioning failure
         self._links_until: float | None = None  # sim time of the last hand-link sample reported
@@ -192,10 +233,10 @@ class PhysicsExecutor(LandingSearch):
         try:
             res = body(pieces)
         except (HapticError, FloatingPointError, ValueError, np.linalg.LinAlgError) as exc:
-            self._on_face = None
+            self.on_face = None
             res = MoveResult(move=move, status="unstable", state=self.state, reason=str(exc))
         except Exception as exc:  # noqa: BLE001 -- mujoco raises plain exceptions on a diverged state
-            self._on_face = None
+            self.on_face = None
             res = MoveResult(move=move, status="unstable", state=self.state,
                              reason=f"{type(exc).__name__}: {exc}")  # fmt: skip
         trace = ContactTrace.concatenate([p.trace for p in pieces])
@@ -223,20 +264,22 @@ class PhysicsExecutor(LandingSearch):
         when the roll cannot have been over an edge between the two faces."""
         seg = self.segmenter
         fit_a = self._face_fit(face, trace)
-        roll_all = ContactTrace.concatenate([trace.select(trace.phase == PHASES.index(phase)).tail(8), roll])
+        lead = trace.select(trace.phase == PHASES.index(phase)).tail(self.settings.roll_lead_rows)
+        roll_all = ContactTrace.concatenate([lead, roll])
         why = seg.edge_inconsistency(fit_a, fit_b, kind == "convex", roll_all)
         if why is not None:
             return fit_a, None, f"no edge between the faces: {why}"
         return fit_a, seg.edge_line(fit_a, fit_b, kind == "convex", roll_all, corner), ""
 
-    def _fail(self, move: Move, res: PrimitiveResult | str, reason: str) -> MoveResult:
-        """The move failed with ``reason``: its status is the primitive's failure, or "unreachable" for an
-        outcome that is no :class:`MoveStatus` (a primitive that ended "ok" short of the move, an event such as
-        "undercut" that one move recovers from and another cannot)."""
+    def failed_result(self, move: Move, res: PrimitiveResult | str, reason: str) -> MoveResult:
+        """A failed move: the status of ``res`` (a primitive's result, or a status), the state before the move;
+        the pad is no longer known to rest on a face. An outcome that is no :class:`MoveStatus` (a primitive that
+        ended "ok" short of the move, an event such as "undercut" that one move recovers from and another
+        cannot) counts as "unreachable"."""
         status = res if isinstance(res, str) else res.status
         if status == "ok" or status not in MOVE_STATUSES:
             status = "unreachable"
-        self._on_face = None
+        self.on_face = None
         return MoveResult(move=move, status=status, state=self.state, reason=reason)
 
     def _face_fit(self, fid: int, extra: ContactTrace | None = None) -> FaceFit:
@@ -253,8 +296,9 @@ class PhysicsExecutor(LandingSearch):
                 nrm = np.vstack([nrm, extra.normal_in_world[keep]])
         return fit_face(pts, nrm, self.bounds)
 
-    def _store_face(self, fid: int, trace: ContactTrace, fit: FaceFit) -> None:
-        mask = face_rows(trace, fit.normal, self.bounds.face_cone)
+    def store_face(self, fid: int, trace: ContactTrace, fit: FaceFit) -> None:
+        """Keep the rows of ``trace`` on data face ``fid`` (those within the face cone of its fit ``fit``)."""
+        mask = face_rows(trace, fit.normal, self.bounds.face_cone, self.bounds.min_refine_rows)
         pts, nrm = trace.point_in_world[mask], trace.normal_in_world[mask]
         self._faces[fid] = _FaceData(pts, nrm, pts[-1].copy())
 
@@ -262,7 +306,8 @@ class PhysicsExecutor(LandingSearch):
         """The exploring fingertip's sensed contacts now."""
         return self.robot.read().contacts[self.robot.fingers.index(self._finger)]
 
-    def _contact_point(self) -> np.ndarray:
+    def contact_point(self) -> np.ndarray:
+        """The sensed contact point now, or the pad centre when there is no contact [m]."""
         t = self.toucher
         return t.contact[2].copy() if t.contact[2] is not None else t.tip.copy()
 
@@ -289,15 +334,16 @@ class PhysicsExecutor(LandingSearch):
             return self._run(move, lambda pieces: probe_move(self, move, pieces))
         return MoveResult(move=move, status="invalid", state=self.state, reason=f"unknown move {move!r}")
 
-    def _invalid(self, move: Move, reason: str) -> MoveResult:
+    def invalid_result(self, move: Move, reason: str) -> MoveResult:
+        """A move that cannot be made from the current state (status ``invalid``, the state unchanged)."""
         return MoveResult(move=move, status="invalid", state=self.state, reason=reason)
 
     def _ensure_on_face(self, fid: int, pieces: list[PrimitiveResult], near: np.ndarray | None = None) -> str:
         """Put the pad on data face ``fid`` (at ``near`` when given, else where it last touched it)."""
         t = self.toucher
         n = self.segmenter.faces[fid].component.normal
-        if (near is None and self._on_face == fid and t.contact[1] is not None
-                and angle(t.normal, n) < math.radians(5.0)):  # fmt: skip
+        if (near is None and self.on_face == fid and t.contact[1] is not None
+                and angle(t.normal, n) < self.bounds.resting_cone):  # fmt: skip
             return "ok"
         target = self._faces[fid].anchor if near is None else near
         if self.workspace.pad_clearance(target, n) < self.settings.pad_clearance:
@@ -308,10 +354,10 @@ class PhysicsExecutor(LandingSearch):
         if not r.ok:
             self._why = f"{r.status}/{r.event}"
             return r.status
-        if angle(r.info["normal"], n) > math.radians(6.0):
+        if angle(r.info["normal"], n) > self.bounds.retouch_cone:
             self._why = f"touched a normal {math.degrees(angle(r.info['normal'], n)):.0f}° off the face"
             return "unreachable"
-        self._on_face = fid
+        self.on_face = fid
         return "ok"
 
     def _cross_and_acquire(
@@ -348,40 +394,40 @@ class PhysicsExecutor(LandingSearch):
         st, t, seg = self.state, self.toucher, self.segmenter
         d = np.asarray(move.direction, dtype=float)
         if d.shape != (3,) or not np.all(np.isfinite(d)):
-            return self._invalid(move, "direction must be a finite 3-vector")
+            return self.invalid_result(move, "direction must be a finite 3-vector")
         n_a = seg.faces[st.face].component.normal
-        inplane = d - (d @ n_a) * n_a
-        if np.linalg.norm(inplane) < 0.1 * max(np.linalg.norm(d), 1e-12):
-            return self._invalid(move, "direction is not in the plane of the current face")
+        inplane = in_plane(d, n_a)
+        if inplane is None:
+            return self.invalid_result(move, "direction is not in the plane of the current face")
         status = self._ensure_on_face(st.face, pieces)
         if status != "ok":
-            return self._fail(move, status, f"could not return to the current face: {self._why}")
+            return self.failed_result(move, status, f"could not return to the current face: {self._why}")
         r = t.trace_face(inplane, n_a, self.settings.max_face_trace)
         pieces.append(r)
         if not r.ok:
             if r.event == "table":
-                return self._fail(move, r, "the finger would meet the table before an edge")
-            return self._fail(move, r, f"trace across the face: {r.event}")
+                return self.failed_result(move, r, "the finger would meet the table before an edge")
+            return self.failed_result(move, r, f"trace across the face: {r.event}")
         if r.event == "done":
-            return self._fail(move, "unreachable", "no edge within the longest trace")
+            return self.failed_result(move, "unreachable", "no edge within the longest trace")
         kind = r.info["kind"]
-        corner = self._contact_point()
+        corner = self.contact_point()
         status, reason, roll, stroke, fit_b = self._cross_and_acquire(kind, r.info["face_normal"], r.info["direction"],
                                                                       pieces)  # fmt: skip
         if status == "undercut":
             return self._edge_only(move, r, roll, reason, pieces)
         if status != "ok":
-            return self._fail(move, status, reason)
+            return self.failed_result(move, status, reason)
         fit_a, line, why = self._edge_between(st.face, r.trace, "face", roll, fit_b, kind, corner)
         if line is None:
-            return self._fail(move, "unreachable", why)
+            return self.failed_result(move, "unreachable", why)
         new_face = seg.next_id + 1
         edge = seg.add_edge(line, (st.face, new_face), kind == "convex", (fit_a.normal, fit_b.normal),
                             adjacent=(st.face,))  # fmt: skip
         face = seg.add_face(fit_b, adjacent=(edge.id,))
-        self._store_face(face.id, stroke, fit_b)
-        self._on_face = face.id
-        self.state = SensorState(position=self._contact_point(), face=face.id, edge=edge.id,
+        self.store_face(face.id, stroke, fit_b)
+        self.on_face = face.id
+        self.state = SensorState(position=self.contact_point(), face=face.id, edge=edge.id,
                                  edge_faces=(st.face, face.id))  # fmt: skip
         return MoveResult(move=move, status="ok", components=(edge, face), distance=r.distance,
                           cost=self.costs.face_move(r.distance), state=self.state, info={"kind": kind})  # fmt: skip
@@ -395,29 +441,28 @@ class PhysicsExecutor(LandingSearch):
         it traced."""
         st, seg = self.state, self.segmenter
         fit_a = self._face_fit(st.face, r.trace)
-        got = seg.edge_from_roll(fit_a, ContactTrace.concatenate([r.trace.select(r.trace.phase ==
-                                                                                 PHASES.index("face")).tail(8), roll]))
+        lead = r.trace.select(r.trace.phase == PHASES.index("face")).tail(self.settings.roll_lead_rows)
+        got = seg.edge_from_roll(fit_a, ContactTrace.concatenate([lead, roll]))
         if isinstance(got, str):
-            return self._fail(move, "unreachable", f"{reason}; no edge from the roll: {got}")
+            return self.failed_result(move, "unreachable", f"{reason}; no edge from the roll: {got}")
         line, n_last = got
         ridge = self._probe_ridge(line.direction, fit_a.normal, n_last, pieces)
         if isinstance(ridge, str):
-            return self._fail(move, "unreachable", f"{reason}; {ridge}")
+            return self.failed_result(move, "unreachable", f"{reason}; {ridge}")
         line = line_from_points(ridge, line.direction, line.direction_sigma, seg.bounds)
         edge = seg.add_edge(line, (st.face, None), True, (fit_a.normal, n_last), adjacent=(st.face,))
-        self._on_face = None
+        self.on_face = None
         self.state = SensorState(position=line.point + line.direction * 0.5 * sum(line.s_range), face=st.face)
         return MoveResult(move=move, status="ok", components=(edge,), distance=r.distance,
                           cost=self.costs.face_move(r.distance), state=self.state,
                           info={"kind": "convex", "next_face": "out of reach"})  # fmt: skip
 
-    @staticmethod
-    def _on_ridge(rows: ContactTrace, u: np.ndarray) -> np.ndarray:
-        """Rows of a ridge-following trace in contact on the ridge itself: the sensed normal within 4° of
-        perpendicular to the edge direction ``u`` (not rolling on a vertex at its end)."""
+    def _on_ridge(self, rows: ContactTrace, u: np.ndarray) -> np.ndarray:
+        """Rows of a ridge-following trace in contact on the ridge itself: the sensed normal within
+        ``ridge_row_cone`` of perpendicular to the edge direction ``u`` (not rolling on a vertex at its end)."""
         ok = rows.in_contact & (rows.phase == PHASES.index("ridge"))
         along = np.where(ok[:, None], rows.normal_in_world, 0.0) @ u
-        return ok & (np.abs(along) < math.sin(math.radians(4.0)))
+        return ok & (np.abs(along) < math.sin(self.bounds.ridge_row_cone))
 
     def _probe_ridge(
         self, e: np.ndarray, n_a: np.ndarray, n_b: np.ndarray, pieces: list[PrimitiveResult]
@@ -443,16 +488,9 @@ class PhysicsExecutor(LandingSearch):
                 return f"following the edge: {f.event}"
         pts = np.concatenate(pts)
         span = float(np.ptp(pts @ e)) if len(pts) else 0.0
-        if len(pts) < 10 or span < RIDGE_MIN_SPAN:
-            return f"no edge along the roll's axis (the ridge spans {span * 1e3:.1f} mm: a vertex?)"
+        if len(pts) < self.bounds.min_line_points or span < RIDGE_MIN_SPAN:
+            return f"no edge along the roll's axis (the ridge spans {span * MM:.1f} mm: a vertex?)"
         return pts
-
-    @staticmethod
-    def _last_on(trace: ContactTrace, normal: np.ndarray) -> np.ndarray:
-        ok = trace.in_contact
-        on = ok & (np.where(ok[:, None], trace.normal_in_world, 0.0) @ normal > math.cos(math.radians(4.0)))
-        idx = np.flatnonzero(on)
-        return trace.point_in_world[idx[-1]].copy() if len(idx) else trace.point_in_world[np.flatnonzero(ok)[0]]
 
     def _edge_frame(self, eid: int):
         rec = self.segmenter.edges[eid]
@@ -465,47 +503,48 @@ class PhysicsExecutor(LandingSearch):
     def _edge_move(self, move: EdgeMove, pieces: list[PrimitiveResult]) -> MoveResult:
         st, t, seg, s = self.state, self.toucher, self.segmenter, self.settings
         if st.edge is None:
-            return self._invalid(move, "no current edge: an edge move starts on or near an edge")
+            return self.invalid_result(move, "no current edge: an edge move starts on or near an edge")
         if move.sense not in (1, -1):
-            return self._invalid(move, f"sense must be +1 or -1, got {move.sense!r}")
+            return self.invalid_result(move, f"sense must be +1 or -1, got {move.sense!r}")
         rec, n_a, n_b, toward_a = self._edge_frame(st.edge)
         if st.vertex is not None and st.vertex in rec.vertices:
             s_v = rec.vertices[st.vertex]
             lo, hi = rec.interval
-            if (move.sense > 0 and s_v >= hi - 1e-9) or (move.sense < 0 and s_v <= lo + 1e-9):
-                return self._invalid(move, "the sensor is already at the vertex in that sense")
+            if (move.sense > 0 and s_v >= hi - AT_END) or (move.sense < 0 and s_v <= lo + AT_END):
+                return self.invalid_result(move, "the sensor is already at the vertex in that sense")
         u = move.sense * rec.direction
         on_clean = t.normal is not None and any(
-            angle(t.normal, seg.faces[f].component.normal) < math.radians(4.0) for f in rec.faces
+            angle(t.normal, seg.faces[f].component.normal) < self.bounds.face_cone for f in rec.faces
         )
-        if self._on_face not in rec.faces or self._line_distance(rec, t.tip) > 0.03 or not on_clean:
+        if self.on_face not in rec.faces or self._line_distance(rec, t.tip) > s.edge_reach or not on_clean:
             fid = st.face if st.face in rec.faces else rec.faces[1]
             near = self.workspace.reentry_point(rec, seg.faces[fid].component.normal, rec.inward[fid],
-                                                rec.param(self._contact_point()), u, s.edge_reentry)  # fmt: skip
+                                                rec.param(self.contact_point()), u, s.edge_reentry,
+                                                s.reentry)  # fmt: skip
             if near is None:
-                return self._fail(move, "unreachable", "the edge next to the table is out of the pad's reach")
+                return self.failed_result(move, "unreachable", "the edge next to the table is out of the pad's reach")
             status = self._ensure_on_face(fid, pieces, near=near)
             if status != "ok":
-                return self._fail(move, status, f"could not return next to the edge: {self._why}")
+                return self.failed_result(move, status, f"could not return next to the edge: {self._why}")
         acq = t.follow_edge(u, n_a, n_b, toward_a, 0.0, acquire_only=True)
         pieces.append(acq)
         if not acq.ok:
-            return self._fail(move, acq, f"acquiring the ridge: {acq.event}")
-        s_from = rec.param(self._contact_point())
+            return self.failed_result(move, acq, f"acquiring the ridge: {acq.event}")
+        s_from = rec.param(self.contact_point())
         r = t.follow_edge(u, n_a, n_b, toward_a, s.max_edge_trace)
         pieces.append(r)
         if not r.ok:
-            return self._fail(move, r, f"following the edge: {r.event}")
-        hold = t.hold(0.05)
+            return self.failed_result(move, r, f"following the edge: {r.event}")
+        hold = t.hold(s.vertex_hold)
         pieces.append(hold)
         rows = ContactTrace.concatenate([r.trace, hold.trace])
         s_v, s_sigma = self._vertex_param(rec, rows, u, r.info.get("event_sign", 1))
         if s_v is None:
-            return self._fail(move, "unreachable", "could not locate the vertex")
+            return self.failed_result(move, "unreachable", "could not locate the vertex")
         # refine the line with the ridge contacts (convex edges), then extend it to the vertex
         ridge = self._on_ridge(rows, u)
         w_v, w_from = rec.at(s_v), rec.at(s_from)
-        seg.refine_edge(st.edge, rows.point_in_world[ridge] if ridge.sum() >= 10 else None,
+        seg.refine_edge(st.edge, rows.point_in_world[ridge] if ridge.sum() >= seg.bounds.min_line_points else None,
                         (self._face_fit(rec.faces[0]), self._face_fit(rec.faces[1])))  # fmt: skip
         s_v, s_from = rec.param(w_v), rec.param(w_from)
         edge, vertex = seg.extend_edge(st.edge, s_from, s_v, s_sigma, 1 if float(u @ rec.direction) > 0 else -1)
@@ -513,7 +552,7 @@ class PhysicsExecutor(LandingSearch):
         fid = st.face if st.face in rec.faces else rec.faces[1]
         rest = vertex.position - s.vertex_standoff * u + s.vertex_standoff * rec.inward[fid]
         status = self._ensure_on_face(fid, pieces, near=rest)
-        position = self._contact_point() if status == "ok" else vertex.position.copy()
+        position = self.contact_point() if status == "ok" else vertex.position.copy()
         self.state = SensorState(position=position, face=st.face, edge=st.edge, vertex=vertex.id,
                                  edge_faces=st.edge_faces)  # fmt: skip
         return MoveResult(move=move, status="ok", components=(edge, vertex), distance=r.distance,
@@ -532,38 +571,38 @@ class PhysicsExecutor(LandingSearch):
         ok = rows.in_contact
         n = np.where(ok[:, None], rows.normal_in_world, 0.0)
         c = n @ u
-        b = self.bounds
+        b, s = self.bounds, self.settings
         if event_sign > 0:
-            at_v = ok & (c > math.sin(math.radians(5.0)))
-            if at_v.sum() < 3:  # contact was lost: the last contacts
-                idx = np.flatnonzero(ok)[-5:]
+            at_v = ok & (c > s.touch.loss_lean_sin)  # the pad rolls on the vertex
+            if at_v.sum() < s.min_vertex_rows:  # contact was lost: the last contacts
+                idx = np.flatnonzero(ok)[-s.lost_vertex_rows :]
                 at_v = np.zeros(len(rows), bool)
                 at_v[idx] = True
             if not at_v.any():
                 return None, 0.0
-            s = (rows.point_in_world[at_v] - rec.point) @ rec.direction
-            return float(np.median(s)), max(float(np.std(s)), b.point_sigma) / math.sqrt(len(s))
+            along = (rows.point_in_world[at_v] - rec.point) @ rec.direction
+            return float(np.median(along)), max(float(np.std(along)), b.point_sigma) / math.sqrt(len(along))
         contacts = self._finger_contacts()
         if not contacts:
             return None, 0.0
         blk = min(contacts, key=lambda cc: float(cc.normal_in_world @ u))
         denom = float(blk.normal_in_world @ rec.direction)
-        if abs(denom) < 0.2:
+        if abs(denom) < s.min_block_cos:
             return None, 0.0
-        s = float((blk.point_in_world - rec.point) @ blk.normal_in_world) / denom
-        return s, b.point_sigma / abs(denom)
+        s_v = float((blk.point_in_world - rec.point) @ blk.normal_in_world) / denom
+        return s_v, b.point_sigma / abs(denom)
 
     def _vertex_move(self, move: VertexMove, pieces: list[PrimitiveResult]) -> MoveResult:
         st, t, seg, s = self.state, self.toucher, self.segmenter, self.settings
         if st.vertex is None or st.edge is None:
-            return self._invalid(move, "no current vertex: a vertex move starts near a vertex on a known edge")
+            return self.invalid_result(move, "no current vertex: a vertex move starts near a vertex on a known edge")
         if move.across_face not in st.edge_faces:
-            return self._invalid(move, f"face {move.across_face} is not a face of the current edge (faces "
+            return self.invalid_result(move, f"face {move.across_face} is not a face of the current edge (faces "
                                        f"{st.edge_faces})")  # fmt: skip
         rec = seg.edges[st.edge]
         f = move.across_face
         if f not in rec.inward or st.vertex not in rec.vertices:
-            return self._invalid(move, "the current edge does not know that face or vertex")
+            return self.invalid_result(move, "the current edge does not know that face or vertex")
         vtx = seg.vertices[st.vertex].position
         u = toward_vertex(rec, rec.vertices[st.vertex])
         w_f = rec.inward[f]
@@ -572,36 +611,37 @@ class PhysicsExecutor(LandingSearch):
         p0 = vtx + rho * (-math.cos(beta) * u + math.sin(beta) * w_f)
         sweep = self.workspace.circle_sweep_off_table(vtx, n_f, u, w_f)
         if sweep <= 0.0:
-            return self._fail(move, "unreachable", "the vertex is next to the table: the circle around it would "
-                                                   "put the pad on the table")  # fmt: skip
+            return self.failed_result(move, "unreachable", "the vertex is next to the table: the circle around it "
+                                                          "would put the pad on the table")  # fmt: skip
         status = self._ensure_on_face(f, pieces, near=p0)
         if status != "ok":
-            return self._fail(move, status, f"could not reach the face next to the vertex: {self._why}")
+            return self.failed_result(move, status, f"could not reach the face next to the vertex: {self._why}")
         tangent = math.sin(beta) * u + math.cos(beta) * w_f
         r = t.circle_vertex(vtx, n_f, tangent, rho, max_sweep=sweep)
         pieces.append(r)
         if not r.ok:
             if r.event == "table":
-                return self._fail(move, r, "circling the vertex: no edge before the circle would meet the table")
-            return self._fail(move, r, f"circling the vertex: {r.event}")
+                return self.failed_result(move, r,
+                                          "circling the vertex: no edge before the circle would meet the table")
+            return self.failed_result(move, r, f"circling the vertex: {r.event}")
         kind = r.info["kind"]
-        corner = self._contact_point()
+        corner = self.contact_point()
         status, reason, roll, stroke, fit_g = self._cross_and_acquire(
             kind, r.info["face_normal"], r.info["direction"], pieces, away_from=vtx
         )
         if status != "ok":
-            return self._fail(move, status, reason)
+            return self.failed_result(move, status, reason)
         fit_f, line, why = self._edge_between(f, r.trace, "circle", roll, fit_g, kind, corner)
         if line is None:
-            return self._fail(move, "unreachable", why)
+            return self.failed_result(move, "unreachable", why)
         new_face = seg.next_id + 1
         s_vtx = float((vtx - line.point) @ line.direction)
         edge = seg.add_edge(line, (f, new_face), kind == "convex", (fit_f.normal, fit_g.normal),
                             adjacent=(st.vertex, f), vertex=(st.vertex, s_vtx))  # fmt: skip
         face = seg.add_face(fit_g, adjacent=(edge.id,))
-        self._store_face(face.id, stroke, fit_g)
-        self._on_face = face.id
-        self.state = SensorState(position=self._contact_point(), face=face.id, edge=edge.id, vertex=st.vertex,
+        self.store_face(face.id, stroke, fit_g)
+        self.on_face = face.id
+        self.state = SensorState(position=self.contact_point(), face=face.id, edge=edge.id, vertex=st.vertex,
                                  edge_faces=(f, face.id))  # fmt: skip
         return MoveResult(move=move, status="ok", components=(edge, face), distance=r.distance,
                           cost=self.costs.vertex_move(r.distance), state=self.state, info={"kind": kind})  # fmt: skip

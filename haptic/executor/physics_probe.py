@@ -41,7 +41,7 @@ import numpy as np
 from haptic.executor.primitives import PrimitiveResult
 from haptic.executor.segment import FaceFit
 from haptic.geometry.se3 import angle, perpendicular, unit
-from haptic.matching.probes import FreeSegment
+from haptic.matching.free_space import FreeSegment
 from haptic.matching.trace import ContactTrace
 from haptic.planning.handpath import CLEARANCE, LIFT, over_the_top, safe_height
 from haptic.planning.moves import MoveResult, ProbeMove, SensorState
@@ -73,6 +73,8 @@ class ProbeSettings:
     """The transfer is blocked when the pad lags its command by more than this [m] ..."""
     probe_lag: float = 0.004
     """... the approach along the line by more than this [m]."""
+    min_free_length: float = 1e-4
+    """A free segment shorter than this is not reported [m]."""
 
 
 SETTINGS = ProbeSettings()
@@ -82,16 +84,18 @@ def _free_distance(pieces: list[PrimitiveResult]) -> float:
     return float(sum(p.distance for p in pieces))
 
 
-def _leading_segment(tips: np.ndarray, u: np.ndarray, radius: float, cut: float, bound: float) -> FreeSegment | None:
+def _leading_segment(tips: np.ndarray, u: np.ndarray, radius: float, cut: float, bound: float,
+                     min_length: float = SETTINGS.min_free_length) -> FreeSegment | None:  # fmt: skip
     """The free segment of the leading point for the pad centres ``tips`` (n, 3) measured along a line of
     direction ``u``: from the first centre plus ``radius`` along ``u``, as far as they went less ``cut``; its
-    bound is ``bound`` plus the largest sideways deviation of the centres from that line. None when too short."""
+    bound is ``bound`` plus the largest sideways deviation of the centres from that line. None when shorter than
+    ``min_length``."""
     if len(tips) < 2:
         return None
     p0 = tips[0]
     s = (tips - p0) @ u
     length = float(s.max()) - cut
-    if length <= 1e-4:
+    if length <= min_length:
         return None
     side = tips - p0 - s[:, None] * u[None, :]
     dev = float(np.linalg.norm(side, axis=1).max())
@@ -103,7 +107,7 @@ def probe_move(ex: PhysicsExecutor, move: ProbeMove, pieces: list[PrimitiveResul
     """Carry out ``move`` with ``ex``'s hand (module docstring); a failure is a status, never an exception."""
     t, st, seg = ex.toucher, ex.state, ex.segmenter
     if (problem := move.problem()) is not None:
-        return ex._invalid(move, problem)
+        return ex.invalid_result(move, problem)
     start = np.asarray(move.start, dtype=float)
     u = np.asarray(move.direction, dtype=float)
     length = float(move.length)
@@ -112,12 +116,12 @@ def probe_move(ex: PhysicsExecutor, move: ProbeMove, pieces: list[PrimitiveResul
     centre1 = centre0 + length * u
     floor = TABLE_TOP_Z + ex.settings.pad_clearance
     if min(centre0[2], centre1[2]) - r < floor:
-        return ex._invalid(move, "the line would bring the pad onto the table")
+        return ex.invalid_result(move, "the line would bring the pad onto the table")
     z_reach = TABLE_TOP_Z + ex.settings.max_approach_height
     z_safe = safe_height(_highest_contact(ex), r, centre0, t.tip, settings.clearance)
     if z_safe > z_reach:
-        return ex._fail(move, "unreachable", "the line's start is above the hand's reach over the region")
-    was_on = ex._on_face if (ex._on_face == st.face and t.contact[1] is not None) else None
+        return ex.failed_result(move, "unreachable", "the line's start is above the hand's reach over the region")
+    was_on = ex.on_face if (ex.on_face == st.face and t.contact[1] is not None) else None
     free: list[PrimitiveResult] = []  # the pieces through free space, for the distance
 
     def leg(point: np.ndarray, speed: float, lag: float, phase: str = "free") -> PrimitiveResult:
@@ -129,20 +133,21 @@ def probe_move(ex: PhysicsExecutor, move: ProbeMove, pieces: list[PrimitiveResul
     # 1. leave the surface
     n_left = t.normal.copy() if t.contact[1] is not None and t.normal is not None else np.array([0.0, 0.0, 1.0])
     if t.contact[1] is not None:
-        res = t.move_free(t.tip + settings.lift * n_left, timeout=2.0, tol=2e-3)
+        res = t.move_free(t.tip + settings.lift * n_left, timeout=t.config.lift_timeout, tol=t.config.lift_tol)
         pieces.append(res)
         free.append(res)
         if not res.ok:
-            return ex._fail(move, res, f"leaving the surface: {res.event}")
+            return ex.failed_result(move, res, f"leaving the surface: {res.event}")
     lifted = t.tip.copy()
-    ex._on_face = None
+    ex.on_face = None
     went_along = False  # the pad has been on the line (the way back may follow it)
 
     def fail(res, reason: str) -> MoveResult:
         """The failed move's result, after going back the way it came (off the object first, when touching)."""
-        out = ex._fail(move, res, reason)
+        out = ex.failed_result(move, res, reason)
         if t.contact[1] is not None and t.normal is not None:
-            pieces.append(t.move_free(t.tip + settings.lift * t.normal, timeout=2.0, tol=2e-3))
+            pieces.append(t.move_free(t.tip + settings.lift * t.normal, timeout=t.config.lift_timeout,
+                                      tol=t.config.lift_tol))  # fmt: skip
         if went_along:
             _return(ex, lifted, z_safe, n_left, was_on, settings, pieces, [], centre0)
         else:
@@ -151,7 +156,7 @@ def probe_move(ex: PhysicsExecutor, move: ProbeMove, pieces: list[PrimitiveResul
     # 2. up, across, down to the line's start
     for name, w in zip(("rising", "moving across", "descending to the line"), over_the_top(lifted, z_safe, centre0),
                        strict=True):  # fmt: skip
-        if float(np.linalg.norm(w - t.tip)) < 1e-3:
+        if float(np.linalg.norm(w - t.tip)) < t.config.target_tol:
             continue
         res = leg(w, settings.transfer_speed, settings.transfer_lag)
         if not res.ok or res.event != "done":
@@ -167,19 +172,19 @@ def probe_move(ex: PhysicsExecutor, move: ProbeMove, pieces: list[PrimitiveResul
     if not approach.ok:
         return fail(approach, f"approach along the line: {approach.event}")
     if approach.event == "done":  # a miss: the whole line is free
-        segment = _leading_segment(tips, u, r, 0.0, bound)
+        segment = _leading_segment(tips, u, r, 0.0, bound, settings.min_free_length)
         back = _return(ex, lifted, z_safe, n_left, was_on, settings, pieces, free, centre0)
         s = _free_distance(free)
         return MoveResult(move=move, status="ok", distance=s, cost=ex.costs.probe_move(s), state=st,
                           free_space=(segment,) if segment is not None else (),
                           info={"contact": None, "returned": back})  # fmt: skip
     # 4. a hit: the path to the first touch is free; touch again slowly, settle, stroke for the normal
-    segment = _leading_segment(tips, u, r, settings.free_margin, bound)
+    segment = _leading_segment(tips, u, r, settings.free_margin, bound, settings.min_free_length)
     travel = float(approach.info["travel"])
     s = _free_distance(free)
-    retreat = t.move_free(t.tip - settings.back_off * u, timeout=1.0, tol=1e-3)
+    retreat = t.move_free(t.tip - settings.back_off * u, timeout=t.config.back_off_timeout, tol=t.config.target_tol)
     pieces.append(retreat)
-    touch = t.approach(u, settings.back_off + 0.004)
+    touch = t.approach(u, settings.back_off + t.config.approach_overshoot)
     pieces.append(touch)
     if not touch.ok:
         return fail(touch, f"touching the contact again: {touch.event}")
@@ -189,9 +194,9 @@ def probe_move(ex: PhysicsExecutor, move: ProbeMove, pieces: list[PrimitiveResul
     if fit is None:
         return fail("unreachable", "the probe touched an edge or a vertex: no face normal there")
     face = seg.add_face(fit, ())
-    ex._store_face(face.id, trace, fit)
-    ex._on_face = face.id
-    ex.state = SensorState(position=ex._contact_point(), face=face.id)
+    ex.store_face(face.id, trace, fit)
+    ex.on_face = face.id
+    ex.state = SensorState(position=ex.contact_point(), face=face.id)
     return MoveResult(move=move, status="ok", components=(face,), distance=s,
                       cost=ex.costs.probe_move(s) + ex.costs.c_n, state=ex.state,
                       free_space=(segment,) if segment is not None else (),
@@ -209,11 +214,11 @@ def _measure_face(ex: PhysicsExecutor, point: np.ndarray, n0: np.ndarray,
     phi0 = ex.rng.uniform(0.0, 2.0 * math.pi)
     floor = TABLE_TOP_Z + t.pad_radius + s.table_margin
     trace = ContactTrace.concatenate([])
-    for k in range(4):
+    for k in range(s.stroke_headings):
         if k > 0:
             again = t.lift_and_approach(point, n0, floor_z=floor)
             pieces.append(again)
-            if not again.ok or angle(again.info["normal"], n0) > math.radians(6.0):
+            if not again.ok or angle(again.info["normal"], n0) > ex.bounds.retouch_cone:
                 return None, trace
         phi = phi0 + k * math.pi / 2.0
         d1 = math.cos(phi) * a + math.sin(phi) * np.cross(n0, a)
@@ -227,7 +232,7 @@ def _measure_face(ex: PhysicsExecutor, point: np.ndarray, n0: np.ndarray,
         if legs[-1].status == "unstable":
             return None, trace
         trace = ContactTrace.concatenate([r.trace for r in legs])
-        if len(legs) == 2 and all(r.ok and r.event == "done" for r in legs) and ex._on_one_face(trace):
+        if len(legs) == 2 and all(r.ok and r.event == "done" for r in legs) and ex.on_one_face(trace):
             fit = seg.fit_face_trace(trace, legs[-1].info["face_normal"], two_d=True)
             if fit is not None:
                 return fit, trace
@@ -267,7 +272,7 @@ def _return(ex: PhysicsExecutor, lifted: np.ndarray, z_safe: float, n_left: np.n
     if (not up.ok or up.event != "done") and line_start is not None:
         # under an overhang: off the object, back along the line (free: the pad came that way), then up
         if t.contact[1] is not None and t.normal is not None:
-            off = t.move_free(t.tip + settings.lift * t.normal, timeout=2.0, tol=2e-3)
+            off = t.move_free(t.tip + settings.lift * t.normal, timeout=t.config.lift_timeout, tol=t.config.lift_tol)
             pieces.append(off)
             free.append(off)
         for w in (line_start, np.array([line_start[0], line_start[1], z_safe])):
@@ -277,20 +282,20 @@ def _return(ex: PhysicsExecutor, lifted: np.ndarray, z_safe: float, n_left: np.n
     elif not up.ok or up.event != "done":
         return False
     for w in way[1:]:
-        if float(np.linalg.norm(w - t.tip)) < 1e-3:
+        if float(np.linalg.norm(w - t.tip)) < t.config.target_tol:
             continue
         res = go(w)
         if not res.ok or res.event != "done":
             return False
     if was_on is None:
         return False
-    res = t.approach(-n_left, 2 * settings.lift + 0.004)
+    res = t.approach(-n_left, 2 * settings.lift + t.config.approach_overshoot)
     pieces.append(res)
     free.append(res)
     n_face = ex.segmenter.faces[was_on].component.normal
-    if not res.ok or angle(unit(res.info["normal"]), n_face) > math.radians(6.0):
+    if not res.ok or angle(unit(res.info["normal"]), n_face) > ex.bounds.retouch_cone:
         return False
-    ex._on_face = was_on
+    ex.on_face = was_on
     return True
 
 

@@ -8,6 +8,10 @@ ends with an *event* (why it stopped: ``"contact"``, ``"convex-edge"``, ``"conca
 (``"no-contact"``, ``"unreachable"``, ``"timeout"``, ``"unstable"``), and returns the contact trace it
 recorded (time, fingertip pose, contact point, normal, force, phase) and the distance the fingertip travelled.
 
+Every number of the primitives is a field of :class:`TouchConfig` (motion, forces, timing, event detection)
+or, where the segmenter shares it (the sensor's σ, the cones of a face's normals), of
+:class:`~haptic.executor.segment.SegmentBounds`.
+
 Detection follows ``docs/physics-notes.md``: contact when the sensed force exceeds max(0.1 F, 5 σF) for 3 samples
 with a valid normal (pitfall 5); an edge when the filtered normal leaves the running face normal by more
 than 10° for 3 samples (convex when it tilts towards the direction of travel -- the surface falls away --,
@@ -26,106 +30,21 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from haptic.executor.segment import SegmentBounds
+from haptic.executor.touch_config import TouchConfig
 from haptic.geometry.se3 import angle, perpendicular, unit
 from haptic.matching.trace import PHASES, ContactTrace, empty_trace
 from haptic.sim.robot import RobotInterface
 from haptic.sim.scene import PAD_RADIUS
 
-DOWN = np.diag([-1.0, 1.0, -1.0])
-"""Hand rotation ``world_from_hand`` with the fingers pointing down (the tracing posture)."""
-
 SERVO_LAG = 0.13
 """The position servo trails a moving command by about this much time [s] (measured: 15 mm at 0.15 m/s)."""
+OPPOSED = 1e-6
+"""Two unit normals whose sum is shorter than this (squared) are opposed: they have no bisector [-]."""
+AT_CENTRE = 1e-6
+"""A contact this close to the vertex circle's centre has no radial direction [m]."""
 FAILURES = ("no-contact", "unreachable", "timeout", "unstable")
 """Failure statuses of a primitive (the move statuses of :class:`~haptic.planning.moves.MoveResult`)."""
-UNDERCUT_SLACK = math.radians(3.0)
-"""Rolling off a face that itself leans under near the limit, the roll ends for the undercut only once the
-normal leans this much further than the face's (not on a noisy first reading) [rad]."""
-
-@dataclass(frozen=True)
-class TouchConfig:
-    """Speeds, forces and detection thresholds of the primitives (one home for the executor's numbers)."""
-
-    force: float = 1.0
-    """Normal force target while tracing [N]."""
-    force_sigma: float = 0.02
-    """σF of the touch sensor, for the contact threshold [N]."""
-    face_speed: float = 0.02
-    """Tracing speed across a face [m/s] (friction × speed / force ≤ 0.012 (m/s)/N, pitfall 1)."""
-    edge_speed: float = 0.015
-    """Ridge-following speed along an edge [m/s]."""
-    roll_speed: float = 0.015
-    """Speed of the pad centre while rolling over an edge [m/s]."""
-    approach_speed: float = 0.02
-    """Guarded-approach speed [m/s]."""
-    free_speed: float = 0.20
-    """Speed of free-space moves [m/s]."""
-    contact_fraction: float = 0.1
-    """Contact is sensed above max(contact_fraction × force, 5 σF) [-]."""
-    debounce: int = 3
-    """Consecutive samples a detection must hold [ticks]."""
-    normal_filter: float = 0.25
-    """Per-tick low-pass weight of a new normal sample (0..1]."""
-    edge_angle: float = math.radians(10.0)
-    """Edge: the filtered normal leaves the face normal by more than this [rad]."""
-    loss_fraction: float = 0.3
-    """Edge backup / contact loss: force below this fraction of the target ... [-]"""
-    loss_time: float = 0.02
-    """... for this long [s]."""
-    stall_time: float = 0.3
-    """Blocked: over this window [s] ..."""
-    stall_fraction: float = 0.2
-    """... the fingertip advanced less than this fraction of the commanded travel [-]."""
-    vertex_sin: float = math.sin(math.radians(15.0))
-    """Vertex: the filtered normal's component along the edge exceeds this [-]."""
-    loss_lean_sin: float = math.sin(math.radians(5.0))
-    """Contact lost while following a ridge is its vertex (the surface fell away) only when the filtered normal
-    had leaned at least this far along the edge: the pad cannot leave the end of an edge without rolling on to
-    the vertex. Lost with the normal still across the edge, the pad was lifted off it -- another part of the
-    finger met the object (a frame's rim above a valley) -- and the edge goes on [-]."""
-    roll_window: float = 0.001
-    """A roll is over when the normal turned less than ``roll_settled`` over this much travel [m] ..."""
-    roll_settled: float = math.radians(1.5)
-    """... [rad]."""
-    max_undercut: float = math.radians(30.0)
-    """The pad reaches a surface whose normal leans at most this far back against the finger's axis (past
-    perpendicular to it); beyond, the finger's phalanx meets the object first and the pad loses contact. A
-    roll over a convex edge stops there (event ``"undercut"``) [rad]."""
-    roll_max: float = 0.04
-    """Longest pad travel while rolling over or climbing onto an edge [m]."""
-    step_in: float = 0.0015
-    """Travel onto a new face, away from the edge, after the roll settled [m]."""
-    stroke: float = 0.006
-    """Length of the stroke along the edge on a new face (the second leg of the L for its normal) [m]."""
-    ridge_gain: float = 12.0
-    """Sideways servo of ridge following: pad speed per radian of normal error, per metre of pad radius [1/s]."""
-    settle_time: float = 0.15
-    """Shortest hold after a guarded contact before moving [s] ..."""
-    settle_max: float = 0.6
-    """... longest: the hold ends once the force has stayed within ``settle_band`` of the target for
-    ``settle_time`` (the impact transient of the approach takes ~0.3 s to die out) [s]."""
-    settle_band: float = 0.15
-    """Relative force band of a settled contact [-]."""
-    ramp_time: float = 0.25
-    """Tangential speeds ramp up over this time at the start of a slide (a step start loses force) [s]."""
-    lift: float = 0.008
-    """Clearance of a repositioning move above the surface [m] ..."""
-    narrow_lift: float = 0.002
-    """... and of its second try when the first was blocked (a slot narrower than 2 × pad radius + lift) [m]."""
-    overpass: float = 0.02
-    """A repositioning move whose straight legs are blocked (a non-convex solid) goes round over the top, this
-    far above the higher of its start and its target [m]."""
-    hand_rotation: np.ndarray = field(default_factory=lambda: DOWN.copy())
-    """Hand rotation held while exploring (3, 3)."""
-    link_every: int = 10
-    """The hand's link positions (forward kinematics, for recordings) are sampled every this many ticks
-    (0: never) [ticks]."""
-
-    @property
-    def contact_threshold(self) -> float:
-        """Sensed force above which a contact counts [N]."""
-        return max(self.contact_fraction * self.force, 5.0 * self.force_sigma)
-
 
 @dataclass(frozen=True, eq=False)
 class PrimitiveResult:
@@ -152,18 +71,21 @@ class Toucher:
     """Runs the primitives with one finger of the robot and records everything it senses.
 
     The toucher keeps the filtered normal, the contact debouncer and the path length across primitives; each
-    primitive returns the trace rows it recorded.
+    primitive returns the trace rows it recorded. ``bounds``: the sensor's σ and the cones of a face's normals
+    it shares with the segmenter.
     """
 
-    def __init__(self, robot: RobotInterface, config: TouchConfig | None = None, finger: str = "index") -> None:
+    def __init__(self, robot: RobotInterface, config: TouchConfig | None = None, finger: str = "index",
+                 bounds: SegmentBounds | None = None) -> None:  # fmt: skip
         if not isinstance(robot, RobotInterface):
             raise TypeError(f"Toucher needs a RobotInterface (the robot-side handle), got {type(robot).__name__}")
         self.robot = robot
         self.config = config or TouchConfig()
+        self.bounds = bounds or SegmentBounds()
         self.finger = finger
         robot.set_finger(finger)
         self.dt = robot.tick_period
-        self.threshold = self.config.contact_threshold
+        self.threshold = self.config.contact_threshold(self.bounds.force_sigma)
         self.normal: np.ndarray | None = None  # filtered sensed normal
         self.contact_ticks = 0  # consecutive valid-contact samples
         self.weak_ticks = 0  # consecutive samples with force below loss_fraction × force
@@ -200,8 +122,9 @@ class Toucher:
                 nf = self.normal + self.config.normal_filter * (n - self.normal)
                 self.normal = unit(nf)
             d = math.sqrt(float((tip - p) @ (tip - p)))
-            if 0.005 < d < 0.03:
-                self.pad_radius += 0.02 * (d - self.pad_radius)
+            lo, hi = self.config.pad_radius_range
+            if lo < d < hi:
+                self.pad_radius += self.config.pad_radius_gain * (d - self.pad_radius)
         else:
             self.contact_ticks = 0
         self.weak_ticks = self.weak_ticks + 1 if f < self.config.loss_fraction * self.config.force else 0
@@ -210,7 +133,7 @@ class Toucher:
         self._rows.append((r.time, tip, rot, p if valid else nan3, n if valid else nan3, f, PHASES.index(phase)))
         if not (np.all(np.isfinite(tip)) and math.isfinite(f)):
             self._unhealthy = True
-        elif len(self._rows) % 20 == 0 and not r.is_stable():
+        elif len(self._rows) % self.config.stability_every == 0 and not r.is_stable():
             self._unhealthy = True
         self._ticks += 1
         every = self.config.link_every
@@ -285,9 +208,12 @@ class Toucher:
         return min(1.0, (k + 1) * self.dt / self.config.ramp_time)
 
     # -- free space ----------------------------------------------------------------------------------------------
-    def move_free(self, point: np.ndarray, timeout: float = 4.0, tol: float = 7e-4) -> PrimitiveResult:
-        """Move the pad centre to ``point`` [m] in free space along a straight line (position control)."""
+    def move_free(self, point: np.ndarray, timeout: float | None = None, tol: float | None = None) -> PrimitiveResult:
+        """Move the pad centre to ``point`` [m] in free space along a straight line (position control), within
+        ``timeout`` [s] (default ``free_timeout``) to within ``tol`` [m] (default ``free_tol``)."""
         cfg = self.config
+        timeout = cfg.free_timeout if timeout is None else timeout
+        tol = cfg.free_tol if tol is None else tol
         start = self.tip.copy()
         self.hybrid = False
         self.normal = None
@@ -328,9 +254,9 @@ class Toucher:
         u = (target - start) / dist if dist > 0 else np.zeros(3)
         n_ticks = max(1, int(math.ceil(dist / speed / self.dt)))
         others = [f for f in self.robot.fingers if f != self.finger]
-        settle_ticks = int(0.5 / self.dt)
+        settle_ticks = int(cfg.guarded_settle / self.dt)
         max_lag = max_lag + SERVO_LAG * speed
-        timeout = timeout if timeout is not None else dist / speed + 2.0
+        timeout = timeout if timeout is not None else dist / speed + cfg.timeout_slack
         for k in range(1, int(timeout / self.dt)):
             s = min(1.0, k / n_ticks)
             command = start + s * (target - start)
@@ -352,7 +278,7 @@ class Toucher:
             if float(np.linalg.norm(self.tip - command)) > max_lag and s < 1.0:
                 self.robot.move_fingertip(self.tip.copy(), cfg.hand_rotation)
                 return self._result("unreachable", "blocked", 0.0, travel=travel)
-            if s >= 1.0 and (np.linalg.norm(self.tip - target) < 7e-4 or k > n_ticks + settle_ticks):
+            if s >= 1.0 and (np.linalg.norm(self.tip - target) < cfg.free_tol or k > n_ticks + settle_ticks):
                 return self._result("ok", "done", 0.0, travel=travel)
         return self._result("timeout", "limit", 0.0)
 
@@ -374,7 +300,7 @@ class Toucher:
         start = self.tip.copy()
         target = start.copy()
         speed = speed or cfg.approach_speed
-        timeout = timeout or (max_distance / speed + 2.0)
+        timeout = timeout or (max_distance / speed + cfg.timeout_slack)
         step = speed * self.dt
         touched = False
         for _ in range(int(timeout / self.dt)):
@@ -387,7 +313,7 @@ class Toucher:
             if self.touching:
                 touched = True
                 break
-            if float((self.tip - start) @ d) >= max_distance - 1e-4:
+            if float((self.tip - start) @ d) >= max_distance - cfg.approach_end_tol:
                 return self._result("no-contact", "done", 0.0)
         if not touched:
             return self._result("timeout", "limit", 0.0)
@@ -418,7 +344,7 @@ class Toucher:
         more with the lift cut to ``narrow_lift``."""
         res = self._lift_and_approach(point_on_surface, normal, floor_z, self.config.lift)
         n_t = unit(np.asarray(normal, dtype=float))
-        wrong = res.ok and angle(res.info["normal"], n_t) > math.radians(60.0)
+        wrong = res.ok and angle(res.info["normal"], n_t) > self.config.opposite_wall_angle
         if res.status == "timeout" or wrong:
             again = self._lift_and_approach(point_on_surface, normal, floor_z, self.config.narrow_lift)
             res = PrimitiveResult(again.status, again.event, ContactTrace.concatenate([res.trace, again.trace]),
@@ -442,28 +368,28 @@ class Toucher:
         above = q_t + clear * n_t
         mid = 0.5 * (lifted + above)
         bis = n_c + n_t
-        bis = unit(bis) if bis @ bis > 1e-6 else np.array([0.0, 0.0, 1.0])
+        bis = unit(bis) if bis @ bis > OPPOSED else np.array([0.0, 0.0, 1.0])
         deficit = max(clear - float((mid - q_c) @ n_c), clear - float((mid - q_t) @ n_t), 0.0)
-        waypoint = mid + deficit / max(float(bis @ n_c), 0.2) * bis
+        waypoint = mid + deficit / max(float(bis @ n_c), cfg.min_bisector_cos) * bis
         points = [lifted, waypoint, above]
         if floor_z is not None:
             for w in points:
                 w[2] = max(w[2], floor_z)
         pieces = []
-        res = self.move_free(points[0], timeout=2.0, tol=2e-3)
+        res = self.move_free(points[0], timeout=cfg.lift_timeout, tol=cfg.lift_tol)
         pieces.append(res)
-        for w, tol in ((points[1], 3e-3), (points[2], 1e-3)):
+        for w, tol in ((points[1], cfg.via_tol), (points[2], cfg.target_tol)):
             if not res.ok:
                 break
-            if float(np.linalg.norm(w - self.tip)) > 1e-3:
-                res = self.move_free(w, timeout=3.0, tol=tol)
+            if float(np.linalg.norm(w - self.tip)) > cfg.target_tol:
+                res = self.move_free(w, timeout=cfg.via_timeout, tol=tol)
                 pieces.append(res)
         if res.status == "timeout":
             # blocked: the straight legs cut a corner of a non-convex solid. Go round over the top instead:
             # straight up, across above the target, down to it (objects rest on the table; nothing is above)
             res = self._over_the_top(above, cfg.overpass, pieces)
         if res.ok:
-            res = self.approach(-n_t, 2 * lift + 0.004)
+            res = self.approach(-n_t, 2 * lift + cfg.approach_overshoot)
             pieces.append(res)
         return PrimitiveResult(res.status, res.event, ContactTrace.concatenate([p.trace for p in pieces]),
                                sum(p.distance for p in pieces), res.info)  # fmt: skip
@@ -471,11 +397,12 @@ class Toucher:
     def _over_the_top(self, above: np.ndarray, rise: float, pieces: list[PrimitiveResult]) -> PrimitiveResult:
         """Free moves from the pad's position straight up to ``rise`` above the higher of it and ``above``,
         across, and down to ``above``. The last result (status ``timeout`` when still blocked)."""
+        cfg = self.config
         z = max(float(self.tip[2]), float(above[2])) + rise
         res = self._result("ok", "done", 0.0)
-        for w, tol in ((np.array([self.tip[0], self.tip[1], z]), 3e-3), (np.array([above[0], above[1], z]), 3e-3),
-                       (above, 1e-3)):  # fmt: skip
-            res = self.move_free(w, timeout=3.0, tol=tol)
+        for w, tol in ((np.array([self.tip[0], self.tip[1], z]), cfg.via_tol),
+                       (np.array([above[0], above[1], z]), cfg.via_tol), (above, cfg.target_tol)):  # fmt: skip
+            res = self.move_free(w, timeout=cfg.via_timeout, tol=tol)
             pieces.append(res)
             if not res.ok:
                 break
@@ -501,7 +428,7 @@ class Toucher:
         window = max(2, int(cfg.stall_time / self.dt))
         n_sum = np.zeros(3)
         n_run = n_f
-        timeout = max_distance / cfg.face_speed * 2.0 + 2.0
+        timeout = max_distance / cfg.face_speed * cfg.timeout_factor + cfg.timeout_slack
         for k in range(int(timeout / self.dt)):
             self._press(self.ramp(k) * cfg.face_speed * d)
             self.tick(phase)
@@ -524,9 +451,9 @@ class Toucher:
                         return self._result("ok", f"{kind}-edge", 0.0, face_normal=n_run, direction=d, kind=kind)
                 else:
                     over = 0
-                    if angle(n, n_f) < math.radians(3.0):  # the face's samples, never a slow drift
+                    if angle(n, n_f) < self.bounds.sample_cone:  # the face's samples, never a slow drift
                         n_sum += self.contact[1]
-                        if k > 10:
+                        if k > cfg.run_min_samples:
                             n_run = unit(n_sum)
             if travelled >= max_distance:
                 return self._result("ok", "done", 0.0, face_normal=n_run, direction=d)
@@ -544,7 +471,7 @@ class Toucher:
         n_a = unit(np.asarray(n_a, dtype=float))
         d = np.asarray(direction, dtype=float)
         e = unit(np.cross(n_a, self.normal)) if self.normal is not None else perpendicular(n_a)
-        if e @ e < 0.5:
+        if e @ e < cfg.roll_axis_sin2:
             e = unit(np.cross(n_a, d))
         sign = -1.0 if kind == "convex" else 1.0
         back = -(np.asarray(cfg.hand_rotation, dtype=float) @ np.array([0.0, 0.0, 1.0]))  # up the finger
@@ -554,9 +481,9 @@ class Toucher:
         lost = 0
         for _ in range(int(cfg.roll_max / cfg.roll_speed * 2.0 / self.dt)):
             n = self.normal if self.normal is not None else n_a
-            if angle(n, n_a) > math.radians(3.0):
+            if angle(n, n_a) > self.bounds.sample_cone:
                 e_new = np.cross(n_a, n)
-                if e_new @ e_new > 1e-4:
+                if e_new @ e_new > cfg.turned_axis_sin2:
                     e = unit(e_new)
             t = unit(np.cross(n, e))
             if sign * float(t @ n_a) < 0:
@@ -571,14 +498,14 @@ class Toucher:
             last = self.tip.copy()
             if self.contact[1] is None:
                 lost += 1
-                if lost * self.dt > 0.15:
+                if lost * self.dt > cfg.roll_loss_time:
                     return self._result("no-contact", "lost", 0.0)
                 continue
             lost = 0
             hist.append((travelled, self.normal.copy()))
             # leaning under past the limit, and further than face a (from a face near the limit, noise alone
             # must not end the roll)
-            limit = min(-math.sin(cfg.max_undercut), float(n_a @ back) - math.sin(UNDERCUT_SLACK))
+            limit = min(-math.sin(cfg.max_undercut), float(n_a @ back) - math.sin(cfg.undercut_slack))
             if kind == "convex" and float(self.normal @ back) < limit:
                 self._press(np.zeros(3))
                 self.tick("roll")
@@ -617,7 +544,7 @@ class Toucher:
         trace = ContactTrace.concatenate([p.trace for p in pieces])
         ok_rows = trace.in_contact & (trace.phase == PHASES.index("stroke"))
         nn = trace.normal_in_world[ok_rows]
-        keep = nn @ n_f > math.cos(math.radians(4.0))
+        keep = nn @ n_f > math.cos(self.bounds.face_cone)
         n_mean = unit(nn[keep].sum(axis=0)) if keep.any() else n_f
         failed = [p for p in pieces if not p.ok and p.event != "table"]
         status = failed[-1].status if failed else "ok"
@@ -662,22 +589,24 @@ class Toucher:
         lean = -1.0  # the filtered normal's largest component along ``along`` on the ridge
         progress: list[float] = []
         window = max(2, int(cfg.stall_time / self.dt))
-        timeout = (max_distance / cfg.edge_speed if not acquire_only else 0.0) * 2.0 + 3.0
+        timeout = (max_distance / cfg.edge_speed if not acquire_only else 0.0) * cfg.timeout_factor + (
+            cfg.ridge_timeout_slack
+        )
         err = 0.0
         # rolling onto the bisector takes pad radius × angle at the sideways speed limit; allow twice that
         n0 = self.normal if self.normal is not None else n_b
         roll_angle = abs(target - math.atan2(float(n0 @ m), float(n0 @ nb_p)))
-        acquire_time = 2.0 * self.pad_radius * roll_angle / 0.012 + 0.6
+        acquire_time = 2.0 * self.pad_radius * roll_angle / cfg.ridge_side_speed + cfg.ridge_acquire_slack
         timeout += acquire_time
         for _ in range(int(timeout / self.dt)):
             n = self.normal if self.normal is not None else n_b
             alpha = math.atan2(float(n @ m), float(n @ nb_p))
             err = target - alpha
             v_side = cfg.ridge_gain * self.pad_radius * err
-            lim = 0.012
+            lim = cfg.ridge_side_speed
             v_side = max(-lim, min(lim, v_side))
             s_dir = unit(side - float(side @ n) * n)
-            ridge_ok = abs(err) < math.radians(8.0)
+            ridge_ok = abs(err) < cfg.ridge_cone
             v = v_side * s_dir + (self.ramp(on_ridge) * speed * u if (ridge_ok or on_ridge > 0) else 0.0 * u)
             self._press(v)
             self.tick("ridge")
@@ -685,7 +614,7 @@ class Toucher:
                 return self._result("unstable", "nan", 0.0)
             if ridge_ok:
                 on_ridge += 1
-                if acquire_only and on_ridge >= 10:
+                if acquire_only and on_ridge >= cfg.ridge_acquired_ticks:
                     return self._result("ok", "done", 0.0, error=err)
             travelled = float((self.tip - start) @ u)
             progress.append(travelled)
@@ -712,7 +641,7 @@ class Toucher:
                 continue
             if travelled > max_distance:
                 return self._result("unreachable", "limit", 0.0)
-            if len(progress) > window + 20 and progress[-1] - progress[-1 - window] < (
+            if len(progress) > window + cfg.stall_warmup and progress[-1] - progress[-1 - window] < (
                 cfg.stall_fraction * speed * cfg.stall_time
             ):
                 return self._result("ok", "vertex", 0.0, event_sign=-1, stalled=True)
@@ -734,15 +663,18 @@ class Toucher:
         normal: np.ndarray,
         start_direction: np.ndarray,
         radius: float,
-        max_sweep: float = 1.9 * math.pi,
+        max_sweep: float | None = None,
     ) -> PrimitiveResult:
         """Slide on the face of ``normal`` along a circle of ``radius`` about ``vertex``, leaving along
         ``start_direction`` (the in-plane tangent at the start), until the next edge (convex or concave).
         ``max_sweep``: the circle gives up (``unreachable``, event ``"table"``) after sweeping this angle
-        [rad] -- the executor sets it where the circle would bring the pad onto the table; the pad's reaching
+        [rad] (default, and at most, ``circle_max_sweep``: then it ends with ``timeout``) -- the executor sets it
+        where the circle would bring the pad onto the table; the pad's reaching
         :attr:`floor_z` ends it the same way. ``info``: like :meth:`trace_face`, plus ``arc`` (the angle
         swept [rad])."""
         cfg = self.config
+        full = cfg.circle_max_sweep
+        max_sweep = full if max_sweep is None else max_sweep
         n_f = unit(np.asarray(normal, dtype=float))
         vtx = np.asarray(vertex, dtype=float)
         p0 = self.contact[2] if self.contact[2] is not None else self.tip - self.pad_radius * n_f
@@ -755,7 +687,7 @@ class Toucher:
         prev = r0
         n_sum = np.zeros(3)
         n_run = n_f
-        timeout = 2.0 * math.pi * radius / cfg.face_speed * 1.5 + 2.0
+        timeout = 2.0 * math.pi * radius / cfg.face_speed * cfg.circle_timeout_factor + cfg.timeout_slack
         progress_t: list[float] = []
         window = max(2, int(cfg.stall_time / self.dt))
         start_tip = self.tip.copy()
@@ -765,9 +697,9 @@ class Toucher:
             r = p - vtx
             r = r - (r @ n_f) * n_f
             rad = math.sqrt(float(r @ r))
-            rh = r / rad if rad > 1e-6 else r0
+            rh = r / rad if rad > AT_CENTRE else r0
             t = unit(np.cross(axis, rh))
-            v = cfg.face_speed * t + 4.0 * (radius - rad) * rh
+            v = cfg.face_speed * t + cfg.circle_gain * (radius - rad) * rh
             self._press(v)
             prev_tip = self.tip.copy()
             self.tick("circle")
@@ -777,7 +709,7 @@ class Toucher:
             progress_t.append(path)
             swept += angle(prev, rh)
             prev = rh
-            if (swept > max_sweep and max_sweep < 1.9 * math.pi) or self.below_floor(t):
+            if (swept > max_sweep and max_sweep < full) or self.below_floor(t):
                 return self._result("unreachable", "table", 0.0, arc=swept)
             if self.weak_ticks * self.dt >= cfg.loss_time:
                 return self._result("ok", "convex-edge", 0.0, face_normal=n_run, direction=t, kind="convex",
@@ -793,11 +725,11 @@ class Toucher:
                                             arc=swept)  # fmt: skip
                 else:
                     over = 0
-                    if angle(n, n_f) < math.radians(3.0):  # the face's samples, never a slow drift
+                    if angle(n, n_f) < self.bounds.sample_cone:  # the face's samples, never a slow drift
                         n_sum += self.contact[1]
-                        if k > 10:
+                        if k > cfg.run_min_samples:
                             n_run = unit(n_sum)
-            if swept > min(max_sweep, 1.9 * math.pi):
+            if swept > min(max_sweep, full):
                 return self._result("timeout", "limit", 0.0, arc=swept)
             if len(progress_t) > window and path - progress_t[-1 - window] < (
                 cfg.stall_fraction * cfg.face_speed * cfg.stall_time
@@ -814,12 +746,10 @@ def _path_length(points: np.ndarray, offset: float = 0.0) -> float:
 
 
 __all__ = [
-    "DOWN",
     "FAILURES",
     "PHASES",
     "ContactTrace",
     "PrimitiveResult",
-    "TouchConfig",
     "Toucher",
     "angle",
     "empty_trace",

@@ -21,21 +21,24 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from haptic.geometry.se3 import perpendicular, unit
-from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex, NoiseModel
+from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex, NoiseModel, SensorNoise
 from haptic.matching.trace import ContactTrace
 
 
 @dataclass(frozen=True)
 class SegmentBounds:
-    """The sensor-noise model and the systematic floors from which error bounds are derived."""
+    """The executor's sensing and segmentation settings: the per-sample sensor noise (that of
+    :class:`~haptic.matching.components.NoiseModel`, :meth:`from_model`), the systematic floors from which
+    error bounds are derived, and the thresholds by which the primitives, the physics executor and the
+    segmenter tell faces, edges and vertices apart in the sensed normals and points."""
 
-    normal_sigma: float = math.radians(1.0)
+    normal_sigma: float = NoiseModel.normal_std
     """σn of one sensed contact normal, per tangent axis [rad]."""
-    point_sigma: float = 2e-4
+    point_sigma: float = NoiseModel.point_std
     """σp of one sensed contact point, per axis [m]."""
-    force_sigma: float = 0.02
+    force_sigma: float = NoiseModel.force_std
     """σF of the sensed normal force [N]."""
-    k: float = 3.0
+    k: float = SensorNoise.k
     """A bound is k standard deviations."""
     normal_floor: float = math.radians(0.25)
     """Systematic σ of a face normal (pad compliance, contact-frame bias) [rad]."""
@@ -53,6 +56,49 @@ class SegmentBounds:
     """Fewest contact rows a face is fitted from."""
     face_cone: float = math.radians(4.0)
     """A row belongs to a face when its sensed normal is within this of the face normal [rad]."""
+    sample_cone: float = math.radians(3.0)
+    """A sensed normal within this of a face's is one of the face's samples (the primitives' running face
+    normal); beyond it the normal has turned off the face (rolling over an edge) [rad]."""
+    ridge_row_cone: float = math.radians(4.0)
+    """A row of a ridge trace is on the ridge itself when its sensed normal is within this of perpendicular to
+    the edge (not rolling on the vertex at its end) [rad]."""
+    resting_cone: float = math.radians(5.0)
+    """The pad still rests on a data face when its filtered normal is within this of the face's [rad]."""
+    retouch_cone: float = math.radians(6.0)
+    """Touching a known face again, the sensed normal is within this of the face's; farther, the pad met
+    something else [rad]."""
+    roll_axis_slack: float = math.radians(3.0)
+    """Rolling over an edge whose next face is out of reach, the sensed normals stay this close (beyond the
+    noise) to the plane perpendicular to the edge; a roll round a vertex turns them out of any one plane [rad] ..."""
+    roll_axis_quantile: float = 0.9
+    """... this quantile of them [-]."""
+    min_refine_rows: int = 3
+    """A face's rows are picked again about their own mean normal when at least this many agree with the guess."""
+    min_roll_rows: int = 3
+    """Fewest rolling contacts between the two faces' normals that locate a convex edge or test a roll."""
+    min_turned_rows: int = 5
+    """Fewest rolling contacts, turned off the face, from which a roll alone gives an edge."""
+    min_plane_points: int = 6
+    """A face's plane fit counts with at least this many points ..."""
+    min_plane_spread: float = 1e-3
+    """... spread (rms) at least this far along their second axis [m]."""
+    two_d_extent: float = 1e-3
+    """Pad centres spanning more than this across their principal axis are a 2-D stroke (the turn rate is
+    measured over both axes) [m]."""
+    max_spread_sigmas: float = 2.0 * math.sqrt(2.0)
+    """A face's sensed normals spread (rms) at most this many σn ..."""
+    spread_slack: float = math.radians(0.5)
+    """... plus this [rad]; more, and the rows do not come from one plane."""
+    min_line_points: int = 10
+    """A line fit of contact points along an edge (the ridge) counts with at least this many points ..."""
+    min_line_spread: float = 2e-3
+    """... spread (rms) at least this far along it [m]."""
+    fit_agreement_sigmas: float = 5.0
+    """A point fit (plane, line) is combined with the normals' estimate when they agree within this many σ ..."""
+    fit_agreement_slack: float = math.radians(1.0)
+    """... plus this [rad]."""
+    min_edge_sin: float = 0.2
+    """The sine of the angle between two faces' normals below which an edge's σ stops growing (its floor) [-]."""
     side_reach: float = 4e-3
     """Side points of an edge lie this far in on each face from the explored interval [m]."""
     min_face_extent: float = 3e-3
@@ -73,6 +119,11 @@ class SegmentBounds:
     max_roll_offset: float = 2e-3
     """The contact points of a roll over a convex edge lie on the edge, hence on both faces' planes; a roll
     farther than this (median) from either plane was not over the edge between them [m]."""
+
+    def agree(self, a: np.ndarray, b: np.ndarray, sigma: float) -> bool:
+        """Whether two estimates of one direction agree within :attr:`fit_agreement_sigmas` × ``sigma`` plus
+        :attr:`fit_agreement_slack`."""
+        return angle_between(a, b) < self.fit_agreement_sigmas * sigma + self.fit_agreement_slack
 
     @classmethod
     def from_noise(cls, force_std: float, normal_std: float, point_std: float, **kw) -> SegmentBounds:
@@ -128,13 +179,16 @@ class LineFit:
     """Explored interval ``[s_lo, s_hi]`` along ``direction`` from ``point`` [m]."""
 
 
-def face_rows(trace: ContactTrace, normal_guess: np.ndarray, cone: float) -> np.ndarray:
-    """Mask of the rows whose sensed normal lies within ``cone`` of the face normal (refined once)."""
+def face_rows(
+    trace: ContactTrace, normal_guess: np.ndarray, cone: float, min_rows: int = SegmentBounds.min_refine_rows
+) -> np.ndarray:
+    """Mask of the rows whose sensed normal lies within ``cone`` of the face normal (refined once, about their
+    mean normal, when at least ``min_rows`` agree with the guess)."""
     ok = trace.in_contact
     n = np.where(ok[:, None], trace.normal_in_world, 0.0)
     c = math.cos(cone)
     mask = ok & (n @ normal_guess > c)
-    if mask.sum() >= 3:
+    if mask.sum() >= min_rows:
         mask = ok & (n @ unit(n[mask].sum(axis=0)) > c)
     return mask
 
@@ -147,15 +201,15 @@ def fit_face(points: np.ndarray, normals: np.ndarray, bounds: SegmentBounds) -> 
     s_mean = bounds.normal_sigma / math.sqrt(max(nn, 1))
     centroid = points.mean(axis=0)
     normal, s_n = n_mean, s_mean
-    if len(points) >= 6:
+    if len(points) >= bounds.min_plane_points:
         q = points - centroid
         _, sv, vt = np.linalg.svd(q, full_matrices=False)
         spread2 = sv[1] / math.sqrt(len(points))  # rms extent along the second axis [m]
         resid = sv[2] / math.sqrt(len(points))
-        if spread2 > 1e-3:
+        if spread2 > bounds.min_plane_spread:
             n_fit = vt[2] if vt[2] @ n_mean > 0 else -vt[2]
             s_fit = max(resid, bounds.point_sigma) / (spread2 * math.sqrt(len(points)))
-            if angle_between(n_fit, n_mean) < 5 * math.hypot(s_fit, s_mean) + math.radians(1.0):
+            if bounds.agree(n_fit, n_mean, math.hypot(s_fit, s_mean)):
                 w1, w2 = 1.0 / s_mean**2, 1.0 / s_fit**2
                 normal = unit(w1 * n_mean + w2 * n_fit)
                 s_n = 1.0 / math.sqrt(w1 + w2)
@@ -184,15 +238,17 @@ def angle_between(a: np.ndarray, b: np.ndarray) -> float:
     return math.acos(max(-1.0, min(1.0, float(unit(a) @ unit(b)))))
 
 
-def edge_direction(face_a: FaceFit, face_b: FaceFit) -> tuple[np.ndarray, float]:
+def edge_direction(face_a: FaceFit, face_b: FaceFit, bounds: SegmentBounds) -> tuple[np.ndarray, float]:
     """``n_a × n_b`` normalised, and its σ from the normals' σ and the dihedral angle."""
     c = np.cross(face_a.normal, face_b.normal)
     s = math.sqrt(float(c @ c))
-    sigma = math.hypot(face_a.normal_sigma, face_b.normal_sigma) / max(s, 0.2)
+    sigma = math.hypot(face_a.normal_sigma, face_b.normal_sigma) / max(s, bounds.min_edge_sin)
     return c / s, sigma
 
 
-def plane_intersection(face_a: FaceFit, face_b: FaceFit, near: np.ndarray) -> tuple[np.ndarray, float]:
+def plane_intersection(
+    face_a: FaceFit, face_b: FaceFit, near: np.ndarray, bounds: SegmentBounds
+) -> tuple[np.ndarray, float]:
     """The point of the intersection line of two planes nearest ``near``, and its position σ."""
     na, nb = face_a.normal, face_b.normal
     b = unit(np.cross(na, nb))
@@ -203,7 +259,7 @@ def plane_intersection(face_a: FaceFit, face_b: FaceFit, near: np.ndarray) -> tu
     # plane offsets and the normals' tilt over the distance to the touched points
     lever = max(float(np.linalg.norm(face_a.points.mean(axis=0) - p)), float(np.linalg.norm(face_b.points.mean(0) - p)))
     tilt = lever * math.hypot(face_a.normal_sigma, face_b.normal_sigma)
-    sigma = math.hypot(math.hypot(face_a.offset_sigma, face_b.offset_sigma), tilt) / max(s, 0.2)
+    sigma = math.hypot(math.hypot(face_a.offset_sigma, face_b.offset_sigma), tilt) / max(s, bounds.min_edge_sin)
     return p, sigma
 
 
@@ -215,14 +271,14 @@ def line_from_points(
     c = points.mean(axis=0)
     b, s_b = unit(direction), direction_sigma
     q = points - c
-    if len(points) >= 10:
+    if len(points) >= bounds.min_line_points:
         _, sv, vt = np.linalg.svd(q, full_matrices=False)
         length_rms = sv[0] / math.sqrt(len(points))
-        if length_rms > 2e-3:
+        if length_rms > bounds.min_line_spread:
             b_fit = vt[0] if vt[0] @ b > 0 else -vt[0]
             resid = math.hypot(sv[1], sv[2]) / math.sqrt(len(points))
             s_fit = max(resid, bounds.point_sigma) / (length_rms * math.sqrt(len(points)))
-            if angle_between(b_fit, b) < 5 * math.hypot(s_fit, s_b) + math.radians(1.0):
+            if bounds.agree(b_fit, b, math.hypot(s_fit, s_b)):
                 w1, w2 = 1.0 / s_b**2, 1.0 / s_fit**2
                 b = unit(w1 * b + w2 * b_fit)
                 s_b = 1.0 / math.sqrt(w1 + w2)
@@ -233,9 +289,10 @@ def line_from_points(
     return LineFit(c, b, s_b, s_pos, (float(s.min()), float(s.max())))
 
 
-ROLL_AXIS_SLACK = math.radians(3.0)
-"""Rolling over an edge whose next face is out of reach, the sensed normals stay this close (beyond the noise)
-to the plane perpendicular to the edge; a roll round a vertex turns them out of any one plane [rad]."""
+MM = 1e3
+"""Millimetres per metre (the unit of lengths in messages)."""
+AT_END = 1e-9
+"""A vertex's parameter within this of an end of an edge's explored interval is at that end (round-off) [m]."""
 
 
 # ----------------------------------------------------------------------------------------------------------- book
@@ -305,7 +362,8 @@ class Segmenter:
         ``min_face_rows`` rows, when the normals spread more than noise allows, or when the pad centres of the
         rows do not span ``min_face_extent`` (and ``min_face_width`` across, with ``two_d``): the pad touched a
         vertex or an edge, not a face."""
-        mask = face_rows(trace, unit(np.asarray(normal_guess, float)), self.bounds.face_cone)
+        b = self.bounds
+        mask = face_rows(trace, unit(np.asarray(normal_guess, float)), b.face_cone, b.min_refine_rows)
         if mask.sum() < self.bounds.min_face_rows:
             return None
         tips = trace.tip_in_world[mask]
@@ -314,14 +372,14 @@ class Segmenter:
         ext = np.ptp(q @ vt[:2].T, axis=0)
         if ext[0] < self.bounds.min_face_extent or (two_d and ext[1] < self.bounds.min_face_width):
             return None
-        if normal_turn_rate(q @ vt[: 2 if ext[1] > 1e-3 else 1].T, trace.normal_in_world[mask]) > (
+        if normal_turn_rate(q @ vt[: 2 if ext[1] > self.bounds.two_d_extent else 1].T, trace.normal_in_world[mask]) > (
             self.bounds.max_face_curvature
         ):
             return None
         normals = trace.normal_in_world[mask]
         mean = unit(normals.sum(axis=0))
         spread = float(np.sqrt(np.mean(np.sum((normals - mean) ** 2, axis=1))))  # rms angle [rad]
-        if spread > 2.0 * math.sqrt(2.0) * self.bounds.normal_sigma + math.radians(0.5):
+        if spread > self.bounds.max_spread_sigmas * self.bounds.normal_sigma + self.bounds.spread_slack:
             return None  # the rows do not come from one plane (a roll, a vertex)
         return fit_face(trace.point_in_world[mask], normals, self.bounds)
 
@@ -349,17 +407,17 @@ class Segmenter:
         """The line of the edge between faces a and b. Convex: through the contact points recorded while the
         pad rolled over it (normals between the two faces); concave: the planes' intersection, the explored
         interval where the pad was in the corner (``roll`` rows)."""
-        b_dir, s_b = edge_direction(fit_a, fit_b)
         bounds = self.bounds
+        b_dir, s_b = edge_direction(fit_a, fit_b, bounds)
         if convex:
             ok = roll.in_contact
             n = roll.normal_in_world[ok]
             pts = roll.point_in_world[ok]
-            c = math.cos(math.radians(3.0))
+            c = math.cos(bounds.sample_cone)
             between = (n @ fit_a.normal < c) & (n @ fit_b.normal < c)
-            if between.sum() >= 3:
+            if between.sum() >= bounds.min_roll_rows:
                 return line_from_points(pts[between], b_dir, s_b, bounds)
-        p, s_p = plane_intersection(fit_a, fit_b, corner_hint)
+        p, s_p = plane_intersection(fit_a, fit_b, corner_hint, bounds)
         ok = roll.in_contact
         if ok.any():
             s = (roll.point_in_world[ok] - p) @ b_dir
@@ -379,8 +437,8 @@ class Segmenter:
         ok = roll.in_contact
         n, pts = roll.normal_in_world[ok], roll.point_in_world[ok]
         n_a = fit_a.normal
-        turned = n @ n_a < math.cos(math.radians(3.0))
-        if turned.sum() < 5:
+        turned = n @ n_a < math.cos(b.sample_cone)
+        if turned.sum() < b.min_turned_rows:
             return "too few contacts while rolling over the edge"
         n, pts = n[turned], pts[turned]
         sin2 = 1.0 - np.clip(n @ n_a, -1.0, 1.0) ** 2
@@ -388,7 +446,7 @@ class Segmenter:
             return "the normal turned too little over the edge"
         off = float(np.median(np.abs(pts @ n_a - fit_a.offset)))
         if off > b.max_roll_offset:
-            return f"the roll lies {off * 1e3:.1f} mm off the face's plane"
+            return f"the roll lies {off * MM:.1f} mm off the face's plane"
         # the edge direction e ⊥ n_a: e = cos φ u + sin φ w; each rolling normal gives n·e = 0
         u = perpendicular(n_a)
         w = np.cross(n_a, u)
@@ -397,7 +455,7 @@ class Segmenter:
         e = unit(vt[-1, 0] * u + vt[-1, 1] * w)
         resid = n @ e
         # with no second face to check the edge against, every rolling normal must have turned about it
-        if float(np.quantile(np.abs(resid), 0.9)) > math.sin(ROLL_AXIS_SLACK) + b.k * b.normal_sigma:
+        if float(np.quantile(np.abs(resid), b.roll_axis_quantile)) > math.sin(b.roll_axis_slack) + b.k * b.normal_sigma:
             return "the roll turned about more than one axis (round a vertex?)"
         sigma_n = max(float(np.sqrt(np.mean(resid**2))), b.normal_sigma)
         s_e = math.hypot(sigma_n / math.sqrt(float(sin2.sum())), fit_a.normal_sigma)
@@ -416,9 +474,9 @@ class Segmenter:
             return None
         n = roll.normal_in_world[ok]
         pts = roll.point_in_world[ok]
-        c = math.cos(math.radians(3.0))
+        c = math.cos(b.sample_cone)
         between = (n @ fit_a.normal < c) & (n @ fit_b.normal < c)
-        if between.sum() < 3:
+        if between.sum() < b.min_roll_rows:
             return None
         e = unit(np.cross(fit_a.normal, fit_b.normal))
         if float(np.median(np.abs(n[between] @ e))) > math.sin(b.max_roll_skew):
@@ -428,7 +486,7 @@ class Segmenter:
             off = max(float(np.median(np.abs(q @ fit_a.normal - fit_a.offset))),
                       float(np.median(np.abs(q @ fit_b.normal - fit_b.offset))))  # fmt: skip
             if off > b.max_roll_offset:
-                return f"the roll lies {off * 1e3:.1f} mm off the faces' planes"
+                return f"the roll lies {off * MM:.1f} mm off the faces' planes"
         return None
 
     def add_edge(
@@ -471,8 +529,8 @@ class Segmenter:
         rec = self.edges[eid]
         b = self.bounds
         lo, hi = rec.interval
-        start = next((v for v, s in rec.vertices.items() if abs(s - lo) < 1e-9), None)
-        end = next((v for v, s in rec.vertices.items() if abs(s - hi) < 1e-9), None)
+        start = next((v for v, s in rec.vertices.items() if abs(s - lo) < AT_END), None)
+        end = next((v for v, s in rec.vertices.items() if abs(s - hi) < AT_END), None)
         comp = DataEdge(
             id=eid,
             direction=rec.direction,
@@ -494,9 +552,9 @@ class Segmenter:
         """Refine an edge's line with the contact points of a ridge trace along it (convex edges), keeping the
         sign of its direction."""
         rec = self.edges[eid]
-        if ridge_points is None or len(ridge_points) < 10 or not rec.convex:
+        if ridge_points is None or len(ridge_points) < self.bounds.min_line_points or not rec.convex:
             return
-        b_dir, s_b = edge_direction(*fits)
+        b_dir, s_b = edge_direction(*fits, self.bounds)
         if b_dir @ rec.direction < 0:
             b_dir = -b_dir
         old_ends = [rec.at(s) for s in rec.interval]
@@ -551,6 +609,8 @@ class Segmenter:
 
 
 __all__ = [
+    "AT_END",
+    "MM",
     "EdgeRecord",
     "FaceFit",
     "FaceRecord",

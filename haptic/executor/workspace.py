@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -23,6 +24,24 @@ from haptic.planning.moves import EdgeMove, FaceMove, Move, SensorState, VertexM
 from haptic.planning.table import circle_sweep_off_table, pad_height
 from haptic.sim.physics import FingertipContact
 from haptic.sim.scene import OBJECT_REGION, TABLE_TOP_Z
+
+GRID_END = 1e-9
+"""The landing grid reaches its far end despite round-off [m]."""
+
+
+@dataclass(frozen=True)
+class ReentrySearch:
+    """Where an edge move touches its face again when the place beside the last contact is within the pad's reach
+    of the table: the nearest place further along the edge that is not."""
+
+    distance: float = 0.0301
+    """Places up to this far on along the edge are tried [m] ..."""
+    step: float = 0.002
+    """... in steps of this [m] ..."""
+    slack: float = 1e-3
+    """... within this beyond the explored interval [m] ..."""
+    margin: float = 0.001
+    """... the first where the pad stays this much above its limit over the table [m]."""
 
 
 class Workspace:
@@ -40,6 +59,9 @@ class Workspace:
         pad_limit: float,
         vertex_radius: float,
         vertex_start_angle: float,
+        *,
+        table_normal_cos: float,
+        table_contact_cos: float,
     ) -> None:
         self.toucher = toucher
         self.table_z = TABLE_TOP_Z
@@ -47,6 +69,8 @@ class Workspace:
         self.pad_limit = pad_limit
         self.vertex_radius = vertex_radius
         self.vertex_start_angle = vertex_start_angle
+        self.table_normal_cos = table_normal_cos
+        self.table_contact_cos = table_contact_cos
 
     def pad_clearance(self, point: np.ndarray, normal: np.ndarray) -> float:
         """Height above the table top of the pad's lowest point when it touches ``point`` of a face of
@@ -55,12 +79,13 @@ class Workspace:
 
     def is_table(self, normal: np.ndarray, point: np.ndarray | None) -> bool:
         """Whether a contact at ``point`` with ``normal`` is the table top (not the object)."""
-        return point is not None and normal[2] > 0.99 and point[2] < self.table_z + self.table_margin
+        return point is not None and normal[2] > self.table_normal_cos and point[2] < self.table_z + self.table_margin
 
     def touching_table(self, contacts: Sequence[FingertipContact]) -> bool:
         """Whether one of a fingertip's sensed contacts is with the table top."""
         return any(
-            c.point_in_world[2] < self.table_z + self.table_margin and c.normal_in_world[2] > 0.95 for c in contacts
+            c.point_in_world[2] < self.table_z + self.table_margin and c.normal_in_world[2] > self.table_contact_cos
+            for c in contacts
         )
 
     def circle_sweep_off_table(self, vtx: np.ndarray, n_f: np.ndarray, u: np.ndarray, w_f: np.ndarray) -> float:
@@ -73,34 +98,38 @@ class Workspace:
         )  # fmt: skip
 
     def reentry_point(
-        self, rec: EdgeRecord, n: np.ndarray, inward: np.ndarray, s0: float, u: np.ndarray, reentry: float
-    ) -> np.ndarray | None:
+        self, rec: EdgeRecord, n: np.ndarray, inward: np.ndarray, s0: float, u: np.ndarray, reentry: float,
+        search: ReentrySearch,
+    ) -> np.ndarray | None:  # fmt: skip
         """Where an edge move touches the face of normal ``n`` again ``reentry`` in from edge ``rec`` (``inward``
         into the face) before following it along ``u``: beside the last contact (parameter ``s0`` on the
         edge), or -- when that is within the pad's reach of the table -- the nearest point further along ``u``
-        (inside the explored interval) that is not. None: no such point."""
+        (inside the explored interval) that is not, by ``search``. None: no such point."""
         lo, hi = rec.interval
         sense = 1.0 if float(u @ rec.direction) > 0 else -1.0
-        for shift in np.arange(0.0, 0.0301, 0.002):
+        for shift in np.arange(0.0, search.distance, search.step):
             s_k = s0 + sense * shift
-            if shift > 0 and not (lo - 1e-3 <= s_k <= hi + 1e-3):
+            if shift > 0 and not (lo - search.slack <= s_k <= hi + search.slack):
                 break
             p = rec.at(s_k) + reentry * inward
-            if self.pad_clearance(p, n) >= self.pad_limit + 0.001:
+            if self.pad_clearance(p, n) >= self.pad_limit + search.margin:
                 return p
         return None
 
 
-def landing_points(spacing: float, margin: float, rng: np.random.Generator) -> list[np.ndarray]:
+def landing_points(
+    spacing: float, margin: float, rng: np.random.Generator, jitter: float, order_jitter: float
+) -> list[np.ndarray]:
     """The start's landing grid over the object region (a workspace prior), ``spacing`` apart and ``margin``
-    beyond the region, jittered, nearest the region's centre first."""
+    beyond the region, jittered by up to ``jitter`` × ``spacing``, nearest the region's centre first (to
+    within ``order_jitter`` [m])."""
     (x0, x1), (y0, y1) = OBJECT_REGION
-    xs = np.arange(x0 - margin, x1 + margin + 1e-9, spacing)
-    ys = np.arange(y0 - margin, y1 + margin + 1e-9, spacing)
+    xs = np.arange(x0 - margin, x1 + margin + GRID_END, spacing)
+    ys = np.arange(y0 - margin, y1 + margin + GRID_END, spacing)
     centre = np.array([(x0 + x1) / 2, (y0 + y1) / 2])
     pts = np.array([[x, y] for x in xs for y in ys])
-    pts = pts + rng.uniform(-0.3, 0.3, pts.shape) * spacing
-    order = np.argsort(np.linalg.norm(pts - centre, axis=1) + rng.uniform(0, 0.01, len(pts)))
+    pts = pts + rng.uniform(-jitter, jitter, pts.shape) * spacing
+    order = np.argsort(np.linalg.norm(pts - centre, axis=1) + rng.uniform(0, order_jitter, len(pts)))
     return [pts[i] for i in order]
 
 
@@ -141,4 +170,4 @@ def admissible_moves(
     return moves
 
 
-__all__ = ["Workspace", "admissible_moves", "landing_points", "toward_vertex"]
+__all__ = ["GRID_END", "ReentrySearch", "Workspace", "admissible_moves", "landing_points", "toward_vertex"]

@@ -351,14 +351,6 @@ class Polyhedron:
         s = np.einsum("ij,ij->i", np.cross(nl, nr), self.edge_directions)
         return _readonly(np.where(s > 0, 1, -1))
 
-    @cached_property
-    def edge_dihedral(self) -> np.ndarray:
-        """Interior dihedral angle at each edge, in (0, 2π): < π convex, > π concave [rad]."""
-        nl = self.face_normals[self.edge_left_face]
-        nr = self.face_normals[self.edge_right_face]
-        between = np.arccos(np.clip(np.einsum("ij,ij->i", nl, nr), -1.0, 1.0))
-        return _readonly(np.pi - self.edge_convexity * between)
-
     # ------------------------------------------------------------------------------------------ adjacency
 
     def face_vertices(self, f: int) -> tuple[int, ...]:
@@ -368,10 +360,6 @@ class Polyhedron:
     def edge_faces(self, e: int) -> tuple[int, int]:
         """(left, right) faces of edge ``e``."""
         return int(self.edge_left_face[e]), int(self.edge_right_face[e])
-
-    def edge_vertices(self, e: int) -> tuple[int, int]:
-        """(source, destination) vertices of edge ``e``."""
-        return int(self.edges[e, 0]), int(self.edges[e, 1])
 
     @cached_property
     def vertex_edges(self) -> tuple[tuple[int, ...], ...]:
@@ -390,14 +378,6 @@ class Polyhedron:
             for a in loop:
                 out[a].append(f)
         return tuple(tuple(x) for x in out)
-
-    @cached_property
-    def face_neighbors(self) -> tuple[tuple[int, ...], ...]:
-        """Faces sharing an edge with each face, in loop order."""
-        left, right = self.edge_left_face, self.edge_right_face
-        return tuple(
-            tuple(int(right[e] if left[e] == f else left[e]) for e in fe) for f, fe in enumerate(self.face_edges)
-        )
 
     # ------------------------------------------------------------------------------------------ solid
 

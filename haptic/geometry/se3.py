@@ -25,10 +25,6 @@ class SE3:
         return cls(np.eye(3), np.zeros(3))
 
     @classmethod
-    def from_rotation_and_translation(cls, rotation, translation) -> SE3:
-        return cls(np.asarray(rotation, dtype=float), np.asarray(translation, dtype=float))
-
-    @classmethod
     def random(cls, rng: np.random.Generator, translation_scale: float = 0.0) -> SE3:
         """A uniformly random rotation and a translation drawn uniformly in a cube of half-size ``scale``."""
         return cls(random_rotation(rng), rng.uniform(-translation_scale, translation_scale, 3))
@@ -61,10 +57,6 @@ class SE3:
         m[:3, :3] = self.rotation
         m[:3, 3] = self.translation
         return m
-
-    def rotation_angle_to(self, other: SE3) -> float:
-        """Angle of the rotation taking this orientation to the other's [rad]."""
-        return rotation_angle(self.rotation.T @ other.rotation)
 
 
 def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -163,13 +163,14 @@ def random_face_point(poly: Polyhedron, face: int, rng: np.random.Generator, mar
     origin = poly.face_normals[face] * poly.face_offsets[face]
     for _ in range(10_000):
         q = rng.uniform(lo, hi)
-        if _inside_polygon(q, uv) and _boundary_distance(q, uv) >= margin:
+        if inside_polygon(q, uv) and boundary_distance(q, uv) >= margin:
             return origin + q[0] * u + q[1] * w
     # a face too small for the margin: its centroid-like interior point
     return pts.mean(axis=0)
 
 
-def _inside_polygon(q: np.ndarray, poly2: np.ndarray) -> bool:
+def inside_polygon(q: np.ndarray, poly2: np.ndarray) -> bool:
+    """Whether the 2-D point ``q`` lies inside the polygon of vertices ``poly2`` (n, 2) (even-odd rule)."""
     x, y = q
     inside = False
     n = len(poly2)
@@ -181,7 +182,8 @@ def _inside_polygon(q: np.ndarray, poly2: np.ndarray) -> bool:
     return inside
 
 
-def _boundary_distance(q: np.ndarray, poly2: np.ndarray) -> float:
+def boundary_distance(q: np.ndarray, poly2: np.ndarray) -> float:
+    """Distance of the 2-D point ``q`` from the boundary of the polygon of vertices ``poly2`` (n, 2)."""
     a = poly2
     b = np.roll(poly2, -1, axis=0)
     ab = b - a

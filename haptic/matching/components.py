@@ -21,7 +21,8 @@ import numpy as np
 from haptic.errors import HapticError
 
 
-def _vec(x) -> np.ndarray:
+def readonly_vector(x) -> np.ndarray:
+    """``x`` as a float array that cannot be written (the arrays of frozen records)."""
     a = np.array(x, dtype=float)
     a.setflags(write=False)
     return a
@@ -47,8 +48,8 @@ class DataFace:
     kind = "face"
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "normal", _vec(self.normal))
-        object.__setattr__(self, "points", _vec(np.atleast_2d(self.points)))
+        object.__setattr__(self, "normal", readonly_vector(self.normal))
+        object.__setattr__(self, "points", readonly_vector(np.atleast_2d(self.points)))
         object.__setattr__(self, "adjacent", tuple(int(i) for i in self.adjacent))
 
     @property
@@ -99,10 +100,10 @@ class DataEdge:
     kind = "edge"
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "direction", _vec(self.direction))
-        object.__setattr__(self, "point", _vec(self.point))
+        object.__setattr__(self, "direction", readonly_vector(self.direction))
+        object.__setattr__(self, "point", readonly_vector(self.point))
         object.__setattr__(self, "adjacent", tuple(int(i) for i in self.adjacent))
-        object.__setattr__(self, "side_points", tuple((int(f), _vec(q)) for f, q in self.side_points))
+        object.__setattr__(self, "side_points", tuple((int(f), readonly_vector(q)) for f, q in self.side_points))
 
     @property
     def end_point(self) -> np.ndarray:
@@ -126,7 +127,7 @@ class DataVertex:
     kind = "vertex"
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "position", _vec(self.position))
+        object.__setattr__(self, "position", readonly_vector(self.position))
         object.__setattr__(self, "adjacent", tuple(int(i) for i in self.adjacent))
 
 

@@ -5,7 +5,7 @@ images are told apart) and, through their lines, the translation. :func:`pose_fr
 form. :func:`estimate_pose` uses every pairing of an interpretation: a rotation from all directions (face
 normals, edge directions with their senses) by the proper-rotation solution of Wahba's problem, a translation
 by linear least squares on planes, lines and vertices, then Gauss–Newton on all residuals weighted by the
-error bounds. The arrays and steps are those of :class:`~haptic.matching.poses.StackedPoses`, for one
+error bounds. The arrays and steps are those of :class:`~haptic.matching.batch_poses.StackedPoses`, for one
 interpretation.
 """
 
@@ -17,8 +17,8 @@ import numpy as np
 
 from haptic.geometry.polyhedron import Polyhedron
 from haptic.geometry.se3 import SE3, rotation_angle
+from haptic.matching.batch_poses import StackedPoses, proper_rotations
 from haptic.matching.components import DataComponent
-from haptic.matching.poses import StackedPoses, proper_rotations
 
 
 def _unit(v: np.ndarray) -> np.ndarray:

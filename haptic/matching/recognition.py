@@ -35,6 +35,10 @@ def model_symmetries(model: Polyhedron) -> list[SE3]:
     return _SYMMETRY[model]
 
 
+POSE_BOUNDS = 6
+"""Two poses fitted to the same data are equal within this many times the data's largest error bound."""
+
+
 @dataclass(frozen=True)
 class PoseTolerance:
     """When two poses are the same (up to noise): derived from the data's error bounds by :meth:`from_data`."""
@@ -46,13 +50,14 @@ class PoseTolerance:
 
     @classmethod
     def from_data(cls, data) -> PoseTolerance:
-        """``max(3°, 6 × the largest angular bound)`` and ``max(3 mm, 6 × the largest position bound)``: distinct
-        pose classes of a rigid solid differ by far more than the pose noise."""
+        """``max(3°, 6 × the largest angular bound)`` and ``max(3 mm, 6 × the largest position bound)`` (the
+        defaults, and :data:`POSE_BOUNDS`): distinct pose classes of a rigid solid differ by far more than the pose
+        noise."""
         ang, pos = 0.0, 0.0
         for c in data:
             ang = max(ang, getattr(c, "normal_bound", 0.0), getattr(c, "direction_bound", 0.0))
             pos = max(pos, getattr(c, "position_bound", 0.0), getattr(c, "length_bound", 0.0))
-        return cls(max(np.deg2rad(3.0), 6 * ang), max(3e-3, 6 * pos))
+        return cls(max(cls.angle, POSE_BOUNDS * ang), max(cls.distance, POSE_BOUNDS * pos))
 
 
 def same_pose(a: SE3, b: SE3, model: Polyhedron, tol: PoseTolerance) -> bool:

@@ -41,13 +41,14 @@ class ContactTrace:
 
     def select(self, mask: np.ndarray) -> ContactTrace:
         """The rows where ``mask`` holds."""
-        return ContactTrace(*(a[mask] for a in self._arrays()))
+        return ContactTrace(*(a[mask] for a in self.columns()))
 
     def tail(self, k: int) -> ContactTrace:
         """The last ``k`` rows."""
-        return ContactTrace(*(a[max(len(self) - k, 0) :] for a in self._arrays()))
+        return ContactTrace(*(a[max(len(self) - k, 0) :] for a in self.columns()))
 
-    def _arrays(self):
+    def columns(self) -> tuple[np.ndarray, ...]:
+        """The trace's arrays in the order of the constructor's arguments."""
         return (self.time, self.tip_in_world, self.hand_rotation, self.point_in_world, self.normal_in_world,
                 self.force, self.phase)  # fmt: skip
 
@@ -56,7 +57,7 @@ class ContactTrace:
         traces = [t for t in traces if len(t)]
         if not traces:
             return empty_trace()
-        return ContactTrace(*(np.concatenate(cols) for cols in zip(*(t._arrays() for t in traces), strict=True)))
+        return ContactTrace(*(np.concatenate(cols) for cols in zip(*(t.columns() for t in traces), strict=True)))
 
 
 def empty_trace() -> ContactTrace:

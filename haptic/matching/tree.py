@@ -38,9 +38,9 @@ from haptic.errors import MatchError
 from haptic.geometry.polyhedron import Polyhedron
 from haptic.geometry.se3 import SE3
 from haptic.matching import constraints as C
+from haptic.matching.batch_poses import StackedPoses
 from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex
 from haptic.matching.library import EDGE, FACE, KIND_INDEX, KINDS, VERTEX, LibraryArrays
-from haptic.matching.poses import StackedPoses
 
 PARALLEL_FACES = 1e-6
 """Model face normals closer than this to (anti-)parallel take the plane-distance test [rad]."""
@@ -269,7 +269,7 @@ class InterpretationTree:
 
     def retain(self, keep: np.ndarray) -> int:
         """Eliminate the leaves where ``keep`` (shape (N,) bool) is False: evidence that is no pairing, such as
-        the free space a probe passed through (:mod:`haptic.matching.probes`). Returns the number left; the
+        the free space a probe passed through (:mod:`haptic.matching.free_space`). Returns the number left; the
         count after the last ``add`` is updated to it."""
         keep = np.asarray(keep, dtype=bool)
         if keep.shape != (self.count,):
@@ -579,7 +579,7 @@ class InterpretationTree:
     def poses(self, leaves: Sequence[int], refine: bool = True) -> list[SE3 | None]:
         """Poses ``world_from_model`` of some leaves (None where the data do not determine one yet), least-squares
         refined unless ``refine`` is False: all of them in one batch
-        (:class:`~haptic.matching.poses.StackedPoses`), from the unrefined ones for a refinement. Poses are kept
+        (:class:`~haptic.matching.batch_poses.StackedPoses`), from the unrefined ones for a refinement. Poses are kept
         until the next ``add``, so a leaf is posed once per data update."""
         leaves = [int(i) for i in leaves]
         todo = sorted({i for i in leaves if (refine, i) not in self._pose_cache})

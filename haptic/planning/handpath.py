@@ -1,6 +1,6 @@
 """The path of a free-space probe on the simulated hand: the one rule the physics executor
 follows (:mod:`haptic.executor.physics_probe`) and the planner predicts its cost by
-(:func:`~haptic.planning.probes.predict_probes`).
+(:func:`~haptic.planning.probe_prediction.predict_probes`).
 
 The fingers point down and end in a pad of radius ``r``; positions here are the pad's *centre*. From the
 centre ``c`` on the surface of sensed outward normal ``n``, the hand

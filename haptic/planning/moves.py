@@ -14,7 +14,7 @@ from enum import StrEnum
 import numpy as np
 
 from haptic.matching.components import DataComponent
-from haptic.matching.probes import FreeSegment
+from haptic.matching.free_space import FreeSegment
 from haptic.matching.trace import ContactTrace
 
 MOVE_SETS = ("tracing", "probing", "all")
@@ -131,6 +131,20 @@ VERTEX_RADIUS = 0.008
 """Radius of a vertex move's circle round the vertex [m], the hand's: the physics executor circles the contact
 point this far from the vertex (its pad, of 12 mm radius, touching the face there, not the edges round the
 vertex). Both executors' settings default to it, and each world gives its executor's to the planner."""
+
+MIN_IN_PLANE = 0.1
+"""A face move's direction must keep at least this fraction of its length in the plane of the face [-]."""
+ZERO_LENGTH = 1e-12
+"""A direction shorter than this has no length (round-off) [-]."""
+
+
+def in_plane(direction: np.ndarray, normal: np.ndarray) -> np.ndarray | None:
+    """The component of a face move's ``direction`` in the plane of unit ``normal``, or None when it is shorter
+    than :data:`MIN_IN_PLANE` of the direction's length (the direction is not in the plane of the face)."""
+    inplane = direction - (direction @ normal) * normal
+    if np.linalg.norm(inplane) < MIN_IN_PLANE * max(np.linalg.norm(direction), ZERO_LENGTH):
+        return None
+    return inplane
 
 
 @dataclass(frozen=True, eq=False)

@@ -38,11 +38,11 @@ from haptic.errors import PlanningError
 from haptic.matching.components import DataComponent
 from haptic.planning.efficiency import class_weights
 from haptic.planning.hypothesis import Hypothesis
+from haptic.planning.move_scores import Context, Decision, Scored, same_move, score_all, score_probe
 from haptic.planning.moves import Move, ProbeMove, SensorState
 from haptic.planning.policies import PlannerPolicy, Policy
 from haptic.planning.predict import Prediction
-from haptic.planning.probes import ProbePrediction
-from haptic.planning.scoring import Context, Decision, Scored, same_move, score_all, score_probe
+from haptic.planning.probe_prediction import ProbePrediction
 from haptic.planning.search import Branch, branches, probe_branches
 
 MAX_PROBES = 4

@@ -19,9 +19,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from haptic.errors import PlanningError
-from haptic.planning.moves import Move
-from haptic.planning.predict import candidate_moves
-from haptic.planning.scoring import (  # noqa: F401 -- Context, Decision, refusal, same_move: re-exported
+from haptic.planning.move_scores import (  # noqa: F401 -- Context, Decision, refusal, same_move: re-exported
     Context,
     Decision,
     Scored,
@@ -31,6 +29,8 @@ from haptic.planning.scoring import (  # noqa: F401 -- Context, Decision, refusa
     same_move,
     score_all,
 )
+from haptic.planning.moves import Move
+from haptic.planning.predict import candidate_moves
 from haptic.planning.search import lookahead_choice
 from haptic.planning.table import table_safe_moves
 

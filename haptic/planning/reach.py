@@ -76,7 +76,7 @@ def touch_distance(poly: Polyhedron, world_from_model: SE3, points: np.ndarray, 
     return best
 
 
-def _touchable(
+def touchable(
     poly: Polyhedron, world_from_model: SE3, pts: np.ndarray, nrm: np.ndarray, config: PlannerConfig, room: float
 ) -> np.ndarray:
     """Which world points ``pts`` of faces of normals ``nrm`` the pad can touch: clear of the table by
@@ -108,7 +108,7 @@ def reachable(
     """The reachable sample points of ``poly`` at ``world_from_model``, world frame, and their normals."""
     pts_m, nrm_m = surface_samples(poly, spacing)
     pts, nrm = world_from_model.apply(pts_m), world_from_model.rotate(nrm_m)
-    ok = _touchable(poly, world_from_model, pts, nrm, config, TRACE_ROOM)
+    ok = touchable(poly, world_from_model, pts, nrm, config, TRACE_ROOM)
     return pts[ok], nrm[ok]
 
 
@@ -136,7 +136,7 @@ def observable_edges(
             k = max(2, int(np.ceil((length - 2 * EDGE_ONLY_CLEARANCE) / spacing)) + 1)
             ts = np.linspace(EDGE_ONLY_CLEARANCE / length, 1.0 - EDGE_ONLY_CLEARANCE / length, k)
             pts = p0 + ts[:, None] * (p1 - p0)
-            ok = _touchable(poly, world_from_model, pts, np.broadcast_to(n_a, pts.shape), config, 0.0)
+            ok = touchable(poly, world_from_model, pts, np.broadcast_to(n_a, pts.shape), config, 0.0)
             # the roll to the limit (the normal turned toward n_b until it leans under by max_undercut) clears
             # the table
             m = _limit_normal(n_a, n_b, lean)

@@ -22,10 +22,10 @@ from haptic.matching.components import DataComponent, SensorNoise
 from haptic.planning.config import PlannerConfig
 from haptic.planning.efficiency import class_weights, outcome_groups
 from haptic.planning.hypothesis import Hypothesis
+from haptic.planning.move_scores import Context, predict_probe_moves, refusal, same_move, score_prediction
 from haptic.planning.moves import Move, ProbeMove, SensorState
 from haptic.planning.predict import candidate_moves, predict
-from haptic.planning.probes import ProbePrediction
-from haptic.planning.scoring import Context, predict_probe_moves, refusal, same_move, score_prediction
+from haptic.planning.probe_prediction import ProbePrediction
 from haptic.planning.simulate import simulate, simulate_probe
 
 

@@ -1,6 +1,6 @@
 """A move carried out exactly in one hypothesis's world (noiseless): the data it would produce and the sensor
 state it would end in. The look-ahead (:mod:`haptic.planning.search`) predicts the next moves from there; the
-candidate filter of :mod:`haptic.planning.scoring` asks it which vertex moves only circle back.
+candidate filter of :mod:`haptic.planning.move_scores` asks it which vertex moves only circle back.
 
 A free-space probe (:func:`simulate_probe`) ends as the executors end one: a hit is a face touched at the
 contact, adjacent to nothing known, with the sensor resting on it; a miss adds no component and leaves the
@@ -137,7 +137,7 @@ def simulate_probe(
     noise: SensorNoise | None = None,
 ) -> tuple[Hypothesis, SensorState, dict[int, DataComponent]] | None:
     """Probe ``move`` carried out exactly in hypothesis ``h``'s world (the line cast at its posed model, as
-    :func:`~haptic.planning.probes.predict_probes` casts it). A hit: a new data face at the contact with the
+    :func:`~haptic.planning.probe_prediction.predict_probes` casts it). A hit: a new data face at the contact with the
     outward normal of the model face hit (bounds from ``noise``, as every simulated face), adjacent to nothing;
     the correspondence extended by it; the sensor on it, at no edge or vertex. A miss: ``h``, ``state`` and the
     components unchanged. None when ``h`` has no pose."""

@@ -64,7 +64,9 @@ def circle_points(
 VERTEX_START_ANGLE = np.deg2rad(25.0)
 """A vertex move's circle starts this far from the current edge (the physics executor's start) [rad]."""
 SWEEP_STEP = np.deg2rad(2.0)
-"""Spacing of the points of a vertex circle checked against the table [rad]."""
+"""Spacing of the points of a vertex circle checked against the table [rad] (how far it can sweep) ..."""
+CIRCLE_CHECK_STEP = np.deg2rad(3.0)
+"""... and of those checked for a vertex move's admissibility under a hypothesis [rad]."""
 
 
 def circle_sweep_off_table(
@@ -157,7 +159,7 @@ def table_prediction(
             return np.nan, np.nan, np.nan
         u = poly.edge_directions[e_m] * (1.0 if poly.edges[e_m, 1] == v_m else -1.0)
         pts = circle_points(poly.vertices[v_m], u, _inward(poly, e_m, a_m), config.vertex_radius,
-                            VERTEX_START_ANGLE, hit.angle, np.deg2rad(3.0))  # fmt: skip
+                            VERTEX_START_ANGLE, hit.angle, CIRCLE_CHECK_STEP)  # fmt: skip
         n_w = t.rotate(poly.face_normals[a_m])
         if min(pad_clearance(q, n_w, config) for q in t.apply(pts)) < lim:
             return 1.0, np.nan, np.nan

@@ -2,7 +2,7 @@
 
 The planner's scoring (seed §4.1) with one hypothesis left has nothing to eliminate; what a move is worth then
 is what it *measures* of the remaining model that has not been measured yet: each model face, edge or vertex
-still missing from the coverage target (:mod:`haptic.matching.verify`) that the move is predicted to reach, in
+still missing from the coverage target (:mod:`haptic.matching.acceptance`) that the move is predicted to reach, in
 the hypothesis's world (:func:`~haptic.planning.search.simulate`), per unit of predicted cost, discounted by the
 same risks as the planner's moves (the table, a steep descent). A move that measures nothing new now is scored
 by the best two-move sequence it starts (the look-ahead of :mod:`haptic.planning.search`), and, when no such
@@ -68,7 +68,7 @@ def reachable_features(
     allf = frozenset(range(poly.n_faces))
     if config.table_z is None:
         return allf, frozenset(range(poly.n_edges)), frozenset(range(poly.n_vertices))
-    from haptic.planning.reach import SPACING, TRACE_ROOM, _touchable
+    from haptic.planning.reach import SPACING, TRACE_ROOM, touchable
 
     faces = set()
     for f in range(poly.n_faces):  # interior sample points of the face's triangles
@@ -84,7 +84,7 @@ def reachable_features(
         if not len(p):
             continue
         nrm = np.broadcast_to(poly.face_normals[f], p.shape)
-        ok = _touchable(poly, world_from_model, world_from_model.apply(p), world_from_model.rotate(nrm), config,
+        ok = touchable(poly, world_from_model, world_from_model.apply(p), world_from_model.rotate(nrm), config,
                         TRACE_ROOM)  # fmt: skip
         if int(ok.sum()) >= MIN_SAMPLES:
             faces.add(f)
@@ -288,9 +288,9 @@ def _probe_targets(
                     out.append((p, f))
                     break
     if mf:
-        from haptic.planning.probes import _face_targets
+        from haptic.planning.probe_lines import face_targets
 
-        centres = _face_targets(poly)
+        centres = face_targets(poly)
         out += [(centres[f], int(f)) for f in sorted(mf) if faces_ok is None or f in faces_ok]
     return out
 
@@ -303,12 +303,12 @@ def verification_probes(
     """Free-space probes that carry the sensor to what of hypothesis ``h``'s model is still missing, with their
     predicted cost and risk, when the configuration admits probes (``config.moves``): a probe measures no edge
     or vertex, but it lands on a face beside one for ``c_p`` plus ``c_s`` per metre of free space, where tracing
-    there costs ``c_f`` per metre of face and ``c_e`` per metre of edge. Lines (:func:`~haptic.planning.probes.
+    there costs ``c_f`` per metre of face and ``c_e`` per metre of edge. Lines (:func:`~haptic.planning.probe_lines.
     aimed_probes`) at the targets of :func:`_probe_targets` at least :data:`MIN_PROBE_TRANSFER` from the sensor,
     the :data:`MAX_VERIFY_PROBES` nearest, predicted to hit their face in ``h``'s world and not to fail there (the
     hand's checks); none after a probe failed from here (``avoid``), nor along a line probed before (``probed``)."""
-    from haptic.planning.probes import aimed_probes
-    from haptic.planning.scoring import Context, predict_probe_moves, probe_config, same_move
+    from haptic.planning.move_scores import Context, predict_probe_moves, probe_config, same_move
+    from haptic.planning.probe_lines import aimed_probes
 
     no_probes = config.moves == "tracing" or config.table_z is not None  # the hand verifies by tracing
     if no_probes or h.world_from_model is None or any(m.kind == "probe" for m in avoid):
@@ -393,12 +393,12 @@ __all__ = ["aimed_face_moves", "choose_verification_move", "hidden_vertices", "r
 
 
 class Verifier:
-    """The verification stage of an episode (``mode`` "fast" or "full", :data:`~haptic.matching.verify.TARGETS`):
+    """The verification stage of an episode (``mode`` "fast" or "full", :data:`~haptic.matching.acceptance.TARGETS`):
     once one pose class is left, :meth:`verdict` says whether the data confirm it, contradict it, or must
     go on; :meth:`choose` picks the next verification move; :meth:`record` is what the episode reports."""
 
     def __init__(self, mode: str, noise: SensorNoise, config: PlannerConfig, k_sigma: float | None = None) -> None:
-        from haptic.matching.verify import K_SIGMA, check_verify_mode
+        from haptic.matching.acceptance import K_SIGMA, check_verify_mode
 
         self.mode = check_verify_mode(mode)
         self.noise, self.config = noise, config
@@ -427,7 +427,7 @@ class Verifier:
     def verdict(self, tree, rec, cost: float) -> str:
         """"confirmed", "mismatch", "incomplete" or "verifying" for a recognition ``rec`` (status recognized)
         of ``tree``, at path cost ``cost``."""
-        from haptic.matching.verify import acceptance, coverage, pose_check
+        from haptic.matching.acceptance import acceptance, coverage, pose_check
 
         cls = rec.classes[0]
         if self.started_at is None:

@@ -18,11 +18,11 @@ if TYPE_CHECKING:
     from haptic.planning.policies import Decision
 
 
-def _transform(t: SE3) -> rr.Transform3D:
+def transform(t: SE3) -> rr.Transform3D:
     return rr.Transform3D(translation=np.asarray(t.translation, dtype=float), mat3x3=np.asarray(t.rotation))
 
 
-def _mesh(model: Polyhedron, color: tuple[int, ...]) -> rr.Mesh3D:
+def mesh(model: Polyhedron, color: tuple[int, ...]) -> rr.Mesh3D:
     """Flat-shaded mesh in the model frame (vertices repeated per triangle so each face keeps its normal)."""
     tris = np.asarray(model.triangles)
     pos = np.asarray(model.vertices, dtype=float)[tris].reshape(-1, 3)
@@ -33,12 +33,12 @@ def _mesh(model: Polyhedron, color: tuple[int, ...]) -> rr.Mesh3D:
     )  # fmt: skip
 
 
-def _wireframe(model: Polyhedron, color: tuple[int, ...], radius: float) -> rr.LineStrips3D:
+def wireframe(model: Polyhedron, color: tuple[int, ...], radius: float) -> rr.LineStrips3D:
     v = np.asarray(model.vertices, dtype=float)
     return rr.LineStrips3D([v[list(e)] for e in np.asarray(model.edges)], colors=[color], radii=radius)
 
 
-def _patch(face: DataFace) -> tuple[np.ndarray, np.ndarray]:
+def patch(face: DataFace) -> tuple[np.ndarray, np.ndarray]:
     """A square in the face's plane around its touched points (half-size: their spread + PATCH_RADIUS)."""
     n = face.normal
     a, b = plane_basis(n)
@@ -63,7 +63,7 @@ def _edge_crossing(start: np.ndarray, direction: np.ndarray, edge: DataEdge) -> 
     return edge.point + u * b
 
 
-def _waypoints(prev: np.ndarray | None, result: MoveResult, new: np.ndarray | None) -> np.ndarray:
+def waypoints(prev: np.ndarray | None, result: MoveResult, new: np.ndarray | None) -> np.ndarray:
     """The sensed points of a move in the order they were met, from the previous sensor position to the new
     one: the geometric executor's path (it has no fingertip trajectory)."""
     pts: list[np.ndarray] = [prev] if prev is not None else []
@@ -106,7 +106,7 @@ def _waypoints(prev: np.ndarray | None, result: MoveResult, new: np.ndarray | No
     return np.array(out).reshape(-1, 3)
 
 
-def _contacts(components: tuple[DataComponent, ...]) -> tuple[np.ndarray, np.ndarray]:
+def contacts(components: tuple[DataComponent, ...]) -> tuple[np.ndarray, np.ndarray]:
     """Contact points and normals of a move from its components (geometric executor): face points with the
     face normal."""
     pts, nrm = [], []
@@ -119,14 +119,14 @@ def _contacts(components: tuple[DataComponent, ...]) -> tuple[np.ndarray, np.nda
     return np.array(pts), np.array(nrm)
 
 
-def _subsample(a: np.ndarray, k: int) -> np.ndarray:
+def subsample(a: np.ndarray, k: int) -> np.ndarray:
     """At most ``k`` rows of ``a``, evenly spaced, first and last kept."""
     if len(a) <= k:
         return a
     return a[np.unique(np.linspace(0, len(a) - 1, k).round().astype(int))]
 
 
-def _trace_of(result: MoveResult) -> Any:
+def trace_of(result: MoveResult) -> Any:
     """The move's contact trace (``result.trace``) when it looks like one, else None."""
     tr = getattr(result, "trace", None)
     needed = ("time", "tip_in_world", "point_in_world", "normal_in_world", "force")
@@ -135,14 +135,14 @@ def _trace_of(result: MoveResult) -> Any:
     return tr
 
 
-def _score_color(r: float) -> tuple[int, int, int]:
+def score_color(r: float) -> tuple[int, int, int]:
     """Dark blue (worst) to yellow (best)."""
     r = float(min(max(r, 0.0), 1.0))
     lo, hi = np.array([40, 30, 120]), np.array([250, 230, 40])
     return tuple(int(x) for x in lo + r * (hi - lo))
 
 
-def _chain_index(names: list[str], chains: Any) -> list[np.ndarray]:
+def chain_index(names: list[str], chains: Any) -> list[np.ndarray]:
     """Row indices of each polyline of link names (chains naming an unknown link, or with fewer than two
     links, are left out)."""
     if not chains:
@@ -156,12 +156,12 @@ def _chain_index(names: list[str], chains: Any) -> list[np.ndarray]:
     return out
 
 
-def _log_count(n: float) -> float:
+def log_count(n: float) -> float:
     """What the log10 plots show for ``n`` interpretations or pose classes (:data:`NO_COUNT` for none)."""
     return math.log10(n) if n >= 1 else NO_COUNT
 
 
-def _entity_name(name: Any) -> str:
+def entity_name(name: Any) -> str:
     """A link name as one entity-path part (slashes and spaces replaced)."""
     return str(name).replace("/", "_").replace(" ", "_") or "_"
 
@@ -176,7 +176,7 @@ def _rotate(wxyz: np.ndarray, v: np.ndarray) -> np.ndarray:
     return v + 2.0 * np.cross(q, np.cross(q, v) + w * v)
 
 
-def _geom_archetypes(kind: str, geoms: list[Any], alpha: float = 1.0) -> list[tuple[str, Any]]:
+def geom_archetypes(kind: str, geoms: list[Any], alpha: float = 1.0) -> list[tuple[str, Any]]:
     """Rerun archetypes drawing ``geoms`` (all of one kind, in their link's frame; their opacity times
     ``alpha``): (entity suffix, archetype) pairs. Raises ValueError for a kind rerun cannot draw here."""
     pose = np.array([np.asarray(g.pose, dtype=float) for g in geoms]).reshape(len(geoms), 7)
@@ -221,10 +221,10 @@ def _bar(r: float, width: int = 20) -> str:
     return "`" + "=" * n + " " * (width - n) + "`"
 
 
-def _decision_table(i: int, decision: Decision) -> str:
+def decision_table(i: int, decision: Decision) -> str:
     """Markdown: the decision's candidate moves, best first, with a bar of their score against the best."""
     cands = sorted(decision.candidates, key=lambda c: -c.score if math.isfinite(c.score) else math.inf)
-    head = f"**move {i}**: chose **{_move_name(decision.move)}**"
+    head = f"**move {i}**: chose **{move_name(decision.move)}**"
     if not cands:
         return head + " (no scored candidates: the fallback policy)"
     best = max((float(c.score) for c in cands if math.isfinite(c.score)), default=0.0)
@@ -232,7 +232,7 @@ def _decision_table(i: int, decision: Decision) -> str:
             "| move | score | | exp. cost | exp. eliminated |", "|---|---|---|--:|--:|"]  # fmt: skip
     shown = cands[:MAX_TABLE_ROWS]
     for c in shown:
-        name = f"**{_move_name(c.move)}** (chosen)" if c.move == decision.move else _move_name(c.move)
+        name = f"**{move_name(c.move)}** (chosen)" if c.move == decision.move else move_name(c.move)
         r = float(c.score) / best if best > 0 and math.isfinite(c.score) else 0.0
         rows.append(f"| {name} | {_bar(r)} | {c.score:.3g} | {c.expected_cost:.2f} | "
                     f"{c.expected_eliminated:.2f} |")  # fmt: skip
@@ -241,7 +241,7 @@ def _decision_table(i: int, decision: Decision) -> str:
     return "\n".join(rows)
 
 
-def _move_name(move: Move) -> str:
+def move_name(move: Move) -> str:
     """The move's kind and direction: ``face (+0.92, +0.33, -0.22)`` (a world direction), ``edge +``,
     ``vertex across f2``, ``probe (+0.00, -0.71, -0.71) 12 cm`` (the approach direction and the line's length)."""
     kind = getattr(move, "kind", "?")

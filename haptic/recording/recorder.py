@@ -23,21 +23,21 @@ from haptic.geometry import SE3, Polyhedron
 from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex
 from haptic.recording.blueprint import Framing, default_blueprint
 from haptic.recording.drawing import (
-    _chain_index,
-    _contacts,
-    _decision_table,
-    _entity_name,
-    _geom_archetypes,
-    _log_count,
-    _mesh,
-    _move_name,
-    _patch,
-    _score_color,
-    _subsample,
-    _trace_of,
-    _transform,
-    _waypoints,
-    _wireframe,
+    chain_index,
+    contacts,
+    decision_table,
+    entity_name,
+    geom_archetypes,
+    log_count,
+    mesh,
+    move_name,
+    patch,
+    score_color,
+    subsample,
+    trace_of,
+    transform,
+    waypoints,
+    wireframe,
 )
 from haptic.recording.style import (
     APPLICATION_ID,
@@ -278,9 +278,9 @@ class EpisodeRecorder:
         ``object`` view's target from its size and place."""
         rec, s = self.stream, self._s
         rec.send_recording_name(f"{true_model.name}")
-        rec.log("world/truth", _transform(world_from_model), static=True)
-        rec.log("world/truth/object", _mesh(true_model, TRUTH_COLOR), static=True)
-        rec.log("world/truth/edges", _wireframe(true_model, (120, 120, 120), rr.components.Radius.ui_points(1.0)),
+        rec.log("world/truth", transform(world_from_model), static=True)
+        rec.log("world/truth/object", mesh(true_model, TRUTH_COLOR), static=True)
+        rec.log("world/truth/edges", wireframe(true_model, (120, 120, 120), rr.components.Radius.ui_points(1.0)),
                 static=True)  # fmt: skip
         v = np.asarray(true_model.vertices, dtype=float) @ np.asarray(world_from_model.rotation).T
         v = v + np.asarray(world_from_model.translation, dtype=float)
@@ -304,9 +304,9 @@ class EpisodeRecorder:
 
         # the path: the physics trace when there is one, else the sensed waypoints
         if trace is not None and len(trace.time):
-            path = _subsample(np.asarray(trace.tip_in_world, dtype=float), TRACE_MAX_POINTS)
+            path = subsample(np.asarray(trace.tip_in_world, dtype=float), TRACE_MAX_POINTS)
         else:
-            path = _waypoints(prev, result, new)
+            path = waypoints(prev, result, new)
         if len(path) == 1:
             path = np.vstack([path, path])
         if len(path):
@@ -335,13 +335,13 @@ class EpisodeRecorder:
         # contacts of this move
         if trace is not None and len(trace.time):
             ok = np.isfinite(np.asarray(trace.normal_in_world, dtype=float)[:, 0])
-            pts = _subsample(np.asarray(trace.point_in_world, dtype=float)[ok], MOVE_CONTACTS)
-            nrm = _subsample(np.asarray(trace.normal_in_world, dtype=float)[ok], MOVE_CONTACTS)
+            pts = subsample(np.asarray(trace.point_in_world, dtype=float)[ok], MOVE_CONTACTS)
+            nrm = subsample(np.asarray(trace.normal_in_world, dtype=float)[ok], MOVE_CONTACTS)
             self._log_trace(trace)
         else:
-            pts, nrm = _contacts(result.components)
+            pts, nrm = contacts(result.components)
         rec.log("world/contacts/points", rr.Points3D(pts, radii=CONTACT_RADIUS, colors=[CONTACT_COLOR]))
-        k = _subsample(np.arange(len(pts)), MOVE_NORMALS)
+        k = subsample(np.arange(len(pts)), MOVE_NORMALS)
         rec.log(
             "world/contacts/normals",
             rr.Arrows3D(origins=pts[k], vectors=nrm[k] * CONTACT_NORMAL_SCALE * s.radius, colors=[CONTACT_COLOR],
@@ -356,14 +356,14 @@ class EpisodeRecorder:
         # the counts, on a log axis, with a marker of the move's kind
         s.cost += float(result.cost)
         n_classes = len(recognition.classes) if recognition is not None and recognition.classes else None
-        self._log_counts(_log_count(n_interpretations), _log_count(n_classes) if n_classes is not None else None,
+        self._log_counts(log_count(n_interpretations), log_count(n_classes) if n_classes is not None else None,
                          kind)  # fmt: skip
         rec.log("plots/path_cost", rr.Scalars(s.cost))
         if recognition is not None and recognition.status == "recognized" and recognition.world_from_model:
             model = next((c.model for c in recognition.classes if c.name == recognition.model), None)
             if model is not None:
-                rec.log("world/estimate", _transform(recognition.world_from_model))
-                rec.log("world/estimate/edges", _wireframe(model, ESTIMATE_COLOR, EDGE_RADIUS))
+                rec.log("world/estimate", transform(recognition.world_from_model))
+                rec.log("world/estimate/edges", wireframe(model, ESTIMATE_COLOR, EDGE_RADIUS))
         if i not in s.decided:
             self._no_decision(i, kind)
 
@@ -415,7 +415,7 @@ class EpisodeRecorder:
         """Move ``i``'s contact trace (None without one), after setting the clocks to it and sending the
         blueprint with the first move."""
         s = self._s
-        trace = _trace_of(result)
+        trace = trace_of(result)
         if trace is not None and len(trace.time):
             s.sim_time = float(trace.time[-1])
         if not s.blueprint_sent:
@@ -433,7 +433,7 @@ class EpisodeRecorder:
             self._log_trace(trace)
         self._log_hand(result, trace)
         if trace is not None and len(trace.time):
-            path = _subsample(np.asarray(trace.tip_in_world, dtype=float), TRACE_MAX_POINTS)
+            path = subsample(np.asarray(trace.tip_in_world, dtype=float), TRACE_MAX_POINTS)
             if len(path) >= 2:
                 s.failed_strips.append(path)
                 rec.log("world/trace/failed", rr.LineStrips3D(s.failed_strips, colors=[KIND_COLORS["failed"]],
@@ -451,7 +451,7 @@ class EpisodeRecorder:
         rec.log(
             "log/moves",
             rr.TextLog(
-                f"move {i} ({_move_name(result.move)}) failed: {result.status}" + (f" ({reason})" if reason else ""),
+                f"move {i} ({move_name(result.move)}) failed: {result.status}" + (f" ({reason})" if reason else ""),
                 level=rr.TextLogLevel.WARN,
             ),
         )
@@ -475,16 +475,16 @@ class EpisodeRecorder:
                     continue
                 origins.append(s.position)
                 vectors.append(d * CANDIDATE_SCALE * s.radius * (0.5 + 0.5 * r))
-                colors.append(_score_color(r))
-                labels.append(f"{_move_name(c.move)} {c.score:.3g}")
+                colors.append(score_color(r))
+                labels.append(f"{move_name(c.move)} {c.score:.3g}")
             probes = [(c, r) for c, r in zip(cands, rel, strict=True) if getattr(c.move, "kind", None) == "probe"]
             probes = sorted(probes, key=lambda cr: -cr[1])[:CANDIDATE_PROBES]  # the best lines only: dozens hide all
             if probes:
                 rec.log(
                     "world/decision/probes",
                     rr.LineStrips3D([np.array([c.move.start, c.move.end]) for c, _ in probes],
-                                    colors=[_score_color(r) for _, r in probes], radii=ARROW_RADIUS,
-                                    labels=[f"{_move_name(c.move)} {c.score:.3g}" for c, _ in probes],
+                                    colors=[score_color(r) for _, r in probes], radii=ARROW_RADIUS,
+                                    labels=[f"{move_name(c.move)} {c.score:.3g}" for c, _ in probes],
                                     show_labels=False),
                 )  # fmt: skip
             if origins:
@@ -494,7 +494,7 @@ class EpisodeRecorder:
                                 show_labels=False),
                 )  # fmt: skip
             lines = [
-                f"  {_move_name(c.move):<16} score {c.score:10.4g}  cost {c.expected_cost:7.2f}  "
+                f"  {move_name(c.move):<16} score {c.score:10.4g}  cost {c.expected_cost:7.2f}  "
                 f"eliminated {c.expected_eliminated:6.2f}"
                 for c in sorted(cands, key=lambda c: -c.score if math.isfinite(c.score) else math.inf)
             ]
@@ -505,7 +505,7 @@ class EpisodeRecorder:
                 "world/decision/chosen",
                 rr.Arrows3D(origins=[decision.move.start], vectors=[decision.move.end - decision.move.start],
                             colors=[(255, 255, 255)], radii=rr.components.Radius.ui_points(2.5),
-                            labels=[_move_name(decision.move)], show_labels=False),
+                            labels=[move_name(decision.move)], show_labels=False),
             )  # fmt: skip
         d = self._move_direction(decision.move)
         if d is not None and s.position is not None:
@@ -513,14 +513,14 @@ class EpisodeRecorder:
                 "world/decision/chosen",
                 rr.Arrows3D(origins=[s.position], vectors=[d * CANDIDATE_SCALE * s.radius * 1.2],
                             colors=[(255, 255, 255)], radii=rr.components.Radius.ui_points(2.5),
-                            labels=[_move_name(decision.move)], show_labels=False),
+                            labels=[move_name(decision.move)], show_labels=False),
             )  # fmt: skip
         s.decision_shown = True
-        rec.log("decision/scores", rr.TextDocument(_decision_table(i, decision), media_type=rr.MediaType.MARKDOWN))
+        rec.log("decision/scores", rr.TextDocument(decision_table(i, decision), media_type=rr.MediaType.MARKDOWN))
         rec.log(
             "log/decisions",
             rr.TextLog(
-                f"move {i}: chose {_move_name(decision.move)} among {len(cands)} candidates"
+                f"move {i}: chose {move_name(decision.move)} among {len(cands)} candidates"
                 + ("\n" + "\n".join(lines) if lines else ""),
                 level=rr.TextLogLevel.INFO,
             ),
@@ -621,7 +621,7 @@ class EpisodeRecorder:
         if faces:
             verts, tris = [], []
             for f in faces:
-                v, t = _patch(f)
+                v, t = patch(f)
                 tris.append(t + sum(len(x) for x in verts))
                 verts.append(v)
             rec.log(
@@ -713,9 +713,9 @@ class EpisodeRecorder:
             groups.setdefault((getattr(g, "link", None), str(getattr(g, "kind", "?"))), []).append(g)
         links: set[str] = set()
         for (link, kind), items in groups.items():
-            base = f"world/robot/{_entity_name(link)}" if link is not None else "world/table"
+            base = f"world/robot/{entity_name(link)}" if link is not None else "world/table"
             try:
-                archetypes = _geom_archetypes(kind, items, ROBOT_ALPHA if link is not None else 1.0)
+                archetypes = geom_archetypes(kind, items, ROBOT_ALPHA if link is not None else 1.0)
             except ValueError as exc:
                 warnings.warn(f"link_geoms: {exc}; skipped", stacklevel=3)
                 continue
@@ -737,7 +737,7 @@ class EpisodeRecorder:
                               stacklevel=3)  # fmt: skip
                 continue
             quat = a[:, [4, 5, 6, 3]]  # (w, x, y, z) -> rerun's (x, y, z, w)
-            path = f"world/robot/{_entity_name(name)}"
+            path = f"world/robot/{entity_name(name)}"
             if t is not None and len(t) == len(a):
                 rec.send_columns(path, indexes=[rr.TimeColumn("sim_time", duration=t)],
                                  columns=rr.Transform3D.columns(translation=a[:, :3], quaternion=quat))  # fmt: skip
@@ -781,7 +781,7 @@ class EpisodeRecorder:
             t = None
         if t is None and trace is not None and len(trace.time) == n and n > 1:
             t = np.asarray(trace.time, dtype=float)
-        strips = _chain_index(names, chains)
+        strips = chain_index(names, chains)
         if t is not None and n:
             index = [rr.TimeColumn("sim_time", duration=t)]
             rec.send_columns(

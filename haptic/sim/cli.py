@@ -8,13 +8,17 @@ from __future__ import annotations
 
 import argparse
 import sys
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from haptic.errors import HapticError, SceneError
 
+if TYPE_CHECKING:
+    from haptic.options import Subcommands
 
-def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
+
+def add_parser(subparsers: Subcommands) -> argparse.ArgumentParser:
     """Register the ``scene`` subcommand on ``subparsers``; returns its parser."""
     from haptic.options import seed_int
 

@@ -30,12 +30,12 @@ import numpy as np
 
 from haptic.errors import SceneError
 from haptic.sim.physics import N_ARM, ContactSummary, Simulation, finger_index
-from haptic.sim.scene import ARM_HOME, FINGERS
+from haptic.sim.scene import ARM_HOME, FINGERS, ROTATION_ATOL, ZERO_VECTOR
 
 
 @dataclass(frozen=True)
 class ControlGains:
-    """Gains and rates of :class:`Controller` (one home for the controller's numbers)."""
+    """Gains and rates of :class:`Controller` and of the fingertip IK (one home for the controller's numbers)."""
 
     control_every: int = 5
     """Physics steps per control tick (1 ms steps: 5 -> a 200 Hz control law)."""
@@ -65,8 +65,23 @@ class ControlGains:
     """Largest lead of the tangential reference ahead of the tip [m]."""
     contact_lost_after: float = 0.03
     """Time without contact after which tangential motion stops [s]."""
-    contact_threshold: float = 0.1
-    """Contact is sensed above max(contact_threshold * force target, 5 sigma_F, 0.02 N)."""
+    contact_fraction: float = 0.1
+    """Contact is sensed above max(contact_fraction * force target, contact_sigmas * sigma_F,
+    min_contact_force) ..."""
+    contact_sigmas: float = 5.0
+    """... [-] (sigma_F: the simulated force sensor's noise) ..."""
+    min_contact_force: float = 0.02
+    """... [N]."""
+    task_damping: float = 1e-8
+    """Added to the diagonal of the task-space inverse inertia before it is factored (damped least squares:
+    exact away from singularities) [-]."""
+    ik_damping: float = 1e-4
+    """Fingertip IK: damping of its least-squares steps [-] ..."""
+    ik_max_step: float = 0.2
+    """... the largest joint step per iteration [rad] ..."""
+    ik_rotation_weight: float = 0.1
+    """... and, choosing the best of its starts when none reaches the target, the weight of the orientation
+    error against the position error [m/rad]."""
     normal_filter: float = 0.25
     """Per-tick low-pass weight of a new normal sample (0..1]."""
 
@@ -116,13 +131,16 @@ def solve_fingertip_ik(
     position_tol: float = 1e-4,
     rotation_tol: float = 1e-3,
     max_iters: int = 300,
+    gains: ControlGains | None = None,
 ) -> IKResult:
     """Arm posture putting ``finger``'s pad centre at ``point_in_world`` [m] (and the hand frame -- the
     flange site, z along the fingers -- at ``rotation_in_world`` (3, 3) if given), hand held at ``hand_q``;
     joint limits respected. This is the reachability check of a fingertip target.
 
-    Damped least squares on a scratch copy of the state; the simulation itself is not touched.
+    Damped least squares (``gains``: its damping, step and weights) on a scratch copy of the state; the
+    simulation itself is not touched.
     """
+    g = gains or ControlGains()
     k = finger_index(finger)
     m = sim.model
     d = mujoco.MjData(m)
@@ -156,10 +174,10 @@ def solve_fingertip_ik(
                 break
             mujoco.mj_jacSite(m, d, jacp, jacr, site)
             j = jacp[:, sim.arm] if rotation_in_world is None else np.vstack([jacp[:, sim.arm], jacr[:, sim.arm]])
-            dq = j.T @ np.linalg.solve(j @ j.T + 1e-4 * np.eye(len(e)), e)
+            dq = j.T @ np.linalg.solve(j @ j.T + g.ik_damping * np.eye(len(e)), e)
             n = np.linalg.norm(dq)
-            if n > 0.2:
-                dq *= 0.2 / n
+            if n > g.ik_max_step:
+                dq *= g.ik_max_step / n
             q = np.clip(q + dq, lo, hi)
         d.qpos[sim.arm] = q
         mujoco.mj_kinematics(m, d)
@@ -170,7 +188,8 @@ def solve_fingertip_ik(
         res = IKResult(e_p < position_tol and e_r < rotation_tol, q.copy(), e_p, e_r)
         if res.reachable:
             return res
-        if best is None or e_p + 0.1 * e_r < best.position_error + 0.1 * best.rotation_error:
+        w = g.ik_rotation_weight
+        if best is None or e_p + w * e_r < best.position_error + w * best.rotation_error:
             best = res
     assert best is not None
     return best
@@ -205,10 +224,7 @@ class Controller:
         self._jacp, self._jacr = self._jac[:3], self._jac[3:]
         self._jac_arm = self._jac[:, :N_ARM]
         self._mfull = np.zeros((m.nv, m.nv))
-        self._tau_lo = m.actuator_ctrlrange[sim.arm, 0].copy()
-        self._tau_hi = m.actuator_ctrlrange[sim.arm, 1].copy()
         self._hand_lo = m.actuator_ctrlrange[sim.hand, 0].copy()
-        self._hand_hi = m.actuator_ctrlrange[sim.hand, 1].copy()
         self._hand_kp = sim.hand_kp
         self._eye3 = np.eye(3)
         self._hand_site = int(sim.flange_site)
@@ -312,22 +328,25 @@ class Controller:
             raise SceneError(f"hybrid target: need force > 0 [N] and a finite (3,) velocity, got {force}, {v!r}")
         prev = self._hybrid if (keep_state and self._mode == "hybrid") else None
         hint = np.array([0.0, 0.0, 1.0]) if normal_hint is None else np.asarray(normal_hint, dtype=float)
-        if np.linalg.norm(hint) < 1e-9:
+        if np.linalg.norm(hint) < ZERO_VECTOR:
             raise SceneError("hybrid target: normal_hint must be a non-zero vector")
         hint = hint / np.linalg.norm(hint)
         if prev is not None:
             prev.force, prev.velocity = float(force), v.copy()
-            g = self.gains
-            self._threshold = max(g.contact_threshold * float(force), 5 * self.sim.noise.force_std, 0.02)
+            self._threshold = self._contact_threshold(force)
             if normal_hint is not None:
                 prev.hint = hint
             return
         x, _ = self.fingertip_pose()
         self._mode = "hybrid"
-        g = self.gains
-        self._threshold = max(g.contact_threshold * float(force), 5 * self.sim.noise.force_std, 0.02)
+        self._threshold = self._contact_threshold(force)
         self._r_ref = self._rotation_arg(rotation_in_world)
         self._hybrid = _Hybrid(force=float(force), velocity=v.copy(), normal=None, hint=hint, reference=x)
+
+    def _contact_threshold(self, force: float) -> float:
+        """The sensed force above which the hybrid mode counts a contact, for a target ``force`` [N]."""
+        g = self.gains
+        return max(g.contact_fraction * float(force), g.contact_sigmas * self.sim.noise.force_std, g.min_contact_force)
 
     def hybrid_status(self) -> HybridStatus | None:
         """State of the hybrid mode, or None in another mode."""
@@ -352,7 +371,7 @@ class Controller:
                 raise SceneError(f"rotation_in_world: expected a (3, 3) rotation, 'hold' or None, got {rot!r}")
             return self.hand_rotation()
         r = np.asarray(rot, dtype=float)
-        if r.shape != (3, 3) or not np.allclose(r.T @ r, self._eye3, atol=1e-6):
+        if r.shape != (3, 3) or not np.allclose(r.T @ r, self._eye3, atol=ROTATION_ATOL):
             raise SceneError(f"rotation_in_world: expected a (3, 3) rotation matrix, got {r!r}")
         return r.copy()
 
@@ -409,7 +428,7 @@ class Controller:
                 g.rot_kd * (jacr @ qvel)
             )
             jjt = j @ j.T
-            mujoco.mju_cholFactor(jjt, 1e-8)  # damped least squares: exact away from singularities
+            mujoco.mju_cholFactor(jjt, g.task_damping)  # damped least squares: exact away from singularities
             mujoco.mju_cholSolve(self._y6, jjt, a)
             tau = m6 @ (self._y6 @ j)
             if force is not None:
@@ -418,7 +437,7 @@ class Controller:
         jp = jacp[:, :N_ARM]
         m6_inv = np.linalg.inv(m6)
         lam_inv = jp @ m6_inv @ jp.T
-        lam_inv.flat[::4] += 1e-8
+        lam_inv.flat[::4] += g.task_damping
         lam = np.linalg.inv(lam_inv)
         f = lam @ a_pos
         if force is not None:

@@ -60,6 +60,26 @@ TABLE_TOP_Z = _table_top_z(mjcf.from_path(str(TABLETOP_XML)))
 """Height of the table's top surface in the world frame [m], read from scenes/tabletop.xml."""
 PAD_RADIUS = _pad_radius(mjcf.from_path(str(HAND_XML)))
 """Radius of the tracing (index) fingertip's pad [m], read from assets/mjcf/hand/hand.xml."""
+ROTATION_ATOL = 1e-6
+"""A (3, 3) matrix is a rotation when ``RᵀR`` is the identity within this (absolute, per entry) [-]."""
+ZERO_VECTOR = 1e-9
+"""A vector shorter than this has no direction (round-off) [-]."""
+ANTIPARALLEL = 1e-12
+"""Two unit vectors whose dot product is within this of −1 are opposite (round-off) [-]."""
+PARALLEL = 1e-6
+"""Two unit vectors whose dot product is within this of 1 are the same direction (hull facets of one plane);
+a cross product shorter than this has no direction [-]."""
+PLANE_DECIMALS = 9
+"""Hull facet equations are rounded to this many decimals before duplicates are merged."""
+MIN_PART_POINTS = 4
+"""Fewest vertices of a convex part of an object (a tetrahedron's)."""
+MIN_PART_VOLUME = 1e-9
+"""Smallest volume of a convex part of an object [m^3]."""
+STABLE_MARGIN = 0.002
+"""A resting facet is stable when the solid's centroid projects into it at least this far from its border [m]."""
+OBJECT_RGBA = (0.25, 0.6, 0.35, 1.0)
+"""Colour of the object's geoms (red, green, blue, alpha)."""
+
 OBJECT_REGION = ((0.46, 0.62), (-0.10, 0.10))
 """Where a random object centre is placed on the table: ((x_min, x_max), (y_min, y_max)) in world [m]."""
 
@@ -145,14 +165,15 @@ def scene_object_from_parts(name: str, parts: Sequence[np.ndarray]) -> SceneObje
     checked = []
     for i, p in enumerate(parts):
         arr = np.asarray(p, dtype=float)
-        if arr.ndim != 2 or arr.shape[1] != 3 or len(arr) < 4 or not np.all(np.isfinite(arr)):
+        if arr.ndim != 2 or arr.shape[1] != 3 or len(arr) < MIN_PART_POINTS or not np.all(np.isfinite(arr)):
             raise SceneError(f"object {name!r}, part {i}: expected an (n>=4, 3) finite vertex array, got {arr.shape}")
         try:
             hull = ConvexHull(arr)
         except QhullError as exc:
             raise SceneError(f"object {name!r}, part {i}: the vertices span no volume (flat or degenerate)") from exc
-        if hull.volume < 1e-9:
-            raise SceneError(f"object {name!r}, part {i}: volume {hull.volume:.3g} m^3 is below 1e-9 m^3")
+        if hull.volume < MIN_PART_VOLUME:
+            raise SceneError(f"object {name!r}, part {i}: volume {hull.volume:.3g} m^3 is below "
+                             f"{MIN_PART_VOLUME:.0e} m^3")
         checked.append(arr[hull.vertices])
     if not checked:
         raise SceneError(f"object {name!r}: no convex parts; give at least one (n>=4, 3) vertex array")
@@ -191,9 +212,9 @@ def _rotation_taking(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """The smallest rotation (3, 3) taking unit vector a to unit vector b."""
     v = np.cross(a, b)
     c = float(np.dot(a, b))
-    if c < -1 + 1e-12:  # antiparallel: half turn about any axis perpendicular to a
+    if c < -1 + ANTIPARALLEL:  # antiparallel: half turn about any axis perpendicular to a
         axis = np.cross(a, [1.0, 0.0, 0.0])
-        if np.linalg.norm(axis) < 1e-6:
+        if np.linalg.norm(axis) < PARALLEL:
             axis = np.cross(a, [0.0, 1.0, 0.0])
         axis /= np.linalg.norm(axis)
         return 2 * np.outer(axis, axis) - np.eye(3)
@@ -201,7 +222,7 @@ def _rotation_taking(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.eye(3) + vx + vx @ vx / (1 + c)
 
 
-def stable_resting_rotations(obj: SceneObject, margin: float = 0.002) -> list[np.ndarray]:
+def stable_resting_rotations(obj: SceneObject, margin: float = STABLE_MARGIN) -> list[np.ndarray]:
     """Rotations (3, 3) ``world_from_object`` that rest the object on a hull facet, stably.
 
     A facet is stable when the solid's centroid projects into it at least ``margin`` [m] from its border.
@@ -209,16 +230,16 @@ def stable_resting_rotations(obj: SceneObject, margin: float = 0.002) -> list[np
     points = obj.vertices
     hull = ConvexHull(points)
     centroid = _solid_centroid(obj.parts)
-    planes = np.unique(np.round(hull.equations, 9), axis=0)
+    planes = np.unique(np.round(hull.equations, PLANE_DECIMALS), axis=0)
     out = []
     seen: list[np.ndarray] = []
     for n_d in planes:
         n, d = n_d[:3], n_d[3]
-        if any(np.dot(n, s) > 1 - 1e-6 for s in seen):
+        if any(np.dot(n, s) > 1 - PARALLEL for s in seen):
             continue
         seen.append(n)
         p = centroid - (np.dot(n, centroid) + d) * n  # projection on the facet plane
-        others = planes[np.einsum("ij,j->i", planes[:, :3], n) < 1 - 1e-6]
+        others = planes[np.einsum("ij,j->i", planes[:, :3], n) < 1 - PARALLEL]
         if np.all(others[:, :3] @ p + others[:, 3] <= -margin):
             out.append(_rotation_taking(n, np.array([0.0, 0.0, -1.0])))
     if not out:  # no facet is stable by the margin: fall back to the largest-area support
@@ -249,7 +270,7 @@ def _check_pose(world_from_object: np.ndarray) -> np.ndarray:
     if t.shape != (4, 4) or not np.all(np.isfinite(t)):
         raise SceneError(f"world_from_object: expected a finite (4, 4) transform, got shape {t.shape}")
     r = t[:3, :3]
-    if not np.allclose(r.T @ r, np.eye(3), atol=1e-6) or np.linalg.det(r) < 0:
+    if not np.allclose(r.T @ r, np.eye(3), atol=ROTATION_ATOL) or np.linalg.det(r) < 0:
         raise SceneError("world_from_object: the upper-left (3, 3) block must be a proper rotation")
     return t
 
@@ -310,14 +331,14 @@ def compose_scene(
                 type="mesh",
                 mesh=mesh_name,
                 dclass="scene",
-                rgba=(0.25, 0.6, 0.35, 1.0),
+                rgba=OBJECT_RGBA,
                 group=0,
             )
     scene.model = f"haptic_{obj.name}" if obj is not None else "haptic_empty"
 
-    n_act = 6 + len(HAND_JOINTS)
-    ctrl = np.zeros(n_act)
-    ctrl[6:] = HAND_TRACE
+    n_arm = len(ARM_JOINTS)
+    ctrl = np.zeros(n_arm + len(HAND_JOINTS))
+    ctrl[n_arm:] = HAND_TRACE
     scene.keyframe.add("key", name="home", qpos=np.concatenate([ARM_HOME, HAND_TRACE]), ctrl=ctrl)
     return ComposedScene(mjcf_model=scene, object=obj, world_from_object=pose)
 

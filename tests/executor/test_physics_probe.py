@@ -14,7 +14,7 @@ from haptic.matching.components import DataFace, SensorNoise
 from haptic.planning.handpath import HandStart
 from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import ProbeMove
-from haptic.planning.probes import predict_probes
+from haptic.planning.probe_prediction import predict_probes
 from haptic.sim import RobotInterface, SimulatedSensorNoise, Simulation, compose_scene, random_object_pose
 from haptic.sim.scene import PAD_RADIUS, TABLE_TOP_Z, scene_object_from_polyhedron
 

@@ -4,7 +4,6 @@ import numpy as np
 import pytest
 
 from haptic.executor.geometric import GeometricExecutor, GeometricSettings
-from haptic.executor.probe import execute_probe
 from haptic.geometry import SE3, load_library
 from haptic.matching.components import SensorNoise
 from haptic.planning.moves import FaceMove, ProbeMove
@@ -32,7 +31,7 @@ def test_a_hit_is_a_face_within_its_bounds_and_the_sensor_rests_on_it(at_bounds)
     ex = _executor(at_bounds=at_bounds)
     f = int(np.argmax(ex.model.face_areas))
     p, n, move = _at_face(ex, f)
-    res = execute_probe(ex, move)
+    res = ex.execute(move)
     assert res.ok and len(res.components) == 1
     face = res.components[0]
     assert ex.truth[face.id] == ("face", f) and face.adjacent == ()
@@ -56,7 +55,7 @@ def test_a_miss_reports_the_whole_line_free_and_leaves_the_sensor_where_it_was()
     p, n, move = _at_face(ex, 0)
     before = ex.state
     away = ProbeMove(p + 0.05 * n, n, 0.1)  # heading away from the object
-    res = execute_probe(ex, away)
+    res = ex.execute(away)
     assert res.ok and res.components == () and res.info["contact"] is None
     assert res.free_space[0].length == pytest.approx(0.1)
     assert ex.state is before
@@ -68,9 +67,9 @@ def test_a_miss_reports_the_whole_line_free_and_leaves_the_sensor_where_it_was()
 def test_bad_probes_are_refused_without_raising():
     ex = _executor()
     inside = ex.world_from_model.apply(ex.model.centroid)
-    assert execute_probe(ex, ProbeMove(inside, [0, 0, 1.0], 0.1)).status == "unreachable"
-    assert execute_probe(ex, ProbeMove([0, 0, 1.0], [0, 0, 2.0], 0.1)).status == "invalid"
-    assert execute_probe(ex, ProbeMove([0, 0, 1.0], [0, 0, 1.0], -1.0)).status == "invalid"
-    assert execute_probe(ex, ProbeMove([0, np.nan, 1.0], [0, 0, 1.0], 0.1)).status == "invalid"
+    assert ex.execute(ProbeMove(inside, [0, 0, 1.0], 0.1)).status == "unreachable"
+    assert ex.execute(ProbeMove([0, 0, 1.0], [0, 0, 2.0], 0.1)).status == "invalid"
+    assert ex.execute(ProbeMove([0, 0, 1.0], [0, 0, 1.0], -1.0)).status == "invalid"
+    assert ex.execute(ProbeMove([0, np.nan, 1.0], [0, 0, 1.0], 0.1)).status == "invalid"
     fresh = GeometricExecutor(LIB["BOX01"], SE3.identity())
-    assert execute_probe(fresh, ProbeMove([0, 0, 1.0], [0, 0, -1.0], 1.0)).status == "invalid"
+    assert fresh.execute(ProbeMove([0, 0, 1.0], [0, 0, -1.0], 1.0)).status == "invalid"

@@ -8,9 +8,9 @@ from haptic.geometry import SE3, load_library
 from haptic.matching.components import DataFace, SensorNoise
 from haptic.planning.config import PlannerConfig
 from haptic.planning.hypothesis import Hypothesis
+from haptic.planning.move_scores import Context, eliminates, fresh_moves
 from haptic.planning.moves import FaceMove, SensorState
 from haptic.planning.predict import predict
-from haptic.planning.scoring import Context, eliminates, fresh_moves
 
 LIB = load_library()
 CFG = PlannerConfig(table_z=0.0, max_undercut=np.deg2rad(30.0), touch_evidence=True)

@@ -1,4 +1,5 @@
-"""Probes planned for the simulated hand (haptic.planning.handpath and the pad's checks in haptic.planning.probes):
+"""Probes planned for the simulated hand (haptic.planning.handpath and the pad's checks in
+haptic.planning.probe_prediction and haptic.planning.finger_clearance):
 the predicted path and its cost, and the lines on which the pad or the finger would touch the object otherwise
 than the line-cast predicts. The BOX01N cases are the lines that failed on the hand in the physics episode
 BOX01N seed 1 (``scripts/physics_episodes.py --objects BOX01N --poses 1 --moves all``), at that episode's
@@ -12,10 +13,11 @@ import pytest
 from haptic.geometry import SE3, load_library
 from haptic.geometry.se3 import quat_to_matrix
 from haptic.matching.components import SensorNoise
+from haptic.planning.finger_clearance import finger_clear
 from haptic.planning.handpath import HandStart, foot_near_boundary, over_the_top, pad_touches_first, probe_distances
 from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import CostModel, ProbeMove
-from haptic.planning.probes import finger_clear, predict_probes
+from haptic.planning.probe_prediction import predict_probes
 
 PAD = 0.0118
 UNDERCUT = np.deg2rad(20.0)

@@ -12,7 +12,7 @@ from haptic.planning.config import PlannerConfig
 from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import ProbeMove, SensorState
 from haptic.planning.optimal import OptimalPolicy
-from haptic.planning.probes import predict_probes
+from haptic.planning.probe_prediction import predict_probes
 from haptic.planning.search import branches
 from haptic.planning.simulate import simulate, simulate_probe
 

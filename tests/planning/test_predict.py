@@ -59,8 +59,8 @@ def test_predicted_eliminations_agree_with_the_matcher():
     from haptic.episode.worlds import run_episode
     from haptic.planning import policies as P
     from haptic.planning.efficiency import distinguishable
+    from haptic.planning.move_scores import fresh_moves
     from haptic.planning.predict import predict
-    from haptic.planning.scoring import fresh_moves
     from haptic.planning.search import matcher_eliminations
 
     agree = total = 0

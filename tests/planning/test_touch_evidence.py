@@ -7,9 +7,9 @@ from haptic.episode.perception import fits_touches
 from haptic.geometry import SE3, load_library
 from haptic.matching.recognition import PoseClass
 from haptic.planning.config import PlannerConfig
+from haptic.planning.move_scores import eliminates, refusal
 from haptic.planning.moves import FaceMove
 from haptic.planning.predict import Prediction
-from haptic.planning.scoring import eliminates, refusal
 
 LIB = load_library()
 

@@ -65,7 +65,7 @@ def test_vertices_under_an_overhang_are_hidden_and_the_table_ones_are_not():
     from dataclasses import replace
 
     from haptic.geometry.se3 import quat_to_matrix
-    from haptic.matching.verify import Coverage
+    from haptic.matching.acceptance import Coverage
     from haptic.planning.verify import hidden_vertices, reachable_features
 
     poly = LIB["LBLOCK01"]

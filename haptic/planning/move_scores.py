@@ -20,13 +20,14 @@ from haptic.planning.handpath import HandStart
 from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import FaceMove, Move, ProbeMove, SensorState
 from haptic.planning.predict import Prediction, candidate_moves, crossed_edge, predict
-from haptic.planning.probes import ProbeConfig, ProbePrediction, candidate_probes, predict_probes
+from haptic.planning.probe_lines import ProbeConfig, candidate_probes
+from haptic.planning.probe_prediction import ProbePrediction, predict_probes
 from haptic.planning.simulate import simulate
 from haptic.planning.table import descent_risk
 
 PROBE_RISK = 0.25
 """Probes the hand's pad is predicted to fail in this share of the hypotheses' weight or more are not offered
-(:meth:`~haptic.planning.probes.ProbePrediction.risk`): a failed probe tells the matcher nothing, and the loop
+(:meth:`~haptic.planning.probe_prediction.ProbePrediction.risk`): a failed probe tells the matcher nothing, and the loop
 then falls back to tracing moves; the rest are discounted by their risk."""
 
 
@@ -105,7 +106,7 @@ def score_probe(pred: ProbePrediction, weights: np.ndarray) -> tuple | None:
 
 
 def probe_moves(ctx: Context) -> list[ProbeMove]:
-    """Candidate free-space probes (:func:`~haptic.planning.probes.candidate_probes`) when the configuration admits
+    """Candidate free-space probes (:func:`~haptic.planning.probe_lines.candidate_probes`) when the configuration admits
     them (``config.moves``) and every hypothesis has a pose to predict from, less those that failed from here."""
     if ctx.config.moves == "tracing" or not ctx.hypotheses or any(h.world_from_model is None for h in ctx.hypotheses):
         return []

@@ -32,7 +32,7 @@ import numpy as np
 from haptic.geometry.distance import point_triangle_distance
 from haptic.geometry.polyhedron import Polyhedron
 from haptic.geometry.se3 import SE3
-from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex
+from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex, SensorNoise
 from haptic.matching.tree import Interpretation
 
 VERIFY_MODES = ("none", "fast", "full")
@@ -160,7 +160,7 @@ def pose_check(model: Polyhedron, data: Sequence[DataComponent], it: Interpretat
 ACCEPT_ALPHA = 1e-3
 """False-alarm probability of the acceptance test (:func:`acceptance`) on an object that is the model, under the
 noise model: the chance that a true recognition is turned away as no-match."""
-K_SIGMA = 3.0
+K_SIGMA = SensorNoise.k
 """A component's error bound is this many standard deviations (:class:`~haptic.matching.components.SensorNoise`
 ``k``): the acceptance test's σ of a residual is its bound over ``K_SIGMA``."""
 K_SIGMA_PHYSICS = 6.0

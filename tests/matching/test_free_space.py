@@ -12,11 +12,10 @@ from hypothesis import strategies as st
 
 from haptic.errors import MatchError
 from haptic.executor.geometric import GeometricExecutor, GeometricSettings, random_walk
-from haptic.executor.probe import execute_probe
 from haptic.geometry import SE3, load_library, tracing
 from haptic.matching.components import DataFace, SensorNoise
+from haptic.matching.free_space import MAX_POSED, FreeSegment, apply_probes, free_segment_consistent, probe_face
 from haptic.matching.library import LibraryArrays
-from haptic.matching.probes import MAX_POSED, FreeSegment, apply_probes, free_segment_consistent, probe_face
 from haptic.matching.recognition import PoseTolerance
 from haptic.matching.tree import InterpretationTree
 from haptic.planning.moves import CostModel, ProbeMove
@@ -71,7 +70,7 @@ def _check(name: str, seed: int, n_moves: int, n_probes: int, level: float, at_b
 def _probe_and_check(ex, tree, move, free: list, hits: list, label: tuple):
     """Carry out ``move``, match its data (hits in the tree, then the probe filter over all the probe data so
     far), asserting after each step that the true interpretation is left; the result, None when it failed."""
-    res = execute_probe(ex, move)
+    res = ex.execute(move)
     if not res.ok:
         return None
     for c in res.components:
@@ -137,7 +136,7 @@ def test_a_grazing_miss_displaced_into_the_object_by_its_bound_keeps_the_truth(n
         u = np.cross(n, rng.normal(size=3))
         u /= np.linalg.norm(u)
         start = p + 5e-5 * n - 0.15 * u
-        if execute_probe(ex, ProbeMove(start, u, 0.3)).components:
+        if ex.execute(ProbeMove(start, u, 0.3)).components:
             continue  # the path meets another part of the object: not a miss
         segments.append(FreeSegment(start - rho * n, u, 0.3, rho))
     assert segments
@@ -176,7 +175,7 @@ def test_probe_hits_prune_by_the_face_pair_angle_without_adjacency():
     f = int(np.argmax(m.face_areas))
     p = ex.world_from_model.apply(m.vertices[list(m.faces[f])].mean(axis=0))
     n = ex.world_from_model.rotate(m.face_normals[f])
-    res = execute_probe(ex, ProbeMove(p + 0.1 * n, -n, 0.2))
+    res = ex.execute(ProbeMove(p + 0.1 * n, -n, 0.2))
     assert res.ok and len(res.components) == 1 and res.components[0].adjacent == ()
     before = tree.count
     tree.add(res.components[0])
@@ -209,7 +208,7 @@ def test_probe_cost_is_a_constant_plus_free_space_distance():
 def _check_probes_alone(name: str, seed: int, n_probes: int, level: float, at_bounds: bool) -> int:
     """The start, then probes only: the opening's lines toward the region the contacts leave (as under ``--moves
     probing``, before poses), every few a random line at the object; returns how many hits."""
-    from haptic.planning.probes import LibraryExtent, opening_probes
+    from haptic.planning.opening_probes import LibraryExtent, opening_probes
 
     rng = np.random.default_rng(seed)
     ex = GeometricExecutor(
@@ -243,7 +242,7 @@ def test_opening_probes_hit_the_object():
 
 
 def test_position_span_says_when_the_data_fix_a_position_in_every_direction():
-    from haptic.matching.probes import MIN_SPAN, position_span
+    from haptic.matching.free_space import MIN_SPAN, position_span
 
     def face(i, n):
         return probe_face(i, np.zeros(3), np.asarray(n, dtype=float) / np.linalg.norm(n), 0.01, 0.0005)

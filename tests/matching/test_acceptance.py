@@ -1,4 +1,4 @@
-"""The pose check and coverage of verification (haptic.matching.verify).
+"""The pose check and coverage of verification (haptic.matching.acceptance).
 
 Soundness (property): with noise inside the bounds -- and at the bounds, the worst case -- the true
 interpretation passes the pose check, with the geometric executor's bounds and with the physics executor's
@@ -17,10 +17,7 @@ from haptic.errors import HapticError
 from haptic.executor.geometric import GeometricExecutor, GeometricSettings, random_walk
 from haptic.geometry import SE3, load_library
 from haptic.geometry.perturb import scale_dimension
-from haptic.matching.components import SensorNoise, from_json
-from haptic.matching.library import LibraryArrays
-from haptic.matching.tree import InterpretationTree
-from haptic.matching.verify import (
+from haptic.matching.acceptance import (
     K_SIGMA_PHYSICS,
     POSE_SAFETY,
     acceptance,
@@ -28,6 +25,9 @@ from haptic.matching.verify import (
     coverage,
     pose_check,
 )
+from haptic.matching.components import SensorNoise, from_json
+from haptic.matching.library import LibraryArrays
+from haptic.matching.tree import InterpretationTree
 
 from .helpers import true_leaves
 

@@ -4,13 +4,13 @@ import numpy as np
 import pytest
 
 from haptic.executor.geometric import GeometricExecutor
-from haptic.executor.probe import execute_probe
 from haptic.geometry import SE3, load_library
 from haptic.matching.components import SensorNoise
 from haptic.planning.efficiency import class_weights
 from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import CostModel
-from haptic.planning.probes import ProbeConfig, candidate_probes, predict_probes
+from haptic.planning.probe_lines import ProbeConfig, candidate_probes
+from haptic.planning.probe_prediction import predict_probes
 
 LIB = load_library()
 
@@ -34,7 +34,7 @@ def test_prediction_under_the_true_pose_is_the_geometric_outcome(name):
     kinds = set()
     for mv in moves:
         (pred,) = predict_probes(hyps, [mv], ex.state.position, [], SensorNoise().scaled(0.0))
-        res = execute_probe(ex, mv)
+        res = ex.execute(mv)
         assert res.ok
         hit = len(res.components) == 1
         kinds.add(hit)
@@ -67,7 +67,7 @@ def test_candidates_for_a_pad_keep_it_off_the_table_and_reachable_from_above():
     """With the hand's pad: its lowest point (up to a radius below the line) clears the table, the pad centre at
     the start and the column above it lie outside the sphere holding every hypothesis by the radius, and no
     face leaning under past the limit is aimed at -- while the point sensor's candidates include such lines."""
-    from haptic.planning.probes import _region
+    from haptic.planning.probe_lines import _region
 
     rng = np.random.default_rng(2)
     poly = LIB["LBLOCK01"]
@@ -158,8 +158,8 @@ def test_a_hypothesis_without_a_pose_is_refused_by_name():
 def test_the_finger_above_the_pad_must_clear_every_hypothesis():
     """A line running under a hypothesis's object (a ledge over the pad) is blocked for the finger above the pad,
     up to where that hypothesis is met; one running beside it, or stopping at its face, is clear."""
+    from haptic.planning.finger_clearance import finger_clear
     from haptic.planning.moves import ProbeMove
-    from haptic.planning.probes import finger_clear
 
     poly = LIB["BOX01"]
     lo, hi = poly.vertices.min(axis=0), poly.vertices.max(axis=0)

@@ -9,7 +9,7 @@ Lozano-Pérez's paradigm). What it yields:
   prune the pairings. Against every other data face that is the face-pair angle, which §2.6 notes needs no
   adjacency (outward normals have consistent senses); against vertices and edges the tree's height and
   face–edge angle tests. Once a leaf's pose is known, :func:`consistent_leaves` adds the pose check of
-  :mod:`haptic.matching.verify`: with the pose refitted over every pairing, the hit point must lie on the
+  :mod:`haptic.matching.acceptance`: with the pose refitted over every pairing, the hit point must lie on the
   model face's polygon (plane *and* extent) within its bounds, as every other component must.
 - **A miss**, and the path of a hit up to its contact, is a :class:`FreeSegment`: negative evidence. A leaf
   whose posed model that segment enters is eliminated, but only when it enters deeper than the segment's
@@ -31,10 +31,10 @@ import numpy as np
 from haptic.geometry.polyhedron import Polyhedron
 from haptic.geometry.raycast import depth_samples
 from haptic.geometry.se3 import SE3
-from haptic.matching.components import DataFace, _vec
+from haptic.matching.acceptance import pose_check
+from haptic.matching.components import DataFace, readonly_vector
 from haptic.matching.recognition import PoseTolerance
 from haptic.matching.tree import InterpretationTree
-from haptic.matching.verify import pose_check
 
 MIN_SPAN = 0.3
 """Smallest ratio of singular values of the directions that fix the data's position (face normals, per touched
@@ -63,8 +63,8 @@ class FreeSegment:
     kind = "free"
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "start", _vec(self.start))
-        object.__setattr__(self, "direction", _vec(self.direction))
+        object.__setattr__(self, "start", readonly_vector(self.start))
+        object.__setattr__(self, "direction", readonly_vector(self.direction))
         object.__setattr__(self, "length", float(self.length))
 
     @property
@@ -131,7 +131,7 @@ def consistent_leaves(
     data fix a position only weakly (:func:`position_span` below :data:`MIN_SPAN`), is kept.
     A leaf with a pose is eliminated when one of the ``free`` segments enters its posed model deeper than the
     bounds allow (:func:`free_segment_consistent`), or when it pairs one of the ``probe_faces`` (data ids of
-    probe hits) and fails the pose check of :func:`~haptic.matching.verify.pose_check` (every component,
+    probe hits) and fails the pose check of :func:`~haptic.matching.acceptance.pose_check` (every component,
     the hit point included, on its model component within ``POSE_SAFETY`` times its bounds).
     """
     n = tree.count

@@ -1,0 +1,173 @@
+"""The numbers of the force-controlled primitives (:mod:`haptic.executor.primitives`): speeds, forces, timing
+and the thresholds of their events, in one frozen settings object; the sensor's σ and the cones of a face's
+normals the primitives share with the segmenter are :class:`~haptic.executor.segment.SegmentBounds`'."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from haptic.sim.control import ControlGains
+
+DOWN = np.diag([-1.0, 1.0, -1.0])
+"""Hand rotation ``world_from_hand`` with the fingers pointing down (the tracing posture)."""
+
+
+@dataclass(frozen=True)
+class TouchConfig:
+    """Speeds, forces and detection thresholds of the primitives (one home for the executor's numbers)."""
+
+    force: float = 1.0
+    """Normal force target while tracing [N]."""
+    face_speed: float = 0.02
+    """Tracing speed across a face [m/s] (friction × speed / force ≤ 0.012 (m/s)/N, pitfall 1)."""
+    edge_speed: float = 0.015
+    """Ridge-following speed along an edge [m/s]."""
+    roll_speed: float = 0.015
+    """Speed of the pad centre while rolling over an edge [m/s]."""
+    approach_speed: float = 0.02
+    """Guarded-approach speed [m/s]."""
+    free_speed: float = 0.20
+    """Speed of free-space moves [m/s]."""
+    contact_fraction: float = ControlGains.contact_fraction
+    """Contact is sensed above max(contact_fraction × force, contact_sigmas × σF) [-] (the defaults: the
+    hybrid controller's) ..."""
+    contact_sigmas: float = ControlGains.contact_sigmas
+    """... [-] (σF: :attr:`SegmentBounds.force_sigma <haptic.executor.segment.SegmentBounds.force_sigma>`)."""
+    debounce: int = 3
+    """Consecutive samples a detection must hold [ticks]."""
+    normal_filter: float = ControlGains.normal_filter
+    """Per-tick low-pass weight of a new normal sample (0..1]."""
+    edge_angle: float = math.radians(10.0)
+    """Edge: the filtered normal leaves the face normal by more than this [rad]."""
+    loss_fraction: float = 0.3
+    """Edge backup / contact loss: force below this fraction of the target ... [-]"""
+    loss_time: float = 0.02
+    """... for this long [s]."""
+    stall_time: float = 0.3
+    """Blocked: over this window [s] ..."""
+    stall_fraction: float = 0.2
+    """... the fingertip advanced less than this fraction of the commanded travel [-]."""
+    vertex_sin: float = math.sin(math.radians(15.0))
+    """Vertex: the filtered normal's component along the edge exceeds this [-]."""
+    loss_lean_sin: float = math.sin(math.radians(5.0))
+    """Contact lost while following a ridge is its vertex (the surface fell away) only when the filtered normal
+    had leaned at least this far along the edge: the pad cannot leave the end of an edge without rolling on to
+    the vertex. Lost with the normal still across the edge, the pad was lifted off it -- another part of the
+    finger met the object (a frame's rim above a valley) -- and the edge goes on [-]."""
+    roll_window: float = 0.001
+    """A roll is over when the normal turned less than ``roll_settled`` over this much travel [m] ..."""
+    roll_settled: float = math.radians(1.5)
+    """... [rad]."""
+    undercut_slack: float = math.radians(3.0)
+    """Rolling off a face that itself leans under near the limit, the roll ends for the undercut only once the
+    normal leans this much further than the face's (not on a noisy first reading) [rad]."""
+    max_undercut: float = math.radians(30.0)
+    """The pad reaches a surface whose normal leans at most this far back against the finger's axis (past
+    perpendicular to it); beyond, the finger's phalanx meets the object first and the pad loses contact. A
+    roll over a convex edge stops there (event ``"undercut"``) [rad]."""
+    roll_max: float = 0.04
+    """Longest pad travel while rolling over or climbing onto an edge [m]."""
+    roll_loss_time: float = 0.15
+    """A roll fails once contact has been lost this long [s]."""
+    roll_axis_sin2: float = 0.5
+    """At the start of a roll the edge's axis is ``n_a × n`` when its squared length (sin² of the turn) is at
+    least this, else ``n_a ×`` the direction of travel [-] ..."""
+    turned_axis_sin2: float = 1e-4
+    """... and during the roll it follows ``n_a × n`` while that is longer than this (squared) [-]."""
+    step_in: float = 0.0015
+    """Travel onto a new face, away from the edge, after the roll settled [m]."""
+    stroke: float = 0.006
+    """Length of the stroke along the edge on a new face (the second leg of the L for its normal) [m]."""
+    ridge_gain: float = 12.0
+    """Sideways servo of ridge following: pad speed per radian of normal error, per metre of pad radius [1/s]."""
+    ridge_side_speed: float = 0.012
+    """Largest sideways speed of that servo [m/s]; rolling onto the ridge is given twice the time it takes at
+    this speed ..."""
+    ridge_acquire_slack: float = 0.6
+    """... plus this [s]."""
+    ridge_cone: float = math.radians(8.0)
+    """The pad is on the ridge when the normal is within this of the bisector; only then does it move along [rad]."""
+    ridge_acquired_ticks: int = 10
+    """Ticks on the ridge after which acquiring it is done [ticks]."""
+    ridge_timeout_slack: float = 3.0
+    """Ridge following gives up after twice the time its distance takes, plus the acquiring time, plus this [s]."""
+    stall_warmup: int = 20
+    """Ticks beyond the stall window before ridge following tests for a stall [ticks]."""
+    settle_time: float = 0.15
+    """Shortest hold after a guarded contact before moving [s] ..."""
+    settle_max: float = 0.6
+    """... longest: the hold ends once the force has stayed within ``settle_band`` of the target for
+    ``settle_time`` (the impact transient of the approach takes ~0.3 s to die out) [s]."""
+    settle_band: float = 0.15
+    """Relative force band of a settled contact [-]."""
+    ramp_time: float = 0.25
+    """Tangential speeds ramp up over this time at the start of a slide (a step start loses force) [s]."""
+    lift: float = 0.008
+    """Clearance of a repositioning move above the surface [m] ..."""
+    narrow_lift: float = 0.002
+    """... and of its second try when the first was blocked (a slot narrower than 2 × pad radius + lift) [m]."""
+    approach_overshoot: float = 0.004
+    """The guarded approach that ends a repositioning (or touches a contact again) runs this far past where the
+    surface is expected [m]."""
+    opposite_wall_angle: float = math.radians(60.0)
+    """A repositioning that touches a normal more than this from the target face's touched the opposite wall of
+    a slot [rad]."""
+    min_bisector_cos: float = 0.2
+    """The repositioning's waypoint is pushed out along the bisector of the two normals by the clearance
+    deficit over at most 1 / this [-]."""
+    lift_timeout: float = 2.0
+    """Free moves off a surface along its normal: time limit [s] ..."""
+    lift_tol: float = 2e-3
+    """... and arrival tolerance [m]."""
+    via_timeout: float = 3.0
+    """Free moves to a waypoint of a repositioning or a landing: time limit [s] ..."""
+    via_tol: float = 3e-3
+    """... and arrival tolerance [m]."""
+    target_tol: float = 1e-3
+    """Arrival tolerance of a free move's last point (a move shorter than this is skipped) [m]."""
+    back_off_timeout: float = 1.0
+    """Time limit of a short free move backing off a contact [s]."""
+    free_timeout: float = 4.0
+    """Time limit of a free move [s] ..."""
+    free_tol: float = 7e-4
+    """... and its arrival tolerance, also of a guarded move [m]."""
+    guarded_settle: float = 0.5
+    """A guarded move waits at most this long after its command reached the end [s]."""
+    timeout_factor: float = 2.0
+    """A slide or an approach gives up after this times the time its distance takes ..."""
+    timeout_slack: float = 2.0
+    """... plus this [s]."""
+    approach_end_tol: float = 1e-4
+    """An approach that came this close to its full distance without contact has touched nothing [m]."""
+    run_min_samples: int = 10
+    """The running face normal of a slide replaces the given one after this many ticks of samples [ticks]."""
+    circle_gain: float = 4.0
+    """Radial servo of the vertex circle: speed per metre of radius error [1/s]."""
+    circle_timeout_factor: float = 1.5
+    """The vertex circle gives up after this times the time a full circle takes, plus ``timeout_slack``."""
+    circle_max_sweep: float = 1.9 * math.pi
+    """The vertex circle gives up after sweeping this angle [rad]."""
+    pad_radius_range: tuple[float, float] = (0.005, 0.03)
+    """Sensed distances of the pad centre from the contact point within this range refine the pad radius [m] ..."""
+    pad_radius_gain: float = 0.02
+    """... by this fraction of the difference per tick [-]."""
+    stability_every: int = 20
+    """The simulation's stability is checked every this many ticks [ticks]."""
+    overpass: float = 0.02
+    """A repositioning move whose straight legs are blocked (a non-convex solid) goes round over the top, this
+    far above the higher of its start and its target [m]."""
+    hand_rotation: np.ndarray = field(default_factory=lambda: DOWN.copy())
+    """Hand rotation held while exploring (3, 3)."""
+    link_every: int = 10
+    """The hand's link positions (forward kinematics, for recordings) are sampled every this many ticks
+    (0: never) [ticks]."""
+
+    def contact_threshold(self, force_sigma: float) -> float:
+        """Sensed force above which a contact counts [N], for a force sensor of σ ``force_sigma`` [N]."""
+        return max(self.contact_fraction * self.force, self.contact_sigmas * force_sigma)
+
+
+__all__ = ["DOWN", "TouchConfig"]
