@@ -71,6 +71,14 @@ def view(**kw):
     return out
 
 
+def started(model: str = "BOX01", seed: int = 3) -> EpisodeState:
+    """The state of a geometric episode after its start (one face measured)."""
+    ep = build_episode(EpisodeSpec(model, seed=seed), LIB)
+    state = EpisodeState.begin(ep.library, ep.noise, ep.config, None)
+    state.took(ep.executor.start())
+    return state
+
+
 def spy(monkeypatch, name: str, answer):
     """Replace ``sources.<name>`` by a function that keeps its calls and returns ``answer``."""
     calls = []
@@ -126,9 +134,7 @@ def test_the_tracing_opening_on_a_table_passes_the_pose_classes(monkeypatch):
 
 
 def test_the_tracing_opening_of_a_real_start_is_a_random_face_move_drawn_from_the_policy_generator():
-    ep = build_episode(EpisodeSpec("BOX01", seed=3), LIB)
-    state = EpisodeState.begin(ep.library, ep.noise, ep.config, None)
-    state.took(ep.executor.start())
+    state = started()
     a = TracingOpening(np.random.default_rng(7)).propose(state)
     b = TracingOpening(np.random.default_rng(7)).propose(state)
     assert isinstance(a, FaceMove) and np.array_equal(a.direction, b.direction)
@@ -212,9 +218,7 @@ def test_after_a_probe_failed_from_here_the_policies_decide_among_tracing_moves(
 
 
 def test_the_random_fallback_always_proposes_a_decision_drawn_from_the_episode_generator():
-    ep = build_episode(EpisodeSpec("BOX01", seed=3), LIB)
-    state = EpisodeState.begin(ep.library, ep.noise, ep.config, None)
-    state.took(ep.executor.start())
+    state = started()
     a = RandomFallback(np.random.default_rng(5)).propose(state)
     b = RandomFallback(np.random.default_rng(5)).propose(state)
     assert isinstance(a, Decision) and a.candidates == () and a.move.kind in ("face", "edge", "vertex")
