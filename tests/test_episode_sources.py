@@ -301,6 +301,15 @@ def test_a_loop_without_a_source_that_proposes_ends_failed_naming_the_sources_as
     assert record.detail == "no move: no move source proposed a move (asked: never)"
 
 
+def test_an_error_of_the_driver_at_a_decision_point_ends_the_episode_as_failed():
+    def refuse(point):
+        raise PlanningError("the agent has no move")
+
+    record = drive(steps(EpisodeSpec("LBLOCK01", seed=7, noise=0.5)), refuse)
+    assert record.outcome == "failed" and record.detail == "no move: the agent has no move"
+    assert record.moves >= 3 and record.decision_times_s == []  # the opening's moves, then the refusal
+
+
 def test_decisions_are_timed_and_observed_for_the_policy_and_the_fallback_alone():
     seen = []
     obs = EpisodeObserver(on_decision=lambda n, d: seen.append((n, len(d.candidates) > 0)))
