@@ -93,7 +93,7 @@ class EpisodeState:
     cum_cost: list[float] = field(default_factory=list)
     """Path cost after the start and after each successful move [units]."""
     kinds: list[str] = field(default_factory=list)
-    """Kind of the start ("start") and of each successful move."""
+    """Kind of the start's move ("start" when it reports none) and of each successful move."""
     decision_times: list[float] = field(default_factory=list)
     """Wall time of each decision a policy took [s]."""
     _hypotheses: tuple[Recognition | None, list[Hypothesis]] = (None, [])
