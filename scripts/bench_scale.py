@@ -5,8 +5,8 @@ validating the files; building the matcher's arrays), the peak memory of a worke
 matcher update after a move (its components added to the interpretation tree, then the verdict) plus the
 policy's choice of the next move (pose classes to hypotheses, scoring) — as median and 95th percentile over
 every decision the loop makes (``fallback_decisions`` counts those it leaves to a random move because the
-matcher has no pose classes yet: more than ``haptic.episode.loop.MAX_POSED`` interpretations, or poses
-undetermined), the episode wall time, episodes per minute on the workers, and the outcomes.
+matcher has no pose classes yet: more than ``haptic.episode.state.MAX_GROUPED_INTERPRETATIONS`` interpretations, or
+poses undetermined), the episode wall time, episodes per minute on the workers, and the outcomes.
 Wall-clock and CPU time of the deciding process are both reported: on a shared machine the wall clock counts
 the time other processes held the core.
 
@@ -15,12 +15,13 @@ against library size, log-log, with the fitted growth exponent); prints the tabl
 
     .venv/bin/python scripts/bench_scale.py [--sizes 10,30,100,300,1000] [--episodes 200] [--workers 2]
         [--seed 1] [--library-seed 0] [--libraries out/bench_scale/libraries] [--out out/bench_scale]
-        [--compare-bound SIZE] [--bound N] [--max-posed N]
+        [--compare-bound SIZE] [--bound N] [--max-grouped N]
 
 ``--compare-bound SIZE`` runs the episodes of library SIZE a second time with no bound on the planner's
 hypotheses (``PlannerConfig.max_hypotheses=None``) and reports the change in path cost and outcomes; ``--bound N``
-sets the bound of the first runs (default: ``PlannerConfig``'s); ``--max-posed N`` sets the largest number of
-interpretations the loop poses into pose classes (``haptic.episode.loop.MAX_POSED``; above it, a random move).
+sets the bound of the first runs (default: ``PlannerConfig``'s); ``--max-grouped N`` sets the largest number of
+interpretations the loop groups into pose classes (``haptic.episode.state.MAX_GROUPED_INTERPRETATIONS``; above
+it, a random move).
 """
 
 from __future__ import annotations
@@ -59,12 +60,12 @@ class _TimedExecutor:
         return out
 
 
-def _init_worker(max_posed: int | None = None) -> None:
-    import haptic.episode.loop as loop
+def _init_worker(max_grouped: int | None = None) -> None:
+    import haptic.episode.state as state
     import haptic.episode.worlds as worlds
 
-    if max_posed is not None:
-        loop.MAX_POSED = max_posed
+    if max_grouped is not None:
+        state.MAX_GROUPED_INTERPRETATIONS = max_grouped
     make = worlds.make_geometric_executor
     worlds.make_geometric_executor = lambda *a, **k: _TimedExecutor(make(*a, **k))
 
@@ -145,11 +146,11 @@ def _build_times(directory: Path) -> dict:
 
 
 def _run(
-    specs: list[dict], workers: int, bound: int | None, max_posed: int | None = None
+    specs: list[dict], workers: int, bound: int | None, max_grouped: int | None = None
 ) -> tuple[list[dict], float]:
     tasks = [{"spec": s, "bound": bound} for s in specs]
     t0 = time.perf_counter()
-    with ProcessPoolExecutor(max_workers=workers, initializer=_init_worker, initargs=(max_posed,)) as pool:
+    with ProcessPoolExecutor(max_workers=workers, initializer=_init_worker, initargs=(max_grouped,)) as pool:
         results = list(pool.map(_episode, tasks, chunksize=1))
     return results, time.perf_counter() - t0
 
@@ -247,7 +248,10 @@ def main(argv=None) -> int:
     ap.add_argument("--compare-bound", type=int, default=None, metavar="SIZE")
     ap.add_argument("--bound", type=int, default=None, help="PlannerConfig.max_hypotheses (default: its default)")
     ap.add_argument(
-        "--max-posed", type=int, default=None, help="haptic.episode.loop.MAX_POSED in the workers (default: its value)"
+        "--max-grouped",
+        type=int,
+        default=None,
+        help="haptic.episode.state.MAX_GROUPED_INTERPRETATIONS in the workers (default: its value)",
     )
     args = ap.parse_args(argv)
     if args.bound is None:
@@ -271,12 +275,12 @@ def main(argv=None) -> int:
             {"model": s.model, "seed": s.seed, "policy": s.policy, "models": str(lib_dir)}
             for s in plan_sweep(names, args.episodes, args.seed, [args.policy])
         ]
-        results, wall = _run(specs, args.workers, args.bound, args.max_posed)
+        results, wall = _run(specs, args.workers, args.bound, args.max_grouped)
         row = _summary(size, results, wall, args.workers, build)
         rows.append(row)
         print(json.dumps(row), flush=True)
         if args.compare_bound == size:
-            free, wall_free = _run(specs, args.workers, None, args.max_posed)
+            free, wall_free = _run(specs, args.workers, None, args.max_grouped)
             paired = [(a, b) for a, b in zip(results, free, strict=True)]
             compare = {
                 "models": size,

@@ -28,7 +28,7 @@ BEFORE = [
     ["LBLOCK01", 7, 0.5, None, "recognized", 5, 16.180386, [76, 210, 210, 132, 13, 1]],
     ["PYR01", 11, 4.0, None, "recognized", 3, 12.772623, [76, 24, 24, 2]],
     # its fifth move is chosen at 488 interpretations: a random move while the loop posed at most 400 (then cost
-    # 48.39866 at 6 mm); a planner decision since it poses up to 4000 (loop.MAX_POSED)
+    # 48.39866 at 6 mm); a planner decision since it poses up to 4000 (MAX_GROUPED_INTERPRETATIONS)
     ["LA_NOTCH_30x20", 9, 1.0, LOOKALIKE, "recognized", 6, 26.220298, [219, 700, 692, 488, 23, 6, 2]],
 ]
 

@@ -269,53 +269,76 @@ def _first_exit_felt(model: Polyhedron, face: int, start_m: np.ndarray, d_m: np.
 def _missed(
     results, model: Polyhedron, rot: np.ndarray, trans: np.ndarray, by_id: dict, tol: EvaluationTolerances
 ) -> tuple[int, dict]:
-    missed = 0
+    """The successful tracing moves whose new component is not the true feature the move should have met next
+    (:data:`_FEATURE_CHECKS`, each from the sensor state before the move), and every check made."""
     checks = []
     prev_state = None
     for r in results:
-        if r.ok and r.move.kind == "face" and prev_state is not None and r.components:
-            f_score = by_id.get(prev_state.face)
-            e_score = by_id.get(r.components[0].id)
-            trace = r.trace
-            if f_score and f_score.true_id is not None and e_score and trace is not None:
-                rows = trace.in_contact & (trace.phase == PHASES.index("face"))  # where the straight trace began
-                if rows.any():
-                    start = trace.point_in_world[np.flatnonzero(rows)[0]]
-                    d = np.asarray(r.move.direction, float)
-                    start_m = rot.T @ (start - trans)
-                    d_m = rot.T @ d
-                    n = model.face_normals[f_score.true_id]
-                    d_m = d_m - (d_m @ n) * n
-                    start_m = start_m - (start_m @ n - model.face_offsets[f_score.true_id]) * n
-                    hit = first_felt_edge(model, f_score.true_id, start_m, d_m, tol)
-                    if hit is not None:
-                        ok = e_score.true_id == hit.edge
-                        missed += 0 if ok else 1
-                        checks.append(("face", r.components[0].id, hit.edge, e_score.true_id, ok))
-        if r.ok and r.move.kind == "edge" and prev_state is not None and prev_state.edge is not None:
-            # the vertex reached must be an end of the true edge followed (else the trace ran past one)
-            e_score = by_id.get(prev_state.edge)
-            v = next((c for c in r.components if c.kind == "vertex"), None)
-            v_score = by_id.get(v.id) if v is not None else None
-            if e_score and e_score.true_id is not None and v_score and v_score.true_id is not None:
-                ok = v_score.true_id in (int(model.edges[e_score.true_id, 0]), int(model.edges[e_score.true_id, 1]))
-                missed += 0 if ok else 1
-                checks.append(("edge", v.id, e_score.true_id, v_score.true_id, ok))
-        if r.ok and r.move.kind == "vertex" and prev_state is not None and prev_state.vertex is not None:
-            # the new edge must leave the vertex circled and bound the face circled across
-            v_score = by_id.get(prev_state.vertex)
-            f_score = by_id.get(r.move.across_face)
-            e_score = by_id.get(r.components[0].id)
-            if v_score and f_score and e_score and None not in (v_score.true_id, f_score.true_id, e_score.true_id):
-                e = e_score.true_id
-                ok = v_score.true_id in (int(model.edges[e, 0]), int(model.edges[e, 1])) and (
-                    f_score.true_id in model.edge_faces(e)
-                )
-                missed += 0 if ok else 1
-                checks.append(("vertex", r.components[0].id, v_score.true_id, e, ok))
+        if r.ok and prev_state is not None and r.move.kind in _FEATURE_CHECKS:
+            check = _FEATURE_CHECKS[r.move.kind](r, prev_state, model, rot, trans, by_id, tol)
+            if check is not None:
+                checks.append(check)
         if r.ok:
             prev_state = r.state
-    return missed, {"checks": checks}
+    return sum(1 for c in checks if not c[-1]), {"checks": checks}
+
+
+def _face_check(r, prev_state, model: Polyhedron, rot: np.ndarray, trans: np.ndarray, by_id: dict,
+                tol: EvaluationTolerances) -> tuple | None:  # fmt: skip
+    """A face move: its edge must be the first true edge the pad feels from where the straight trace began."""
+    f_score = by_id.get(prev_state.face)
+    e_score = by_id.get(r.components[0].id) if r.components else None
+    trace = r.trace
+    if not (f_score and f_score.true_id is not None and e_score and trace is not None):
+        return None
+    rows = trace.in_contact & (trace.phase == PHASES.index("face"))  # where the straight trace began
+    if not rows.any():
+        return None
+    start = trace.point_in_world[np.flatnonzero(rows)[0]]
+    d = np.asarray(r.move.direction, float)
+    start_m = rot.T @ (start - trans)
+    d_m = rot.T @ d
+    n = model.face_normals[f_score.true_id]
+    d_m = d_m - (d_m @ n) * n
+    start_m = start_m - (start_m @ n - model.face_offsets[f_score.true_id]) * n
+    hit = first_felt_edge(model, f_score.true_id, start_m, d_m, tol)
+    if hit is None:
+        return None
+    return ("face", r.components[0].id, hit.edge, e_score.true_id, e_score.true_id == hit.edge)
+
+
+def _edge_check(r, prev_state, model: Polyhedron, rot: np.ndarray, trans: np.ndarray, by_id: dict,
+                tol: EvaluationTolerances) -> tuple | None:  # fmt: skip
+    """An edge move: the vertex reached must be an end of the true edge followed (else the trace ran past one)."""
+    if prev_state.edge is None:
+        return None
+    e_score = by_id.get(prev_state.edge)
+    v = next((c for c in r.components if c.kind == "vertex"), None)
+    v_score = by_id.get(v.id) if v is not None else None
+    if not (e_score and e_score.true_id is not None and v_score and v_score.true_id is not None):
+        return None
+    ok = v_score.true_id in (int(model.edges[e_score.true_id, 0]), int(model.edges[e_score.true_id, 1]))
+    return ("edge", v.id, e_score.true_id, v_score.true_id, ok)
+
+
+def _vertex_check(r, prev_state, model: Polyhedron, rot: np.ndarray, trans: np.ndarray, by_id: dict,
+                  tol: EvaluationTolerances) -> tuple | None:  # fmt: skip
+    """A vertex move: the new edge must leave the vertex circled and bound the face circled across."""
+    if prev_state.vertex is None:
+        return None
+    v_score = by_id.get(prev_state.vertex)
+    f_score = by_id.get(r.move.across_face)
+    e_score = by_id.get(r.components[0].id)
+    if not (v_score and f_score and e_score and None not in (v_score.true_id, f_score.true_id, e_score.true_id)):
+        return None
+    e = e_score.true_id
+    ok = v_score.true_id in (int(model.edges[e, 0]), int(model.edges[e, 1])) and f_score.true_id in model.edge_faces(e)
+    return ("vertex", r.components[0].id, v_score.true_id, e, ok)
+
+
+_FEATURE_CHECKS = {"face": _face_check, "edge": _edge_check, "vertex": _vertex_check}
+"""Per kind of tracing move, the check of what it met against the truth: a row (kind, data id of the new
+component, the two true ids compared, ok), or None when the truth cannot say."""
 
 
 __all__ = ["ComponentScore", "EvaluationTolerances", "PerceptionScore", "score_components"]

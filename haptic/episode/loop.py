@@ -1,6 +1,11 @@
 """The closed loop of one episode: executor → matcher → planner until recognised, ambiguous, no-match, out of
 budget, or failed.
 
+Each turn the loop checks its ending conditions (:data:`ENDINGS`), then asks an ordered list of move sources
+(:mod:`haptic.episode.sources`) for the next move, carries it out and books the result in the episode's state
+(:class:`~haptic.episode.state.EpisodeState`). It owns the order, the budgets and the bookkeeping; which move comes
+next is each source's rule.
+
 The loop sees the object only through the executor's data components. The true model and pose are used
 here only to place the object (for the geometric executor) and, at the end, to score the outcome.
 """
@@ -8,42 +13,28 @@ here only to place the object (for the geometric executor) and, at the end, to s
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Generator
-from dataclasses import asdict, dataclass, field, fields, replace
+from collections.abc import Callable, Generator, Sequence
+from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 from typing import Protocol
 
 import numpy as np
 
-from haptic.episode.opening import (
-    cheaper_opening,
-    edge_run_of,
-    opening_move,
-    opening_probe,
-    tracing_remainder,
-)
 from haptic.episode.outcome import score_outcome
-from haptic.episode.perception import on_the_table, touched_points
+from haptic.episode.sources import DecisionPoint, MoveSource, episode_sources
 from haptic.episode.spec import EpisodeSpec
-from haptic.errors import HapticError
+from haptic.episode.state import EpisodeState, hypotheses_from
+from haptic.errors import HapticError, PlanningError
 from haptic.geometry import SE3, Polyhedron
 from haptic.geometry.se3 import matrix_to_quat
 from haptic.matching.acceptance import K_SIGMA, K_SIGMA_PHYSICS
-from haptic.matching.components import DataComponent, SensorNoise
-from haptic.matching.free_space import MAX_POSED as PROBES_MAX_POSED
-from haptic.matching.free_space import FreeSegment, apply_probes
-from haptic.matching.recognition import AMBIGUOUS, EXPLORING, NO_MATCH, RECOGNIZED, Recognition, recognize
-from haptic.matching.tree import InterpretationTree
+from haptic.matching.components import SensorNoise
+from haptic.matching.recognition import AMBIGUOUS, NO_MATCH, RECOGNIZED, Recognition
 from haptic.planning.config import PlannerConfig
-from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import Move, MoveResult
-from haptic.planning.opening_probes import LibraryExtent
-from haptic.planning.policies import Context, Decision, Policy, RandomPolicy
+from haptic.planning.policies import Decision, Policy
 from haptic.planning.verify import Verifier
 
-MAX_POSED = 4000
-"""Largest number of interpretations whose poses are computed to group them into pose classes (all of them in one
-batch); above it the loop takes a random move."""
 MAX_FAILED_MOVES = 4
 """Consecutive failed moves after which the episode ends as "failed"."""
 MAX_INTERPRETATIONS = 200_000
@@ -149,36 +140,6 @@ def chain_observers(*observers: Observer | None) -> EpisodeObserver:
     return EpisodeObserver(**{f.name: hook(f.name) for f in fields(EpisodeObserver)})
 
 
-def hypotheses_from(tree: InterpretationTree, rec: Recognition) -> list[Hypothesis]:
-    """One hypothesis per pose class, from the class's first interpretation."""
-    out = []
-    for c in rec.classes:
-        it = tree.interpretation(c.leaves[0], with_pose=True, refine=True)
-        out.append(
-            Hypothesis(
-                model=c.name,
-                poly=c.model,
-                world_from_model=it.world_from_model or c.world_from_model,
-                faces=it.faces,
-                edges=it.edges,
-                vertices=it.vertices,
-                size=len(c.leaves),
-                leaves=tuple(c.leaves),
-            )
-        )
-    return out
-
-
-@dataclass(frozen=True, eq=False)
-class DecisionPoint:
-    """Where the loop asks its policy for the next move (:func:`loop_steps` yields one)."""
-
-    context: Context
-    """What the policy decides from: two or more pose classes left, no verification under way."""
-    rng: np.random.Generator
-    """The episode's policy generator (the one the opening moves draw from too)."""
-
-
 def run_loop(
     spec: EpisodeSpec,
     library: dict[str, Polyhedron],
@@ -223,193 +184,179 @@ def loop_steps(
     config: PlannerConfig,
     rng: np.random.Generator,
     observer: Observer | None = None,
+    sources: Sequence[MoveSource] | None = None,
 ) -> Generator[DecisionPoint, Decision, EpisodeRecord]:
     """The closed loop as a generator: it yields a :class:`DecisionPoint` whenever the policy is to choose
     and takes the :class:`Decision` sent back (a ``HapticError`` thrown in ends the episode as failed); it
-    returns the :class:`EpisodeRecord`. Opening moves, verification moves and the random fallback (fewer than
-    two pose classes) are chosen inside. :func:`run_loop` drives it with a policy, :mod:`haptic.env` with
-    the actions of an agent."""
+    returns the :class:`EpisodeRecord`. The moves come from ``sources``, asked in order each turn (default:
+    :func:`~haptic.episode.sources.episode_sources`, drawing from ``rng``: opening moves, verification moves and
+    the random fallback when fewer than two pose classes are left are chosen inside). :func:`run_loop` drives it
+    with a policy, :mod:`haptic.env` with the actions of an agent."""
     t0 = time.perf_counter()
     obs = observer or EpisodeObserver()
     if obs.on_start:
         obs.on_start(true_model, world_from_model)
-    tree = InterpretationTree(library)
-    components: dict[int, DataComponent] = {}
-    counts: list[int] = []
-    n_classes: list[int] = []
-    cum_cost: list[float] = []
-    kinds: list[str] = []
-    decision_times: list[float] = []
-    cost = 0.0
-    failed_in_a_row = failed_total = 0
-    failed_here: list[Move] = []
-    rec: Recognition | None = None
-    outcome, detail = EXPLORING, ""
-    fallback = RandomPolicy()
-    verifier = None
-    if spec.verify != "none":
-        verifier = Verifier(spec.verify, noise, config, K_SIGMA_PHYSICS if spec.executor == "physics" else K_SIGMA)
+    view = EpisodeState.begin(library, noise, config, _verifier(spec, noise, config))
+    sources = episode_sources(library, config, rng) if sources is None else sources
+    end = _start(view, executor, obs)
+    while end is None:
+        end = ending(view, spec)
+        if end is None:
+            end = yield from _turn(view, sources, executor, obs)
+    record = _record(spec, library, true_model, world_from_model, view, end, time.perf_counter() - t0)
+    if obs.on_end:
+        obs.on_end(record)
+    return record
 
-    touched: list[tuple[np.ndarray, np.ndarray]] = []
-    free: list[FreeSegment] = []  # free space the probes travelled (a miss's line, a hit's approach)
-    probe_faces: list[int] = []  # data ids of the faces probes hit
-    probed: list[Move] = []  # probes carried out or failed: the same line again would tell nothing new (or fail again)
 
-    def assess() -> Recognition:
-        """The verdict on the data so far (with the table and the touched points, when known)."""
-        r = recognize(tree, max_interpretations=MAX_POSED)
-        if config.table_z is None:
-            return r
-        if not touched:
-            return on_the_table(r, tree, components, config)
-        both = (np.concatenate([p for p, _ in touched]), np.concatenate([n for _, n in touched]))
-        return on_the_table(r, tree, components, config, both)
-
-    def absorb(result: MoveResult) -> None:
-        nonlocal cost, rec
-        for c in result.components:
-            components[c.id] = c
-            tree.add(c)
-        free.extend(result.free_space)
-        if result.move is not None and result.move.kind == "probe":
-            probe_faces.extend(c.id for c in result.components)
-            probed.append(result.move)
-        if free:  # after every add: poses tighten, and leaves unposed or too many before become testable
-            apply_probes(tree, free, probe_faces)
-        if config.touch_evidence:
-            touched.append(touched_points(result, config))
-        cost += result.cost
-        rec = assess()
-        counts.append(tree.count)
-        n_classes.append(len(rec.classes) if rec.classes else tree.count)
-        cum_cost.append(cost)
-        kinds.append(result.move.kind if result.move is not None else "start")
-
-    n_moves = 0
+def _start(view: EpisodeState, executor: Executor, obs: Observer) -> Ending | None:
+    """The executor finds the object: its first data are booked (an ending when it cannot)."""
     first = executor.start()
     if not first.ok:
-        outcome, detail = "failed", f"start: {first.status}"
-    else:
-        absorb(first)
-        state = first.state
-        if obs.on_move:
-            obs.on_move(0, first, tree.count, rec)
-        probing = config.moves == "probing"  # probes until the hypotheses have poses: the opening is probes
-        # each new face of the opening by a tracing move or a probe; the simulated hand (a table) keeps the seed's
-        # tracing opening: its probes cost more than predicted, and failed ones more again
-        choosing = config.moves == "all" and config.table_z is None
-        fixed = [] if probing else ["face", "edge", "vertex"]
-        extent = LibraryExtent.of(library.values()) if probing or choosing else None
-        while True:
-            verifying = verifier is not None and rec is not None and rec.status == RECOGNIZED
-            if verifying:
-                verdict = verifier.verdict(tree, rec, cost)
-                if verdict != "verifying":
-                    outcome, detail = verifier.outcome(), verifier.detail()
-                    break
-            elif rec is not None and rec.status in (RECOGNIZED, AMBIGUOUS, NO_MATCH):
-                outcome = rec.status
-                break
-            if cost > spec.budget or n_moves - (verifier.moves if verifier else 0) >= spec.max_moves:
-                outcome = "budget"
-                break
-            if tree.count > MAX_INTERPRETATIONS:
-                outcome = "failed"
-                detail = f"{tree.count} interpretations, more than the matcher holds ({MAX_INTERPRETATIONS})"
-                break
-            move = None
-            if verifying:
-                move = verifier.choose(hypotheses_from(tree, rec)[0], state, components, tuple(failed_here), probed)
-            posed = rec is not None and bool(rec.classes)
-            probe_failed = any(m.kind == "probe" for m in failed_here)
-            if choosing and move is None and not posed and not verifying:
-                # the tracing opening from where the sensor is, or a probe when it measures the next face for less
-                # (not after a probe failed from here: probes aimed at the same region would fail the same way)
-                fixed = tracing_remainder(state)
-                if not probe_failed:
-                    run = edge_run_of(tree, state.edge) if state.edge is not None else None
-                    move = cheaper_opening(fixed, state, components, extent, config, rng, (*failed_here, *probed), run)
-                if move is not None:
-                    fixed = []
-            if fixed and move is None:
-                hyps = (
-                    tuple(hypotheses_from(tree, rec))
-                    if config.table_z is not None and rec is not None and rec.classes else ()
-                )  # fmt: skip
-                move = opening_move(fixed.pop(0), state, components, config, rng, tuple(failed_here), hyps)
-            if probing and move is None and not verifying and (not posed or tree.count > PROBES_MAX_POSED):
-                move = opening_probe(components, extent, config, rng, (*failed_here, *probed), unmeasured=posed)
-            if move is None:
-                t_dec = time.perf_counter()
-                hyps = hypotheses_from(tree, rec) if rec is not None and rec.classes else []
-                # after a probe failed from here (the hand could not get along its line), tracing moves until one
-                # succeeds: probes aimed at the same region would fail the same way
-                cfg = replace(config, moves="tracing") if config.moves == "all" and probe_failed else config
-                ctx = Context(hyps, state, components, noise, cfg, avoid=(*failed_here, *probed), tree=tree)
-                try:
-                    if len(hyps) >= 2 and not verifying:
-                        decision = yield DecisionPoint(ctx, rng)
-                    else:
-                        decision = fallback.choose(ctx, rng)
-                except HapticError as exc:
-                    outcome, detail = "failed", f"no move: {exc}"
-                    break
-                move = decision.move
-                decision_times.append(time.perf_counter() - t_dec)
-                if obs.on_decision:
-                    obs.on_decision(n_moves + 1, decision)
-            result = executor.execute(move)
-            n_moves += 1
-            if not result.ok:
-                failed_total += 1
-                failed_in_a_row += 1
-                failed_here.append(move)
-                if move.kind == "probe":  # its line is where it is, whatever the state: not offered again
-                    probed.append(move)
-                cost += result.cost
-                if obs.on_failed_move:
-                    obs.on_failed_move(n_moves, result)
-                if result.state is not None:
-                    state = result.state
-                if config.touch_evidence and rec is not None:
-                    touched.append(touched_points(result, config))
-                    before = len(rec.classes)
-                    rec = assess()
-                    if len(rec.classes) < before:  # the failed move's touches told something
-                        failed_in_a_row = 0
-                if failed_in_a_row >= MAX_FAILED_MOVES:
-                    outcome, detail = "failed", f"{failed_in_a_row} failed moves in a row (last: {result.status})"
-                    break
-                continue
-            failed_in_a_row = 0
-            failed_here.clear()
-            absorb(result)
-            state = result.state
-            if obs.on_move:
-                obs.on_move(n_moves, result, tree.count, rec)
+        return Ending("failed", f"start: {first.status}")
+    view.took(first)
+    if obs.on_move:
+        obs.on_move(0, first, view.tree.count, view.rec)
+    return None
 
+
+def _turn(
+    view: EpisodeState, sources: Sequence[MoveSource], executor: Executor, obs: Observer
+) -> Generator[DecisionPoint, Decision, Ending | None]:
+    """One move: the first proposal of ``sources``, carried out and booked; every source hears the result. An
+    ending when no move can be had (a :class:`~haptic.errors.HapticError` from a source or the driver)."""
+    try:
+        move = yield from _next_move(view, sources, obs)
+    except HapticError as exc:
+        return Ending("failed", f"no move: {exc}")
+    result = executor.execute(move)
+    view.moves += 1
+    if result.ok:
+        view.took(result)
+        if obs.on_move:
+            obs.on_move(view.moves, result, view.tree.count, view.rec)
+    else:
+        view.failed(move, result)
+        if obs.on_failed_move:
+            obs.on_failed_move(view.moves, result)
+    for source in sources:
+        source.on_result(view, move, result)
+    return None
+
+
+def _next_move(
+    view: EpisodeState, sources: Sequence[MoveSource], obs: Observer
+) -> Generator[DecisionPoint, Decision, Move]:
+    """The first move a source proposes; a decision point goes to the driver, and a policy's decision (the
+    driver's or one taken inside a source) is timed and shown to the observer."""
+    for source in sources:
+        t = time.perf_counter()
+        proposal = source.propose(view)
+        if isinstance(proposal, DecisionPoint):
+            proposal = yield proposal
+        if isinstance(proposal, Decision):
+            view.decision_times.append(time.perf_counter() - t)
+            if obs.on_decision:
+                obs.on_decision(view.moves + 1, proposal)
+            return proposal.move
+        if proposal is not None:
+            return proposal
+    raise PlanningError(f"no move source proposed a move (asked: {', '.join(s.name for s in sources)})")
+
+
+def _verifier(spec: EpisodeSpec, noise: SensorNoise, config: PlannerConfig) -> Verifier | None:
+    """The episode's verification stage (None with ``spec.verify`` "none"), its bounds by executor."""
+    if spec.verify == "none":
+        return None
+    return Verifier(spec.verify, noise, config, K_SIGMA_PHYSICS if spec.executor == "physics" else K_SIGMA)
+
+
+@dataclass(frozen=True)
+class Ending:
+    """How an episode ends."""
+
+    outcome: str
+    """"recognized", "ambiguous", "no-match", "budget" or "failed"."""
+    detail: str = ""
+    """Why, in words ("" when the outcome says it)."""
+
+
+def failed_in_a_row(view: EpisodeState, spec: EpisodeSpec) -> Ending | None:
+    """Failed: :data:`MAX_FAILED_MOVES` moves failed in a row."""
+    if view.failed_in_a_row < MAX_FAILED_MOVES:
+        return None
+    return Ending("failed", f"{view.failed_in_a_row} failed moves in a row (last: {view.last_failure})")
+
+
+def verdict(view: EpisodeState, spec: EpisodeSpec) -> Ending | None:
+    """The matcher's verdict when final (recognised, ambiguous, no-match); with verification on, a recognition
+    is final only when the verifier's verdict is (:meth:`~haptic.planning.verify.Verifier.verdict`)."""
+    if view.verifying:
+        v = view.verifier
+        return None if v.verdict(view.tree, view.rec, view.cost) == "verifying" else Ending(v.outcome(), v.detail())
+    if view.rec is not None and view.rec.status in (RECOGNIZED, AMBIGUOUS, NO_MATCH):
+        return Ending(view.rec.status)
+    return None
+
+
+def out_of_budget(view: EpisodeState, spec: EpisodeSpec) -> Ending | None:
+    """Budget: the path cost is over ``spec.budget``, or ``spec.max_moves`` moves are made (verification moves
+    not counted)."""
+    exempt = view.verifier.moves if view.verifier is not None else 0
+    return Ending("budget") if view.cost > spec.budget or view.moves - exempt >= spec.max_moves else None
+
+
+def too_many_interpretations(view: EpisodeState, spec: EpisodeSpec) -> Ending | None:
+    """Failed: the tree holds more than :data:`MAX_INTERPRETATIONS` interpretations."""
+    if view.tree.count <= MAX_INTERPRETATIONS:
+        return None
+    return Ending("failed", f"{view.tree.count} interpretations, more than the matcher holds ({MAX_INTERPRETATIONS})")
+
+
+ENDINGS = (failed_in_a_row, verdict, out_of_budget, too_many_interpretations)
+"""The ending conditions, checked in this order before every move."""
+
+
+def ending(view: EpisodeState, spec: EpisodeSpec) -> Ending | None:
+    """The first of :data:`ENDINGS` that ends the episode now, or None."""
+    for check in ENDINGS:
+        end = check(view, spec)
+        if end is not None:
+            return end
+    return None
+
+
+def _record(
+    spec: EpisodeSpec,
+    library: dict[str, Polyhedron],
+    true_model: Polyhedron,
+    world_from_model: SE3,
+    view: EpisodeState,
+    end: Ending,
+    wall_time: float,
+) -> EpisodeRecord:
+    """The episode's record: what the loop booked, and the outcome scored against the truth."""
+    verifier, rec, outcome = view.verifier, view.rec, end.outcome
     if verifier is not None and outcome == NO_MATCH and verifier.status == "verifying":
         verifier.status = "mismatch"  # the matcher itself left no interpretation during the verification
-    recognized = rec.model if rec is not None and outcome == RECOGNIZED else None
-    in_library = spec.model in library
     err_mm, err_deg, correct = score_outcome(spec, library, true_model, world_from_model, outcome, rec)
-    n_by_kind = {k: sum(1 for c in components.values() if c.kind == k) for k in ("face", "edge", "vertex")}
-    n_probes = kinds.count("probe")
-    record = EpisodeRecord(
-        model=true_model.name if in_library else str(Path(spec.model).name),
+    n_by_kind = {k: sum(1 for c in view.components.values() if c.kind == k) for k in ("face", "edge", "vertex")}
+    n_probes = view.kinds.count("probe")
+    return EpisodeRecord(
+        model=true_model.name if spec.model in library else str(Path(spec.model).name),
         pose={
             "quat_wxyz": [round(float(x), 9) for x in matrix_to_quat(world_from_model.rotation)],
             "translation_m": [round(float(x), 9) for x in world_from_model.translation],
         },
         outcome=outcome,
-        recognized=recognized,
+        recognized=rec.model if rec is not None and outcome == RECOGNIZED else None,
         correct=bool(correct),
-        moves=n_moves,
-        path_cost=round(cost, 6),
-        interpretations=counts,
-        classes=n_classes,
-        cum_cost=[round(c, 6) for c in cum_cost],
-        move_kinds=kinds,
+        moves=view.moves,
+        path_cost=round(view.cost, 6),
+        interpretations=view.counts,
+        classes=view.classes,
+        cum_cost=[round(c, 6) for c in view.cum_cost],
+        move_kinds=view.kinds,
         pose_error_mm=err_mm,
         pose_error_deg=err_deg,
         seed=spec.seed,
@@ -419,16 +366,32 @@ def loop_steps(
         faces=n_by_kind["face"],
         edges=n_by_kind["edge"],
         vertices=n_by_kind["vertex"],
-        wall_time_s=round(time.perf_counter() - t0, 4),
-        decision_times_s=[round(t, 6) for t in decision_times],
-        failed_moves=failed_total,
-        detail=detail,
+        wall_time_s=round(wall_time, 4),
+        decision_times_s=[round(t, 6) for t in view.decision_times],
+        failed_moves=view.failed_total,
+        detail=end.detail,
         verify=spec.verify,
-        verified=verifier.record(cost) if verifier is not None else None,
+        verified=verifier.record(view.cost) if verifier is not None else None,
         move_set=spec.moves,
         probes=n_probes,
-        probe_misses=n_probes - len(probe_faces),
+        probe_misses=n_probes - len(view.probe_faces),
     )
-    if obs.on_end:
-        obs.on_end(record)
-    return record
+
+
+__all__ = [
+    "ENDINGS",
+    "MAX_FAILED_MOVES",
+    "MAX_INTERPRETATIONS",
+    "DecisionPoint",
+    "Ending",
+    "EpisodeObserver",
+    "EpisodeRecord",
+    "Executor",
+    "Observer",
+    "chain_observers",
+    "drive",
+    "ending",
+    "hypotheses_from",
+    "loop_steps",
+    "run_loop",
+]

@@ -44,7 +44,7 @@ fitted to the data is off along the weak direction by more than the pose check's
 allow, and the truth could be eliminated."""
 MAX_POSED = 400
 """Most leaves whose poses :func:`consistent_leaves` computes; above it every leaf is kept (sound, as the
-matcher's recognition does: ``haptic.episode.MAX_POSED``)."""
+matcher's recognition does: ``haptic.episode.state.MAX_GROUPED_INTERPRETATIONS``)."""
 
 
 @dataclass(frozen=True, eq=False)

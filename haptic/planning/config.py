@@ -63,7 +63,7 @@ class PlannerConfig:
     """Most pose classes a policy scores moves against; above it, a reduced set chosen model by model
     (:mod:`haptic.planning.bound`). None: no bound. 256 is above the most pose classes the shipped libraries
     leave at a planner decision (255, look-alike library, with the loop posing up to
-    ``haptic.episode.loop.MAX_POSED`` interpretations), so their decisions are unchanged."""
+    ``haptic.episode.state.MAX_GROUPED_INTERPRETATIONS`` interpretations), so their decisions are unchanged."""
     moves: str = "tracing"
     """Admissible kinds of move (``MOVE_SETS``): "tracing" (face, edge and vertex moves), "probing" (free-space
     probes) or "all" (both, ranked together by one efficiency, seed §1.1)."""
