@@ -41,8 +41,8 @@ from haptic.matching.free_space import MAX_POSED as PROBES_MAX_POSED
 from haptic.matching.recognition import AMBIGUOUS, EXPLORING, NO_MATCH, RECOGNIZED
 from haptic.planning.config import PlannerConfig
 from haptic.planning.moves import EdgeMove, FaceMove, MoveResult, ProbeMove, SensorState
-from haptic.planning.policies import Decision, PlannerPolicy
 from haptic.planning.opening_probes import LibraryExtent
+from haptic.planning.policies import Decision, PlannerPolicy
 
 LIB = cached_library(None)
 FACE = FaceMove(np.array([1.0, 0.0, 0.0]))

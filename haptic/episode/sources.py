@@ -27,8 +27,8 @@ from haptic.geometry import Polyhedron
 from haptic.matching.free_space import MAX_POSED as PROBES_MAX_POSED
 from haptic.planning.config import PlannerConfig
 from haptic.planning.moves import Move, MoveResult
-from haptic.planning.policies import Context, Decision, Policy, RandomPolicy
 from haptic.planning.opening_probes import LibraryExtent
+from haptic.planning.policies import Context, Decision, Policy, RandomPolicy
 
 TRACING_OPENING = ("face", "edge", "vertex")
 """The seed's opening sequence (§4.1) from a face."""
