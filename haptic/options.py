@@ -64,6 +64,37 @@ def noise_levels(text: str) -> list[float]:
     return [noise_level(p) for p in parts]
 
 
+class DefaultsHelpFormatter(argparse.HelpFormatter):
+    """Help that states every option's default: "(default X)" after its text, unless the text already speaks of
+    its default or the option has none (a flag off, an option unset)."""
+
+    def _get_help_string(self, action: argparse.Action) -> str:
+        text = action.help or ""
+        default = action.default
+        if (not action.option_strings or default is None or default is False or default == argparse.SUPPRESS
+                or "(default" in text or text == argparse.SUPPRESS):  # fmt: skip
+            return text
+        if isinstance(default, list | tuple):
+            default = ",".join(f"{x:g}" if isinstance(x, float) else str(x) for x in default)
+        elif isinstance(default, float):
+            default = f"{default:g}"
+        return f"{text} (default {str(default).replace('%', '%%')})"
+
+
+UNITS_HELP = (
+    "units of the model files that declare none: m, cm or mm (default: the library's library.toml, else m; an OBJ "
+    "'# units:' comment or a native model's units come first)"
+)
+"""The ``--units`` option's help, the same on every subcommand."""
+
+
+def add_units_option(parser: argparse.ArgumentParser) -> None:
+    """``--units mm|cm|m`` (:data:`UNITS_HELP`)."""
+    from haptic.geometry.io import UNITS
+
+    parser.add_argument("--units", choices=tuple(UNITS), default=None, help=UNITS_HELP)
+
+
 def check_output_file(path: str | os.PathLike, option: str, example: str, error=HapticError) -> Path:
     """Check that ``path`` can be written as a regular file, without changing anything there.
 

@@ -15,7 +15,7 @@ from haptic.episode.spec import EpisodeSpec
 from haptic.episode.worlds import run_episode
 from haptic.recording import EpisodeRecorder, RecordingError, load_recording
 
-SPEC = EpisodeSpec(model="WEDGE01", seed=3, policy="planner")
+SPEC = EpisodeSpec(model="WEDGE01", seed=3, policy="planner", verify="none", moves="tracing")
 
 
 def _count(values: list | None) -> int:
@@ -224,7 +224,8 @@ def test_physics_trace_and_hand_links_are_recorded(tmp_path):
 def physics_recorded(tmp_path_factory) -> tuple[Path, EpisodeRecord]:
     out = tmp_path_factory.mktemp("phys") / "physics.rrd"
     with EpisodeRecorder(out) as recorder:
-        record = run_episode(EpisodeSpec(model="PYR01", seed=1, executor="physics"), observer=recorder.observer())
+        spec = EpisodeSpec(model="PYR01", seed=1, executor="physics", verify="none")
+        record = run_episode(spec, observer=recorder.observer())
     return out, record
 
 
@@ -481,7 +482,7 @@ def test_probes_are_drawn_hits_and_misses_apart(tmp_path):
 def test_candidate_probes_are_named_as_probes(tmp_path):
     out = tmp_path / "all.rrd"
     recorder = EpisodeRecorder(out)
-    record = run_episode(EpisodeSpec(model="WEDGE01", seed=1, moves="all"), observer=recorder.observer())
+    record = run_episode(EpisodeSpec(model="WEDGE01", seed=1, moves="all", verify="none"), observer=recorder.observer())
     recorder.close()
     assert record.probes >= 1
     ents = load_recording(out)

@@ -38,6 +38,7 @@ from haptic.recording.drawing import (
     _transform,
     _waypoints,
     _wireframe,
+    decision_summary,
 )
 from haptic.recording.style import (
     APPLICATION_ID,
@@ -520,7 +521,7 @@ class EpisodeRecorder:
         rec.log(
             "log/decisions",
             rr.TextLog(
-                f"move {i}: chose {_move_name(decision.move)} among {len(cands)} candidates"
+                decision_summary(i, decision, _move_name(decision.move))
                 + ("\n" + "\n".join(lines) if lines else ""),
                 level=rr.TextLogLevel.INFO,
             ),

@@ -63,7 +63,7 @@ def test_optimal_recognizes_and_is_no_costlier_than_the_planner_on_small_library
 
 
 def test_optimal_is_deterministic_and_named():
-    spec = EpisodeSpec(model="WEDGE01", seed=4, policy="optimal")
+    spec = EpisodeSpec(model="WEDGE01", seed=4, policy="optimal", verify="none", moves="tracing")
     a, b = (run_episode(spec, library=LIB).to_json() for _ in range(2))
     for r in (a, b):
         r.pop("wall_time_s")
