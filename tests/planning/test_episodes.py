@@ -44,7 +44,7 @@ def test_mirror_tetrahedra_are_never_confused():
 
 
 def test_planner_costs_less_than_random_on_the_same_episodes():
-    specs = plan_sweep(SEED_OBJECTS, 24, seed=11, policies=["planner", "random"])
+    specs = plan_sweep(SEED_OBJECTS, 24, seed=11, policies=["planner", "random"], **SEED_EPISODE)
     costs = {"planner": [], "random": []}
     for s in specs:
         r = run_episode(s, library=LIB)

@@ -31,7 +31,7 @@ class Recording(PlannerPolicy):
 
 def _contexts(n_episodes=6):
     out = []
-    for spec in plan_sweep(SMALL, n_episodes, seed=3, policies=["planner"]):
+    for spec in plan_sweep(SMALL, n_episodes, seed=3, policies=["planner"], verify="none", moves="tracing"):
         pol = Recording()
         run_episode(spec, library=LIB, policy=pol)
         out += [c for c in pol.contexts if 2 <= len(c.hypotheses) <= 30]
@@ -52,7 +52,7 @@ def test_search_never_expects_more_than_following_the_planner():
 
 
 def test_optimal_recognizes_and_is_no_costlier_than_the_planner_on_small_library():
-    specs = plan_sweep(SMALL, 6, seed=7, policies=["planner", "optimal"])
+    specs = plan_sweep(SMALL, 6, seed=7, policies=["planner", "optimal"], verify="none", moves="tracing")
     cost = {"planner": [], "optimal": []}
     for s in specs:
         r = run_episode(s, library=LIB)
