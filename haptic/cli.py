@@ -23,21 +23,31 @@ Runner = Callable[[argparse.Namespace], int]
 
 
 def _add_models(sub: Subcommands) -> None:
+    from haptic.options import add_units_option
+
     p = sub.add_parser("models", help="list, show and check polyhedral models")
     msub = p.add_subparsers(dest="models_cmd", required=True, metavar="{list,show,check,generate}")
 
     lp = msub.add_parser("list", help="the models of a library: V/E/F, genus, convexity, symmetry order")
     lp.add_argument("--models", metavar="DIR", help="library directory (default: the shipped assets/models)")
+    add_units_option(lp)
     lp.add_argument("--json", action="store_true", help="one JSON object per line instead of a table")
     lp.set_defaults(run=_models_list)
 
     sp = msub.add_parser("show", help="one model in full: faces, edges, vertices, symmetry")
     sp.add_argument("name", help="a model name in the library, or a path to a model file")
     sp.add_argument("--models", metavar="DIR", help="library directory (default: the shipped assets/models)")
+    add_units_option(sp)
     sp.set_defaults(run=_models_show)
 
-    cp = msub.add_parser("check", help="validate model files; exit 1 if any is bad")
-    cp.add_argument("files", nargs="+", metavar="FILE")
+    cp = msub.add_parser(
+        "check",
+        help="validate model files; exit 1 if any is bad",
+        description="Load and validate each FILE as a library would: one line per file, 'ok' with its size and "
+        "counts, or the error; a warning when a model's size suggests misread units. Exit 1 if any file is bad.",
+    )
+    cp.add_argument("files", nargs="+", metavar="FILE", help="model files (.json, .obj, .stl, .ply)")
+    add_units_option(cp)
     cp.set_defaults(run=_models_check)
 
     gp = msub.add_parser(
@@ -48,7 +58,7 @@ def _add_models(sub: Subcommands) -> None:
         "model files into a new directory OUT, then loaded back and validated like any library.",
     )
     gp.add_argument("--count", type=int, required=True, metavar="N", help="number of models")
-    gp.add_argument("--seed", type=int, default=0, help="seed of the draw (default 0)")
+    gp.add_argument("--seed", type=int, default=0, help="seed of the draw")
     gp.add_argument("--out", required=True, metavar="DIR", help="new (or empty) library directory to write")
     gp.set_defaults(run=_models_generate)
 
@@ -58,8 +68,10 @@ def _models_list(args: argparse.Namespace) -> int:
 
     from haptic.geometry.io import scan_library
     from haptic.geometry.symmetry import model_summary
+    from haptic.options import report_sizes
 
-    scan = scan_library(args.models, progress=True)
+    scan = scan_library(args.models, progress=True, units=args.units)
+    report_sizes(scan.size_warnings())
     models = list(scan.models.values())
     rows = [model_summary(m) for m in tqdm(models, desc="symmetry", unit="model", disable=None, leave=False)]
     for msg in scan.errors.values():
@@ -90,17 +102,19 @@ def _models_show(args: argparse.Namespace) -> int:
     import numpy as np
 
     from haptic.geometry import convex_decomposition, resolve_model, symmetry_group
-    from haptic.geometry.io import scan_library
+    from haptic.geometry.io import scan_library, size_warning
     from haptic.geometry.symmetry import model_summary
+    from haptic.options import report_sizes
 
     lib = None
     if not os.path.exists(args.name):
-        scan = scan_library(args.models)
+        scan = scan_library(args.models, units=args.units)
         bad = [msg for path, msg in scan.errors.items() if path.stem == args.name]
         if bad:
             raise HapticError(bad[0])
         lib = scan.models
-    m = resolve_model(args.name, lib)
+    m = resolve_model(args.name, lib, units=args.units)
+    report_sizes([size_warning(m, args.units)])
     sym = symmetry_group(m)
     s = model_summary(m, symmetry=sym)
     print(f"{m.name}  ({m.source})")
@@ -126,17 +140,23 @@ def _models_show(args: argparse.Namespace) -> int:
 
 
 def _models_check(args: argparse.Namespace) -> int:
+    import numpy as np
+
     from haptic.geometry import load_model
+    from haptic.geometry.io import size_warning
+    from haptic.options import report_sizes
 
     bad = 0
     for f in args.files:
         try:
-            m = load_model(f)
+            m = load_model(f, units=args.units)
         except HapticError as exc:
-            print(f"haptic: {exc}", file=sys.stderr)
+            print(f"haptic: error: {exc}", file=sys.stderr)
             bad += 1
         else:
-            print(f"{f}: ok  V={m.n_vertices} E={m.n_edges} F={m.n_faces} genus={m.genus}")
+            size = " x ".join(f"{x * 1e3:.4g}" for x in np.ptp(m.vertices, axis=0))
+            print(f"{f}: ok  V={m.n_vertices} E={m.n_edges} F={m.n_faces} genus={m.genus}  size {size} mm")
+            report_sizes([size_warning(m, args.units)])
     return 1 if bad else 0
 
 
@@ -170,7 +190,14 @@ def _optional_subcommands() -> list[Callable[[Subcommands], None]]:
 
 
 class _Parser(argparse.ArgumentParser):
-    """Usage errors as one line on stderr (exit 2), like every other error of the command."""
+    """Usage errors as one line on stderr (exit 2), like every other error of the command; help that states
+    every option's default (:class:`~haptic.options.DefaultsHelpFormatter`)."""
+
+    def __init__(self, *args, **kwargs) -> None:
+        from haptic.options import DefaultsHelpFormatter
+
+        kwargs.setdefault("formatter_class", DefaultsHelpFormatter)
+        super().__init__(*args, **kwargs)
 
     def error(self, message: str):
         self.exit(2, f"{self.prog}: error: {message} (see '{self.prog} --help')\n")

@@ -115,6 +115,7 @@ class ExploreEnv(gym.Env):
         spec = EpisodeSpec(
             model=model, seed=int(episode_seed), policy="agent", executor=self.executor, noise=self.noise,
             models=self.models, budget=self.budget, max_moves=self.max_moves, verify=self.verify,
+            moves="tracing",  # the actions index tracing moves (candidate_moves)
         )  # fmt: skip
         self.episode = build_episode(spec, self.library, self.config)
         self.record, self._cost = None, 0.0

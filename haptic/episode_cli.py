@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -16,32 +17,46 @@ from haptic.errors import HapticError, RecordingError
 if TYPE_CHECKING:
     from haptic.options import Subcommands
 
-
 def add_parser(sub: Subcommands) -> None:
+    from haptic.episode.spec import (
+        DEFAULT_EXECUTOR,
+        DEFAULT_MAX_MOVES,
+        DEFAULT_NOISE,
+        DEFAULT_POLICY,
+        DEFAULT_SEED,
+        EXECUTORS,
+    )
     from haptic.matching.acceptance import DEFAULT_VERIFY, VERIFY_MODES
-    from haptic.options import noise_level, positive_int, seed_int
+    from haptic.options import add_units_option, noise_level, positive_int, seed_int
     from haptic.planning.moves import DEFAULT_MOVES, HAND_DEFAULT_MOVES, MOVE_SETS
     from haptic.planning.registry import POLICY_NAMES
 
     p = sub.add_parser(
         "explore",
         help="run one episode: explore an object by touch until it is recognised",
-        description="One episode. Exit 0 when the episode ends normally, whatever its outcome.",
+        description="One episode. Prints a line per move as it happens (on a terminal, or with --progress), then "
+        "a summary. Exit 0 when the episode ends normally, whatever its outcome.",
     )
     p.add_argument("--object", required=True, help="model name in the library, or a path to a model file")
     p.add_argument("--models", metavar="DIR", help="library directory (default: the shipped assets/models)")
+    add_units_option(p)
     p.add_argument(
         "--skip-invalid", action="store_true", help="use the library's valid models when some files are bad"
     )
-    p.add_argument("--executor", choices=("geometric", "physics"), default="geometric")
-    p.add_argument("--seed", type=seed_int, default=0, help="seed of the pose, noise and policy (an integer >= 0)")
-    p.add_argument("--policy", default="planner", choices=POLICY_NAMES)
-    p.add_argument("--noise", type=noise_level, default=1.0, help="sensor-noise level, x the default sigma (0 to 10)")
-    p.add_argument("--max-moves", type=positive_int, default=40)
+    p.add_argument("--executor", choices=EXECUTORS, default=DEFAULT_EXECUTOR,
+                   help="geometric: the ideal sensor with noise (fast); physics: the simulated hand in MuJoCo")
+    p.add_argument("--seed", type=seed_int, default=DEFAULT_SEED,
+                   help="seed of the pose, noise and policy (an integer >= 0)")
+    p.add_argument("--policy", default=DEFAULT_POLICY, choices=POLICY_NAMES, help="how the next move is chosen")
+    p.add_argument("--noise", type=noise_level, default=DEFAULT_NOISE,
+                   help="sensor-noise level, x the default sigma (0 to 10)")
+    p.add_argument("--max-moves", type=positive_int, default=DEFAULT_MAX_MOVES,
+                   help="move budget: the episode ends as 'budget' after this many moves (verification moves "
+                   "not counted)")
     p.add_argument(
         "--verify", choices=VERIFY_MODES, default=DEFAULT_VERIFY,
-        help=f"verification before recognition (default {DEFAULT_VERIFY}): none, fast (pose check; every face "
-        "and edge measured) or full (also every vertex)",
+        help="verification before recognition: none, fast (pose check; every face and edge measured) or full "
+        "(also every vertex)",
     )  # fmt: skip
     p.add_argument(
         "--moves", choices=MOVE_SETS, default=None,
@@ -53,30 +68,130 @@ def add_parser(sub: Subcommands) -> None:
     p.add_argument("--json", metavar="OUT", help="write the episode's JSON record here")
     p.add_argument("--record", metavar="OUT.rrd", help="write a rerun recording here")
     p.add_argument("--spawn", action="store_true", help="open the rerun viewer (where one is installed)")
+    talk = p.add_mutually_exclusive_group()
+    talk.add_argument("--progress", action="store_true",
+                      help="print a line per move as it happens even when stdout is not a terminal "
+                      "(default: only on a terminal)")
+    talk.add_argument("--quiet", action="store_true", help="print no line per move, only the summary")
     p.set_defaults(run=run)
 
 
-def summary_lines(rec: dict) -> list[str]:
+GROWTH_NOTE = "grows where new data fit several model features each"
+"""Why an interpretation count rises: each interpretation branches into every model feature the new data fit."""
+
+
+def move_line(n: int, kind: str, status: str, why: str, counts: tuple[int, int], classes: int | None,
+              cost: float) -> str:  # fmt: skip
+    """One move as ``explore`` prints it while the episode runs: number, kind, ok or failed and why, the
+    interpretations before -> after, the pose classes, the path cost so far."""
+    before, after = counts
+    done = "ok" if status == "ok" else f"failed ({why or status})"
+    noun = "interpretation" if after == 1 else "interpretations"
+    if status != "ok" or n == 0 or before == after:
+        trace = f"{after} {noun}"
+    else:
+        trace = f"{before} -> {after} {noun}" + (f" ({GROWTH_NOTE})" if after > before else "")
+    pose = f"{classes} pose class{'es' if classes != 1 else ''}" if classes else "no pose fixed yet"
+    return f"move {n:>2}  {kind:<7} {done:<8} {trace}; {pose}; cost {cost:.1f}"
+
+
+class MovePrinter:
+    """An observer that prints :func:`move_line` for every move as the episode runs (flushed at once)."""
+
+    def __init__(self, out=None) -> None:
+        self.out = out or sys.stdout
+        self.count = 0
+        self.classes: int | None = None
+        self.cost = 0.0
+
+    def observer(self):
+        from haptic.episode.loop import EpisodeObserver
+
+        return EpisodeObserver(on_move=self.on_move, on_failed_move=self.on_failed_move)
+
+    def _print(self, line: str) -> None:
+        print(line, file=self.out, flush=True)
+
+    def on_move(self, n: int, result, count: int, rec) -> None:
+        self.cost += result.cost
+        self.classes = len(rec.classes) if rec is not None and rec.classes else None
+        kind = "start" if n == 0 or result.move is None else result.move.kind
+        self._print(move_line(n, kind, "ok", "", (self.count, count), self.classes, self.cost))
+        self.count = count
+
+    def on_failed_move(self, n: int, result) -> None:
+        self.cost += result.cost
+        kind = result.move.kind if result.move is not None else "start"
+        self._print(move_line(n, kind, str(result.status), result.reason, (self.count, self.count), self.classes,
+                              self.cost))  # fmt: skip
+
+
+def budget_text(rec: dict, budget: float, max_moves: int) -> str:
+    """Which budget a "budget" episode ran out of, and its value."""
+    if rec["path_cost"] > budget:
+        return f"path cost {rec['path_cost']:.1f} passed the cost budget of {budget:g}"
+    v = rec.get("verified") or {}
+    counted = rec["moves"] - v.get("moves", 0)
+    extra = f" ({v['moves']} verification moves not counted)" if v.get("moves") else ""
+    return f"{counted} moves reached the move budget of {max_moves} (--max-moves){extra}"
+
+
+def verified_line(rec: dict) -> str:
+    """What the verification confirmed, in words that count what they say."""
+    v = rec["verified"]
+    status = v["status"]
+    if status == "verifying":  # the episode ended before the verification did
+        return (f"{v['mode']}: not finished: the episode ended {rec['outcome']} during verification, after "
+                f"{v['moves']} verification moves (cost {v['cost']:.1f})")  # fmt: skip
+    if status == "not needed":
+        return f"{v['mode']}: not needed (no single pose class was left to verify)"
+    line = f"{v['mode']}: {status}"
+    if "faces" in v:
+        parts, totals = [], []
+        for what in ("faces", "edges", "vertices"):
+            reach = v[f"{what}_reachable"]
+            got = round(v[f"{what}_fraction"] * reach)
+            parts.append(f"{got}/{reach} {what}")
+            totals.append(f"{v[what]}/{v.get(f'{what}_total', '?')}")
+        line += f"; measured of the reachable: {', '.join(parts)} (of all the model's: {', '.join(totals)})"
+    if "pose_residual" in v:
+        line += f"; largest residual {v['pose_residual']:.2f} x its bound ({v['pose_what']})"
+    return line + f"; {v['moves']} verification moves, cost {v['cost']:.1f}"
+
+
+def summary_lines(rec: dict, budget: float | None = None, max_moves: int | None = None) -> list[str]:
+    """The summary ``explore`` prints after an episode. ``budget`` and ``max_moves`` (default: the record's key,
+    else :class:`~haptic.episode.spec.EpisodeSpec`'s defaults) say which budget a "budget" episode ran out of."""
+    from haptic.episode.spec import DEFAULT_BUDGET, DEFAULT_MAX_MOVES
+
+    key = rec.get("key") or {}
+    budget = budget if budget is not None else key.get("budget", DEFAULT_BUDGET)
+    max_moves = max_moves if max_moves is not None else key.get("max_moves", DEFAULT_MAX_MOVES)
+    outcome = f"outcome     {rec['outcome']}"
+    if rec["recognized"]:
+        outcome += f": {rec['recognized']}"
+    if rec["outcome"] == "budget":
+        outcome += f": {budget_text(rec, budget, max_moves)}"
+    outcome += "  [correct]" if rec["correct"] else "  [wrong]" if rec["outcome"] == "recognized" else ""
+    counts = rec["interpretations"]
+    trace = " -> ".join(str(c) for c in counts)
+    if any(b > a for a, b in zip(counts, counts[1:], strict=False)):
+        trace += f"  ({GROWTH_NOTE})"
     lines = [
         f"object      {rec['model']}  (executor {rec['executor']}, policy {rec['policy']}, seed {rec['seed']})",
-        f"outcome     {rec['outcome']}" + (f": {rec['recognized']}" if rec["recognized"] else "")
-        + ("  [correct]" if rec["correct"] else "  [wrong]" if rec["outcome"] == "recognized" else ""),
+        outcome,
         f"moves       {rec['moves']} ({', '.join(rec['move_kinds'][1:]) or 'none'}"
         + (f"; {rec['failed_moves']} failed)" if rec.get("failed_moves") else ")"),
         f"path cost   {rec['path_cost']:.1f} units",
         f"data        {rec['faces']} faces, {rec['edges']} edges, {rec['vertices']} vertices",
-        "interpret.  " + " -> ".join(str(c) for c in rec["interpretations"]),
+        "interpret.  " + trace,
     ]
+    if rec.get("classes") and rec["classes"] != counts:
+        lines.append("pose cl.    " + " -> ".join(str(c) for c in rec["classes"])
+                     + "  (pose classes; the interpretation count where no pose is fixed yet)")  # fmt: skip
     lines.append("verdict     " + verdict_line(rec))
-    v = rec.get("verified")
-    if v:
-        line = f"verified    {v['mode']}: {v['status']}"
-        if "faces" in v:
-            line += (f"; measured {v['faces']}/{v['faces_reachable']} faces, {v['edges']}/{v['edges_reachable']} "
-                     f"edges, {v['vertices']}/{v['vertices_reachable']} vertices (reachable)")  # fmt: skip
-        if "pose_residual" in v:
-            line += f"; largest residual {v['pose_residual']:.2f} x its bound ({v['pose_what']})"
-        lines.append(line + f"; {v['moves']} moves, cost {v['cost']:.1f}")
+    if rec.get("verified"):
+        lines.append("verified    " + verified_line(rec))
     if rec["pose_error_mm"] is not None:
         lines.append(f"pose error  {rec['pose_error_mm']:.3f} mm, {rec['pose_error_deg']:.3f} deg")
     time_line = f"wall time   {rec['wall_time_s']:.2f} s"
@@ -102,39 +217,46 @@ def verdict_line(rec: dict) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    from haptic.episode.spec import EpisodeSpec
+    from haptic.episode.spec import EpisodeSpec, check_settings, cli_option
     from haptic.episode.worlds import run_episode
-    from haptic.geometry import load_library
-    from haptic.geometry.io import atomic_write
-    from haptic.options import check_output_file, report_skipped
-    from haptic.planning.moves import default_moves
+    from haptic.geometry import load_library, resolve_model
+    from haptic.geometry.io import atomic_write, size_warning
+    from haptic.options import check_output_file, report_sizes, report_skipped
 
     # output paths are checked before the episode runs, so that its result cannot be lost at the end
     if args.json:
         check_output_file(args.json, "--json", "out/episode.json")
     if args.record:
         check_output_file(args.record, "--record", "out/episode.rrd", RecordingError)
-    library = load_library(args.models, skip_invalid=args.skip_invalid)
-    report_skipped(args.models, args.skip_invalid)
-    spec = EpisodeSpec(
+    settings = dict(
         model=args.object, seed=args.seed, policy=args.policy, executor=args.executor, noise=args.noise,
         models=args.models, max_moves=args.max_moves, record=args.record, skip_invalid=args.skip_invalid,
-        verify=args.verify,
-        moves=args.moves or default_moves(args.executor),
-    )
-    observer = None
+        verify=args.verify, moves=args.moves, units=args.units,
+    )  # fmt: skip
+    check_settings(settings, cli_option)
+    spec = EpisodeSpec(**settings)
+    library = load_library(args.models, skip_invalid=args.skip_invalid, units=args.units)
+    report_skipped(args.models, args.skip_invalid, args.units)
+    if args.object not in library:  # a model file outside the library
+        report_sizes([size_warning(resolve_model(args.object, library, units=args.units), args.units)])
+    observers = []
+    if args.progress or (not args.quiet and sys.stdout.isatty()):
+        observers.append(MovePrinter().observer())
     recorder = None
     if args.record or args.spawn:
         from haptic.recording import EpisodeRecorder
 
         recorder = EpisodeRecorder(args.record, spawn=args.spawn)
-        observer = recorder.observer()
+        observers.append(recorder.observer())
     try:
+        from haptic.episode.loop import chain_observers
+
+        observer = chain_observers(*observers) if observers else None
         record = run_episode(spec, library=library, observer=observer).to_json()
     finally:
         if recorder is not None:
             recorder.close()
-    for line in summary_lines(record):
+    for line in summary_lines(record, spec.budget, spec.max_moves):
         print(line)
     if args.json:
         try:

@@ -14,6 +14,7 @@ import signal
 import sys
 import tempfile
 import threading
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any, Protocol
 
@@ -28,14 +29,24 @@ class Subcommands(Protocol):
     def add_parser(self, name: str, **kwargs: Any) -> argparse.ArgumentParser: ...
 
 
-def report_skipped(models: str | None, skipped: bool) -> None:
-    """Name on stderr, one line each, the library files ``--skip-invalid`` left out."""
+def report_skipped(models: str | None, skipped: bool, units: str | None = None) -> None:
+    """Name on stderr, one line each, the library files ``--skip-invalid`` left out, and warn of every model
+    whose size suggests misread units."""
+    from haptic.geometry.io import scan_library
+
+    scan = scan_library(models, units=units)
+    report_sizes(scan.size_warnings())
     if not skipped:
         return
-    from haptic.geometry.io import scan_library  # the library scan loads only when files were skipped
-
-    for msg in scan_library(models).errors.values():
+    for msg in scan.errors.values():
         print(f"haptic: skipped invalid model file: {msg}", file=sys.stderr)
+
+
+def report_sizes(warnings: Sequence[str | None]) -> None:
+    """Each size warning (:func:`~haptic.geometry.io.size_warning`) as one line on stderr."""
+    for text in warnings:
+        if text:
+            print(f"haptic: warning: {text}", file=sys.stderr)
 
 
 def int_at_least(low: int):
@@ -81,6 +92,37 @@ def noise_levels(text: str) -> list[float]:
     if not parts or any(not p for p in parts):
         raise argparse.ArgumentTypeError(f"expected comma-separated noise levels, got {text!r}")
     return [noise_level(p) for p in parts]
+
+
+class DefaultsHelpFormatter(argparse.HelpFormatter):
+    """Help that states every option's default: "(default X)" after its text, unless the text already speaks of
+    its default or the option has none (a flag off, an option unset)."""
+
+    def _get_help_string(self, action: argparse.Action) -> str:
+        text = action.help or ""
+        default = action.default
+        if (not action.option_strings or default is None or default is False or default == argparse.SUPPRESS
+                or "(default" in text or text == argparse.SUPPRESS):  # fmt: skip
+            return text
+        if isinstance(default, list | tuple):
+            default = ",".join(f"{x:g}" if isinstance(x, float) else str(x) for x in default)
+        elif isinstance(default, float):
+            default = f"{default:g}"
+        return f"{text} (default {str(default).replace('%', '%%')})"
+
+
+UNITS_HELP = (
+    "units of the model files that declare none: m, cm or mm (default: the library's library.toml, else m; an OBJ "
+    "'# units:' comment or a native model's units come first)"
+)
+"""The ``--units`` option's help, the same on every subcommand."""
+
+
+def add_units_option(parser: argparse.ArgumentParser) -> None:
+    """``--units mm|cm|m`` (:data:`UNITS_HELP`)."""
+    from haptic.geometry.io import UNITS
+
+    parser.add_argument("--units", choices=tuple(UNITS), default=None, help=UNITS_HELP)
 
 
 def check_output_file(path: str | os.PathLike, option: str, example: str, error=HapticError) -> Path:

@@ -54,7 +54,8 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     import ray
 
-    specs = plan_sweep(sorted(load_library(None)), args.episodes, args.seed, args.policy.split(","))
+    specs = plan_sweep(sorted(load_library(None)), args.episodes, args.seed, args.policy.split(","),
+                       verify="none", moves="tracing")
     t0 = time.perf_counter()
     local = list(run_sweep(specs, workers=args.workers))
     local_s = time.perf_counter() - t0

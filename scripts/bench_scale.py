@@ -272,7 +272,8 @@ def main(argv=None) -> int:
         build = _build_times(lib_dir)
         names = sorted(load_library(lib_dir))
         specs = [
-            {"model": s.model, "seed": s.seed, "policy": s.policy, "models": str(lib_dir)}
+            {"model": s.model, "seed": s.seed, "policy": s.policy, "models": str(lib_dir), "verify": "none",
+             "moves": "tracing"}  # the seed's episodes: what this script's figures were measured with
             for s in plan_sweep(names, args.episodes, args.seed, [args.policy])
         ]
         results, wall = _run(specs, args.workers, args.bound, args.max_grouped)

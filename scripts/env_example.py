@@ -45,7 +45,7 @@ def main(argv: list[str] | None = None) -> int:
     env_id = "haptic/Explore-v0" if args.executor == "geometric" else "haptic/ExplorePhysics-v0"
     env = gym.make(env_id, models=args.models, verify=args.verify)
     specs = plan_sweep(sorted(cached_library(args.models)), args.episodes, args.seed, ["planner"],
-                       executor=args.executor, verify=args.verify, models=args.models)  # fmt: skip
+                       executor=args.executor, verify=args.verify, models=args.models, moves="tracing")  # fmt: skip
     rng = np.random.default_rng(args.seed)
     planner = PolicyAgent("planner")
     agents = {

@@ -54,10 +54,10 @@ def test_the_physics_environment_passes_the_gymnasium_checks(small_library):
 
 
 def test_the_planner_through_the_environment_is_the_bench_planner():
-    """Same (model, seed) draws as ``haptic bench --seed 3 --episodes 4 --verify none``: the same path cost per
-    episode, hence the same mean; the rewards add up to it. (``scripts/env_example.py`` compares more episodes,
-    with verification.)"""
-    specs = plan_sweep(sorted(cached_library()), 4, 3, ["planner"], verify="none")
+    """Same (model, seed) draws as ``haptic bench --seed 3 --episodes 4 --verify none --moves tracing``: the same
+    path cost per episode, hence the same mean; the rewards add up to it. (``scripts/env_example.py`` compares more
+    episodes, with verification.)"""
+    specs = plan_sweep(sorted(cached_library()), 4, 3, ["planner"], verify="none", moves="tracing")
     bench = {(r["model"], r["seed"]): r["path_cost"] for r in run_sweep(specs)}
     env, agent = gym.make("haptic/Explore-v0", verify="none"), PolicyAgent("planner")
     costs = []

@@ -108,7 +108,8 @@ def test_the_edge_run_is_half_the_model_edges_the_interpretations_pair_the_data_
 
 @pytest.mark.parametrize(("model", "seed"), [("BOX01", 1), ("PYR01", 3), ("LBLOCK01", 2)])
 def test_with_cheap_probes_the_opening_is_a_face_move_then_probes(model, seed):
-    rec = run_episode(EpisodeSpec(model=model, seed=seed, moves="all"), config=PlannerConfig(costs=CostModel(c_p=0.5)))
+    spec = EpisodeSpec(model=model, seed=seed, moves="all", verify="none")
+    rec = run_episode(spec, config=PlannerConfig(costs=CostModel(c_p=0.5)))
     assert rec.outcome == "recognized" and rec.correct, rec
     assert rec.move_kinds[1:3] == ["face", "probe"], rec.move_kinds
 
@@ -116,8 +117,8 @@ def test_with_cheap_probes_the_opening_is_a_face_move_then_probes(model, seed):
 @pytest.mark.parametrize(("model", "seed"), [("BOX01", 1), ("PYR01", 3), ("LBLOCK01", 2)])
 def test_with_dear_probes_the_opening_is_the_seeds(model, seed):
     cfg = PlannerConfig(costs=CostModel(c_p=50.0))
-    rec = run_episode(EpisodeSpec(model=model, seed=seed, moves="all"), config=cfg)
-    traced = run_episode(EpisodeSpec(model=model, seed=seed, moves="tracing"), config=cfg)
+    rec = run_episode(EpisodeSpec(model=model, seed=seed, moves="all", verify="none"), config=cfg)
+    traced = run_episode(EpisodeSpec(model=model, seed=seed, moves="tracing", verify="none"), config=cfg)
     assert rec.outcome == "recognized" and rec.correct, rec
     assert rec.move_kinds[1:4] == ["face", "edge", "vertex"] == traced.move_kinds[1:4]
     assert rec.cum_cost[:4] == traced.cum_cost[:4]  # the same moves: the opening drew what tracing draws

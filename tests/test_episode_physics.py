@@ -11,7 +11,7 @@ from haptic.episode.worlds import run_episode
 
 
 def test_a_physics_episode_recognises_the_pyramid():
-    rec = run_episode(EpisodeSpec(model="PYR01", seed=1, executor="physics"))
+    rec = run_episode(EpisodeSpec(model="PYR01", seed=1, executor="physics", verify="none"))
     assert rec.outcome == "recognized", rec.detail
     assert rec.recognized == "PYR01" and rec.correct
     assert rec.pose_error_mm < 1.0 and rec.pose_error_deg < 1.0
@@ -25,7 +25,7 @@ def test_a_physics_episode_recognises_the_pyramid():
 def test_touches_past_an_unreachable_edge_tell_the_box_family_apart():
     # BOX01P resting tilted: the moves that separate it from BOX01 and BOX01N all end stepping onto a face
     # leaning under the pad; their touches on the way still rule the look-alikes out
-    rec = run_episode(EpisodeSpec(model="BOX01P", seed=2, executor="physics"))
+    rec = run_episode(EpisodeSpec(model="BOX01P", seed=2, executor="physics", verify="none"))
     assert rec.outcome == "recognized" and rec.correct, rec.detail
     assert rec.failed_moves >= 1
 
@@ -35,7 +35,7 @@ def test_a_slot_against_the_table_shows_as_an_edge_on_the_side():
     # but cannot reach the slot's ceiling; the edge alone tells BOX01N from BOX01
     edge_only = []
     obs = EpisodeObserver(on_move=lambda n, r, count, rec: edge_only.append(r.info.get("next_face") is not None))
-    rec = run_episode(EpisodeSpec(model="BOX01N", seed=3, executor="physics"), observer=obs)
+    rec = run_episode(EpisodeSpec(model="BOX01N", seed=3, executor="physics", verify="none"), observer=obs)
     assert rec.outcome == "recognized" and rec.correct, (rec.outcome, rec.detail)
     assert any(edge_only)
 
@@ -55,7 +55,7 @@ def test_touched_points_lie_on_the_true_surface():
         on_move=lambda n, r, count, rec: seen.append(touched_points(r, cfg)),
         on_failed_move=lambda n, r: seen.append(touched_points(r, cfg)),
     )
-    run_episode(EpisodeSpec(model="BOX01N", seed=1, executor="physics", max_moves=12), observer=obs)
+    run_episode(EpisodeSpec(model="BOX01N", seed=1, executor="physics", max_moves=12, verify="none"), observer=obs)
     pts, nrm = np.concatenate([p for p, _ in seen]), np.concatenate([n for _, n in seen])
     assert len(pts) > 100
     d = touch_distance(truth["model"], truth["pose"], pts, nrm)
@@ -65,7 +65,7 @@ def test_touched_points_lie_on_the_true_surface():
 def test_faces_beside_a_seam_of_the_simulated_pieces_read_true():
     # BOX01P is simulated as convex pieces; at this pose the first two faces are traced next to seams between
     # coplanar pieces, whose edges touch the pad too (noiseless, the normals read 1.5° off before patches)
-    rec = run_episode(EpisodeSpec(model="BOX01P", seed=22, executor="physics", noise=0.0))
+    rec = run_episode(EpisodeSpec(model="BOX01P", seed=22, executor="physics", noise=0.0, verify="none"))
     assert rec.outcome == "recognized" and rec.correct, rec.outcome
     assert rec.perception["face_normal_deg"]["max"] < 0.3, rec.perception["face_normal_deg"]
 

@@ -14,21 +14,22 @@ CHEAP = PlannerConfig(costs=CostModel(c_p=0.5))
 
 @pytest.mark.parametrize(("model", "seed"), [("BOX01", 1), ("LBLOCK01", 2), ("WEDGE01", 1)])
 def test_cheap_probes_are_chosen_and_the_episode_recognises_correctly(model, seed):
-    rec = run_episode(EpisodeSpec(model=model, seed=seed, moves="all"), config=CHEAP)
+    rec = run_episode(EpisodeSpec(model=model, seed=seed, moves="all", verify="none"), config=CHEAP)
     assert rec.outcome == "recognized" and rec.correct, rec
     assert rec.probes >= 1 and rec.move_kinds.count("probe") == rec.probes
     assert rec.move_set == "all" and 0 <= rec.probe_misses <= rec.probes
 
 
 def test_tracing_admits_no_probes_whatever_they_cost():
-    rec = run_episode(EpisodeSpec(model="BOX01", seed=1), config=CHEAP)
+    rec = run_episode(EpisodeSpec(model="BOX01", seed=1, verify="none", moves="tracing"), config=CHEAP)
     assert rec.correct and rec.probes == 0 and "probe" not in rec.move_kinds and rec.move_set == "tracing"
 
 
 def test_random_policy_takes_probes_too():
     kinds = set()
     for seed in range(4):  # until an episode takes one
-        rec = run_episode(EpisodeSpec(model="BOX01", seed=seed, policy="random", moves="all"), config=CHEAP)
+        spec = EpisodeSpec(model="BOX01", seed=seed, policy="random", moves="all", verify="none")
+        rec = run_episode(spec, config=CHEAP)
         kinds |= set(rec.move_kinds)
         if "probe" in kinds:
             break
@@ -57,7 +58,7 @@ def test_probes_are_admitted_on_the_simulated_hand():
 @pytest.mark.parametrize(("model", "seed"), [("BOX01", 1), ("WEDGE01", 1), ("LBLOCK01", 2), ("TETRA01L", 3)])
 @pytest.mark.parametrize("policy", ["planner", "greedy", "random"])
 def test_probes_alone_recognise_correctly(model, seed, policy):
-    rec = run_episode(EpisodeSpec(model=model, seed=seed, policy=policy, moves="probing"))
+    rec = run_episode(EpisodeSpec(model=model, seed=seed, policy=policy, moves="probing", verify="none"))
     assert rec.outcome == "recognized" and rec.correct, rec
     assert rec.move_set == "probing" and set(rec.move_kinds[1:]) == {"probe"}  # [0]: the start
     assert rec.probes == rec.moves and rec.probes >= 2
@@ -69,7 +70,7 @@ def test_probes_alone_on_the_look_alike_library():
     models = "assets/libraries/lookalike"
     lib = cached_library(models)
     for name in sorted(lib)[:2]:
-        rec = run_episode(EpisodeSpec(model=name, seed=0, moves="probing", models=models), lib)
+        rec = run_episode(EpisodeSpec(model=name, seed=0, moves="probing", models=models, verify="none"), lib)
         assert rec.outcome == "recognized" and rec.correct, rec
 
 
@@ -112,7 +113,7 @@ def test_a_failed_probe_is_not_tried_again_and_tracing_moves_follow_it():
     from haptic.planning.move_scores import same_move
     from haptic.planning.moves import MoveResult
 
-    episode = build_episode(EpisodeSpec(model="BOX01", seed=1, moves="all"), config=CHEAP)
+    episode = build_episode(EpisodeSpec(model="BOX01", seed=1, moves="all", verify="none"), config=CHEAP)
     inner = episode.executor
     kinds, lines = [], []
 

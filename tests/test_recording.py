@@ -14,8 +14,9 @@ from haptic.episode.loop import EpisodeObserver, EpisodeRecord
 from haptic.episode.spec import EpisodeSpec
 from haptic.episode.worlds import run_episode
 from haptic.recording import EpisodeRecorder, RecordingError, load_recording
+from haptic.recording.drawing import UNSCORED
 
-SPEC = EpisodeSpec(model="WEDGE01", seed=3, policy="planner")
+SPEC = EpisodeSpec(model="WEDGE01", seed=3, policy="planner", verify="none", moves="tracing")
 
 
 def _count(values: list | None) -> int:
@@ -113,7 +114,7 @@ def test_recording_reads_back_with_rerun(recorded):
     _, tables = ents["decision/scores"].series("TextDocument:text")
     decided = [t[0] for t in tables if "chose" in t[0]]
     assert len(decided) == len(record.decision_times_s), "one candidate table per decision, kept"
-    assert all("| move | score |" in t or "fallback" in t for t in decided)
+    assert all("| move | score |" in t or UNSCORED in t for t in decided)
     assert ents["log/episode"].series("TextLog:text")[1][0][0].startswith(record.outcome)
 
     # the blueprint: the object view's eye on the object, opening on the move timeline (no physics traces)
@@ -224,7 +225,8 @@ def test_physics_trace_and_hand_links_are_recorded(tmp_path):
 def physics_recorded(tmp_path_factory) -> tuple[Path, EpisodeRecord]:
     out = tmp_path_factory.mktemp("phys") / "physics.rrd"
     with EpisodeRecorder(out) as recorder:
-        record = run_episode(EpisodeSpec(model="PYR01", seed=1, executor="physics"), observer=recorder.observer())
+        spec = EpisodeSpec(model="PYR01", seed=1, executor="physics", verify="none")
+        record = run_episode(spec, observer=recorder.observer())
     return out, record
 
 
@@ -481,7 +483,7 @@ def test_probes_are_drawn_hits_and_misses_apart(tmp_path):
 def test_candidate_probes_are_named_as_probes(tmp_path):
     out = tmp_path / "all.rrd"
     recorder = EpisodeRecorder(out)
-    record = run_episode(EpisodeSpec(model="WEDGE01", seed=1, moves="all"), observer=recorder.observer())
+    record = run_episode(EpisodeSpec(model="WEDGE01", seed=1, moves="all", verify="none"), observer=recorder.observer())
     recorder.close()
     assert record.probes >= 1
     ents = load_recording(out)
@@ -493,3 +495,16 @@ def test_candidate_probes_are_named_as_probes(tmp_path):
     assert all(re.search(r"\| probe \([+-]\d\.\d\d, [+-]\d\.\d\d, [+-]\d\.\d\d\) \d+ cm", t) for t in chosen)
     _, lines = ents["world/decision/probes"].series("LineStrips3D:strips")
     assert lines and all(1 <= len(ls) <= 5 for ls in lines)
+
+
+def test_a_decision_without_candidates_says_what_it_was():
+    from haptic.planning.scoring import Decision
+
+    from haptic.planning.moves import FaceMove
+    from haptic.recording.drawing import _decision_table, decision_summary
+
+    move = FaceMove(direction=np.array([1.0, 0.0, 0.0]))
+    line = decision_summary(3, Decision(move), "face +x")
+    assert line == f"move 3: chose face +x ({UNSCORED})"
+    assert "among 0" not in line and "fallback" not in line
+    assert UNSCORED in _decision_table(3, Decision(move))

@@ -20,8 +20,10 @@ EXIT_SIGINT, EXIT_SIGTERM = 130, 143
 
 
 def add_parser(sub: Subcommands) -> None:
+    from haptic.bench import DEFAULT_EPISODES, DEFAULT_NOISES, DEFAULT_OUT, DEFAULT_POLICIES
+    from haptic.episode.spec import DEFAULT_EXECUTOR, DEFAULT_MAX_MOVES, DEFAULT_SEED, EXECUTORS
     from haptic.matching.acceptance import DEFAULT_VERIFY, VERIFY_MODES
-    from haptic.options import noise_levels, positive_int, seed_int
+    from haptic.options import add_units_option, noise_levels, positive_int, seed_int
     from haptic.planning.moves import DEFAULT_MOVES, HAND_DEFAULT_MOVES, MOVE_SETS
     from haptic.planning.registry import POLICY_NAMES
 
@@ -31,24 +33,30 @@ def add_parser(sub: Subcommands) -> None:
         description="Models x random poses x noise levels x policies. Every policy runs on the same "
         "(model, pose) draws. Appends to OUT (JSON lines, one per episode as it ends, each with its episode's "
         "key) and writes, from the whole of OUT, OUT with .md (summary table) and .png (pose classes remaining "
-        "vs path cost), at the end and on interrupt (exit 130 on SIGINT, 143 on SIGTERM).",
+        "vs path cost), at the end and on interrupt (exit 130 on SIGINT, 143 on SIGTERM). Prints a few columns "
+        "per policy on stdout; the .md has them all.",
     )
     p.add_argument("--models", metavar="DIR", help="library directory (default: the shipped assets/models)")
+    add_units_option(p)
     p.add_argument(
         "--skip-invalid", action="store_true", help="use the library's valid models when some files are bad"
     )
-    p.add_argument("--executor", choices=("geometric", "physics"), default="geometric")
+    p.add_argument("--executor", choices=EXECUTORS, default=DEFAULT_EXECUTOR,
+                   help="geometric: the ideal sensor with noise (fast); physics: the simulated hand in MuJoCo")
     p.add_argument(
-        "--policy", default="planner,random", help=f"comma-separated policies from {', '.join(POLICY_NAMES)}"
+        "--policy", default=",".join(DEFAULT_POLICIES),
+        help=f"comma-separated policies from {', '.join(POLICY_NAMES)}, each run on the same draws",
     )
-    p.add_argument("--episodes", type=positive_int, default=50, help="random (model, pose) draws (default 50)")
-    p.add_argument("--seed", type=seed_int, default=0, help="seed of the sweep's draws (an integer >= 0)")
+    p.add_argument("--episodes", type=positive_int, default=DEFAULT_EPISODES, help="random (model, pose) draws")
+    p.add_argument("--seed", type=seed_int, default=DEFAULT_SEED, help="seed of the sweep's draws (an integer >= 0)")
     p.add_argument(
-        "--noise", type=noise_levels, default="1", help="comma-separated sensor-noise levels (x default sigma, 0 to 10)"
+        "--noise", type=noise_levels, default=list(DEFAULT_NOISES),
+        help="comma-separated sensor-noise levels (x the sensor model's sigma, 0 to 10)",
     )
     p.add_argument(
         "--verify", choices=VERIFY_MODES, default=DEFAULT_VERIFY,
-        help=f"verification before recognition (default {DEFAULT_VERIFY}): none, fast or full",
+        help="verification before recognition: none, fast (pose check; every face and edge measured) or full "
+        "(also every vertex)",
     )
     p.add_argument(
         "--moves", choices=MOVE_SETS, default=None,
@@ -57,12 +65,15 @@ def add_parser(sub: Subcommands) -> None:
         "(free-space probes alone, geometric executor; a verification traces too) or all (both, one "
         "planner ranking them)",
     )  # fmt: skip
-    p.add_argument("--out", default="out/bench/results.jsonl", help="results file (JSON lines)")
+    p.add_argument("--out", default=DEFAULT_OUT, help="results file (JSON lines)")
     p.add_argument("--workers", type=positive_int, default=1,
                    help="worker processes (local backend); CPUs of a Ray started here (ray backend)")
     p.add_argument("--backend", choices=("local", "ray"), default="local",
-                   help="ray: the cluster named by RAY_ADDRESS, else a Ray started on this machine")
-    p.add_argument("--max-moves", type=positive_int, default=40)
+                   help="local: processes of this machine; ray: the cluster named by RAY_ADDRESS, else a Ray "
+                   "started on this machine")
+    p.add_argument("--max-moves", type=positive_int, default=DEFAULT_MAX_MOVES,
+                   help="move budget of each episode: it ends as 'budget' after this many moves (verification "
+                   "moves not counted)")
     again = p.add_mutually_exclusive_group()
     again.add_argument("--resume", action="store_true",
                        help="keep OUT's episodes and run only those of the sweep not in it yet")
@@ -79,9 +90,9 @@ def run(args: argparse.Namespace) -> int:
 def _run(args: argparse.Namespace, held: DeferredInterrupts) -> int:
     from haptic.bench.results import ResultsWriter, drop_partial_line, iter_results
     from haptic.bench.runner import episode_key, key_id, plan_sweep, ray_available
+    from haptic.episode.spec import check_settings, cli_option
     from haptic.geometry import load_library
     from haptic.options import check_output_file, report_skipped
-    from haptic.planning.moves import default_moves
     from haptic.planning.registry import POLICY_NAMES
 
     # Everything is checked before any episode runs or any file is touched.
@@ -95,14 +106,14 @@ def _run(args: argparse.Namespace, held: DeferredInterrupts) -> int:
     summaries = [out.with_suffix(".md")] + ([] if args.no_plot else [out.with_suffix(".png")])
     for path in summaries:
         check_output_file(path, "--out (its summary beside it)", "out/bench/results.jsonl", BenchError)
-    library = load_library(args.models, skip_invalid=args.skip_invalid)
-    report_skipped(args.models, args.skip_invalid)
-    specs = plan_sweep(
-        sorted(library), args.episodes, args.seed, policies, args.noise,
+    common = dict(
         executor=args.executor, models=args.models, max_moves=args.max_moves, skip_invalid=args.skip_invalid,
-        verify=args.verify,
-        moves=args.moves or default_moves(args.executor),
-    )
+        verify=args.verify, moves=args.moves, units=args.units,
+    )  # fmt: skip
+    check_settings(common, cli_option)
+    library = load_library(args.models, skip_invalid=args.skip_invalid, units=args.units)
+    report_skipped(args.models, args.skip_invalid, args.units)
+    specs = plan_sweep(sorted(library), args.episodes, args.seed, policies, args.noise, **common)
     has_results = out.is_file() and out.stat().st_size > 0
     if has_results and not (args.resume or args.force):
         raise BenchError(
@@ -180,16 +191,17 @@ def _sweep(specs, args: argparse.Namespace, writer) -> None:
 def _write_summary(out: Path, no_plot: bool, quiet: bool = False) -> None:
     """The summary table and the plot, from every record of ``out``, each written atomically."""
     from haptic.bench.results import read_results
-    from haptic.bench.summary import markdown_table, plot_interpretations_vs_cost, summary_rows
+    from haptic.bench.summary import compact_table, markdown_table, plot_interpretations_vs_cost, summary_rows
     from haptic.geometry.io import atomic_write
 
     records = read_results(out) if out.exists() else []
     probing = any(r.get("move_set", "tracing") != "tracing" for r in records)  # a column only where it tells
     keys = ("library", "executor", "noise", "verify", *(("move_set",) if probing else ()), "policy")
-    table = markdown_table(summary_rows(records, keys))
-    atomic_write(out.with_suffix(".md"), table)
+    rows = summary_rows(records, keys)
+    atomic_write(out.with_suffix(".md"), markdown_table(rows))
     if not quiet:
-        print(table, end="")
+        print(compact_table(rows), end="")
+        print(f"table: {out.with_suffix('.md')} (every column)")
     if not no_plot and records:
         libraries = sorted({str(r.get("library")) for r in records})
         png = plot_interpretations_vs_cost(records, out.with_suffix(".png"), title=f"{', '.join(libraries)} library")

@@ -17,9 +17,10 @@ from pathlib import Path
 
 import numpy as np
 
-from haptic.episode.spec import EpisodeSpec
+from haptic.episode.spec import LEGACY_DEFAULTS, EpisodeSpec
 from haptic.episode.worlds import run_episode
 from haptic.errors import BenchError
+from haptic.geometry.io import default_units
 from haptic.options import DeferredInterrupts
 
 
@@ -62,16 +63,21 @@ def library_name(models: str | os.PathLike | None) -> str:
 
 
 def episode_key(spec: EpisodeSpec) -> dict:
-    """What defines an episode's result: the library's name and every field of ``spec`` not in KEY_EXCLUDED."""
+    """What defines an episode's result: the library's name and every field of ``spec`` not in KEY_EXCLUDED,
+    with ``units`` the units the library's files that declare none are read in (``spec.units``, else the
+    library's ``library.toml``, else "m"): a library read in other units is another library."""
     key: dict = {"library": library_name(spec.models)}
     key.update({f.name: getattr(spec, f.name) for f in fields(EpisodeSpec) if f.name not in KEY_EXCLUDED})
+    key["units"] = default_units(spec.models, spec.units)
     return key
 
 
 def key_id(key: dict) -> str:
     """The canonical text of a key (for comparing keys). A field missing from a key written before that
-    field existed takes :class:`EpisodeSpec`'s default."""
+    field existed takes the value episodes were run with then (:data:`~haptic.episode.spec.LEGACY_DEFAULTS`,
+    else :class:`EpisodeSpec`'s default)."""
     full = {f.name: f.default for f in fields(EpisodeSpec) if f.name not in KEY_EXCLUDED and f.default is not MISSING}
+    full.update(LEGACY_DEFAULTS)
     full.update(key)
     return json.dumps(full, sort_keys=True, separators=(",", ":"))
 

@@ -106,6 +106,31 @@ def markdown_table(rows: Sequence[dict]) -> str:
     return "\n".join(lines) + "\n"
 
 
+def compact_table(rows: Sequence[dict]) -> str:
+    """The summary rows in a few columns for a terminal: the settings that differ between rows (the policy
+    always), episodes, correct, wrong (model or pose), other endings, and the mean path cost and moves of the
+    recognised episodes. The markdown table (:func:`markdown_table`) has the rest."""
+    if not rows:
+        return "(no episodes)\n"
+    keys = [k for k in rows[0] if k in ("library", "executor", "noise", "verify", "move_set", "model")
+            and len({str(r[k]) for r in rows}) > 1] + ["policy"]  # fmt: skip
+    head = [*keys, "episodes", "correct", "wrong", "other", "mean cost", "mean moves"]
+    body = []
+    for r in rows:
+        other = r["ambiguous"] + r["no_match"] + r["budget"] + r["failed"]
+        body.append([*(str(r[k]) for k in keys), str(r["episodes"]), f"{r['correct']} ({r['correct_pct']:.0f}%)",
+                     str(r["wrong_model"] + r["wrong_pose"]), str(other), f"{r['cost_mean']:.1f}",
+                     f"{r['moves_mean']:.1f}"])  # fmt: skip
+    widths = [max(len(x) for x in col) for col in zip(head, *body, strict=True)]
+    n_keys = len(keys)
+
+    def line(cells: Sequence[str]) -> str:
+        return "  ".join(c.ljust(w) if i < n_keys else c.rjust(w)
+                         for i, (c, w) in enumerate(zip(cells, widths, strict=True))).rstrip()  # fmt: skip
+
+    return "\n".join([line(head), *(line(b) for b in body)]) + "\n"
+
+
 def plot_interpretations_vs_cost(records: Sequence[dict], path: str | os.PathLike, title: str = "") -> Path:
     """Median pose classes remaining against cumulative path cost, one curve per policy (and library).
 

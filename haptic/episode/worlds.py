@@ -81,9 +81,10 @@ def _setup(
     """What every world starts from: the library (loaded once per process unless given), the true model, and
     the one split of the episode's seed into the generators of the pose, the executor, the policy and the
     simulator (children 0-3 of ``SeedSequence(spec.seed)``; a world uses those it needs)."""
-    library = library if library is not None else cached_library(spec.models, skip_invalid=spec.skip_invalid)
+    if library is None:
+        library = cached_library(spec.models, skip_invalid=spec.skip_invalid, units=spec.units)
     rngs = [np.random.default_rng(s) for s in np.random.SeedSequence(spec.seed).spawn(4)]
-    return library, resolve_model(spec.model, library), rngs
+    return library, resolve_model(spec.model, library, units=spec.units), rngs
 
 
 class GeometricWorld:

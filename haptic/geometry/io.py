@@ -27,8 +27,13 @@ FORMAT_VERSION = 1
 DEFAULT_LIBRARY = Path(__file__).resolve().parents[2] / "assets" / "models"
 
 
-def load_model(path: str | os.PathLike, name: str | None = None) -> Polyhedron:
-    """Load and validate one model file; its name is the file stem unless given."""
+def load_model(path: str | os.PathLike, name: str | None = None, units: str | None = None) -> Polyhedron:
+    """Load and validate one model file; its name is the file stem unless given.
+
+    Lengths are read in the units the file declares (an OBJ ``# units:`` comment, a native model's ``units``),
+    else in ``units`` ("mm", "cm" or "m"), else in those its folder's ``library.toml`` declares, else in metres
+    (:func:`default_units`).
+    """
     path = Path(path)
     name = name or path.stem
     if not path.exists():
@@ -40,15 +45,96 @@ def load_model(path: str | os.PathLike, name: str | None = None) -> Polyhedron:
         raise ModelError(f"{path}: unknown model file extension {path.suffix!r}; valid: {', '.join(MODEL_SUFFIXES)}")
     if path.stat().st_size == 0:
         raise ModelError(f"{path}: the file is empty")
+    scale = UNITS[default_units(path.parent, units)]
     if suffix == NATIVE_SUFFIX:
-        return _load_native(path, name)
+        return _load_native(path, name, scale)
     if suffix == ".obj":
-        return _load_obj(path, name)
-    return _load_mesh(path, name)
+        return _load_obj(path, name, scale)
+    return _load_mesh(path, name, scale)
 
 
 UNITS = {"m": 1.0, "cm": 1e-2, "mm": 1e-3}
 """Length units a model file may declare, in metres."""
+LIBRARY_FILE = "library.toml"
+"""A library folder's declaration file: ``units = "mm"`` applies to every model file in the folder that does not
+declare its own units."""
+
+
+def check_units(units: str | None, option: str = "units=") -> str | None:
+    """``units`` when it is None or one of :data:`UNITS`, else a :class:`ModelError` naming ``option`` (how the
+    caller spells the setting: ``units=`` from Python, ``--units`` on the command line) and the valid values."""
+    if units is None or units in UNITS:
+        return units
+    raise ModelError(f"{option}{units!r} is not a length unit; valid: {', '.join(UNITS)}")
+
+
+def library_units(directory: str | os.PathLike | None) -> str | None:
+    """The units a library folder's ``library.toml`` declares (None: no file, or no ``units`` in it).
+
+    Raises :class:`ModelError` naming the file when it is not TOML or declares units other than :data:`UNITS`.
+    """
+    import tomllib
+
+    path = Path(directory or DEFAULT_LIBRARY) / LIBRARY_FILE
+    if not path.is_file():
+        return None
+    try:
+        doc = tomllib.loads(path.read_text())
+    except (UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
+        raise ModelError(f"{path}: not valid TOML ({exc}); write for example: units = \"mm\"") from None
+    units = doc.get("units")
+    if units is not None and units not in UNITS:
+        raise ModelError(f"{path}: units = {units!r} is not a length unit; valid: {', '.join(repr(u) for u in UNITS)}")
+    return units
+
+
+def default_units(directory: str | os.PathLike | None, units: str | None = None) -> str:
+    """The units of the model files of ``directory`` that declare none: ``units`` when given (``--units``), else
+    the folder's ``library.toml`` (:func:`library_units`), else metres."""
+    return check_units(units) or library_units(directory) or "m"
+
+
+SIZE_RANGE = (0.005, 1.0)
+"""Sizes across [m] outside which a model more likely had its units misread than is meant at that size."""
+
+
+def size_warning(model: Polyhedron, units: str | None = None) -> str | None:
+    """A one-line warning when ``model`` (loaded with ``units``, see :func:`load_model`) is larger or smaller across
+    than :data:`SIZE_RANGE`, naming its file and the units that would make its size plausible; None otherwise."""
+    across = float(np.ptp(model.vertices, axis=0).max()) if model.n_vertices else 0.0
+    lo, hi = SIZE_RANGE
+    if lo <= across <= hi or not model.source:
+        return None
+    path = Path(model.source)
+    read = file_units(path) or default_units(path.parent, units)
+    raw = across / UNITS[read]  # the file's own numbers
+    fits = [u for u, s in UNITS.items() if lo <= raw * s <= hi and u != read]
+    what = "larger" if across > hi else "smaller"
+    msg = f"{path}: {across * 1e3:.6g} mm across, {what} than a graspable object ({lo * 1e3:g} mm to {hi:g} m)"
+    if not fits:
+        return msg
+    best = min(fits, key=lambda u: abs(np.log(raw * UNITS[u] / 0.1)))
+    if file_units(path):
+        return msg + f"; its file declares {read}: did it mean {best}?"
+    return msg + f"; did you mean --units {best} (or units = \"{best}\" in {LIBRARY_FILE})?"
+
+
+def file_units(path: Path) -> str | None:
+    """The units a model file declares itself (an OBJ ``# units:`` comment, a native model's ``units``), or None."""
+    suffix = path.suffix.lower()
+    try:
+        if suffix == NATIVE_SUFFIX:
+            units = json.loads(path.read_text()).get("units")
+            return units if units in UNITS else None
+        if suffix == ".obj":
+            for line in path.read_text().splitlines():
+                if line.lstrip().startswith("#"):
+                    declared = _obj_units(line.strip())
+                    if declared is not None and declared > 0:
+                        return next(u for u, s in UNITS.items() if s == declared)
+    except (OSError, UnicodeDecodeError, ValueError, AttributeError):
+        return None
+    return None
 
 
 def text_quantum(tokens: list[str]) -> float:
@@ -83,7 +169,7 @@ def _source_precision(quantum: float, vertices: np.ndarray) -> float:
     return min(float(quantum), 1e-4 * size)
 
 
-def _load_native(path: Path, name: str) -> Polyhedron:
+def _load_native(path: Path, name: str, default_scale: float = 1.0) -> Polyhedron:
     tokens: list[str] = []
 
     def number(tok: str) -> float:
@@ -98,7 +184,7 @@ def _load_native(path: Path, name: str) -> Polyhedron:
         raise ModelError(f"{path}: a native model is a JSON object with 'vertices' and 'faces' lists")
     if not isinstance(doc["faces"], list):
         raise ModelError(f"{path}: 'faces' must be a list of vertex-index lists")
-    scale = UNITS.get(doc.get("units", "m"))
+    scale = UNITS.get(doc["units"]) if "units" in doc else default_scale
     if scale is None:
         raise ModelError(f"{path}: unknown units {doc.get('units')!r}; valid: {', '.join(UNITS)}")
     try:
@@ -118,17 +204,17 @@ def _obj_units(line: str) -> float | None:
     return None
 
 
-def _load_obj(path: Path, name: str) -> Polyhedron:
+def _load_obj(path: Path, name: str, default_scale: float = 1.0) -> Polyhedron:
     """Wavefront OBJ read directly, so that polygonal faces (convex or not) keep their loops.
 
-    A comment ``# units: mm`` (or ``cm``, ``m``) declares the units; metres otherwise. Vertices keep their
-    file numbers (1-based) in messages.
+    A comment ``# units: mm`` (or ``cm``, ``m``) declares the units; ``default_scale`` [m per file unit]
+    otherwise. Vertices keep their file numbers (1-based) in messages.
     """
     vertices: list[list[float]] = []
     loops: list[list[int]] = []
     face_lines: list[int] = []
     tokens: list[str] = []
-    scale = 1.0
+    scale = default_scale
     try:
         text = path.read_text()
     except UnicodeDecodeError:
@@ -244,7 +330,8 @@ def _mesh_precision(path: Path, vertices: np.ndarray) -> float:
     return _source_precision(FLOAT32_QUANTUM * float(np.abs(vertices).max(initial=0.0)), vertices)
 
 
-def _load_mesh(path: Path, name: str) -> Polyhedron:
+def _load_mesh(path: Path, name: str, scale: float = 1.0) -> Polyhedron:
+    """STL or PLY through trimesh; these formats declare no units: ``scale`` [m per file unit] applies."""
     import trimesh
 
     try:
@@ -253,7 +340,7 @@ def _load_mesh(path: Path, name: str) -> Polyhedron:
         raise ModelError(f"{path}: cannot read as a mesh ({type(exc).__name__}: {exc})") from None
     if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
         raise ModelError(f"{path}: the file holds no triangles")
-    vertices = np.asarray(mesh.vertices, dtype=float)
+    vertices = np.asarray(mesh.vertices, dtype=float) * scale
     if not np.isfinite(vertices).all():
         bad = int(np.flatnonzero(~np.isfinite(vertices).all(axis=1))[0])
         raise ModelError(f"{path}: vertex {bad} has a non-finite coordinate {vertices[bad].tolist()}")
@@ -497,15 +584,34 @@ class LibraryScan:
     """Every valid model, by name (file stem)."""
     errors: dict[Path, str]
     """Every bad model file, with its one-line error message."""
+    units: str = "m"
+    """The units of the files that declare none (:func:`default_units`)."""
+
+    def size_warnings(self) -> list[str]:
+        """A :func:`size_warning` for every model whose size across suggests misread units."""
+        return [w for m in self.models.values() if (w := size_warning(m, self.units)) is not None]
 
 
 _SCANS: dict[tuple, LibraryScan] = {}
 
 
-def scan_library(directory: str | os.PathLike | None = None, progress: bool = False) -> LibraryScan:
+def library_stamp(directory: str | os.PathLike | None = None) -> tuple:
+    """What a library's models depend on: its directory, and the name, size and modification time of each of its
+    model files and of its ``library.toml`` (the models are loaded again when any of them changes)."""
+    where = Path(directory or DEFAULT_LIBRARY)
+    files = model_files(where)
+    decl = where / LIBRARY_FILE
+    extra = [decl] if decl.is_file() else []
+    return (str(where.resolve()), *((f.name, st.st_mtime_ns, st.st_size) for f in files + extra for st in (f.stat(),)))
+
+
+def scan_library(
+    directory: str | os.PathLike | None = None, progress: bool = False, units: str | None = None
+) -> LibraryScan:
     """Import every model file of a library directory (default: the shipped ``assets/models``), keeping the
-    valid models and the error of each bad file. A bar on stderr shows the import when ``progress`` is set
-    (and stderr is a terminal).
+    valid models and the error of each bad file. ``units``: those of the files that declare none (else the
+    library's ``library.toml``, else metres; see :func:`load_model`). A bar on stderr shows the import when
+    ``progress`` is set (and stderr is a terminal).
 
     The scan is remembered per process while no file of the directory changes (models are immutable).
     """
@@ -513,7 +619,8 @@ def scan_library(directory: str | os.PathLike | None = None, progress: bool = Fa
     files = model_files(where)
     if not files:
         raise ModelError(f"{where}: the library holds no model files ({', '.join(MODEL_SUFFIXES)})")
-    stamp = (str(where.resolve()), tuple((f.name, f.stat().st_mtime_ns, f.stat().st_size) for f in files))
+    read_in = default_units(where, units)
+    stamp = (read_in, *library_stamp(where))
     if stamp in _SCANS:
         return _SCANS[stamp]
     models: dict[str, Polyhedron] = {}
@@ -528,22 +635,25 @@ def scan_library(directory: str | os.PathLike | None = None, progress: bool = Fa
             errors[f] = f"{f}: model name {f.stem!r} is used by two files in the library"
             continue
         try:
-            models[f.stem] = load_model(f)
+            models[f.stem] = load_model(f, units=read_in)
         except ModelError as exc:
             errors[f] = str(exc)
-    scan = LibraryScan(where, models, errors)
+    scan = LibraryScan(where, models, errors, read_in)
     _SCANS.clear()  # one library is in use at a time; keep memory flat
     _SCANS[stamp] = scan
     return scan
 
 
-def load_library(directory: str | os.PathLike | None = None, skip_invalid: bool = False) -> dict[str, Polyhedron]:
-    """Every model of a library directory (default: the shipped ``assets/models``), by name.
+def load_library(
+    directory: str | os.PathLike | None = None, skip_invalid: bool = False, units: str | None = None
+) -> dict[str, Polyhedron]:
+    """Every model of a library directory (default: the shipped ``assets/models``), by name; ``units`` as in
+    :func:`scan_library`.
 
     A library with bad files is refused, naming every bad file and why, unless ``skip_invalid``: then the valid
     models are returned (and the caller says which files were skipped, from :func:`scan_library`).
     """
-    scan = scan_library(directory)
+    scan = scan_library(directory, units=units)
     if scan.errors and not skip_invalid:
         n = len(scan.errors)
         raise ModelError(
@@ -556,13 +666,14 @@ def load_library(directory: str | os.PathLike | None = None, skip_invalid: bool 
     return dict(scan.models)
 
 
-def resolve_model(spec: str, library: dict[str, Polyhedron] | None = None) -> Polyhedron:
-    """A model by library name, or by path to a model file (which need not be in the library)."""
+def resolve_model(spec: str, library: dict[str, Polyhedron] | None = None, units: str | None = None) -> Polyhedron:
+    """A model by library name, or by path to a model file (which need not be in the library; read in
+    ``units`` as :func:`load_model` says)."""
     if library is not None and spec in library:
         return library[spec]
     p = Path(spec)
     if p.suffix.lower() in MODEL_SUFFIXES or p.exists():
-        return load_model(p)
+        return load_model(p, units=units)
     names = ", ".join(sorted(library)) if library else "(empty library)"
     raise ModelError(f"unknown model {spec!r}: not a file and not in the library; valid names: {names}")
 

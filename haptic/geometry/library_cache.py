@@ -9,9 +9,8 @@ from __future__ import annotations
 
 import os
 from collections import OrderedDict
-from pathlib import Path
 
-from haptic.geometry.io import DEFAULT_LIBRARY, load_library, model_files
+from haptic.geometry.io import default_units, library_stamp, load_library
 from haptic.geometry.polyhedron import Polyhedron
 
 CACHE_SIZE = 4
@@ -19,16 +18,17 @@ CACHE_SIZE = 4
 _CACHE: OrderedDict[tuple, dict[str, Polyhedron]] = OrderedDict()
 
 
-def cached_library(directory: str | os.PathLike | None = None, skip_invalid: bool = False) -> dict[str, Polyhedron]:
-    """:func:`~haptic.geometry.io.load_library`, from this process's cache when the files are unchanged.
+def cached_library(
+    directory: str | os.PathLike | None = None, skip_invalid: bool = False, units: str | None = None
+) -> dict[str, Polyhedron]:
+    """:func:`~haptic.geometry.io.load_library`, from this process's cache when the files (and the units they
+    are read in) are unchanged.
 
     Returns a new dict each time (of the same, immutable, models)."""
-    d = Path(directory or DEFAULT_LIBRARY).resolve()
-    files = model_files(d)
-    key = (str(d), skip_invalid, *((f.name, st.st_size, st.st_mtime_ns) for f in files for st in (f.stat(),)))
+    key = (skip_invalid, default_units(directory, units), *library_stamp(directory))
     lib = _CACHE.get(key)
     if lib is None:
-        lib = load_library(directory, skip_invalid=skip_invalid)
+        lib = load_library(directory, skip_invalid=skip_invalid, units=units)
         _CACHE[key] = lib
         while len(_CACHE) > CACHE_SIZE:
             _CACHE.popitem(last=False)

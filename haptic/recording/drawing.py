@@ -221,12 +221,24 @@ def _bar(r: float, width: int = 20) -> str:
     return "`" + "=" * n + " " * (width - n) + "`"
 
 
+UNSCORED = ("a random admissible move, none scored: fewer than two pose hypotheses were left to tell apart (or "
+            "the verification had no move for what it lacks), or the policy is random")
+"""What a decision without scored candidates was, in words."""
+
+
+def decision_summary(i: int, decision: Decision, name: str) -> str:
+    """One line for a decision: the move chosen (named ``name``) and among how many scored candidates, or
+    :data:`UNSCORED`."""
+    n = len(decision.candidates)
+    return f"move {i}: chose {name} " + (f"among {n} scored candidates" if n else f"({UNSCORED})")
+
+
 def decision_table(i: int, decision: Decision) -> str:
     """Markdown: the decision's candidate moves, best first, with a bar of their score against the best."""
     cands = sorted(decision.candidates, key=lambda c: -c.score if math.isfinite(c.score) else math.inf)
     head = f"**move {i}**: chose **{move_name(decision.move)}**"
     if not cands:
-        return head + " (no scored candidates: the fallback policy)"
+        return head + f" ({UNSCORED})"
     best = max((float(c.score) for c in cands if math.isfinite(c.score)), default=0.0)
     rows = [head + f" among {len(cands)} candidates", "",
             "| move | score | | exp. cost | exp. eliminated |", "|---|---|---|--:|--:|"]  # fmt: skip

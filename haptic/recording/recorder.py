@@ -25,6 +25,7 @@ from haptic.recording.blueprint import Framing, default_blueprint
 from haptic.recording.drawing import (
     chain_index,
     contacts,
+    decision_summary,
     decision_table,
     entity_name,
     geom_archetypes,
@@ -520,7 +521,7 @@ class EpisodeRecorder:
         rec.log(
             "log/decisions",
             rr.TextLog(
-                f"move {i}: chose {move_name(decision.move)} among {len(cands)} candidates"
+                decision_summary(i, decision, move_name(decision.move))
                 + ("\n" + "\n".join(lines) if lines else ""),
                 level=rr.TextLogLevel.INFO,
             ),

@@ -186,14 +186,15 @@ def scene_object_from_polyhedron(poly) -> SceneObject:
     return scene_object_from_parts(poly.name, parts)
 
 
-def load_object(name: str, models_dir: str | os.PathLike | None = None) -> SceneObject:
-    """The library model ``name`` (or a model file path) as a :class:`SceneObject`.
+def load_object(name: str, models_dir: str | os.PathLike | None = None, units: str | None = None) -> SceneObject:
+    """The library model ``name`` (or a model file path) as a :class:`SceneObject`; ``units``: those of the
+    files that declare none (:func:`~haptic.geometry.io.load_model`).
 
     Raises :class:`SceneError` naming the valid model names when ``name`` is unknown.
     """
     try:
-        library = load_library(models_dir)
-        poly = resolve_model(name, library)
+        library = load_library(models_dir, units=units)
+        poly = resolve_model(name, library, units=units)
     except HapticError as exc:
         raise SceneError(f"cannot load object {name!r}: {exc}") from exc
     return scene_object_from_polyhedron(poly)

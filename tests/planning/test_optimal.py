@@ -33,7 +33,7 @@ class Recording(PlannerPolicy):
 
 def _contexts(n_episodes=6):
     out = []
-    for spec in plan_sweep(SMALL, n_episodes, seed=3, policies=["planner"]):
+    for spec in plan_sweep(SMALL, n_episodes, seed=3, policies=["planner"], verify="none", moves="tracing"):
         pol = Recording()
         run_episode(spec, library=LIB, policy=pol)
         out += [c for c in pol.contexts if 2 <= len(c.hypotheses) <= 30]
@@ -54,7 +54,7 @@ def test_search_never_expects_more_than_following_the_planner():
 
 
 def test_optimal_recognizes_and_is_no_costlier_than_the_planner_on_small_library():
-    specs = plan_sweep(SMALL, 6, seed=7, policies=["planner", "optimal"])
+    specs = plan_sweep(SMALL, 6, seed=7, policies=["planner", "optimal"], verify="none", moves="tracing")
     cost = {"planner": [], "optimal": []}
     for s in specs:
         r = run_episode(s, library=LIB)
@@ -67,7 +67,7 @@ def test_optimal_recognizes_and_is_no_costlier_than_the_planner_on_small_library
 def test_optimal_is_deterministic_and_named():
     # the default search (two moves deep, then planner roll-outs) on four of the models: a decision costs a tenth
     lib = {k: LIB[k] for k in ("BOX01", "WEDGE01", "PYR01", "TETRA01L")}
-    spec = EpisodeSpec(model="WEDGE01", seed=4, policy="optimal")
+    spec = EpisodeSpec(model="WEDGE01", seed=4, policy="optimal", verify="none", moves="tracing")
     a, b = (run_episode(spec, library=lib).to_json() for _ in range(2))
     assert a["decision_times_s"]  # a move was decided, not only the opening
     for r in (a, b):

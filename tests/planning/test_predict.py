@@ -11,6 +11,8 @@ from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import CostModel
 from haptic.planning.predict import candidate_moves, predict_one
 
+SEED_EPISODE = {"verify": "none", "moves": "tracing"}
+"""The seed's episodes: tracing moves, recognition without verification."""
 LIB = load_library()
 
 
@@ -79,7 +81,7 @@ def test_predicted_eliminations_agree_with_the_matcher():
     P.PlannerPolicy.choose = checking
     try:
         for name, seed in (("BOX01", 1), ("WEDGE01", 2), ("BOX01N", 3)):
-            run_episode(EpisodeSpec(model=name, seed=seed, policy="planner"), library=LIB)
+            run_episode(EpisodeSpec(model=name, seed=seed, policy="planner", **SEED_EPISODE), library=LIB)
     finally:
         P.PlannerPolicy.choose = original
     assert total > 500

@@ -25,7 +25,9 @@ def test_scene_export(tmp_path, capsys):
 
 
 def test_scene_unknown_object_is_one_line_on_stderr(tmp_path, capsys):
-    assert _run(["scene", "--object", "NOPE", "--export", str(tmp_path / "scene.xml")]) == 1
+    from haptic.cli import main
+
+    assert main(["scene", "--object", "NOPE", "--export", str(tmp_path / "scene.xml")]) == 1
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "valid names" in err
+    assert err.count("\n") == 1 and "valid names" in err and err.startswith("haptic: error: ")
     assert not (tmp_path / "scene.xml").exists()
