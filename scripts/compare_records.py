@@ -2,7 +2,8 @@
 
     .venv/bin/python scripts/compare_records.py BEFORE AFTER [--fields outcome,moves,path_cost]
 
-BEFORE and AFTER are ``haptic bench`` results (``.jsonl``, keyed by each record's ``key``) or a JSON list of
+BEFORE and AFTER are ``haptic bench`` results (``.jsonl``, keyed by each record's ``key``, a field missing from an
+older key read as the value episodes were run with then: ``haptic.bench.runner.key_id``) or a JSON list of
 records (``scripts/physics_episodes.py --json``, keyed by model, seed and policy). Episodes in only one of
 the files are counted apart (a sweep still running). Prints every difference and a summary line; exit 1 when an
 episode in both differs.
@@ -22,10 +23,14 @@ def load(path: str) -> dict[str, dict]:
         records = [json.loads(line) for line in text.splitlines() if line.strip()]
     else:
         records = json.loads(text)
+    from haptic.bench.runner import key_id
+
     out = {}
     for r in records:
-        key = r["key"] if "key" in r else {"model": r["model"], "seed": r["seed"], "policy": r.get("policy")}
-        out[json.dumps(key, sort_keys=True)] = r
+        if "key" in r:
+            out[key_id(r["key"])] = r
+        else:
+            out[json.dumps({"model": r["model"], "seed": r["seed"], "policy": r.get("policy")}, sort_keys=True)] = r
     return out
 
 

@@ -305,7 +305,7 @@ def test_an_error_of_the_driver_at_a_decision_point_ends_the_episode_as_failed()
     def refuse(point):
         raise PlanningError("the agent has no move")
 
-    record = drive(steps(EpisodeSpec("LBLOCK01", seed=7, noise=0.5)), refuse)
+    record = drive(steps(EpisodeSpec("LBLOCK01", seed=7, noise=0.5, verify="none", moves="tracing")), refuse)
     assert record.outcome == "failed" and record.detail == "no move: the agent has no move"
     assert record.moves >= 3 and record.decision_times_s == []  # the opening's moves, then the refusal
 

@@ -498,13 +498,12 @@ def test_candidate_probes_are_named_as_probes(tmp_path):
 
 
 def test_a_decision_without_candidates_says_what_it_was():
-    from haptic.planning.scoring import Decision
-
+    from haptic.planning.move_scores import Decision
     from haptic.planning.moves import FaceMove
-    from haptic.recording.drawing import _decision_table, decision_summary
+    from haptic.recording.drawing import decision_summary, decision_table
 
     move = FaceMove(direction=np.array([1.0, 0.0, 0.0]))
     line = decision_summary(3, Decision(move), "face +x")
     assert line == f"move 3: chose face +x ({UNSCORED})"
     assert "among 0" not in line and "fallback" not in line
-    assert UNSCORED in _decision_table(3, Decision(move))
+    assert UNSCORED in decision_table(3, Decision(move))

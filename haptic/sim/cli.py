@@ -57,14 +57,3 @@ def run(args: argparse.Namespace) -> int:
         path = export_scene(scene, args.export)
         print(f"wrote {path}")
     return 0
-
-
-def main(argv: list[str] | None = None) -> int:
-    """Stand-alone entry point (``python -m haptic.sim.cli scene ...``): ``haptic``'s own."""
-    from haptic.cli import main as haptic_main
-
-    return haptic_main(argv)
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())
