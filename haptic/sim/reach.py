@@ -34,6 +34,9 @@ from haptic.sim.scene import (
     ComposedScene,
 )
 
+MM = 1000.0
+"""Millimetres per metre, for messages."""
+
 
 class ReachFailure(StrEnum):
     """Why a set of fingertip targets cannot be reached. A ``str``: records and messages show the value."""
@@ -91,6 +94,10 @@ class ReachSettings:
     """Weight of the approach direction against the position (1)."""
     damping: float = 1e-3
     """Levenberg-Marquardt damping of the QP."""
+    approach_damping: float = 1e-2
+    """Levenberg-Marquardt damping of an approach task (bounds the step when the finger points against it)."""
+    at_limit: float = 1e-3
+    """A joint this close to a limit counts as held there [rad]."""
     reach_margin: float = 0.95
     """Targets farther from the shoulder than this fraction of the arm's and finger's stretched length are
     outside the workspace before any solving."""
@@ -231,8 +238,8 @@ class ReachSolver:
             i = far[0]
             dist = float(np.linalg.norm(points[i] - self._shoulder))
             return self._answer(q0, q0[None], targets, ReachFailure.WORKSPACE, 0,
-                                f"{fingers[i]} target {dist * 1000:.0f} mm from the shoulder, more than the arm's "
-                                f"reach ({s.reach_margin * self._stretch * 1000:.0f} mm)")  # fmt: skip
+                                f"{fingers[i]} target {dist * MM:.0f} mm from the shoulder, more than the arm's "
+                                f"reach ({s.reach_margin * self._stretch * MM:.0f} mm)")  # fmt: skip
 
         cfg = self.configuration
         cfg.update(q0)
@@ -244,7 +251,7 @@ class ReachSolver:
             if t.approach_in_world is not None:
                 a = np.asarray(t.approach_in_world, dtype=float)
                 align = mink.AxisAlignTask(self._site[t.finger], "site", axis=_finger_axis(t.finger),
-                                           cost=s.approach_cost, lm_damping=1e-2)  # fmt: skip
+                                           cost=s.approach_cost, lm_damping=s.approach_damping)  # fmt: skip
                 align.set_target(a / np.linalg.norm(a))
                 tasks.append(align)
         posture = mink.PostureTask(self.model, cost=s.posture_cost)
@@ -346,13 +353,13 @@ class ReachSolver:
         on_object = self._distance(rest, self._object_geoms) if self._object_geoms else 1.0
         if np.all(pos_err < s.position_tol) and np.all(app_err < s.approach_tol):
             if table < 0.0:
-                return ReachFailure.TABLE, f"the hand would touch the table ({-table * 1000:.2f} mm into it)"
+                return ReachFailure.TABLE, f"the hand would touch the table ({-table * MM:.2f} mm into it)"
             if on_object < 0.0:
-                return ReachFailure.OBJECT, f"the hand would touch the object ({-on_object * 1000:.2f} mm into it)"
+                return ReachFailure.OBJECT, f"the hand would touch the object ({-on_object * MM:.2f} mm into it)"
             return None, ""
         worst = int(np.argmax(pos_err / s.position_tol + app_err / s.approach_tol))
         t = targets[worst]
-        miss = f"{t.finger} {pos_err[worst] * 1000:.1f} mm from its target, {np.rad2deg(app_err[worst]):.0f}° off"
+        miss = f"{t.finger} {pos_err[worst] * MM:.1f} mm from its target, {np.rad2deg(app_err[worst]):.0f}° off"
         if blocked is not None:
             return blocked, f"{miss}: the next step would enter {blocked}"
         if table < s.clearance + s.position_tol:
@@ -360,7 +367,7 @@ class ReachSolver:
         if on_object < s.clearance + s.position_tol:
             return ReachFailure.OBJECT, f"{miss}: the hand is held off the object"
         lo, hi = self.model.jnt_range[:, 0], self.model.jnt_range[:, 1]
-        at = np.flatnonzero((q - lo < 1e-3) | (hi - q < 1e-3))
+        at = np.flatnonzero((q - lo < s.at_limit) | (hi - q < s.at_limit))
         if len(at):
             names = [mujoco.mj_id2name(self.model, mujoco.mjtObj.mjOBJ_JOINT, int(j)) for j in at]
             return ReachFailure.JOINT_LIMIT, f"{miss}: at the limit of {', '.join(n.split('/')[-1] for n in names)}"
