@@ -21,6 +21,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import re
 import sys
 import time
 from collections import Counter
@@ -81,19 +82,31 @@ def one(model: str, seed: int, policy: str, moves: str = "tracing", verify: str 
     failed (``probes_failed``) and why (``probe_failures``), and with ``probe_costs`` their predicted and
     actual costs (``probe_costs``, :class:`ProbeCosts`)."""
     failed: list[str] = []
+    kinds: list[tuple[str, bool]] = []
+    reasons: list[tuple[str, str]] = []
+
+    def on_move(n, result, *rest) -> None:
+        if n > 0 and result.move is not None:  # the start is no move
+            kinds.append((result.move.kind, True))
 
     def on_failed(n, result) -> None:
-        if result.move is not None and result.move.kind == "probe":
-            failed.append(f"{result.status}: {result.reason or result.info.get('reason', '')}")
+        if result.move is None:
+            return
+        why = result.reason or result.info.get("reason", "") or str(result.status)
+        kinds.append((result.move.kind, False))
+        reasons.append((result.move.kind, why))
+        if result.move.kind == "probe":
+            failed.append(f"{result.status}: {why}")
 
     watch = ProbeCosts(make_policy(policy)) if probe_costs else None
     try:
         spec = EpisodeSpec(model=model, seed=seed, policy=policy, executor="physics", moves=moves, verify=verify)
-        obs = chain_observers(EpisodeObserver(on_failed_move=on_failed), watch.observer() if watch else None)
+        mine = EpisodeObserver(on_move=on_move, on_failed_move=on_failed)
+        obs = chain_observers(mine, watch.observer() if watch else None)
         rec = run_episode(spec, observer=obs, policy=watch).to_json()
     except HapticError as exc:
         return {"model": model, "seed": seed, "outcome": "error", "correct": False, "detail": str(exc)}
-    rec.update(probes_failed=len(failed), probe_failures=failed)
+    rec.update(probes_failed=len(failed), probe_failures=failed, move_results=kinds, failure_reasons=reasons)
     if watch is not None:
         rec["probe_costs"] = watch.rows
     return rec
@@ -134,6 +147,25 @@ def _print_probe_costs(records: list[dict]) -> None:
         print(f"probes carried out {len(a)}: actual − predicted (for the outcome) mean {a.mean():+.2f}, "
               f"mean |·| {np.abs(a).mean():.2f}, range {a.min():+.2f} … {a.max():+.2f}; actual − expected mean "
               f"{e.mean():+.2f}, range {e.min():+.2f} … {e.max():+.2f} [units]")  # fmt: skip
+
+
+def reason_class(reason: str) -> str:
+    """A failure's reason without its figures, so that like failures count together."""
+    return re.sub(r"-?\d+(\.\d+)?", "#", reason).split("; no edge from the roll")[0]
+
+
+def print_moves(records: list[dict]) -> None:
+    """Move success by kind, then the failed moves by reason (most frequent first)."""
+    kinds = Counter((k, ok) for r in records for k, ok in r.get("move_results", []))
+    print()
+    print("moves by kind: " + ", ".join(
+        f"{k} {kinds[(k, True)]}/{kinds[(k, True)] + kinds[(k, False)]} "
+        f"({100 * kinds[(k, True)] / max(1, kinds[(k, True)] + kinds[(k, False)]):.0f} %)"
+        for k in ("face", "edge", "vertex", "probe") if kinds[(k, True)] + kinds[(k, False)]))  # fmt: skip
+    why = Counter((k, reason_class(w)) for r in records for k, w in r.get("failure_reasons", []))
+    print(f"failed moves by reason ({sum(why.values())}):")
+    for (k, w), n in why.most_common():
+        print(f"  {n:>4}  {k:<6} {w}")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -196,6 +228,7 @@ def main(argv: list[str] | None = None) -> int:
     print(f"correct {len(good)}/{len(records)}, wrong recognitions {wrong_total}; outcomes: "
           f"{', '.join(f'{k} {v}' for k, v in sorted(outcomes.items()))}; median wall time to recognition "
           f"{_f(float(np.median(walls)) if walls else None)} s; total {time.perf_counter() - t0:.0f} s")  # fmt: skip
+    print_moves(records)
     if args.probe_costs:
         _print_probe_costs(records)
     if args.json:

@@ -146,6 +146,13 @@ class PhysicsSettings:
     roll_lead_rows: int = 8
     """The last rows of a trace on a face before a roll count with the roll (for the edge between) [-]."""
     stroke_headings: int = 4
+    reacquire_turns: tuple[float, ...] = tuple(math.radians(a) for a in (90.0, 60.0, 120.0, 40.0, 140.0))
+    """A crossing that lost the next face (contact lost, the roll's limit, too few contacts on it) touches it
+    afresh, lifted off: at these guessed turns of its normal about the edge, the roll's own last normal first [rad]."""
+    reacquire_inset: float = 0.005
+    """... at a point this far from the edge on the guessed face [m] ..."""
+    reacquire_cone: float = math.radians(12.0)
+    """... skipping a guess within this of one tried [rad]."""
     """An L stroke for a face's normal is tried in up to this many headings, a quarter turn apart."""
     approach_slack: float = 0.01
     """Start: a pad more than this below the approach height lifts straight up first [m]."""
@@ -345,7 +352,23 @@ class PhysicsExecutor(LandingSearch):
         if (near is None and self.on_face == fid and t.contact[1] is not None
                 and angle(t.normal, n) < self.bounds.resting_cone):  # fmt: skip
             return "ok"
-        target = self._faces[fid].anchor if near is None else near
+        if near is not None:
+            targets = [near]
+        else:  # where it last touched the face, else the middle of what it touched of it
+            fd = self._faces[fid]
+            middle = fd.points.mean(axis=0)
+            targets = [fd.anchor, middle - float((middle - fd.anchor) @ n) * n]
+        status = "unreachable"
+        for target in targets:
+            status = self._touch_face(fid, n, target, pieces)
+            if status == "ok" or status == "unstable":
+                break
+        return status
+
+    def _touch_face(self, fid: int, n: np.ndarray, target: np.ndarray, pieces: list[PrimitiveResult]) -> str:
+        """Lift off and touch data face ``fid`` (normal ``n``) at ``target``; "ok", or a failure with the reason
+        in ``self._why``."""
+        t = self.toucher
         if self.workspace.pad_clearance(target, n) < self.settings.pad_clearance:
             self._why = "the touch would put the pad on the table"
             return "unreachable"
@@ -368,13 +391,17 @@ class PhysicsExecutor(LandingSearch):
         t = self.toucher
         if kind == "concave" and self.workspace.touching_table(self._finger_contacts()):
             return "unreachable", "the finger met the table", None, None, None
+        corner = self.contact_point()
         r = t.cross_edge(kind, n_a, direction)
         pieces.append(r)
         if not r.ok:
             if r.event == "undercut":
                 return "undercut", f"crossing the {kind} edge: the next face leans under, out of the pad's reach", \
                     r.trace, None, None
-            return r.status, f"crossing the {kind} edge: {r.event}", None, None, None
+            if r.status == "unstable":
+                return r.status, f"crossing the {kind} edge: {r.event}", None, None, None
+            return self._reacquire(kind, n_a, direction, corner, r.trace, None, pieces, away_from,
+                                   f"crossing the {kind} edge: {r.event}")  # fmt: skip
         n_b = r.info["normal"]
         if self.workspace.is_table(n_b, t.contact[2]):
             return "unreachable", "the edge lies on the table", None, None, None
@@ -383,12 +410,63 @@ class PhysicsExecutor(LandingSearch):
             along = -along
         st = t.stroke(n_b, r.info["away"], along)
         pieces.append(st)
-        if not st.ok:
-            return st.status, f"stroke on the next face failed: {st.event}", None, None, None
-        fit = self.segmenter.fit_face_trace(st.trace, st.info["normal"])
+        fit = self.segmenter.fit_face_trace(st.trace, st.info["normal"]) if st.ok else None
         if fit is None:
-            return "unreachable", "too few contacts on the next face", None, None, None
+            why = f"stroke on the next face failed: {st.event}" if not st.ok else "too few contacts on the next face"
+            if st.status == "unstable":
+                return st.status, why, None, None, None
+            return self._reacquire(kind, n_a, direction, corner, r.trace, n_b, pieces, away_from, why)
         return "ok", "", r.trace, st.trace, fit
+
+    def _reacquire(self, kind: str, n_a: np.ndarray, direction: np.ndarray, corner: np.ndarray, roll: ContactTrace,
+                   n_roll: np.ndarray | None, pieces: list[PrimitiveResult], away_from, why: str):  # fmt: skip
+        """The next face after a crossing that lost it (``why``): lifted off, touch it afresh a little past the
+        edge at ``corner``, its normal guessed as turned about the edge (the roll's settled normal ``n_roll``
+        first, then :attr:`PhysicsSettings.reacquire_turns`); a touched normal that turned about the edge is the
+        next face's, and an L stroke on it measures it. Returns what :meth:`_cross_and_acquire` returns; the
+        failure ``why`` when no guess gives the face."""
+        t, s, seg = self.toucher, self.settings, self.segmenter
+        d = in_plane(np.asarray(direction, dtype=float), n_a)
+        if d is None:
+            return "unreachable", why, None, None, None
+        e = unit(np.cross(n_a, d))
+        sign = 1.0 if kind == "convex" else -1.0
+        guesses = [] if n_roll is None else [unit(n_roll - float(n_roll @ e) * e)]
+        guesses += [math.cos(a) * n_a + sign * math.sin(a) * d for a in s.reacquire_turns]
+        floor = TABLE_TOP_Z + t.pad_radius + s.table_margin
+        tried: list[np.ndarray] = []
+        for n_b in guesses:
+            if any(angle(n_b, m) < s.reacquire_cone for m in tried):
+                continue
+            tried.append(n_b)
+            away_b = unit(np.cross(e, n_b))  # on the next face, away from the edge: down past a convex one
+            if sign * float(away_b @ n_a) > 0:
+                away_b = -away_b
+            target = corner + s.reacquire_inset * away_b
+            if self.workspace.pad_clearance(target, n_b) < s.pad_clearance:
+                continue
+            r = t.lift_and_approach(target, n_b, floor_z=floor)
+            pieces.append(r)
+            if not r.ok:
+                continue
+            n = r.info["normal"]
+            # a face past the edge: turned from n_a toward the travel (a convex edge met at a slant turns it about
+            # another axis than n_a x d; the edge's line then comes from the two planes)
+            if sign * float(n @ d) <= 0 or angle(n, n_a) < seg.bounds.min_edge_angle:
+                continue
+            if self.workspace.is_table(n, t.contact[2]):
+                return "unreachable", "the edge lies on the table", None, None, None
+            e_n = unit(np.cross(n_a, n))
+            away = unit(np.cross(n, e_n))
+            if float(away @ (t.tip - corner)) < 0:
+                away = -away
+            along = e_n if away_from is None or float((t.tip - away_from) @ e_n) >= 0 else -e_n
+            st = t.stroke(n, away, along)
+            pieces.append(st)
+            fit = seg.fit_face_trace(st.trace, st.info["normal"]) if st.ok else None
+            if fit is not None:
+                return "ok", "", roll, st.trace, fit
+        return "unreachable", why, None, None, None
 
     def _face_move(self, move: FaceMove, pieces: list[PrimitiveResult]) -> MoveResult:
         st, t, seg = self.state, self.toucher, self.segmenter
@@ -500,6 +578,25 @@ class PhysicsExecutor(LandingSearch):
         toward_a = rec.inward.get(fa, np.zeros(3)) - rec.inward.get(fb, np.zeros(3))
         return rec, n_a, n_b, toward_a
 
+    def _return_next_to_edge(self, rec, u: np.ndarray, face: int, pieces: list[PrimitiveResult]) -> str:
+        """Put the pad on a face of edge ``rec`` next to it, before following it along ``u``: on the current
+        face ``face`` when it is one of the edge's, else on the other; when that touch fails, on the other face."""
+        s, seg = self.settings, self.segmenter
+        first = face if face in rec.faces else rec.faces[1]
+        s0 = rec.param(self.contact_point())
+        status, why = "unreachable", "the edge next to the table is out of the pad's reach"
+        for fid in (first, *(f for f in rec.faces if f != first and f in rec.inward)):
+            n = seg.faces[fid].component.normal
+            near = self.workspace.reentry_point(rec, n, rec.inward[fid], s0, u, s.edge_reentry, s.reentry)
+            if near is None:
+                continue
+            status = self._ensure_on_face(fid, pieces, near=near)
+            if status in ("ok", "unstable"):
+                return status
+            why = f"could not return next to the edge: {self._why}"
+        self._why = why
+        return status
+
     def _edge_move(self, move: EdgeMove, pieces: list[PrimitiveResult]) -> MoveResult:
         st, t, seg, s = self.state, self.toucher, self.segmenter, self.settings
         if st.edge is None:
@@ -517,15 +614,9 @@ class PhysicsExecutor(LandingSearch):
             angle(t.normal, seg.faces[f].component.normal) < self.bounds.face_cone for f in rec.faces
         )
         if self.on_face not in rec.faces or self._line_distance(rec, t.tip) > s.edge_reach or not on_clean:
-            fid = st.face if st.face in rec.faces else rec.faces[1]
-            near = self.workspace.reentry_point(rec, seg.faces[fid].component.normal, rec.inward[fid],
-                                                rec.param(self.contact_point()), u, s.edge_reentry,
-                                                s.reentry)  # fmt: skip
-            if near is None:
-                return self.failed_result(move, "unreachable", "the edge next to the table is out of the pad's reach")
-            status = self._ensure_on_face(fid, pieces, near=near)
+            status = self._return_next_to_edge(rec, u, st.face, pieces)
             if status != "ok":
-                return self.failed_result(move, status, f"could not return next to the edge: {self._why}")
+                return self.failed_result(move, status, self._why)
         acq = t.follow_edge(u, n_a, n_b, toward_a, 0.0, acquire_only=True)
         pieces.append(acq)
         if not acq.ok:

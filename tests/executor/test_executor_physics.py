@@ -265,3 +265,44 @@ def test_a_vertex_move_whose_next_face_leans_under_fails_as_unreachable(monkeypa
     assert not r.ok
     assert r.status == "unreachable"
     assert "leans under" in r.reason and "MoveStatus" not in r.reason
+
+
+@pytest.mark.parametrize("failure", ["lost", "few contacts"])
+def test_a_face_move_whose_crossing_loses_the_next_face_touches_it_afresh(monkeypatch, failure):
+    """A roll over the edge that loses contact, or a stroke on the next face with too few contacts, does not
+    fail the face move: the hand lifts off and touches the next face a little past the edge at guessed turns
+    about it, and reports the edge and the next face within their bounds -- the same as an undisturbed move."""
+    from haptic.executor.primitives import PrimitiveResult
+    from haptic.matching.trace import empty_trace
+
+    poly, sim = _setup("BOX01", 3)
+    ex = PhysicsExecutor(RobotInterface(sim), rng=np.random.default_rng(3))
+    assert ex.start().ok
+    calls = {"n": 0}
+    if failure == "lost":
+        lost = PrimitiveResult("no-contact", "lost", empty_trace(), 0.0)
+        monkeypatch.setattr(ex.toucher, "cross_edge", lambda *a, **k: calls.__setitem__("n", calls["n"] + 1) or lost)
+    else:
+        real = ex.segmenter.fit_face_trace
+
+        def first_too_few(*a, **k):
+            calls["n"] += 1
+            return None if calls["n"] == 1 else real(*a, **k)
+
+        monkeypatch.setattr(ex.segmenter, "fit_face_trace", first_too_few)
+    rng = np.random.default_rng(4)
+    for _ in range(FACE_DIRECTIONS):
+        r = ex.execute(ex.admissible_moves(rng, 1)[0])
+        if calls["n"]:  # the move that met the edge, and the failure
+            break
+    assert calls["n"] >= 1
+    assert r.ok, r.reason
+    assert [c.kind for c in r.components] == ["edge", "face"]
+    truth = SE3.from_matrix(sim.ground_truth().world_from_object)
+    score = score_components(ex.components, poly, truth, [r])
+    assert score.spurious == 0 and score.missed == 0
+    face = r.components[1]
+    assert np.radians(score.errors("face", "angle")).max() < face.normal_bound
+    edge = r.components[0]
+    assert score.errors("edge", "position").max() < 2.0
+    assert edge.kind == "edge"
