@@ -334,6 +334,8 @@ def test_the_endings_are_checked_failed_in_a_row_first():
     assert failed_in_a_row(ending_view(failed_in_a_row=MAX_FAILED_MOVES - 1), SPEC) is None
     end = failed_in_a_row(ending_view(failed_in_a_row=MAX_FAILED_MOVES, last_failure="no-contact"), SPEC)
     assert end == Ending("failed", f"{MAX_FAILED_MOVES} failed moves in a row (last: no-contact)")
+    # a verification is bounded by its own stall rule: failed moves in a row do not end it
+    assert failed_in_a_row(ending_view(failed_in_a_row=MAX_FAILED_MOVES + 3, verifying=True), SPEC) is None
 
 
 def test_the_verdict_ends_on_a_final_recognition_and_waits_for_the_verifier_when_verifying():

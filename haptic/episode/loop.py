@@ -282,8 +282,11 @@ class Ending:
 
 
 def failed_in_a_row(view: EpisodeState, spec: EpisodeSpec) -> Ending | None:
-    """Failed: :data:`MAX_FAILED_MOVES` moves failed in a row."""
-    if view.failed_in_a_row < MAX_FAILED_MOVES:
+    """Failed: :data:`MAX_FAILED_MOVES` moves failed in a row -- while recognising. A verification is bounded by
+    its own rule instead (:data:`~haptic.planning.verify.STALL_MOVES` moves that measure nothing missing end it
+    as incomplete, saying what was not measured): each failed verification move is one it does not ask again from
+    there, and the next may measure what it needs."""
+    if view.failed_in_a_row < MAX_FAILED_MOVES or view.verifying:
         return None
     return Ending("failed", f"{view.failed_in_a_row} failed moves in a row (last: {view.last_failure})")
 

@@ -398,7 +398,7 @@ class PhysicsExecutor(LandingSearch):
             if r.event == "undercut":
                 return "undercut", f"crossing the {kind} edge: the next face leans under, out of the pad's reach", \
                     r.trace, None, None
-            if r.status == "unstable":
+            if r.event != "lost":  # the roll went on turning (limit), or the state is bad: nothing to touch afresh
                 return r.status, f"crossing the {kind} edge: {r.event}", None, None, None
             return self._reacquire(kind, n_a, direction, corner, r.trace, None, pieces, away_from,
                                    f"crossing the {kind} edge: {r.event}")  # fmt: skip
@@ -439,6 +439,8 @@ class PhysicsExecutor(LandingSearch):
             if any(angle(n_b, m) < s.reacquire_cone for m in tried):
                 continue
             tried.append(n_b)
+            if float(n_b[2]) < -math.sin(t.config.max_undercut):  # a face leaning under: not from above
+                continue
             away_b = unit(np.cross(e, n_b))  # on the next face, away from the edge: down past a convex one
             if sign * float(away_b @ n_a) > 0:
                 away_b = -away_b
