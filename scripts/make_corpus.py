@@ -2,6 +2,10 @@
 
     python scripts/make_corpus.py out/corpus            # out/corpus/{obj6,objmm3,stl,objtri}/ + manifest.json
     python scripts/make_corpus.py out/corpus --check    # also import each file: V/E/F and symmetry order
+    python scripts/make_corpus.py out/sized --sizes 30:150 --encodings obj6   # each solid at a drawn size
+
+``--sizes MIN:MAX`` scales each solid so that its largest extent is drawn uniformly from MIN to MAX mm (seeded),
+for exploring objects of many sizes on the hand; the formulas' counts do not change.
 
 The table printed by ``--check`` counts, per family and encoding, the files whose V/E/F (and symmetry order)
 match the formula, out of the total. Exit 1 when any does not.
@@ -14,9 +18,22 @@ import sys
 import time
 from collections import defaultdict
 
+import numpy as np
+
 from haptic.errors import HapticError
-from haptic.geometry import load_model, symmetry_group
+from haptic.geometry import Polyhedron, load_model, symmetry_group
 from haptic.geometry.corpus import ENCODINGS, corpus_solids, write_corpus
+
+
+def sized(solids, lo: float, hi: float, rng: np.random.Generator):
+    """Each solid scaled about its centroid so that its largest extent is drawn uniformly from ``lo`` to ``hi`` [m]."""
+    out = []
+    for spec, poly in solids:
+        extent = float(np.ptp(poly.vertices, axis=0).max())
+        k = rng.uniform(lo, hi) / extent
+        c = poly.centroid
+        out.append((spec, Polyhedron.from_faces(c + k * (poly.vertices - c), poly.faces, name=poly.name)))
+    return out
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -24,9 +41,24 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("out", help="directory to write the corpus into")
     ap.add_argument("--seed", type=int, default=0, help="seed of the poses and random hulls (default 0)")
     ap.add_argument("--check", action="store_true", help="import every file and compare with the formula")
+    ap.add_argument("--sizes", default=None, metavar="MIN:MAX",
+                    help="scale each solid to a largest extent drawn from MIN to MAX mm (default: as the formulas)")
+    ap.add_argument("--encodings", default=",".join(ENCODINGS), help=f"comma-separated, of {', '.join(ENCODINGS)}")
     args = ap.parse_args(argv)
+    encodings = tuple(e for e in args.encodings.split(",") if e)
+    bad = [e for e in encodings if e not in ENCODINGS]
+    if bad or not encodings:
+        ap.error(f"--encodings: {', '.join(bad) or 'none given'}; valid: {', '.join(ENCODINGS)}")
     solids = corpus_solids(seed=args.seed)
-    dirs = write_corpus(args.out, seed=args.seed, solids=solids)
+    if args.sizes:
+        try:
+            lo, hi = (float(x) for x in args.sizes.split(":"))
+        except ValueError:
+            ap.error(f"--sizes: expected MIN:MAX in mm (e.g. 30:150), got {args.sizes!r}")
+        if not 0 < lo <= hi:
+            ap.error(f"--sizes: expected 0 < MIN <= MAX, got {args.sizes!r}")
+        solids = sized(solids, lo / 1000.0, hi / 1000.0, np.random.default_rng(args.seed))
+    dirs = write_corpus(args.out, seed=args.seed, solids=solids, encodings=encodings)
     print(f"{len(solids)} solids x {len(dirs)} encodings written under {args.out}")
     if not args.check:
         return 0

@@ -33,6 +33,7 @@ from haptic.episode.loop import EpisodeObserver, chain_observers
 from haptic.episode.spec import EpisodeSpec
 from haptic.episode.worlds import run_episode
 from haptic.errors import HapticError
+from haptic.geometry import load_library
 from haptic.geometry.io import atomic_write
 from haptic.planning.efficiency import class_weights
 from haptic.planning.move_scores import bounded, predict_probe_moves
@@ -77,7 +78,7 @@ class ProbeCosts:
 
 
 def one(model: str, seed: int, policy: str, moves: str = "tracing", verify: str = "none",
-        probe_costs: bool = False) -> dict:  # fmt: skip
+        probe_costs: bool = False, models: str | None = None) -> dict:  # fmt: skip
     """One physics episode's record as JSON (an ``error`` entry when it could not run), with the probes that
     failed (``probes_failed``) and why (``probe_failures``), and with ``probe_costs`` their predicted and
     actual costs (``probe_costs``, :class:`ProbeCosts`)."""
@@ -100,7 +101,8 @@ def one(model: str, seed: int, policy: str, moves: str = "tracing", verify: str 
 
     watch = ProbeCosts(make_policy(policy)) if probe_costs else None
     try:
-        spec = EpisodeSpec(model=model, seed=seed, policy=policy, executor="physics", moves=moves, verify=verify)
+        spec = EpisodeSpec(model=model, seed=seed, policy=policy, executor="physics", moves=moves, verify=verify,
+                           models=models)  # fmt: skip
         mine = EpisodeObserver(on_move=on_move, on_failed_move=on_failed)
         obs = chain_observers(mine, watch.observer() if watch else None)
         rec = run_episode(spec, observer=obs, policy=watch).to_json()
@@ -172,7 +174,9 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--poses", type=int, default=3, help="random resting poses (episodes) per object")
     ap.add_argument("--first-seed", type=int, default=1)
-    ap.add_argument("--objects", default=",".join(SEED_OBJECTS))
+    ap.add_argument("--objects", default=None,
+                    help="comma-separated model names (default: the seed objects, or every model of --models)")
+    ap.add_argument("--models", default=None, metavar="DIR", help="library directory (default: the shipped one)")
     ap.add_argument("--policy", default="planner")
     ap.add_argument("--moves", default="tracing", choices=("tracing", "all"), help="admissible kinds of move")
     ap.add_argument("--probe-costs", action="store_true",
@@ -183,8 +187,16 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--json", default=None, help="write every episode record here")
     args = ap.parse_args(argv)
 
-    objects = [o for o in args.objects.split(",") if o]
-    jobs = [(o, args.first_seed + k, args.policy, args.moves, args.verify, args.probe_costs)
+    if args.objects:
+        objects = [o for o in args.objects.split(",") if o]
+    elif args.models:
+        try:
+            objects = sorted(load_library(args.models))
+        except HapticError as exc:
+            ap.error(str(exc))
+    else:
+        objects = list(SEED_OBJECTS)
+    jobs = [(o, args.first_seed + k, args.policy, args.moves, args.verify, args.probe_costs, args.models)
             for o in objects for k in range(args.poses)]
     t0 = time.perf_counter()
     if args.jobs > 1:
@@ -193,11 +205,12 @@ def main(argv: list[str] | None = None) -> int:
     else:
         records = [one(*j) for j in jobs]
 
-    print(f"{'object':<10} {'seed':>4} {'outcome':<10} {'ok':<3} {'moves':>5} {'fail':>4} {'probes':>6} "
+    width = max(10, *(len(o) for o in objects))
+    print(f"{'object':<{width}} {'seed':>4} {'outcome':<10} {'ok':<3} {'moves':>5} {'fail':>4} {'probes':>6} "
           f"{'cost':>6} {'wall s':>6} {'sim s':>6} {'err mm':>6} {'err °':>5}  perception (medians)")  # fmt: skip
     for r in records:
         probes = f"{r.get('probes', 0)}/{r.get('probe_misses', 0)}/{r.get('probes_failed', 0)}"
-        print(f"{r['model']:<10} {r['seed']:>4} {r['outcome']:<10} {'yes' if r['correct'] else 'no':<3} "
+        print(f"{r['model']:<{width}} {r['seed']:>4} {r['outcome']:<10} {'yes' if r['correct'] else 'no':<3} "
               f"{r.get('moves', 0):>5} {r.get('failed_moves', 0):>4} {probes:>6} {_f(r.get('path_cost')):>6} "
               f"{_f(r.get('wall_time_s')):>6} {_f(r.get('sim_time_s')):>6} {_f(r.get('pose_error_mm'), '.2f'):>6} "
               f"{_f(r.get('pose_error_deg'), '.2f'):>5}  {_perception(r)}")  # fmt: skip
@@ -205,7 +218,7 @@ def main(argv: list[str] | None = None) -> int:
             print(f"{'':<16}{r['detail']}")
 
     print()
-    print(f"{'object':<10} {'correct':>7} {'wrong':>5} {'moves':>6} {'cost':>6} {'wall s':>6} {'sim s':>6} "
+    print(f"{'object':<{width}} {'correct':>7} {'wrong':>5} {'moves':>6} {'cost':>6} {'wall s':>6} {'sim s':>6} "
           f"{'err mm':>6}  (medians over the correctly recognised episodes; probes: used/missed/failed)")  # fmt: skip
     wrong_total = 0
     for o in objects:
@@ -218,7 +231,7 @@ def main(argv: list[str] | None = None) -> int:
             v = [r[k] for r in good if r.get(k) is not None]
             return float(np.median(v)) if v else None
 
-        print(f"{o:<10} {len(good):>3}/{len(rs):<3} {len(wrong):>5} {_f(med('moves')):>6} "
+        print(f"{o:<{width}} {len(good):>3}/{len(rs):<3} {len(wrong):>5} {_f(med('moves')):>6} "
               f"{_f(med('path_cost')):>6} {_f(med('wall_time_s')):>6} {_f(med('sim_time_s')):>6} "
               f"{_f(med('pose_error_mm'), '.2f'):>6}")  # fmt: skip
     good = [r for r in records if r["correct"]]
