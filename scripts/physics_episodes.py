@@ -85,10 +85,12 @@ def one(model: str, seed: int, policy: str, moves: str = "tracing", verify: str 
     failed: list[str] = []
     kinds: list[tuple[str, bool]] = []
     reasons: list[tuple[str, str]] = []
+    recovered: list[tuple[str, str]] = []
 
     def on_move(n, result, *rest) -> None:
         if n > 0 and result.move is not None:  # the start is no move
             kinds.append((result.move.kind, True))
+            recovered.extend((result.move.kind, why) for why in result.info.get("recoveries", ()))
 
     def on_failed(n, result) -> None:
         if result.move is None:
@@ -108,7 +110,8 @@ def one(model: str, seed: int, policy: str, moves: str = "tracing", verify: str 
         rec = run_episode(spec, observer=obs, policy=watch).to_json()
     except HapticError as exc:
         return {"model": model, "seed": seed, "outcome": "error", "correct": False, "detail": str(exc)}
-    rec.update(probes_failed=len(failed), probe_failures=failed, move_results=kinds, failure_reasons=reasons)
+    rec.update(probes_failed=len(failed), probe_failures=failed, move_results=kinds, failure_reasons=reasons,
+               recoveries=recovered)
     if watch is not None:
         rec["probe_costs"] = watch.rows
     return rec
@@ -167,6 +170,10 @@ def print_moves(records: list[dict]) -> None:
     why = Counter((k, reason_class(w)) for r in records for k, w in r.get("failure_reasons", []))
     print(f"failed moves by reason ({sum(why.values())}):")
     for (k, w), n in why.most_common():
+        print(f"  {n:>4}  {k:<6} {w}")
+    rec = Counter((k, reason_class(w)) for r in records for k, w in r.get("recoveries", []))
+    print(f"moves that recovered instead of failing ({sum(rec.values())}):")
+    for (k, w), n in rec.most_common():
         print(f"  {n:>4}  {k:<6} {w}")
 
 

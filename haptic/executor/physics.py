@@ -219,6 +219,8 @@ class PhysicsExecutor(LandingSearch):
         self.traces: list[ContactTrace] = []
         """Every contact trace recorded, one per move (start included)."""
         self._faces: dict[int, _FaceData] = {}
+        self.recoveries: list[str] = []
+        """What the move under way did to recover instead of failing (in its result's ``info["recoveries"]``)."""
         self.on_face: int | None = None
         """The data face the pad is known to rest on (None: not known)."""
         self._finger = finger
@@ -234,6 +236,7 @@ class PhysicsExecutor(LandingSearch):
     def _run(self, move: Move, body) -> MoveResult:
         t0, w0 = self.robot.time, time.perf_counter()
         pieces: list[PrimitiveResult] = []
+        self.recoveries = []
         self.toucher.take_links()  # drop samples taken outside a move
         if self.robot.time != self._links_until:  # the pose at the start, unless the last move reported it
             self.toucher.sample_links()
@@ -252,7 +255,8 @@ class PhysicsExecutor(LandingSearch):
         return MoveResult(move=res.move, status=res.status, components=res.components, distance=res.distance,
                           cost=res.cost, state=res.state, touches=touches_of(trace), trace=trace, reason=res.reason,
                           links=links, sim_time=self.robot.time - t0, wall_time=time.perf_counter() - w0,
-                          free_space=res.free_space, info=res.info)  # fmt: skip
+                          free_space=res.free_space,
+                          info={**res.info, "recoveries": list(self.recoveries)} if self.recoveries else res.info)
 
     def _hand_links(self) -> HandLinks:
         """The hand's link poses sampled during the move (the robot's own forward kinematics), for
@@ -359,8 +363,10 @@ class PhysicsExecutor(LandingSearch):
             middle = fd.points.mean(axis=0)
             targets = [fd.anchor, middle - float((middle - fd.anchor) @ n) * n]
         status = "unreachable"
-        for target in targets:
+        for k, target in enumerate(targets):
             status = self._touch_face(fid, n, target, pieces)
+            if status == "ok" and k:
+                self.recoveries.append("the face touched again at the middle of its contacts")
             if status == "ok" or status == "unstable":
                 break
         return status
@@ -467,6 +473,7 @@ class PhysicsExecutor(LandingSearch):
             pieces.append(st)
             fit = seg.fit_face_trace(st.trace, st.info["normal"]) if st.ok else None
             if fit is not None:
+                self.recoveries.append(f"{why}: the next face touched afresh")
                 return "ok", "", roll, st.trace, fit
         return "unreachable", why, None, None, None
 
@@ -593,6 +600,8 @@ class PhysicsExecutor(LandingSearch):
             if near is None:
                 continue
             status = self._ensure_on_face(fid, pieces, near=near)
+            if status == "ok" and fid != first:
+                self.recoveries.append("the edge approached from its other face")
             if status in ("ok", "unstable"):
                 return status
             why = f"could not return next to the edge: {self._why}"

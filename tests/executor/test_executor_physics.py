@@ -297,6 +297,7 @@ def test_a_face_move_whose_crossing_loses_the_next_face_touches_it_afresh(monkey
             break
     assert calls["n"] >= 1
     assert r.ok, r.reason
+    assert any("touched afresh" in why for why in r.info["recoveries"])
     assert [c.kind for c in r.components] == ["edge", "face"]
     truth = SE3.from_matrix(sim.ground_truth().world_from_object)
     score = score_components(ex.components, poly, truth, [r])
