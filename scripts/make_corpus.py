@@ -4,8 +4,8 @@
     python scripts/make_corpus.py out/corpus --check    # also import each file: V/E/F and symmetry order
     python scripts/make_corpus.py out/sized --sizes 30:150 --encodings obj6   # each solid at a drawn size
 
-``--sizes MIN:MAX`` scales each solid so that its largest extent is drawn uniformly from MIN to MAX mm (seeded),
-for exploring objects of many sizes on the hand; the formulas' counts do not change.
+``--sizes MIN:MAX`` scales each solid so that its size (largest vertex-to-vertex distance) is drawn uniformly
+from MIN to MAX mm (seeded), for exploring objects of many sizes on the hand; the formulas' counts do not change.
 
 The table printed by ``--check`` counts, per family and encoding, the files whose V/E/F (and symmetry order)
 match the formula, out of the total. Exit 1 when any does not.
@@ -26,10 +26,12 @@ from haptic.geometry.corpus import ENCODINGS, corpus_solids, write_corpus
 
 
 def sized(solids, lo: float, hi: float, rng: np.random.Generator):
-    """Each solid scaled about its centroid so that its largest extent is drawn uniformly from ``lo`` to ``hi`` [m]."""
+    """Each solid scaled about its centroid so that its size (the largest distance between two of its vertices,
+    whatever its pose) is drawn uniformly from ``lo`` to ``hi`` [m]."""
     out = []
     for spec, poly in solids:
-        extent = float(np.ptp(poly.vertices, axis=0).max())
+        v = poly.vertices
+        extent = float(np.linalg.norm(v[:, None] - v[None], axis=2).max())
         k = rng.uniform(lo, hi) / extent
         c = poly.centroid
         out.append((spec, Polyhedron.from_faces(c + k * (poly.vertices - c), poly.faces, name=poly.name)))
@@ -42,7 +44,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seed", type=int, default=0, help="seed of the poses and random hulls (default 0)")
     ap.add_argument("--check", action="store_true", help="import every file and compare with the formula")
     ap.add_argument("--sizes", default=None, metavar="MIN:MAX",
-                    help="scale each solid to a largest extent drawn from MIN to MAX mm (default: as the formulas)")
+                    help="scale each solid to a size (largest vertex distance) drawn from MIN to MAX mm "
+                    "(default: as the formulas)")
     ap.add_argument("--encodings", default=",".join(ENCODINGS), help=f"comma-separated, of {', '.join(ENCODINGS)}")
     args = ap.parse_args(argv)
     encodings = tuple(e for e in args.encodings.split(",") if e)
