@@ -535,6 +535,11 @@ class PhysicsExecutor(LandingSearch):
         pieces.append(r)
         if not r.ok:
             return self.failed_result(move, r, f"following the edge: {r.event}")
+        if r.info.get("event_sign", 1) < 0 and self.workspace.touching_table(self._finger_contacts()):
+            # stopped by the table, not by the object: where the edge line meets the table plane is no vertex
+            # (the edge may end above it, or at a chamfer the pad cannot reach)
+            return self.failed_result(move, "unreachable", "following the edge: the pad met the table before the "
+                                                           "edge's end")  # fmt: skip
         hold = t.hold(s.vertex_hold)
         pieces.append(hold)
         rows = ContactTrace.concatenate([r.trace, hold.trace])
