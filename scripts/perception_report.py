@@ -48,8 +48,9 @@ import numpy as np
 from haptic.episode.evaluate import score_components, score_face
 from haptic.episode.spec import EpisodeSpec
 from haptic.executor.physics import PhysicsExecutor
-from haptic.geometry import SE3, Polyhedron, load_library
+from haptic.geometry import SE3, load_library
 from haptic.geometry.io import save_model
+from haptic.geometry.perturb import scaled_to
 from haptic.matching.tree import InterpretationTree
 from haptic.planning.moves import EdgeMove, FaceMove, Move, VertexMove
 from haptic.sim import RobotInterface, SimulatedSensorNoise, Simulation, compose_scene, random_object_pose
@@ -244,8 +245,7 @@ def write_library(models: dict, out: Path, size_mm: float | None) -> Path:
         return out
     out.mkdir(parents=True, exist_ok=True)
     for name, poly in models.items():
-        f = 1.0 if size_mm is None else size_mm * 1e-3 / float(np.max(poly.extents))
-        save_model(Polyhedron.from_faces(poly.vertices * f, poly.faces, name=name), out / f"{name}.json")
+        save_model(poly if size_mm is None else scaled_to(poly, size_mm * 1e-3, name), out / f"{name}.json")
     return out
 
 

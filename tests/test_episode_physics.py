@@ -7,7 +7,7 @@ import numpy as np
 
 from haptic.episode.loop import EpisodeObserver
 from haptic.episode.spec import EpisodeSpec
-from haptic.episode.worlds import run_episode
+from haptic.episode.worlds import build_episode, run_episode
 
 
 def test_a_physics_episode_recognises_the_pyramid():
@@ -85,3 +85,35 @@ def test_a_pad_lifted_off_a_valley_reports_no_vertex():
     assert rec.outcome != "no-match", rec.detail
     assert rec.perception["spurious"] == 0
     assert lost and lost[0].status == "no-contact"
+
+
+def _scaled_seed_library(directory, extent: float) -> str:
+    """The seed library with every model scaled to ``extent`` [m] across (``scripts/perception_report.py
+    --sizes``), written to ``directory``."""
+    from haptic.geometry import load_library
+    from haptic.geometry.io import save_model
+    from haptic.geometry.perturb import scaled_to
+
+    for name, poly in load_library().items():
+        save_model(scaled_to(poly, extent), directory / f"{name}.json")
+    return str(directory)
+
+
+def test_an_edge_move_stopped_by_the_table_reports_no_vertex(tmp_path):
+    # BOX01P 40 mm across, seed 1 (perception_report.py --sizes 40): two edge moves ran down an edge until the
+    # pad met the table; each reported a "vertex" where the edge line meets the table plane. The second edge
+    # ends 8 mm above the table and that vertex lay 14 mm past it (5.9 bounds), and the episode ended no-match.
+    # Stopped by the table the move reports nothing: the edge may end above the table or at a chamfer.
+    from haptic.episode.evaluate import bound_ratios
+    from haptic.sim.scene import TABLE_TOP_Z
+
+    failed = []
+    obs = EpisodeObserver(on_failed_move=lambda n, r: failed.append(r))
+    spec = EpisodeSpec(model="BOX01P", seed=1, executor="physics", models=_scaled_seed_library(tmp_path, 0.04),
+                       max_moves=11)  # fmt: skip
+    ep = build_episode(spec)
+    ep.run(None, obs)
+    assert any(r.move.kind == "edge" and "met the table" in r.reason for r in failed)
+    vertices = [c for c in ep.executor.components if c.kind == "vertex"]
+    assert vertices and all(v.position[2] > TABLE_TOP_Z + 0.002 for v in vertices)
+    assert max(r.ratio for r in bound_ratios(ep.executor.components, ep.true_model, ep.world_from_model)) <= 1.0
