@@ -117,3 +117,20 @@ def test_an_edge_move_stopped_by_the_table_reports_no_vertex(tmp_path):
     vertices = [c for c in ep.executor.components if c.kind == "vertex"]
     assert vertices and all(v.position[2] > TABLE_TOP_Z + 0.002 for v in vertices)
     assert max(r.ratio for r in bound_ratios(ep.executor.components, ep.true_model, ep.world_from_model)) <= 1.0
+
+
+def test_a_concave_edge_whose_end_the_pad_rolls_past_reports_no_vertex(tmp_path):
+    # FRAME01 40 mm across, seed 1: an edge move along a concave edge of the hole ran to its end, where the
+    # faces' corners are obtuse: the pad's contacts rolled on along the rims and the vertex was put at their
+    # median, 3.6 mm past the true end (2.7 bounds; the edge's extent 1.2 bounds), and the episode ended
+    # no-match. The surface falling away does not locate a concave edge's end: the move reports nothing.
+    from haptic.episode.evaluate import bound_ratios
+
+    failed = []
+    obs = EpisodeObserver(on_failed_move=lambda n, r: failed.append(r))
+    spec = EpisodeSpec(model="FRAME01", seed=1, executor="physics", models=_scaled_seed_library(tmp_path, 0.04),
+                       max_moves=5)  # fmt: skip
+    ep = build_episode(spec)
+    ep.run(None, obs)
+    assert any(r.move.kind == "edge" and "concave edge" in r.reason for r in failed)
+    assert max(r.ratio for r in bound_ratios(ep.executor.components, ep.true_model, ep.world_from_model)) <= 1.0

@@ -545,7 +545,8 @@ class PhysicsExecutor(LandingSearch):
         rows = ContactTrace.concatenate([r.trace, hold.trace])
         s_v, s_sigma = self._vertex_param(rec, rows, u, r.info.get("event_sign", 1))
         if s_v is None:
-            return self.failed_result(move, "unreachable", "could not locate the vertex")
+            why = "could not locate the vertex (no contact there, or a concave edge's end, which its faces run past)"
+            return self.failed_result(move, "unreachable", why)
         # refine the line with the ridge contacts (convex edges), then extend it to the vertex
         ridge = self._on_ridge(rows, u)
         w_v, w_from = rec.at(s_v), rec.at(s_from)
@@ -577,6 +578,11 @@ class PhysicsExecutor(LandingSearch):
         n = np.where(ok[:, None], rows.normal_in_world, 0.0)
         c = n @ u
         b, s = self.bounds, self.settings
+        if event_sign > 0 and not rec.convex:
+            # the pad in a concave corner touches the two faces, not the edge: where their corners at its end are
+            # obtuse the faces run on past it and so do the contacts, rolling on along the rims (FRAME01's hole
+            # at 40 mm: 3.6 mm past): the surface falling away does not locate a concave edge's end
+            return None, 0.0
         if event_sign > 0:
             at_v = ok & (c > s.touch.loss_lean_sin)  # the pad rolls on the vertex
             if at_v.sum() < s.min_vertex_rows:  # contact was lost: the last contacts
