@@ -134,3 +134,24 @@ def test_a_concave_edge_whose_end_the_pad_rolls_past_reports_no_vertex(tmp_path)
     ep.run(None, obs)
     assert any(r.move.kind == "edge" and "concave edge" in r.reason for r in failed)
     assert max(r.ratio for r in bound_ratios(ep.executor.components, ep.true_model, ep.world_from_model)) <= 1.0
+
+
+def test_a_face_move_that_rolls_round_a_vertex_reports_no_edge(tmp_path):
+    # bipyramid_06 of the formula corpus at 60 mm across, seed 1 (perception_report.py --corpus --sizes 60): a face
+    # move rolled round the apex onto a face sharing no edge with the first; the "edge" reported between them
+    # (n_a × n_b through the apex) lay 36 mm off every true edge (48 bounds) and the episode ended no-match.
+    # The rolling normals leaned along that line more than the noise allows: no edge is reported.
+    from haptic.episode.evaluate import bound_ratios
+    from haptic.geometry.corpus import corpus_solids
+    from haptic.geometry.io import save_model
+    from haptic.geometry.perturb import scaled_to
+
+    for s, poly in corpus_solids():
+        save_model(scaled_to(poly, 0.06, s.name), tmp_path / f"{s.name}.json")
+    failed = []
+    obs = EpisodeObserver(on_failed_move=lambda n, r: failed.append(r))
+    ep = build_episode(EpisodeSpec(model="bipyramid_06", seed=1, executor="physics", models=str(tmp_path),
+                                   max_moves=11))  # fmt: skip
+    ep.run(None, obs)
+    assert any(r.move.kind == "face" and "more than the noise allows" in r.reason for r in failed)
+    assert max(r.ratio for r in bound_ratios(ep.executor.components, ep.true_model, ep.world_from_model)) <= 1.0
