@@ -136,22 +136,46 @@ def test_a_concave_edge_whose_end_the_pad_rolls_past_reports_no_vertex(tmp_path)
     assert max(r.ratio for r in bound_ratios(ep.executor.components, ep.true_model, ep.world_from_model)) <= 1.0
 
 
+def _scaled_corpus(directory, extent: float) -> str:
+    """The formula corpus with every solid scaled to ``extent`` [m] across (``scripts/perception_report.py
+    --corpus --sizes``), written to ``directory``."""
+    from haptic.geometry.corpus import corpus_solids
+    from haptic.geometry.io import save_model
+    from haptic.geometry.perturb import scaled_to
+
+    for s, poly in corpus_solids():
+        save_model(scaled_to(poly, extent, s.name), directory / f"{s.name}.json")
+    return str(directory)
+
+
 def test_a_face_move_that_rolls_round_a_vertex_reports_no_edge(tmp_path):
     # bipyramid_06 of the formula corpus at 60 mm across, seed 1 (perception_report.py --corpus --sizes 60): a face
     # move rolled round the apex onto a face sharing no edge with the first; the "edge" reported between them
     # (n_a × n_b through the apex) lay 36 mm off every true edge (48 bounds) and the episode ended no-match.
     # The rolling normals leaned along that line more than the noise allows: no edge is reported.
     from haptic.episode.evaluate import bound_ratios
-    from haptic.geometry.corpus import corpus_solids
-    from haptic.geometry.io import save_model
-    from haptic.geometry.perturb import scaled_to
 
-    for s, poly in corpus_solids():
-        save_model(scaled_to(poly, 0.06, s.name), tmp_path / f"{s.name}.json")
     failed = []
     obs = EpisodeObserver(on_failed_move=lambda n, r: failed.append(r))
-    ep = build_episode(EpisodeSpec(model="bipyramid_06", seed=1, executor="physics", models=str(tmp_path),
-                                   max_moves=11))  # fmt: skip
+    spec = EpisodeSpec(model="bipyramid_06", seed=1, executor="physics", models=_scaled_corpus(tmp_path, 0.06),
+                       max_moves=11)  # fmt: skip
+    ep = build_episode(spec)
     ep.run(None, obs)
     assert any(r.move.kind == "face" and "more than the noise allows" in r.reason for r in failed)
+    assert max(r.ratio for r in bound_ratios(ep.executor.components, ep.true_model, ep.world_from_model)) <= 1.0
+
+
+def test_an_edge_move_that_goes_on_round_a_shallow_vertex_reports_no_vertex(tmp_path):
+    # prism_12 of the formula corpus at 60 mm, seed 1: an edge move along a cap edge of the 12-gon went on round
+    # its end, where the next cap edge turns by only 30°, and the vertex was put at the contacts there, 1.7 mm
+    # past the end (1.4 bounds). Those contacts lay 1.1 mm off the edge's line (those of a pad rolling on a
+    # vertex 0.2-0.3 mm): the move reports nothing.
+    from haptic.episode.evaluate import bound_ratios
+
+    failed = []
+    obs = EpisodeObserver(on_failed_move=lambda n, r: failed.append(r))
+    ep = build_episode(EpisodeSpec(model="prism_12", seed=1, executor="physics", models=_scaled_corpus(tmp_path, 0.06),
+                                   max_moves=18))  # fmt: skip
+    ep.run(None, obs)
+    assert any(r.move.kind == "edge" and "off the edge's line" in r.reason for r in failed)
     assert max(r.ratio for r in bound_ratios(ep.executor.components, ep.true_model, ep.world_from_model)) <= 1.0

@@ -545,7 +545,8 @@ class PhysicsExecutor(LandingSearch):
         rows = ContactTrace.concatenate([r.trace, hold.trace])
         s_v, s_sigma = self._vertex_param(rec, rows, u, r.info.get("event_sign", 1))
         if s_v is None:
-            why = "could not locate the vertex (no contact there, or a concave edge's end, which its faces run past)"
+            why = ("could not locate the vertex (no contact there, a concave edge's end, which its faces run past, or "
+                   "contacts off the edge's line, on an edge turning little from it)")  # fmt: skip
             return self.failed_result(move, "unreachable", why)
         # refine the line with the ridge contacts (convex edges), then extend it to the vertex
         ridge = self._on_ridge(rows, u)
@@ -591,7 +592,13 @@ class PhysicsExecutor(LandingSearch):
                 at_v[idx] = True
             if not at_v.any():
                 return None, 0.0
-            along = (rows.point_in_world[at_v] - rec.point) @ rec.direction
+            rel = rows.point_in_world[at_v] - rec.point
+            along = rel @ rec.direction
+            off = float(np.median(np.linalg.norm(rel - along[:, None] * rec.direction, axis=1)))
+            if off > b.bound(rec.position_sigma, b.position_floor):
+                # rolling on the vertex the contacts stay on the edge's line; off it, the pad went on round the
+                # vertex along an edge turning little from this one (a 12-gon's, 30°): the contacts lie past it
+                return None, 0.0
             return float(np.median(along)), max(float(np.std(along)), b.point_sigma) / math.sqrt(len(along))
         contacts = self._finger_contacts()
         if not contacts:
