@@ -237,6 +237,9 @@ def fixed_plan(args: argparse.Namespace) -> int:
 
 # -- episodes: error / bound per quantity -------------------------------------------------------------------
 
+DEFAULT_LIBRARIES = "out/perception/libraries"
+"""Where the scaled libraries are written (``--libraries``)."""
+
 
 def write_library(models: dict, out: Path, size_mm: float | None) -> Path:
     """``models`` (name -> Polyhedron) as native model files in ``out``, each scaled so that its largest
@@ -313,12 +316,12 @@ def _worst_ratio(r: dict) -> float:
     return max((x[2] for x in rows), default=0.0)
 
 
-def replay(r: dict) -> str:
-    """The command that replays a record's episode."""
-    key = r.get("key", {})
+def replay(r: dict, libraries: str = DEFAULT_LIBRARIES) -> str:
+    """The command that replays a record's episode (a library other than the seed one: the directory of that
+    name under ``libraries``)."""
     parts = [f"haptic explore --executor physics --object {r['model']} --seed {r['seed']}"]
-    if key.get("models"):
-        parts.append(f"--models {key['models']}")
+    if r.get("library", "seed") != "seed":
+        parts.append(f"--models {Path(libraries) / r['library']}")
     if r.get("verify", "full") != "full":
         parts.append(f"--verify {r['verify']}")
     if r.get("noise", 1.0) != 1.0:
@@ -326,7 +329,7 @@ def replay(r: dict) -> str:
     return " ".join(parts)
 
 
-def summarize(records: list[dict], worst: int = 10, plot: str | None = None) -> int:
+def summarize(records: list[dict], worst: int = 10, plot: str | None = None, libraries: str = DEFAULT_LIBRARIES) -> int:
     """Print the error / bound distribution per quantity, the counts outside bounds, the outcomes and the worst
     cases; with ``plot``, write a histogram of the ratios per quantity. Returns the components outside bounds."""
     from haptic.episode.evaluate import BOUND_QUANTITIES
@@ -348,6 +351,10 @@ def summarize(records: list[dict], worst: int = 10, plot: str | None = None) -> 
     n_comp = len({(id(r), cid) for _, _, cid, r in rows})
     eps = {id(r) for x, _, _, r in rows if x > 1.0}
     print(f"components outside their bounds: {len(outside)} of {n_comp}, in {len(eps)} of {len(records)} episodes")
+    missed = sum((r.get("perception") or {}).get("missed", 0) for r in records)
+    spurious = sum((r.get("perception") or {}).get("spurious", 0) for r in records)
+    print(f"components farther than 5° or 3 mm from every true feature (spurious): {spurious}; moves that met "
+          f"another feature than the one they reported (missed): {missed}")  # fmt: skip
     out = Counter(r["outcome"] for r in records)
     wrong = [r for r in records if r["recognized"] and not r["correct"]]
     print("outcomes: " + ", ".join(f"{k} {v}" for k, v in sorted(out.items()))
@@ -361,7 +368,7 @@ def summarize(records: list[dict], worst: int = 10, plot: str | None = None) -> 
     print(f"worst {worst}:")
     for ratio, what, cid, r in sorted(rows, key=lambda x: -x[0])[:worst]:
         print(f"  {ratio:6.2f} {what:14} component {cid:2d}  {r['library']} {r['model']} seed {r['seed']}: "
-              f"{replay(r)}")  # fmt: skip
+              f"{replay(r, libraries)}")  # fmt: skip
     if plot:
         _plot(rows, plot)
     return len(outside)
@@ -403,7 +410,7 @@ def main(argv=None) -> int:
     ap.add_argument("--models", default=None, help="library directory (default: the seed library)")
     ap.add_argument("--corpus", action="store_true", help="the formula corpus (scripts/make_corpus.py) instead")
     ap.add_argument("--sizes", default=None, help="comma-separated largest extents [mm]: one library per size")
-    ap.add_argument("--libraries", default="out/perception/libraries", help="where scaled libraries are written")
+    ap.add_argument("--libraries", default=DEFAULT_LIBRARIES, help="where scaled libraries are written")
     ap.add_argument("--per-library", type=int, default=None, help="objects drawn per library (default: all)")
     ap.add_argument("--first-seed", type=int, default=1, help="episode seed of the first pose")
     ap.add_argument("--verify", default="full", choices=("none", "fast", "full"))
@@ -425,7 +432,7 @@ def main(argv=None) -> int:
         from haptic.bench.results import read_results
 
         records = read_results(args.out)
-    summarize(records, args.worst, args.plot)
+    summarize(records, args.worst, args.plot, args.libraries)
     return 0
 
 
