@@ -179,3 +179,21 @@ def test_an_edge_move_that_goes_on_round_a_shallow_vertex_reports_no_vertex(tmp_
     ep.run(None, obs)
     assert any(r.move.kind == "edge" and "off the edge's line" in r.reason for r in failed)
     assert max(r.ratio for r in bound_ratios(ep.executor.components, ep.true_model, ep.world_from_model)) <= 1.0
+
+
+def test_a_vertex_move_whose_circle_meets_an_edge_of_another_vertex_reports_no_edge(tmp_path):
+    # trapezohedron_12 of the formula corpus at 60 mm, seed 1: circling a vertex across a kite narrower than the
+    # circle, the pad met an edge that does not leave that vertex; the edge was reported adjacent to it (within
+    # its geometric bounds, but a wrong adjacency) and the tree pruned the truth: no-match. The edge's line
+    # passes far from the vertex circled: the move reports nothing.
+    from haptic.episode.evaluate import score_components
+
+    failed, results = [], []
+    obs = EpisodeObserver(on_move=lambda n, r, *a: results.append(r),
+                          on_failed_move=lambda n, r: (failed.append(r), results.append(r)))  # fmt: skip
+    spec = EpisodeSpec(model="trapezohedron_12", seed=1, executor="physics", models=_scaled_corpus(tmp_path, 0.06),
+                       max_moves=6)  # fmt: skip
+    ep = build_episode(spec)
+    ep.run(None, obs)
+    assert any(r.move.kind == "vertex" and "leaves another vertex" in r.reason for r in failed)
+    assert score_components(ep.executor.components, ep.true_model, ep.world_from_model, results).missed == 0

@@ -654,6 +654,15 @@ class PhysicsExecutor(LandingSearch):
             return self.failed_result(move, "unreachable", why)
         new_face = seg.next_id + 1
         s_vtx = float((vtx - line.point) @ line.direction)
+        b = self.bounds
+        off = float(np.linalg.norm(vtx - line.point - s_vtx * line.direction))
+        lever = abs(s_vtx - float(np.clip(s_vtx, *line.s_range)))  # from the explored interval to the vertex
+        allowed = (seg.vertices[st.vertex].position_bound + b.bound(line.position_sigma, b.position_floor)
+                   + lever * b.bound(line.direction_sigma, b.direction_floor))  # fmt: skip
+        if off > allowed:
+            # the circle crossed an edge that does not leave the vertex (on a face narrower than the circle)
+            return self.failed_result(move, "unreachable", f"the edge met passes {off * MM:.1f} mm from the vertex "
+                                                           "circled: it leaves another vertex")  # fmt: skip
         edge = seg.add_edge(line, (f, new_face), kind == "convex", (fit_f.normal, fit_g.normal),
                             adjacent=(st.vertex, f), vertex=(st.vertex, s_vtx))  # fmt: skip
         face = seg.add_face(fit_g, adjacent=(edge.id,))
