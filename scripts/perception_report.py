@@ -1,14 +1,30 @@
-"""Perception errors of the physics executor per seed object over random poses, move success, matcher
-acceptance, and face-move throughput.
+"""Perception of the simulated hand: every data component's error in units of its own bound, over physics
+episodes; or (``--fixed-plan``) errors per seed object over a fixed sequence of moves.
 
-    .venv/bin/python scripts/perception_report.py [--poses 5] [--objects BOX01,WEDGE01,...] [--seed 0]
+    .venv/bin/python scripts/perception_report.py --out out/perception/seed.jsonl [--models DIR | --corpus]
+        [--sizes 30,90,150] [--objects A,B] [--poses 2] [--first-seed 1] [--verify full] [--noise 1]
+        [--workers 2] [--resume] [--plot hist.png] [--worst 10]
+    .venv/bin/python scripts/perception_report.py --summarize A.jsonl [B.jsonl ...] [--plot hist.png]
+    .venv/bin/python scripts/perception_report.py --fixed-plan [--poses 5] [--objects BOX01,WEDGE01,...] [--seed 0]
 
-Each run: start, then the fixed sequence face, edge, vertex, edge, face, edge, vertex (random choices through
-a seeded generator; a failed move is retried with another choice, up to 4 times; an edge move in the sense of
-a vertex already reached is not asked). On objects with concave edges a *concave probe* follows: face moves
-whose directions are chosen with the ground truth (an oracle standing in for the planner -- the executor is
-as blind as ever) towards the nearest concave edge of the current face -- or, from a face without one, towards
-the middle of the edge to a face that has one --, until one is reported or 6 moves are spent.
+**Episodes** (the default): the real ``haptic explore --executor physics`` episodes (``EpisodeSpec`` with the
+command line's defaults but those given), each object of the library (``--objects``: some of them) at
+``--poses`` random resting poses (episode seeds ``first-seed``, ``first-seed + 1``, ...), on ``--workers``
+processes. ``--sizes`` (mm) scales every model so that its largest extent is that size, one library per size,
+written under ``--libraries`` (the objects are recognised within the library at their size); ``--corpus`` is
+the formula corpus of ``scripts/make_corpus.py`` instead of the seed library. Each record is appended to
+``--out`` as it ends (``--resume`` skips the episodes already there). Each record's ``perception`` holds every
+component's quantities in units of their bounds, scored against the truth outside the executor
+(:func:`haptic.episode.evaluate.bound_ratios`): the report prints the distribution per quantity, the counts of
+components and episodes outside their bounds, the outcomes (wrong recognitions, no-match), the worst cases with
+the command that replays each, and with ``--plot`` a histogram of the ratios per quantity.
+
+**Fixed plan**: start, then the fixed sequence face, edge, vertex, edge, face, edge, vertex (random choices
+through a seeded generator; a failed move is retried with another choice, up to 4 times; an edge move in the
+sense of a vertex already reached is not asked). On objects with concave edges a *concave probe* follows: face
+moves whose directions are chosen with the ground truth (an oracle standing in for the planner -- the executor
+is as blind as ever) towards the nearest concave edge of the current face -- or, from a face without one,
+towards the middle of the edge to a face that has one --, until one is reported or 6 moves are spent.
 
 The components are scored against ground truth by ``haptic.episode.evaluate`` (outside the executor); every
 component of every run is also fed, unchanged, to the interpretation-tree matcher, and the run counts as
@@ -25,12 +41,16 @@ from __future__ import annotations
 import argparse
 import time
 from collections import Counter
+from pathlib import Path
 
 import numpy as np
 
 from haptic.episode.evaluate import score_components, score_face
+from haptic.episode.spec import EpisodeSpec
 from haptic.executor.physics import PhysicsExecutor
 from haptic.geometry import SE3, load_library
+from haptic.geometry.io import save_model
+from haptic.geometry.perturb import scaled_to
 from haptic.matching.tree import InterpretationTree
 from haptic.planning.moves import EdgeMove, FaceMove, Move, VertexMove
 from haptic.sim import RobotInterface, SimulatedSensorNoise, Simulation, compose_scene, random_object_pose
@@ -152,18 +172,14 @@ def matcher_accepts(poly, components, library) -> tuple[bool, str]:
     return True, ""
 
 
-def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--poses", type=int, default=5)
-    ap.add_argument("--objects", default=",".join(SEED_OBJECTS))
-    ap.add_argument("--seed", type=int, default=0)
-    args = ap.parse_args(argv)
+def fixed_plan(args: argparse.Namespace) -> int:
+    """Errors per seed object over the fixed sequence of moves (module doc)."""
     lib = load_library()
     all_rates = []
     totals: Counter = Counter()
     print(f"{'object':9} {'face ok':>8} {'edge ok':>8} {'vtx ok':>8} {'table':>5} {'normal°':>13} {'edge dir°':>13} "
           f"{'edge pos mm':>13} {'vertex mm':>13} {'spur':>4} {'miss':>4} {'concave':>7} {'matcher':>7}")  # fmt: skip
-    for name in args.objects.split(","):
+    for name in (args.objects or ",".join(SEED_OBJECTS)).split(","):
         poly = lib[name]
         faces, dirs, epos, verts = [], [], [], []
         c: Counter = Counter()
@@ -216,6 +232,207 @@ def main(argv=None) -> int:
         wall_t = sum(w for _, w in all_rates)
         print(f"face move throughput: {sim_t / wall_t:.1f} simulated s per wall s over {len(all_rates)} face moves "
               f"(mean {sim_t / len(all_rates):.2f} s simulated each)")  # fmt: skip
+    return 0
+
+
+# -- episodes: error / bound per quantity -------------------------------------------------------------------
+
+DEFAULT_LIBRARIES = "out/perception/libraries"
+"""Where the scaled libraries are written (``--libraries``)."""
+
+
+def write_library(models: dict, out: Path, size_mm: float | None) -> Path:
+    """``models`` (name -> Polyhedron) as native model files in ``out``, each scaled so that its largest
+    extent is ``size_mm`` (None: as they are); the directory is written once and reused."""
+    if out.is_dir() and any(out.glob("*.json")):
+        return out
+    out.mkdir(parents=True, exist_ok=True)
+    for name, poly in models.items():
+        save_model(poly if size_mm is None else scaled_to(poly, size_mm * 1e-3, name), out / f"{name}.json")
+    return out
+
+
+def libraries(args: argparse.Namespace) -> list[Path | None]:
+    """The library directories of the sweep: one per size, or the library as it is (None: the seed one)."""
+    if args.corpus:
+        from haptic.geometry.corpus import corpus_solids
+
+        models, base = {s.name: p for s, p in corpus_solids()}, "corpus"
+    elif args.models:
+        models, base = load_library(args.models), Path(args.models).resolve().name
+    else:
+        models, base = load_library(), "seed"
+    if not args.sizes:
+        return [write_library(models, Path(args.libraries) / base, None) if args.corpus else args.models]
+    root = Path(args.libraries)
+    return [write_library(models, root / f"{base}_{float(s):03.0f}mm", float(s)) for s in args.sizes.split(",")]
+
+
+def plan(args: argparse.Namespace) -> list[EpisodeSpec]:
+    """The episodes: every object (or ``--objects``, or ``--per-library`` drawn from ``--first-seed``) of each
+    library at ``--poses`` seeds."""
+    specs = []
+    for lib_dir in libraries(args):
+        names = sorted(load_library(lib_dir))
+        if args.objects:
+            names = [n for n in names if n in args.objects.split(",")]
+        if args.per_library and args.per_library < len(names):
+            rng = np.random.default_rng(args.first_seed)
+            names = sorted(rng.choice(names, size=args.per_library, replace=False).tolist())
+        settings = {"executor": "physics", "verify": args.verify, "noise": args.noise}
+        if lib_dir is not None:
+            settings["models"] = str(lib_dir)
+        specs += [EpisodeSpec(model=n, seed=args.first_seed + k, **settings)
+                  for k in range(args.poses) for n in names]  # fmt: skip
+    return specs
+
+
+def run_episodes(args: argparse.Namespace) -> None:
+    """Run the planned episodes not yet in ``--out``, appending each record as it ends."""
+    from contextlib import closing
+
+    from haptic.bench.results import ResultsWriter, drop_partial_line, read_results
+    from haptic.bench.runner import episode_key, key_id, run_sweep
+
+    out = Path(args.out)
+    if out.exists() and out.stat().st_size and not args.resume:
+        raise SystemExit(f"perception_report: {out} holds records; --resume to add the missing episodes to it")
+    drop_partial_line(out)
+    done = {key_id(r["key"]) for r in read_results(out)} if out.exists() else set()
+    todo = [s for s in plan(args) if key_id(episode_key(s)) not in done]
+    print(f"{len(todo)} episodes to run ({len(done)} already in {out}) on {args.workers} workers", flush=True)
+    t0 = time.time()
+    with ResultsWriter(out) as writer, closing(run_sweep(todo, workers=args.workers)) as records:
+        for i, r in enumerate(records, 1):
+            writer.write(r)
+            worst = _worst_ratio(r)
+            print(f"  {i}/{len(todo)} {r['library']} {r['model']} seed {r['seed']}: {r['outcome']}"
+                  f"{'' if r['correct'] else ' (wrong)' if r['recognized'] else ''}, largest ratio "
+                  f"{worst:.2f}, {time.time() - t0:.0f} s", flush=True)  # fmt: skip
+
+
+def _worst_ratio(r: dict) -> float:
+    rows = (r.get("perception") or {}).get("ratios") or []
+    return max((x[2] for x in rows), default=0.0)
+
+
+def replay(r: dict, libraries: str = DEFAULT_LIBRARIES) -> str:
+    """The command that replays a record's episode (a library other than the seed one: the directory of that
+    name under ``libraries``)."""
+    parts = [f"haptic explore --executor physics --object {r['model']} --seed {r['seed']}"]
+    if r.get("library", "seed") != "seed":
+        parts.append(f"--models {Path(libraries) / r['library']}")
+    if r.get("verify", "full") != "full":
+        parts.append(f"--verify {r['verify']}")
+    if r.get("noise", 1.0) != 1.0:
+        parts.append(f"--noise {r['noise']:g}")
+    return " ".join(parts)
+
+
+def summarize(records: list[dict], worst: int = 10, plot: str | None = None, libraries: str = DEFAULT_LIBRARIES) -> int:
+    """Print the error / bound distribution per quantity, the counts outside bounds, the outcomes and the worst
+    cases; with ``plot``, write a histogram of the ratios per quantity. Returns the components outside bounds."""
+    from haptic.episode.evaluate import BOUND_QUANTITIES
+
+    rows = []  # (ratio, what, data id, record)
+    for r in records:
+        for cid, what, ratio, _ in (r.get("perception") or {}).get("ratios") or []:
+            rows.append((float(ratio), what, int(cid), r))
+    libs = Counter(r["library"] for r in records)
+    print(f"{len(records)} episodes ({', '.join(f'{k} {v}' for k, v in sorted(libs.items()))})")
+    print(f"{'quantity':15} {'n':>5} {'median':>7} {'p90':>7} {'p99':>7} {'max':>7} {'> 1':>5}")
+    for what in BOUND_QUANTITIES:
+        a = np.array([x for x, w, _, _ in rows if w == what])
+        if not len(a):
+            continue
+        q = np.quantile(a, [0.5, 0.9, 0.99])
+        print(f"{what:15} {len(a):5d} {q[0]:7.2f} {q[1]:7.2f} {q[2]:7.2f} {a.max():7.2f} {int((a > 1).sum()):5d}")
+    outside = {(id(r), cid) for x, _, cid, r in rows if x > 1.0}
+    n_comp = len({(id(r), cid) for _, _, cid, r in rows})
+    eps = {id(r) for x, _, _, r in rows if x > 1.0}
+    print(f"components outside their bounds: {len(outside)} of {n_comp}, in {len(eps)} of {len(records)} episodes")
+    missed = sum((r.get("perception") or {}).get("missed", 0) for r in records)
+    spurious = sum((r.get("perception") or {}).get("spurious", 0) for r in records)
+    print(f"components farther than 5° or 3 mm from every true feature (spurious): {spurious}; moves that met "
+          f"another feature than the one they reported (missed): {missed}")  # fmt: skip
+    out = Counter(r["outcome"] for r in records)
+    wrong = [r for r in records if r["recognized"] and not r["correct"]]
+    print("outcomes: " + ", ".join(f"{k} {v}" for k, v in sorted(out.items()))
+          + f"; wrong recognitions {len(wrong)}")  # fmt: skip
+    for r in wrong:
+        print(f"  wrong: {r['library']} {r['model']} seed {r['seed']} as {r['recognized']} "
+              f"({r['pose_error_mm']} mm, {r['pose_error_deg']} deg)")  # fmt: skip
+    for r in records:
+        if r["outcome"] == "no-match":
+            print(f"  no-match: {r['library']} {r['model']} seed {r['seed']}: {r['detail']}")
+    print(f"worst {worst}:")
+    for ratio, what, cid, r in sorted(rows, key=lambda x: -x[0])[:worst]:
+        print(f"  {ratio:6.2f} {what:14} component {cid:2d}  {r['library']} {r['model']} seed {r['seed']}: "
+              f"{replay(r, libraries)}")  # fmt: skip
+    if plot:
+        _plot(rows, plot)
+    return len(outside)
+
+
+def _plot(rows: list, path: str) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from haptic.episode.evaluate import BOUND_QUANTITIES
+
+    fig, axes = plt.subplots(2, 3, figsize=(12, 6), sharex=True)
+    bins = np.linspace(-3, 1.5, 46)
+    for ax, what in zip(axes.ravel(), BOUND_QUANTITIES, strict=True):
+        a = np.array([x for x, w, _, _ in rows if w == what])
+        ax.hist(np.log10(np.maximum(a, 1e-3)), bins=bins, color="tab:blue")
+        ax.axvline(0.0, color="tab:red", lw=1)
+        ax.set_title(f"{what} (n {len(a)}, {int((a > 1).sum())} > 1)", fontsize=10)
+    for ax in axes[-1]:
+        ax.set_xlabel("log10 (error / bound)")
+    fig.tight_layout()
+    tmp = Path(path).with_suffix(".tmp.png")
+    fig.savefig(tmp, dpi=110)
+    tmp.replace(path)
+    print(f"histogram: {path}")
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--fixed-plan", action="store_true", help="errors per seed object over a fixed plan of moves")
+    ap.add_argument("--summarize", nargs="+", default=None, metavar="JSONL", help="report on records already run")
+    ap.add_argument("--poses", type=int, default=None, help="poses per object (default 2; fixed plan: 5)")
+    ap.add_argument("--objects", default=None, help="comma-separated model names (default: all)")
+    ap.add_argument("--seed", type=int, default=0, help="fixed plan: seed of the poses")
+    ap.add_argument("--out", default="out/perception/records.jsonl", help="episode records (JSON lines)")
+    ap.add_argument("--resume", action="store_true", help="run only the episodes not yet in --out")
+    ap.add_argument("--models", default=None, help="library directory (default: the seed library)")
+    ap.add_argument("--corpus", action="store_true", help="the formula corpus (scripts/make_corpus.py) instead")
+    ap.add_argument("--sizes", default=None, help="comma-separated largest extents [mm]: one library per size")
+    ap.add_argument("--libraries", default=DEFAULT_LIBRARIES, help="where scaled libraries are written")
+    ap.add_argument("--per-library", type=int, default=None, help="objects drawn per library (default: all)")
+    ap.add_argument("--first-seed", type=int, default=1, help="episode seed of the first pose")
+    ap.add_argument("--verify", default="full", choices=("none", "fast", "full"))
+    ap.add_argument("--noise", type=float, default=1.0, help="sensor-noise level")
+    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--worst", type=int, default=10, help="worst cases listed")
+    ap.add_argument("--plot", default=None, help="histogram of error / bound per quantity (PNG)")
+    args = ap.parse_args(argv)
+    if args.fixed_plan:
+        args.poses = args.poses or 5
+        return fixed_plan(args)
+    if args.summarize:
+        from haptic.bench.results import read_results
+
+        records = [r for p in args.summarize for r in read_results(p)]
+    else:
+        args.poses = args.poses or 2
+        run_episodes(args)
+        from haptic.bench.results import read_results
+
+        records = read_results(args.out)
+    summarize(records, args.worst, args.plot, args.libraries)
     return 0
 
 

@@ -7,7 +7,7 @@ import numpy as np
 
 from haptic.episode.loop import EpisodeObserver
 from haptic.episode.spec import EpisodeSpec
-from haptic.episode.worlds import run_episode
+from haptic.episode.worlds import build_episode, run_episode
 
 
 def test_a_physics_episode_recognises_the_pyramid():
@@ -85,3 +85,115 @@ def test_a_pad_lifted_off_a_valley_reports_no_vertex():
     assert rec.outcome != "no-match", rec.detail
     assert rec.perception["spurious"] == 0
     assert lost and lost[0].status == "no-contact"
+
+
+def _scaled_seed_library(directory, extent: float) -> str:
+    """The seed library with every model scaled to ``extent`` [m] across (``scripts/perception_report.py
+    --sizes``), written to ``directory``."""
+    from haptic.geometry import load_library
+    from haptic.geometry.io import save_model
+    from haptic.geometry.perturb import scaled_to
+
+    for name, poly in load_library().items():
+        save_model(scaled_to(poly, extent), directory / f"{name}.json")
+    return str(directory)
+
+
+def test_an_edge_move_stopped_by_the_table_reports_no_vertex(tmp_path):
+    # BOX01P 40 mm across, seed 1 (perception_report.py --sizes 40): two edge moves ran down an edge until the
+    # pad met the table; each reported a "vertex" where the edge line meets the table plane. The second edge
+    # ends 8 mm above the table and that vertex lay 14 mm past it (5.9 bounds), and the episode ended no-match.
+    # Stopped by the table the move reports nothing: the edge may end above the table or at a chamfer.
+    from haptic.episode.evaluate import bound_ratios
+    from haptic.sim.scene import TABLE_TOP_Z
+
+    failed = []
+    obs = EpisodeObserver(on_failed_move=lambda n, r: failed.append(r))
+    spec = EpisodeSpec(model="BOX01P", seed=1, executor="physics", models=_scaled_seed_library(tmp_path, 0.04),
+                       max_moves=11)  # fmt: skip
+    ep = build_episode(spec)
+    ep.run(None, obs)
+    assert any(r.move.kind == "edge" and "met the table" in r.reason for r in failed)
+    vertices = [c for c in ep.executor.components if c.kind == "vertex"]
+    assert vertices and all(v.position[2] > TABLE_TOP_Z + 0.002 for v in vertices)
+    assert max(r.ratio for r in bound_ratios(ep.executor.components, ep.true_model, ep.world_from_model)) <= 1.0
+
+
+def test_a_concave_edge_whose_end_the_pad_rolls_past_reports_no_vertex(tmp_path):
+    # FRAME01 40 mm across, seed 1: an edge move along a concave edge of the hole ran to its end, where the
+    # faces' corners are obtuse: the pad's contacts rolled on along the rims and the vertex was put at their
+    # median, 3.6 mm past the true end (2.7 bounds; the edge's extent 1.2 bounds), and the episode ended
+    # no-match. The surface falling away does not locate a concave edge's end: the move reports nothing.
+    from haptic.episode.evaluate import bound_ratios
+
+    failed = []
+    obs = EpisodeObserver(on_failed_move=lambda n, r: failed.append(r))
+    spec = EpisodeSpec(model="FRAME01", seed=1, executor="physics", models=_scaled_seed_library(tmp_path, 0.04),
+                       max_moves=5)  # fmt: skip
+    ep = build_episode(spec)
+    ep.run(None, obs)
+    assert any(r.move.kind == "edge" and "concave edge" in r.reason for r in failed)
+    assert max(r.ratio for r in bound_ratios(ep.executor.components, ep.true_model, ep.world_from_model)) <= 1.0
+
+
+def _scaled_corpus(directory, extent: float) -> str:
+    """The formula corpus with every solid scaled to ``extent`` [m] across (``scripts/perception_report.py
+    --corpus --sizes``), written to ``directory``."""
+    from haptic.geometry.corpus import corpus_solids
+    from haptic.geometry.io import save_model
+    from haptic.geometry.perturb import scaled_to
+
+    for s, poly in corpus_solids():
+        save_model(scaled_to(poly, extent, s.name), directory / f"{s.name}.json")
+    return str(directory)
+
+
+def test_a_face_move_that_rolls_round_a_vertex_reports_no_edge(tmp_path):
+    # bipyramid_06 of the formula corpus at 60 mm across, seed 1 (perception_report.py --corpus --sizes 60): a face
+    # move rolled round the apex onto a face sharing no edge with the first; the "edge" reported between them
+    # (n_a × n_b through the apex) lay 36 mm off every true edge (48 bounds) and the episode ended no-match.
+    # The rolling normals leaned along that line more than the noise allows: no edge is reported.
+    from haptic.episode.evaluate import bound_ratios
+
+    failed = []
+    obs = EpisodeObserver(on_failed_move=lambda n, r: failed.append(r))
+    spec = EpisodeSpec(model="bipyramid_06", seed=1, executor="physics", models=_scaled_corpus(tmp_path, 0.06),
+                       max_moves=11)  # fmt: skip
+    ep = build_episode(spec)
+    ep.run(None, obs)
+    assert any(r.move.kind == "face" and "more than the noise allows" in r.reason for r in failed)
+    assert max(r.ratio for r in bound_ratios(ep.executor.components, ep.true_model, ep.world_from_model)) <= 1.0
+
+
+def test_an_edge_move_that_goes_on_round_a_shallow_vertex_reports_no_vertex(tmp_path):
+    # prism_12 of the formula corpus at 60 mm, seed 1: an edge move along a cap edge of the 12-gon went on round
+    # its end, where the next cap edge turns by only 30°, and the vertex was put at the contacts there, 1.7 mm
+    # past the end (1.4 bounds). Those contacts lay 1.1 mm off the edge's line (those of a pad rolling on a
+    # vertex 0.2-0.3 mm): the move reports nothing.
+    from haptic.episode.evaluate import bound_ratios
+
+    failed = []
+    obs = EpisodeObserver(on_failed_move=lambda n, r: failed.append(r))
+    ep = build_episode(EpisodeSpec(model="prism_12", seed=1, executor="physics", models=_scaled_corpus(tmp_path, 0.06),
+                                   max_moves=18))  # fmt: skip
+    ep.run(None, obs)
+    assert any(r.move.kind == "edge" and "off the edge's line" in r.reason for r in failed)
+    assert max(r.ratio for r in bound_ratios(ep.executor.components, ep.true_model, ep.world_from_model)) <= 1.0
+
+
+def test_a_vertex_move_whose_circle_meets_an_edge_of_another_vertex_reports_no_edge(tmp_path):
+    # trapezohedron_12 of the formula corpus at 60 mm, seed 1: circling a vertex across a kite narrower than the
+    # circle, the pad met an edge that does not leave that vertex; the edge was reported adjacent to it (within
+    # its geometric bounds, but a wrong adjacency) and the tree pruned the truth: no-match. The edge's line
+    # passes far from the vertex circled: the move reports nothing.
+    from haptic.episode.evaluate import score_components
+
+    failed, results = [], []
+    obs = EpisodeObserver(on_move=lambda n, r, *a: results.append(r),
+                          on_failed_move=lambda n, r: (failed.append(r), results.append(r)))  # fmt: skip
+    spec = EpisodeSpec(model="trapezohedron_12", seed=1, executor="physics", models=_scaled_corpus(tmp_path, 0.06),
+                       max_moves=6)  # fmt: skip
+    ep = build_episode(spec)
+    ep.run(None, obs)
+    assert any(r.move.kind == "vertex" and "leaves another vertex" in r.reason for r in failed)
+    assert score_components(ep.executor.components, ep.true_model, ep.world_from_model, results).missed == 0

@@ -59,3 +59,46 @@ def test_the_pad_tracing_a_low_wall_first_meets_the_floor():
     hit = first_felt_edge(poly, 7, start, d, tol)
     assert np.allclose(poly.vertices[poly.edges[hit.edge]][:, 2], 0.06)  # the wall's foot
     assert poly.edge_convexity[hit.edge] < 0 and 0.070 < hit.point[2] < 0.073  # contact 12 mm over the floor
+
+
+def test_bound_ratios_measure_each_quantity_in_units_of_its_bound():
+    # BOX01 at a pose: a face, an edge and a vertex measured exactly, then each moved by a known multiple of its
+    # bound; the ratios follow, against the true feature that explains each best
+    from haptic.episode.evaluate import BOUND_QUANTITIES, bound_ratios
+    from haptic.geometry import SE3
+    from haptic.matching.components import DataEdge, DataVertex
+
+    poly = LIB["BOX01"]
+    pose = SE3.from_matrix(np.array([[0.0, -1, 0, 0.4], [1, 0, 0, -0.1], [0, 0, 1, 0.02], [0, 0, 0, 1]]))
+    top = int(np.argmax(poly.face_normals[:, 2]))
+    n_w = pose.rotate(poly.face_normals[top])
+    loop = poly.vertices[list(poly.faces[top])]
+    pts = pose.apply(0.7 * loop + 0.3 * loop.mean(axis=0))
+    e = 0
+    a, b = pose.apply(poly.vertices[poly.edges[e]])
+    u = (b - a) / np.linalg.norm(b - a)
+    v = int(poly.edges[e, 1])
+
+    def ratios(face_shift, edge_shift, vertex_shift, extent):
+        across = np.cross(u, n_w) if abs(u @ n_w) < 0.9 else np.cross(u, [1.0, 0, 0])
+        across /= np.linalg.norm(across)
+        comps = [
+            DataFace(0, n_w, pts + face_shift * 0.001 * n_w, 0.01, 0.001),
+            DataEdge(1, u, a + 0.01 * u + edge_shift * 0.001 * across, np.linalg.norm(b - a) - 0.02 + extent * 0.001,
+                     0.01, 0.001, 0.001),
+            DataVertex(2, pose.apply(poly.vertices[v]) + vertex_shift * 0.001 * n_w, 0.001),
+        ]
+        rows = bound_ratios(comps, poly, pose)
+        assert {r.what for r in rows} <= set(BOUND_QUANTITIES)
+        return {(r.id, r.what): r.ratio for r in rows}, {r.id: r.true_id for r in rows}
+
+    exact, ids = ratios(0.0, 0.0, 0.0, 0.0)
+    assert max(exact.values()) < 1e-6
+    assert ids == {0: top, 1: e, 2: v}
+    moved, _ = ratios(2.0, 1.5, 3.0, 10.0)  # the edge's interval runs 10 mm - 10 mm = 0 past its true end...
+    assert np.isclose(moved[(0, "face point")], 2.0, rtol=1e-3)
+    assert np.isclose(moved[(1, "edge line")], 1.5, rtol=1e-3)
+    assert np.isclose(moved[(2, "vertex")], 3.0, rtol=1e-3)
+    assert moved[(1, "edge extent")] < 1e-6
+    past, _ = ratios(0.0, 0.0, 0.0, 12.5)  # ... and 2.5 mm past it: 2.5 length bounds
+    assert np.isclose(past[(1, "edge extent")], 2.5, rtol=1e-3)

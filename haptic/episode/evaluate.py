@@ -11,6 +11,13 @@ boundary within the position tolerance of a vertex is not checked --, an edge mo
 of the true edge it followed, and a vertex move whose new edge does not leave the circled vertex on the face
 circled across each count one *missed* component.
 
+Every component is also scored **in units of its own error bounds** (:func:`bound_ratios`): each quantity the
+pose check of verification tests (:func:`haptic.matching.acceptance.residual_ratios`: a face's normal and
+touched points, an edge's direction, line and extent, a vertex's position) at the true pose, against the true
+feature of its kind that explains the component best. A ratio above 1 is a component outside its bounds: the
+true object itself does not fit it, and a matcher that trusts the bounds may prune the truth or keep a wrong
+model.
+
 The executor and the segmenter never import this module.
 """
 
@@ -25,8 +32,10 @@ from haptic.geometry import tracing
 from haptic.geometry.distance import point_triangle_distance
 from haptic.geometry.polyhedron import Polyhedron
 from haptic.geometry.se3 import SE3, plane_basis
+from haptic.matching.acceptance import residual_ratios
 from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex
 from haptic.matching.trace import PHASES
+from haptic.matching.tree import Interpretation
 from haptic.sim.scene import PAD_RADIUS
 
 
@@ -74,6 +83,13 @@ class PerceptionScore:
     """Data edges matched to concave true edges."""
     details: dict = field(default_factory=dict)
     """Per-move checks."""
+    ratios: tuple[BoundRatio, ...] = ()
+    """Every measured quantity of every component in units of its bound (:func:`bound_ratios`)."""
+
+    @property
+    def outside_bounds(self) -> tuple[int, ...]:
+        """Ids of the components with a quantity more than its bound from the best true feature."""
+        return tuple(sorted({r.id for r in self.ratios if r.ratio > 1.0}))
 
     def errors(self, kind: str, what: str) -> np.ndarray:
         """Errors of matched components of ``kind``: ``what`` is ``angle`` or ``position``."""
@@ -98,7 +114,62 @@ class PerceptionScore:
             "spurious": self.spurious,
             "missed": self.missed,
             "concave_edges_found": self.concave_edges_found,
+            "bound_ratio": {
+                what: stats(np.array([r.ratio for r in self.ratios if r.what == what])) for what in BOUND_QUANTITIES
+            },
+            "outside_bounds": len(self.outside_bounds),
+            "ratios": [[r.id, r.what, round(r.ratio, 4), r.true_id] for r in self.ratios],
         }
+
+
+BOUND_QUANTITIES = ("face normal", "face point", "edge direction", "edge line", "edge extent", "vertex")
+"""What :func:`bound_ratios` scores, as the pose check names it."""
+
+
+@dataclass(frozen=True)
+class BoundRatio:
+    """One measured quantity of a data component against the truth, in units of its bound."""
+
+    id: int
+    """Data id."""
+    what: str
+    """One of :data:`BOUND_QUANTITIES`."""
+    ratio: float
+    """Residual at the true pose over the component's bound (≤ 1: the bound holds)."""
+    true_id: int
+    """The true feature (model face, edge or vertex index) the component was scored against."""
+
+
+def bound_ratios(components, model: Polyhedron, world_from_model: SE3) -> list[BoundRatio]:
+    """Every quantity of every data component (the latest report of each id) in units of its own bound, at the
+    true pose, against the true feature of its kind (and, for an edge, the sense) whose largest ratio is the
+    smallest: the feature that explains the component best. The quantities and their residuals are those of
+    verification's pose check (:func:`~haptic.matching.acceptance.residual_ratios`), so a ratio above 1 is
+    a component that the true object at its true pose does not explain within its bounds."""
+    data = {c.id: c for c in _latest(components)}
+    out: list[BoundRatio] = []
+    for c in data.values():
+        if isinstance(c, DataFace):
+            options = [({c.id: f}, {}, {}, {}) for f in range(model.n_faces)]
+        elif isinstance(c, DataEdge):
+            options = [({}, {c.id: e}, {}, {c.id: s}) for e in range(model.n_edges) for s in (1, -1)]
+        else:
+            near = int(np.argmin(np.linalg.norm(world_from_model.apply(model.vertices) - c.position, axis=1)))
+            options = [({}, {}, {c.id: near}, {})]
+        best = None
+        for faces, edges, vertices, senses in options:
+            it = Interpretation(model, 0, faces, edges, vertices, senses, world_from_model, 0)
+            rows = residual_ratios(model, data, it, world_from_model)
+            worst = max(r for r, _, _ in rows)
+            if best is None or worst < best[0]:
+                true_id = next(iter((faces or edges or vertices).values()))
+                best = (worst, rows, true_id)
+        # one ratio per quantity: the largest (an edge's line is tested at both ends)
+        per: dict[str, float] = {}
+        for r, _, what in best[1]:
+            per[what] = max(per.get(what, 0.0), float(r))
+        out += [BoundRatio(c.id, what, r, best[2]) for what, r in per.items()]
+    return out
 
 
 def _latest(components) -> list[DataComponent]:
@@ -189,7 +260,9 @@ def score_components(
     missed, details = 0, {}
     if results:
         missed, details = _missed(results, model, rot, trans, by_id, tol)
-    return PerceptionScore(tuple(scores), sum(1 for s in scores if s.true_id is None), missed, concave, details)
+    ratios = tuple(bound_ratios(components, model, world_from_model))
+    return PerceptionScore(tuple(scores), sum(1 for s in scores if s.true_id is None), missed, concave, details,
+                           ratios)  # fmt: skip
 
 
 MIN_TILT = math.radians(10.0)
@@ -341,4 +414,12 @@ _FEATURE_CHECKS = {"face": _face_check, "edge": _edge_check, "vertex": _vertex_c
 component, the two true ids compared, ok), or None when the truth cannot say."""
 
 
-__all__ = ["ComponentScore", "EvaluationTolerances", "PerceptionScore", "score_components"]
+__all__ = [
+    "BOUND_QUANTITIES",
+    "BoundRatio",
+    "ComponentScore",
+    "EvaluationTolerances",
+    "PerceptionScore",
+    "bound_ratios",
+    "score_components",
+]

@@ -637,12 +637,19 @@ class PhysicsExecutor(LandingSearch):
         pieces.append(r)
         if not r.ok:
             return self.failed_result(move, r, f"following the edge: {r.event}")
+        if r.info.get("event_sign", 1) < 0 and self.workspace.touching_table(self._finger_contacts()):
+            # stopped by the table, not by the object: where the edge line meets the table plane is no vertex
+            # (the edge may end above it, or at a chamfer the pad cannot reach)
+            return self.failed_result(move, "unreachable", "following the edge: the pad met the table before the "
+                                                           "edge's end")  # fmt: skip
         hold = t.hold(s.vertex_hold)
         pieces.append(hold)
         rows = ContactTrace.concatenate([r.trace, hold.trace])
         s_v, s_sigma = self._vertex_param(rec, rows, u, r.info.get("event_sign", 1))
         if s_v is None:
-            return self.failed_result(move, "unreachable", "could not locate the vertex")
+            why = ("could not locate the vertex (no contact there, a concave edge's end, which its faces run past, or "
+                   "contacts off the edge's line, on an edge turning little from it)")  # fmt: skip
+            return self.failed_result(move, "unreachable", why)
         # refine the line with the ridge contacts (convex edges), then extend it to the vertex
         ridge = self._on_ridge(rows, u)
         w_v, w_from = rec.at(s_v), rec.at(s_from)
@@ -674,6 +681,11 @@ class PhysicsExecutor(LandingSearch):
         n = np.where(ok[:, None], rows.normal_in_world, 0.0)
         c = n @ u
         b, s = self.bounds, self.settings
+        if event_sign > 0 and not rec.convex:
+            # the pad in a concave corner touches the two faces, not the edge: where their corners at its end are
+            # obtuse the faces run on past it and so do the contacts, rolling on along the rims (FRAME01's hole
+            # at 40 mm: 3.6 mm past): the surface falling away does not locate a concave edge's end
+            return None, 0.0
         if event_sign > 0:
             at_v = ok & (c > s.touch.loss_lean_sin)  # the pad rolls on the vertex
             if at_v.sum() < s.min_vertex_rows:  # contact was lost: the last contacts
@@ -682,7 +694,13 @@ class PhysicsExecutor(LandingSearch):
                 at_v[idx] = True
             if not at_v.any():
                 return None, 0.0
-            along = (rows.point_in_world[at_v] - rec.point) @ rec.direction
+            rel = rows.point_in_world[at_v] - rec.point
+            along = rel @ rec.direction
+            off = float(np.median(np.linalg.norm(rel - along[:, None] * rec.direction, axis=1)))
+            if off > b.bound(rec.position_sigma, b.position_floor):
+                # rolling on the vertex the contacts stay on the edge's line; off it, the pad went on round the
+                # vertex along an edge turning little from this one (a 12-gon's, 30°): the contacts lie past it
+                return None, 0.0
             return float(np.median(along)), max(float(np.std(along)), b.point_sigma) / math.sqrt(len(along))
         contacts = self._finger_contacts()
         if not contacts:
@@ -738,6 +756,15 @@ class PhysicsExecutor(LandingSearch):
             return self.failed_result(move, "unreachable", why)
         new_face = seg.next_id + 1
         s_vtx = float((vtx - line.point) @ line.direction)
+        b = self.bounds
+        off = float(np.linalg.norm(vtx - line.point - s_vtx * line.direction))
+        lever = abs(s_vtx - float(np.clip(s_vtx, *line.s_range)))  # from the explored interval to the vertex
+        allowed = (seg.vertices[st.vertex].position_bound + b.bound(line.position_sigma, b.position_floor)
+                   + lever * b.bound(line.direction_sigma, b.direction_floor))  # fmt: skip
+        if off > allowed:
+            # the circle crossed an edge that does not leave the vertex (on a face narrower than the circle)
+            return self.failed_result(move, "unreachable", f"the edge met passes {off * MM:.1f} mm from the vertex "
+                                                           "circled: it leaves another vertex")  # fmt: skip
         edge = seg.add_edge(line, (f, new_face), kind == "convex", (fit_f.normal, fit_g.normal),
                             adjacent=(st.vertex, f), vertex=(st.vertex, s_vtx))  # fmt: skip
         face = seg.add_face(fit_g, adjacent=(edge.id,))

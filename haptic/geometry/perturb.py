@@ -25,6 +25,15 @@ def scale_dimension(poly: Polyhedron, axis: int, factor: float, name: str | None
     return Polyhedron.from_faces(v, poly.faces, name=name or f"{poly.name}_x{axis}_{factor:g}")
 
 
+def scaled_to(poly: Polyhedron, extent: float, name: str | None = None) -> Polyhedron:
+    """The model scaled about the origin so that its largest extent (bounding box) is ``extent`` [m]: the
+    same solid at another size (a library at the sizes a hand must explore)."""
+    if not np.isfinite(extent) or extent <= 0:
+        raise ModelError(f"{poly.name}: scaled_to takes an extent > 0 [m], got {extent}")
+    f = extent / float(np.max(poly.extents))
+    return Polyhedron.from_faces(np.array(poly.vertices) * f, poly.faces, name=name or poly.name)
+
+
 def vertex_normal(poly: Polyhedron, vertex: int) -> np.ndarray:
     """Unit mean of the outward normals of the faces at ``vertex`` (weighted equally)."""
     n = poly.face_normals[list(poly.vertex_faces[vertex])].sum(axis=0)

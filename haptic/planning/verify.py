@@ -89,7 +89,14 @@ def reachable_features(
         if int(ok.sum()) >= MIN_SAMPLES:
             faces.add(f)
     edges = {e for e in range(poly.n_edges) if {int(poly.edge_left_face[e]), int(poly.edge_right_face[e])} <= faces}
-    vertices = {v for v in range(poly.n_vertices) if sum(f in faces for f in poly.vertex_faces[v]) >= 2}
+    vertices = [v for v in range(poly.n_vertices) if sum(f in faces for f in poly.vertex_faces[v]) >= 2]
+    # ... where the pad touching the vertex from one of them stays clear of the table: an edge move run down to a
+    # vertex nearer the table is stopped by the table, which locates no vertex
+    r = config.pad_radius
+    low = config.table_z + config.table_clearance
+    z = world_from_model.apply(poly.vertices)[:, 2]
+    nz = world_from_model.rotate(poly.face_normals)[:, 2]
+    vertices = [v for v in vertices if any(z[v] + r * nz[f] - r >= low for f in poly.vertex_faces[v] if f in faces)]
     return frozenset(faces), frozenset(edges), frozenset(vertices)
 
 

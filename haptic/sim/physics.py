@@ -11,7 +11,7 @@ to the model or data, so nothing read through them can reveal the object's pose 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import mujoco
 import numpy as np
@@ -56,6 +56,11 @@ def merge_patches(points: np.ndarray, normals: np.ndarray, forces: np.ndarray) -
     return w @ points[keep], normal / math.sqrt(float(normal @ normal))
 
 
+WRIST_TORQUE_LEVER = 0.1
+"""The wrist sensor's torque noise is its force noise at this lever arm, about the distance from the wrist to the
+fingertips [m]."""
+
+
 @dataclass(frozen=True)
 class SimulatedSensorNoise:
     """Zero-mean Gaussian noise of the simulated sensors, per sample (all zero: ideal sensors): the per-sample
@@ -70,6 +75,8 @@ class SimulatedSensorNoise:
     """σp: contact point, per axis [m]."""
     joint_std: float = 0.0
     """Joint encoder [rad]."""
+    torque_std: float = 0.0
+    """The wrist sensor's torque, per axis [N m] (its force per axis: ``force_std``)."""
 
     @property
     def any(self) -> bool:
@@ -78,9 +85,11 @@ class SimulatedSensorNoise:
 
     @classmethod
     def from_model(cls, model: NoiseModel) -> SimulatedSensorNoise:
-        """The per-sample noise of ``model`` at its level."""
+        """The per-sample noise of ``model`` at its level (the wrist torque's: its force's at
+        :data:`WRIST_TORQUE_LEVER`)."""
         k = model.level
-        return cls(model.force_std * k, model.normal_std * k, model.point_std * k, model.joint_std * k)
+        return cls(model.force_std * k, model.normal_std * k, model.point_std * k, model.joint_std * k,
+                   model.force_std * k * WRIST_TORQUE_LEVER)  # fmt: skip
 
     @classmethod
     def from_notes(cls) -> SimulatedSensorNoise:
@@ -103,6 +112,21 @@ class FingertipContact:
 
 
 @dataclass(frozen=True)
+class LinkContact:
+    """A contact of a robot link other than a fingertip pad with anything (the object, the table), as the
+    link's contact readout senses it (world frame): where the hand touches what it did not mean to."""
+
+    link: str
+    """The link's name (one of :data:`LINK_NAMES`)."""
+    point_in_world: np.ndarray
+    """Contact point (3,) [m]."""
+    normal_in_world: np.ndarray
+    """Unit normal (3,) of the touched surface, pointing out of it towards the link."""
+    normal_force: float
+    """Force along the normal [N]."""
+
+
+@dataclass(frozen=True)
 class SensorReading:
     """A snapshot of what the robot senses. Per-finger arrays follow ``FINGERS`` order."""
 
@@ -122,6 +146,13 @@ class SensorReading:
     """Touch sensor per fingertip (4,) [N]: sum of normal forces inside the tip site."""
     contacts: tuple[tuple[FingertipContact, ...], ...]
     """Per fingertip, its pad's contacts (possibly none)."""
+    wrist_force: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    """The wrist force/torque sensor's force (3,) [N], world frame: what the flange exerts on the hand (the
+    hand's weight and every contact of the hand, pads and links)."""
+    wrist_torque: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    """... its torque (3,) [N m] about the wrist site (the hand's origin at the flange), world frame."""
+    link_contacts: tuple[LinkContact, ...] = ()
+    """Contacts of the robot's links other than the fingertip pads (the palm, the finger links, the arm)."""
 
     def finger(self, name: str) -> int:
         """Index of finger ``name`` in the per-finger arrays."""
@@ -292,6 +323,13 @@ class Simulation:
         self._geom_finger = np.full(m.ngeom, -1, dtype=int)
         self._geom_finger[self.pad_geom] = np.arange(len(FINGERS))
         self._geom_finger_list: list[int] = self._geom_finger.tolist()
+        self._geom_link = self._robot_geom_links()
+        """Per geom: the index in :data:`LINK_NAMES` of the robot link it belongs to (-1: a pad, the object,
+        the table)."""
+        self._geom_link_list: list[int] = self._geom_link.tolist()
+        ft = [oid(mujoco.mjtObj.mjOBJ_SENSOR, HAND_PREFIX + n) for n in ("wrist_force", "wrist_torque")]
+        self.wrist_adr = np.concatenate([m.sensor_adr[s] + np.arange(3) for s in ft])
+        self.wrist_site = oid(mujoco.mjtObj.mjOBJ_SITE, HAND_PREFIX + "wrist_ft")
         self.home_key = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_KEY, "home")
         self._force6 = np.zeros(6)
         self.reset()
@@ -305,7 +343,23 @@ class Simulation:
         d.qpos[self.hand] = HAND_TRACE if hand_q is None else hand_q
         d.ctrl[self.hand] = d.qpos[self.hand]
         self._rng = np.random.default_rng(self._seed)
+        # the added senses draw their noise apart, so that the fingertip's readings are those of the same seed
+        self._senses_rng = np.random.default_rng([self._seed, 1])
         mujoco.mj_forward(m, d)
+
+    def _robot_geom_links(self) -> np.ndarray:
+        """Per geom, the :data:`LINK_NAMES` index of the robot link body it hangs from (its own body or the
+        nearest ancestor among them); -1 for the fingertip pads and every geom not of the robot."""
+        m = self.model
+        link_of = {int(b): i for i, b in enumerate(self.link_body)}
+        out = np.full(m.ngeom, -1, dtype=int)
+        for g in range(m.ngeom):
+            b = int(m.geom_bodyid[g])
+            while b > 0 and b not in link_of:
+                b = int(m.body_parentid[b])
+            if b in link_of and g not in set(self.pad_geom.tolist()) and m.geom_contype[g] | m.geom_conaffinity[g]:
+                out[g] = link_of[b]
+        return out
 
     def step(self, n: int = 1) -> None:
         """Advance ``n`` physics steps with the current controls (``mj_step`` with ``nstep``)."""
@@ -405,6 +459,45 @@ class Simulation:
                 normal /= math.sqrt(float(normal @ normal))
         return total, normal, point, len(raw)
 
+    def wrist_wrench(self) -> tuple[np.ndarray, np.ndarray]:
+        """The wrist force/torque sensor (MuJoCo ``force`` and ``torque`` sensors at the hand's ``wrist_ft``
+        site): force (3,) [N] and torque (3,) [N m] in the world frame, noise applied."""
+        raw = self.data.sensordata[self.wrist_adr]
+        rot = self.data.site_xmat[self.wrist_site].reshape(3, 3)
+        force, torque = rot @ raw[:3], rot @ raw[3:]
+        nz = self.noise
+        if nz.force_std > 0:
+            force = force + nz.force_std * self._senses_rng.standard_normal(3)
+        if nz.torque_std > 0:
+            torque = torque + nz.torque_std * self._senses_rng.standard_normal(3)
+        return force, torque
+
+    def link_contacts(self) -> tuple[LinkContact, ...]:
+        """Contacts of the robot's links other than the fingertip pads with anything not of the robot (the
+        object, the table), noise applied as to a pad's contacts: each link's contact readout."""
+        d, nz = self.data, self.noise
+        if d.ncon == 0:
+            return ()
+        owner = self._geom_link_list
+        out = []
+        for i, (g1, g2) in enumerate(d.contact.geom.tolist()):
+            k1, k2 = owner[g1], owner[g2]
+            if (k1 < 0) == (k2 < 0):  # neither a link, or link against link
+                continue
+            c = d.contact[i]
+            if c.efc_address < 0:
+                continue
+            mujoco.mj_contactForce(self.model, d, i, self._force6)
+            normal = c.frame.reshape(3, 3)[0].copy()  # geom1 -> geom2
+            link = k1 if k1 >= 0 else k2
+            if k1 >= 0:
+                normal = -normal  # out of the touched surface, towards the link
+            point = c.pos.copy()
+            if nz.point_std > 0:
+                point = point + nz.point_std * self._senses_rng.standard_normal(3)
+            out.append(LinkContact(LINK_NAMES[link], point, normal, float(self._force6[0])))
+        return tuple(out)
+
     def touch(self) -> np.ndarray:
         """Touch force per fingertip (4,) [N], noise applied (clipped at 0)."""
         t = self.data.sensordata[self.touch_adr].copy()
@@ -490,6 +583,7 @@ class Simulation:
             if nz.point_std > 0:
                 p = p + nz.point_std * self._rng.standard_normal(3)
             per[k].append(FingertipContact(p, self._noisy_normal(n), f, fn))
+        wrench = self.wrist_wrench()
         return SensorReading(
             time=float(d.time),
             arm_q=q[self.arm],
@@ -499,4 +593,7 @@ class Simulation:
             fingertip_in_world=self.fingertip_positions(),
             touch=self.touch(),
             contacts=tuple(tuple(c) for c in per),
+            wrist_force=wrench[0],
+            wrist_torque=wrench[1],
+            link_contacts=self.link_contacts(),
         )

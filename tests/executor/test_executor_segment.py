@@ -148,3 +148,28 @@ def test_a_roll_too_short_or_round_a_vertex_gives_no_edge():
     then = _noisy_roll(np.array([1.0, 0.0, 0.0]), first.normal_in_world[-1], 25.0, pivot, rng, 30)
     both = ContactTrace.concatenate([first, then])
     assert "axis" in seg.edge_from_roll(_face_fit(n_a), both)
+
+
+def test_a_roll_round_a_vertex_leans_along_the_edge_more_than_the_noise_allows():
+    # a roll onto a face that shares only a vertex with the first turns the normals about an axis a few degrees
+    # off n_a × n_b (bipyramid_06 at 60 mm: median |n · e| 0.051); a roll over the edge between them leans along
+    # it by the sensor noise alone (σn 1°: median 0.012): the first is no edge, the second is
+    top, side = np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0])
+    edge_pt = np.array([0.0, 0.01, 0.0])
+    fa, fb = _plane(top, np.array([-0.01, 0.0, 0.0])), _plane(side, np.array([0.0, 0.0, -0.01]))
+    rng = np.random.default_rng(5)
+
+    def noisy(roll: ContactTrace, sigma: float) -> ContactTrace:
+        n = roll.normal_in_world + sigma * rng.normal(size=roll.normal_in_world.shape)
+        n /= np.linalg.norm(n, axis=1, keepdims=True)
+        return ContactTrace(roll.time, roll.tip_in_world, roll.hand_rotation, roll.point_in_world, n, roll.force,
+                            roll.phase)  # fmt: skip
+
+    seg = Segmenter()
+    over_edge = noisy(_roll(np.array([0.0, 1.0, 0.0]), top, side, edge_pt), math.radians(1.0))
+    assert seg.edge_inconsistency(fa, fb, True, over_edge) is None
+    tilt = math.radians(4.0)  # the roll's axis 4° off the edge: the normals lean along it by up to sin 4°
+    axis = np.array([math.sin(tilt), math.cos(tilt), 0.0])
+    round_vertex = noisy(_roll(axis, top, side, edge_pt), math.radians(1.0))
+    why = seg.edge_inconsistency(fa, fb, True, round_vertex)
+    assert why is not None and "more than the noise allows" in why

@@ -78,3 +78,29 @@ def test_vertices_under_an_overhang_are_hidden_and_the_table_ones_are_not():
         cov = Coverage(frozenset(), frozenset(), frozenset(v), f, e, v)
         assert hidden_vertices(poly, pose, cov, table) == hidden
         assert hidden_vertices(poly, pose, cov, PlannerConfig()) == []
+
+
+def test_a_vertex_the_pad_cannot_touch_clear_of_the_table_is_hidden():
+    """BOX01P 40 mm across lying on its side (the pose of perception_report.py --sizes 40, seed 1): the block's
+    corners 14 mm up would put the 12 mm pad's lowest point under the table's clearance from every face they
+    bound (an edge move down to one was stopped by the table): hidden, so that verification says it is
+    incomplete instead of asking for them; the corners 26 mm up are measured."""
+    from dataclasses import replace
+
+    from haptic.geometry.perturb import scaled_to
+    from haptic.geometry.se3 import quat_to_matrix
+    from haptic.matching.acceptance import Coverage
+    from haptic.planning.verify import hidden_vertices, reachable_features
+
+    poly = scaled_to(LIB["BOX01P"], 0.04)
+    table = replace(PlannerConfig(), table_z=0.35, pad_radius=0.012)
+    pose = SE3(quat_to_matrix(np.array([0.603677588, 0.368202892, -0.603677588, 0.368202892])),
+               np.array([0.584767923, -0.029057174, 0.35]))  # fmt: skip
+    z = pose.apply(poly.vertices)[:, 2] - 0.35
+    f, e, v = reachable_features(poly, pose, table)
+    cov = Coverage(frozenset(), frozenset(), frozenset(v), f, e, v)
+    hidden = hidden_vertices(poly, pose, cov, table)
+    low, high = np.flatnonzero(np.isclose(z, 0.014)), np.flatnonzero(np.isclose(z, 0.026))
+    assert len(low) == len(high) == 4
+    assert set(low.tolist()) <= set(hidden) and not set(low.tolist()) & set(v)
+    assert set(high.tolist()) & set(v)

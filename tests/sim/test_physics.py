@@ -11,7 +11,7 @@ from conftest import BOX_CENTRE, BOX_HALF, box_parts, box_pose
 
 from haptic.errors import SceneError
 from haptic.sim.control import Controller
-from haptic.sim.physics import FingertipContact, SensorReading, SimulatedSensorNoise, Simulation
+from haptic.sim.physics import FingertipContact, LinkContact, SensorReading, SimulatedSensorNoise, Simulation
 from haptic.sim.robot import RobotInterface
 from haptic.sim.scene import FINGERS, compose_scene, scene_object_from_parts
 
@@ -69,7 +69,8 @@ def test_unknown_finger_names_the_valid_ones(box_scene):
 
 
 # -- no peeking ------------------------------------------------------------------------------------------------
-ROBOT_FIELDS = {"time", "arm_q", "arm_qd", "hand_q", "hand_qd", "fingertip_in_world", "touch", "contacts"}
+ROBOT_FIELDS = {"time", "arm_q", "arm_qd", "hand_q", "hand_qd", "fingertip_in_world", "touch", "contacts",
+                "wrist_force", "wrist_torque", "link_contacts"}  # fmt: skip
 
 
 def test_sensor_reading_holds_robot_quantities_only():
@@ -80,6 +81,8 @@ def test_sensor_reading_holds_robot_quantities_only():
         "force_in_world",
         "normal_force",
     }
+    assert {f.name for f in dataclasses.fields(LinkContact)} == {"link", "point_in_world", "normal_in_world",
+                                                               "normal_force"}  # fmt: skip
 
 
 def test_robot_interface_has_no_path_to_the_object(box_scene):
@@ -116,3 +119,40 @@ def test_readings_do_not_depend_on_where_the_object_is():
             assert va == vb
     gt = [Simulation(compose_scene(obj, box_pose(BOX_CENTRE + [dx, 0, 0]))).ground_truth() for dx in (0, 0.05)]
     assert gt[1].world_from_object[0, 3] - gt[0].world_from_object[0, 3] == pytest.approx(0.05)
+
+
+def test_the_wrist_sensor_weighs_the_hand_and_feels_the_fingertip_press(box_scene):
+    # at rest in free space the flange holds the hand's weight; pressing the index pad down on the box with
+    # 1 N the flange's upward force drops by about that much (the box carries it)
+    sim = Simulation(box_scene)
+    ctl = Controller(sim)
+    ctl.hold_posture()
+    ctl.step(int(0.5 / ctl.tick_period))
+    hand = [b for b in range(sim.model.nbody) if sim.model.body(b).name.startswith("arm/hand/")]
+    weight = float(sim.model.body_mass[hand].sum()) * 9.81
+    r = sim.read_sensors()
+    assert np.allclose(r.wrist_force, [0.0, 0.0, weight], atol=0.02 * weight)
+    assert r.link_contacts == ()
+    _press_index_on_top(sim, force=1.0)
+    pressed = sim.read_sensors()
+    assert pressed.touch[0] > 0.5
+    assert weight - pressed.wrist_force[2] == pytest.approx(pressed.touch[0], abs=0.3)
+    # the pad's contact is the pad's, not a link's
+    assert pressed.link_contacts == ()
+
+
+def test_a_link_pushed_into_the_table_is_sensed_by_that_link(box_scene):
+    from haptic.sim.control import solve_fingertip_ik
+    from haptic.sim.scene import TABLE_TOP_Z
+
+    sim = Simulation(box_scene, noise=SimulatedSensorNoise.from_notes(), seed=2)
+    target = np.array([0.55, 0.25, TABLE_TOP_Z + 0.012 - 0.03])  # the index pad's centre 3 cm into the table
+    ik = solve_fingertip_ik(sim, "index", target)
+    assert ik.reachable
+    sim.reset(arm_q=ik.arm_q)
+    r = sim.read_sensors()
+    links = {c.link for c in r.link_contacts}
+    assert links and links <= {"index_proximal", "index_medial", "index_distal"}
+    for c in r.link_contacts:
+        assert abs(c.point_in_world[2] - TABLE_TOP_Z) < 0.01
+    assert len(r.contacts[0]) >= 1  # and the pad's own contact stays the pad's
