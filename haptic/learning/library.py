@@ -58,12 +58,30 @@ def model_text(poly: Polyhedron, provenance: dict) -> str:
     decimals = decimals_for(poly.precision) if poly.precision > 0 else 9
     verts = ",\n    ".join("[" + ", ".join(f"{float(x):.{decimals}f}" for x in p) + "]" for p in poly.vertices)
     faces = ",\n    ".join(json.dumps(list(f)) for f in poly.faces)
-    prov = json.dumps(provenance, indent=2, sort_keys=True, default=str).replace("\n", "\n  ")
+    prov = json.dumps(_short(provenance), indent=2, sort_keys=True, default=str).replace("\n", "\n  ")
     return (
         f'{{\n  "format": "haptic-polyhedron",\n  "version": {FORMAT_VERSION},\n  "name": {json.dumps(poly.name)},\n'
         f'  "units": "m",\n  "vertices": [\n    {verts}\n  ],\n  "faces": [\n    {faces}\n  ],\n'
         f'  "provenance": {prov}\n}}\n'
     )
+
+
+PROVENANCE_DIGITS = 3
+"""Significant digits of the provenance's numbers: fewer than any coordinate's, for a native file's precision is
+read from its longest-written numbers (:func:`haptic.geometry.io.text_quantum`)."""
+
+
+def _short(x):
+    """``x`` with every float rounded to :data:`PROVENANCE_DIGITS` significant digits (a whole number written as
+an integer: ``163.0`` would count four)."""
+    if isinstance(x, dict):
+        return {k: _short(v) for k, v in x.items()}
+    if isinstance(x, list | tuple):
+        return [_short(v) for v in x]
+    if isinstance(x, float):
+        v = float(f"{x:.{PROVENANCE_DIGITS}g}")
+        return int(v) if v.is_integer() else v
+    return x
 
 
 def write_learned(poly: Polyhedron, directory: str | os.PathLike, spec, bounds: LearnBounds, learned: dict) -> Path:

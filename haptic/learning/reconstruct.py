@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from haptic.errors import ModelError
-from haptic.geometry.polyhedron import Polyhedron
+from haptic.geometry.polyhedron import LearnedBounds, Polyhedron
 from haptic.geometry.se3 import plane_basis
 from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex
 
@@ -464,10 +464,13 @@ def learned_model(est: ConvexEstimate, name: str = "learned") -> Polyhedron:
     verts = verts[used]
     faces = [[index[g] for g in f] for f in faces]
     last: ModelError | None = None
+    b = est.bounds
+    learned = LearnedBounds(b.normal, b.position, b.direction)
     for attempt in (verts, planarize(verts, faces, PLANAR_ROUNDS)):
         for q in PRECISIONS:
             try:
-                return Polyhedron.from_faces(rounded(attempt, q), faces, name=name, precision=q)
+                return Polyhedron.from_faces(rounded(attempt, q), faces, name=name, precision=q,
+                                             learned_bounds=learned)  # fmt: skip
             except ModelError as exc:
                 last = exc
     raise LearnError(f"{name}: the learned solid is not a valid model ({last})")
