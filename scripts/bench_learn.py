@@ -41,7 +41,7 @@ from bench_unknown import _same_shape, variants  # noqa: E402
 from haptic.bench.runner import run_sweep  # noqa: E402
 from haptic.episode.spec import EpisodeSpec  # noqa: E402
 from haptic.errors import HapticError  # noqa: E402
-from haptic.geometry import SE3, Polyhedron, load_library, load_model, model_files, save_model  # noqa: E402
+from haptic.geometry import Polyhedron, load_library, load_model, model_files, save_model  # noqa: E402
 from haptic.geometry.distance import point_triangle_distance  # noqa: E402
 from haptic.geometry.generate import iter_library  # noqa: E402
 from haptic.geometry.io import atomic_write  # noqa: E402
@@ -59,8 +59,10 @@ def surface_distance(a: Polyhedron, b: Polyhedron, samples: int, rng: np.random.
     worst = 0.0
     for p, q in ((a, b), (b, a)):
         pts, _ = trimesh.sample.sample_surface(p.to_trimesh(), samples, seed=int(rng.integers(2**31)))
-        pts = np.vstack([pts, p.vertices])  # (P, 3); the distances below are (P, T): a few MB per thousand points
-        worst = max(worst, float(point_triangle_distance(pts, q.vertices[q.triangles]).min(axis=1).max()))
+        pts = np.vstack([pts, p.vertices])
+        tris = q.vertices[q.triangles]
+        for i in range(0, len(pts), 1000):
+            worst = max(worst, float(point_triangle_distance(pts[i : i + 1000], tris).min(axis=1).max()))
     return worst
 
 
@@ -163,7 +165,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--poses", type=int, default=5, help="re-identification episodes per learned model")
     ap.add_argument("--others", type=int, default=3, help="library objects tried per learned model (false)")
     ap.add_argument("--poses-others", type=int, default=1, help="episodes per library object tried")
-    ap.add_argument("--samples", type=int, default=20000, help="surface points per model for the Hausdorff distance")
+    ap.add_argument("--samples", type=int, default=5000, help="surface points per model for the Hausdorff distance")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--out", default="out/learn", help="output directory")
     args = ap.parse_args(argv)

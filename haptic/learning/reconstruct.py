@@ -466,14 +466,60 @@ def learned_model(est: ConvexEstimate, name: str = "learned") -> Polyhedron:
     last: ModelError | None = None
     b = est.bounds
     learned = LearnedBounds(b.normal, b.position, b.direction)
+    model = None
     for attempt in (verts, planarize(verts, faces, PLANAR_ROUNDS)):
         for q in PRECISIONS:
             try:
-                return Polyhedron.from_faces(rounded(attempt, q), faces, name=name, precision=q,
-                                             learned_bounds=learned)  # fmt: skip
+                model = Polyhedron.from_faces(rounded(attempt, q), faces, name=name, precision=q,
+                                              learned_bounds=learned)  # fmt: skip
+                break
             except ModelError as exc:
                 last = exc
-    raise LearnError(f"{name}: the learned solid is not a valid model ({last})")
+        if model is not None:
+            break
+    if model is None:
+        raise LearnError(f"{name}: the learned solid is not a valid model ({last})")
+    sym = symmetrized(model, SYMMETRY_FACTOR * b.position)
+    for q in PRECISIONS:
+        try:
+            return Polyhedron.from_faces(rounded(sym, q), faces, name=name, precision=q, learned_bounds=learned)
+        except ModelError:
+            continue
+    return model
+
+
+SYMMETRY_FACTOR = 2.0
+"""Rigid motions that map a learned model onto itself within this many times the data's position bound are
+taken for symmetries of the object (:func:`symmetrized`) [-]."""
+SYMMETRY_ROUNDS = 50
+"""Most rounds of :func:`symmetrized`."""
+
+
+def symmetrized(model: Polyhedron, eps: float) -> np.ndarray:
+    """The vertices of ``model`` made exactly symmetric under the rigid motions that map it onto itself within
+    ``eps`` [m]: each vertex the mean of its images under them, the motions fitted again, until they map the
+    vertices onto each other to round-off. A model learned from noisy data is symmetric only within its
+    bounds; the matcher groups the poses of a model by its exact symmetry group, so an object's symmetric poses
+    would otherwise stay apart, never to be told from each other."""
+    from haptic.geometry.symmetry import _congruences, _fit_rotation
+
+    pairs = _congruences(model, model, eps)
+    v = np.array(model.vertices, dtype=float)
+    if len(pairs) <= 1:
+        return v
+    perms = [perm for _, perm in pairs]
+    for _ in range(SYMMETRY_ROUNDS):
+        acc = np.zeros_like(v)
+        worst = 0.0
+        for perm in perms:  # the motion carries vertex i to vertex perm[i]
+            r, t = _fit_rotation(v, v[perm])
+            moved = v @ r.T + t
+            worst = max(worst, float(np.linalg.norm(moved - v[perm], axis=1).max()))
+            acc[perm] += moved
+        v = acc / len(perms)
+        if worst < NUMERIC * max(float(np.ptp(v)), 1.0):
+            break
+    return v
 
 
 def planarize(vertices: np.ndarray, faces: list[list[int]], rounds: int) -> np.ndarray:
