@@ -65,6 +65,11 @@ def add_parser(sub: Subcommands) -> None:
         "(free-space probes alone, geometric executor; a verification traces too) or all (both, one "
         "planner ranking them)",
     )  # fmt: skip
+    p.add_argument("--learn", metavar="DIR",
+                   help="after no-match, explore on until the object's surface is closed and write its model "
+                   "into the library directory DIR (the object is convex; its own budget, reported)")
+    p.add_argument("--learn-name", metavar="NAME",
+                   help="the learned model's name (default: learned_ and a digest of the episode's settings)")
     p.add_argument("--json", metavar="OUT", help="write the episode's JSON record here")
     p.add_argument("--record", metavar="OUT.rrd", help="write a rerun recording here")
     p.add_argument("--spawn", action="store_true", help="open the rerun viewer (where one is installed)")
@@ -205,7 +210,20 @@ def summary_lines(rec: dict, budget: float | None = None, max_moves: int | None 
         )
     if rec.get("detail"):
         lines.append(f"detail      {rec['detail']}")
+    if rec.get("learned"):
+        lines.append("learned     " + learned_line(rec["learned"]))
     return lines
+
+
+def learned_line(learned: dict) -> str:
+    """How learning the object went: the model and its file, or why there is none; the learning's own cost."""
+    cost = f"{learned['moves']} learning moves, cost {learned['path_cost']:.1f}"
+    if "name" in learned:
+        where = f" -> {learned['path']}" if "path" in learned else ""
+        return (f"{learned['name']} (V {learned['V']}, E {learned['E']}, F {learned['F']}, "
+                f"{learned['volume_cm3']:.2f} cm^3){where}; {cost}")  # fmt: skip
+    detail = f" ({learned['detail']})" if learned.get("detail") else ""
+    return f"no model: {learned['status']}{detail}; {cost}"
 
 
 def verdict_line(rec: dict) -> str:
@@ -228,10 +246,16 @@ def run(args: argparse.Namespace) -> int:
         check_output_file(args.json, "--json", "out/episode.json")
     if args.record:
         check_output_file(args.record, "--record", "out/episode.rrd", RecordingError)
+    if args.learn_name is not None and args.learn is None:
+        raise HapticError("--learn-name names a learned model: give --learn DIR too")
+    if args.learn is not None:
+        from haptic.learning.library import check_learn_target
+
+        check_learn_target(args.learn, args.learn_name)
     settings = dict(
         model=args.object, seed=args.seed, policy=args.policy, executor=args.executor, noise=args.noise,
         models=args.models, max_moves=args.max_moves, record=args.record, skip_invalid=args.skip_invalid,
-        verify=args.verify, moves=args.moves, units=args.units,
+        verify=args.verify, moves=args.moves, units=args.units, learn=args.learn, learn_name=args.learn_name,
     )  # fmt: skip
     check_settings(settings, cli_option)
     spec = EpisodeSpec(**settings)

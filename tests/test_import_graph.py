@@ -1,8 +1,8 @@
 """The import graph of ``haptic``: module-level and function-level imports, and imports of modules named by
 string literals (``__import__``, ``importlib.import_module``), read with ``ast``.
 
-It has no cycle, between modules or between layers, and the pure core (geometry, matching, planning) imports
-nothing of the layers built on it, nor a simulator or a viewer.
+It has no cycle, between modules or between layers, and the pure core (geometry, matching, planning, learning)
+imports nothing of the layers built on it, nor a simulator or a viewer.
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ import pytest
 
 import haptic
 
-CORE = ("haptic.geometry", "haptic.matching", "haptic.planning")
+CORE = ("haptic.geometry", "haptic.matching", "haptic.planning", "haptic.learning")
 OUTER = ("haptic.sim", "haptic.executor", "haptic.episode", "haptic.bench", "haptic.recording", "haptic.env")
 HEAVY = ("mujoco", "dm_control", "mink", "rerun", "gymnasium")
 """Third-party packages the pure core must not import."""

@@ -74,6 +74,9 @@ def add_parser(sub: Subcommands) -> None:
     p.add_argument("--max-moves", type=positive_int, default=DEFAULT_MAX_MOVES,
                    help="move budget of each episode: it ends as 'budget' after this many moves (verification "
                    "moves not counted)")
+    p.add_argument("--learn", metavar="DIR",
+                   help="after no-match, explore on until the object's surface is closed and write its model "
+                   "into the library directory DIR (named learned_ and a digest of the episode's settings)")
     again = p.add_mutually_exclusive_group()
     again.add_argument("--resume", action="store_true",
                        help="keep OUT's episodes and run only those of the sweep not in it yet")
@@ -111,6 +114,10 @@ def _run(args: argparse.Namespace, held: DeferredInterrupts) -> int:
         verify=args.verify, moves=args.moves, units=args.units,
     )  # fmt: skip
     check_settings(common, cli_option)
+    if args.learn is not None:
+        from haptic.learning.library import check_learn_target
+
+        common["learn"] = str(check_learn_target(args.learn, None).resolve())
     library = load_library(args.models, skip_invalid=args.skip_invalid, units=args.units)
     report_skipped(args.models, args.skip_invalid, args.units)
     specs = plan_sweep(sorted(library), args.episodes, args.seed, policies, args.noise, **common)

@@ -48,7 +48,7 @@ def plan_sweep(
     ]
 
 
-KEY_EXCLUDED = ("models", "record")
+KEY_EXCLUDED = ("models", "record", "learn_name")
 """Fields of :class:`EpisodeSpec` that do not change an episode's result, left out of its key.
 
 Every other field is part of the key, so a setting added to ``EpisodeSpec`` (with a default that gives the

@@ -81,6 +81,9 @@ class EpisodeRecord:
     """Free-space probes carried out."""
     probe_misses: int = 0
     """Of those, probes that met nothing (negative evidence)."""
+    learned: dict | None = None
+    """How learning the object went after ``no-match`` (``--learn DIR``: :mod:`haptic.episode.learning`; None:
+    no learning)."""
 
     def to_json(self) -> dict:
         return asdict(self)
@@ -185,6 +188,7 @@ def loop_steps(
     rng: np.random.Generator,
     observer: Observer | None = None,
     sources: Sequence[MoveSource] | None = None,
+    endings: Sequence[Callable[[EpisodeState, EpisodeSpec], Ending | None]] | None = None,
 ) -> Generator[DecisionPoint, Decision, EpisodeRecord]:
     """The closed loop as a generator: it yields a :class:`DecisionPoint` whenever the policy is to choose
     and takes the :class:`Decision` sent back (a ``HapticError`` thrown in ends the episode as failed); it
@@ -200,7 +204,7 @@ def loop_steps(
     sources = episode_sources(library, config, rng) if sources is None else sources
     end = _start(view, executor, obs)
     while end is None:
-        end = ending(view, spec)
+        end = ending(view, spec, endings)
         if end is None:
             end = yield from _turn(view, sources, executor, obs)
     record = _record(spec, library, true_model, world_from_model, view, end, time.perf_counter() - t0)
@@ -320,9 +324,9 @@ ENDINGS = (failed_in_a_row, verdict, out_of_budget, too_many_interpretations)
 """The ending conditions, checked in this order before every move."""
 
 
-def ending(view: EpisodeState, spec: EpisodeSpec) -> Ending | None:
-    """The first of :data:`ENDINGS` that ends the episode now, or None."""
-    for check in ENDINGS:
+def ending(view: EpisodeState, spec: EpisodeSpec, endings: Sequence | None = None) -> Ending | None:
+    """The first of ``endings`` (default :data:`ENDINGS`) that ends the episode now, or None."""
+    for check in ENDINGS if endings is None else endings:
         end = check(view, spec)
         if end is not None:
             return end

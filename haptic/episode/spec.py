@@ -151,6 +151,11 @@ class EpisodeSpec:
     units: str | None = None
     """Units of the library's model files that declare none ("mm", "cm" or "m"; None: the library's
     ``library.toml``, else metres). A file's own declaration comes first."""
+    learn: str | None = None
+    """Library directory a model learned after ``no-match`` is written into (``--learn DIR``: the episode explores
+    on until the object's surface is closed, :mod:`haptic.episode.learning`); None: no learning."""
+    learn_name: str | None = None
+    """The learned model's name (None: ``learned_`` and a digest of the episode's key)."""
 
     def __post_init__(self) -> None:
         check_settings({k: getattr(self, k) for k in self.__dataclass_fields__})

@@ -201,8 +201,15 @@ def run_episode(
     config: PlannerConfig | None = None,
     policy: Policy | None = None,
 ) -> EpisodeRecord:
-    """Run one episode: built in its world (:func:`build_episode`), then the closed loop."""
-    return build_episode(spec, library, config).run(policy, observer)
+    """Run one episode: built in its world (:func:`build_episode`), then the closed loop; with ``spec.learn``, on
+    after ``no-match`` until the object is learned (:func:`haptic.episode.learning.run_learning`)."""
+    episode = build_episode(spec, library, config)
+    if spec.learn is None:
+        return episode.run(policy, observer)
+    from haptic.episode.learning import LearnSettings, run_learning
+
+    record, _ = run_learning(episode, LearnSettings(spec.learn, spec.learn_name), policy, observer)
+    return record
 
 
 def _jsonable(x):

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from haptic.errors import ModelError
-from haptic.geometry.polyhedron import Polyhedron, newell_normal, triangulate_polygon
+from haptic.geometry.polyhedron import LearnedBounds, Polyhedron, newell_normal, triangulate_polygon
 from haptic.geometry.tolerances import FLOAT32_QUANTUM, Tolerances, decimal_quantum
 
 NATIVE_SUFFIX = ".json"
@@ -193,7 +193,25 @@ def _load_native(path: Path, name: str, default_scale: float = 1.0) -> Polyhedro
         raise ModelError(f"{path}: 'vertices' must be a list of [x, y, z] numbers") from None
     shaped = vertices.ndim == 2 and vertices.shape[1:] == (3,) and len(vertices) > 0
     precision = _source_precision(text_quantum(tokens) * scale, vertices) if shaped else 0.0
-    return Polyhedron.from_faces(vertices, doc["faces"], name=name, source=str(path), precision=precision)
+    return Polyhedron.from_faces(vertices, doc["faces"], name=name, source=str(path), precision=precision,
+                                 learned_bounds=_learned_bounds(path, doc))  # fmt: skip
+
+
+def _learned_bounds(path: Path, doc: dict) -> LearnedBounds | None:
+    """The data bounds a learned model's file declares (``provenance.bounds``: ``normal_rad``, ``position_m``,
+    ``direction_rad``), or None when it declares none."""
+    prov = doc.get("provenance")
+    bounds = prov.get("bounds") if isinstance(prov, dict) else None
+    if bounds is None:
+        return None
+    keys = ("normal_rad", "position_m", "direction_rad")
+    try:
+        values = [float(bounds[k]) for k in keys]
+    except (TypeError, KeyError, ValueError):
+        raise ModelError(f"{path}: provenance.bounds must hold the numbers {', '.join(keys)}") from None
+    if not all(np.isfinite(x) and x >= 0 for x in values):
+        raise ModelError(f"{path}: provenance.bounds must be finite numbers >= 0, got {values}")
+    return LearnedBounds(*values)
 
 
 def _obj_units(line: str) -> float | None:

@@ -33,6 +33,18 @@ def newell_normal(points: np.ndarray) -> np.ndarray:
     return np.cross(points, nxt).sum(axis=0)
 
 
+@dataclass(frozen=True)
+class LearnedBounds:
+    """The error bounds of the data a learned model was made from (a model file's ``provenance.bounds``)."""
+
+    normal: float
+    """Face normal direction [rad]."""
+    position: float
+    """Position of a face, an edge or a vertex [m]."""
+    direction: float
+    """Edge direction [rad]."""
+
+
 @dataclass(frozen=True, eq=False)
 class Polyhedron:
     """A validated closed, connected, consistently oriented polyhedral solid (any genus, any convexity).
@@ -52,6 +64,9 @@ class Polyhedron:
     """How far the source rounded each coordinate: half a unit of its last written digit, 0 for exact data [m]."""
     vertex_labels: tuple[str, ...] | None = field(default=None, repr=False)
     """The source file's own number of each vertex (1-based for OBJ), for messages; ``None``: the index here."""
+    learned_bounds: LearnedBounds | None = field(default=None, repr=False)
+    """For a model learned by touch: the error bounds of the data it was learned from, which its features are
+    known to no better than (the verification widens its tests by them); ``None`` for a model made exactly."""
 
     tolerances: Tolerances = field(init=False, repr=False)
     """Numerical tolerances of this model, from its size and :attr:`precision`."""
@@ -82,11 +97,13 @@ class Polyhedron:
         source: str | None = None,
         precision: float = 0.0,
         vertex_labels=None,
+        learned_bounds: LearnedBounds | None = None,
     ) -> Polyhedron:
         """Validate and build a polyhedron from vertex positions [m] and CCW-from-outside face loops.
 
         ``precision`` is how far the source rounded each coordinate [m] (the tolerances follow it);
-        ``vertex_labels`` the source's own vertex numbers, for messages. Raises :class:`ModelError` naming the
+        ``vertex_labels`` the source's own vertex numbers, for messages; ``learned_bounds`` those of a learned
+        model's data. Raises :class:`ModelError` naming the
         model and the offending element when the input is not a closed, connected, consistently
         outward-oriented 2-manifold with planar, non-degenerate faces that do not cross each other.
         """
@@ -125,7 +142,7 @@ class Polyhedron:
             raise ModelError(f"{where}: a closed polyhedron needs at least 4 faces, got {len(loops)}")
         return cls(
             name=name, vertices=_readonly(v), faces=tuple(loops), source=source, precision=float(precision),
-            vertex_labels=labels,
+            vertex_labels=labels, learned_bounds=learned_bounds,
         )  # fmt: skip
 
     def vertex_label(self, i: int) -> str:
@@ -444,7 +461,7 @@ class Polyhedron:
         v = self.vertices @ np.asarray(rotation).T + np.asarray(translation)
         return Polyhedron.from_faces(
             v, self.faces, name=name or self.name, source=self.source, precision=self.precision,
-            vertex_labels=self.vertex_labels,
+            vertex_labels=self.vertex_labels, learned_bounds=self.learned_bounds,
         )  # fmt: skip
 
     def mirrored(self, name: str | None = None) -> Polyhedron:
@@ -453,7 +470,7 @@ class Polyhedron:
         faces = [tuple(reversed(loop)) for loop in self.faces]
         return Polyhedron.from_faces(
             v, faces, name=name or f"{self.name}_mirror", source=self.source, precision=self.precision,
-            vertex_labels=self.vertex_labels,
+            vertex_labels=self.vertex_labels, learned_bounds=self.learned_bounds,
         )  # fmt: skip
 
     def to_trimesh(self):

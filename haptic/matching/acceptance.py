@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from haptic.geometry.distance import point_triangle_distance
-from haptic.geometry.polyhedron import Polyhedron
+from haptic.geometry.polyhedron import LearnedBounds, Polyhedron
 from haptic.geometry.se3 import SE3
 from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex, SensorNoise
 from haptic.matching.tree import Interpretation
@@ -102,24 +102,37 @@ def _coplanar(model: Polyhedron, f: int) -> np.ndarray:
     return np.flatnonzero((model.face_normals @ n > 1.0 - 1e-9) & (np.abs(model.face_offsets - d) < 1e-7))
 
 
+EXACT = LearnedBounds(0.0, 0.0, 0.0)
+"""A model made exactly: its features add nothing to the data's bounds."""
+
+
+def _model_bounds(model: Polyhedron) -> LearnedBounds:
+    """How far the model's own features may be off: a learned model's data bounds
+    (:attr:`~haptic.geometry.polyhedron.Polyhedron.learned_bounds`), which each test adds to the data's in
+    quadrature (independent errors), else none."""
+    return model.learned_bounds if model.learned_bounds is not None else EXACT
+
+
 def residual_ratios(
     model: Polyhedron, data: Sequence[DataComponent], it: Interpretation, world_from_model: SE3
 ) -> list[tuple[float, int, str]]:
     """``(residual / bound, data id, what)`` of every measured quantity of interpretation ``it`` at a pose."""
     inv = world_from_model.inverse()
+    mb = _model_bounds(model)
     out: list[tuple[float, int, str]] = []
     for i, f in it.faces.items():
         c = data[i]
         assert isinstance(c, DataFace)
         n_m = model.face_normals[f]
-        out.append((_angle(inv.rotate(c.normal), n_m) / (c.normal_bound + ROUND_OFF), i, "face normal"))
+        out.append((_angle(inv.rotate(c.normal), n_m) / (np.hypot(c.normal_bound, mb.normal) + ROUND_OFF), i,
+                    "face normal"))  # fmt: skip
         q = inv.apply(c.points)
         # distance to the model face's polygon (or a coplanar face's: the robot cannot tell which of two faces
         # in one plane it touched, and the interpretation may pair either): off its plane, or beyond them
         same = _coplanar(model, f)
         tri = model.vertices[model.triangles[np.isin(model.triangle_faces, same)]]
         d = point_triangle_distance(q, tri).min(axis=1)
-        out.append((float(d.max()) / (c.position_bound + ROUND_OFF), i, "face point"))
+        out.append((float(d.max()) / (np.hypot(c.position_bound, mb.position) + ROUND_OFF), i, "face point"))
     for i, e in it.edges.items():
         c = data[i]
         assert isinstance(c, DataEdge)
@@ -127,20 +140,20 @@ def residual_ratios(
         s = it.edge_senses.get(i, 0)
         if s != 0:
             turn = _angle(inv.rotate(c.direction), s * b_m)
-            out.append((turn / (c.direction_bound + ROUND_OFF), i, "edge direction"))
+            out.append((turn / (np.hypot(c.direction_bound, mb.direction) + ROUND_OFF), i, "edge direction"))
         ends = inv.apply(np.array([c.point, c.end_point])) - p_m
         along = ends @ b_m
         perp = np.linalg.norm(ends - along[:, None] * b_m, axis=1)
-        rho = c.position_bound + ROUND_OFF
+        rho = np.hypot(c.position_bound, mb.position) + ROUND_OFF
         out.append((float(perp[0]) / rho, i, "edge line"))
-        out.append((float(perp[1]) / (rho + c.length * c.direction_bound), i, "edge line"))
+        out.append((float(perp[1]) / (rho + c.length * np.hypot(c.direction_bound, mb.direction)), i, "edge line"))
         beyond = float(np.maximum(-along, along - l_m).max())
-        out.append((max(beyond, 0.0) / (c.length_bound + ROUND_OFF), i, "edge extent"))
+        out.append((max(beyond, 0.0) / (np.hypot(c.length_bound, mb.position) + ROUND_OFF), i, "edge extent"))
     for i, v in it.vertices.items():
         c = data[i]
         assert isinstance(c, DataVertex)
         d = float(np.linalg.norm(inv.apply(c.position) - model.vertices[v]))
-        out.append((d / (c.position_bound + ROUND_OFF), i, "vertex"))
+        out.append((d / (np.hypot(c.position_bound, mb.position) + ROUND_OFF), i, "vertex"))
     return out
 
 
@@ -207,14 +220,15 @@ def acceptance(
     from scipy.stats import chi2
 
     inv = world_from_model.inverse()
+    mb = _model_bounds(model)
     total, dims = 0.0, 0
     for i, f in it.faces.items():
         c = data[i]
         assert isinstance(c, DataFace)
         n_m = model.face_normals[f]
-        total += (_angle(inv.rotate(c.normal), n_m) * k_sigma / (c.normal_bound + ROUND_OFF)) ** 2
+        total += (_angle(inv.rotate(c.normal), n_m) * k_sigma / (np.hypot(c.normal_bound, mb.normal) + ROUND_OFF)) ** 2
         off = float(np.mean(inv.apply(c.points) @ n_m - model.face_offsets[f]))
-        total += (off * k_sigma / (c.position_bound + ROUND_OFF)) ** 2
+        total += (off * k_sigma / (np.hypot(c.position_bound, mb.position) + ROUND_OFF)) ** 2
         dims += 3
     for i, e in it.edges.items():
         c = data[i]
@@ -222,17 +236,18 @@ def acceptance(
         p_m, b_m = model.edge_points[e], model.edge_directions[e]
         s = it.edge_senses.get(i, 0)
         if s != 0:
-            total += (_angle(inv.rotate(c.direction), s * b_m) * k_sigma / (c.direction_bound + ROUND_OFF)) ** 2
+            turn = _angle(inv.rotate(c.direction), s * b_m)
+            total += (turn * k_sigma / (np.hypot(c.direction_bound, mb.direction) + ROUND_OFF)) ** 2
             dims += 2
         q = inv.apply(c.point) - p_m
         perp = float(np.linalg.norm(q - (q @ b_m) * b_m))
-        total += (perp * k_sigma / (c.position_bound + ROUND_OFF)) ** 2
+        total += (perp * k_sigma / (np.hypot(c.position_bound, mb.position) + ROUND_OFF)) ** 2
         dims += 2
     for i, v in it.vertices.items():
         c = data[i]
         assert isinstance(c, DataVertex)
         d = float(np.linalg.norm(inv.apply(c.position) - model.vertices[v]))
-        total += (d * k_sigma / (c.position_bound + ROUND_OFF)) ** 2
+        total += (d * k_sigma / (np.hypot(c.position_bound, mb.position) + ROUND_OFF)) ** 2
         dims += 3
     dof = dims - 6
     threshold = float(chi2.ppf(1.0 - alpha, dof)) if dof > 0 else float("inf")

@@ -1,0 +1,375 @@
+"""Learning an object the library does not hold: after ``no-match``, explore until the surface is closed, then
+write its model into a library (``--learn DIR``).
+
+:class:`ClosureMoves` is a move source (:mod:`haptic.episode.sources`), asked before all others once the
+matcher's verdict is ``no-match``. Each turn it rebuilds the object's convex estimate from the data alone
+(:func:`~haptic.learning.reconstruct.convex_estimate`) and chooses the move that measures the most of its
+unmeasured boundary -- open faces (where the data do not bound the object yet), edges and vertices not met --
+per unit of path cost, looking up to :attr:`LearnSettings.depth` moves ahead in the estimate's own world
+(:func:`~haptic.planning.simulate.simulate`). It has its own budget (:class:`LearnSettings`), reported in the
+record's ``learned``.
+
+:func:`learning_endings` replaces the loop's ending conditions: a ``no-match`` verdict starts the learning
+instead of ending the episode, which then ends, still ``no-match``, when the surface is closed, when the data
+show the object is not convex, or when the learning budget is spent. :func:`run_learning` runs such an episode
+and writes the model (:func:`~haptic.learning.library.write_learned`).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Mapping
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from haptic.episode.loop import (
+    Ending,
+    EpisodeRecord,
+    failed_in_a_row,
+    loop_steps,
+    out_of_budget,
+    too_many_interpretations,
+    verdict,
+)
+from haptic.episode.sources import MoveSource, episode_sources
+from haptic.episode.state import EpisodeState
+from haptic.errors import ModelError
+from haptic.geometry import SE3, Polyhedron
+from haptic.learning.reconstruct import ConvexEstimate, LearnError, convex_estimate, convexity_violation, edge_faces
+from haptic.matching.components import DataComponent
+from haptic.matching.recognition import NO_MATCH
+from haptic.planning.config import PlannerConfig
+from haptic.planning.hypothesis import Hypothesis, trace_in
+from haptic.planning.move_scores import same_move
+from haptic.planning.moves import EdgeMove, FaceMove, Move, MoveResult, SensorState
+from haptic.planning.predict import candidate_moves
+from haptic.planning.simulate import simulate
+
+FACE_GAIN = 2.0
+"""What measuring a new plane is worth against an edge or a vertex (a plane bounds several of each) [-]."""
+
+
+@dataclass(frozen=True)
+class LearnSettings:
+    """How an episode learns an object the library does not hold (``--learn DIR``)."""
+
+    directory: str | None = None
+    """Library directory the learned model is written into (None: reconstructed, not written)."""
+    name: str | None = None
+    """The learned model's name (None: ``learned_`` and a digest of the episode's key)."""
+    budget: float = 3000.0
+    """Path-cost budget of the learning, on top of the episode's [units]."""
+    max_moves: int = 150
+    """Move budget of the learning, on top of the episode's."""
+    depth: int = 3
+    """Moves looked ahead when no single move measures anything new."""
+
+
+class ClosureMoves(MoveSource):
+    """After ``no-match``: the move that measures the most unmeasured boundary of the convex estimate per unit
+    of path cost (module docstring); None when no move within :attr:`LearnSettings.depth` measures anything
+    (the next source answers)."""
+
+    name = "learning"
+
+    def __init__(self, settings: LearnSettings) -> None:
+        self.settings = settings
+        self.active = False
+        """Whether the learning is under way (the matcher said no-match)."""
+        self.moves = 0
+        self.failed = 0
+        self.cost = 0.0
+        self.started: float | None = None
+        self.status = "not started"
+        """"closed", "not convex", "no solid", "budget", "failed" or "open" (still exploring)."""
+        self.detail = ""
+        self.estimate: ConvexEstimate | None = None
+        self.components: dict[int, DataComponent] = {}
+        self._asked: Move | None = None
+        self._seen = -1
+
+    # ---------------------------------------------------------------------------------------- state
+
+    def start(self, view: EpisodeState) -> None:
+        self.active, self.started, self.status = True, time.perf_counter(), "open"
+        self.update(view)
+
+    def update(self, view: EpisodeState) -> None:
+        """The estimate of the data so far (rebuilt when they changed), and the learning's status."""
+        if len(view.cum_cost) == self._seen:
+            return
+        self._seen = len(view.cum_cost)
+        self.components = dict(view.components)
+        try:
+            est = convex_estimate(self.components)
+        except LearnError as exc:
+            self.estimate, self.status, self.detail = None, "no solid", str(exc)
+            return
+        bad = convexity_violation(self.components, est.planes, est.bounds)
+        if bad is not None:
+            self.estimate, self.status = est, "not convex"
+            self.detail = f"a measured point lies {bad[1] * 1e3:.2f} mm outside measured plane {bad[0]}"
+            return
+        self.estimate = est
+        self.status = "closed" if est.closed else "open"
+
+    def ending(self, view: EpisodeState) -> Ending | None:
+        """The learning's end (the episode's outcome stays ``no-match``), or None while it goes on."""
+        self.update(view)
+        if self.status in ("closed", "not convex", "no solid"):
+            return Ending(NO_MATCH, f"learning: {self.status}" + (f" ({self.detail})" if self.detail else ""))
+        s = self.settings
+        if self.cost > s.budget or self.moves >= s.max_moves:
+            self.status = "budget"
+            return Ending(NO_MATCH, f"learning: budget ({self.moves} moves, cost {self.cost:.1f})")
+        return None
+
+    # ---------------------------------------------------------------------------------------- moves
+
+    def propose(self, view: EpisodeState) -> Move | None:
+        if not self.active or self.estimate is None or view.sensor is None:
+            return None
+        plan = ClosurePlan.of(self.estimate, self.components, view.config)
+        if plan is None:
+            return None
+        move = plan.best_move(view.sensor, tuple(view.failed_here), self.settings.depth)
+        self._asked = move
+        return move
+
+    def on_result(self, view: EpisodeState, move: Move, result: MoveResult) -> None:
+        if not self.active or move is not self._asked:
+            return
+        self.moves += 1
+        self.cost += result.cost
+        self.failed += 0 if result.ok else 1
+
+    def record(self) -> dict:
+        """The learning's part of the episode record."""
+        est = self.estimate
+        out = {
+            "status": self.status, "moves": self.moves, "failed_moves": self.failed, "path_cost": round(self.cost, 6),
+            "wall_time_s": round(time.perf_counter() - self.started, 4) if self.started else 0.0,
+            "budget": self.settings.budget, "max_moves": self.settings.max_moves,
+        }  # fmt: skip
+        if est is not None:
+            out["estimate"] = est.counts()
+        if self.detail:
+            out["detail"] = self.detail
+        return out
+
+
+# -------------------------------------------------------------------------------------------- planning
+
+
+@dataclass(eq=False)
+class ClosurePlan:
+    """The convex estimate as a world to predict moves in: a hypothesis whose model is the estimate (box faces
+    and all, at the identity pose), and what of it is unmeasured."""
+
+    hypothesis: Hypothesis
+    """The estimate as a hypothesis (data ids → the estimate's faces, edges and vertices)."""
+    open_faces: frozenset[int]
+    """Faces of the estimate's model that are the box's (unmeasured boundary)."""
+    unmeasured_edges: frozenset[int]
+    """Edges of the model neither traced nor between two measured vertices."""
+    vertex_group: dict[int, int]
+    """Model vertex → its group (the object's vertex)."""
+    unmeasured_groups: frozenset[int]
+    """Groups no data vertex was met at."""
+    config: PlannerConfig
+    """Costs and the vertex circle's radius."""
+    components: Mapping[int, DataComponent]
+    """The data the estimate was made from."""
+
+    @classmethod
+    def of(cls, est: ConvexEstimate, components: Mapping[int, DataComponent], config: PlannerConfig):
+        """The plan of estimate ``est`` over ``components``; None when its solid is no valid model (noise)."""
+        poly = est.polytope
+        order = sorted(poly.loops)
+        try:
+            model = Polyhedron.from_faces(poly.vertices, [poly.loops[j] for j in order], name="estimate")
+        except ModelError:
+            return None
+        face_of_plane = {j: i for i, j in enumerate(order)}
+        plane_of = {f: k for k, p in enumerate(est.planes) for f in p.faces}
+        faces = {f: face_of_plane[k] for f, k in plane_of.items() if k in face_of_plane}
+        sides = zip(model.edge_left_face, model.edge_right_face, strict=True)
+        edge_of = {frozenset((int(a), int(b))): e for e, (a, b) in enumerate(sides)}
+        edges = {}
+        for eid, fs in edge_faces(components).items():
+            pair = frozenset(faces[f] for f in fs if f in faces)
+            if len(pair) == 2 and pair in edge_of:
+                edges[eid] = edge_of[pair]
+        vertices = dict(est.vertex_data)
+        group = est.group_of()
+        unmeasured = frozenset(est.unmeasured_vertices())
+        traced = set(edges.values())
+        un_edges = frozenset(
+            e for e in range(model.n_edges)
+            if e not in traced and (group[int(model.edges[e, 0])] in unmeasured or group[int(model.edges[e, 1])]
+                                    in unmeasured)
+        )  # fmt: skip
+        open_faces = frozenset(face_of_plane[j] for j in est.open_faces())
+        h = Hypothesis("estimate", model, SE3.identity(), faces, edges, vertices)
+        return cls(h, open_faces, un_edges, group, unmeasured, config, dict(components))
+
+    def gain(self, before: Hypothesis, after: Hypothesis, counted: set) -> float:
+        """What a move measures: a new plane (an open face met), edges and vertices not measured before (each
+        counted once in a sequence, ``counted``)."""
+        g = 0.0
+        for f in set(after.faces.values()) - set(before.faces.values()):
+            if f in self.open_faces and ("f", f) not in counted:
+                counted.add(("f", f))
+                g += FACE_GAIN
+        for e in set(after.edges.values()) - set(before.edges.values()):
+            if e in self.unmeasured_edges and ("e", e) not in counted:
+                counted.add(("e", e))
+                g += 1.0
+        for v in set(after.vertices.values()) - set(before.vertices.values()):
+            grp = self.vertex_group.get(v)
+            if grp in self.unmeasured_groups and ("v", grp) not in counted:
+                counted.add(("v", grp))
+                g += 1.0
+        return g
+
+    def candidates(self, state: SensorState, components: Mapping[int, DataComponent], h: Hypothesis) -> list[Move]:
+        """The seed's moves from ``state``: edge and vertex moves, and face moves toward the middle of each edge of
+        the face under the sensor (in the estimate), kept where they cross it clear of its vertices."""
+        moves = [m for m in candidate_moves(state, components, replace(self.config, n_directions=4))
+                 if not isinstance(m, FaceMove)]  # fmt: skip
+        f = h.faces.get(state.face)
+        if f is None:
+            return moves
+        model = h.poly
+        for e in model.face_edges[f]:
+            if state.edge is not None and h.edges.get(state.edge) == e:
+                continue
+            a, b = model.vertices[model.edges[e]]
+            d = 0.5 * (a + b) - state.position
+            n = model.face_normals[f]
+            d = d - (d @ n) * n
+            norm = float(np.linalg.norm(d))
+            if norm < 1e-9:
+                continue
+            move = FaceMove(d / norm)
+            tr = trace_in(h, move, state)
+            if tr is None or tr.hit.distance < self.config.min_face_travel:
+                continue
+            if tr.clearance(model) < self.config.min_vertex_clearance:
+                continue
+            moves.append(move)
+        return moves
+
+    def cost(self, h: Hypothesis, move: Move, state: SensorState, after: SensorState) -> float:
+        """The move's predicted path cost in the estimate's world [units]."""
+        c = self.config.costs
+        if isinstance(move, FaceMove):
+            tr = trace_in(h, move, state)
+            return c.face_move(tr.hit.distance if tr is not None else float(np.linalg.norm(after.position
+                                                                                          - state.position)))
+        if isinstance(move, EdgeMove):
+            return c.edge_move(float(np.linalg.norm(after.position - state.position)))
+        return c.vertex_move(self.config.vertex_radius * np.pi / 2)
+
+    def best_move(self, state: SensorState, avoid: tuple[Move, ...], depth: int) -> Move | None:
+        """The first move of the sequence (up to ``depth`` moves) with the most gain per unit cost; None when
+        none gains anything."""
+        comps = dict(self.components)
+        best: tuple[float, Move | None] = (0.0, None)
+        for d in range(1, depth + 1):
+            best = self._search(self.hypothesis, state, comps, d, avoid)
+            if best[1] is not None:
+                break
+        return best[1]
+
+    def _search(self, h, state, comps, depth, avoid) -> tuple[float, Move | None]:
+        best_rate, best_move = 0.0, None
+        stack = [(h, state, comps, 0.0, 0.0, None, 0, frozenset())]
+        while stack:
+            h0, s0, c0, gain, cost, first, level, counted = stack.pop()
+            for move in self.candidates(s0, c0, h0):
+                if level == 0 and any(same_move(move, bad) for bad in avoid):
+                    continue
+                out = simulate(h0, move, s0, c0, self.config)
+                if out is None:
+                    continue
+                h1, s1, c1 = out
+                seen = set(counted)
+                g = gain + self.gain(h0, h1, seen)
+                c = cost + self.cost(h0, move, s0, s1)
+                f = first if first is not None else move
+                if g > 0 and g / c > best_rate:
+                    best_rate, best_move = g / c, f
+                met_open = any(x in self.open_faces for x in h1.faces.values())
+                if level + 1 < depth and not met_open:
+                    stack.append((h1, s1, c1, g, c, f, level + 1, frozenset(seen)))
+        return best_rate, best_move
+
+
+def learning_endings(source: ClosureMoves):
+    """The loop's ending conditions for a learning episode: as the loop's own, except that a ``no-match``
+    verdict starts the learning (:attr:`ClosureMoves.active`) and the learning's own end and budget then apply;
+    moves that fail in a row end the learning, not as a failed episode."""
+
+    def failing(view: EpisodeState, spec) -> Ending | None:
+        end = failed_in_a_row(view, spec)
+        if end is not None and source.active:
+            source.status = "failed"
+            return Ending(NO_MATCH, f"learning: {end.detail}")
+        return end
+
+    def judged(view: EpisodeState, spec) -> Ending | None:
+        if source.active:
+            return source.ending(view)
+        end = verdict(view, spec)
+        if end is None or end.outcome != NO_MATCH:
+            return end
+        source.start(view)
+        return source.ending(view)
+
+    def budget(view: EpisodeState, spec) -> Ending | None:
+        return None if source.active else out_of_budget(view, spec)
+
+    return (failing, judged, budget, too_many_interpretations)
+
+
+def run_learning(
+    episode, settings: LearnSettings, policy=None, observer=None
+) -> tuple[EpisodeRecord, Polyhedron | None]:
+    """Run ``episode`` (:class:`~haptic.episode.worlds.Episode`) with the learning (:class:`ClosureMoves` first
+    among the sources, :func:`learning_endings`); when it closes the surface, the learned model, written into
+    ``settings.directory`` when given. The record's ``learned`` says how the learning went."""
+    from haptic.episode.loop import chain_observers, drive
+    from haptic.learning.library import learned_name, write_learned
+    from haptic.learning.reconstruct import learned_model
+    from haptic.planning.registry import make_policy
+
+    spec = episode.spec
+    source = ClosureMoves(settings)
+    sources = [source, *episode_sources(episode.library, episode.config, episode.policy_rng)]
+    steps = loop_steps(
+        spec, episode.library, episode.true_model, episode.world_from_model, episode.executor, episode.noise,
+        episode.config, episode.policy_rng, chain_observers(observer, episode.observer), sources=sources,
+        endings=learning_endings(source),
+    )  # fmt: skip
+    chooser = policy or make_policy(spec.policy)
+    record = drive(steps, lambda point: chooser.choose(point.context, point.rng))
+    if episode.finish is not None:
+        episode.finish(record)
+    learned = source.record() if source.active else None
+    model = None
+    if source.status == "closed":
+        name = settings.name or learned_name(spec)
+        try:
+            model = learned_model(source.estimate, name)
+        except LearnError as exc:
+            learned["status"], learned["detail"] = "invalid", str(exc)
+        else:
+            learned.update(name=name, V=model.n_vertices, E=model.n_edges, F=model.n_faces,
+                           volume_cm3=round(model.volume * 1e6, 4), precision_m=model.precision)  # fmt: skip
+            if settings.directory is not None:
+                path = write_learned(model, settings.directory, spec, source.estimate.bounds, learned)
+                learned["path"] = str(path)
+    record.learned = learned
+    return record, model

@@ -1,0 +1,5 @@
+"""Learning an object outside the library: its model from the data components, written into a library.
+
+Pure numpy and scipy (no simulator, no recording): :mod:`haptic.learning.reconstruct` makes the model,
+:mod:`haptic.learning.library` writes it with its provenance.
+"""

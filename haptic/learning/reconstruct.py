@@ -1,0 +1,557 @@
+"""A convex object's model from the data components alone: planes from the faces, a solid from the planes.
+
+The executor reports every face it meets under a new id (it cannot tell that it touches a face again), so the
+data faces are first grouped into the planes of the object (:func:`face_planes`): two data faces are one plane
+when their normals and points agree within their error bounds. Each plane is fitted to every point known to lie
+on it -- the touched points of its faces, the explored ends of the edges between its faces and the data vertices
+on those edges -- with the measured normals as a prior (:func:`fit_plane`).
+
+The solid is the intersection of the planes' inner half-spaces (:func:`convex_estimate`, with
+``scipy.spatial.HalfspaceIntersection``), bounded by a box well outside the data where the data do not bound it
+yet: the box's faces are the object's unmeasured boundary. Its vertices are then checked against the data
+vertices (:class:`ConvexEstimate`): the surface is *closed* when every face is a measured plane and every vertex
+was met by the sensor, for a face that the data miss would cut off at least one vertex of the estimate.
+
+Where noisy planes meet at a vertex of more than three faces they do not meet in one point but along an edge
+too short for the data to tell from a point; such edges (shorter than :meth:`LearnBounds.merge_length`, and not
+split by two data vertices) are contracted (:func:`learned_model`). The result passes the validation of an
+imported model file, at the precision the data support.
+
+Tolerances come from the data's own error bounds (:class:`LearnBounds`). Pure numpy and scipy.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from haptic.errors import ModelError
+from haptic.geometry.polyhedron import LearnedBounds, Polyhedron
+from haptic.geometry.se3 import plane_basis
+from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex
+
+BOX_MARGIN = 0.1
+"""How far outside the data the box that bounds an open estimate lies [m]."""
+BOUND_FLOOR = 1e-6
+"""Smallest error bound used for a noiseless component: positions [m], angles [rad]."""
+MERGE_FACTOR = 2.0
+"""An edge of the estimate shorter than this many times the error of a vertex placed by planes is noise (two
+noisy planes where one vertex of more than three faces is) [-]."""
+NUMERIC = 1e-9
+"""Vertices of the half-space intersection closer than this, relative to the size, are one point [-]."""
+
+
+class LearnError(ModelError):
+    """The data do not make a model: no bounded solid, an object that is not convex, an estimate not closed."""
+
+
+@dataclass(frozen=True)
+class LearnBounds:
+    """The error bounds of the data a model is learned from: the largest of each kind over the components."""
+
+    normal: float
+    """Face normal direction [rad]."""
+    position: float
+    """Position perpendicular to a face, an edge, or of a vertex [m]."""
+    direction: float
+    """Edge direction [rad]."""
+    size: float
+    """Size of the data: the diagonal of the box round every measured point [m]."""
+
+    @classmethod
+    def of(cls, components: Iterable[DataComponent]) -> LearnBounds:
+        nb, pb, db = BOUND_FLOOR, BOUND_FLOOR, BOUND_FLOOR
+        for c in components:
+            if isinstance(c, DataFace):
+                nb, pb = max(nb, c.normal_bound), max(pb, c.position_bound)
+            elif isinstance(c, DataEdge):
+                db, pb = max(db, c.direction_bound), max(pb, c.position_bound)
+            else:
+                pb = max(pb, c.position_bound)
+        pts = data_points(components)
+        size = float(np.linalg.norm(np.ptp(pts, axis=0))) if len(pts) else 0.0
+        return cls(nb, pb, db, size)
+
+    @property
+    def vertex(self) -> float:
+        """How far a vertex placed by three fitted planes may lie from the true one [m]: a plane's offset, and
+        its tilt over the size of the data."""
+        return self.position + self.size * np.sin(self.normal)
+
+    @property
+    def merge_length(self) -> float:
+        """Edges of an estimate shorter than this are contracted into one vertex [m]."""
+        return MERGE_FACTOR * self.vertex
+
+    def to_json(self) -> dict:
+        return {"normal_rad": self.normal, "position_m": self.position, "direction_rad": self.direction,
+                "size_m": self.size}  # fmt: skip
+
+
+def data_points(components: Iterable[DataComponent]) -> np.ndarray:
+    """Every measured point: touched points, explored edge ends, vertices, shape (P, 3) [m]."""
+    pts: list[np.ndarray] = []
+    for c in components:
+        if isinstance(c, DataFace):
+            pts.extend(c.points)
+        elif isinstance(c, DataEdge):
+            pts.extend((c.point, c.end_point))
+        else:
+            pts.append(c.position)
+    return np.array(pts, dtype=float).reshape(-1, 3)
+
+
+# ------------------------------------------------------------------------------------------------- planes
+
+
+@dataclass(frozen=True, eq=False)
+class Plane:
+    """One plane of the object: the data faces on it, fitted."""
+
+    normal: np.ndarray
+    """Outward unit normal, shape (3,)."""
+    offset: float
+    """``d`` with ``n·w − d = 0`` [m]."""
+    faces: tuple[int, ...]
+    """Ids of the data faces on it."""
+    normal_bound: float
+    """The largest error bound of its faces' normals [rad]."""
+    position_bound: float
+    """The largest error bound of its faces' points [m]."""
+
+    def distance(self, points: np.ndarray) -> np.ndarray:
+        """Signed distance of ``points`` from the plane (positive outside) [m]."""
+        return np.asarray(points) @ self.normal - self.offset
+
+
+def edge_faces(components: Mapping[int, DataComponent]) -> dict[int, set[int]]:
+    """The data faces on either side of each data edge: those it names (its side points, its adjacency) and
+    those that name it."""
+    out: dict[int, set[int]] = {}
+    for c in components.values():
+        if isinstance(c, DataEdge):
+            s = out.setdefault(c.id, set())
+            s.update(f for f, _ in c.side_points if isinstance(components.get(f), DataFace))
+            s.update(a for a in c.adjacent if isinstance(components.get(a), DataFace))
+    for c in components.values():
+        if isinstance(c, DataFace):
+            for a in c.adjacent:
+                if a in out:
+                    out[a].add(c.id)
+    return out
+
+
+def vertex_edges(components: Mapping[int, DataComponent]) -> dict[int, set[int]]:
+    """The data edges at each data vertex (those that start or end there, those it names)."""
+    out: dict[int, set[int]] = {c.id: set() for c in components.values() if isinstance(c, DataVertex)}
+    for c in components.values():
+        if isinstance(c, DataEdge):
+            for v in (c.start_vertex, c.end_vertex, *c.adjacent):
+                if v in out:
+                    out[v].add(c.id)
+        elif isinstance(c, DataVertex):
+            out[c.id].update(a for a in c.adjacent if isinstance(components.get(a), DataEdge))
+    return out
+
+
+def _same_plane(a: DataFace, n: np.ndarray, d: float, pts: np.ndarray, nb: float, pb: float) -> bool:
+    """Whether data face ``a`` lies on the plane ``(n, d)`` fitted to ``pts`` within both error bounds."""
+    angle = float(np.arccos(np.clip(a.normal @ n, -1.0, 1.0)))
+    if angle > a.normal_bound + nb + BOUND_FLOOR:
+        return False
+    centre = pts.mean(axis=0)
+    lever = np.linalg.norm(a.points - centre, axis=1)
+    off = np.abs(a.points @ n - d)
+    return bool((off <= a.position_bound + pb + lever * np.sin(nb) + BOUND_FLOOR).all())
+
+
+def fit_plane(points: np.ndarray, normals: np.ndarray, position_bound: float, normal_bound: float):
+    """The plane ``(n, d)`` nearest to ``points`` (each within ``position_bound`` of it) and to the measured
+    ``normals`` (each within ``normal_bound``): the smallest eigenvector of
+    ``Σ (p − p̄)(p − p̄)ᵀ / σp² + Σ (I − n_j n_jᵀ) / σn²``, turned to agree with the normals."""
+    pb, nb = max(position_bound, BOUND_FLOOR), max(normal_bound, BOUND_FLOOR)
+    centre = points.mean(axis=0)
+    q = points - centre
+    a = q.T @ q / pb**2 + (len(normals) * np.eye(3) - normals.T @ normals) / nb**2
+    w, v = np.linalg.eigh(a)
+    n = v[:, 0]
+    mean = normals.sum(axis=0)
+    if n @ mean < 0:
+        n = -n
+    return n / np.linalg.norm(n), float(centre @ n)
+
+
+def face_planes(components: Mapping[int, DataComponent]) -> list[Plane]:
+    """The object's planes: the data faces grouped by agreement (in order of acquisition, each joining the
+    first plane it agrees with), each group fitted to its points, edge ends and vertices (:func:`fit_plane`)."""
+    faces = [c for c in components.values() if isinstance(c, DataFace)]
+    faces.sort(key=lambda c: c.id)
+    groups: list[list[DataFace]] = []
+    fitted: list[tuple[np.ndarray, float, np.ndarray, float, float]] = []
+    for f in faces:
+        for k, (n, d, pts, nb, pb) in enumerate(fitted):
+            if _same_plane(f, n, d, pts, nb, pb):
+                groups[k].append(f)
+                g = groups[k]
+                allp = np.concatenate([x.points for x in g])
+                nn, dd = fit_plane(allp, np.array([x.normal for x in g]), max(x.position_bound for x in g),
+                                   max(x.normal_bound for x in g))  # fmt: skip
+                fitted[k] = (nn, dd, allp, max(nb, f.normal_bound), max(pb, f.position_bound))
+                break
+        else:
+            groups.append([f])
+            fitted.append((f.normal.copy(), f.offset, np.array(f.points), f.normal_bound, f.position_bound))
+    # the edges and vertices on each plane join its fit
+    plane_of = {f.id: k for k, g in enumerate(groups) for f in g}
+    extra: list[list[np.ndarray]] = [[] for _ in groups]
+    ef = edge_faces(components)
+    for eid, fs in ef.items():
+        e = components[eid]
+        for k in {plane_of[f] for f in fs if f in plane_of}:
+            extra[k].extend((e.point, e.end_point))
+    for vid, es in vertex_edges(components).items():
+        v = components[vid]
+        ks = {plane_of[f] for e in es for f in ef.get(e, ()) if f in plane_of}
+        for k in ks:
+            extra[k].append(v.position)
+    planes = []
+    for k, g in enumerate(groups):
+        pts = np.concatenate([np.concatenate([x.points for x in g]), np.array(extra[k]).reshape(-1, 3)])
+        nb = max(x.normal_bound for x in g)
+        pb = max(x.position_bound for x in g)
+        n, d = fit_plane(pts, np.array([x.normal for x in g]), pb, nb)
+        planes.append(Plane(n, d, tuple(x.id for x in g), nb, pb))
+    return planes
+
+
+def convexity_violation(components: Mapping[int, DataComponent], planes: list[Plane], bounds: LearnBounds):
+    """A measured point outside a plane beyond what the bounds allow (the object is not convex), as
+    ``(plane index, distance [m])``, or None."""
+    pts = data_points(components.values())
+    if not len(pts) or not planes:
+        return None
+    tol = 2 * bounds.position + bounds.size * np.sin(bounds.normal)
+    for k, p in enumerate(planes):
+        dist = p.distance(pts)
+        if dist.max() > tol:
+            return k, float(dist.max())
+    return None
+
+
+# ------------------------------------------------------------------------------------------------- solid
+
+
+@dataclass(frozen=True, eq=False)
+class Polytope:
+    """The intersection of half-spaces: vertices, and per plane its face's vertex loop (CCW from outside)."""
+
+    vertices: np.ndarray
+    """Vertex positions, shape (V, 3) [m]."""
+    normals: np.ndarray
+    """Outward unit normals of the planes, shape (P, 3)."""
+    offsets: np.ndarray
+    """Plane offsets, shape (P,) [m]."""
+    loops: dict[int, tuple[int, ...]]
+    """Plane index → its face's vertex loop, for the planes that bound the solid."""
+    vertex_planes: tuple[frozenset[int], ...]
+    """The planes through each vertex."""
+
+
+def _interior_point(normals: np.ndarray, offsets: np.ndarray) -> np.ndarray:
+    """The centre of the largest ball inside every half-space ``n·w ≤ d`` (a linear programme)."""
+    from scipy.optimize import linprog
+
+    a = np.hstack([normals, np.ones((len(normals), 1))])
+    res = linprog(c=[0, 0, 0, -1], A_ub=a, b_ub=offsets, bounds=[(None, None)] * 3 + [(0, None)], method="highs")
+    if res.status != 0 or res.x[3] <= 0:
+        raise LearnError("the measured faces bound no solid (their half-spaces do not overlap)")
+    return res.x[:3]
+
+
+def intersect(normals: np.ndarray, offsets: np.ndarray) -> Polytope:
+    """The solid ``{w : n_i·w ≤ d_i for every i}`` (bounded by the planes given) with its faces."""
+    from scipy.spatial import HalfspaceIntersection, QhullError
+
+    normals, offsets = np.asarray(normals, float), np.asarray(offsets, float)
+    inside = _interior_point(normals, offsets)
+    try:
+        hs = HalfspaceIntersection(np.hstack([normals, -offsets[:, None]]), inside)
+    except QhullError as exc:
+        raise LearnError(f"the half-space intersection failed ({str(exc).splitlines()[0]})") from None
+    pts = hs.intersections
+    size = float(np.linalg.norm(np.ptp(pts, axis=0)))
+    # points of one vertex (qhull reports a vertex of more than three planes once per three of them)
+    tol = NUMERIC * max(size, 1.0) * 1e3
+    owner = np.arange(len(pts))
+    for i in range(len(pts)):
+        if owner[i] != i:
+            continue
+        near = np.flatnonzero(np.linalg.norm(pts - pts[i], axis=1) < tol)
+        owner[near[near > i]] = i
+    keep = np.unique(owner)
+    index = {int(o): k for k, o in enumerate(keep)}
+    verts = pts[keep]
+    vplanes: list[set[int]] = [set() for _ in keep]
+    for i, facet in enumerate(hs.dual_facets):
+        vplanes[index[int(owner[i])]].update(int(j) for j in facet)
+    # every plane through a vertex within round-off counts (a vertex of more than three planes)
+    dist = verts @ normals.T - offsets[None, :]
+    for k in range(len(verts)):
+        vplanes[k].update(int(j) for j in np.flatnonzero(np.abs(dist[k]) < tol))
+    loops: dict[int, tuple[int, ...]] = {}
+    for j in range(len(normals)):
+        ids = [k for k in range(len(verts)) if j in vplanes[k]]
+        if len(ids) < 3:
+            continue
+        u, w = plane_basis(normals[j])
+        c = verts[ids].mean(axis=0)
+        ang = [np.arctan2((verts[k] - c) @ w, (verts[k] - c) @ u) for k in ids]
+        loops[j] = tuple(ids[i] for i in np.argsort(ang))
+    return Polytope(verts, normals, offsets, loops, tuple(frozenset(s) for s in vplanes))
+
+
+def box_planes(points: np.ndarray, margin: float = BOX_MARGIN) -> tuple[np.ndarray, np.ndarray]:
+    """The six planes of the axis-aligned box ``margin`` outside ``points``."""
+    lo, hi = points.min(axis=0) - margin, points.max(axis=0) + margin
+    normals = np.vstack([np.eye(3), -np.eye(3)])
+    return normals, np.concatenate([hi, -lo])
+
+
+@dataclass(eq=False)
+class ConvexEstimate:
+    """The object as the data so far bound it: the measured planes cut from a box round the data, with which
+    of its faces, edges and vertices the data measured."""
+
+    planes: list[Plane]
+    """The object's planes found so far (:func:`face_planes`)."""
+    polytope: Polytope
+    """Their solid, bounded by :func:`box_planes` where they leave it open (planes ``len(planes)`` and on)."""
+    bounds: LearnBounds
+    """The data's error bounds."""
+    vertex_data: dict[int, int]
+    """Data vertex → the vertex of the polytope nearest to it, when within :attr:`LearnBounds.vertex` plus the
+    data vertex's bound."""
+    groups: list[list[int]] = field(default_factory=list)
+    """The polytope's vertices grouped into the object's vertices (edges too short to be real contracted)."""
+    measured: set[int] = field(default_factory=set)
+    """Vertices of the polytope within the bounds of a data vertex."""
+
+    @property
+    def n_planes(self) -> int:
+        return len(self.planes)
+
+    def is_box_plane(self, j: int) -> bool:
+        """Whether plane ``j`` of the polytope is the bounding box's (unmeasured boundary)."""
+        return j >= self.n_planes
+
+    def open_faces(self) -> list[int]:
+        """Box planes that bound the polytope: where the object's surface is not measured yet."""
+        return [j for j in self.polytope.loops if self.is_box_plane(j)]
+
+    def group_of(self) -> dict[int, int]:
+        return {k: g for g, ks in enumerate(self.groups) for k in ks}
+
+    def unmeasured_vertices(self) -> list[int]:
+        """Groups (object vertices) no data vertex was measured at (box corners included)."""
+        measured = {self.group_of()[k] for k in self.measured}
+        return [g for g in range(len(self.groups)) if g not in measured]
+
+    @property
+    def closed(self) -> bool:
+        """Every face a measured plane and every vertex measured."""
+        return not self.open_faces() and not self.unmeasured_vertices()
+
+    def counts(self) -> dict:
+        """What is measured of the estimate: planes, open (box) faces, vertices measured of all."""
+        return {"planes": self.n_planes, "open_faces": len(self.open_faces()), "vertices": len(self.groups),
+                "vertices_measured": len(self.groups) - len(self.unmeasured_vertices())}  # fmt: skip
+
+
+def _polytope_edges(poly: Polytope) -> set[tuple[int, int]]:
+    out = set()
+    for loop in poly.loops.values():
+        for a, b in zip(loop, loop[1:] + loop[:1], strict=True):
+            out.add((min(a, b), max(a, b)))
+    return out
+
+
+def convex_estimate(components: Mapping[int, DataComponent], bounds: LearnBounds | None = None) -> ConvexEstimate:
+    """The :class:`ConvexEstimate` of the data so far (a :class:`LearnError` when they bound no solid)."""
+    bounds = bounds or LearnBounds.of(components.values())
+    planes = face_planes(components)
+    if not planes:
+        raise LearnError("no face measured")
+    pts = data_points(components.values())
+    bn, bd = box_planes(pts)
+    normals = np.vstack([np.array([p.normal for p in planes]), bn])
+    offsets = np.concatenate([np.array([p.offset for p in planes]), bd])
+    poly = intersect(normals, offsets)
+    est = ConvexEstimate(planes, poly, bounds, {})
+    verts = [c for c in components.values() if isinstance(c, DataVertex)]
+    real = [k for k in range(len(poly.vertices)) if not any(est.is_box_plane(j) for j in poly.vertex_planes[k])]
+    near: dict[int, set[int]] = {k: set() for k in range(len(poly.vertices))}
+    for v in verts:
+        d = np.linalg.norm(poly.vertices[real] - v.position, axis=1)
+        for i in np.flatnonzero(d <= bounds.vertex + v.position_bound):
+            near[real[int(i)]].add(v.id)
+        if len(d) and d.min() <= bounds.vertex + v.position_bound:
+            est.vertex_data[v.id] = real[int(np.argmin(d))]
+    # contract the edges that one data vertex measures both ends of and no two data vertices tell apart
+    parent = list(range(len(poly.vertices)))
+
+    def find(i: int) -> int:
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    def length(ab: tuple[int, int]) -> float:
+        return float(np.linalg.norm(poly.vertices[ab[0]] - poly.vertices[ab[1]]))
+
+    for a, b in sorted(_polytope_edges(poly), key=length):
+        if length((a, b)) >= bounds.merge_length or not (near[a] & near[b]):
+            continue
+        if near[a] - near[b] and near[b] - near[a]:
+            continue  # a data vertex at each end alone: two vertices
+        parent[find(a)] = find(b)
+    groups: dict[int, list[int]] = {}
+    for k in range(len(poly.vertices)):
+        groups.setdefault(find(k), []).append(k)
+    est.groups = list(groups.values())
+    est.measured = {k for k in range(len(poly.vertices)) if near[k]}
+    return est
+
+
+def _lsq_point(normals: np.ndarray, offsets: np.ndarray) -> np.ndarray:
+    """The point nearest to every plane (least squares)."""
+    x, *_ = np.linalg.lstsq(normals, offsets, rcond=None)
+    return x
+
+
+PRECISIONS = (0.0, 5e-7, 5e-6)
+"""Precisions a learned model is tried at, finest first [m]: the finest at which its faces are planar. A model
+file written with 6 or 5 decimals of metres is read back at the last two (:func:`haptic.geometry.io.text_quantum`)."""
+PLANAR_ROUNDS = 200
+"""Rounds of :func:`planarize` when a learned model's faces are not planar at any of :data:`PRECISIONS`."""
+
+
+def learned_model(est: ConvexEstimate, name: str = "learned") -> Polyhedron:
+    """The validated model of a closed estimate: each group of the polytope's vertices one vertex, placed where
+    its planes meet (least squares), each measured plane one face. Its precision is the finest of
+    :data:`PRECISIONS` at which the faces are planar within the model's tolerance (a vertex of more than three
+    noisy planes lies on none of them exactly)."""
+    if est.open_faces():
+        raise LearnError(f"{name}: the surface is not closed: {len(est.open_faces())} faces not measured")
+    poly = est.polytope
+    gof = est.group_of()
+    planes_of = [set().union(*(poly.vertex_planes[k] for k in ks)) for ks in est.groups]
+    verts = np.array([_lsq_point(poly.normals[sorted(p)], poly.offsets[sorted(p)]) for p in planes_of])
+    faces = []
+    for j in sorted(poly.loops):
+        loop = []
+        for k in poly.loops[j]:
+            g = gof[k]
+            if not loop or loop[-1] != g:
+                loop.append(g)
+        while len(loop) > 1 and loop[0] == loop[-1]:
+            loop.pop()
+        if len(loop) >= 3:
+            faces.append(loop)
+    used = sorted({g for f in faces for g in f})
+    index = {g: i for i, g in enumerate(used)}
+    verts = verts[used]
+    faces = [[index[g] for g in f] for f in faces]
+    last: ModelError | None = None
+    b = est.bounds
+    learned = LearnedBounds(b.normal, b.position, b.direction)
+    model = None
+    for attempt in (verts, planarize(verts, faces, PLANAR_ROUNDS)):
+        for q in PRECISIONS:
+            try:
+                model = Polyhedron.from_faces(rounded(attempt, q), faces, name=name, precision=q,
+                                              learned_bounds=learned)  # fmt: skip
+                break
+            except ModelError as exc:
+                last = exc
+        if model is not None:
+            break
+    if model is None:
+        raise LearnError(f"{name}: the learned solid is not a valid model ({last})")
+    sym = symmetrized(model, SYMMETRY_FACTOR * b.position)
+    for q in PRECISIONS:
+        try:
+            return Polyhedron.from_faces(rounded(sym, q), faces, name=name, precision=q, learned_bounds=learned)
+        except ModelError:
+            continue
+    return model
+
+
+SYMMETRY_FACTOR = 2.0
+"""Rigid motions that map a learned model onto itself within this many times the data's position bound are
+taken for symmetries of the object (:func:`symmetrized`) [-]."""
+SYMMETRY_ROUNDS = 50
+"""Most rounds of :func:`symmetrized`."""
+
+
+def symmetrized(model: Polyhedron, eps: float) -> np.ndarray:
+    """The vertices of ``model`` made exactly symmetric under the rigid motions that map it onto itself within
+    ``eps`` [m]: each vertex the mean of its images under them, the motions fitted again, until they map the
+    vertices onto each other to round-off. A model learned from noisy data is symmetric only within its
+    bounds; the matcher groups the poses of a model by its exact symmetry group, so an object's symmetric poses
+    would otherwise stay apart, never to be told from each other."""
+    from haptic.geometry.symmetry import _congruences, _fit_rotation
+
+    pairs = _congruences(model, model, eps)
+    v = np.array(model.vertices, dtype=float)
+    if len(pairs) <= 1:
+        return v
+    perms = [perm for _, perm in pairs]
+    for _ in range(SYMMETRY_ROUNDS):
+        acc = np.zeros_like(v)
+        worst = 0.0
+        for perm in perms:  # the motion carries vertex i to vertex perm[i]
+            r, t = _fit_rotation(v, v[perm])
+            moved = v @ r.T + t
+            worst = max(worst, float(np.linalg.norm(moved - v[perm], axis=1).max()))
+            acc[perm] += moved
+        v = acc / len(perms)
+        if worst < NUMERIC * max(float(np.ptp(v)), 1.0):
+            break
+    return v
+
+
+def planarize(vertices: np.ndarray, faces: list[list[int]], rounds: int) -> np.ndarray:
+    """Vertices moved toward planar faces: in turn, each face's plane fitted to its vertices and each vertex
+    placed nearest to its faces' planes (least squares; each round lowers the sum of squared distances)."""
+    v = np.array(vertices, dtype=float)
+    vfaces: list[list[int]] = [[] for _ in range(len(v))]
+    for i, f in enumerate(faces):
+        for k in f:
+            vfaces[k].append(i)
+    for _ in range(rounds):
+        normals, offsets = [], []
+        for f in faces:
+            p = v[f]
+            c = p.mean(axis=0)
+            _, _, vt = np.linalg.svd(p - c)
+            n = vt[2] if vt[2] @ np.cross(p[1] - p[0], p[2] - p[0]) >= 0 else -vt[2]
+            normals.append(n)
+            offsets.append(float(c @ n))
+        normals, offsets = np.array(normals), np.array(offsets)
+        v = np.array([_lsq_point(normals[fs], offsets[fs]) for fs in vfaces])
+    return v
+
+
+def rounded(vertices: np.ndarray, precision: float) -> np.ndarray:
+    """Coordinates rounded as a file written at ``precision`` (half a unit of its last decimal) holds them."""
+    if precision <= 0:
+        return np.asarray(vertices, float)
+    decimals = decimals_for(precision)
+    return np.round(np.asarray(vertices, float), decimals)
+
+
+def decimals_for(precision: float) -> int:
+    """Decimals of metres whose half unit is ``precision`` (5e-6 → 5)."""
+    return int(round(-np.log10(2 * precision)))
