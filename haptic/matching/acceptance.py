@@ -24,6 +24,7 @@ change of a feature that is measured is caught by the residual test whatever the
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -102,24 +103,52 @@ def _coplanar(model: Polyhedron, f: int) -> np.ndarray:
     return np.flatnonzero((model.face_normals @ n > 1.0 - 1e-9) & (np.abs(model.face_offsets - d) < 1e-7))
 
 
+_PLANE_TRIANGLES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _plane_triangles(model: Polyhedron) -> np.ndarray:
+    """For each model face, which of the model's triangles lie on it or on a face coplanar with it
+    (:func:`_coplanar`), shape (F, T) bool; computed once per model."""
+    if model not in _PLANE_TRIANGLES:
+        _PLANE_TRIANGLES[model] = np.stack(
+            [np.isin(model.triangle_faces, _coplanar(model, f)) for f in range(model.n_faces)]
+        ).reshape(model.n_faces, len(model.triangles))
+    return _PLANE_TRIANGLES[model]
+
+
+def _face_point_distances(
+    model: Polyhedron, data: Sequence[DataComponent], it: Interpretation, model_from_world: SE3
+) -> np.ndarray:
+    """For each face pairing of ``it`` (in its order), the largest distance of the data face's touched points
+    from the model face's polygon or a coplanar face's (the robot cannot tell which of two faces in one plane
+    it touched, and the interpretation may pair either): off its plane, or beyond them, shape (len(it.faces),)
+    [m]. One distance computation for every point of every face."""
+    pairs = list(it.faces.items())
+    if not pairs:
+        return np.zeros(0)
+    pts = [model_from_world.apply(np.atleast_2d(data[i].points)) for i, _ in pairs]
+    owner = np.repeat(np.arange(len(pairs)), [len(p) for p in pts])
+    d = point_triangle_distance(np.concatenate(pts), model.vertices[model.triangles])
+    allowed = _plane_triangles(model)[np.array([f for _, f in pairs])][owner]
+    nearest = np.where(allowed, d, np.inf).min(axis=1)
+    out = np.full(len(pairs), -np.inf)
+    np.maximum.at(out, owner, nearest)
+    return out
+
+
 def residual_ratios(
     model: Polyhedron, data: Sequence[DataComponent], it: Interpretation, world_from_model: SE3
 ) -> list[tuple[float, int, str]]:
     """``(residual / bound, data id, what)`` of every measured quantity of interpretation ``it`` at a pose."""
     inv = world_from_model.inverse()
     out: list[tuple[float, int, str]] = []
-    for i, f in it.faces.items():
+    farthest = _face_point_distances(model, data, it, inv)
+    for (i, f), d in zip(it.faces.items(), farthest, strict=True):
         c = data[i]
         assert isinstance(c, DataFace)
         n_m = model.face_normals[f]
         out.append((_angle(inv.rotate(c.normal), n_m) / (c.normal_bound + ROUND_OFF), i, "face normal"))
-        q = inv.apply(c.points)
-        # distance to the model face's polygon (or a coplanar face's: the robot cannot tell which of two faces
-        # in one plane it touched, and the interpretation may pair either): off its plane, or beyond them
-        same = _coplanar(model, f)
-        tri = model.vertices[model.triangles[np.isin(model.triangle_faces, same)]]
-        d = point_triangle_distance(q, tri).min(axis=1)
-        out.append((float(d.max()) / (c.position_bound + ROUND_OFF), i, "face point"))
+        out.append((float(d) / (c.position_bound + ROUND_OFF), i, "face point"))
     for i, e in it.edges.items():
         c = data[i]
         assert isinstance(c, DataEdge)
