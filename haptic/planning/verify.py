@@ -1,17 +1,17 @@
 """Verification moves: once one pose class is left, measure what its model predicts and the data lack.
 
 The planner's scoring (seed §4.1) with one hypothesis left has nothing to eliminate; what a move is worth then
-is what it *measures* of the remaining model that has not been measured yet: each model face, edge or vertex
-still missing from the coverage target (:mod:`haptic.matching.acceptance`) that the move is predicted to reach, in
-the hypothesis's world (:func:`~haptic.planning.search.simulate`), per unit of predicted cost, discounted by the
-same risks as the planner's moves (the table, a steep descent). A move that measures nothing new now is scored
-by the best two-move sequence it starts (the look-ahead of :mod:`haptic.planning.search`), and, when no such
-sequence measures anything, the move that ends nearest a missing feature is taken.
+is how much of the verification it leaves: the features of the model still missing from the coverage target
+(:mod:`haptic.matching.acceptance`) are ordered by a tour (:mod:`haptic.planning.tour`), and each candidate move
+is scored by its predicted cost (over its chance of success: the table, a steep descent, as the planner's moves)
+plus the tour's cost over what it leaves to measure, from where it ends in the hypothesis's world
+(:func:`~haptic.planning.search.simulate`); the least score is taken, and the tour is planned afresh after every
+result. When no candidate can be followed in the hypothesis's world, the move that ends nearest a missing feature
+is taken.
 
 Where the move set admits probes (``--moves probing|all``) and the sensor is a point (no table: the geometric
-executor), a free-space probe may carry the sensor to a face beside what is still missing
-(:func:`verification_probes`); it measures no edge or vertex itself, so it is scored with the two tracing moves
-after it. The verification's move budget follows the model (:func:`verify_move_budget`).
+executor), a free-space probe may carry the sensor to a face beside where the tour is cheapest to enter
+(:func:`verification_probes`). The verification's move budget follows the model (:func:`verify_move_budget`).
 """
 
 from __future__ import annotations
