@@ -3,12 +3,16 @@ noise):
 
 - ``optimal``: the policy of least expected path cost to recognition (exhaustive search over move sequences,
   ``--depth`` moves, then planner roll-outs; :mod:`haptic.planning.optimal`);
+- ``lookahead``: one move searched, each outcome valued by planner roll-outs (:class:`~haptic.planning.optimal.
+  LookaheadPolicy`);
 - the hindsight optimum of each episode: the cheapest recognising move sequence found by exhaustive search
   knowing the truth (``--hindsight-depth`` moves after the fixed sequence; :mod:`haptic.bench.oracle`), a
   lower bound for every policy.
 
     .venv/bin/python scripts/bench_optimal.py [--episodes 60] [--seed 7] [--moves tracing] [--jobs 2]
-        [--json out/optimal.jsonl]
+        [--policies optimal,lookahead,planner,greedy,random] [--json out/optimal.jsonl]
+
+The table gives each policy's decision times (the policy's choices, wall time: on a loaded machine they grow).
 
 ``--moves`` sets the policies' admissible moves (as ``haptic bench --moves``); the hindsight optimum searches
 tracing moves whatever it is. ``--hindsight-depth 0`` leaves the hindsight optimum out.
@@ -45,7 +49,7 @@ def _policy_run(spec: EpisodeSpec, depth: int) -> dict:
     t0 = time.perf_counter()
     r = run_episode(spec, library=_library(), policy=make_policy(spec.policy, **options))
     return {"policy": spec.policy, "seed": spec.seed, "model": spec.model, "cost": r.path_cost, "moves": r.moves,
-            "correct": r.correct, "wall_s": time.perf_counter() - t0}
+            "correct": r.correct, "wall_s": time.perf_counter() - t0, "decision_times_s": list(r.decision_times_s)}
 
 
 def _hindsight_run(spec: EpisodeSpec, depth: int) -> dict:
@@ -92,8 +96,8 @@ def main(argv: list[str] | None = None) -> int:
     print(f"hindsight optimum found for {len(hind_ok)}/{len(seeds)} episodes (its column uses those)")
     print()
     print("| policy | correct | mean cost | median cost | mean moves | median moves | wall s/episode | "
-          "mean cost / optimal's | mean cost / hindsight optimum |")
-    print("|---|---|---|---|---|---|---|---|---|")
+          "decision ms p50 / p90 / max | mean cost / optimal's | mean cost / hindsight optimum |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
 
     def mean_cost(p, ks):
         return float(np.mean([by[(p, k)]["cost"] for k in ks]))
@@ -109,8 +113,11 @@ def main(argv: list[str] | None = None) -> int:
         vs_hind = f"{mean_cost(p, hind_ok) / mean_cost('hindsight', hind_ok):.3f}" if hind_ok else "-"
         wall_ep = "-" if p == "hindsight" else f"{np.mean([r['wall_s'] for r in rs]):.2f}"
         correct = "-" if p == "hindsight" else f"{sum(r['correct'] for r in rs)}/{len(rs)}"
+        times = [t * 1e3 for r in rs for t in r.get("decision_times_s") or []]
+        decide = (f"{np.percentile(times, 50):.1f} / {np.percentile(times, 90):.1f} / {max(times):.0f}" if times
+                  else "-")  # fmt: skip
         print(f"| {p} | {correct} | {c.mean():.2f} | {np.median(c):.2f} | {m.mean():.2f} | {np.median(m):.1f} | "
-              f"{wall_ep} | {vs_opt} | {vs_hind} |")
+              f"{wall_ep} | {decide} | {vs_opt} | {vs_hind} |")
     return 0
 
 

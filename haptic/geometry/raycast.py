@@ -104,6 +104,41 @@ def depth_samples(
     return pts, surface_distance(poly, pts)
 
 
+def depth_samples_many(
+    poly: Polyhedron, starts: np.ndarray, directions: np.ndarray, lengths: np.ndarray
+) -> list[tuple[np.ndarray, np.ndarray]]:
+    """:func:`depth_samples` of several segments at once (shapes (S, 3), (S, 3), (S,)): the same points and
+    depths per segment, from one crossing test, one inside test and one distance computation for all of them."""
+    starts = np.atleast_2d(np.asarray(starts, dtype=float))
+    directions = np.atleast_2d(np.asarray(directions, dtype=float))
+    hits = line_hits(poly, starts, directions)
+    cuts, mids = [], []
+    for k, length in enumerate(np.asarray(lengths, dtype=float)):
+        ts = hits.params[k]
+        ts = np.unique(np.clip(ts[np.isfinite(ts)], 0.0, length))
+        c = np.unique(np.concatenate([[0.0], ts, [float(length)]]))
+        cuts.append(c)
+        mids.append(starts[k] + (0.5 * (c[:-1] + c[1:]))[:, None] * directions[k])
+    inside = poly.contains(np.concatenate(mids)) if sum(len(m) for m in mids) else np.zeros(0, dtype=bool)
+    samples, at = [], 0
+    for k, c in enumerate(cuts):
+        ins, at = inside[at : at + len(c) - 1], at + len(c) - 1
+        spans: list[tuple[float, float]] = []
+        for lo, hi, i in zip(c[:-1], c[1:], ins, strict=True):
+            if not i or hi <= lo:
+                continue
+            if spans and abs(spans[-1][1] - lo) < 1e-12:
+                spans[-1] = (spans[-1][0], float(hi))
+            else:
+                spans.append((float(lo), float(hi)))
+        ts = np.concatenate([np.linspace(lo, hi, DEPTH_SAMPLES) for lo, hi in spans]) if spans else np.zeros(0)
+        samples.append(starts[k] + ts[:, None] * directions[k])
+    counts = [len(x) for x in samples]
+    depth = surface_distance(poly, np.concatenate(samples)) if sum(counts) else np.zeros(0)
+    bounds = np.cumsum([0, *counts])
+    return [(samples[k], depth[bounds[k] : bounds[k + 1]]) for k in range(len(samples))]
+
+
 def segment_depth(poly: Polyhedron, start: np.ndarray, direction: np.ndarray, length: float) -> float:
     """How deep the segment ``start + t u``, ``0 ≤ t ≤ length``, runs inside the solid: the largest distance
     from the surface of its inside points, sampled (:func:`depth_samples`), 0 when it stays outside (model
@@ -115,4 +150,12 @@ def segment_depth(poly: Polyhedron, start: np.ndarray, direction: np.ndarray, le
     return float(depth.max()) if len(depth) else 0.0
 
 
-__all__ = ["DEPTH_SAMPLES", "LineHits", "depth_samples", "inside_intervals", "line_hits", "segment_depth"]
+__all__ = [
+    "DEPTH_SAMPLES",
+    "LineHits",
+    "depth_samples",
+    "depth_samples_many",
+    "inside_intervals",
+    "line_hits",
+    "segment_depth",
+]

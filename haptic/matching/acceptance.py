@@ -24,6 +24,7 @@ change of a feature that is measured is caught by the residual test whatever the
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -113,6 +114,39 @@ def _model_bounds(model: Polyhedron) -> LearnedBounds:
     return model.learned_bounds if model.learned_bounds is not None else EXACT
 
 
+_PLANE_TRIANGLES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _plane_triangles(model: Polyhedron) -> np.ndarray:
+    """For each model face, which of the model's triangles lie on it or on a face coplanar with it
+    (:func:`_coplanar`), shape (F, T) bool; computed once per model."""
+    if model not in _PLANE_TRIANGLES:
+        _PLANE_TRIANGLES[model] = np.stack(
+            [np.isin(model.triangle_faces, _coplanar(model, f)) for f in range(model.n_faces)]
+        ).reshape(model.n_faces, len(model.triangles))
+    return _PLANE_TRIANGLES[model]
+
+
+def _face_point_distances(
+    model: Polyhedron, data: Sequence[DataComponent], it: Interpretation, model_from_world: SE3
+) -> np.ndarray:
+    """For each face pairing of ``it`` (in its order), the largest distance of the data face's touched points
+    from the model face's polygon or a coplanar face's (the robot cannot tell which of two faces in one plane
+    it touched, and the interpretation may pair either): off its plane, or beyond them, shape (len(it.faces),)
+    [m]. One distance computation for every point of every face."""
+    pairs = list(it.faces.items())
+    if not pairs:
+        return np.zeros(0)
+    pts = [model_from_world.apply(np.atleast_2d(data[i].points)) for i, _ in pairs]
+    owner = np.repeat(np.arange(len(pairs)), [len(p) for p in pts])
+    d = point_triangle_distance(np.concatenate(pts), model.vertices[model.triangles])
+    allowed = _plane_triangles(model)[np.array([f for _, f in pairs])][owner]
+    nearest = np.where(allowed, d, np.inf).min(axis=1)
+    out = np.full(len(pairs), -np.inf)
+    np.maximum.at(out, owner, nearest)
+    return out
+
+
 def residual_ratios(
     model: Polyhedron, data: Sequence[DataComponent], it: Interpretation, world_from_model: SE3
 ) -> list[tuple[float, int, str]]:
@@ -120,19 +154,14 @@ def residual_ratios(
     inv = world_from_model.inverse()
     mb = _model_bounds(model)
     out: list[tuple[float, int, str]] = []
-    for i, f in it.faces.items():
+    farthest = _face_point_distances(model, data, it, inv)
+    for (i, f), d in zip(it.faces.items(), farthest, strict=True):
         c = data[i]
         assert isinstance(c, DataFace)
         n_m = model.face_normals[f]
         out.append((_angle(inv.rotate(c.normal), n_m) / (np.hypot(c.normal_bound, mb.normal) + ROUND_OFF), i,
                     "face normal"))  # fmt: skip
-        q = inv.apply(c.points)
-        # distance to the model face's polygon (or a coplanar face's: the robot cannot tell which of two faces
-        # in one plane it touched, and the interpretation may pair either): off its plane, or beyond them
-        same = _coplanar(model, f)
-        tri = model.vertices[model.triangles[np.isin(model.triangle_faces, same)]]
-        d = point_triangle_distance(q, tri).min(axis=1)
-        out.append((float(d.max()) / (np.hypot(c.position_bound, mb.position) + ROUND_OFF), i, "face point"))
+        out.append((float(d) / (np.hypot(c.position_bound, mb.position) + ROUND_OFF), i, "face point"))
     for i, e in it.edges.items():
         c = data[i]
         assert isinstance(c, DataEdge)

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from haptic.geometry.polyhedron import Polyhedron
-from haptic.geometry.raycast import depth_samples
+from haptic.geometry.raycast import depth_samples, depth_samples_many
 from haptic.geometry.se3 import SE3
 from haptic.matching.acceptance import pose_check
 from haptic.matching.components import DataFace, readonly_vector
@@ -118,6 +118,24 @@ def free_segment_consistent(
     return bool((depth <= margin).all())
 
 
+def free_segments_consistent(
+    model: Polyhedron, world_from_model: SE3, free: Sequence[FreeSegment], tol: PoseTolerance
+) -> bool:
+    """:func:`free_segment_consistent` for every segment of ``free`` (all of them), the segments tested together
+    (:func:`~haptic.geometry.raycast.depth_samples_many`)."""
+    if not free:
+        return True
+    inv = world_from_model.inverse()
+    starts = inv.apply(np.array([seg.start for seg in free]))
+    dirs = inv.rotate(np.array([seg.direction for seg in free]))
+    samples = depth_samples_many(model, starts, dirs, np.array([seg.length for seg in free]))
+    for seg, (pts_m, depth) in zip(free, samples, strict=True):
+        if len(depth) and not (depth <= free_margin(seg, tol, world_from_model, model,
+                                                    world_from_model.apply(pts_m))).all():  # fmt: skip
+            return False
+    return True
+
+
 def consistent_leaves(
     tree: InterpretationTree,
     free: Sequence[FreeSegment],
@@ -141,6 +159,7 @@ def consistent_leaves(
         return keep
     tol = tol if tol is not None else PoseTolerance.from_data(tree.data)
     data = tree.data
+    tree.poses(range(n), refine=True)  # every leaf's pose in one batch; interpretation() reads them back
     for leaf in range(n):
         it = tree.interpretation(leaf, with_pose=True, refine=True)
         pose = it.world_from_model
@@ -149,7 +168,7 @@ def consistent_leaves(
         if hits & set(it.faces) and not pose_check(it.model, data, it).ok:
             keep[leaf] = False
             continue
-        keep[leaf] = all(free_segment_consistent(it.model, pose, seg, tol) for seg in free)
+        keep[leaf] = free_segments_consistent(it.model, pose, free, tol)
     return keep
 
 
@@ -191,6 +210,7 @@ __all__ = [
     "consistent_leaves",
     "free_margin",
     "free_segment_consistent",
+    "free_segments_consistent",
     "position_span",
     "probe_face",
 ]

@@ -96,6 +96,20 @@ class OptimalPolicy(Policy):
         return Decision(scored[int(rng.choice(best))].move, tuple(scored))
 
 
+class LookaheadPolicy(OptimalPolicy):
+    """The roll-out policy: every candidate move's predicted outcomes (its branches) valued by their cost plus the
+    efficiency planner's cost to recognition from each, simulated ``rollout_moves`` moves on
+    (:class:`OptimalPolicy` searched one move deep); the least expected total wins. With more than
+    ``max_hypotheses`` pose classes, or any without a pose, it decides as the planner does."""
+
+    name = "lookahead"
+
+    def __init__(
+        self, rollout_moves: int = 4, unresolved_cost: float = 20.0, max_hypotheses: int = 30, max_probes: int = 2
+    ) -> None:
+        super().__init__(1, rollout_moves, unresolved_cost, max_hypotheses, max_probes)
+
+
 class _Search:
     """Expected cost to recognition within the planner's model, from one decision's context."""
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from haptic.errors import PlanningError
-from haptic.planning.optimal import OptimalPolicy
+from haptic.planning.optimal import LookaheadPolicy, OptimalPolicy
 from haptic.planning.policies import GreedyPolicy, PlannerPolicy, Policy, RandomPolicy
 
 POLICIES: dict[str, Callable[..., Policy]] = {
@@ -13,11 +13,12 @@ POLICIES: dict[str, Callable[..., Policy]] = {
     "greedy": GreedyPolicy,
     "random": RandomPolicy,
     "optimal": OptimalPolicy,
+    "lookahead": LookaheadPolicy,
 }
 
 
 def make_policy(name: str, **options) -> Policy:
-    """A policy by name: planner, greedy, random, optimal."""
+    """A policy by name: planner, greedy, random, optimal, lookahead."""
     try:
         return POLICIES[name](**options)
     except KeyError:

@@ -1,21 +1,22 @@
 """Verification moves: once one pose class is left, measure what its model predicts and the data lack.
 
 The planner's scoring (seed §4.1) with one hypothesis left has nothing to eliminate; what a move is worth then
-is what it *measures* of the remaining model that has not been measured yet: each model face, edge or vertex
-still missing from the coverage target (:mod:`haptic.matching.acceptance`) that the move is predicted to reach, in
-the hypothesis's world (:func:`~haptic.planning.search.simulate`), per unit of predicted cost, discounted by the
-same risks as the planner's moves (the table, a steep descent). A move that measures nothing new now is scored
-by the best two-move sequence it starts (the look-ahead of :mod:`haptic.planning.search`), and, when no such
-sequence measures anything, the move that ends nearest a missing feature is taken.
+is how much of the verification it leaves: the features of the model still missing from the coverage target
+(:mod:`haptic.matching.acceptance`) are ordered by a tour (:mod:`haptic.planning.tour`), and each candidate move
+is scored by its predicted cost (over its chance of success: the table, a steep descent, as the planner's moves)
+plus the tour's cost over what it leaves to measure, from where it ends in the hypothesis's world
+(:func:`~haptic.planning.search.simulate`); the least score is taken, and the tour is planned afresh after every
+result. When no candidate can be followed in the hypothesis's world, the move that ends nearest a missing feature
+is taken.
 
 Where the move set admits probes (``--moves probing|all``) and the sensor is a point (no table: the geometric
-executor), a free-space probe may carry the sensor to a face beside what is still missing
-(:func:`verification_probes`); it measures no edge or vertex itself, so it is scored with the two tracing moves
-after it. The verification's move budget follows the model (:func:`verify_move_budget`).
+executor), a free-space probe may carry the sensor to a face beside where the tour is cheapest to enter
+(:func:`verification_probes`). The verification's move budget follows the model (:func:`verify_move_budget`).
 """
 
 from __future__ import annotations
 
+import time
 import weakref
 from collections.abc import Mapping, Sequence
 
@@ -29,6 +30,19 @@ from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import FaceMove, Move, SensorState
 from haptic.planning.predict import candidate_moves, predict
 from haptic.planning.table import descent_risk
+from haptic.planning.tour import (
+    AIM_NEAR_VERTEX,
+    EDGE,
+    FACE,
+    PROBE_INSET,
+    VERTEX,
+    LegCosts,
+    Tour,
+    features,
+    plan_tour,
+    start_costs,
+    tour_lower_bound,
+)
 
 STALL_MOVES = 8
 """Verification moves in a row that measure no missing feature after which the verification ends with what it
@@ -53,12 +67,6 @@ MAX_CHECKED_LEAVES = 16
 """Interpretations of the pose class tried by the pose check (the first that passes counts)."""
 MIN_SAMPLES = 3
 """A face counts as reachable on the table when at least this many of its sample points are touchable."""
-AIM_NEAR_VERTEX = 6e-3
-"""An aimed face move (:func:`aimed_face_moves`) ends on an edge of the current face this far from a missing
-vertex [m] (at most a quarter of the edge), so that a short edge move (``c_e`` × 6 mm + ``c_k`` = 1.6 units)
-measures the vertex, instead of tracing the whole edge to it (§3.1: a face costs half an edge per cm)."""
-
-
 def reachable_features(
     poly: Polyhedron, world_from_model: SE3, config: PlannerConfig
 ) -> tuple[frozenset[int], frozenset[int], frozenset[int]]:
@@ -164,7 +172,7 @@ def aimed_face_moves(
         d = t.apply(p) - state.position
         d = d - (d @ face.normal) * face.normal
         n = float(np.linalg.norm(d))
-        if n < 2 * AIM_NEAR_VERTEX or (along is not None and abs(d @ along) > 0.95 * n):
+        if n < AIM_NEAR_VERTEX or (along is not None and abs(d @ along) > 0.95 * n):
             continue  # at hand, or along the edge the sensor is on (an edge move's business)
         out.append(FaceMove(d / n))
     return out
@@ -197,38 +205,8 @@ def _moves(
     return good or [(m, c, r) for m, c, r, _ in out]
 
 
-def _sequence_score(
-    h: Hypothesis, state: SensorState, components: Mapping[int, DataComponent],
-    missing: tuple[frozenset[int], frozenset[int], frozenset[int]], noise: SensorNoise, config: PlannerConfig,
-    depth: int, gain: int, cost: float, ok: float, fixed_faces: bool,
-) -> float:
-    """The best ``ok · (gain + g) / (cost + c)`` over the sequences of one to ``depth`` fresh tracing moves from
-    here, each move's gain ``g`` (missing features measured, in ``h``'s world), cost ``c`` and success ``ok``
-    (one less its risk) added to those of the moves before (``gain``, ``cost``, ``ok``); 0 when none is
-    admissible."""
-    from haptic.planning.search import simulate
-
-    best = 0.0
-    for m, c, r in _moves(h, state, components, noise, config, (), missing, fixed_faces=fixed_faces):
-        sim = simulate(h, m, state, components, config)
-        if sim is None:
-            continue
-        h1, s1, comps1 = sim
-        new = _new_features(h, h1)
-        g, c1, ok1 = gain + _gain(new, missing), cost + c, ok * (1.0 - r)
-        best = max(best, ok1 * g / max(c1, 1e-9))
-        if depth > 1:
-            left = tuple(x - n for x, n in zip(missing, new, strict=True))
-            best = max(best, _sequence_score(h1, s1, comps1, left, noise, config, depth - 1, g, c1, ok1, False))
-    return best
-
-
 MAX_VERIFY_PROBES = 2
 """Probes a verification decision weighs (:func:`verification_probes`), the nearest targets first."""
-PROBE_INSET = 0.01
-"""A verification probe aims at a point of a face this far from both edges at the missing vertex [m]: the hand's
-contact stays clear of the face's boundary (:func:`~haptic.planning.handpath.foot_near_boundary`), and an aimed
-face move then reaches an edge :data:`AIM_NEAR_VERTEX` from the vertex."""
 MIN_PROBE_TRANSFER = 0.02
 """Targets nearer the sensor than this are left to tracing moves [m]: a probe's constant cost alone buys 2 cm
 across a face."""
@@ -342,18 +320,46 @@ def choose_verification_move(
     probed: Sequence[Move] = (),
     faces_ok: frozenset[int] | None = None,
 ) -> Move | None:
-    """The move that measures the most missing features (faces, edges, vertices of ``missing``) of hypothesis
-    ``h``'s model per unit of predicted cost, looking two tracing moves ahead, or, where the configuration
-    admits probes, a probe (:func:`verification_probes`, not along a line of ``probed``) and the two tracing
-    moves after it; None when no move is admissible. ``avoid``: moves that failed from here."""
+    """The move that starts the cheapest completion of the verification: of the candidates (the planner's
+    tracing moves, face moves aimed at what is missing, and, where the configuration admits probes, probes to
+    the faces beside the tour's cheapest entries; not one of ``avoid``, nor a probe along a line of ``probed``),
+    the least predicted cost (over its chance of success) plus the cost of the tour (:mod:`haptic.planning.tour`)
+    over the features of ``missing`` it leaves to measure, from where it ends; None when no move is admissible.
+    ``avoid``: moves that failed from here."""
+    return plan_verification_move(h, state, components, missing, noise, config, avoid, probed, faces_ok)[0]
+
+
+def plan_verification_move(
+    h: Hypothesis,
+    state: SensorState,
+    components: Mapping[int, DataComponent],
+    missing: tuple[frozenset[int], frozenset[int], frozenset[int]],
+    noise: SensorNoise,
+    config: PlannerConfig,
+    avoid: Sequence[Move] = (),
+    probed: Sequence[Move] = (),
+    faces_ok: frozenset[int] | None = None,
+    previous: Tour | None = None,
+) -> tuple[Move | None, Tour | None, float]:
+    """:func:`choose_verification_move`, with the tour it planned over ``missing`` (from ``previous``'s order,
+    when given) and that tour's cost from the sensor as it is [units] (None and 0 without a pose)."""
     from haptic.planning.search import simulate
     from haptic.planning.simulate import simulate_probe
 
+    if h.world_from_model is None:
+        first = _moves(h, state, components, noise, config, avoid, missing)
+        return (first[0][0] if first else None), None, 0.0
+    poly, legs = h.poly, _legs(config)
+    keys = features(poly).index(missing)
+    tour = plan_tour(poly, keys, legs, previous)
+    here = _start_costs(h, state, keys, legs)
+    now = tour.cost_from(here)
     first = _moves(h, state, components, noise, config, avoid, missing)
-    probes = verification_probes(h, state, components, missing, noise, config, avoid, probed, faces_ok)
+    probes = verification_probes(h, state, components, _entries(poly, tour, here, keys), noise, config, avoid, probed,
+                                 faces_ok)  # fmt: skip
     if not first and not probes:
-        return None
-    best, best_score = None, 0.0
+        return None, tour, now
+    best, best_score = None, np.inf
     ends: list[tuple[Move, np.ndarray | None, float]] = []
     for m, c, r in [*first, *probes]:
         sim = (simulate_probe(h, m, state, components, noise) if m.kind == "probe"
@@ -361,29 +367,57 @@ def choose_verification_move(
         if sim is None:
             ends.append((m, None, c))
             continue
-        h1, s1, comps1 = sim
+        h1, s1, _ = sim
         new = _new_features(h, h1)
-        g1 = _gain(new, missing)
-        score = (1.0 - r) * g1 / max(c, 1e-9)
-        left = tuple(x - n for x, n in zip(missing, new, strict=True))
-        # after a tracing move one more; after a probe, which measures at most a face, two more
-        depth = 2 if m.kind == "probe" else 1
-        score = max(score, _sequence_score(h1, s1, comps1, left, noise, config, depth, g1, c, 1.0 - r,
-                                           m.kind == "probe"))  # fmt: skip
-        if score > best_score:
+        measured = frozenset(int(k) for k in features(poly).index(tuple(  # type: ignore[arg-type]
+            frozenset(n & x) for n, x in zip(new, missing, strict=True))))  # fmt: skip
+        score = c / max(1.0 - r, 1e-9) + tour.cost_from(_start_costs(h1, s1, keys, legs), measured)
+        if score < best_score:
             best, best_score = m, score
         ends.append((m, h.world_from_model.inverse().apply(s1.position), c))
     if best is not None:
-        return best
-    # nothing within two moves: head for the nearest missing feature
+        return best, tour, now
+    # no candidate can be followed in the hypothesis's world: head for the nearest missing feature
     targets = _target_points(h.poly, missing)
     if not len(targets):
-        return ends[0][0]
+        return ends[0][0], tour, now
     scored = [
         (float(np.linalg.norm(targets - p, axis=1).min()) if p is not None else np.inf, c, k)
         for k, (m, p, c) in enumerate(ends)
     ]
-    return ends[min(scored)[2]][0]
+    return ends[min(scored)[2]][0], tour, now
+
+
+def _legs(config: PlannerConfig) -> LegCosts:
+    """The tour's leg costs: probes priced only where the verification offers them (:data:`MAX_VERIFY_PROBES`)."""
+    return LegCosts.of(config, probes=MAX_VERIFY_PROBES > 0)
+
+
+def _start_costs(h: Hypothesis, state: SensorState, keys: np.ndarray, legs: LegCosts) -> np.ndarray:
+    """:func:`~haptic.planning.tour.start_costs` of the targets ``keys`` (sorted feature indices) from the sensor
+    in ``state``, in hypothesis ``h``'s world."""
+    edge = h.edges.get(state.edge) if state.edge is not None else None
+    return start_costs(h.poly, h.model_from_world.apply(state.position), h.faces.get(state.face), edge, keys, legs)
+
+
+def _entries(
+    poly: Polyhedron, tour: Tour, here: np.ndarray, keys: np.ndarray
+) -> tuple[frozenset[int], frozenset[int], frozenset[int]]:
+    """The :data:`MAX_VERIFY_PROBES` targets where the tour is cheapest to enter from the sensor
+    (:meth:`~haptic.planning.tour.Tour.cost_from` per entry), as a ``(faces, edges, vertices)`` triple for
+    :func:`verification_probes`."""
+    if not len(keys):
+        return (frozenset(), frozenset(), frozenset())
+    order = np.array([int(np.searchsorted(keys, t)) for t in tour.order])
+    if len(order) > 1:
+        leg = tour.legs[order, np.roll(order, -1)]
+        entry = here[order] + tour.cost - np.maximum(leg, np.roll(leg, 1))
+    else:
+        entry = here[order]
+    feats = features(poly)
+    best = [int(keys[order[k]]) for k in np.argsort(entry, kind="stable")[:MAX_VERIFY_PROBES]]
+    return tuple(frozenset(int(feats.ids[t]) for t in best if feats.kinds[t] == kind)  # type: ignore[return-value]
+                 for kind in (FACE, EDGE, VERTEX))  # fmt: skip
 
 
 def _target_points(poly: Polyhedron, missing: tuple[frozenset[int], frozenset[int], frozenset[int]]) -> np.ndarray:
@@ -395,8 +429,8 @@ def _target_points(poly: Polyhedron, missing: tuple[frozenset[int], frozenset[in
     return np.array(pts).reshape(-1, 3)
 
 
-__all__ = ["aimed_face_moves", "choose_verification_move", "hidden_vertices", "reachable_features",
-           "verification_probes", "verify_move_budget"]
+__all__ = ["aimed_face_moves", "choose_verification_move", "hidden_vertices", "plan_verification_move",
+           "reachable_features", "verification_probes", "verify_move_budget"]
 
 
 class Verifier:
@@ -430,6 +464,15 @@ class Verifier:
         self._model_name: str | None = None
         self._model: Polyhedron | None = None
         self._reach: dict[str, tuple[frozenset[int], frozenset[int], frozenset[int]]] = {}
+        self._tour: Tour | None = None
+        self._tour_model: Polyhedron | None = None
+        self.tour_planned: float | None = None
+        """The first tour's cost from the sensor where the verification's first move was chosen [units]."""
+        self.tour_bound: float | None = None
+        """A lower bound of the verification's cost from there (:func:`~haptic.planning.tour.tour_lower_bound`;
+        None: no pose, or no vertex to measure)."""
+        self.decision_times: list[float] = []
+        """Wall time of each verification move's choice [s]."""
 
     def verdict(self, tree, rec, cost: float) -> str:
         """"confirmed", "mismatch", "incomplete" or "verifying" for a recognition ``rec`` (status recognized)
@@ -519,13 +562,24 @@ class Verifier:
         """The next verification move for hypothesis ``h`` — in the world of the interpretation whose coverage
         counts, when it has a pose (None: no move admissible). ``avoid``: moves that failed from here;
         ``probed``: the probes' lines so far (not probed again)."""
+        t0 = time.perf_counter()
         self.moves += 1
         if self._hyp is not None and self._hyp.world_from_model is not None:
             h = self._hyp
         missing = self.coverage.missing(self.mode) if self.coverage is not None else (frozenset(),) * 3
         faces_ok = self._reach[self._model_name][0] if self._model_name in self._reach else None
-        return choose_verification_move(h, state, components, missing, self.noise, self.config, avoid, probed,
-                                        faces_ok)  # fmt: skip
+        previous = self._tour if self._tour is not None and self._tour_model is h.poly else None
+        move, self._tour, now = plan_verification_move(h, state, components, missing, self.noise, self.config,
+                                                       avoid, probed, faces_ok, previous)  # fmt: skip
+        self._tour_model = h.poly
+        if self.tour_planned is None and self._tour is not None:
+            legs = _legs(self.config)
+            keys = features(h.poly).index(missing)
+            self.tour_planned = now
+            bound = tour_lower_bound(h.poly, h.model_from_world.apply(state.position), keys, legs)
+            self.tour_bound = bound if bound > 0 else None
+        self.decision_times.append(time.perf_counter() - t0)
+        return move
 
     def record(self, cost: float) -> dict:
         """What was verified: the mode, the verdict, the verification's moves and cost, the pose check's worst
@@ -538,6 +592,11 @@ class Verifier:
         if self.accept is not None:
             out.update(chi2=round(self.accept.statistic, 3), chi2_dof=self.accept.dof,
                        chi2_threshold=round(self.accept.threshold, 3))  # fmt: skip
+        if self.tour_planned is not None:
+            out["tour_planned"] = round(self.tour_planned, 6)
+        if self.tour_bound is not None:
+            out["tour_bound"] = round(self.tour_bound, 6)
+        out["decision_times_s"] = [round(t, 6) for t in self.decision_times]
         if self.coverage is not None:
             out["move_budget"] = self.move_budget()
             out.update(self.coverage.record(self._model))

@@ -74,3 +74,23 @@ def test_depth_is_invariant_under_rigid_motion():
     a = segment_depth(poly, start, u, 0.4)
     b = segment_depth(moved, t.apply(start), t.rotate(u), 0.4)
     assert a > 0.0 and a == pytest.approx(b, abs=1e-9)
+
+
+def test_many_segments_at_once_sample_as_one_at_a_time():
+    from haptic.geometry.raycast import depth_samples, depth_samples_many
+
+    rng = np.random.default_rng(5)
+    for name in ("BOX01", "LBLOCK01", "FRAME01"):
+        poly = load_library()[name]
+        c = poly.centroid
+        starts = c + rng.normal(scale=0.03, size=(12, 3))
+        dirs = rng.normal(size=(12, 3))
+        dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
+        lengths = rng.uniform(0.01, 0.15, size=12)
+        many = depth_samples_many(poly, starts, dirs, lengths)
+        inside = 0
+        for k, (pts, depth) in enumerate(many):
+            one_pts, one_depth = depth_samples(poly, starts[k], dirs[k], lengths[k])
+            assert np.allclose(pts, one_pts) and np.allclose(depth, one_depth)
+            inside += len(depth) > 0
+        assert inside >= 2, name

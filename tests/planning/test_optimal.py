@@ -77,3 +77,22 @@ def test_optimal_is_deterministic_and_named():
     assert isinstance(make_policy("optimal", depth=1), OptimalPolicy)
     with pytest.raises(HapticError, match="depth"):
         make_policy("optimal", depth=0)
+
+
+def test_lookahead_expects_no_more_than_the_planner_and_recognizes():
+    """The roll-out policy's choice at each decision has an expected cost (within the planner's model) no more than
+    following the planner from there, and its episodes recognise the right model."""
+    from haptic.planning.optimal import LookaheadPolicy
+
+    policy = make_policy("lookahead")
+    assert isinstance(policy, LookaheadPolicy) and policy.depth == 1
+    for ctx in _contexts(4)[:6]:
+        hyps = list(ctx.hypotheses)
+        w = class_weights([h.model for h in hyps])
+        search = _Search(ctx, rollout_moves=policy.rollout_moves, unresolved_cost=policy.unresolved_cost)
+        planned = search.rollout(hyps, w, ctx.state, ctx.components, policy.rollout_moves)
+        decision = policy.choose(ctx, np.random.default_rng(0))
+        assert -max(c.score for c in decision.candidates) <= planned + 1e-9
+    for s in plan_sweep(SMALL, 4, seed=11, policies=["lookahead"], verify="none", moves="tracing"):
+        r = run_episode(s, library=LIB, policy=policy)
+        assert r.correct, (s.model, r.outcome)

@@ -1,0 +1,302 @@
+"""The verification's tour: an order in which to measure the features still missing, and what it will cost.
+
+Once one pose class is left, a verification must measure the features of its model that the data lack (the
+vertices under ``full``, the faces and edges under ``fast``: :data:`~haptic.matching.acceptance.TARGETS`). Which
+one next is a travelling-salesman problem over those features, with the cost of getting from one to the next
+(seed §3.1, by the cheapest admissible way) as the distance: a closed tour by nearest neighbour and 2-opt
+(:func:`plan_tour`), entered where it is cheapest from wherever a move leaves the sensor and left open before
+the entry (:meth:`Tour.cost_from`). The verification (:mod:`haptic.planning.verify`) scores each candidate
+move by its own predicted cost plus the tour's from where the move ends, without what the move measures, and
+plans afresh after every result.
+
+The leg costs (:class:`LegCosts`) are estimates in the cost model's units of the moves the verification makes:
+a vertex is measured by an edge move that ends at it; from the vertex before it, along the edge between them
+(a vertex move onto that edge, then the edge), or across a face they share (a face move aimed beside the vertex,
+then a short edge move), or by a free-space probe to the face beside it (where probes are admitted) and the same
+two short moves. A lower bound (:func:`tour_lower_bound`) says how far from the best possible a verification is.
+Pure numpy.
+"""
+
+from __future__ import annotations
+
+import weakref
+from dataclasses import dataclass
+
+import numpy as np
+
+from haptic.geometry.polyhedron import Polyhedron
+from haptic.planning.config import PlannerConfig
+
+FACE, EDGE, VERTEX = 0, 1, 2
+"""Kinds of feature a tour visits (the order of the coverage's ``missing`` triple)."""
+DETOUR = 1.2
+"""A path traced over faces between two features that share no face is this many times the straight line
+between them (the cheapest surface path bends round at least one edge) [-]."""
+AIM_NEAR_VERTEX = 6e-3
+"""An aimed face move (:func:`haptic.planning.verify.aimed_face_moves`) ends on an edge of the current face this
+far from a missing vertex [m] (at most a quarter of the edge), so that a short edge move (``c_e`` × 6 mm + ``c_k``
+= 1.6 units) measures the vertex, instead of tracing the whole edge to it (§3.1: a face costs half an edge per
+cm)."""
+PROBE_INSET = 0.01
+"""A verification probe aims at a point of a face this far from both edges at the missing vertex [m]: the hand's
+contact stays clear of the face's boundary (:func:`~haptic.planning.handpath.foot_near_boundary`), and an aimed
+face move then reaches an edge :data:`AIM_NEAR_VERTEX` from the vertex."""
+MAX_TWO_OPT_PASSES = 400
+"""Most 2-opt improvements of one tour (each the best reversal of all): a bound on the time of a large model's
+first tour; later tours start from the last one and need few."""
+
+
+@dataclass(frozen=True)
+class LegCosts:
+    """What it costs to measure a feature, by the way of getting there, in the cost model's units (§3.1)."""
+
+    face_rate: float
+    """``c_f``: tracing across a face [units/m]."""
+    edge_rate: float
+    """``c_e``: tracing along an edge [units/m]."""
+    probe_rate: float
+    """``c_s``: moving through free space [units/m]; 0 where probes are not admitted."""
+    probe_fixed: float
+    """``c_p``: per probe [units]."""
+    face_events: float
+    """``c_j + c_b + c_n``: a face move's edge contact, edge direction and next normal [units]."""
+    vertex_event: float
+    """``c_k``: detecting a vertex at the end of an edge move [units]."""
+    turn: float
+    """A vertex move onto the next edge at a vertex: a quarter circle at the vertex radius, and its events
+    [units]."""
+    probes: bool
+    """Whether free-space probes are admitted (``config.moves`` not tracing, and no table: the hand verifies by
+    tracing)."""
+
+    @classmethod
+    def of(cls, config: PlannerConfig, probes: bool = True) -> LegCosts:
+        """The leg costs under ``config``; with ``probes`` False, tracing only whatever ``config`` admits."""
+        c = config.costs
+        return cls(
+            face_rate=c.c_f, edge_rate=c.c_e, probe_rate=c.c_s, probe_fixed=c.c_p,
+            face_events=c.c_j + c.c_b + c.c_n, vertex_event=c.c_k,
+            turn=c.c_v * config.vertex_radius * np.pi / 2 + c.c_j + c.c_b + c.c_n,
+            probes=probes and config.moves != "tracing" and config.table_z is None,
+        )  # fmt: skip
+
+    def finish(self, kinds: np.ndarray) -> np.ndarray:
+        """Cost of measuring a feature of each kind once on a face beside it: a vertex, a face move aimed beside
+        it and a short edge move; an edge, a face move to it; a face, nothing more [units]."""
+        vertex = self.face_events + self.edge_rate * AIM_NEAR_VERTEX + self.vertex_event
+        return np.select([kinds == VERTEX, kinds == EDGE], [vertex, self.face_events], 0.0)
+
+    def by_probe(self, distance: np.ndarray, kinds: np.ndarray) -> np.ndarray:
+        """A probe to the face beside the feature (from ``distance`` away), then :meth:`finish` from ``PROBE_INSET``
+        in; inf where probes are not admitted [units]."""
+        if not self.probes:
+            return np.full(np.shape(distance), np.inf)
+        inset = np.where(kinds == FACE, 0.0, self.face_rate * PROBE_INSET)
+        return self.probe_fixed + self.probe_rate * distance + inset + self.finish(kinds)
+
+    def by_tracing(self, distance: np.ndarray, kinds: np.ndarray, cofacial: np.ndarray) -> np.ndarray:
+        """Across a face shared with the feature (straight), else over faces (:data:`DETOUR`, one face move more),
+        then :meth:`finish` [units]."""
+        straight = self.face_rate * distance + self.finish(kinds)
+        return np.where(cofacial, straight, DETOUR * self.face_rate * distance + self.face_events + self.finish(kinds))
+
+
+@dataclass(frozen=True, eq=False)
+class Features:
+    """Every face, edge and vertex of a model as a point to visit (model frame), with which faces each is on."""
+
+    kinds: np.ndarray
+    """:data:`FACE`, :data:`EDGE` or :data:`VERTEX` per feature, shape (K,)."""
+    ids: np.ndarray
+    """The model's index of each feature among those of its kind, shape (K,)."""
+    points: np.ndarray
+    """Where a move measures it: a point inside the face, the edge's midpoint, the vertex, shape (K, 3) [m]."""
+    on_face: np.ndarray
+    """Whether feature k lies on (is, bounds, or is a corner of) model face f, shape (K, F) bool."""
+    edge_between: np.ndarray
+    """The model edge between two vertices (−1: none; -1 for every pair not of two vertices), shape (K, K)."""
+
+    def index(self, missing: tuple[frozenset[int], frozenset[int], frozenset[int]]) -> np.ndarray:
+        """Feature indices of the ``(faces, edges, vertices)`` of ``missing``, in that order, each sorted."""
+        start = {FACE: 0, EDGE: int((self.kinds == FACE).sum()), VERTEX: int((self.kinds != VERTEX).sum())}
+        return np.array([start[k] + i for k, ids in enumerate(missing) for i in sorted(ids)], dtype=np.int64)
+
+
+_FEATURES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def features(poly: Polyhedron) -> Features:
+    """:class:`Features` of ``poly`` (computed once per model)."""
+    if poly in _FEATURES:
+        return _FEATURES[poly]
+    from haptic.planning.probe_lines import face_targets
+
+    nf, ne, nv = poly.n_faces, poly.n_edges, poly.n_vertices
+    kinds = np.concatenate([np.full(nf, FACE), np.full(ne, EDGE), np.full(nv, VERTEX)])
+    ids = np.concatenate([np.arange(nf), np.arange(ne), np.arange(nv)])
+    mids = poly.edge_points + 0.5 * poly.edge_lengths[:, None] * poly.edge_directions
+    points = np.concatenate([face_targets(poly), mids, poly.vertices])
+    on = np.zeros((nf + ne + nv, nf), dtype=bool)
+    on[np.arange(nf), np.arange(nf)] = True
+    on[nf + np.arange(ne), poly.edge_left_face] = True
+    on[nf + np.arange(ne), poly.edge_right_face] = True
+    for f in range(nf):
+        on[nf + ne + np.asarray(poly.faces[f], dtype=np.int64), f] = True
+    between = np.full((len(kinds), len(kinds)), -1, dtype=np.int64)
+    a, b = nf + ne + poly.edges[:, 0], nf + ne + poly.edges[:, 1]
+    between[a, b] = between[b, a] = np.arange(ne)
+    out = Features(kinds, ids, points, on, between)
+    _FEATURES[poly] = out
+    return out
+
+
+def leg_matrix(poly: Polyhedron, targets: np.ndarray, legs: LegCosts) -> np.ndarray:
+    """Cost of measuring target ``j`` after target ``i`` (feature indices of :func:`features`), the cheapest of:
+    along the edge between two vertices (a vertex move onto it, the edge, the vertex's detection), across a face
+    they share or over faces (:meth:`LegCosts.by_tracing`), by a probe (:meth:`LegCosts.by_probe`); shape
+    (n, n), symmetric, 0 on the diagonal [units]."""
+    feats = features(poly)
+    p, kinds = feats.points[targets], feats.kinds[targets]
+    d = np.linalg.norm(p[:, None] - p[None], axis=2)
+    on = feats.on_face[targets].astype(np.int64)
+    cofacial = (on @ on.T) > 0
+    to_kind = np.broadcast_to(kinds[None, :], d.shape)
+    cost = np.minimum(legs.by_tracing(d, to_kind, cofacial), legs.by_probe(d, to_kind))
+    edge = feats.edge_between[np.ix_(targets, targets)]
+    along = legs.turn + legs.edge_rate * d + legs.vertex_event
+    cost = np.where(edge >= 0, np.minimum(cost, along), cost)
+    cost = np.minimum(cost, cost.T)  # the cheaper way either way round
+    np.fill_diagonal(cost, 0.0)
+    return cost
+
+
+def start_costs(
+    poly: Polyhedron, position: np.ndarray, face: int | None, edge: int | None, targets: np.ndarray, legs: LegCosts
+) -> np.ndarray:
+    """Cost of measuring each target first from a sensor at ``position`` (model frame) on model ``face`` and,
+    when known, model ``edge``: by tracing (along the edge to a vertex at its end, or across the face, or over
+    faces) or by a probe; shape (n,) [units]."""
+    feats = features(poly)
+    p, kinds = feats.points[targets], feats.kinds[targets]
+    d = np.linalg.norm(p - np.asarray(position), axis=1)
+    cofacial = feats.on_face[targets, face] if face is not None else np.zeros(len(targets), dtype=bool)
+    cost = np.minimum(legs.by_tracing(d, kinds, cofacial), legs.by_probe(d, kinds))
+    if edge is not None:
+        ends = feats.kinds.size - poly.n_vertices + poly.edges[edge]
+        at_end = np.isin(targets, ends)
+        cost = np.where(at_end, np.minimum(cost, legs.edge_rate * d + legs.vertex_event), cost)
+    return cost
+
+
+@dataclass(frozen=True)
+class Tour:
+    """A closed tour over the targets (feature indices), its legs' costs and its total."""
+
+    order: tuple[int, ...]
+    """Targets in the tour's order (feature indices of :func:`features`)."""
+    legs: np.ndarray
+    """The leg matrix over ``sorted(order)`` (:func:`leg_matrix`)."""
+    cost: float
+    """Sum of the legs round the tour [units]."""
+
+    def cost_from(self, start: np.ndarray, without: frozenset[int] = frozenset()) -> float:
+        """The least cost of visiting every target but ``without`` in the tour's order, either way round, entered
+        at any of them from a sensor whose cost to each is ``start`` (over ``sorted(order)``) and left open
+        before the entry: ``start[k] + tour − (the larger leg at k)`` [units]; 0 with nothing to visit."""
+        keys = sorted(self.order)
+        pos = {t: i for i, t in enumerate(keys)}
+        ring = [pos[t] for t in self.order if t not in without]
+        if not ring:
+            return 0.0
+        if len(ring) == 1:
+            return float(start[ring[0]])
+        r = np.array(ring)
+        nxt = np.roll(r, -1)
+        leg = self.legs[r, nxt]
+        total = float(leg.sum())
+        drop = np.maximum(leg, np.roll(leg, 1))  # the leg after each target, or the one before it
+        return float(np.min(start[r] + total - drop))
+
+
+def _two_opt(order: np.ndarray, legs: np.ndarray) -> np.ndarray:
+    """Closed-tour 2-opt: reverse the stretch whose reversal saves the most, while one saves anything."""
+    n = len(order)
+    if n < 4:
+        return order
+    i, j = np.triu_indices(n, 1)
+    keep = ~((i == 0) & (j == n - 1))
+    i, j = i[keep], j[keep]
+    for _ in range(MAX_TWO_OPT_PASSES):
+        a, b = order[i - 1], order[i]
+        c, d = order[j], order[(j + 1) % n]
+        gain = legs[a, b] + legs[c, d] - legs[a, c] - legs[b, d]
+        k = int(np.argmax(gain))
+        if gain[k] <= 1e-9:
+            break
+        order = np.concatenate([order[: i[k]], order[i[k] : j[k] + 1][::-1], order[j[k] + 1 :]])
+    return order
+
+
+def plan_tour(poly: Polyhedron, targets: np.ndarray, legs: LegCosts, previous: Tour | None = None) -> Tour:
+    """A closed tour over ``targets`` (feature indices): the previous tour's order without the targets measured
+    since, with any new targets inserted where they cost least, or nearest neighbour from the first target; then
+    2-opt (:func:`_two_opt`)."""
+    keys = np.array(sorted(int(t) for t in targets), dtype=np.int64)
+    m = leg_matrix(poly, keys, legs) if len(keys) else np.zeros((0, 0))
+    pos = {int(t): i for i, t in enumerate(keys)}
+    if previous is not None:
+        order = [pos[t] for t in previous.order if t in pos]
+        for t in keys:
+            if pos[int(t)] in order:
+                continue
+            if len(order) < 2:
+                order.append(pos[int(t)])
+                continue
+            r = np.array(order)
+            extra = m[r, pos[int(t)]] + m[pos[int(t)], np.roll(r, -1)] - m[r, np.roll(r, -1)]
+            order.insert(int(np.argmin(extra)) + 1, pos[int(t)])
+    else:
+        order, left = [], set(range(len(keys)))
+        while left:
+            k = min(left, key=lambda j: m[order[-1], j]) if order else min(left)
+            order.append(k)
+            left.discard(k)
+    o = _two_opt(np.array(order, dtype=np.int64), m)
+    cost = float(m[o, np.roll(o, -1)].sum()) if len(o) > 1 else 0.0
+    return Tour(tuple(int(keys[k]) for k in o), m, cost)
+
+
+def tour_lower_bound(poly: Polyhedron, position: np.ndarray, targets: np.ndarray, legs: LegCosts) -> float:
+    """A lower bound of the cost of measuring every vertex among ``targets`` from a sensor at ``position`` (model
+    frame) [units]: each is measured by an edge move that ends at it (``c_k`` each), and the sensor's path
+    passes through all of them, so it is at least their minimum spanning tree with the start, each straight
+    line of length ``d`` at the cheapest way of covering it, ``min(c_f d, c_p + c_s d)`` (probes where admitted:
+    a path of traced and probed stretches costs at least that). Features that are not vertices add nothing."""
+    from scipy.sparse.csgraph import minimum_spanning_tree
+
+    feats = features(poly)
+    pts = feats.points[targets[feats.kinds[targets] == VERTEX]]
+    if not len(pts):
+        return 0.0
+    p = np.vstack([np.asarray(position)[None], pts])
+    d = np.linalg.norm(p[:, None] - p[None], axis=2)
+    w = legs.face_rate * d
+    if legs.probes:
+        w = np.minimum(w, legs.probe_fixed + legs.probe_rate * d)
+    w = np.where(d > 0, np.maximum(w, 1e-12), 0.0)  # a zero entry is no edge to the spanning tree
+    return float(minimum_spanning_tree(w).sum()) + legs.vertex_event * len(pts)
+
+
+__all__ = [
+    "EDGE",
+    "FACE",
+    "VERTEX",
+    "Features",
+    "LegCosts",
+    "Tour",
+    "features",
+    "leg_matrix",
+    "plan_tour",
+    "start_costs",
+    "tour_lower_bound",
+]
