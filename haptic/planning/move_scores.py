@@ -51,6 +51,10 @@ class Context:
     tree: object | None = None
     """The matcher's interpretation tree (an ``InterpretationTree``), when a policy or a check wants to ask
     the matcher itself which hypotheses a predicted outcome would eliminate."""
+    moves: int = 0
+    """Moves carried out or failed so far in the episode (the start not counted)."""
+    cost: float = 0.0
+    """Path cost spent so far in the episode [units]."""
 
 
 @dataclass(frozen=True, eq=False)
