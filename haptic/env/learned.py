@@ -37,12 +37,14 @@ def learned_path(name: str) -> Path:
 def load_model(path: str | os.PathLike):
     """The MaskablePPO model saved at ``path`` (loaded once per process and file version)."""
     try:
+        import torch
         from sb3_contrib import MaskablePPO
     except ImportError:
         raise HapticError("learned policies need the [learn] extra: pip install -e '.[learn]'") from None
     path = Path(path).resolve()
     key = (str(path), path.stat().st_mtime)
     if key not in _MODELS:
+        torch.set_num_threads(1)  # one decision at a time: more threads only contend with the episode workers
         try:
             _MODELS[key] = MaskablePPO.load(str(path), device="cpu")
         except Exception as exc:  # a file of another kind: one line naming it
