@@ -4,9 +4,10 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed-stamp
 RAY_STAMP := $(VENV)/.ray-stamp
+LEARN_STAMP := $(VENV)/.learn-stamp
 export MUJOCO_GL ?= disable
 
-.PHONY: demo test check bench bench-ci lint models ray clean
+.PHONY: demo test check bench bench-ci lint models ray learn clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -20,6 +21,13 @@ $(RAY_STAMP): $(STAMP) pyproject.toml
 	touch $(RAY_STAMP)
 
 ray: $(RAY_STAMP)
+
+# The learning extra (scripts/train_ppo.py, haptic bench --policy learned:PATH), pinned in pyproject.toml.
+$(LEARN_STAMP): $(STAMP) pyproject.toml
+	$(BIN)/python -m pip install --quiet -e '.[dev,learn]'
+	touch $(LEARN_STAMP)
+
+learn: $(LEARN_STAMP)
 
 demo: $(STAMP)
 	$(BIN)/haptic models list

@@ -61,7 +61,7 @@ def view(**kw):
     hyps = kw.pop("hyps", [])
     out = SimpleNamespace(
         posed=bool(hyps), verifying=False, sensor=SensorState(np.zeros(3), 0), components={}, config=PlannerConfig(),
-        noise=None, tree=Counts(10), failed_here=[], probed=[], verifier=None,
+        noise=None, tree=Counts(10), failed_here=[], probed=[], verifier=None, moves=0, cost=0.0,
     )  # fmt: skip
     for k, v in kw.items():
         setattr(out, k, v)

@@ -45,7 +45,8 @@ def add_parser(sub: Subcommands) -> None:
                    help="geometric: the ideal sensor with noise (fast); physics: the simulated hand in MuJoCo")
     p.add_argument(
         "--policy", default=",".join(DEFAULT_POLICIES),
-        help=f"comma-separated policies from {', '.join(POLICY_NAMES)}, each run on the same draws",
+        help=f"comma-separated policies from {', '.join(POLICY_NAMES)} or learned:PATH (a model that "
+        "scripts/train_ppo.py saved; with --moves tracing), each run on the same draws",
     )
     p.add_argument("--episodes", type=positive_int, default=DEFAULT_EPISODES, help="random (model, pose) draws")
     p.add_argument("--seed", type=seed_int, default=DEFAULT_SEED, help="seed of the sweep's draws (an integer >= 0)")
@@ -90,19 +91,38 @@ def run(args: argparse.Namespace) -> int:
         return _run(args, held)
 
 
+def _check_learned(policies: list[str], args: argparse.Namespace) -> None:
+    """A ``learned:PATH`` policy: its model file loads, and it acts on tracing moves (``--moves tracing``)."""
+    from haptic.planning.moves import default_moves
+    from haptic.planning.registry import is_learned
+
+    if not any(map(is_learned, policies)):
+        return
+    from haptic.env.learned import learned_path, load_model
+
+    for name in filter(is_learned, policies):
+        load_model(learned_path(name))
+        moves = args.moves or default_moves(args.executor)
+        if moves != "tracing":
+            raise BenchError(f"--policy {name} chooses among tracing moves; add --moves tracing (not {moves}) so "
+                             "that every policy plays the same moves")  # fmt: skip
+
+
 def _run(args: argparse.Namespace, held: DeferredInterrupts) -> int:
     from haptic.bench.results import ResultsWriter, drop_partial_line, iter_results
     from haptic.bench.runner import episode_key, key_id, plan_sweep, ray_available
     from haptic.episode.spec import check_settings, cli_option
     from haptic.geometry import load_library
     from haptic.options import check_output_file, report_skipped
-    from haptic.planning.registry import POLICY_NAMES
+    from haptic.planning.registry import POLICY_NAMES, is_learned
 
     # Everything is checked before any episode runs or any file is touched.
     policies = [p.strip() for p in args.policy.split(",") if p.strip()]
-    bad = [p for p in policies if p not in POLICY_NAMES]
+    bad = [p for p in policies if p not in POLICY_NAMES and not is_learned(p)]
     if bad or not policies:
-        raise BenchError(f"unknown policy {', '.join(bad) or '(none)'}; valid: {', '.join(POLICY_NAMES)}")
+        raise BenchError(f"unknown policy {', '.join(bad) or '(none)'}; valid: {', '.join(POLICY_NAMES)}, "
+                         "learned:PATH")  # fmt: skip
+    _check_learned(policies, args)
     if args.backend == "ray" and not ray_available():
         raise BenchError("--backend ray needs Ray: pip install -e '.[ray]' (or use --backend local)")
     out = check_output_file(args.out, "--out", "out/bench/results.jsonl", BenchError)

@@ -22,6 +22,7 @@ from haptic.episode.worlds import run_episode
 from haptic.errors import BenchError
 from haptic.geometry.io import default_units
 from haptic.options import DeferredInterrupts
+from haptic.planning.registry import is_learned
 
 
 def plan_sweep(
@@ -85,7 +86,12 @@ def key_id(key: dict) -> str:
 def _run(spec_dict: dict) -> dict:
     """One episode's JSON record, with its library's name and its key."""
     spec = EpisodeSpec(**spec_dict)
-    record = run_episode(spec).to_json()
+    policy = None
+    if is_learned(spec.policy):
+        from haptic.env.learned import learned_policy
+
+        policy = learned_policy(spec.policy, spec.max_moves, spec.budget)
+    record = run_episode(spec, policy=policy).to_json()
     record["library"] = library_name(spec.models)
     record["key"] = episode_key(spec)
     return record

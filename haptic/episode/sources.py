@@ -71,7 +71,7 @@ def decision_context(view: EpisodeState) -> Context:
     if config.moves == "all" and view.probe_failed_here:
         config = replace(config, moves="tracing")
     return Context(view.hypotheses(), view.sensor, view.components, view.noise, config, avoid=view.avoid,
-                   tree=view.tree)  # fmt: skip
+                   tree=view.tree, moves=view.moves, cost=view.cost)  # fmt: skip
 
 
 class VerificationMoves(MoveSource):

@@ -6,6 +6,7 @@ interpretation's model to predict a move's outcome. Pure geometry: no noise, no 
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass
 
 import numpy as np
@@ -129,8 +130,18 @@ def face_edges_at_vertex(poly: Polyhedron, face: int, vertex: int) -> tuple[int,
     return int(fe[k - 1]), int(fe[k])
 
 
+_CORNERS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
 def corner_angle(poly: Polyhedron, face: int, vertex: int) -> float:
-    """Interior angle of ``face`` at ``vertex`` (may exceed π at a reflex corner) [rad]."""
+    """Interior angle of ``face`` at ``vertex`` (may exceed π at a reflex corner) [rad] (cached per model)."""
+    per = _CORNERS.setdefault(poly, {})
+    if (face, vertex) not in per:
+        per[face, vertex] = _corner_angle(poly, face, vertex)
+    return per[face, vertex]
+
+
+def _corner_angle(poly: Polyhedron, face: int, vertex: int) -> float:
     loop = poly.faces[face]
     k = loop.index(vertex)
     v = poly.vertices[vertex]

@@ -19,7 +19,7 @@ from haptic.planning.efficiency import class_weights, distinguishable, efficienc
 from haptic.planning.handpath import HandStart
 from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import FaceMove, Move, ProbeMove, SensorState
-from haptic.planning.predict import Prediction, candidate_moves, crossed_edge, predict
+from haptic.planning.predict import Prediction, candidate_moves, crossed_edge, predict_moves
 from haptic.planning.probe_lines import ProbeConfig, candidate_probes
 from haptic.planning.probe_prediction import ProbePrediction, predict_probes
 from haptic.planning.simulate import simulate
@@ -51,6 +51,10 @@ class Context:
     tree: object | None = None
     """The matcher's interpretation tree (an ``InterpretationTree``), when a policy or a check wants to ask
     the matcher itself which hypotheses a predicted outcome would eliminate."""
+    moves: int = 0
+    """Moves carried out or failed so far in the episode (the start not counted)."""
+    cost: float = 0.0
+    """Path cost spent so far in the episode [units]."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -86,7 +90,7 @@ def score_all(ctx: Context) -> list[tuple[Prediction | ProbePrediction, float, f
     weights = class_weights([h.model for h in ctx.hypotheses])
     out: list = []
     if ctx.config.moves != "probing":
-        preds = [predict(ctx.hypotheses, m, ctx.state, ctx.components, ctx.noise, ctx.config) for m in fresh_moves(ctx)]
+        preds = predict_moves(ctx.hypotheses, fresh_moves(ctx), ctx.state, ctx.components, ctx.noise, ctx.config)
         preds = [p for p in preds if p.reliable(ctx.config)] or preds
         refused = [(p, refusal(p, ctx.config)) for p in preds]
         refused = [(p, r) for p, r in refused if r < ctx.config.table_risk] or refused

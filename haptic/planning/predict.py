@@ -8,6 +8,7 @@ the new face's angle; and what the move would cost there. The planner compares t
 
 from __future__ import annotations
 
+import math
 import weakref
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -143,13 +144,14 @@ def face_directions(
 
 def _signed_dihedral(poly: Polyhedron, f_from: int, f_to: int, edge: int) -> float:
     """Angle between the two faces' normals, negative across a concave edge [rad]."""
-    ang = float(np.arccos(np.clip(poly.face_normals[f_from] @ poly.face_normals[f_to], -1, 1)))
+    ang = math.acos(min(1.0, max(-1.0, float(poly.face_normals[f_from] @ poly.face_normals[f_to]))))
     return ang if poly.edge_convexity[edge] > 0 else -ang
 
 
 def _line_angle(a: np.ndarray, b: np.ndarray) -> float:
     """Angle between two lines (unsigned directions), in [0, π/2] [rad]."""
-    return float(np.arccos(np.clip(abs(a @ b) / (np.linalg.norm(a) * np.linalg.norm(b)), 0.0, 1.0)))
+    c = abs(float(a @ b)) / (math.sqrt(float(a @ a)) * math.sqrt(float(b @ b)))
+    return math.acos(min(1.0, max(0.0, c)))
 
 
 _LOOPS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
@@ -170,12 +172,20 @@ def _face_loop(poly: Polyhedron, face: int) -> tuple[np.ndarray, np.ndarray, np.
 
 
 def trace_all(hypotheses: Sequence[Hypothesis], move: FaceMove, state: SensorState) -> list[FaceTrace | None]:
-    """:func:`trace_in` for every hypothesis at once: the sides of every hypothesis's current face are stacked
-    (padded to the longest loop) and the crossing of the trace with each side solved in one array operation
-    (in the face's plane, ``start + t d = a + u (b − a)``); the first side met ahead, clear of its ends, is the
-    hit. The same outcome as :func:`~haptic.geometry.tracing.trace_face` for each hypothesis."""
-    out: list[FaceTrace | None] = [None] * len(hypotheses)
-    rows, starts, dirs, dirs_raw, normals, loops = [], [], [], [], [], []
+    """:func:`trace_in` for every hypothesis at once (:func:`trace_moves` for one move)."""
+    return trace_moves(hypotheses, [move], state)[0]
+
+
+def trace_moves(
+    hypotheses: Sequence[Hypothesis], moves: Sequence[FaceMove], state: SensorState
+) -> list[list[FaceTrace | None]]:
+    """:func:`trace_in` for every face move and every hypothesis: the sides of every hypothesis's current face are
+    stacked once (padded to the longest loop), and for each move the crossing of its trace with each side is solved
+    in one array operation over the hypotheses (in the face's plane, ``start + t d = a + u (b − a)``); the first side
+    met ahead, clear of its ends, is the hit. The same outcome as :func:`~haptic.geometry.tracing.trace_face` for
+    each hypothesis and move. Returns one list per move, one entry per hypothesis."""
+    out: list[list[FaceTrace | None]] = [[None] * len(hypotheses) for _ in moves]
+    rows, starts, rots, normals, loops = [], [], [], [], []
     for i, h in enumerate(hypotheses):
         f_m = h.faces.get(state.face)
         if h.world_from_model is None or f_m is None:
@@ -183,28 +193,43 @@ def trace_all(hypotheses: Sequence[Hypothesis], move: FaceMove, state: SensorSta
         model_from_world = h.model_from_world
         poly, p_m = h.poly, model_from_world.apply(state.position)
         n = poly.face_normals[f_m]
-        p_m = p_m - (p_m @ n - poly.face_offsets[f_m]) * n
-        d_m = model_from_world.rotate(move.direction)
-        d = d_m - (d_m @ n) * n
-        norm = np.linalg.norm(d)
-        if norm < 1e-9:
-            continue
         rows.append(i)
-        starts.append(p_m)
-        dirs.append(d / norm)
-        dirs_raw.append(d_m)
+        starts.append(p_m - (p_m @ n - poly.face_offsets[f_m]) * n)
+        rots.append(h.world_from_model.rotation)  # SE3.rotate of model_from_world multiplies by it
         normals.append(n)
         loops.append(_face_loop(poly, f_m))
-    if not rows:
+    if not rows or not moves:
         return out
     k = max(len(lp[2]) for lp in loops)
-    m = len(rows)
-    a = np.zeros((m, k, 3))
-    seg = np.zeros((m, k, 3))
-    real = np.zeros((m, k), dtype=bool)
+    a_all = np.zeros((len(rows), k, 3))
+    seg_all = np.zeros((len(rows), k, 3))
+    real_all = np.zeros((len(rows), k), dtype=bool)
     for j, lp in enumerate(loops):
-        a[j, : len(lp[2])], seg[j, : len(lp[2])], real[j, : len(lp[2])] = lp[0], lp[1], True
-    start, d, n = np.array(starts), np.array(dirs), np.array(normals)
+        a_all[j, : len(lp[2])], seg_all[j, : len(lp[2])], real_all[j, : len(lp[2])] = lp[0], lp[1], True
+    start_all, n_all = np.array(starts), np.array(normals)
+    # each move's direction in each hypothesis's model frame (M, m, 3), by the arithmetic of SE3.rotate, and its
+    # part in the face's plane, unit length (by batched row products: the same bits as one hypothesis at a time)
+    dirs = np.array([mv.direction for mv in moves], dtype=float)
+    d_raw = (dirs[:, None, None, :] @ np.array(rots)[None])[:, :, 0]
+    d_in = d_raw - (d_raw[..., None, :] @ n_all[None, :, :, None])[..., 0] * n_all[None]
+    norm_all = np.linalg.norm(d_in, axis=2)
+    for mi in range(len(moves)):
+        use = np.flatnonzero(norm_all[mi] >= 1e-9)
+        if not len(use):
+            continue
+        for j, hit in _first_crossings(
+            start_all[use], d_in[mi, use] / norm_all[mi, use, None], n_all[use], a_all[use], seg_all[use],
+            real_all[use], [loops[j] for j in use], use,
+        ):  # fmt: skip
+            i = rows[j]
+            out[mi][i] = FaceTrace(hypotheses[i].faces[state.face], starts[j], d_raw[mi, j], hit)
+    return out
+
+
+def _first_crossings(start, d, n, a, seg, real, loops, index):
+    """The first side each trace ``start + t d`` meets, as ``(index[j], FaceHit)`` for the traces that meet one
+    clear of its ends (shapes: start, d, n (m, 3); a, seg (m, k, 3); real (m, k))."""
+    k = a.shape[1]
     r = a - start[:, None]
     den = np.einsum("mkc,mc->mk", cross(d[:, None], seg), n)
     safe = np.where(np.abs(den) > 1e-15, den, 1.0)
@@ -215,7 +240,7 @@ def trace_all(hypotheses: Sequence[Hypothesis], move: FaceMove, state: SensorSta
     ok &= np.linalg.norm(miss, axis=2) <= 1e-7
     t_ok = np.where(ok, t, np.inf)
     best = np.argmin(t_ok, axis=1)
-    for j, i in enumerate(rows):
+    for j in range(len(start)):
         b = int(best[j])
         if not np.isfinite(t_ok[j, b]):
             continue
@@ -224,10 +249,8 @@ def trace_all(hypotheses: Sequence[Hypothesis], move: FaceMove, state: SensorSta
             continue
         _, _, edges, beyond = loops[j]
         tj = float(t[j, b])
-        hit = FaceHit(edge=int(edges[b]), distance=tj, point=start[j] + tj * d[j], next_face=int(beyond[b]))
-        f_m = hypotheses[i].faces[state.face]
-        out[i] = FaceTrace(f_m, starts[j], dirs_raw[j], hit)
-    return out
+        yield int(index[j]), FaceHit(edge=int(edges[b]), distance=tj, point=start[j] + tj * d[j],
+                                     next_face=int(beyond[b]))  # fmt: skip
 
 
 def predict_one(
@@ -235,7 +258,13 @@ def predict_one(
 ) -> tuple[np.ndarray, float]:
     """One hypothesis's predicted outcome attributes and cost for a move (NaN attributes when it can't say)."""
     out, cost, _ = _predict_one(h, move, state, components, config)
-    return out, cost
+    return out.copy(), cost
+
+
+_NAN = {kind: np.full(n, np.nan) for kind, n in (("face", 3), ("edge", 1), ("vertex", 2))}
+"""No prediction, per kind of move (read only: :func:`predict` stacks the rows into a new array)."""
+for _row in _NAN.values():
+    _row.flags.writeable = False
 
 
 def _predict_one(
@@ -246,12 +275,10 @@ def _predict_one(
     config: PlannerConfig,
     trace: FaceTrace | None | bool = False,
 ) -> tuple[np.ndarray, float, float]:
-    nan_face, nan_edge, nan_vertex = np.full(3, np.nan), np.full(1, np.nan), np.full(2, np.nan)
+    nan_face, nan_edge, nan_vertex = _NAN["face"], _NAN["edge"], _NAN["vertex"]
     costs = config.costs
     if h.world_from_model is None:
-        return {"face": nan_face, "edge": nan_edge, "vertex": nan_vertex}[move.kind], np.nan, np.nan
-    model_from_world = h.model_from_world
-    p_m = model_from_world.apply(state.position)
+        return _NAN[move.kind], np.nan, np.nan
     poly = h.poly
     if isinstance(move, FaceMove):
         tr = trace_in(h, move, state) if trace is False else trace
@@ -273,7 +300,7 @@ def _predict_one(
         b_world = h.world_from_model.rotate(poly.edge_directions[e_m])
         data_edge = components[state.edge]
         sense_m = move.sense if b_world @ data_edge.direction > 0 else -move.sense
-        hit = trace_edge(poly, e_m, p_m, sense_m)
+        hit = trace_edge(poly, e_m, h.model_from_world.apply(state.position), sense_m)
         return np.array([hit.distance]), costs.edge_move(hit.distance), np.nan
     if isinstance(move, VertexMove):
         e_m = h.edges.get(state.edge) if state.edge is not None else None
@@ -303,10 +330,13 @@ def predict(
     components: Mapping[int, DataComponent],
     noise: SensorNoise,
     config: PlannerConfig,
+    traces: Sequence[FaceTrace | None] | None = None,
 ) -> Prediction:
-    """Every hypothesis's predicted outcome and cost for one candidate move."""
+    """Every hypothesis's predicted outcome and cost for one candidate move (``traces``: a face move's traces in
+    every hypothesis, :func:`trace_moves`, when already computed)."""
     rows, costs, clear = [], [], []
-    traces = trace_all(hypotheses, move, state) if isinstance(move, FaceMove) else [False] * len(hypotheses)
+    if traces is None:
+        traces = trace_all(hypotheses, move, state) if isinstance(move, FaceMove) else [False] * len(hypotheses)
     for h, tr in zip(hypotheses, traces, strict=True):
         o, c, cl = _predict_one(h, move, state, components, config, tr)
         rows.append(o)
@@ -331,3 +361,17 @@ def predict(
         move, np.array(rows), outcome_bounds(noise)[move.kind], costs_arr, np.array(clear, dtype=float), table,
         reach, edge_only,
     )
+
+
+def predict_moves(
+    hypotheses: Sequence[Hypothesis],
+    moves: Sequence[Move],
+    state: SensorState,
+    components: Mapping[int, DataComponent],
+    noise: SensorNoise,
+    config: PlannerConfig,
+) -> list[Prediction]:
+    """:func:`predict` for each of ``moves``, the face moves traced together (:func:`trace_moves`)."""
+    faces = [m for m in moves if isinstance(m, FaceMove)]
+    traced = dict(zip(map(id, faces), trace_moves(hypotheses, faces, state), strict=True))
+    return [predict(hypotheses, m, state, components, noise, config, traced.get(id(m))) for m in moves]

@@ -26,3 +26,12 @@ def make_policy(name: str, **options) -> Policy:
 
 
 POLICY_NAMES = tuple(POLICIES)
+
+LEARNED_PREFIX = "learned:"
+"""``learned:PATH`` names a policy trained on the Gymnasium environment, saved at PATH (``haptic.env.learned``, outside
+the planning layer: the bench builds it)."""
+
+
+def is_learned(name: str) -> bool:
+    """Whether a policy name is a learned policy's (``learned:PATH``)."""
+    return name.startswith(LEARNED_PREFIX)

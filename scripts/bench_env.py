@@ -1,0 +1,86 @@
+"""Steps and resets per second of the Gymnasium environments, per core, for a random agent over the admissible actions.
+
+    .venv/bin/python scripts/bench_env.py [--env geometric,physics] [--verify none,full] [--seconds 30] [--seed 1]
+                                          [--models DIR] [--json out.json]
+
+For each environment and verification mode the script plays episodes (``reset`` without options: the model and the
+episode seed drawn from the environment's generator) with actions drawn uniformly from ``info["action_mask"]``
+until ``--seconds`` of this process's CPU time are spent (at least one reset and one step), and prints the steps
+per second (the time in ``step`` alone) and the resets per second (the time in ``reset`` alone), both in CPU time
+of this process (one core: what other processes on the machine take does not count) and in wall time.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+
+import numpy as np
+
+from haptic.env import ExploreEnv
+from haptic.matching.acceptance import VERIFY_MODES
+
+
+def measure(executor: str, verify: str, seconds: float, seed: int, models: str | None) -> dict:
+    """Play random episodes for ``seconds`` of CPU time; the counts and the CPU and wall time in step and reset."""
+    env = ExploreEnv(executor=executor, models=models, verify=verify)
+    rng = np.random.default_rng(seed)
+    cpu = {"step": 0.0, "reset": 0.0}
+    wall = {"step": 0.0, "reset": 0.0}
+    n = {"step": 0, "reset": 0}
+
+    def timed(kind: str, fn):
+        c, w = time.process_time(), time.perf_counter()
+        out = fn()
+        cpu[kind] += time.process_time() - c
+        wall[kind] += time.perf_counter() - w
+        n[kind] += 1
+        return out
+
+    _, info = timed("reset", lambda: env.reset(seed=seed))
+    while n["step"] == 0 or cpu["step"] + cpu["reset"] < seconds:
+        action = int(rng.choice(np.flatnonzero(info["action_mask"])))
+        _, _, terminated, truncated, info = timed("step", lambda a=action: env.step(a))
+        if terminated or truncated:
+            _, info = timed("reset", env.reset)
+    env.close()
+    return {
+        "env": "haptic/Explore-v0" if executor == "geometric" else "haptic/ExplorePhysics-v0",
+        "verify": verify,
+        "steps": n["step"],
+        "resets": n["reset"],
+        "steps_per_s_cpu": n["step"] / cpu["step"],
+        "resets_per_s_cpu": n["reset"] / cpu["reset"],
+        "steps_per_s_wall": n["step"] / wall["step"],
+        "resets_per_s_wall": n["reset"] / wall["reset"],
+    }
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--env", default="geometric,physics", help="executors, comma-separated: geometric, physics")
+    ap.add_argument("--verify", default="none,full", help=f"modes, comma-separated: {', '.join(VERIFY_MODES)}")
+    ap.add_argument("--seconds", type=float, default=30.0, help="CPU seconds per environment and mode")
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--models", default=None)
+    ap.add_argument("--json", default=None, help="also write the rows to this file")
+    args = ap.parse_args(argv)
+    rows = []
+    print(f"{'environment':26s} {'verify':6s} {'steps':>6s} {'resets':>6s} {'steps/s cpu':>11s} {'resets/s cpu':>12s} "
+          f"{'steps/s wall':>12s} {'resets/s wall':>13s}")  # fmt: skip
+    for executor in args.env.split(","):
+        for verify in args.verify.split(","):
+            r = measure(executor, verify, args.seconds, args.seed, args.models)
+            rows.append(r)
+            print(f"{r['env']:26s} {r['verify']:6s} {r['steps']:6d} {r['resets']:6d} {r['steps_per_s_cpu']:11.1f} "
+                  f"{r['resets_per_s_cpu']:12.2f} {r['steps_per_s_wall']:12.1f} {r['resets_per_s_wall']:13.2f}",
+                  flush=True)  # fmt: skip
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(rows, f, indent=1)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
