@@ -97,6 +97,9 @@ class Toucher:
         tip, rot = robot.fingertip_pose()
         self.tip = tip
         self.rotation = rot
+        self.home_q = robot.arm_posture()
+        """The arm's joint angles when the toucher was made (its posture family: a free move that ran away is
+        brought back to it)."""
         self.contact: tuple[float, np.ndarray | None, np.ndarray | None] = (0.0, None, None)
         self._unhealthy = False
         self.floor_z: float | None = None
@@ -208,9 +211,12 @@ class Toucher:
         return min(1.0, (k + 1) * self.dt / self.config.ramp_time)
 
     # -- free space ----------------------------------------------------------------------------------------------
-    def move_free(self, point: np.ndarray, timeout: float | None = None, tol: float | None = None) -> PrimitiveResult:
+    def move_free(self, point: np.ndarray, timeout: float | None = None, tol: float | None = None,
+                  retry: bool = True) -> PrimitiveResult:  # fmt: skip
         """Move the pad centre to ``point`` [m] in free space along a straight line (position control), within
-        ``timeout`` [s] (default ``free_timeout``) to within ``tol`` [m] (default ``free_tol``)."""
+        ``timeout`` [s] (default ``free_timeout``) to within ``tol`` [m] (default ``free_tol``). A move that runs
+        away from its line (:attr:`TouchConfig.runaway`) is stopped; with ``retry`` the arm goes back to its
+        home posture family above (:meth:`back_to_home_posture`) and the move is made once more from there."""
         cfg = self.config
         timeout = cfg.free_timeout if timeout is None else timeout
         tol = cfg.free_tol if tol is None else tol
@@ -221,6 +227,8 @@ class Toucher:
             return self._result("unreachable", "limit", 0.0, target=point)
         dist = float(np.linalg.norm(point - start))
         n_ticks = max(1, int(dist / cfg.free_speed / self.dt))
+        path = point - start
+        length2 = float(path @ path)
         for k in range(1, int(timeout / self.dt)):
             s = min(1.0, k / n_ticks)
             self.robot.move_fingertip(start + s * (point - start), cfg.hand_rotation)
@@ -229,7 +237,32 @@ class Toucher:
                 return self._result("unstable", "nan", 0.0)
             if s >= 1.0 and np.linalg.norm(self.tip - point) < tol:
                 return self._result("ok", "done", 0.0)
+            along = min(max(float((self.tip - start) @ path) / length2, 0.0), 1.0) if length2 > 0 else 0.0
+            if float(np.linalg.norm(self.tip - start - along * path)) > cfg.runaway:
+                self.robot.hold_posture()
+                self.tick("free")
+                if retry and self.back_to_home_posture(point):
+                    return self.move_free(point, timeout, tol, retry=False)
+                return self._result("unreachable", "runaway", 0.0, target=point)
         return self._result("timeout", "limit", 0.0)
+
+    def back_to_home_posture(self, point: np.ndarray) -> bool:
+        """After a free move ran away: move the arm in joint space to the posture, of the family it started in
+        (:attr:`home_q`), that puts the pad ``overpass`` above the higher of where it is and ``point``; False
+        when there is none or the arm does not get there."""
+        cfg = self.config
+        above = np.array([self.tip[0], self.tip[1], max(float(self.tip[2]), float(point[2])) + cfg.overpass])
+        ik = self.robot.reachable(self.finger, above, cfg.hand_rotation, arm_q0=self.home_q)
+        if not ik.reachable:
+            return False
+        self.robot.hold_posture(ik.arm_q)
+        for _ in range(int(cfg.free_timeout / self.dt)):
+            self.tick("free")
+            if self._unhealthy:
+                return False
+            if float(np.abs(self.robot.arm_posture() - ik.arm_q).max()) < cfg.posture_tol:
+                return True
+        return False
 
     def move_guarded(
         self, point: np.ndarray, speed: float, phase: str = "free", max_lag: float = 0.004, timeout: float | None = None

@@ -134,6 +134,13 @@ class TouchConfig:
     """Time limit of a free move [s] ..."""
     free_tol: float = 7e-4
     """... and its arrival tolerance, also of a guarded move [m]."""
+    runaway: float = 0.02
+    """A free move whose pad leaves the straight path to its target by more than this is stopped and held where
+    it is by its joints (the arm met a joint limit and cannot keep the hand's orientation along the path: the
+    task-space control would carry it on across the workspace); the move ends ``unreachable``, event
+    ``runaway`` [m]."""
+    posture_tol: float = 0.02
+    """A joint-space move back to the arm's home posture family ends when every arm joint is within this [rad]."""
     guarded_settle: float = 0.5
     """A guarded move waits at most this long after its command reached the end [s]."""
     timeout_factor: float = 2.0

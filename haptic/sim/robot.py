@@ -115,11 +115,19 @@ class RobotInterface:
         """Active fingertip position (3,) [m] and hand rotation (3, 3), from the joint encoders."""
         return self._ctl.fingertip_pose()[0], self._ctl.hand_rotation()
 
+    def arm_posture(self) -> np.ndarray:
+        """The arm's joint angles (6,) [rad] from its encoders, without reading the other sensors (no noise
+        drawn)."""
+        return self._sim.data.qpos[self._sim.arm].copy()
+
     def reachable(
-        self, finger: str, point_in_world: np.ndarray, rotation_in_world: np.ndarray | None = None
-    ) -> IKResult:
-        """Whether ``finger`` can put its pad centre at ``point_in_world`` (hand held as commanded)."""
-        return solve_fingertip_ik(self._sim, finger, point_in_world, rotation_in_world, hand_q=self._ctl.hand_posture())
+        self, finger: str, point_in_world: np.ndarray, rotation_in_world: np.ndarray | None = None,
+        arm_q0: np.ndarray | None = None,
+    ) -> IKResult:  # fmt: skip
+        """Whether ``finger`` can put its pad centre at ``point_in_world`` (hand held as commanded); the solver
+        starts from the arm's joint angles now, or from ``arm_q0``."""
+        return solve_fingertip_ik(self._sim, finger, point_in_world, rotation_in_world, arm_q0=arm_q0,
+                                  hand_q=self._ctl.hand_posture())  # fmt: skip
 
     def step(self, ticks: int = 1) -> None:
         """Advance ``ticks`` control ticks."""

@@ -90,3 +90,26 @@ def test_lift_and_approach_inside_a_narrow_slot():
     r = t.lift_and_approach(world([65.0, 40.0, 54.0]), wall_normal)
     assert r.ok, (r.status, r.event)
     assert float(r.info["normal"] @ wall_normal) > np.cos(np.radians(8.0))
+
+
+def test_a_free_move_that_runs_away_from_its_line_is_stopped_and_the_arm_brought_back(monkeypatch):
+    """Task-space control held against a joint limit carries the hand off across the workspace; a free move
+    stops once the pad leaves its straight line by ``runaway``, takes the arm back to its home posture family
+    above, tries once more from there and, running away again, fails as unreachable near where it was."""
+    sim = _box_sim()
+    robot = RobotInterface(sim)
+    t = Toucher(robot)
+    start = t.tip.copy()
+    real = RobotInterface.move_fingertip
+    drift = np.array([0.0, 0.15, 0.0])  # a controller that does not follow the line: it carries the pad sideways
+    monkeypatch.setattr(RobotInterface, "move_fingertip", lambda self, p, r="hold": real(self, p + drift, r))
+    homes = []
+    back = t.back_to_home_posture
+    monkeypatch.setattr(t, "back_to_home_posture", lambda p: homes.append(p) or back(p))
+    target = start + np.array([0.05, 0.0, 0.0])
+    r = t.move_free(target)
+    assert r.status == "unreachable" and r.event == "runaway"
+    assert len(homes) == 1  # brought back once, then the move tried once more
+    assert np.linalg.norm(t.tip - start) < 0.08  # stopped near its line, not carried off
+    monkeypatch.setattr(RobotInterface, "move_fingertip", real)
+    assert t.move_free(target).ok  # the arm still moves where it is asked
