@@ -87,16 +87,37 @@ def test_a_pad_lifted_off_a_valley_reports_no_vertex():
     assert lost and lost[0].status == "no-contact"
 
 
-def _scaled_seed_library(directory, extent: float) -> str:
-    """The seed library with every model scaled to ``extent`` [m] across (``scripts/perception_report.py
-    --sizes``), written to ``directory``."""
+def _scaled_library(directory, extent: float, corpus: bool = False) -> str:
+    """The seed library (or the formula corpus) with every model scaled to ``extent`` [m] across
+    (``scripts/perception_report.py --sizes``, ``--corpus``), written to ``directory``."""
     from haptic.geometry import load_library
+    from haptic.geometry.corpus import corpus_solids
     from haptic.geometry.io import save_model
     from haptic.geometry.perturb import scaled_to
 
-    for name, poly in load_library().items():
-        save_model(scaled_to(poly, extent), directory / f"{name}.json")
+    models = {s.name: p for s, p in corpus_solids()} if corpus else load_library()
+    for name, poly in models.items():
+        save_model(scaled_to(poly, extent, name), directory / f"{name}.json")
     return str(directory)
+
+
+def _replay(directory, model: str, extent: float, max_moves: int, corpus: bool = False):
+    """The first ``max_moves`` moves of the default episode of ``model`` at seed 1 in the library scaled to
+    ``extent``: the episode, its failed moves and every move's result."""
+    failed, results = [], []
+    obs = EpisodeObserver(on_move=lambda n, r, *a: results.append(r),
+                          on_failed_move=lambda n, r: (failed.append(r), results.append(r)))  # fmt: skip
+    spec = EpisodeSpec(model=model, seed=1, executor="physics", models=_scaled_library(directory, extent, corpus),
+                       max_moves=max_moves)  # fmt: skip
+    ep = build_episode(spec)
+    ep.run(None, obs)
+    return ep, failed, results
+
+
+def _within_bounds(ep) -> bool:
+    from haptic.episode.evaluate import bound_ratios
+
+    return max(r.ratio for r in bound_ratios(ep.executor.components, ep.true_model, ep.world_from_model)) <= 1.0
 
 
 def test_an_edge_move_stopped_by_the_table_reports_no_vertex(tmp_path):
@@ -104,19 +125,13 @@ def test_an_edge_move_stopped_by_the_table_reports_no_vertex(tmp_path):
     # pad met the table; each reported a "vertex" where the edge line meets the table plane. The second edge
     # ends 8 mm above the table and that vertex lay 14 mm past it (5.9 bounds), and the episode ended no-match.
     # Stopped by the table the move reports nothing: the edge may end above the table or at a chamfer.
-    from haptic.episode.evaluate import bound_ratios
     from haptic.sim.scene import TABLE_TOP_Z
 
-    failed = []
-    obs = EpisodeObserver(on_failed_move=lambda n, r: failed.append(r))
-    spec = EpisodeSpec(model="BOX01P", seed=1, executor="physics", models=_scaled_seed_library(tmp_path, 0.04),
-                       max_moves=11)  # fmt: skip
-    ep = build_episode(spec)
-    ep.run(None, obs)
+    ep, failed, _ = _replay(tmp_path, "BOX01P", 0.04, 11)
     assert any(r.move.kind == "edge" and "met the table" in r.reason for r in failed)
     vertices = [c for c in ep.executor.components if c.kind == "vertex"]
     assert vertices and all(v.position[2] > TABLE_TOP_Z + 0.002 for v in vertices)
-    assert max(r.ratio for r in bound_ratios(ep.executor.components, ep.true_model, ep.world_from_model)) <= 1.0
+    assert _within_bounds(ep)
 
 
 def test_a_concave_edge_whose_end_the_pad_rolls_past_reports_no_vertex(tmp_path):
@@ -124,28 +139,9 @@ def test_a_concave_edge_whose_end_the_pad_rolls_past_reports_no_vertex(tmp_path)
     # faces' corners are obtuse: the pad's contacts rolled on along the rims and the vertex was put at their
     # median, 3.6 mm past the true end (2.7 bounds; the edge's extent 1.2 bounds), and the episode ended
     # no-match. The surface falling away does not locate a concave edge's end: the move reports nothing.
-    from haptic.episode.evaluate import bound_ratios
-
-    failed = []
-    obs = EpisodeObserver(on_failed_move=lambda n, r: failed.append(r))
-    spec = EpisodeSpec(model="FRAME01", seed=1, executor="physics", models=_scaled_seed_library(tmp_path, 0.04),
-                       max_moves=5)  # fmt: skip
-    ep = build_episode(spec)
-    ep.run(None, obs)
+    ep, failed, _ = _replay(tmp_path, "FRAME01", 0.04, 5)
     assert any(r.move.kind == "edge" and "concave edge" in r.reason for r in failed)
-    assert max(r.ratio for r in bound_ratios(ep.executor.components, ep.true_model, ep.world_from_model)) <= 1.0
-
-
-def _scaled_corpus(directory, extent: float) -> str:
-    """The formula corpus with every solid scaled to ``extent`` [m] across (``scripts/perception_report.py
-    --corpus --sizes``), written to ``directory``."""
-    from haptic.geometry.corpus import corpus_solids
-    from haptic.geometry.io import save_model
-    from haptic.geometry.perturb import scaled_to
-
-    for s, poly in corpus_solids():
-        save_model(scaled_to(poly, extent, s.name), directory / f"{s.name}.json")
-    return str(directory)
+    assert _within_bounds(ep)
 
 
 def test_a_face_move_that_rolls_round_a_vertex_reports_no_edge(tmp_path):
@@ -153,16 +149,9 @@ def test_a_face_move_that_rolls_round_a_vertex_reports_no_edge(tmp_path):
     # move rolled round the apex onto a face sharing no edge with the first; the "edge" reported between them
     # (n_a × n_b through the apex) lay 36 mm off every true edge (48 bounds) and the episode ended no-match.
     # The rolling normals leaned along that line more than the noise allows: no edge is reported.
-    from haptic.episode.evaluate import bound_ratios
-
-    failed = []
-    obs = EpisodeObserver(on_failed_move=lambda n, r: failed.append(r))
-    spec = EpisodeSpec(model="bipyramid_06", seed=1, executor="physics", models=_scaled_corpus(tmp_path, 0.06),
-                       max_moves=11)  # fmt: skip
-    ep = build_episode(spec)
-    ep.run(None, obs)
+    ep, failed, _ = _replay(tmp_path, "bipyramid_06", 0.06, 11, corpus=True)
     assert any(r.move.kind == "face" and "more than the noise allows" in r.reason for r in failed)
-    assert max(r.ratio for r in bound_ratios(ep.executor.components, ep.true_model, ep.world_from_model)) <= 1.0
+    assert _within_bounds(ep)
 
 
 def test_an_edge_move_that_goes_on_round_a_shallow_vertex_reports_no_vertex(tmp_path):
@@ -170,15 +159,9 @@ def test_an_edge_move_that_goes_on_round_a_shallow_vertex_reports_no_vertex(tmp_
     # its end, where the next cap edge turns by only 30°, and the vertex was put at the contacts there, 1.7 mm
     # past the end (1.4 bounds). Those contacts lay 1.1 mm off the edge's line (those of a pad rolling on a
     # vertex 0.2-0.3 mm): the move reports nothing.
-    from haptic.episode.evaluate import bound_ratios
-
-    failed = []
-    obs = EpisodeObserver(on_failed_move=lambda n, r: failed.append(r))
-    ep = build_episode(EpisodeSpec(model="prism_12", seed=1, executor="physics", models=_scaled_corpus(tmp_path, 0.06),
-                                   max_moves=18))  # fmt: skip
-    ep.run(None, obs)
+    ep, failed, _ = _replay(tmp_path, "prism_12", 0.06, 18, corpus=True)
     assert any(r.move.kind == "edge" and "off the edge's line" in r.reason for r in failed)
-    assert max(r.ratio for r in bound_ratios(ep.executor.components, ep.true_model, ep.world_from_model)) <= 1.0
+    assert _within_bounds(ep)
 
 
 def test_a_vertex_move_whose_circle_meets_an_edge_of_another_vertex_reports_no_edge(tmp_path):
@@ -188,12 +171,6 @@ def test_a_vertex_move_whose_circle_meets_an_edge_of_another_vertex_reports_no_e
     # passes far from the vertex circled: the move reports nothing.
     from haptic.episode.evaluate import score_components
 
-    failed, results = [], []
-    obs = EpisodeObserver(on_move=lambda n, r, *a: results.append(r),
-                          on_failed_move=lambda n, r: (failed.append(r), results.append(r)))  # fmt: skip
-    spec = EpisodeSpec(model="trapezohedron_12", seed=1, executor="physics", models=_scaled_corpus(tmp_path, 0.06),
-                       max_moves=6)  # fmt: skip
-    ep = build_episode(spec)
-    ep.run(None, obs)
+    ep, failed, results = _replay(tmp_path, "trapezohedron_12", 0.06, 6, corpus=True)
     assert any(r.move.kind == "vertex" and "leaves another vertex" in r.reason for r in failed)
     assert score_components(ep.executor.components, ep.true_model, ep.world_from_model, results).missed == 0
