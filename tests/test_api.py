@@ -36,7 +36,7 @@ def test_the_example_runs(capsys):
     runpy.run_path(str(EXAMPLE), run_name="__main__")
     out = capsys.readouterr().out.splitlines()
     assert out[0].startswith("10 models: ")
-    assert out[1].startswith("WEDGE01 seed 1: recognized WEDGE01 in 18 moves")
+    assert out[1].startswith("WEDGE01 seed 1: recognized WEDGE01 in 20 moves")
     assert len(out) == 2 + 4 and all(" moves" in line for line in out[2:])
 
 
