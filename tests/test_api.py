@@ -63,7 +63,7 @@ def test_python_and_command_line_give_the_same_record(tmp_path, capsys):
     from_cli = json.loads(out.read_text())
     from_python = haptic.run_episode(haptic.EpisodeSpec(model="WEDGE01", seed=1)).to_json()
     assert untimed(from_cli) == untimed(from_python)
-    assert from_python["verify"] == "full" and from_python["move_set"] == "all" and from_python["moves"] == 18
+    assert from_python["verify"] == "full" and from_python["move_set"] == "all" and from_python["moves"] == 20
 
 
 @pytest.mark.parametrize(
