@@ -77,7 +77,11 @@ def inside_intervals(poly: Polyhedron, start: np.ndarray, direction: np.ndarray,
     if len(cuts) < 2:
         return []
     mids = 0.5 * (cuts[:-1] + cuts[1:])
-    inside = poly.contains(start + mids[:, None] * direction)
+    return _inside_spans(cuts, poly.contains(start + mids[:, None] * direction))
+
+
+def _inside_spans(cuts: np.ndarray, inside: np.ndarray) -> list[tuple[float, float]]:
+    """The pieces between successive ``cuts`` whose midpoints are ``inside``, touching pieces joined."""
     out: list[tuple[float, float]] = []
     for lo, hi, ins in zip(cuts[:-1], cuts[1:], inside, strict=True):
         if not ins or hi <= lo:
@@ -122,15 +126,7 @@ def depth_samples_many(
     inside = poly.contains(np.concatenate(mids)) if sum(len(m) for m in mids) else np.zeros(0, dtype=bool)
     samples, at = [], 0
     for k, c in enumerate(cuts):
-        ins, at = inside[at : at + len(c) - 1], at + len(c) - 1
-        spans: list[tuple[float, float]] = []
-        for lo, hi, i in zip(c[:-1], c[1:], ins, strict=True):
-            if not i or hi <= lo:
-                continue
-            if spans and abs(spans[-1][1] - lo) < 1e-12:
-                spans[-1] = (spans[-1][0], float(hi))
-            else:
-                spans.append((float(lo), float(hi)))
+        spans, at = _inside_spans(c, inside[at : at + len(c) - 1]), at + len(c) - 1
         ts = np.concatenate([np.linspace(lo, hi, DEPTH_SAMPLES) for lo, hi in spans]) if spans else np.zeros(0)
         samples.append(starts[k] + ts[:, None] * directions[k])
     counts = [len(x) for x in samples]

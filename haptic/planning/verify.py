@@ -472,7 +472,7 @@ class Verifier:
         """A lower bound of the verification's cost from there (:func:`~haptic.planning.tour.tour_lower_bound`;
         None: no pose, or no vertex to measure)."""
         self.decision_times: list[float] = []
-        """Wall time of each verification move's choice [s]."""
+        """Wall time of each verification move's choice [s] (not in the record, which is the same on every run)."""
 
     def verdict(self, tree, rec, cost: float) -> str:
         """"confirmed", "mismatch", "incomplete" or "verifying" for a recognition ``rec`` (status recognized)
@@ -596,7 +596,6 @@ class Verifier:
             out["tour_planned"] = round(self.tour_planned, 6)
         if self.tour_bound is not None:
             out["tour_bound"] = round(self.tour_bound, 6)
-        out["decision_times_s"] = [round(t, 6) for t in self.decision_times]
         if self.coverage is not None:
             out["move_budget"] = self.move_budget()
             out.update(self.coverage.record(self._model))

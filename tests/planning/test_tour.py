@@ -112,7 +112,6 @@ def test_no_verification_costs_less_than_its_lower_bound(moves):
         seen += 1
         assert v["cost"] >= v["tour_bound"] - 1e-6, (name, v["cost"], v["tour_bound"])
         assert v["tour_planned"] >= v["tour_bound"] - 1e-6
-        assert len(v["decision_times_s"]) == v["moves"]
     assert seen >= 4
 
 
