@@ -117,6 +117,9 @@ def main(argv: list[str] | None = None) -> int:
     fd, tmp = tempfile.mkstemp(dir=out.parent, suffix=".zip")
     os.close(fd)
     model.save(tmp)
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(tmp, 0o666 & ~umask)  # mkstemp's file is private; the model is an ordinary output file
     os.replace(tmp, out)
     print(f"trained {model.num_timesteps} steps in {train_s / 60:.1f} min ({model.num_timesteps / train_s:.0f} steps/s "
           f"over {args.envs} environments); saved {out}")  # fmt: skip

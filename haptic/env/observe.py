@@ -137,7 +137,7 @@ class Choice:
 def empty_choice(n_candidates: int, counts: tuple[int, int] = (0, 0)) -> Choice:
     """The observation when the episode has ended (no decision): the last counts, action 0 alone admissible."""
     g = np.zeros(len(GLOBALS), np.float32)
-    g[0], g[1] = (np.log1p(c) / _LOG_MAX for c in counts)
+    g[0], g[1] = (min(1.0, np.log1p(c) / _LOG_MAX) for c in counts)
     mask = np.zeros(n_candidates, bool)
     mask[0] = True
     return Choice((), mask, g, np.zeros((n_candidates, MOVE_FEATURES), np.float32),
@@ -179,6 +179,7 @@ def choice_at(
             1 for at, prev in history if same_move(m, prev) and np.linalg.norm(at - ctx.state.position) <= TRIED_RADIUS
         )
         cands[i, _COL["tried"]] = min(tries, MAX_TRIED) / MAX_TRIED
+    np.nan_to_num(cands, copy=False)  # a score the planner could not form counts as none
     mask = _mask(moves, cands, ctx, n_candidates)
     cands[: len(moves), _COL["admissible"]] = mask[: len(moves)]
     g = np.zeros(len(GLOBALS), np.float32)
@@ -191,6 +192,7 @@ def choice_at(
     g[5] = float(n_classes > 0)
     g[6] = mask.sum() / n_candidates
     g[7] = min(1.0, sum(1 for m in ctx.avoid if m.kind in KINDS) / MAX_FAILED_MOVES)
+    np.clip(g, 0.0, 1.0, out=g)
     comps = np.zeros((MAX_COMPONENTS, COMPONENT_FEATURES), np.float32)
     latest = list(ctx.components.values())[-MAX_COMPONENTS:]
     for row, c in zip(comps, latest, strict=False):
