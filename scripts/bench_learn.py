@@ -40,7 +40,7 @@ from bench_unknown import _same_shape, variants  # noqa: E402
 
 from haptic.bench.runner import run_sweep  # noqa: E402
 from haptic.episode.spec import EpisodeSpec  # noqa: E402
-from haptic.errors import HapticError  # noqa: E402
+from haptic.errors import HapticError, ModelError  # noqa: E402
 from haptic.geometry import Polyhedron, load_library, load_model, model_files, save_model  # noqa: E402
 from haptic.geometry.distance import point_triangle_distance  # noqa: E402
 from haptic.geometry.generate import iter_library  # noqa: E402
@@ -77,6 +77,11 @@ def objects(library: dict[str, Polyhedron], hulls: int, seed: int, out: Path) ->
             family = kind if poly.is_convex else f"{kind}, non-convex"
             path = out / f"{poly.name}.json"
             save_model(poly, path)
+            try:
+                load_model(path)
+            except ModelError as exc:  # the file's rounding broke it: not an object to explore
+                print(f"{poly.name} left out: {exc}", file=sys.stderr)
+                continue
             items.append({"path": str(path), "family": family, "size": size, "base": name})
     if hulls:
         count = int(np.ceil(hulls / 0.3)) + 1
