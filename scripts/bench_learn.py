@@ -40,7 +40,7 @@ from bench_unknown import _same_shape, variants  # noqa: E402
 
 from haptic.bench.runner import run_sweep  # noqa: E402
 from haptic.episode.spec import EpisodeSpec  # noqa: E402
-from haptic.errors import HapticError  # noqa: E402
+from haptic.errors import HapticError, ModelError  # noqa: E402
 from haptic.geometry import Polyhedron, load_library, load_model, model_files, save_model  # noqa: E402
 from haptic.geometry.distance import point_triangle_distance  # noqa: E402
 from haptic.geometry.generate import iter_library  # noqa: E402
@@ -74,9 +74,14 @@ def objects(library: dict[str, Polyhedron], hulls: int, seed: int, out: Path) ->
         for kind, size, poly in variants(library[name], np.random.default_rng(rng.integers(2**31))):
             if any(_same_shape(poly, m) for m in library.values()):
                 continue
-            family = kind if library[name].is_convex else f"{kind}, non-convex base"
+            family = kind if poly.is_convex else f"{kind}, non-convex"
             path = out / f"{poly.name}.json"
             save_model(poly, path)
+            try:
+                load_model(path)
+            except ModelError as exc:  # the file's rounding broke it: not an object to explore
+                print(f"{poly.name} left out: {exc}", file=sys.stderr)
+                continue
             items.append({"path": str(path), "family": family, "size": size, "base": name})
     if hulls:
         count = int(np.ceil(hulls / 0.3)) + 1
@@ -206,7 +211,8 @@ def main(argv: list[str] | None = None) -> int:
                    "learn_wall_s": learned.get("wall_time_s", 0.0), "episode_moves": rec["moves"],
                    "episode_cost": rec["path_cost"], "true_VEF": [truth.n_vertices, truth.n_edges, truth.n_faces],
                    "V": None, "vef_right": False, "reid_episodes": 0, "reid_recognized": 0, "reid_cost": [],
-                   "false_episodes": 0, "false_recognitions": 0}  # fmt: skip
+                   "reid_outcomes": [],
+                   "false_episodes": 0, "false_recognitions": 0, "false_outcomes": []}  # fmt: skip
             if learned.get("status") == "closed" and learned.get("path"):
                 model = load_model(learned["path"])
                 row.update(V=model.n_vertices, E=model.n_edges, F=model.n_faces,
@@ -238,9 +244,11 @@ def main(argv: list[str] | None = None) -> int:
                 row["reid_episodes"] += 1
                 row["reid_recognized"] += int(rec["recognized"] == name)
                 row["reid_cost"].append(rec["path_cost"])
+                row["reid_outcomes"].append(rec["recognized"] or rec["outcome"])
             else:
                 row["false_episodes"] += 1
                 row["false_recognitions"] += int(rec["recognized"] == name)
+                row["false_outcomes"].append(rec["recognized"] or rec["outcome"])
         wall = time.perf_counter() - t0
         for r in rows:
             r["reid_cost_mean"] = float(np.mean(r.pop("reid_cost"))) if r["reid_cost"] else None
