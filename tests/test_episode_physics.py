@@ -101,13 +101,13 @@ def _scaled_library(directory, extent: float, corpus: bool = False) -> str:
     return str(directory)
 
 
-def _replay(directory, model: str, extent: float, max_moves: int, corpus: bool = False):
-    """The first ``max_moves`` moves of the default episode of ``model`` at seed 1 in the library scaled to
+def _replay(directory, model: str, extent: float, max_moves: int, corpus: bool = False, seed: int = 1):
+    """The first ``max_moves`` moves of the default episode of ``model`` at ``seed`` in the library scaled to
     ``extent``: the episode, its failed moves and every move's result."""
     failed, results = [], []
     obs = EpisodeObserver(on_move=lambda n, r, *a: results.append(r),
                           on_failed_move=lambda n, r: (failed.append(r), results.append(r)))  # fmt: skip
-    spec = EpisodeSpec(model=model, seed=1, executor="physics", models=_scaled_library(directory, extent, corpus),
+    spec = EpisodeSpec(model=model, seed=seed, executor="physics", models=_scaled_library(directory, extent, corpus),
                        max_moves=max_moves)  # fmt: skip
     ep = build_episode(spec)
     ep.run(None, obs)
@@ -155,11 +155,11 @@ def test_a_face_move_that_rolls_round_a_vertex_reports_no_edge(tmp_path):
 
 
 def test_an_edge_move_that_goes_on_round_a_shallow_vertex_reports_no_vertex(tmp_path):
-    # prism_12 of the formula corpus at 60 mm, seed 1: an edge move along a cap edge of the 12-gon went on round
-    # its end, where the next cap edge turns by only 30°, and the vertex was put at the contacts there, 1.7 mm
-    # past the end (1.4 bounds). Those contacts lay 1.1 mm off the edge's line (those of a pad rolling on a
-    # vertex 0.2-0.3 mm): the move reports nothing.
-    ep, failed, _ = _replay(tmp_path, "prism_12", 0.06, 18, corpus=True)
+    # prism_12 of the formula corpus at 60 mm (seed 1 when found; seed 2 shows it since the moves recover): an
+    # edge move along a cap edge of the 12-gon went on round its end, where the next cap edge turns by only 30°,
+    # and the vertex was put at the contacts there, 1.7 mm past the end (1.4 bounds). Those contacts lay 1.1 mm
+    # off the edge's line (those of a pad rolling on a vertex 0.2-0.3 mm): the move reports nothing.
+    ep, failed, _ = _replay(tmp_path, "prism_12", 0.06, 25, corpus=True, seed=2)
     assert any(r.move.kind == "edge" and "off the edge's line" in r.reason for r in failed)
     assert _within_bounds(ep)
 

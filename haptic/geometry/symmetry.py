@@ -28,10 +28,10 @@ def congruences(a: Polyhedron, b: Polyhedron, eps: float | None = None) -> list[
     (default: the larger of the two models' match tolerances) of its partner and every face onto a face.
     Mirror images are therefore never congruent unless the solid is itself mirror-symmetric.
     """
-    return [t for t, _ in _congruences(a, b, eps)]
+    return [t for t, _ in congruence_pairs(a, b, eps)]
 
 
-def _congruences(a: Polyhedron, b: Polyhedron, eps: float | None) -> list[tuple[SE3, np.ndarray]]:
+def congruence_pairs(a: Polyhedron, b: Polyhedron, eps: float | None) -> list[tuple[SE3, np.ndarray]]:
     """Each congruence with its vertex correspondence (``perm[i]``: the vertex of ``b`` that vertex ``i`` of
     ``a`` goes to)."""
     from scipy.spatial import cKDTree
@@ -76,7 +76,7 @@ def _congruences(a: Polyhedron, b: Polyhedron, eps: float | None) -> list[tuple[
             key = nearest.tobytes()
             if key in found:
                 continue
-            r, t = _fit_rotation(a.vertices, b.vertices[nearest])
+            r, t = fit_rotation(a.vertices, b.vertices[nearest])
             if np.linalg.norm(a.vertices @ r.T + t - b.vertices[nearest], axis=1).max() > eps:
                 continue
             mapped = np.sort(nearest[a.edges], axis=1)
@@ -101,7 +101,7 @@ def _keys(values: np.ndarray, owner: np.ndarray, count: int) -> np.ndarray:
     return keys
 
 
-def _fit_rotation(src: np.ndarray, dst: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def fit_rotation(src: np.ndarray, dst: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The proper rigid motion ``(R, t)`` taking ``src`` closest to ``dst`` in least squares (Kabsch)."""
     cs, cd = src.mean(axis=0), dst.mean(axis=0)
     u, _, vt = np.linalg.svd((src - cs).T @ (dst - cd))
@@ -118,7 +118,7 @@ def symmetry_group(poly: Polyhedron) -> list[SE3]:
     vertex permutations on a few vertices that fix a rigid motion (three not on one line);
     :class:`ModelError` says so when the model's precision leaves it not closed.
     """
-    pairs = _congruences(poly, poly, None)
+    pairs = congruence_pairs(poly, poly, None)
     where = poly.source or poly.name
     perm = np.array([p for _, p in pairs], dtype=np.int64).reshape(len(pairs), poly.n_vertices)
     probe = _spanning_vertices(poly.vertices)
@@ -164,7 +164,7 @@ def library_twin(model: Polyhedron, library: dict[str, Polyhedron]) -> tuple[str
 
 def are_congruent(a: Polyhedron, b: Polyhedron) -> bool:
     """True when a proper rigid motion maps one solid onto the other (mirror images are not congruent)."""
-    return bool(_congruences(a, b, None))
+    return bool(congruence_pairs(a, b, None))
 
 
 def model_summary(poly: Polyhedron, symmetry: list | None = None) -> dict:

@@ -501,9 +501,9 @@ def symmetrized(model: Polyhedron, eps: float) -> np.ndarray:
     vertices onto each other to round-off. A model learned from noisy data is symmetric only within its
     bounds; the matcher groups the poses of a model by its exact symmetry group, so an object's symmetric poses
     would otherwise stay apart, never to be told from each other."""
-    from haptic.geometry.symmetry import _congruences, _fit_rotation
+    from haptic.geometry.symmetry import congruence_pairs, fit_rotation
 
-    pairs = _congruences(model, model, eps)
+    pairs = congruence_pairs(model, model, eps)
     v = np.array(model.vertices, dtype=float)
     if len(pairs) <= 1:
         return v
@@ -512,7 +512,7 @@ def symmetrized(model: Polyhedron, eps: float) -> np.ndarray:
         acc = np.zeros_like(v)
         worst = 0.0
         for perm in perms:  # the motion carries vertex i to vertex perm[i]
-            r, t = _fit_rotation(v, v[perm])
+            r, t = fit_rotation(v, v[perm])
             moved = v @ r.T + t
             worst = max(worst, float(np.linalg.norm(moved - v[perm], axis=1).max()))
             acc[perm] += moved
