@@ -146,6 +146,7 @@ class PhysicsSettings:
     roll_lead_rows: int = 8
     """The last rows of a trace on a face before a roll count with the roll (for the edge between) [-]."""
     stroke_headings: int = 4
+    """An L stroke for a face's normal is tried in up to this many headings, a quarter turn apart."""
     reacquire_turns: tuple[float, ...] = tuple(math.radians(a) for a in (90.0, 60.0, 120.0, 40.0, 140.0))
     """A crossing that lost the next face (contact lost, the roll's limit, too few contacts on it) touches it
     afresh, lifted off: at these guessed turns of its normal about the edge, the roll's own last normal first [rad]."""
@@ -153,7 +154,9 @@ class PhysicsSettings:
     """... at a point this far from the edge on the guessed face [m] ..."""
     reacquire_cone: float = math.radians(12.0)
     """... skipping a guess within this of one tried [rad]."""
-    """An L stroke for a face's normal is tried in up to this many headings, a quarter turn apart."""
+    reacquire_step_in: float = 0.003
+    """... and measuring it by an L whose first leg, away from the edge, is this long: a face must span both legs
+    (a stroke along a ridge keeps one normal too) [m]."""
     approach_slack: float = 0.01
     """Start: a pad more than this below the approach height lifts straight up first [m]."""
     touched_at_once: float = 0.006
@@ -469,9 +472,10 @@ class PhysicsExecutor(LandingSearch):
             if float(away @ (t.tip - corner)) < 0:
                 away = -away
             along = e_n if away_from is None or float((t.tip - away_from) @ e_n) >= 0 else -e_n
-            st = t.stroke(n, away, along)
+            # an L as wide as long enough to tell a face from a ridge (along an edge the normal holds too)
+            st = t.stroke(n, away, along, step_in=s.reacquire_step_in)
             pieces.append(st)
-            fit = seg.fit_face_trace(st.trace, st.info["normal"]) if st.ok else None
+            fit = seg.fit_face_trace(st.trace, st.info["normal"], two_d=True) if st.ok else None
             if fit is not None:
                 self.recoveries.append(f"{why}: the next face touched afresh")
                 return "ok", "", roll, st.trace, fit

@@ -443,10 +443,13 @@ class Toucher:
 
     # -- on a face -------------------------------------------------------------------------------------------
     def trace_face(
-        self, direction: np.ndarray, face_normal: np.ndarray, max_distance: float, phase: str = "face"
+        self, direction: np.ndarray, face_normal: np.ndarray, max_distance: float, phase: str = "face",
+        from_edge: bool = False,
     ) -> PrimitiveResult:
         """Slide across the face of normal ``face_normal`` along ``direction`` until an edge (convex: the
         surface falls away; concave: the finger is blocked), or ``max_distance`` (event ``"done"``).
+        ``from_edge``: the slide starts on the edge it just met (the pad on its ridge, the sensed normal turned
+        from the face's): edges count only once the normal is back on the face, within ``leave_edge`` of travel.
 
         ``info``: ``face_normal`` (the running mean of the sensed normals on the face), ``direction`` (the
         in-plane travel direction), ``kind`` of the edge."""
@@ -475,7 +478,10 @@ class Toucher:
                 return self._result("ok", "convex-edge", 0.0, face_normal=unit(n_sum) if n_sum.any() else n_run,
                                     direction=d, kind="convex", lost=True)  # fmt: skip
             n = self.normal
-            if n is not None and self.contact[1] is not None:
+            if from_edge and n is not None and (angle(n, n_f) <= cfg.edge_angle or travelled > cfg.leave_edge):
+                from_edge = False  # off the ridge: its rows (the pad on the edge, not the face) are not the face's
+                self.take_trace()
+            if n is not None and self.contact[1] is not None and not from_edge:
                 a = angle(n, n_run)
                 if a > cfg.edge_angle:
                     over += 1
@@ -557,7 +563,8 @@ class Toucher:
                 return self._result("unreachable", "limit", 0.0)
         return self._result("timeout", "limit", 0.0)
 
-    def stroke(self, normal: np.ndarray, away: np.ndarray, along: np.ndarray) -> PrimitiveResult:
+    def stroke(self, normal: np.ndarray, away: np.ndarray, along: np.ndarray, step_in: float | None = None
+               ) -> PrimitiveResult:  # fmt: skip
         """A short L on a face for its normal: ``step_in`` along ``away``, then ``stroke`` along ``along`` (the
         other way if an edge comes first). ``info["normal"]``: mean sensed normal on the face.
 
@@ -567,18 +574,16 @@ class Toucher:
         enough)."""
         cfg = self.config
         n_f = unit(np.asarray(normal, dtype=float))
-        pieces = [self.trace_face(away, n_f, cfg.step_in, phase="stroke")]
+        pieces = [self.trace_face(away, n_f, cfg.step_in if step_in is None else step_in, phase="stroke")]
         if not pieces[-1].ok and pieces[-1].event != "table":
             return pieces[-1]
         pieces.append(self.trace_face(along, n_f, cfg.stroke, phase="stroke"))
         if (pieces[-1].ok and pieces[-1].event != "done") or pieces[-1].event == "table":
-            back = self.trace_face(-along, n_f, cfg.stroke * 2.0, phase="stroke")
+            back = self.trace_face(-along, n_f, cfg.stroke * 2.0, phase="stroke", from_edge=True)
             pieces.append(back)
         trace = ContactTrace.concatenate([p.trace for p in pieces])
         ok_rows = trace.in_contact & (trace.phase == PHASES.index("stroke"))
-        nn = trace.normal_in_world[ok_rows]
-        keep = nn @ n_f > math.cos(self.bounds.face_cone)
-        n_mean = unit(nn[keep].sum(axis=0)) if keep.any() else n_f
+        n_mean = dominant_normal(trace.normal_in_world[ok_rows], n_f, self.bounds.face_cone, cfg.edge_angle)
         failed = [p for p in pieces if not p.ok and p.event != "table"]
         status = failed[-1].status if failed else "ok"
         event = failed[-1].event if failed else "done"
@@ -770,6 +775,20 @@ class Toucher:
                 return self._result("unreachable", "blocked", 0.0, arc=swept)
         del start_tip
         return self._result("timeout", "limit", 0.0, arc=swept)
+
+
+def dominant_normal(normals: np.ndarray, guess: np.ndarray, cone: float, within: float) -> np.ndarray:
+    """The mean of the densest cluster of ``normals`` (rows within ``cone`` of each other), among those within
+    ``within`` of ``guess``; ``guess`` when none is. A face's rows share one normal, while a roll's or an edge's
+    spread: the cluster is the face even when ``guess`` (a roll's settled normal near a corner) is a few degrees
+    off it."""
+    nn = np.asarray(normals, dtype=float).reshape(-1, 3)
+    nn = nn[nn @ guess > math.cos(within)]
+    if not len(nn):
+        return guess
+    near = nn @ nn.T > math.cos(cone)
+    seed = nn[int(np.argmax(near.sum(axis=1)))]
+    return unit(nn[nn @ seed > math.cos(cone)].sum(axis=0))
 
 
 def _path_length(points: np.ndarray, offset: float = 0.0) -> float:

@@ -81,6 +81,9 @@ class TouchConfig:
     """Travel onto a new face, away from the edge, after the roll settled [m]."""
     stroke: float = 0.006
     """Length of the stroke along the edge on a new face (the second leg of the L for its normal) [m]."""
+    leave_edge: float = 0.003
+    """A slide that starts on the edge it just met (the back leg of a stroke) counts edges only once the sensed
+    normal is back on the face, or after this much travel [m]."""
     ridge_gain: float = 12.0
     """Sideways servo of ridge following: pad speed per radian of normal error, per metre of pad radius [1/s]."""
     ridge_side_speed: float = 0.012
