@@ -574,6 +574,11 @@ class Toucher:
         enough)."""
         cfg = self.config
         n_f = unit(np.asarray(normal, dtype=float))
+        # out of a concave corner the force is shared by both faces: press on the new one alone before sliding
+        self._press(np.zeros(3), hint=n_f)
+        if not self._settle("settle"):
+            return self._result("unstable", "nan", 0.0)
+        self.take_trace()  # rows in place, not of the stroke
         pieces = [self.trace_face(away, n_f, cfg.step_in if step_in is None else step_in, phase="stroke")]
         if not pieces[-1].ok and pieces[-1].event != "table":
             return pieces[-1]
