@@ -161,7 +161,9 @@ class PhysicsWorld:
         settings = PhysicsSettings()
         executor = PhysicsExecutor(RobotInterface(sim), bounds=bounds, costs=config.costs, rng=exec_rng,
                                    settings=settings)  # fmt: skip
-        config = replace(config, vertex_radius=settings.vertex_radius)  # the circle the executor makes
+        # the circle the executor makes; the concave edges' ends it can tell
+        config = replace(config, vertex_radius=settings.vertex_radius,
+                         concave_end_block=config.concave_end_block or settings.min_block_cos)  # fmt: skip
         results: list[MoveResult] = []  # every move's result, for scoring perception
 
         def keep(*args) -> None:

@@ -154,6 +154,11 @@ class PhysicsSettings:
     """... at a point this far from the edge on the guessed face [m] ..."""
     reacquire_cone: float = math.radians(12.0)
     """... skipping a guess within this of one tried [rad]."""
+    recross_shift: float = 0.006
+    """A face move whose roll went round the edge's end (its normals leaning along the edge) crosses again this
+    much farther inside the edge (plus how far the pad overshot the end) ... [m]"""
+    recross_back: float = 0.008
+    """... starting this far back on the face from where it met the edge [m]."""
     reacquire_step_in: float = 0.003
     """... and measuring it by an L whose first leg, away from the edge, is this long: a face must span both legs
     (a stroke along a ridge keeps one normal too) [m]."""
@@ -493,25 +498,36 @@ class PhysicsExecutor(LandingSearch):
         status = self._ensure_on_face(st.face, pieces)
         if status != "ok":
             return self.failed_result(move, status, f"could not return to the current face: {self._why}")
-        r = t.trace_face(inplane, n_a, self.settings.max_face_trace)
-        pieces.append(r)
-        if not r.ok:
-            if r.event == "table":
-                return self.failed_result(move, r, "the finger would meet the table before an edge")
-            return self.failed_result(move, r, f"trace across the face: {r.event}")
-        if r.event == "done":
-            return self.failed_result(move, "unreachable", "no edge within the longest trace")
-        kind = r.info["kind"]
-        corner = self.contact_point()
-        status, reason, roll, stroke, fit_b = self._cross_and_acquire(kind, r.info["face_normal"], r.info["direction"],
-                                                                      pieces)  # fmt: skip
-        if status == "undercut":
-            return self._edge_only(move, r, roll, reason, pieces)
-        if status != "ok":
-            return self.failed_result(move, status, reason)
-        fit_a, line, why = self._edge_between(st.face, r.trace, "face", roll, fit_b, kind, corner)
-        if line is None:
-            return self.failed_result(move, "unreachable", why)
+        distance = 0.0
+        for attempt in range(2):
+            r = t.trace_face(inplane, n_a, self.settings.max_face_trace)
+            pieces.append(r)
+            if not r.ok:
+                if r.event == "table":
+                    return self.failed_result(move, r, "the finger would meet the table before an edge")
+                return self.failed_result(move, r, f"trace across the face: {r.event}")
+            if r.event == "done":
+                return self.failed_result(move, "unreachable", "no edge within the longest trace")
+            distance = r.distance
+            kind = r.info["kind"]
+            corner = self.contact_point()
+            status, reason, roll, stroke, fit_b = self._cross_and_acquire(kind, r.info["face_normal"],
+                                                                          r.info["direction"], pieces)  # fmt: skip
+            if status == "undercut":
+                return self._edge_only(move, r, roll, reason, pieces)
+            if status != "ok":
+                return self.failed_result(move, status, reason)
+            fit_a, line, why = self._edge_between(st.face, r.trace, "face", roll, fit_b, kind, corner)
+            if line is not None:
+                break
+            shift = self._away_from_vertex(fit_a.normal, fit_b.normal, roll) if attempt == 0 else None
+            if shift is None:
+                return self.failed_result(move, "unreachable", why)
+            # the roll went round the edge's end: cross again farther along the edge, inside it
+            start = corner - self.settings.recross_back * inplane + shift
+            if self._touch_face(st.face, n_a, start, pieces) != "ok":
+                return self.failed_result(move, "unreachable", why)
+            self.recoveries.append(f"{why}: crossed again {np.linalg.norm(shift) * 1000:.0f} mm along the edge")
         new_face = seg.next_id + 1
         edge = seg.add_edge(line, (st.face, new_face), kind == "convex", (fit_a.normal, fit_b.normal),
                             adjacent=(st.face,))  # fmt: skip
@@ -520,8 +536,28 @@ class PhysicsExecutor(LandingSearch):
         self.on_face = face.id
         self.state = SensorState(position=self.contact_point(), face=face.id, edge=edge.id,
                                  edge_faces=(st.face, face.id))  # fmt: skip
-        return MoveResult(move=move, status="ok", components=(edge, face), distance=r.distance,
-                          cost=self.costs.face_move(r.distance), state=self.state, info={"kind": kind})  # fmt: skip
+        return MoveResult(move=move, status="ok", components=(edge, face), distance=distance,
+                          cost=self.costs.face_move(distance), state=self.state, info={"kind": kind})  # fmt: skip
+
+    def _away_from_vertex(self, n_a: np.ndarray, n_b: np.ndarray, roll: ContactTrace) -> np.ndarray | None:
+        """After a roll whose normals leaned along the edge between faces ``n_a`` and ``n_b`` (the pad rolled
+        round the edge's end, its centre past the vertex, so the normals lean from the vertex toward it): the
+        shift along the edge back inside it, ``recross_shift`` plus the overshoot; None when the roll's normals
+        do not lean one way."""
+        e = np.cross(n_a, n_b)
+        if float(e @ e) < 1e-6 or not roll.in_contact.any():
+            return None
+        e = unit(e)
+        n = roll.normal_in_world[roll.in_contact]
+        c = math.cos(self.bounds.sample_cone)
+        between = (n @ n_a < c) & (n @ n_b < c)
+        if not between.any():
+            return None
+        lean = float(np.median(n[between] @ e))
+        if abs(lean) < 1e-3:
+            return None
+        over = self.toucher.pad_radius * abs(lean)
+        return -math.copysign(1.0, lean) * (self.settings.recross_shift + over) * e
 
     def _edge_only(
         self, move: FaceMove, r: PrimitiveResult, roll: ContactTrace, reason: str, pieces: list[PrimitiveResult]

@@ -586,9 +586,14 @@ class Toucher:
         if (pieces[-1].ok and pieces[-1].event != "done") or pieces[-1].event == "table":
             back = self.trace_face(-along, n_f, cfg.stroke * 2.0, phase="stroke", from_edge=True)
             pieces.append(back)
-        trace = ContactTrace.concatenate([p.trace for p in pieces])
+        # the first leg starts where the roll settled, next to the edge and maybe a corner, the pad still touching
+        # their rims: it measures the face only when asked for its width (step_in given) or when the others
+        # hold too few rows
+        rest = ContactTrace.concatenate([p.trace for p in pieces[1:]])
+        narrow = step_in is None and int(rest.in_contact.sum()) >= self.bounds.min_face_rows
+        trace = rest if narrow else ContactTrace.concatenate([p.trace for p in pieces])
         ok_rows = trace.in_contact & (trace.phase == PHASES.index("stroke"))
-        n_mean = dominant_normal(trace.normal_in_world[ok_rows], n_f, self.bounds.face_cone, cfg.edge_angle)
+        n_mean = dominant_normal(trace.normal_in_world[ok_rows], n_f, self.bounds.face_cone / 2.0, cfg.edge_angle)
         failed = [p for p in pieces if not p.ok and p.event != "table"]
         status = failed[-1].status if failed else "ok"
         event = failed[-1].event if failed else "done"

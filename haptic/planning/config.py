@@ -45,6 +45,12 @@ class PlannerConfig:
     executor) [rad]. A face move predicted to roll over an edge onto a face leaning further ends there and
     reports the edge alone (:attr:`~haptic.planning.predict.Prediction.edge_only`); a vertex move doing so
     counts as refused like one running into the table. None: no limit."""
+    concave_end_block: float | None = None
+    """With a table, where the hand can tell a concave edge's end: only where a face there blocks the pad
+    travelling along the edge (its outward normal against the travel by more than this cosine). Past an end
+    where the surface falls away the pad in the corner rolls on along the two faces' rims, so an edge move
+    toward it locates no vertex and counts as refused (set for the physics executor). None: every end is
+    located (a point sensor)."""
     touch_evidence: bool = False
     """Every touched point is checked against each pose class's surface (the episode does so with the
     physics executor's traces), so a face move that cannot step onto its next face still tells how far its

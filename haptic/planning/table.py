@@ -145,8 +145,9 @@ def table_prediction(
         return float(onto_hidden(hit.edge, hit.next_face, hit.point)), float(hit.distance), 0.0
     if isinstance(move, EdgeMove):
         # an edge running down to the table ends at a vertex on it, where the table blocks the finger: the
-        # executor finds that vertex (the only way to measure such an edge), so an edge move is never refused
-        return 0.0, np.nan, np.nan
+        # executor finds that vertex (the only way to measure such an edge), so an edge move is refused only
+        # toward a concave edge's end the hand cannot tell (config.concave_end_block)
+        return float(hidden_concave_end(h, move, state, components, config)), np.nan, np.nan
     if isinstance(move, VertexMove):
         e_m = h.edges.get(state.edge) if state.edge is not None else None
         v_m = h.vertices.get(state.vertex) if state.vertex is not None else None
@@ -167,6 +168,27 @@ def table_prediction(
         at = poly.vertices[v_m] + config.vertex_radius * away
         return float(onto_hidden(hit.edge, hit.next_face, at)), np.nan, np.nan
     raise TypeError(f"unknown move {move!r}")
+
+
+def hidden_concave_end(
+    h: Hypothesis, move: EdgeMove, state: SensorState, components: Mapping[int, DataComponent],
+    config: PlannerConfig,
+) -> bool:
+    """Whether ``move`` runs along a concave edge of ``h`` to an end where no face blocks the pad (the surface
+    falls away past it), which the hand cannot locate (:attr:`PlannerConfig.concave_end_block`)."""
+    if config.concave_end_block is None or h.world_from_model is None:
+        return False
+    poly, t = h.poly, h.world_from_model
+    e_m = h.edges.get(state.edge) if state.edge is not None else None
+    data_edge = components.get(state.edge) if state.edge is not None else None
+    if e_m is None or not isinstance(data_edge, DataEdge) or poly.edge_convexity[e_m] >= 0:
+        return False
+    sense = move.sense if float(t.rotate(poly.edge_directions[e_m]) @ data_edge.direction) > 0 else -move.sense
+    v = int(poly.edges[e_m, 1] if sense > 0 else poly.edges[e_m, 0])
+    u = poly.edge_directions[e_m] * sense
+    own = {int(poly.edge_left_face[e_m]), int(poly.edge_right_face[e_m])}
+    return not any(float(poly.face_normals[f] @ u) < -config.concave_end_block
+                   for f in poly.vertex_faces[v] if int(f) not in own)  # fmt: skip
 
 
 def _vertex_frame(
