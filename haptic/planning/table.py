@@ -144,10 +144,11 @@ def table_prediction(
             return 0.0, float(hit.distance), 1.0
         return float(onto_hidden(hit.edge, hit.next_face, hit.point)), float(hit.distance), 0.0
     if isinstance(move, EdgeMove):
-        # an edge running down to the table ends at a vertex on it, where the table blocks the finger: the
-        # executor finds that vertex (the only way to measure such an edge), so an edge move is refused only
-        # toward a concave edge's end the hand cannot tell (config.concave_end_block)
-        return float(hidden_concave_end(h, move, state, components, config)), np.nan, np.nan
+        # refused toward an end where the pad on the ridge would meet the table first (a motion the table stops
+        # locates no vertex), or toward a concave edge's end the hand cannot tell (config.concave_end_block)
+        refused = edge_end_on_table(h, move, state, components, config) or hidden_concave_end(
+            h, move, state, components, config)
+        return float(refused), np.nan, np.nan
     if isinstance(move, VertexMove):
         e_m = h.edges.get(state.edge) if state.edge is not None else None
         v_m = h.vertices.get(state.vertex) if state.vertex is not None else None
@@ -170,22 +171,50 @@ def table_prediction(
     raise TypeError(f"unknown move {move!r}")
 
 
+def _edge_end(
+    h: Hypothesis, move: EdgeMove, state: SensorState, components: Mapping[int, DataComponent]
+) -> tuple[int, int, np.ndarray] | None:
+    """The model edge of the current data edge in ``h``, the vertex ``move`` runs to and its direction of travel
+    (model frame); None when ``h`` cannot say."""
+    if h.world_from_model is None or state.edge is None:
+        return None
+    poly, t = h.poly, h.world_from_model
+    e_m = h.edges.get(state.edge)
+    data_edge = components.get(state.edge)
+    if e_m is None or not isinstance(data_edge, DataEdge):
+        return None
+    sense = move.sense if float(t.rotate(poly.edge_directions[e_m]) @ data_edge.direction) > 0 else -move.sense
+    v = int(poly.edges[e_m, 1] if sense > 0 else poly.edges[e_m, 0])
+    return int(e_m), v, poly.edge_directions[e_m] * sense
+
+
+def edge_end_on_table(
+    h: Hypothesis, move: EdgeMove, state: SensorState, components: Mapping[int, DataComponent],
+    config: PlannerConfig,
+) -> bool:
+    """Whether the pad following ``move``'s edge of ``h`` (touching both faces, its normal between theirs) comes
+    within ``config.table_clearance`` of the table at the edge's end."""
+    end = _edge_end(h, move, state, components) if config.table_z is not None else None
+    if end is None:
+        return False
+    e_m, v, _ = end
+    poly, t = h.poly, h.world_from_model
+    ridge = poly.face_normals[poly.edge_left_face[e_m]] + poly.face_normals[poly.edge_right_face[e_m]]
+    ridge = ridge / max(float(np.linalg.norm(ridge)), 1e-12)
+    return pad_clearance(t.apply(poly.vertices[v]), t.rotate(ridge), config) < config.table_clearance
+
+
 def hidden_concave_end(
     h: Hypothesis, move: EdgeMove, state: SensorState, components: Mapping[int, DataComponent],
     config: PlannerConfig,
 ) -> bool:
     """Whether ``move`` runs along a concave edge of ``h`` to an end where no face blocks the pad (the surface
     falls away past it), which the hand cannot locate (:attr:`PlannerConfig.concave_end_block`)."""
-    if config.concave_end_block is None or h.world_from_model is None:
+    end = _edge_end(h, move, state, components) if config.concave_end_block is not None else None
+    if end is None or h.poly.edge_convexity[end[0]] >= 0:
         return False
-    poly, t = h.poly, h.world_from_model
-    e_m = h.edges.get(state.edge) if state.edge is not None else None
-    data_edge = components.get(state.edge) if state.edge is not None else None
-    if e_m is None or not isinstance(data_edge, DataEdge) or poly.edge_convexity[e_m] >= 0:
-        return False
-    sense = move.sense if float(t.rotate(poly.edge_directions[e_m]) @ data_edge.direction) > 0 else -move.sense
-    v = int(poly.edges[e_m, 1] if sense > 0 else poly.edges[e_m, 0])
-    u = poly.edge_directions[e_m] * sense
+    poly = h.poly
+    e_m, v, u = end
     own = {int(poly.edge_left_face[e_m]), int(poly.edge_right_face[e_m])}
     return not any(float(poly.face_normals[f] @ u) < -config.concave_end_block
                    for f in poly.vertex_faces[v] if int(f) not in own)  # fmt: skip

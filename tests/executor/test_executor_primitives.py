@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from haptic.executor.primitives import Toucher
+from haptic.executor.primitives import Toucher, dominant_normal
 from haptic.executor.segment import SegmentBounds, face_rows, fit_face
 from haptic.matching.trace import ContactTrace
 from haptic.sim import RobotInterface, SimulatedSensorNoise, Simulation, compose_scene
@@ -113,3 +113,27 @@ def test_a_free_move_that_runs_away_from_its_line_is_stopped_and_the_arm_brought
     assert np.linalg.norm(t.tip - start) < 0.08  # stopped near its line, not carried off
     monkeypatch.setattr(RobotInterface, "move_fingertip", real)
     assert t.move_free(target).ok  # the arm still moves where it is asked
+
+
+def test_a_strokes_normal_is_the_faces_cluster_even_from_a_guess_degrees_off():
+    # a face's rows share one normal (noise 0.1°); a roll's and a rim's spread over 10°: the cluster of the face
+    # wins over the guess, a roll's settled normal 3.5° off it, and over the rows leaning like it
+    rng = np.random.default_rng(3)
+    face = np.array([0.0, -0.6, 0.8])
+    tilt = np.array([1.0, 0.0, 0.0])
+
+    def turned(deg: float, n: int) -> np.ndarray:
+        a = np.radians(deg)
+        v = np.cos(a) * face + np.sin(a) * tilt + rng.normal(0.0, np.radians(0.1), (n, 3))
+        return v / np.linalg.norm(v, axis=1, keepdims=True)
+
+    rows = np.concatenate([turned(0.0, 100), turned(3.5, 40), turned(rng.uniform(4, 10), 30)])
+    guess = turned(3.5, 1)[0]
+    got = dominant_normal(rows, guess, np.radians(2.0), np.radians(10.0))
+    assert np.degrees(np.arccos(np.clip(got @ face, -1, 1))) < 0.1
+    # the mean of the rows within a 4° cone of the guess, as it was taken before, leans toward the guess
+    near = rows[rows @ guess > np.cos(np.radians(4.0))]
+    mean = near.sum(axis=0) / np.linalg.norm(near.sum(axis=0))
+    assert np.degrees(np.arccos(np.clip(mean @ face, -1, 1))) > 0.5
+    # no row near the guess: the guess
+    assert np.allclose(dominant_normal(rows, -face, np.radians(2.0), np.radians(10.0)), -face)
