@@ -163,7 +163,8 @@ class PhysicsWorld:
                                    settings=settings)  # fmt: skip
         # the circle the executor makes; the concave edges' ends it can tell
         config = replace(config, vertex_radius=settings.vertex_radius,
-                         concave_end_block=config.concave_end_block or settings.min_block_cos)  # fmt: skip
+                         concave_end_block=config.concave_end_block or settings.min_block_cos,
+                         min_vertex_clearance=max(config.min_vertex_clearance, settings.crossing_clearance))  # fmt: skip
         results: list[MoveResult] = []  # every move's result, for scoring perception
 
         def keep(*args) -> None:

@@ -154,6 +154,10 @@ class PhysicsSettings:
     """... at a point this far from the edge on the guessed face [m] ..."""
     reacquire_cone: float = math.radians(12.0)
     """... skipping a guess within this of one tried [rad]."""
+    crossing_clearance: float = 0.006
+    """The planner's least distance from a face move's crossing to the nearest vertex on the hand
+    (``PlannerConfig.min_vertex_clearance``, preferred where a move that keeps it exists): nearer, the pad
+    (12 mm) rolls round the edge's end or drops into a concave corner past it [m]."""
     recross_shift: float = 0.006
     """A face move whose roll went round the edge's end (its normals leaning along the edge) crosses again this
     much farther inside the edge (plus how far the pad overshot the end) ... [m]"""
