@@ -73,7 +73,9 @@ def test_faces_beside_a_seam_of_the_simulated_pieces_read_true():
 def test_a_pad_lifted_off_a_valley_reports_no_vertex():
     # FRAME01 standing on its side: following a concave valley of its sloped faces down toward the hole, the
     # finger's distal link meets the frame's rim and lifts the pad off the valley with the normal still across
-    # it; that is no vertex (the surface did not fall away), and the library object is not rejected
+    # it; that is no vertex (the surface did not fall away), and the library object is not rejected. (The
+    # planner no longer offers that move -- the valley's end at the hole is a concave end the hand cannot tell --
+    # so an edge lost here, if any, must still be no vertex.)
     lost = []
 
     def on_failed(n, r) -> None:
@@ -84,7 +86,7 @@ def test_a_pad_lifted_off_a_valley_reports_no_vertex():
     rec = run_episode(spec, observer=EpisodeObserver(on_failed_move=on_failed))
     assert rec.outcome != "no-match", rec.detail
     assert rec.perception["spurious"] == 0
-    assert lost and lost[0].status == "no-contact"
+    assert all(r.status == "no-contact" for r in lost)
 
 
 def _scaled_library(directory, extent: float, corpus: bool = False) -> str:
@@ -127,8 +129,9 @@ def test_an_edge_move_stopped_by_the_table_reports_no_vertex(tmp_path):
     # Stopped by the table the move reports nothing: the edge may end above the table or at a chamfer.
     from haptic.sim.scene import TABLE_TOP_Z
 
+    # The planner now counts such a move refused (tests/planning/test_edge_ends.py): whether or not one is made,
+    # no vertex lies on the table plane and every component is within its bounds.
     ep, failed, _ = _replay(tmp_path, "BOX01P", 0.04, 11)
-    assert any(r.move.kind == "edge" and "met the table" in r.reason for r in failed)
     vertices = [c for c in ep.executor.components if c.kind == "vertex"]
     assert vertices and all(v.position[2] > TABLE_TOP_Z + 0.002 for v in vertices)
     assert _within_bounds(ep)
@@ -139,18 +142,22 @@ def test_a_concave_edge_whose_end_the_pad_rolls_past_reports_no_vertex(tmp_path)
     # faces' corners are obtuse: the pad's contacts rolled on along the rims and the vertex was put at their
     # median, 3.6 mm past the true end (2.7 bounds; the edge's extent 1.2 bounds), and the episode ended
     # no-match. The surface falling away does not locate a concave edge's end: the move reports nothing.
+    # The planner now counts a move toward such an end refused on the hand (tests/planning/test_edge_ends.py).
     ep, failed, _ = _replay(tmp_path, "FRAME01", 0.04, 5)
-    assert any(r.move.kind == "edge" and "concave edge" in r.reason for r in failed)
+    assert not any(r.move.kind == "edge" and "concave edge" in r.reason for r in failed)
     assert _within_bounds(ep)
 
 
 def test_a_face_move_that_rolls_round_a_vertex_reports_no_edge(tmp_path):
-    # bipyramid_06 of the formula corpus at 60 mm across, seed 1 (perception_report.py --corpus --sizes 60): a face
+    # bipyramid_06 of the formula corpus at 60 mm across, seed 1 when found, seed 4 since face moves prefer to cross
+    # their edges 6 mm from a vertex (perception_report.py --corpus --sizes 60): a face
     # move rolled round the apex onto a face sharing no edge with the first; the "edge" reported between them
     # (n_a × n_b through the apex) lay 36 mm off every true edge (48 bounds) and the episode ended no-match.
-    # The rolling normals leaned along that line more than the noise allows: no edge is reported.
-    ep, failed, _ = _replay(tmp_path, "bipyramid_06", 0.06, 11, corpus=True)
-    assert any(r.move.kind == "face" and "more than the noise allows" in r.reason for r in failed)
+    # The rolling normals leaned along that line more than the noise allows: no edge is reported (the move
+    # then crosses again inside the edge, or fails).
+    ep, failed, results = _replay(tmp_path, "bipyramid_06", 0.06, 11, corpus=True, seed=4)
+    said = [r.reason for r in failed] + [x for r in results for x in (r.info or {}).get("recoveries", ())]
+    assert any("more than the noise allows" in x for x in said), said
     assert _within_bounds(ep)
 
 
@@ -159,8 +166,10 @@ def test_an_edge_move_that_goes_on_round_a_shallow_vertex_reports_no_vertex(tmp_
     # edge move along a cap edge of the 12-gon went on round its end, where the next cap edge turns by only 30°,
     # and the vertex was put at the contacts there, 1.7 mm past the end (1.4 bounds). Those contacts lay 1.1 mm
     # off the edge's line (those of a pad rolling on a vertex 0.2-0.3 mm): the move reports nothing.
+    # Since the strokes leave the edge they met and the crossings keep 6 mm from vertices, no edge move of seeds
+    # 1-5 goes round that end; whatever the replay's moves, no component lies outside its bounds.
     ep, failed, _ = _replay(tmp_path, "prism_12", 0.06, 25, corpus=True, seed=2)
-    assert any(r.move.kind == "edge" and "off the edge's line" in r.reason for r in failed)
+    assert all("off the edge's line" in r.reason for r in failed if r.move.kind == "edge" and "locate" in r.reason)
     assert _within_bounds(ep)
 
 

@@ -128,7 +128,7 @@ class LandingSearch:
                 return None, ContactTrace.concatenate([])
             # met an edge: back off the way it came and turn
             back = (
-                t.trace_face(-legs[-1].info.get("direction", d1), n0, s.normal_stroke, phase="stroke", from_edge=True)
+                t.trace_face(-legs[-1].info.get("direction", d1), n0, s.normal_stroke, phase="stroke")
                 if (legs[-1].ok)
                 else None
             )
