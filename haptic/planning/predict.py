@@ -125,7 +125,7 @@ def face_directions(
     if isinstance(edge, DataEdge) and abs(edge.direction @ normal) < 0.5:
         b = edge.direction - (edge.direction @ normal) * normal
         b /= np.linalg.norm(b)
-        inward = np.cross(normal, b)
+        inward = cross(normal, b)
         side = dict(edge.side_points).get(state.face)
         if side is not None:  # a point on the face beside the edge: the face's side of the edge line
             if (side - edge.point) @ inward < 0:
