@@ -213,10 +213,12 @@ class StackedPoses:
                 break
             prob = self if len(active) == self.n else self.subset(active)
             ra, ta = r[active], t[active]
-            f0 = prob.residuals(ra, ta)
-            # the six perturbed poses at once, leading axis 6
-            f = prob.residuals(_FD_ROT[:, None] @ ra, np.einsum("jab,nb->jna", _FD_ROT, ta) + _FD_XI[:, None, 3:])
-            jac = np.moveaxis((f - f0) / _FD_STEP, 0, -1)
+            # the pose and its six perturbations at once, leading axis 7
+            r7 = np.concatenate([ra[None], _FD_ROT[:, None] @ ra])
+            t7 = np.concatenate([ta[None], np.einsum("jab,nb->jna", _FD_ROT, ta) + _FD_XI[:, None, 3:]])
+            f = prob.residuals(r7, t7)
+            f0 = f[0]
+            jac = ((f[1:] - f0) / _FD_STEP).transpose(1, 2, 0)
             step = _gauss_newton_step(jac, f0)
             dr = exp_so3(step[:, :3])
             ra, ta = dr @ ra, (dr @ ta[..., None])[..., 0] + step[:, 3:]
