@@ -10,8 +10,9 @@ episode seed drawn from the environment's generator) with actions drawn uniforml
 observation has already computed) until ``--seconds`` of this process's CPU time are spent and ``--min-steps`` steps
 made (at least one reset and one step), and prints the steps per second (the time in ``step`` alone, the agent's
 choice not counted) and the resets per second (the time in ``reset`` alone), both in CPU time of this process (one
-core: what other processes on the machine take does not count) and in wall time, and the machine's load average
-over the last minute when each row ends (other processes share the caches and the memory bus even so).
+core: what other processes on the machine take does not count) and in wall time, the agent's CPU time per step
+(its choices; 0 for the random agent), and the machine's load average over the last minute when each row ends
+(other processes share the caches and the memory bus even so).
 """
 
 from __future__ import annotations
@@ -36,9 +37,9 @@ def measure(
     env = ExploreEnv(executor=executor, models=models, verify=verify)
     rng = np.random.default_rng(seed)
     planner = PolicyAgent("planner") if agent == "planner" else None
-    cpu = {"step": 0.0, "reset": 0.0}
-    wall = {"step": 0.0, "reset": 0.0}
-    n = {"step": 0, "reset": 0}
+    cpu = {"step": 0.0, "reset": 0.0, "act": 0.0}
+    wall = {"step": 0.0, "reset": 0.0, "act": 0.0}
+    n = {"step": 0, "reset": 0, "act": 0}
 
     def timed(kind: str, fn):
         c, w = time.process_time(), time.perf_counter()
@@ -50,7 +51,10 @@ def measure(
 
     _, info = timed("reset", lambda: env.reset(seed=seed))
     while n["step"] < max(1, min_steps) or cpu["step"] + cpu["reset"] < seconds:
-        action = planner.act(env) if planner is not None else int(rng.choice(np.flatnonzero(info["action_mask"])))
+        if planner is not None:
+            action = timed("act", lambda: planner.act(env))
+        else:
+            action = int(rng.choice(np.flatnonzero(info["action_mask"])))
         _, _, terminated, truncated, info = timed("step", lambda a=action: env.step(a))
         if terminated or truncated:
             _, info = timed("reset", env.reset)
@@ -65,6 +69,7 @@ def measure(
         "resets_per_s_cpu": n["reset"] / cpu["reset"],
         "steps_per_s_wall": n["step"] / wall["step"],
         "resets_per_s_wall": n["reset"] / wall["reset"],
+        "agent_ms_per_step_cpu": 1000.0 * cpu["act"] / n["step"],
         "load_1min": os.getloadavg()[0],
     }
 
@@ -83,14 +88,14 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     rows = []
     print(f"{'environment':26s} {'verify':6s} {'steps':>6s} {'resets':>6s} {'steps/s cpu':>11s} {'resets/s cpu':>12s} "
-          f"{'steps/s wall':>12s} {'resets/s wall':>13s} {'load':>5s}")  # fmt: skip
+          f"{'steps/s wall':>12s} {'resets/s wall':>13s} {'agent ms':>8s} {'load':>5s}")  # fmt: skip
     for executor in args.env.split(","):
         for verify in args.verify.split(","):
             r = measure(executor, verify, args.seconds, args.seed, args.models, args.min_steps, args.agent)
             rows.append(r)
             print(f"{r['env']:26s} {r['verify']:6s} {r['steps']:6d} {r['resets']:6d} {r['steps_per_s_cpu']:11.1f} "
                   f"{r['resets_per_s_cpu']:12.2f} {r['steps_per_s_wall']:12.1f} {r['resets_per_s_wall']:13.2f} "
-                  f"{r['load_1min']:5.1f}",
+                  f"{r['agent_ms_per_step_cpu']:8.2f} {r['load_1min']:5.1f}",
                   flush=True)  # fmt: skip
     if args.json:
         atomic_write(args.json, json.dumps(rows, indent=1))

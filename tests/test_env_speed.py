@@ -4,7 +4,6 @@ the planner and the matcher gives numpy's own results to the last bit."""
 
 from __future__ import annotations
 
-import shutil
 from dataclasses import replace
 
 import numpy as np
@@ -12,7 +11,6 @@ import pytest
 
 import haptic.planning.move_scores as move_scores
 from haptic.env import ExploreEnv, PolicyAgent
-from haptic.geometry.io import DEFAULT_LIBRARY
 from haptic.geometry.se3 import random_rotation
 from haptic.matching.acceptance import _angle
 from haptic.matching.recognition import PoseTolerance, _same_pose_as
@@ -20,16 +18,6 @@ from haptic.planning.config import PlannerConfig
 from haptic.planning.move_scores import bounded, score_all
 from haptic.planning.predict import nan_median
 from haptic.planning.tour import FACE, VERTEX, LegCosts, features, start_costs
-
-
-@pytest.fixture(scope="module")
-def small_library(tmp_path_factory):
-    """Three seed models."""
-    d = tmp_path_factory.mktemp("lib")
-    for name in ("BOX01", "WEDGE01", "TETRA01L"):
-        src = next(DEFAULT_LIBRARY.glob(f"{name}.*"))
-        shutil.copy(src, d / src.name)
-    return str(d)
 
 
 def _posed_context(env: ExploreEnv, seeds=range(1, 40)):
