@@ -60,8 +60,10 @@ def test_a_context_whose_data_changed_is_scored_afresh(small_library):
     after = score_all(own)
     assert all(x[0] is not y[0] for x, y in zip(before, after, strict=True))
     _same_scores(before, after)
-    del own.components[gone]
-    assert score_all(own) is not None  # fewer components: computed again, whatever it gives
+    del own.components[gone]  # fewer components: computed again, as a new context with these data would
+    shorter, fresh = score_all(own), score_all(replace(own, components=dict(own.components)))
+    assert all(x[0] is not y[0] for x, y in zip(after, shorter, strict=False))
+    assert [(type(p.move), *v) for p, *v in shorter] == [(type(p.move), *v) for p, *v in fresh]
 
 
 def test_the_planner_through_the_environment_scores_each_decision_once(small_library, monkeypatch):
