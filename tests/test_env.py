@@ -5,7 +5,6 @@ planner."""
 from __future__ import annotations
 
 import math
-import shutil
 import warnings
 
 import gymnasium as gym
@@ -16,20 +15,9 @@ from gymnasium.utils.env_checker import check_env
 from haptic.bench.runner import plan_sweep, run_sweep
 from haptic.env import GLOBALS, MOVE_COLUMNS, MOVE_FEATURES, ExploreEnv, PolicyAgent
 from haptic.errors import HapticError
-from haptic.geometry.io import DEFAULT_LIBRARY
 from haptic.geometry.library_cache import cached_library
 
 COL = {name: i for i, name in enumerate(MOVE_COLUMNS)}
-
-
-@pytest.fixture(scope="module")
-def small_library(tmp_path_factory):
-    """Three seed models (a smaller tree keeps the checks quick)."""
-    d = tmp_path_factory.mktemp("lib")
-    for name in ("BOX01", "WEDGE01", "TETRA01L"):
-        src = next(DEFAULT_LIBRARY.glob(f"{name}.*"))
-        shutil.copy(src, d / src.name)
-    return str(d)
 
 
 def run(env: gym.Env, act, **reset) -> tuple[float, float, dict]:

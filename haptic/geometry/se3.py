@@ -124,6 +124,11 @@ def frame_from_edge(direction: np.ndarray, face_normal: np.ndarray) -> np.ndarra
     return np.column_stack([b, n, np.cross(b, n)])
 
 
+_X, _Y = np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])
+"""The x and y axes (read only)."""
+_X.flags.writeable = _Y.flags.writeable = False
+
+
 def plane_basis(normal: np.ndarray, assume_unit: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """Two unit vectors ``(u, w)`` spanning the plane normal to ``normal``, with ``u × w = n``: ``u`` is
     ``n × x̂`` normalised (``n × ŷ`` when ``n`` is within ~6° of x̂). With ``assume_unit``, ``normal`` is taken
@@ -131,11 +136,11 @@ def plane_basis(normal: np.ndarray, assume_unit: bool = False) -> tuple[np.ndarr
     n = np.asarray(normal, dtype=float)
     if not assume_unit:
         n = n / np.linalg.norm(n)
-    u = np.cross(n, [1.0, 0.0, 0.0])
+    u = cross(n, _X)
     if np.linalg.norm(u) < 0.1:
-        u = np.cross(n, [0.0, 1.0, 0.0])
+        u = cross(n, _Y)
     u /= np.linalg.norm(u)
-    return u, np.cross(n, u)
+    return u, cross(n, u)
 
 
 def perpendicular(v: np.ndarray) -> np.ndarray:

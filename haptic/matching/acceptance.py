@@ -24,6 +24,7 @@ change of a feature that is measured is caught by the residual test whatever the
 
 from __future__ import annotations
 
+import math
 import weakref
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -94,7 +95,14 @@ class PoseCheck:
 
 
 def _angle(u: np.ndarray, v: np.ndarray) -> float:
-    return float(np.arccos(np.clip(u @ v / (np.linalg.norm(u) * np.linalg.norm(v)), -1.0, 1.0)))
+    """Angle between two 3-vectors [rad]: the arithmetic of ``arccos(clip(u·v / (‖u‖ ‖v‖), −1, 1))`` with numpy
+    (the same bits) on Python floats, which the residuals' per-component loop calls many times."""
+    num, den = float(u @ v), math.sqrt(float(u.dot(u))) * math.sqrt(float(v.dot(v)))
+    if den == 0.0:  # a zero vector: as numpy divides
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return float(np.arccos(np.clip(np.float64(num) / den, -1.0, 1.0)))
+    c = num / den
+    return math.acos(-1.0 if c < -1.0 else 1.0 if c > 1.0 else c)
 
 
 def _coplanar(model: Polyhedron, f: int) -> np.ndarray:

@@ -164,33 +164,40 @@ class StackedPoses:
         if n_rows < 3:
             return np.zeros((self.n, 3)), np.zeros(self.n, bool)
         rt = np.swapaxes(r, -1, -2)
-        nrm = self.plane_n @ rt  # rotated normals, one per touched point
-        plane_rows = self.plane_w[:, None] * nrm
-        plane_rhs = self.plane_w * (np.einsum("nij,ij->ni", nrm, self.plane_q) - self.plane_d)
-        b = self.line_b @ rt
-        perp = np.eye(3) - b[..., :, None] * b[..., None, :]  # (N, L, 3, 3)
-        line_rows = (self.line_w[:, None, None] * perp).reshape(self.n, -1, 3)
-        rel = self.line_x - self.line_p @ rt
-        line_rhs = (self.line_w[:, None] * np.einsum("nlij,nlj->nli", perp, rel)).reshape(self.n, -1)
-        pt_rows = (self.pt_w[:, None, None] * np.eye(3)).reshape(-1, 3)
-        pt_rows = np.broadcast_to(pt_rows, (self.n, *pt_rows.shape))
-        pt_rhs = (self.pt_w[:, None] * (self.pt_d - self.pt_m @ rt)).reshape(self.n, -1)
-        a = np.concatenate([plane_rows, line_rows, pt_rows], axis=1)
-        y = np.concatenate([plane_rhs, line_rhs, pt_rhs], axis=1)
+        rows, rhs = [], []  # (an empty block adds no row: left out, it costs no array operations)
+        if len(self.plane_q):
+            nrm = self.plane_n @ rt  # rotated normals, one per touched point
+            rows.append(self.plane_w[:, None] * nrm)
+            rhs.append(self.plane_w * (np.einsum("nij,ij->ni", nrm, self.plane_q) - self.plane_d))
+        if len(self.line_x):
+            b = self.line_b @ rt
+            perp = np.eye(3) - b[..., :, None] * b[..., None, :]  # (N, L, 3, 3)
+            rows.append((self.line_w[:, None, None] * perp).reshape(self.n, -1, 3))
+            rel = self.line_x - self.line_p @ rt
+            rhs.append((self.line_w[:, None] * np.einsum("nlij,nlj->nli", perp, rel)).reshape(self.n, -1))
+        if len(self.pt_d):
+            pt_rows = (self.pt_w[:, None, None] * np.eye(3)).reshape(-1, 3)
+            rows.append(np.broadcast_to(pt_rows, (self.n, *pt_rows.shape)))
+            rhs.append((self.pt_w[:, None] * (self.pt_d - self.pt_m @ rt)).reshape(self.n, -1))
+        a = np.concatenate(rows, axis=1)
+        y = np.concatenate(rhs, axis=1)
         t, s = _lstsq(a, y)
         return t, s[:, -1] >= MIN_CONDITION * s[:, 0]
 
     def residuals(self, r: np.ndarray, t: np.ndarray) -> np.ndarray:
         """All weighted residuals at poses ``r`` (..., N, 3, 3), ``t`` (..., N, 3): shape (..., N, rows)."""
         lead = r.shape[:-2]
-        dirs = ((self.dirs_w - self.dirs_m @ np.swapaxes(r, -1, -2)) * self._dirs_sw[..., None]).reshape(*lead, -1)
-        q = (self.plane_q - t[..., None, :]) @ r
-        planes = self.plane_w * (np.einsum("...ij,...ij->...i", q, self.plane_n) - self.plane_d)
-        y = (self.line_x - t[..., None, :]) @ r - self.line_p
-        along = np.einsum("...ij,...ij->...i", y, self.line_b)[..., None] * self.line_b
-        lines = (self.line_w[:, None] * (y - along)).reshape(*lead, -1)
-        pts = (self.pt_w[:, None] * ((self.pt_d - t[..., None, :]) @ r - self.pt_m)).reshape(*lead, -1)
-        return np.concatenate([dirs, planes, lines, pts], axis=-1)
+        parts = [((self.dirs_w - self.dirs_m @ np.swapaxes(r, -1, -2)) * self._dirs_sw[..., None]).reshape(*lead, -1)]
+        if len(self.plane_q):  # (an empty block adds no row: left out, it costs no array operations)
+            q = (self.plane_q - t[..., None, :]) @ r
+            parts.append(self.plane_w * (np.einsum("...ij,...ij->...i", q, self.plane_n) - self.plane_d))
+        if len(self.line_x):
+            y = (self.line_x - t[..., None, :]) @ r - self.line_p
+            along = np.einsum("...ij,...ij->...i", y, self.line_b)[..., None] * self.line_b
+            parts.append((self.line_w[:, None] * (y - along)).reshape(*lead, -1))
+        if len(self.pt_d):
+            parts.append((self.pt_w[:, None] * ((self.pt_d - t[..., None, :]) @ r - self.pt_m)).reshape(*lead, -1))
+        return np.concatenate(parts, axis=-1)
 
     def initial(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(R, t, ok)``: the closed-form poses (rotation from directions, then translation), unrefined."""
@@ -213,10 +220,12 @@ class StackedPoses:
                 break
             prob = self if len(active) == self.n else self.subset(active)
             ra, ta = r[active], t[active]
-            f0 = prob.residuals(ra, ta)
-            # the six perturbed poses at once, leading axis 6
-            f = prob.residuals(_FD_ROT[:, None] @ ra, np.einsum("jab,nb->jna", _FD_ROT, ta) + _FD_XI[:, None, 3:])
-            jac = np.moveaxis((f - f0) / _FD_STEP, 0, -1)
+            # the pose and its six perturbations at once, leading axis 7
+            r7 = np.concatenate([ra[None], _FD_ROT[:, None] @ ra])
+            t7 = np.concatenate([ta[None], np.einsum("jab,nb->jna", _FD_ROT, ta) + _FD_XI[:, None, 3:]])
+            f = prob.residuals(r7, t7)
+            f0 = f[0]
+            jac = ((f[1:] - f0) / _FD_STEP).transpose(1, 2, 0)
             step = _gauss_newton_step(jac, f0)
             dr = exp_so3(step[:, :3])
             ra, ta = dr @ ra, (dr @ ta[..., None])[..., 0] + step[:, 3:]

@@ -25,6 +25,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from haptic.geometry.se3 import cross
+
 SAFETY = 1.25
 """Factor on first-order propagated error terms (covers the neglected second-order terms)."""
 ANGLE_FLOOR = 1e-7
@@ -109,7 +111,7 @@ def face_side(normal: np.ndarray, b: np.ndarray, p: np.ndarray, q: np.ndarray) -
     direction ``b`` and the position of a face point ``q`` relative to the edge point ``p``. Walking a face's
     counter-clockwise loop (seen from outside) keeps the face on the left, where ``n × b`` points.
     """
-    return np.where(_dot(np.cross(normal, b), np.asarray(q) - np.asarray(p)) >= 0.0, 1, -1)
+    return np.where(_dot(cross(normal, b), np.asarray(q) - np.asarray(p)) >= 0.0, 1, -1)
 
 
 def force_clockwise(p, b, length, common_face_is_left) -> tuple[np.ndarray, np.ndarray]:
@@ -200,7 +202,7 @@ def edge_position_test(s_d, l_d, s_m, l_m, eps, start_at_vertex=False, end_at_ve
 def skew_distance(p_1, b_1, p_2, b_2) -> np.ndarray:
     """Signed distance between two lines at their closest approach (seed §2.6):
     ``(b_1 × b_2)/‖b_1 × b_2‖ · (p_2 − p_1)``. NaN for parallel lines."""
-    c = np.cross(b_1, b_2)
+    c = cross(b_1, b_2)
     n = _norm(c)
     with np.errstate(divide="ignore", invalid="ignore"):
         return np.where(n > 1e-12, _dot(c, np.asarray(p_2) - np.asarray(p_1)) / n, np.nan)

@@ -116,11 +116,19 @@ def _symmetry_arrays(model: Polyhedron) -> tuple[np.ndarray, np.ndarray]:
     return _SYMMETRY_ARRAYS[model]
 
 
-def _same_pose_as(a: SE3, rotations: np.ndarray, translations: np.ndarray, model: Polyhedron, tol: PoseTolerance):
+def _same_pose_as(
+    a: SE3,
+    rotations: np.ndarray,
+    translations: np.ndarray,
+    model: Polyhedron,
+    tol: PoseTolerance,
+    placed: np.ndarray | None = None,
+):
     """:func:`equivalent_by_symmetry` of the pose ``a`` and each of N poses ``(rotations, translations)``,
-    vectorised over the poses and the model's symmetries."""
+    vectorised over the poses and the model's symmetries (``placed``: the model's centroid placed by each pose,
+    ``translations + rotations @ centroid``, when already computed)."""
     c = model.centroid
-    tb = translations + rotations @ c  # the centroid placed by each pose
+    tb = translations + rotations @ c if placed is None else placed  # the centroid placed by each pose
     s_rot, s_trans = _symmetry_arrays(model)
     r_as = a.rotation @ s_rot  # a ∘ S for every symmetry S
     c_as = r_as @ c + s_trans @ a.rotation.T + a.translation
@@ -139,9 +147,11 @@ def _group(models: Sequence[Polyhedron], model_index: np.ndarray, poses: Sequenc
     groups: list[list[int]] = []
     for m in dict.fromkeys(model_index.tolist()):
         left = np.flatnonzero(model_index == m)
+        placed = np.empty_like(trans)  # each pose's centroid, computed once per model (the same bits)
+        placed[left] = trans[left] + rot[left] @ models[int(left[0])].centroid
         while len(left):
             rep, rest = int(left[0]), left[1:]
-            same = _same_pose_as(poses[rep], rot[rest], trans[rest], models[rep], tol)
+            same = _same_pose_as(poses[rep], rot[rest], trans[rest], models[rep], tol, placed[rest])
             groups.append([rep, *rest[same].tolist()])
             left = rest[~same]
     return sorted(groups)

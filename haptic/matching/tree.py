@@ -36,7 +36,7 @@ import numpy as np
 
 from haptic.errors import MatchError
 from haptic.geometry.polyhedron import Polyhedron
-from haptic.geometry.se3 import SE3
+from haptic.geometry.se3 import SE3, cross
 from haptic.matching import constraints as C
 from haptic.matching.batch_poses import StackedPoses
 from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex
@@ -162,7 +162,7 @@ class _Data:
         # too close to the line for its errors: no side (the sense then comes from another face)
         r = np.asarray(q) - e.point
         margin = e.position_bound + f.position_bound + np.linalg.norm(r) * (e.direction_bound + f.normal_bound)
-        if abs(float(np.cross(f.normal, e.direction) @ r)) <= C.SAFETY * margin + 1e-9:
+        if abs(float(cross(f.normal, e.direction) @ r)) <= C.SAFETY * margin + 1e-9:
             return 0
         return int(C.face_side(f.normal, e.direction, e.point, q))
 

@@ -7,6 +7,7 @@ both score moves with it.
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
@@ -80,13 +81,32 @@ class Decision:
     candidates: tuple[Scored, ...] = ()
 
 
+_SCORES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+"""The scores of a decision (:func:`score_all`), per :class:`Context` object, with the data components they were
+computed from."""
+
+
 def score_all(ctx: Context) -> list[tuple[Prediction | ProbePrediction, float, float, float, float]]:
     """Efficiency, expected eliminations, expected cost and risk of every fresh, reliable candidate move; the
     eliminations come from comparing predicted outcome attributes (§4.1). With a table (``config.table_z``),
     moves the hypotheses predict to run into it are left out and the rest discounted by that risk.
     Free-space probes join them when ``config.moves`` admits them, scored in the same form
     (:meth:`ProbePrediction.score`, on the simulated hand discounted by :meth:`ProbePrediction.risk`), so one
-    planner ranks every kind of move together; ``config.moves == "probing"`` leaves the tracing moves out."""
+    planner ranks every kind of move together; ``config.moves == "probing"`` leaves the tracing moves out.
+
+    Computed once per decision: a context scored again (the observation of :mod:`haptic.env` and then the planner
+    acting through it, at one decision) gets the same scores back while its data components are the same objects;
+    everything else a context holds is fixed when it is made."""
+    comps = tuple(ctx.components.values())
+    hit = _SCORES.get(ctx)
+    if hit is not None and len(hit[0]) == len(comps) and all(a is b for a, b in zip(hit[0], comps, strict=True)):
+        return list(hit[1])
+    out = _score_all(ctx)
+    _SCORES[ctx] = (comps, tuple(out))
+    return out
+
+
+def _score_all(ctx: Context) -> list[tuple[Prediction | ProbePrediction, float, float, float, float]]:
     weights = class_weights([h.model for h in ctx.hypotheses])
     out: list = []
     if ctx.config.moves != "probing":
@@ -202,10 +222,20 @@ def eliminates(pred: Prediction, config: PlannerConfig) -> np.ndarray:
     return np.where(fails[:, None], beyond, d)
 
 
+_BOUNDED: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+""":func:`bounded` per :class:`Context` object (its hypotheses are fixed when it is made)."""
+
+
 def bounded(ctx: Context) -> Context:
-    """``ctx`` with at most ``config.max_hypotheses`` hypotheses (:mod:`haptic.planning.bound`)."""
+    """``ctx`` with at most ``config.max_hypotheses`` hypotheses (:mod:`haptic.planning.bound`); the same object for
+    the same ``ctx`` (so that its scores are computed once: :func:`score_all`)."""
+    if ctx in _BOUNDED:
+        return _BOUNDED[ctx]
     kept = reduce_hypotheses(ctx.hypotheses, ctx.config.max_hypotheses)
-    return ctx if len(kept) == len(ctx.hypotheses) else replace(ctx, hypotheses=tuple(kept))
+    out = ctx if len(kept) == len(ctx.hypotheses) else replace(ctx, hypotheses=tuple(kept))
+    if out is not ctx:  # (the context itself needs no entry: bounded already)
+        _BOUNDED[ctx] = out
+    return out
 
 
 def fresh_moves(ctx: Context) -> list[Move]:

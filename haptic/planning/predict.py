@@ -66,9 +66,19 @@ class Prediction:
         if self.move.kind != "face" or np.isnan(self.outcomes[:, 0]).all():
             return True
         return bool(
-            np.nanmedian(self.outcomes[:, 0]) >= config.min_face_travel
-            and np.nanmedian(self.clearance) >= config.min_vertex_clearance
+            nan_median(self.outcomes[:, 0]) >= config.min_face_travel
+            and nan_median(self.clearance) >= config.min_vertex_clearance
         )
+
+
+def nan_median(x: np.ndarray) -> float:
+    """``np.nanmedian`` of a short 1-D array (the same value: the middle one, or the mean of the two middle ones, of
+    those not NaN; NaN when all are), without its cost on the planner's small arrays."""
+    v = np.sort(x[~np.isnan(x)])
+    m = len(v)
+    if not m:
+        return float("nan")
+    return float(v[m // 2]) if m % 2 else float((v[m // 2 - 1] + v[m // 2]) / 2)
 
 
 def outcome_bounds(noise: SensorNoise) -> dict[str, np.ndarray]:
@@ -125,7 +135,7 @@ def face_directions(
     if isinstance(edge, DataEdge) and abs(edge.direction @ normal) < 0.5:
         b = edge.direction - (edge.direction @ normal) * normal
         b /= np.linalg.norm(b)
-        inward = np.cross(normal, b)
+        inward = cross(normal, b)
         side = dict(edge.side_points).get(state.face)
         if side is not None:  # a point on the face beside the edge: the face's side of the edge line
             if (side - edge.point) @ inward < 0:
@@ -244,7 +254,8 @@ def _first_crossings(start, d, n, a, seg, real, loops, index):
         b = int(best[j])
         if not np.isfinite(t_ok[j, b]):
             continue
-        seg_len = float(np.linalg.norm(seg[j, b]))
+        sj = seg[j, b]
+        seg_len = math.sqrt(float(sj.dot(sj)))  # np.linalg.norm's arithmetic (a row: contiguous)
         if min(u[j, b], 1 - u[j, b]) * seg_len < 1e-6:
             continue
         _, _, edges, beyond = loops[j]

@@ -17,6 +17,7 @@ from dataclasses import replace
 import numpy as np
 
 from haptic.geometry.raycast import line_hits
+from haptic.geometry.se3 import cross
 from haptic.geometry.tracing import circle_vertex, trace_edge
 from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex, SensorNoise
 from haptic.planning.config import PlannerConfig
@@ -86,12 +87,12 @@ def simulate(
         hi = min(float(poly.edge_lengths[e_m]), s + EDGE_PROBE / 2)
         eid, fid = nxt, nxt + 1
         adj = (from_face,) if isinstance(move, FaceMove) else (state.vertex, from_face)
-        inward = np.cross(poly.face_normals[g_m], b_m)
+        inward = cross(poly.face_normals[g_m], b_m)
         if poly.edge_left_face[e_m] != g_m:
             inward = -inward
         onto = at_m + STEP_ONTO * inward
         f_from = h.faces[from_face]
-        back = np.cross(poly.face_normals[f_from], b_m)
+        back = cross(poly.face_normals[f_from], b_m)
         if poly.edge_left_face[e_m] != f_from:
             back = -back
         sides = ((from_face, t.apply(at_m + STEP_ONTO * back)), (fid, t.apply(onto)))

@@ -86,19 +86,24 @@ class LegCosts:
         vertex = self.face_events + self.edge_rate * AIM_NEAR_VERTEX + self.vertex_event
         return np.select([kinds == VERTEX, kinds == EDGE], [vertex, self.face_events], 0.0)
 
-    def by_probe(self, distance: np.ndarray, kinds: np.ndarray) -> np.ndarray:
+    def by_probe(self, distance: np.ndarray, kinds: np.ndarray, finish: np.ndarray | None = None) -> np.ndarray:
         """A probe to the face beside the feature (from ``distance`` away), then :meth:`finish` from ``PROBE_INSET``
-        in; inf where probes are not admitted [units]."""
+        in (``finish``: :meth:`finish` of ``kinds`` when already computed); inf where probes are not admitted
+        [units]."""
         if not self.probes:
             return np.full(np.shape(distance), np.inf)
         inset = np.where(kinds == FACE, 0.0, self.face_rate * PROBE_INSET)
-        return self.probe_fixed + self.probe_rate * distance + inset + self.finish(kinds)
+        fin = self.finish(kinds) if finish is None else finish
+        return self.probe_fixed + self.probe_rate * distance + inset + fin
 
-    def by_tracing(self, distance: np.ndarray, kinds: np.ndarray, cofacial: np.ndarray) -> np.ndarray:
+    def by_tracing(
+        self, distance: np.ndarray, kinds: np.ndarray, cofacial: np.ndarray, finish: np.ndarray | None = None
+    ) -> np.ndarray:
         """Across a face shared with the feature (straight), else over faces (:data:`DETOUR`, one face move more),
-        then :meth:`finish` [units]."""
-        straight = self.face_rate * distance + self.finish(kinds)
-        return np.where(cofacial, straight, DETOUR * self.face_rate * distance + self.face_events + self.finish(kinds))
+        then :meth:`finish` (``finish``: that of ``kinds`` when already computed) [units]."""
+        fin = self.finish(kinds) if finish is None else finish
+        straight = self.face_rate * distance + fin
+        return np.where(cofacial, straight, DETOUR * self.face_rate * distance + self.face_events + fin)
 
 
 @dataclass(frozen=True, eq=False)
@@ -180,10 +185,11 @@ def start_costs(
     p, kinds = feats.points[targets], feats.kinds[targets]
     d = np.linalg.norm(p - np.asarray(position), axis=1)
     cofacial = feats.on_face[targets, face] if face is not None else np.zeros(len(targets), dtype=bool)
-    cost = np.minimum(legs.by_tracing(d, kinds, cofacial), legs.by_probe(d, kinds))
+    fin = legs.finish(kinds)
+    cost = np.minimum(legs.by_tracing(d, kinds, cofacial, fin), legs.by_probe(d, kinds, fin))
     if edge is not None:
-        ends = feats.kinds.size - poly.n_vertices + poly.edges[edge]
-        at_end = np.isin(targets, ends)
+        a, b = feats.kinds.size - poly.n_vertices + poly.edges[edge]
+        at_end = (targets == a) | (targets == b)
         cost = np.where(at_end, np.minimum(cost, legs.edge_rate * d + legs.vertex_event), cost)
     return cost
 

@@ -28,7 +28,7 @@ from haptic.matching.components import DataComponent, DataEdge, DataFace, Sensor
 from haptic.planning.config import PlannerConfig
 from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import FaceMove, Move, SensorState
-from haptic.planning.predict import candidate_moves, predict
+from haptic.planning.predict import candidate_moves, predict_moves
 from haptic.planning.table import descent_risk
 from haptic.planning.tour import (
     AIM_NEAR_VERTEX,
@@ -195,10 +195,8 @@ def _moves(
     aimed = aimed_face_moves(h, state, components, missing) if missing is not None else []
     fixed_faces = fixed_faces and not aimed
     planner = [m for m in candidate_moves(state, components, config) if fixed_faces or m.kind != "face"]
-    for m in planner + aimed:
-        if any(same_move(m, bad) for bad in avoid):
-            continue
-        pred = predict([h], m, state, components, noise, config)
+    fresh = [m for m in planner + aimed if not any(same_move(m, bad) for bad in avoid)]
+    for m, pred in zip(fresh, predict_moves([h], fresh, state, components, noise, config), strict=True):
         risk = 1.0 - (1.0 - refusal(pred, config)) * (1.0 - descent_risk(m, config))
         out.append((m, float(pred.costs[0]), risk, pred.reliable(config)))
     good = [(m, c, r) for m, c, r, rel in out if rel and r < config.table_risk]

@@ -1,0 +1,150 @@
+"""What makes environment steps cheap changes no result: the scores of a decision computed once (the observation and
+the planner acting through the environment share them) equal scores computed afresh, and the faster arithmetic of
+the planner and the matcher gives numpy's own results to the last bit."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+import haptic.planning.move_scores as move_scores
+from haptic.env import ExploreEnv, PolicyAgent
+from haptic.geometry.se3 import random_rotation
+from haptic.matching.acceptance import _angle
+from haptic.matching.recognition import PoseTolerance, _same_pose_as
+from haptic.planning.config import PlannerConfig
+from haptic.planning.move_scores import bounded, score_all
+from haptic.planning.predict import nan_median
+from haptic.planning.tour import FACE, VERTEX, LegCosts, features, start_costs
+
+
+def _posed_context(env: ExploreEnv, seeds=range(1, 40)):
+    """A decision of some episode at which the data fix the poses of two or more classes."""
+    for seed in seeds:
+        env.reset(seed=seed)
+        ctx = env.context
+        if ctx is not None and len(ctx.hypotheses) >= 2:
+            return ctx
+    pytest.fail("no episode reached a decision with pose classes")
+
+
+def _same_scores(a, b) -> None:
+    assert len(a) == len(b) > 0
+    for (pa, *va), (pb, *vb) in zip(a, b, strict=True):
+        assert move_scores.same_move(pa.move, pb.move)
+        assert va == vb  # efficiency, eliminations, cost, risk: exactly
+        np.testing.assert_array_equal(pa.outcomes, pb.outcomes)
+        np.testing.assert_array_equal(pa.costs, pb.costs)
+
+
+def test_cached_scores_equal_fresh_ones(small_library):
+    env = ExploreEnv(models=small_library, verify="none")
+    ctx = _posed_context(env)
+    first = score_all(bounded(ctx))  # the observation computed these at reset: a cache hit
+    again = score_all(bounded(ctx))
+    assert all(x[0] is y[0] for x, y in zip(first, again, strict=True))
+    fresh = score_all(replace(bounded(ctx)))  # a new context: computed afresh
+    assert all(x[0] is not y[0] for x, y in zip(first, fresh, strict=True))
+    _same_scores(first, fresh)
+
+
+def test_a_context_whose_data_changed_is_scored_afresh(small_library):
+    env = ExploreEnv(models=small_library, verify="none")
+    ctx = _posed_context(env)
+    own = replace(ctx, components=dict(ctx.components))
+    before = score_all(own)
+    gone = max(own.components)
+    own.components[gone] = replace(own.components[gone])  # the same data, another object: not the scores' data
+    after = score_all(own)
+    assert all(x[0] is not y[0] for x, y in zip(before, after, strict=True))
+    _same_scores(before, after)
+    del own.components[gone]  # fewer components: computed again, as a new context with these data would
+    shorter, fresh = score_all(own), score_all(replace(own, components=dict(own.components)))
+    assert all(x[0] is not y[0] for x, y in zip(after, shorter, strict=False))
+    assert [(type(p.move), *v) for p, *v in shorter] == [(type(p.move), *v) for p, *v in fresh]
+
+
+def test_the_planner_through_the_environment_scores_each_decision_once(small_library, monkeypatch):
+    calls = []
+    real = move_scores._score_all
+    monkeypatch.setattr(move_scores, "_score_all", lambda ctx: calls.append(ctx) or real(ctx))
+    env, agent = ExploreEnv(models=small_library, verify="none"), PolicyAgent("planner")
+    decisions = 0
+    for seed in range(1, 6):
+        env.reset(seed=seed)
+        while True:
+            posed = env.context is not None and len(env.context.hypotheses) > 0
+            decisions += posed
+            _, _, terminated, truncated, _ = env.step(agent.act(env))
+            if terminated or truncated:
+                break
+    assert decisions > 0
+    assert len(calls) == decisions
+
+
+def test_nan_median_is_numpys():
+    rng = np.random.default_rng(5)
+    for _ in range(3000):
+        x = rng.normal(size=int(rng.integers(1, 30))) * rng.choice([1e-3, 1.0, 1e3]) + rng.choice([0.0, 0.1])
+        x[rng.random(len(x)) < 0.3] = np.nan
+        if rng.random() < 0.1:
+            x[~np.isnan(x)] = 0.02  # ties
+        if np.isnan(x).all():
+            assert np.isnan(nan_median(x))
+            continue
+        assert nan_median(x) == np.nanmedian(x)
+
+
+def test_the_residuals_angle_is_numpys():
+    rng = np.random.default_rng(6)
+    for _ in range(3000):
+        u = rng.normal(size=3)
+        v = (u * rng.uniform(0.5, 2.0) + rng.normal(size=3) * rng.choice([0.0, 1e-9, 1e-4, 1.0])) * rng.choice([1, -1])
+        want = float(np.arccos(np.clip(u @ v / (np.linalg.norm(u) * np.linalg.norm(v)), -1.0, 1.0)))
+        assert _angle(u, v) == want
+
+
+@pytest.mark.parametrize("moves", ["all", "tracing"])
+def test_start_costs_are_the_legs_cost_formula(moves):
+    from haptic.geometry import load_library
+
+    legs = LegCosts.of(PlannerConfig(moves=moves))
+    rng = np.random.default_rng(7)
+    for name in ("BOX01", "LBLOCK01", "TETRA01L"):
+        poly = load_library()[name]
+        feats = features(poly)
+        targets = np.flatnonzero(rng.random(len(feats.kinds)) < 0.6)
+        for face, edge in ((0, None), (1, 0), (None, None), (2, poly.n_edges - 1)):
+            p = poly.vertices.mean(axis=0) + rng.normal(size=3) * 0.01
+            got = start_costs(poly, p, face, edge, targets, legs)
+            kinds = feats.kinds[targets]
+            d = np.linalg.norm(feats.points[targets] - p, axis=1)
+            cof = feats.on_face[targets, face] if face is not None else np.zeros(len(targets), bool)
+            want = np.minimum(legs.by_tracing(d, kinds, cof), legs.by_probe(d, kinds))
+            if edge is not None:
+                ends = feats.kinds.size - poly.n_vertices + poly.edges[edge]
+                want = np.where(np.isin(targets, ends), np.minimum(want, legs.edge_rate * d + legs.vertex_event), want)
+            np.testing.assert_array_equal(got, want)
+            assert (kinds == FACE).any() or (kinds == VERTEX).any()
+
+
+def test_pose_grouping_with_the_centroids_placed_once_is_the_same():
+    from haptic.geometry import load_library
+
+    poly = load_library()["BOX01"]
+    rng = np.random.default_rng(8)
+    rot = np.stack([random_rotation(rng) for _ in range(40)])
+    rot[20:] = rot[:20]  # some poses equal
+    trans = rng.normal(size=(40, 3)) * 0.01
+    trans[20:] = trans[:20]
+    tol = PoseTolerance(np.deg2rad(2.0), 0.002)
+    from haptic.geometry.se3 import SE3
+
+    a = SE3(rot[3], trans[3])
+    placed = trans + rot @ poly.centroid
+    np.testing.assert_array_equal(
+        _same_pose_as(a, rot, trans, poly, tol), _same_pose_as(a, rot, trans, poly, tol, placed)
+    )
+    assert _same_pose_as(a, rot, trans, poly, tol).sum() >= 2
