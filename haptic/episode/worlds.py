@@ -162,9 +162,9 @@ class PhysicsWorld:
         executor = PhysicsExecutor(RobotInterface(sim), bounds=bounds, costs=config.costs, rng=exec_rng,
                                    settings=settings)  # fmt: skip
         # the circle the executor makes; the concave edges' ends it can tell
-        config = replace(config, vertex_radius=settings.vertex_radius,
-                         concave_end_block=config.concave_end_block or settings.min_block_cos,
-                         min_vertex_clearance=max(config.min_vertex_clearance, settings.crossing_clearance))  # fmt: skip
+        clearance = max(config.min_vertex_clearance, settings.crossing_clearance)
+        config = replace(config, vertex_radius=settings.vertex_radius, min_vertex_clearance=clearance,
+                         concave_end_block=config.concave_end_block or settings.min_block_cos)  # fmt: skip
         results: list[MoveResult] = []  # every move's result, for scoring perception
 
         def keep(*args) -> None:
