@@ -461,10 +461,15 @@ def learned_model(est: ConvexEstimate, name: str = "learned") -> Polyhedron:
             faces.append(loop)
     used = sorted({g for f in faces for g in f})
     index = {g: i for i, g in enumerate(used)}
-    verts = verts[used]
-    faces = [[index[g] for g in f] for f in faces]
+    return validated_model(verts[used], [[index[g] for g in f] for f in faces], est.bounds, name)
+
+
+def validated_model(verts: np.ndarray, faces: list[list[int]], b: LearnBounds, name: str) -> Polyhedron:
+    """The model of ``verts`` and ``faces`` (CCW loops) validated like an imported file at the finest of
+    :data:`PRECISIONS` its faces are planar at (moved toward planar faces when none: :func:`planarize`), then
+    made exactly symmetric under the motions that map it onto itself within the data's bounds
+    (:func:`symmetrized`)."""
     last: ModelError | None = None
-    b = est.bounds
     learned = LearnedBounds(b.normal, b.position, b.direction)
     model = None
     for attempt in (verts, planarize(verts, faces, PLANAR_ROUNDS)):
