@@ -111,9 +111,20 @@ class BoundaryWalk:
 
     # ------------------------------------------------------------------------------------------ search
 
-    def _goal(self, v: int, k: int) -> bool:
+    def exploring(self, v: int, k: int) -> tuple[int, float] | None:
+        """``(plane, sense)`` of a vertex move from edge ``k`` at vertex ``v`` that measures an edge not known yet:
+        across a face of the edge whose fan at the vertex is open, toward no known edge; None when none does."""
         be = self.est.edges[k]
-        return not be.closed or any((v, p) in self.open_fans for p in be.planes)
+        for p in dict.fromkeys(be.planes):
+            if (v, p) not in self.open_fans:
+                continue
+            for sense in self._sides(k, p, v):
+                if self.next_round(v, k, p, sense) is None:
+                    return p, sense
+        return None
+
+    def _goal(self, v: int, k: int) -> bool:
+        return not self.est.edges[k].closed or self.exploring(v, k) is not None
 
     def route(self, starts: list[tuple[float, int, int, tuple]]) -> list[tuple] | None:
         """The cheapest sequence of graph steps from any of ``starts`` ``(cost, vertex, edge, first step)`` to a
@@ -222,13 +233,8 @@ class BoundaryWalk:
             return None
         step = found[0]
         if step is None:  # a goal here: the exploring move
-            for p in dict.fromkeys(be.planes):
-                if (v, p) in self.open_fans:
-                    for sense in self._sides(k, p, v) or [1.0]:
-                        move = self._vertex_move(state, v, k, p, sense)
-                        if move is not None:
-                            return move
-            return None
+            p, sense = self.exploring(v, k)
+            return self._vertex_move(state, v, k, p, sense)
         return self._step_move(state, step)
 
     def _face_move(self, state: SensorState, avoid: tuple[Move, ...], turn: int) -> Move | None:

@@ -73,6 +73,9 @@ class LearnSettings:
     """Move budget of the learning, on top of the episode's."""
     depth: int = 3
     """Moves looked ahead when no single move measures anything new."""
+    stall: int = 12
+    """Moves after which a convex estimate that measured no new plane or vertex gives way to tracing the
+    boundary (the object is taken for non-convex)."""
 
 
 class ClosureMoves(MoveSource):
@@ -103,6 +106,8 @@ class ClosureMoves(MoveSource):
         self.components: dict[int, DataComponent] = {}
         self._asked: Move | None = None
         self._seen = -1
+        self._best: tuple = ()
+        self._since = 0
 
     # ---------------------------------------------------------------------------------------- state
 
@@ -121,8 +126,9 @@ class ClosureMoves(MoveSource):
             return
         try:
             est = convex_estimate(self.components)
-        except LearnError as exc:
-            self.estimate, self.status, self.detail = None, "no solid", str(exc)
+        except LearnError as exc:  # the measured planes bound no convex solid: the object is not convex
+            self.estimate, self.convex, self.nonconvex = None, False, str(exc)
+            self._update_boundary()
             return
         bad = convexity_violation(self.components, est.planes, est.bounds)
         if bad is not None:
@@ -132,6 +138,16 @@ class ClosureMoves(MoveSource):
             return
         self.estimate = est
         self.status = "closed" if est.closed else "open"
+        c = est.counts()
+        progress = (c["planes"], c["vertices_measured"], -c["open_faces"])
+        if progress > self._best:
+            self._best, self._since = progress, self.moves
+        elif self.moves - self._since >= self.settings.stall:
+            # the estimate's faces and vertices are not where the moves find the object: not convex, though no
+            # measured point shows it yet
+            self.convex = False
+            self.nonconvex = f"the convex estimate measured nothing new in {self.settings.stall} moves"
+            self._update_boundary()
 
     def _update_boundary(self) -> None:
         try:
