@@ -211,7 +211,7 @@ def main(argv: list[str] | None = None) -> int:
                    "learn_wall_s": learned.get("wall_time_s", 0.0), "episode_moves": rec["moves"],
                    "episode_cost": rec["path_cost"], "true_VEF": [truth.n_vertices, truth.n_edges, truth.n_faces],
                    "V": None, "vef_right": False, "reid_episodes": 0, "reid_recognized": 0, "reid_cost": [],
-                   "reid_outcomes": [],
+                   "reid_outcomes": [], "reid_seeds": [], "reid_missed": [], "false_seeds": [],
                    "false_episodes": 0, "false_recognitions": 0, "false_outcomes": []}  # fmt: skip
             if learned.get("status") == "closed" and learned.get("path"):
                 model = load_model(learned["path"])
@@ -245,10 +245,15 @@ def main(argv: list[str] | None = None) -> int:
                 row["reid_recognized"] += int(rec["recognized"] == name)
                 row["reid_cost"].append(rec["path_cost"])
                 row["reid_outcomes"].append(rec["recognized"] or rec["outcome"])
+                row["reid_seeds"].append(rec["seed"])
+                if rec["recognized"] != name:
+                    row["reid_missed"].append({"seed": rec["seed"], "outcome": rec["outcome"], "detail": rec["detail"]})
             else:
                 row["false_episodes"] += 1
                 row["false_recognitions"] += int(rec["recognized"] == name)
                 row["false_outcomes"].append(rec["recognized"] or rec["outcome"])
+                if rec["recognized"] == name:
+                    row["false_seeds"].append({"model": rec["model"], "seed": rec["seed"]})
         wall = time.perf_counter() - t0
         for r in rows:
             r["reid_cost_mean"] = float(np.mean(r.pop("reid_cost"))) if r["reid_cost"] else None
