@@ -126,11 +126,28 @@ class BoundaryWalk:
     def _goal(self, v: int, k: int) -> bool:
         return not self.est.edges[k].closed or self.exploring(v, k) is not None
 
+    def steps(self, v: int, k: int) -> list[tuple[float, int, int, tuple]]:
+        """The graph steps from the sensor at vertex ``v`` on edge ``k``: ``(cost, vertex, edge, step)`` of the
+        edge move to the edge's other end and of each vertex move round ``v`` to a known edge."""
+        c = self.config.costs
+        be = self.est.edges[k]
+        out = []
+        for w in be.vertices:
+            if w != v:
+                length = float(np.linalg.norm(self.est.positions[w] - self.est.positions[v]))
+                out.append((c.edge_move(length), w, k, ("edge", v, k, w)))
+        for p in dict.fromkeys(be.planes):
+            for sense in self._sides(k, p, v):
+                nxt = self.next_round(v, k, p, sense)
+                if nxt is not None:
+                    out.append(
+                        (c.vertex_move(self.config.vertex_radius * nxt[1]), v, nxt[0], ("vertex", v, k, p, sense))
+                    )
+        return out
+
     def route(self, starts: list[tuple[float, int, int, tuple]]) -> list[tuple] | None:
         """The cheapest sequence of graph steps from any of ``starts`` ``(cost, vertex, edge, first step)`` to a
         place where a move measures something new (Dijkstra); the steps' first, or None."""
-        c = self.config.costs
-        r = self.config.vertex_radius
         heap = [(cost, i, v, k, first) for i, (cost, v, k, first) in enumerate(starts)]
         heapq.heapify(heap)
         done: set[tuple[int, int]] = set()
@@ -142,18 +159,7 @@ class BoundaryWalk:
             done.add((v, k))
             if self._goal(v, k):
                 return [first]
-            be = self.est.edges[k]
-            steps = []
-            for w in be.vertices:
-                if w != v:
-                    length = float(np.linalg.norm(self.est.positions[w] - self.est.positions[v]))
-                    steps.append((c.edge_move(length), w, k, ("edge", v, k, w)))
-            for p in dict.fromkeys(be.planes):
-                for sense in self._sides(k, p, v):
-                    nxt = self.next_round(v, k, p, sense)
-                    if nxt is not None:
-                        steps.append((c.vertex_move(r * nxt[1]), v, nxt[0], ("vertex", v, k, p, sense)))
-            for dc, w, k2, step in steps:
+            for dc, w, k2, step in self.steps(v, k):
                 if (w, k2) not in done:
                     tie += 1
                     heapq.heappush(heap, (cost + dc, tie, w, k2, first if first is not None else step))

@@ -23,6 +23,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from haptic.episode.boundary_walk import BoundaryWalk
 from haptic.episode.loop import (
     Ending,
     EpisodeRecord,
@@ -36,7 +37,6 @@ from haptic.episode.sources import MoveSource, episode_sources
 from haptic.episode.state import EpisodeState
 from haptic.errors import ModelError
 from haptic.geometry import SE3, Polyhedron
-from haptic.episode.boundary_walk import BoundaryWalk
 from haptic.learning.boundary import BoundaryEstimate, boundary_estimate
 from haptic.learning.reconstruct import (
     ConvexEstimate,

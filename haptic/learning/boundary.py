@@ -320,7 +320,7 @@ def _trace_faces(est: BoundaryEstimate) -> None:
         if any(v == pl for v, pl in est.unbalanced if pl == p):
             continue
 
-        def angle(a: int, b: int) -> float:
+        def angle(a: int, b: int, x: np.ndarray = x, y: np.ndarray = y) -> float:
             d = est.positions[b] - est.positions[a]
             return float(np.arctan2(d @ y, d @ x))
 

@@ -77,8 +77,8 @@ def test_an_edge_left_out_leaves_the_boundary_open():
     comps = exact_boundary(model, SE3.identity())
     e = model.n_faces + 3
     edge = comps[e]
-    comps[e] = DataEdge(e, edge.direction, edge.point, 0.5 * edge.length, 0.0, 0.0, 0.0,
-                        start_vertex=edge.start_vertex, adjacent=edge.adjacent, side_points=edge.side_points)  # fmt: skip
+    comps[e] = DataEdge(e, edge.direction, edge.point, 0.5 * edge.length, 0.0, 0.0, 0.0, start_vertex=edge.start_vertex,
+                        adjacent=edge.adjacent, side_points=edge.side_points)  # fmt: skip
     est = boundary_estimate(comps)
     assert est.open_edges() and not est.closed
 
