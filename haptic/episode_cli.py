@@ -67,7 +67,7 @@ def add_parser(sub: Subcommands) -> None:
     )  # fmt: skip
     p.add_argument("--learn", metavar="DIR",
                    help="after no-match, explore on until the object's surface is closed and write its model "
-                   "into the library directory DIR (the object is convex; its own budget, reported)")
+                   "into the library directory DIR (its own budget, reported)")
     p.add_argument("--learn-name", metavar="NAME",
                    help="the learned model's name (default: learned_ and a digest of the episode's settings)")
     p.add_argument("--json", metavar="OUT", help="write the episode's JSON record here")

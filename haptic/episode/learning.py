@@ -6,13 +6,17 @@ matcher's verdict is ``no-match``. Each turn it rebuilds the object's convex est
 (:func:`~haptic.learning.reconstruct.convex_estimate`) and chooses the move that measures the most of its
 unmeasured boundary -- open faces (where the data do not bound the object yet), edges and vertices not met --
 per unit of path cost, looking up to :attr:`LearnSettings.depth` moves ahead in the estimate's own world
-(:func:`~haptic.planning.simulate.simulate`). It has its own budget (:class:`LearnSettings`), reported in the
-record's ``learned``.
+(:func:`~haptic.planning.simulate.simulate`). Once the data show the object is not convex (a measured point
+outside a measured plane, planes that bound no solid, or an estimate that measured nothing new in
+:attr:`LearnSettings.stall` moves) it traces the object's boundary instead
+(:func:`~haptic.learning.boundary.boundary_estimate`), walking over it to the nearest open edge or vertex
+(:class:`~haptic.episode.boundary_walk.BoundaryWalk`). It has its own budget (:class:`LearnSettings`), reported
+in the record's ``learned``.
 
 :func:`learning_endings` replaces the loop's ending conditions: a ``no-match`` verdict starts the learning
-instead of ending the episode, which then ends, still ``no-match``, when the surface is closed, when the data
-show the object is not convex, or when the learning budget is spent. :func:`run_learning` runs such an episode
-and writes the model (:func:`~haptic.learning.library.write_learned`).
+instead of ending the episode, which then ends, still ``no-match``, when the surface is closed or when the
+learning budget is spent. :func:`run_learning` runs such an episode and writes the model (the half-space
+intersection of a convex object, the traced boundary of any other: :func:`~haptic.learning.library.write_learned`).
 """
 
 from __future__ import annotations
