@@ -36,10 +36,12 @@ from haptic.learning.reconstruct import (
     LearnBounds,
     LearnError,
     Plane,
+    edge_faces,
     face_planes,
     validated_model,
+    vertex_edges,
 )
-from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex
+from haptic.matching.components import DataComponent, DataEdge, DataVertex
 
 PRIOR_WEIGHT = 1e-3
 """Weight of a vertex's measured position against its planes when placing it, relative to a plane's [-]: enough
@@ -121,34 +123,11 @@ class BoundaryEstimate:
 
 
 def _edge_vertices(components: Mapping[int, DataComponent]) -> dict[int, set[int]]:
-    """The data vertices at each data edge: those it starts or ends at or names, and those that name it."""
+    """The data vertices at each data edge (:func:`~haptic.learning.reconstruct.vertex_edges` turned round)."""
     out: dict[int, set[int]] = {}
-    for c in components.values():
-        if isinstance(c, DataEdge):
-            s = out.setdefault(c.id, set())
-            for v in (c.start_vertex, c.end_vertex, *c.adjacent):
-                if v is not None and isinstance(components.get(v), DataVertex):
-                    s.add(int(v))
-    for c in components.values():
-        if isinstance(c, DataVertex):
-            for a in c.adjacent:
-                if a in out:
-                    out[a].add(c.id)
-    return out
-
-
-def _edge_faces(components: Mapping[int, DataComponent]) -> dict[int, list[int]]:
-    """The data faces on either side of each data edge, in order of mention."""
-    out: dict[int, list[int]] = {}
-    for c in components.values():
-        if isinstance(c, DataEdge):
-            fs = [f for f, _ in c.side_points] + list(c.adjacent)
-            out[c.id] = [f for f in dict.fromkeys(fs) if isinstance(components.get(f), DataFace)]
-    for c in components.values():
-        if isinstance(c, DataFace):
-            for a in c.adjacent:
-                if a in out and c.id not in out[a]:
-                    out[a].append(c.id)
+    for v, es in vertex_edges(components).items():
+        for e in es:
+            out.setdefault(e, set()).add(v)
     return out
 
 
@@ -213,7 +192,7 @@ def boundary_estimate(components: Mapping[int, DataComponent], bounds: LearnBoun
     vertex_of = _group_vertices(dverts)
     n_v = len(set(vertex_of.values()))
     ev = _edge_vertices(components)
-    ef = _edge_faces(components)
+    ef = edge_faces(components)
     problems: list[str] = []
     # data edges by pair of planes, grouped along the pair's line
     by_pair: dict[tuple[int, int], list[DataEdge]] = {}
@@ -254,7 +233,7 @@ def boundary_estimate(components: Mapping[int, DataComponent], bounds: LearnBoun
                 for f, q in e.side_points:
                     if f in plane_of:
                         be.sides.setdefault(plane_of[f], []).append(np.asarray(q))
-                for f in ef.get(e.id, []):  # no side point: the face's touched point nearest to the edge
+                for f in sorted(ef.get(e.id, ())):  # no side point: the face's touched point nearest to the edge
                     k = plane_of.get(f)
                     if k is not None and k not in be.sides and not be.flat:
                         pts = components[f].points
