@@ -67,7 +67,7 @@ def add_parser(sub: Subcommands) -> None:
     )  # fmt: skip
     p.add_argument("--learn", metavar="DIR",
                    help="after no-match, explore on until the object's surface is closed and write its model "
-                   "into the library directory DIR (the object is convex; its own budget, reported)")
+                   "into the library directory DIR (its own budget, reported)")
     p.add_argument("--learn-name", metavar="NAME",
                    help="the learned model's name (default: learned_ and a digest of the episode's settings)")
     p.add_argument("--json", metavar="OUT", help="write the episode's JSON record here")
@@ -237,7 +237,7 @@ def verdict_line(rec: dict) -> str:
 def run(args: argparse.Namespace) -> int:
     from haptic.episode.spec import EpisodeSpec, check_settings, cli_option
     from haptic.episode.worlds import run_episode
-    from haptic.geometry import load_library, resolve_model
+    from haptic.geometry import load_library, load_model, resolve_model
     from haptic.geometry.io import atomic_write, size_warning
     from haptic.options import check_output_file, report_sizes, report_skipped
 
@@ -277,6 +277,9 @@ def run(args: argparse.Namespace) -> int:
 
         observer = chain_observers(*observers) if observers else None
         record = run_episode(spec, library=library, observer=observer).to_json()
+        learned = record.get("learned") or {}
+        if recorder is not None and learned.get("path"):
+            recorder.log_learned(load_model(learned["path"]), record["moves"])
     finally:
         if recorder is not None:
             recorder.close()

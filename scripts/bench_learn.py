@@ -51,16 +51,30 @@ HAUSDORFF_GOAL_MM = 1.0
 VOLUME_GOAL = 0.02
 
 
-def surface_distance(a: Polyhedron, b: Polyhedron, samples: int, rng: np.random.Generator) -> float:
-    """Hausdorff distance between the surfaces of ``a`` and ``b`` [m]: over the vertices of each and ``samples``
-    points drawn uniformly on each (trimesh), the largest distance to the other surface."""
-    import trimesh
+def surface_points(vertices: np.ndarray, triangles: np.ndarray, samples: int, rng: np.random.Generator) -> np.ndarray:
+    """``samples`` points drawn uniformly (by area) on the triangles ``vertices[triangles]``, and the vertices."""
+    tri = vertices[triangles]
+    area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+    pick = rng.choice(len(tri), size=samples, p=area / area.sum())
+    u, v = rng.random(samples), rng.random(samples)
+    flip = u + v > 1
+    u, v = np.where(flip, 1 - u, u), np.where(flip, 1 - v, v)
+    t = tri[pick]
+    pts = t[:, 0] + u[:, None] * (t[:, 1] - t[:, 0]) + v[:, None] * (t[:, 2] - t[:, 0])
+    return np.vstack([pts, vertices])
 
+
+def surface_distance(a: Polyhedron, b: Polyhedron, b_pose: tuple[np.ndarray, np.ndarray], samples: int,
+                     rng: np.random.Generator) -> float:
+    """Hausdorff distance between the surface of ``a`` and that of ``b`` at ``b_pose`` (rotation, translation)
+    [m]: over the vertices of each and ``samples`` points drawn uniformly on each, the largest distance to the
+    other surface (the model's triangles posed as arrays: a posed model is not validated again)."""
+    r, t = b_pose
+    surfaces = [(np.asarray(a.vertices, float), a.triangles), (np.asarray(b.vertices, float) @ r.T + t, b.triangles)]
     worst = 0.0
-    for p, q in ((a, b), (b, a)):
-        pts, _ = trimesh.sample.sample_surface(p.to_trimesh(), samples, seed=int(rng.integers(2**31)))
-        pts = np.vstack([pts, p.vertices])
-        tris = q.vertices[q.triangles]
+    for (pv, pt), (qv, qt) in (surfaces, surfaces[::-1]):
+        pts = surface_points(pv, pt, samples, rng)
+        tris = qv[qt]
         for i in range(0, len(pts), 1000):
             worst = max(worst, float(point_triangle_distance(pts[i : i + 1000], tris).min(axis=1).max()))
     return worst
@@ -204,21 +218,27 @@ def main(argv: list[str] | None = None) -> int:
             learned = rec.get("learned") or {}
             truth = load_model(it["path"])
             q, t = rec["pose"]["quat_wxyz"], rec["pose"]["translation_m"]
-            posed = truth.transformed(quat_to_matrix(np.array(q)), np.array(t))
+            pose = (quat_to_matrix(np.array(q)), np.array(t))
             row = {"object": Path(it["path"]).stem, "family": it["family"], "size": it["size"], "base": it["base"],
                    "outcome": rec["outcome"], "learned_status": learned.get("status"),
                    "learn_moves": learned.get("moves", 0), "learn_cost": learned.get("path_cost", 0.0),
                    "learn_wall_s": learned.get("wall_time_s", 0.0), "episode_moves": rec["moves"],
                    "episode_cost": rec["path_cost"], "true_VEF": [truth.n_vertices, truth.n_edges, truth.n_faces],
                    "V": None, "vef_right": False, "reid_episodes": 0, "reid_recognized": 0, "reid_cost": [],
-                   "reid_outcomes": [],
+                   "reid_outcomes": [], "reid_seeds": [], "reid_missed": [], "false_seeds": [],
                    "false_episodes": 0, "false_recognitions": 0, "false_outcomes": []}  # fmt: skip
             if learned.get("status") == "closed" and learned.get("path"):
-                model = load_model(learned["path"])
+                try:
+                    model = load_model(learned["path"])
+                except ModelError as exc:
+                    row["score_error"] = str(exc)
+                    it["row"] = row
+                    rows.append(row)
+                    continue
                 row.update(V=model.n_vertices, E=model.n_edges, F=model.n_faces,
                            vef_right=(model.n_vertices, model.n_edges, model.n_faces)
                            == (truth.n_vertices, truth.n_edges, truth.n_faces),
-                           hausdorff_mm=1e3 * surface_distance(model, posed, args.samples, rng),
+                           hausdorff_mm=1e3 * surface_distance(model, truth, pose, args.samples, rng),
                            volume_error=model.volume / truth.volume - 1.0)  # fmt: skip
                 for _ in range(args.poses):
                     reid_specs.append((row, EpisodeSpec(model=it["path"], seed=int(rng.integers(2**31 - 1)),
@@ -245,10 +265,15 @@ def main(argv: list[str] | None = None) -> int:
                 row["reid_recognized"] += int(rec["recognized"] == name)
                 row["reid_cost"].append(rec["path_cost"])
                 row["reid_outcomes"].append(rec["recognized"] or rec["outcome"])
+                row["reid_seeds"].append(rec["seed"])
+                if rec["recognized"] != name:
+                    row["reid_missed"].append({"seed": rec["seed"], "outcome": rec["outcome"], "detail": rec["detail"]})
             else:
                 row["false_episodes"] += 1
                 row["false_recognitions"] += int(rec["recognized"] == name)
                 row["false_outcomes"].append(rec["recognized"] or rec["outcome"])
+                if rec["recognized"] == name:
+                    row["false_seeds"].append({"model": rec["model"], "seed": rec["seed"]})
         wall = time.perf_counter() - t0
         for r in rows:
             r["reid_cost_mean"] = float(np.mean(r.pop("reid_cost"))) if r["reid_cost"] else None

@@ -6,13 +6,17 @@ matcher's verdict is ``no-match``. Each turn it rebuilds the object's convex est
 (:func:`~haptic.learning.reconstruct.convex_estimate`) and chooses the move that measures the most of its
 unmeasured boundary -- open faces (where the data do not bound the object yet), edges and vertices not met --
 per unit of path cost, looking up to :attr:`LearnSettings.depth` moves ahead in the estimate's own world
-(:func:`~haptic.planning.simulate.simulate`). It has its own budget (:class:`LearnSettings`), reported in the
-record's ``learned``.
+(:func:`~haptic.planning.simulate.simulate`). Once the data show the object is not convex (a measured point
+outside a measured plane, planes that bound no solid, or an estimate that measured nothing new in
+:attr:`LearnSettings.stall` moves) it traces the object's boundary instead
+(:func:`~haptic.learning.boundary.boundary_estimate`), walking over it to the nearest open edge or vertex
+(:class:`~haptic.episode.boundary_walk.BoundaryWalk`). It has its own budget (:class:`LearnSettings`), reported
+in the record's ``learned``.
 
 :func:`learning_endings` replaces the loop's ending conditions: a ``no-match`` verdict starts the learning
-instead of ending the episode, which then ends, still ``no-match``, when the surface is closed, when the data
-show the object is not convex, or when the learning budget is spent. :func:`run_learning` runs such an episode
-and writes the model (:func:`~haptic.learning.library.write_learned`).
+instead of ending the episode, which then ends, still ``no-match``, when the surface is closed or when the
+learning budget is spent. :func:`run_learning` runs such an episode and writes the model (the half-space
+intersection of a convex object, the traced boundary of any other: :func:`~haptic.learning.library.write_learned`).
 """
 
 from __future__ import annotations
@@ -23,6 +27,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from haptic.episode.boundary_walk import BoundaryWalk
 from haptic.episode.loop import (
     Ending,
     EpisodeRecord,
@@ -36,7 +41,15 @@ from haptic.episode.sources import MoveSource, episode_sources
 from haptic.episode.state import EpisodeState
 from haptic.errors import ModelError
 from haptic.geometry import SE3, Polyhedron
-from haptic.learning.reconstruct import ConvexEstimate, LearnError, convex_estimate, convexity_violation, edge_faces
+from haptic.learning.boundary import BoundaryEstimate, boundary_estimate
+from haptic.learning.reconstruct import (
+    ConvexEstimate,
+    LearnBounds,
+    LearnError,
+    convex_estimate,
+    convexity_violation,
+    edge_faces,
+)
 from haptic.matching.components import DataComponent
 from haptic.matching.recognition import NO_MATCH
 from haptic.planning.config import PlannerConfig
@@ -64,6 +77,9 @@ class LearnSettings:
     """Move budget of the learning, on top of the episode's."""
     depth: int = 3
     """Moves looked ahead when no single move measures anything new."""
+    stall: int = 12
+    """Moves after which a convex estimate that measured no new plane or vertex gives way to tracing the
+    boundary (the object is taken for non-convex)."""
 
 
 class ClosureMoves(MoveSource):
@@ -82,12 +98,20 @@ class ClosureMoves(MoveSource):
         self.cost = 0.0
         self.started: float | None = None
         self.status = "not started"
-        """"closed", "not convex", "no solid", "budget", "failed" or "open" (still exploring)."""
+        """"closed", "no solid", "budget", "failed" or "open" (still exploring)."""
         self.detail = ""
         self.estimate: ConvexEstimate | None = None
+        self.convex = True
+        """Whether the data so far are those of a convex object (else the boundary is traced to closure)."""
+        self.nonconvex = ""
+        """What showed the object is not convex."""
+        self.boundary: BoundaryEstimate | None = None
+        """The traced boundary (once the object is known not to be convex)."""
         self.components: dict[int, DataComponent] = {}
         self._asked: Move | None = None
         self._seen = -1
+        self._best: tuple = ()
+        self._since = 0
 
     # ---------------------------------------------------------------------------------------- state
 
@@ -101,23 +125,52 @@ class ClosureMoves(MoveSource):
             return
         self._seen = len(view.cum_cost)
         self.components = dict(view.components)
+        if not self.convex:
+            self._update_boundary()
+            return
         try:
             est = convex_estimate(self.components)
-        except LearnError as exc:
-            self.estimate, self.status, self.detail = None, "no solid", str(exc)
+        except LearnError as exc:  # the measured planes bound no convex solid: the object is not convex
+            self.estimate, self.convex, self.nonconvex = None, False, str(exc)
+            self._update_boundary()
             return
         bad = convexity_violation(self.components, est.planes, est.bounds)
         if bad is not None:
-            self.estimate, self.status = est, "not convex"
-            self.detail = f"a measured point lies {bad[1] * 1e3:.2f} mm outside measured plane {bad[0]}"
+            self.estimate, self.convex = est, False
+            self.nonconvex = f"a measured point lies {bad[1] * 1e3:.2f} mm outside measured plane {bad[0]}"
+            self._update_boundary()
             return
         self.estimate = est
         self.status = "closed" if est.closed else "open"
+        c = est.counts()
+        progress = (c["planes"], c["vertices_measured"], -c["open_faces"])
+        if progress > self._best:
+            self._best, self._since = progress, self.moves
+        elif self.moves - self._since >= self.settings.stall:
+            # the estimate's faces and vertices are not where the moves find the object: not convex, though no
+            # measured point shows it yet
+            self.convex = False
+            self.nonconvex = f"the convex estimate measured nothing new in {self.settings.stall} moves"
+            self._update_boundary()
+
+    def _update_boundary(self) -> None:
+        try:
+            self.boundary = boundary_estimate(self.components)
+        except LearnError as exc:
+            self.boundary, self.status, self.detail = None, "no solid", str(exc)
+            return
+        self.status = "closed" if self.boundary.closed else "open"
+
+    @property
+    def bounds(self) -> LearnBounds | None:
+        """The error bounds of the data the model is learned from."""
+        est = self.estimate if self.convex else self.boundary
+        return est.bounds if est is not None else None
 
     def ending(self, view: EpisodeState) -> Ending | None:
         """The learning's end (the episode's outcome stays ``no-match``), or None while it goes on."""
         self.update(view)
-        if self.status in ("closed", "not convex", "no solid"):
+        if self.status in ("closed", "no solid"):
             return Ending(NO_MATCH, f"learning: {self.status}" + (f" ({self.detail})" if self.detail else ""))
         s = self.settings
         if self.cost > s.budget or self.moves >= s.max_moves:
@@ -128,7 +181,16 @@ class ClosureMoves(MoveSource):
     # ---------------------------------------------------------------------------------------- moves
 
     def propose(self, view: EpisodeState) -> Move | None:
-        if not self.active or self.estimate is None or view.sensor is None:
+        if not self.active or view.sensor is None:
+            return None
+        if not self.convex:
+            if self.boundary is None:
+                return None
+            walk = BoundaryWalk(self.boundary, self.components, view.config)
+            move = walk.best_move(view.sensor, tuple(view.failed_here), turn=self.moves + len(view.failed_here))
+            self._asked = move
+            return move
+        if self.estimate is None:
             return None
         plan = ClosurePlan.of(self.estimate, self.components, view.config)
         if plan is None:
@@ -152,7 +214,12 @@ class ClosureMoves(MoveSource):
             "wall_time_s": round(time.perf_counter() - self.started, 4) if self.started else 0.0,
             "budget": self.settings.budget, "max_moves": self.settings.max_moves,
         }  # fmt: skip
-        if est is not None:
+        out["convex"] = self.convex
+        if not self.convex:
+            out["not_convex"] = self.nonconvex
+            if self.boundary is not None:
+                out["estimate"] = self.boundary.counts()
+        elif est is not None:
             out["estimate"] = est.counts()
         if self.detail:
             out["detail"] = self.detail
@@ -341,6 +408,7 @@ def run_learning(
     among the sources, :func:`learning_endings`); when it closes the surface, the learned model, written into
     ``settings.directory`` when given. The record's ``learned`` says how the learning went."""
     from haptic.episode.loop import chain_observers, drive
+    from haptic.learning.boundary import boundary_model
     from haptic.learning.library import learned_name, write_learned
     from haptic.learning.reconstruct import learned_model
     from haptic.planning.registry import make_policy
@@ -362,14 +430,17 @@ def run_learning(
     if source.status == "closed":
         name = settings.name or learned_name(spec)
         try:
-            model = learned_model(source.estimate, name)
+            if source.convex:
+                model = learned_model(source.estimate, name)
+            else:
+                model = boundary_model(source.boundary, name)
         except LearnError as exc:
             learned["status"], learned["detail"] = "invalid", str(exc)
         else:
             learned.update(name=name, V=model.n_vertices, E=model.n_edges, F=model.n_faces,
                            volume_cm3=round(model.volume * 1e6, 4), precision_m=model.precision)  # fmt: skip
             if settings.directory is not None:
-                path = write_learned(model, settings.directory, spec, source.estimate.bounds, learned)
+                path = write_learned(model, settings.directory, spec, source.bounds, learned)
                 learned["path"] = str(path)
     record.learned = learned
     return record, model

@@ -39,6 +39,8 @@ BOUND_FLOOR = 1e-6
 MERGE_FACTOR = 2.0
 """An edge of the estimate shorter than this many times the error of a vertex placed by planes is noise (two
 noisy planes where one vertex of more than three faces is) [-]."""
+REGROUP_ROUNDS = 3
+"""Rounds of regrouping the data faces once every plane is fitted (:func:`face_planes`)."""
 NUMERIC = 1e-9
 """Vertices of the half-space intersection closer than this, relative to the size, are one point [-]."""
 
@@ -167,6 +169,14 @@ def _same_plane(a: DataFace, n: np.ndarray, d: float, pts: np.ndarray, nb: float
     return bool((off <= a.position_bound + pb + lever * np.sin(nb) + BOUND_FLOOR).all())
 
 
+def _misfit(a: DataFace, n: np.ndarray, d: float, nb: float, pb: float) -> float:
+    """How far data face ``a`` is from the plane ``(n, d)``: its normal's angle and its points' mean distance,
+    each over its bound [-]."""
+    angle = float(np.arccos(np.clip(a.normal @ n, -1.0, 1.0)))
+    off = float(np.mean(np.abs(a.points @ n - d)))
+    return angle / (a.normal_bound + nb + BOUND_FLOOR) + off / (a.position_bound + pb + BOUND_FLOOR)
+
+
 def fit_plane(points: np.ndarray, normals: np.ndarray, position_bound: float, normal_bound: float):
     """The plane ``(n, d)`` nearest to ``points`` (each within ``position_bound`` of it) and to the measured
     ``normals`` (each within ``normal_bound``): the smallest eigenvector of
@@ -184,25 +194,65 @@ def fit_plane(points: np.ndarray, normals: np.ndarray, position_bound: float, no
 
 
 def face_planes(components: Mapping[int, DataComponent]) -> list[Plane]:
-    """The object's planes: the data faces grouped by agreement (in order of acquisition, each joining the
-    first plane it agrees with), each group fitted to its points, edge ends and vertices (:func:`fit_plane`)."""
+    """The object's planes: the data faces grouped by agreement (in order of acquisition, each joining the plane
+    it agrees with best, by normal, but never one that holds a face a data edge divides it from: two faces that
+    meet at an edge are two planes, however small the angle between them), each group fitted to its points,
+    edge ends and vertices (:func:`fit_plane`)."""
     faces = [c for c in components.values() if isinstance(c, DataFace)]
     faces.sort(key=lambda c: c.id)
+    ef = edge_faces(components)
+    apart: dict[int, set[int]] = {}
+    for fs in ef.values():
+        for a in fs:
+            apart.setdefault(a, set()).update(b for b in fs if b != a)
     groups: list[list[DataFace]] = []
     fitted: list[tuple[np.ndarray, float, np.ndarray, float, float]] = []
     for f in faces:
-        for k, (n, d, pts, nb, pb) in enumerate(fitted):
-            if _same_plane(f, n, d, pts, nb, pb):
-                groups[k].append(f)
-                g = groups[k]
+        agree = [
+            (_misfit(f, n, d, nb, pb), k)
+            for k, (n, d, pts, nb, pb) in enumerate(fitted)
+            if not apart.get(f.id, set()) & {x.id for x in groups[k]} and _same_plane(f, n, d, pts, nb, pb)
+        ]  # fmt: skip
+        if not agree:
+            groups.append([f])
+            fitted.append((f.normal.copy(), f.offset, np.array(f.points), f.normal_bound, f.position_bound))
+            continue
+        k = min(agree)[1]
+        _, _, _, nb, pb = fitted[k]
+        g = groups[k]
+        g.append(f)
+        allp = np.concatenate([x.points for x in g])
+        nn, dd = fit_plane(allp, np.array([x.normal for x in g]), max(x.position_bound for x in g),
+                           max(x.normal_bound for x in g))  # fmt: skip
+        fitted[k] = (nn, dd, allp, max(nb, f.normal_bound), max(pb, f.position_bound))
+    # every face again to the plane it agrees with best, now that the planes are fitted to all their faces (a face
+    # grouped early, by a touch or two, may fit another plane better)
+    for _ in range(REGROUP_ROUNDS):
+        moved = False
+        for f in faces:
+            here = next(k for k, g in enumerate(groups) if f in g)
+            if len(groups[here]) == 1:
+                continue
+            agree = [
+                (_misfit(f, n, d, nb, pb), k)
+                for k, (n, d, pts, nb, pb) in enumerate(fitted)
+                if not apart.get(f.id, set()) & {x.id for x in groups[k] if x is not f}
+                and _same_plane(f, n, d, pts, nb, pb)
+            ]  # fmt: skip
+            if not agree or min(agree)[1] == here:
+                continue
+            k = min(agree)[1]
+            groups[here].remove(f)
+            groups[k].append(f)
+            for j in (here, k):
+                g = groups[j]
                 allp = np.concatenate([x.points for x in g])
                 nn, dd = fit_plane(allp, np.array([x.normal for x in g]), max(x.position_bound for x in g),
                                    max(x.normal_bound for x in g))  # fmt: skip
-                fitted[k] = (nn, dd, allp, max(nb, f.normal_bound), max(pb, f.position_bound))
-                break
-        else:
-            groups.append([f])
-            fitted.append((f.normal.copy(), f.offset, np.array(f.points), f.normal_bound, f.position_bound))
+                fitted[j] = (nn, dd, allp, max(x.normal_bound for x in g), max(x.position_bound for x in g))
+            moved = True
+        if not moved:
+            break
     # the edges and vertices on each plane join its fit
     plane_of = {f.id: k for k, g in enumerate(groups) for f in g}
     extra: list[list[np.ndarray]] = [[] for _ in groups]
@@ -461,10 +511,15 @@ def learned_model(est: ConvexEstimate, name: str = "learned") -> Polyhedron:
             faces.append(loop)
     used = sorted({g for f in faces for g in f})
     index = {g: i for i, g in enumerate(used)}
-    verts = verts[used]
-    faces = [[index[g] for g in f] for f in faces]
+    return validated_model(verts[used], [[index[g] for g in f] for f in faces], est.bounds, name)
+
+
+def validated_model(verts: np.ndarray, faces: list[list[int]], b: LearnBounds, name: str) -> Polyhedron:
+    """The model of ``verts`` and ``faces`` (CCW loops) validated like an imported file at the finest of
+    :data:`PRECISIONS` its faces are planar at (moved toward planar faces when none: :func:`planarize`), then
+    made exactly symmetric under the motions that map it onto itself within the data's bounds
+    (:func:`symmetrized`)."""
     last: ModelError | None = None
-    b = est.bounds
     learned = LearnedBounds(b.normal, b.position, b.direction)
     model = None
     for attempt in (verts, planarize(verts, faces, PLANAR_ROUNDS)):

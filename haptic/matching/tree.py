@@ -29,13 +29,13 @@ without knowing it; the geometric tests decide (two data faces on one model face
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from types import MappingProxyType
 
 import numpy as np
 
 from haptic.errors import MatchError
-from haptic.geometry.polyhedron import Polyhedron
+from haptic.geometry.polyhedron import LearnedBounds, Polyhedron
 from haptic.geometry.se3 import SE3, cross
 from haptic.matching import constraints as C
 from haptic.matching.batch_poses import StackedPoses
@@ -177,6 +177,33 @@ def _kind_of(comp) -> int:
     raise MatchError(f"not a data component: {type(comp).__name__} (expected DataFace, DataEdge or DataVertex)")
 
 
+def learned_widening(models) -> LearnedBounds | None:
+    """The bounds a library's learned models were learned with (the largest of each kind), or None when every
+    model is exact. A learned model's features are no more exact than the data it was learned from, so the tests
+    of seed §2.4, which take the model as exact, see every data component's bounds widened by them."""
+    learned = [m.learned_bounds for m in models if m.learned_bounds is not None]
+    if not learned:
+        return None
+    return LearnedBounds(max(b.normal for b in learned), max(b.position for b in learned),
+                         max(b.direction for b in learned))  # fmt: skip
+
+
+def widened(c: DataComponent, w: LearnedBounds) -> DataComponent:
+    """``c`` with its error bounds and ``w``'s added in quadrature (independent errors): normal and direction
+    angles, positions, and an edge interval's ends (a model edge's end is a vertex, off by a position bound)."""
+
+    def q(a: float, b: float) -> float:
+        return float(np.hypot(a, b))
+
+    if isinstance(c, DataFace):
+        return replace(c, normal_bound=q(c.normal_bound, w.normal), position_bound=q(c.position_bound, w.position))
+    if isinstance(c, DataEdge):
+        return replace(c, direction_bound=q(c.direction_bound, w.direction),
+                       position_bound=q(c.position_bound, w.position),
+                       length_bound=q(c.length_bound, w.position))  # fmt: skip
+    return replace(c, position_bound=q(c.position_bound, w.position))
+
+
 class InterpretationTree:
     """Incremental interpretation tree over a model library (seed §2.3).
 
@@ -186,7 +213,10 @@ class InterpretationTree:
 
     def __init__(self, library: Mapping[str, Polyhedron] | Sequence[Polyhedron] | LibraryArrays) -> None:
         self.library = library if isinstance(library, LibraryArrays) else LibraryArrays.build(library)
+        self.widen = learned_widening(self.library.models)
+        """The largest learned model's own bounds, added to every data component's (None: every model exact)."""
         self._data = _Data()
+        self._raw: dict[int, DataComponent] = {}
         self._model = np.zeros(0, dtype=np.int64)
         self._assign = np.zeros((0, 0), dtype=np.int64)
         self._sense = np.zeros((0, 0), dtype=np.int8)
@@ -207,8 +237,11 @@ class InterpretationTree:
 
     @property
     def data(self) -> tuple[DataComponent, ...]:
-        """The data components so far (re-reported edges in their latest form), indexed by id."""
-        return tuple(self._data.items)
+        """The data components so far (re-reported edges in their latest form), indexed by id, with the bounds
+        they were reported with (the tests' widening for learned models left out)."""
+        if self.widen is None:
+            return tuple(self._data.items)
+        return tuple(self._raw.get(i, c) for i, c in enumerate(self._data.items))
 
     @property
     def model_indices(self) -> np.ndarray:
@@ -235,6 +268,7 @@ class InterpretationTree:
         t._data.items = list(self._data.items)
         t._data.kinds = list(self._data.kinds)
         t._data.adj = [set(a) for a in self._data.adj]
+        t._raw = dict(self._raw)
         t._model, t._assign, t._sense = self._model.copy(), self._assign.copy(), self._sense.copy()
         t.counts = list(self.counts)
         return t
@@ -243,6 +277,9 @@ class InterpretationTree:
 
     def add(self, component: DataComponent) -> int:
         """Add a data component (or a re-reported, extended edge); returns the number of interpretations."""
+        if self.widen is not None:
+            self._raw[component.id] = component
+            component = widened(component, self.widen)
         kind, new = self._check_input(component)
         if new:
             parents, cands = self._candidates(component, kind)

@@ -541,6 +541,16 @@ class EpisodeRecorder:
         self.stream.log("log/episode", rr.TextLog(text, level=level))
         self.completed = True
 
+    def log_learned(self, model: Polyhedron, moves: int) -> None:
+        """The model learned in the episode (its vertices in the world frame) drawn over the true one at the last
+        move: its edges in the estimate's colour, its faces faintly."""
+        rec = self.stream
+        self._set_time(moves)
+        rec.log("world/learned/object", mesh(model, (*ESTIMATE_COLOR, 70)))
+        rec.log("world/learned/edges", wireframe(model, ESTIMATE_COLOR, rr.components.Radius.ui_points(2.0)))
+        rec.log("log/episode", rr.TextLog(f"learned {model.name}: V {model.n_vertices}, E {model.n_edges}, "
+                                          f"F {model.n_faces} (green, over the true object)"))  # fmt: skip
+
     # ------------------------------------------------------------------------------------------ helpers
 
     def _log_static(self) -> None:
