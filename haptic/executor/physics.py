@@ -502,7 +502,6 @@ class PhysicsExecutor(LandingSearch):
         status = self._ensure_on_face(st.face, pieces)
         if status != "ok":
             return self.failed_result(move, status, f"could not return to the current face: {self._why}")
-        distance = 0.0
         for attempt in range(2):
             r = t.trace_face(inplane, n_a, self.settings.max_face_trace)
             pieces.append(r)
@@ -512,7 +511,6 @@ class PhysicsExecutor(LandingSearch):
                 return self.failed_result(move, r, f"trace across the face: {r.event}")
             if r.event == "done":
                 return self.failed_result(move, "unreachable", "no edge within the longest trace")
-            distance = r.distance
             kind = r.info["kind"]
             corner = self.contact_point()
             status, reason, roll, stroke, fit_b = self._cross_and_acquire(kind, r.info["face_normal"],
@@ -540,8 +538,8 @@ class PhysicsExecutor(LandingSearch):
         self.on_face = face.id
         self.state = SensorState(position=self.contact_point(), face=face.id, edge=edge.id,
                                  edge_faces=(st.face, face.id))  # fmt: skip
-        return MoveResult(move=move, status="ok", components=(edge, face), distance=distance,
-                          cost=self.costs.face_move(distance), state=self.state, info={"kind": kind})  # fmt: skip
+        return MoveResult(move=move, status="ok", components=(edge, face), distance=r.distance,
+                          cost=self.costs.face_move(r.distance), state=self.state, info={"kind": kind})  # fmt: skip
 
     def _away_from_vertex(self, n_a: np.ndarray, n_b: np.ndarray, roll: ContactTrace) -> np.ndarray | None:
         """After a roll whose normals leaned along the edge between faces ``n_a`` and ``n_b`` (the pad rolled
