@@ -27,7 +27,7 @@ from haptic.geometry.se3 import SE3
 from haptic.matching.components import DataComponent, DataEdge, DataFace, SensorNoise
 from haptic.planning.config import PlannerConfig
 from haptic.planning.hypothesis import Hypothesis
-from haptic.planning.moves import FaceMove, Move, SensorState
+from haptic.planning.moves import EdgeMove, FaceMove, Move, SensorState
 from haptic.planning.predict import candidate_moves, predict_moves
 from haptic.planning.table import descent_risk
 from haptic.planning.tour import (
@@ -137,45 +137,100 @@ def _gain(new: tuple[set[int], set[int], set[int]], missing: tuple[frozenset[int
     return sum(len(n & m) for n, m in zip(new, missing, strict=True))
 
 
+AIM_OFF_EDGE = np.deg2rad(45.0)
+"""A face move re-aimed past a concave edge whose end the hand cannot follow to (:func:`aimed_face_moves`) leaves
+that edge at least this steeply [rad]: along it the pad stays in the corner, touching both faces."""
+
+
 def aimed_face_moves(
     h: Hypothesis,
     state: SensorState,
     components: Mapping[int, DataComponent],
     missing: tuple[frozenset[int], frozenset[int], frozenset[int]],
+    config: PlannerConfig | None = None,
 ) -> list[FaceMove]:
     """Face moves across the current face aimed, in hypothesis ``h``'s world, at what of it is missing: a point
     :data:`AIM_NEAR_VERTEX` from each missing vertex of the face on either edge at it, and the midpoint of each
     missing edge of the face. The planner's fixed directions (§4.1) rarely end near a vertex; these do, so
-    that the vertex costs a short edge move rather than an edge's length."""
+    that the vertex costs a short edge move rather than an edge's length.
+
+    A target along the edge the sensor is on is an edge move's business, except where ``config`` refuses that
+    edge move: toward a concave edge's end where the surface falls away (``config.concave_end_block``, the
+    hand's setting; a reflex corner's vertex on a top face). The target then moves along its edge away from the
+    vertex, at least the pad's radius beyond :data:`AIM_NEAR_VERTEX` (in the corner the pad touches the face
+    across it) and until the move leaves the current edge by :data:`AIM_OFF_EDGE`, within half the edge; the
+    edge move from where it ends runs into the corner, which blocks the pad at the vertex."""
     face = components.get(state.face)
     f_m = h.faces.get(state.face)
     if not isinstance(face, DataFace) or f_m is None or h.world_from_model is None:
         return []
     poly, t = h.poly, h.world_from_model
     loop = [int(v) for v in poly.faces[f_m]]
-    targets = []
+    targets: list[tuple[np.ndarray, int | None, np.ndarray | None]] = []  # (point, vertex, unit along its edge)
+    hand = config is not None and config.concave_end_block is not None
+    ids = {frozenset(int(x) for x in poly.edges[e]): int(e) for e in poly.face_edges[f_m]}
     for k, v in enumerate(loop):
         if v not in missing[2]:
             continue
-        for nb in (loop[k - 1], loop[(k + 1) % len(loop)]):
+        ends = (loop[k - 1], loop[(k + 1) % len(loop)])
+        concave = [poly.edge_convexity[ids[frozenset((v, nb))]] < 0 for nb in ends]
+        for nb, into_corner, beside in zip(ends, concave, concave[::-1], strict=True):
+            if hand and into_corner:
+                continue  # the pad in the corner touches both faces: the move ends on the concave edge
             d = poly.vertices[nb] - poly.vertices[v]
             length = float(np.linalg.norm(d))
+            aim = AIM_NEAR_VERTEX + config.pad_radius if hand and beside else AIM_NEAR_VERTEX
             if length > 0:
-                targets.append(poly.vertices[v] + min(AIM_NEAR_VERTEX, 0.25 * length) * d / length)
+                targets.append((poly.vertices[v] + min(aim, 0.25 * length if aim == AIM_NEAR_VERTEX
+                                                     else 0.5 * length) * d / length, v, d))  # fmt: skip
     for e in poly.face_edges[f_m]:
         if int(e) in missing[1]:
-            targets.append(poly.edge_points[e] + 0.5 * poly.edge_lengths[e] * poly.edge_directions[e])
+            targets.append((poly.edge_points[e] + 0.5 * poly.edge_lengths[e] * poly.edge_directions[e], None, None))
     edge = components.get(state.edge) if state.edge is not None else None
     along = edge.direction if isinstance(edge, DataEdge) else None
     out = []
-    for p in targets:
-        d = t.apply(p) - state.position
-        d = d - (d @ face.normal) * face.normal
+    for p, v, span in targets:
+        d = _in_plane(t.apply(p) - state.position, face.normal)
         n = float(np.linalg.norm(d))
+        if along is not None and n >= AIM_NEAR_VERTEX and abs(d @ along) > 0.95 * n and v is not None:
+            d = _off_concave_edge(h, state, components, config, v, span, along)
+            n = float(np.linalg.norm(d)) if d is not None else 0.0
         if n < AIM_NEAR_VERTEX or (along is not None and abs(d @ along) > 0.95 * n):
             continue  # at hand, or along the edge the sensor is on (an edge move's business)
         out.append(FaceMove(d / n))
     return out
+
+
+def _in_plane(d: np.ndarray, normal: np.ndarray) -> np.ndarray:
+    return d - (d @ normal) * normal
+
+
+def _off_concave_edge(
+    h: Hypothesis, state: SensorState, components: Mapping[int, DataComponent], config: PlannerConfig | None,
+    v: int, span: np.ndarray, along: np.ndarray,
+) -> np.ndarray | None:
+    """For :func:`aimed_face_moves`: the direction (in the current face's plane, world frame) to a point of the
+    edge from model vertex ``v`` along ``span`` (to its other end) that leaves the current edge (unit ``along``)
+    by :data:`AIM_OFF_EDGE`, when an edge move along the current edge toward ``v`` is refused as a concave
+    edge's hidden end (:func:`~haptic.planning.table.hidden_concave_end`); None otherwise, or when no point
+    within half the edge does."""
+    from haptic.planning.table import hidden_concave_end
+
+    if config is None or config.concave_end_block is None:
+        return None
+    t, face = h.world_from_model, components[state.face]
+    vertex = h.poly.vertices[v]
+    sense = 1 if float((t.apply(vertex) - state.position) @ along) > 0 else -1
+    if not hidden_concave_end(h, EdgeMove(sense), state, components, config):
+        return None
+    length = float(np.linalg.norm(span))
+    first = min(AIM_NEAR_VERTEX + config.pad_radius, 0.5 * length)
+    for s in np.linspace(first, 0.5 * length, 5):
+        d = _in_plane(t.apply(vertex + s * span / length) - state.position, face.normal)
+        n = float(np.linalg.norm(d))
+        if n >= AIM_NEAR_VERTEX and abs(float(d @ along)) <= np.cos(AIM_OFF_EDGE) * n:
+            return d
+    return None
 
 
 def _moves(
@@ -192,7 +247,7 @@ def _moves(
     from haptic.planning.policies import refusal, same_move
 
     out = []
-    aimed = aimed_face_moves(h, state, components, missing) if missing is not None else []
+    aimed = aimed_face_moves(h, state, components, missing, config) if missing is not None else []
     fixed_faces = fixed_faces and not aimed
     planner = [m for m in candidate_moves(state, components, config) if fixed_faces or m.kind != "face"]
     fresh = [m for m in planner + aimed if not any(same_move(m, bad) for bad in avoid)]

@@ -1,0 +1,75 @@
+"""Verification on the hand at a reflex corner: the vertex where a concave edge ends on a top face is measured
+from the convex edge beside it, not by aiming into the corner (haptic.planning.verify.aimed_face_moves)."""
+
+import numpy as np
+
+from haptic.geometry import SE3, load_library
+from haptic.matching.components import DataEdge, DataFace
+from haptic.planning.config import PlannerConfig
+from haptic.planning.hypothesis import Hypothesis
+from haptic.planning.moves import EdgeMove, SensorState
+from haptic.planning.search import simulate
+from haptic.planning.table import table_conflict
+from haptic.planning.verify import AIM_NEAR_VERTEX, aimed_face_moves
+
+LIB = load_library()
+TABLE_Z = 0.35
+HAND = PlannerConfig(table_z=TABLE_Z, pad_radius=0.012, concave_end_block=0.2)
+REFLEX, BELOW, WALL, TOP_EDGE, CONCAVE = 3, 9, 4, 10, 11
+"""LBLOCK01's reflex corner: vertex 3 on the L-shaped face 0, the concave edge 11 down from it to vertex 9 between
+the inner walls 4 and 5, and the convex edge 10 along the top of wall 4 (the test checks these)."""
+
+
+def _in_the_corner(height: float):
+    """LBLOCK01 upside down on the table (the L-shaped face 0 on top, as at seed 3 of the physics benchmark), the
+    sensor on wall 4 against the concave edge ``height`` above the table: the true hypothesis, state, components."""
+    poly = LIB["LBLOCK01"]
+    assert poly.edge_convexity[CONCAVE] < 0 < poly.edge_convexity[TOP_EDGE]
+    assert set(poly.edges[CONCAVE].tolist()) == {REFLEX, BELOW} and REFLEX in poly.edges[TOP_EDGE]
+    pose = SE3(np.diag([1.0, -1.0, -1.0]), np.array([0.55, 0.05, TABLE_Z + 0.05]))
+    n = pose.rotate(poly.face_normals[WALL])
+    loop = poly.vertices[list(poly.faces[WALL])]
+    face = DataFace(1, n, pose.apply(loop.mean(axis=0) + 0.3 * (loop - loop.mean(axis=0))), 1e-2, 1e-3)
+    a, b = pose.apply(poly.vertices[BELOW]), pose.apply(poly.vertices[REFLEX])
+    inner = 0.3 * (b - a)
+    edge = DataEdge(2, (b - a) / np.linalg.norm(b - a), a + inner, float(np.linalg.norm(b - a - 2 * inner)), 1e-2,
+                    1e-3, 1e-3)  # fmt: skip
+    h = Hypothesis("LBLOCK01", poly, pose, {1: WALL}, {2: CONCAVE}, {})
+    at = a + (height - a[2] + TABLE_Z) * edge.direction / edge.direction[2]
+    state = SensorState(at + 0.001 * n, face=1, edge=2, edge_faces=(1,))
+    return h, state, {1: face, 2: edge}
+
+
+def test_a_reflex_corners_vertex_is_aimed_at_beside_the_corner_and_an_edge_move_reaches_it():
+    """From low on the concave edge (its hidden top end refused to an edge move) and from near its top, the move
+    aimed at the corner's vertex leaves the edge, ends on the convex edge along the wall's top more than the pad's
+    radius from the corner (nearer, the pad touches the wall across the corner and the move ends on the concave
+    edge), and an edge move from there, not refused, measures the vertex."""
+    for height in (0.01, 0.045):
+        h, state, comps = _in_the_corner(height)
+        missing = (frozenset(), frozenset(), frozenset({REFLEX}))
+        moves = aimed_face_moves(h, state, comps, missing, HAND)
+        assert moves, height
+        reached = False
+        for m in moves:
+            sim = simulate(h, m, state, comps, HAND)
+            assert sim is not None
+            h1, s1, c1 = sim
+            assert h1.edges[s1.edge] == TOP_EDGE
+            end = h.world_from_model.inverse().apply(s1.position)
+            assert np.linalg.norm(end - h.poly.vertices[REFLEX]) > HAND.pad_radius + AIM_NEAR_VERTEX / 2
+            for sense in (1, -1):
+                sim2 = simulate(h1, EdgeMove(sense), s1, c1, HAND)
+                if sim2 is not None and REFLEX in sim2[0].vertices.values():
+                    assert table_conflict(h1, EdgeMove(sense), s1, c1, HAND) == 0.0
+                    reached = True
+        assert reached, height
+
+
+def test_off_the_hand_the_corner_is_aimed_at_as_any_vertex():
+    """Without ``concave_end_block`` (the geometric executor, which follows a concave edge to its end) the aimed
+    moves are those of any vertex: none along the current edge, the others AIM_NEAR_VERTEX from it."""
+    h, state, comps = _in_the_corner(0.045)
+    missing = (frozenset(), frozenset(), frozenset({REFLEX}))
+    assert [m.direction.tolist() for m in aimed_face_moves(h, state, comps, missing)] == [
+        m.direction.tolist() for m in aimed_face_moves(h, state, comps, missing, PlannerConfig())]
