@@ -37,6 +37,10 @@ AIM_NEAR_VERTEX = 6e-3
 far from a missing vertex [m] (at most a quarter of the edge), so that a short edge move (``c_e`` × 6 mm + ``c_k``
 = 1.6 units) measures the vertex, instead of tracing the whole edge to it (§3.1: a face costs half an edge per
 cm)."""
+CONCAVE_STEP_OFF = 3e-3
+"""On the hand a face move that starts on a concave edge (the pad in the corner, touching both faces) first touches
+its face this far beyond the pad's radius in from the edge, and is aimed from there
+(:func:`haptic.planning.verify.aimed_face_moves`, ``PhysicsSettings.concave_step_off``) [m]."""
 PROBE_INSET = 0.01
 """A verification probe aims at a point of a face this far from both edges at the missing vertex [m]: the hand's
 contact stays clear of the face's boundary (:func:`~haptic.planning.handpath.foot_near_boundary`), and an aimed

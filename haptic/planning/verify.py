@@ -29,9 +29,10 @@ from haptic.planning.config import PlannerConfig
 from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import EdgeMove, FaceMove, Move, SensorState
 from haptic.planning.predict import candidate_moves, predict_moves
-from haptic.planning.table import descent_risk
+from haptic.planning.table import _inward, descent_risk, hidden_concave_end
 from haptic.planning.tour import (
     AIM_NEAR_VERTEX,
+    CONCAVE_STEP_OFF,
     EDGE,
     FACE,
     PROBE_INSET,
@@ -137,11 +138,6 @@ def _gain(new: tuple[set[int], set[int], set[int]], missing: tuple[frozenset[int
     return sum(len(n & m) for n, m in zip(new, missing, strict=True))
 
 
-AIM_OFF_EDGE = np.deg2rad(45.0)
-"""A face move re-aimed past a concave edge whose end the hand cannot follow to (:func:`aimed_face_moves`) leaves
-that edge at least this steeply [rad]: along it the pad stays in the corner, touching both faces."""
-
-
 def aimed_face_moves(
     h: Hypothesis,
     state: SensorState,
@@ -154,19 +150,22 @@ def aimed_face_moves(
     missing edge of the face. The planner's fixed directions (§4.1) rarely end near a vertex; these do, so
     that the vertex costs a short edge move rather than an edge's length.
 
-    A target along the edge the sensor is on is an edge move's business, except where ``config`` refuses that
-    edge move: toward a concave edge's end where the surface falls away (``config.concave_end_block``, the
-    hand's setting; a reflex corner's vertex on a top face). The target then moves along its edge away from the
-    vertex, at least the pad's radius beyond :data:`AIM_NEAR_VERTEX` (in the corner the pad touches the face
-    across it) and until the move leaves the current edge by :data:`AIM_OFF_EDGE`, within half the edge; the
-    edge move from where it ends runs into the corner, which blocks the pad at the vertex."""
+    On the hand (``config.concave_end_block`` set), at a reflex corner (a missing vertex where a concave edge
+    of the face ends, or whose corner of the face is reflex): no target on a concave edge (the pad in the corner
+    touches both faces, and the move ends on that edge), and those on the convex edges the pad's radius
+    farther from the vertex (at most half the edge): nearer, the pad rolling over the edge touches the face
+    across the corner too; from a concave edge the move is aimed from where it starts on the hand,
+    :data:`~haptic.planning.tour.CONCAVE_STEP_OFF` beyond the pad's radius in from the edge; and a target along
+    that edge is kept where the edge move toward it is refused (its end hidden: the surface falls away past it),
+    else it is an edge move's business. The edge move from where such a move ends runs into the corner, which
+    blocks the pad at the vertex."""
     face = components.get(state.face)
     f_m = h.faces.get(state.face)
     if not isinstance(face, DataFace) or f_m is None or h.world_from_model is None:
         return []
     poly, t = h.poly, h.world_from_model
     loop = [int(v) for v in poly.faces[f_m]]
-    targets: list[tuple[np.ndarray, int | None, np.ndarray | None]] = []  # (point, vertex, unit along its edge)
+    targets: list[tuple[np.ndarray, int | None]] = []  # (point, the missing vertex it is beside)
     hand = config is not None and config.concave_end_block is not None
     ids = {frozenset(int(x) for x in poly.edges[e]): int(e) for e in poly.face_edges[f_m]}
     for k, v in enumerate(loop):
@@ -174,29 +173,40 @@ def aimed_face_moves(
             continue
         ends = (loop[k - 1], loop[(k + 1) % len(loop)])
         concave = [poly.edge_convexity[ids[frozenset((v, nb))]] < 0 for nb in ends]
+        e1, e2 = (poly.vertices[nb] - poly.vertices[v] for nb in ends)
+        reflex = float(np.cross(e1, e2) @ poly.face_normals[f_m]) > 0  # the loop runs counter-clockwise
         for nb, into_corner, beside in zip(ends, concave, concave[::-1], strict=True):
             if hand and into_corner:
                 continue  # the pad in the corner touches both faces: the move ends on the concave edge
             d = poly.vertices[nb] - poly.vertices[v]
             length = float(np.linalg.norm(d))
-            aim = AIM_NEAR_VERTEX + config.pad_radius if hand and beside else AIM_NEAR_VERTEX
+            aim = AIM_NEAR_VERTEX + config.pad_radius if hand and (beside or reflex) else AIM_NEAR_VERTEX
             if length > 0:
                 targets.append((poly.vertices[v] + min(aim, 0.25 * length if aim == AIM_NEAR_VERTEX
-                                                     else 0.5 * length) * d / length, v, d))  # fmt: skip
+                                                     else 0.5 * length) * d / length, v))  # fmt: skip
     for e in poly.face_edges[f_m]:
         if int(e) in missing[1]:
-            targets.append((poly.edge_points[e] + 0.5 * poly.edge_lengths[e] * poly.edge_directions[e], None, None))
+            targets.append((poly.edge_points[e] + 0.5 * poly.edge_lengths[e] * poly.edge_directions[e], None))
     edge = components.get(state.edge) if state.edge is not None else None
     along = edge.direction if isinstance(edge, DataEdge) else None
+    origin = state.position
+    e_m = h.edges.get(state.edge) if state.edge is not None else None
+    if hand and e_m is not None and poly.edge_convexity[e_m] < 0 and f_m in (poly.edge_left_face[e_m],
+                                                                            poly.edge_right_face[e_m]):
+        p0, u = t.apply(poly.edge_points[e_m]), t.rotate(poly.edge_directions[e_m])  # the edge's line, world
+        on_line = p0 + float((origin - p0) @ u) * u
+        origin = on_line + (config.pad_radius + CONCAVE_STEP_OFF) * t.rotate(_inward(poly, e_m, f_m))
     out = []
-    for p, v, span in targets:
-        d = _in_plane(t.apply(p) - state.position, face.normal)
+    for p, v in targets:
+        if float(np.linalg.norm(_in_plane(t.apply(p) - state.position, face.normal))) < AIM_NEAR_VERTEX:
+            continue  # at hand
+        d = _in_plane(t.apply(p) - origin, face.normal)
         n = float(np.linalg.norm(d))
-        if along is not None and n >= AIM_NEAR_VERTEX and abs(d @ along) > 0.95 * n and v is not None:
-            d = _off_concave_edge(h, state, components, config, v, span, along)
-            n = float(np.linalg.norm(d)) if d is not None else 0.0
-        if n < AIM_NEAR_VERTEX or (along is not None and abs(d @ along) > 0.95 * n):
-            continue  # at hand, or along the edge the sensor is on (an edge move's business)
+        if n < 1e-9:
+            continue
+        if along is not None and abs(d @ along) > 0.95 * n and not (
+                v is not None and _edge_move_refused(h, state, components, config, v, along)):
+            continue  # along the edge the sensor is on: an edge move's business
         out.append(FaceMove(d / n))
     return out
 
@@ -205,32 +215,16 @@ def _in_plane(d: np.ndarray, normal: np.ndarray) -> np.ndarray:
     return d - (d @ normal) * normal
 
 
-def _off_concave_edge(
+def _edge_move_refused(
     h: Hypothesis, state: SensorState, components: Mapping[int, DataComponent], config: PlannerConfig | None,
-    v: int, span: np.ndarray, along: np.ndarray,
-) -> np.ndarray | None:
-    """For :func:`aimed_face_moves`: the direction (in the current face's plane, world frame) to a point of the
-    edge from model vertex ``v`` along ``span`` (to its other end) that leaves the current edge (unit ``along``)
-    by :data:`AIM_OFF_EDGE`, when an edge move along the current edge toward ``v`` is refused as a concave
-    edge's hidden end (:func:`~haptic.planning.table.hidden_concave_end`); None otherwise, or when no point
-    within half the edge does."""
-    from haptic.planning.table import hidden_concave_end
-
+    v: int, along: np.ndarray,
+) -> bool:
+    """Whether, on the hand, the edge move along the current edge (unit ``along``) toward model vertex ``v`` is
+    refused as a concave edge's hidden end (:func:`~haptic.planning.table.hidden_concave_end`)."""
     if config is None or config.concave_end_block is None:
-        return None
-    t, face = h.world_from_model, components[state.face]
-    vertex = h.poly.vertices[v]
-    sense = 1 if float((t.apply(vertex) - state.position) @ along) > 0 else -1
-    if not hidden_concave_end(h, EdgeMove(sense), state, components, config):
-        return None
-    length = float(np.linalg.norm(span))
-    first = min(AIM_NEAR_VERTEX + config.pad_radius, 0.5 * length)
-    for s in np.linspace(first, 0.5 * length, 5):
-        d = _in_plane(t.apply(vertex + s * span / length) - state.position, face.normal)
-        n = float(np.linalg.norm(d))
-        if n >= AIM_NEAR_VERTEX and abs(float(d @ along)) <= np.cos(AIM_OFF_EDGE) * n:
-            return d
-    return None
+        return False
+    sense = 1 if float((h.world_from_model.apply(h.poly.vertices[v]) - state.position) @ along) > 0 else -1
+    return hidden_concave_end(h, EdgeMove(sense), state, components, config)
 
 
 def _moves(

@@ -9,7 +9,8 @@ from haptic.planning.config import PlannerConfig
 from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import EdgeMove, SensorState
 from haptic.planning.search import simulate
-from haptic.planning.table import table_conflict
+from haptic.planning.table import _inward, table_conflict
+from haptic.planning.tour import CONCAVE_STEP_OFF
 from haptic.planning.verify import AIM_NEAR_VERTEX, aimed_face_moves
 
 LIB = load_library()
@@ -42,17 +43,21 @@ def _in_the_corner(height: float):
 
 def test_a_reflex_corners_vertex_is_aimed_at_beside_the_corner_and_an_edge_move_reaches_it():
     """From low on the concave edge (its hidden top end refused to an edge move) and from near its top, the move
-    aimed at the corner's vertex leaves the edge, ends on the convex edge along the wall's top more than the pad's
-    radius from the corner (nearer, the pad touches the wall across the corner and the move ends on the concave
-    edge), and an edge move from there, not refused, measures the vertex."""
+    aimed at the corner's vertex, started where the hand starts it (stepped off the concave edge), ends on the
+    convex edge along the wall's top more than the pad's radius from the corner (nearer, the pad touches the wall
+    across the corner and the move ends on the concave edge), and an edge move from there, not refused,
+    measures the vertex."""
     for height in (0.01, 0.045):
         h, state, comps = _in_the_corner(height)
+        inward = h.world_from_model.rotate(_inward(h.poly, CONCAVE, WALL))
+        stepped = SensorState(state.position + (HAND.pad_radius + CONCAVE_STEP_OFF) * inward, face=state.face,
+                              edge=state.edge, edge_faces=state.edge_faces)  # fmt: skip
         missing = (frozenset(), frozenset(), frozenset({REFLEX}))
         moves = aimed_face_moves(h, state, comps, missing, HAND)
         assert moves, height
         reached = False
         for m in moves:
-            sim = simulate(h, m, state, comps, HAND)
+            sim = simulate(h, m, stepped, comps, HAND)
             assert sim is not None
             h1, s1, c1 = sim
             assert h1.edges[s1.edge] == TOP_EDGE
