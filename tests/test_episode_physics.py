@@ -183,3 +183,27 @@ def test_a_vertex_move_whose_circle_meets_an_edge_of_another_vertex_reports_no_e
     ep, failed, results = _replay(tmp_path, "trapezohedron_12", 0.06, 6, corpus=True)
     assert any(r.move.kind == "vertex" and "leaves another vertex" in r.reason for r in failed)
     assert score_components(ep.executor.components, ep.true_model, ep.world_from_model, results).missed == 0
+
+
+def test_face_moves_out_of_a_concave_corner_leave_it(tmp_path):
+    # BOX01N seed 2 stands on an end with its slot upright, 30 mm wide for the 24 mm pad. Verifying it, face moves
+    # started from the slot's concave edges, traced from the corner where the pad rested touching both faces: each
+    # met the face across after 2-3 mm and reported a concave edge again, the verifier crossed from wall to wall,
+    # and the stall rule ended it incomplete with 6 vertices not measured. A face move now steps off a concave
+    # edge by the pad's radius first, and the verifier aims it from there (docs/physics-notes.md).
+    del tmp_path
+    start, ended = [None], []
+
+    def on_move(n, r, count, rec):
+        if r.move.kind == "face" and start[0] is not None:
+            ended.append((start[0], r.info.get("kind"), r.distance))
+        start[0] = r.state.edge
+
+    spec = EpisodeSpec(model="BOX01N", seed=2, executor="physics", verify="full")
+    ep = build_episode(spec)
+    rec = ep.run(None, EpisodeObserver(on_move=on_move))
+    edges = ep.executor.segmenter.edges
+    from_corner = [(kind, dist) for e, kind, dist in ended if not edges[e].convex]
+    assert from_corner
+    assert not [d for kind, d in from_corner if kind == "concave" and d < ep.executor.toucher.pad_radius]
+    assert rec.outcome == "recognized" and rec.correct, rec.detail

@@ -504,13 +504,13 @@ class PhysicsExecutor(LandingSearch):
         if inplane is None:
             return self.invalid_result(move, "direction is not in the plane of the current face")
         rec = seg.edges.get(st.edge) if st.edge is not None else None
+        stepped = "no"
         if rec is not None and not rec.convex and st.face in rec.inward:
             # the pad in a concave corner touches both faces: the trace would meet the edge it starts on at once
             on_line = rec.at(rec.param(self.contact_point()))
             start = on_line + (t.pad_radius + self.settings.concave_step_off) * rec.inward[st.face]
-            if self._touch_face(st.face, n_a, start, pieces) != "ok":
-                return self.failed_result(move, "unreachable", f"could not step off the concave edge: {self._why}")
-        else:
+            stepped = self._touch_face(st.face, n_a, start, pieces)  # a face narrower there: from where it is
+        if stepped != "ok":
             status = self._ensure_on_face(st.face, pieces)
             if status != "ok":
                 return self.failed_result(move, status, f"could not return to the current face: {self._why}")
