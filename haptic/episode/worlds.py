@@ -161,10 +161,11 @@ class PhysicsWorld:
         settings = PhysicsSettings()
         executor = PhysicsExecutor(RobotInterface(sim), bounds=bounds, costs=config.costs, rng=exec_rng,
                                    settings=settings)  # fmt: skip
-        # the circle the executor makes; the concave edges' ends it can tell
+        # the circle the executor makes; the concave edges' ends it can tell; no move from a concave vertex
         clearance = max(config.min_vertex_clearance, settings.crossing_clearance)
         config = replace(config, vertex_radius=settings.vertex_radius, min_vertex_clearance=clearance,
-                         concave_end_block=config.concave_end_block or settings.min_block_cos)  # fmt: skip
+                         concave_end_block=config.concave_end_block or settings.min_block_cos,
+                         leave_concave_vertices=False)  # fmt: skip
         results: list[MoveResult] = []  # every move's result, for scoring perception
 
         def keep(*args) -> None:

@@ -51,6 +51,12 @@ class PlannerConfig:
     where the surface falls away the pad in the corner rolls on along the two faces' rims, so an edge move
     toward it locates no vertex and counts as refused (set for the physics executor). None: every end is
     located (a point sensor)."""
+    leave_concave_vertices: bool = True
+    """Whether an edge or vertex move may start at a vertex where a concave edge ends. On the hand (False) the
+    12 mm pad resting there touches the face across the concave edge: acquiring the ridge, or circling the vertex
+    8 mm out, ends at the limit (in the logged verification moves over the non-convex seed episodes, 0 of 8 such
+    edge moves and 0 of 17 such vertex moves succeeded, against 12 of 12 and 14 of 14 from other vertices), so
+    they count as refused."""
     touch_evidence: bool = False
     """Every touched point is checked against each pose class's surface (the episode does so with the
     physics executor's traces), so a face move that cannot step onto its next face still tells how far its

@@ -95,11 +95,13 @@ def table_conflict(
     """Whether hypothesis ``h`` predicts ``move`` to bring the pad onto the table (1.0), not (0.0), or cannot
     say (NaN): a face move sliding down to an edge within the pad's reach of the table or stepping onto a face
     the table hides; a vertex move whose circle, before it meets the next edge, would put the pad on the table,
-    or whose next face the table hides. Edge moves are never refused (one running down to the table ends at
-    the vertex the table blocks, which the executor finds). A workspace prior (``config.table_z``) with the
-    hypothesis's own pose; 0.0 without a table. With ``config.max_undercut``, a vertex move stepping over a
-    convex edge onto a face that leans under further than the pad reaches counts too (a face move doing so
-    ends at the edge instead: :attr:`~haptic.planning.predict.Prediction.edge_only`)."""
+    or whose next face the table hides; an edge move toward an end the hand cannot locate
+    (:func:`edge_end_on_table`, :func:`hidden_concave_end`); an edge or vertex move from a vertex that ends a
+    concave edge, where ``config.leave_concave_vertices`` is False (the hand: :func:`at_concave_vertex`). A
+    workspace prior (``config.table_z``) with the hypothesis's own pose; 0.0 without a table. With
+    ``config.max_undercut``, a vertex move stepping over a convex edge onto a face that leans under further than
+    the pad reaches counts too (a face move doing so ends at the edge instead:
+    :attr:`~haptic.planning.predict.Prediction.edge_only`)."""
     return table_prediction(h, move, state, components, config)[0]
 
 
@@ -147,7 +149,7 @@ def table_prediction(
         # refused toward an end where the pad on the ridge would meet the table first (a motion the table stops
         # locates no vertex), or toward a concave edge's end the hand cannot tell (config.concave_end_block)
         refused = edge_end_on_table(h, move, state, components, config) or hidden_concave_end(
-            h, move, state, components, config)
+            h, move, state, components, config) or at_concave_vertex(h, state, config)
         return float(refused), np.nan, np.nan
     if isinstance(move, VertexMove):
         e_m = h.edges.get(state.edge) if state.edge is not None else None
@@ -155,6 +157,8 @@ def table_prediction(
         a_m = h.faces.get(move.across_face)
         if e_m is None or v_m is None or a_m is None:
             return np.nan, np.nan, np.nan
+        if at_concave_vertex(h, state, config):
+            return 1.0, np.nan, np.nan
         try:
             hit = circle_vertex(poly, v_m, e_m, a_m, config.vertex_radius)
         except ValueError:
@@ -218,6 +222,15 @@ def hidden_concave_end(
     own = {int(poly.edge_left_face[e_m]), int(poly.edge_right_face[e_m])}
     return not any(float(poly.face_normals[f] @ u) < -config.concave_end_block
                    for f in poly.vertex_faces[v] if int(f) not in own)  # fmt: skip
+
+
+def at_concave_vertex(h: Hypothesis, state: SensorState, config: PlannerConfig) -> bool:
+    """Whether the sensor is at a vertex of ``h`` where a concave edge ends and moves may not start there
+    (:attr:`PlannerConfig.leave_concave_vertices` False: the hand)."""
+    if config.leave_concave_vertices or state.vertex is None:
+        return False
+    v_m = h.vertices.get(state.vertex)
+    return v_m is not None and any(h.poly.edge_convexity[e] < 0 for e in h.poly.vertex_edges[v_m])
 
 
 def _vertex_frame(

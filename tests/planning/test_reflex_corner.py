@@ -78,3 +78,28 @@ def test_off_the_hand_the_corner_is_aimed_at_as_any_vertex():
     missing = (frozenset(), frozenset(), frozenset({REFLEX}))
     assert [m.direction.tolist() for m in aimed_face_moves(h, state, comps, missing)] == [
         m.direction.tolist() for m in aimed_face_moves(h, state, comps, missing, PlannerConfig())]
+
+
+def test_no_edge_or_vertex_move_starts_at_the_corners_vertex_on_the_hand():
+    """The sensor at the corner's vertex 3 (the concave edge 11 ends there) on the convex edge 10: on the hand
+    (``leave_concave_vertices`` False) an edge move away along edge 10 and a vertex move round the corner count as
+    refused (the pad resting there touches wall 5); at the edge's other end, vertex 2, and off the hand, not."""
+    from dataclasses import replace
+
+    from haptic.planning.moves import VertexMove
+    from haptic.planning.table import at_concave_vertex
+
+    hand = replace(HAND, leave_concave_vertices=False)
+    h, _, _ = _in_the_corner(0.02)
+    poly, pose = h.poly, h.world_from_model
+    a, b = (pose.apply(poly.vertices[v]) for v in poly.edges[TOP_EDGE])
+    edge = DataEdge(2, (b - a) / np.linalg.norm(b - a), a, float(np.linalg.norm(b - a)), 1e-2, 1e-3, 1e-3)
+    face = DataFace(1, pose.rotate(poly.face_normals[WALL]), np.array([a, b, 0.5 * (a + b)]), 1e-2, 1e-3)
+    comps = {1: face, 2: edge}
+    for v, refused in ((REFLEX, True), (int(poly.edges[TOP_EDGE][0] + poly.edges[TOP_EDGE][1]) - REFLEX, False)):
+        hv = Hypothesis("LBLOCK01", poly, pose, {1: WALL}, {2: TOP_EDGE}, {5: v})
+        at = SensorState(pose.apply(poly.vertices[v]), face=1, edge=2, vertex=5, edge_faces=(1,))
+        assert at_concave_vertex(hv, at, hand) == refused and not at_concave_vertex(hv, at, HAND)
+        away = 1 if int(poly.edges[TOP_EDGE][0]) == v else -1  # the data edge runs along the model edge
+        for move in (EdgeMove(away), VertexMove(1)):
+            assert (table_conflict(hv, move, at, comps, hand) == 1.0) == refused, (v, move)
