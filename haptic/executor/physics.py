@@ -59,7 +59,6 @@ from haptic.planning.moves import (
     in_plane,
 )
 from haptic.planning.table import VERTEX_START_ANGLE
-from haptic.planning.tour import CONCAVE_STEP_OFF
 from haptic.sim.robot import RobotInterface
 from haptic.sim.scene import TABLE_TOP_Z
 
@@ -159,9 +158,6 @@ class PhysicsSettings:
     """The planner's least distance from a face move's crossing to the nearest vertex on the hand
     (``PlannerConfig.min_vertex_clearance``, preferred where a move that keeps it exists): nearer, the pad
     (12 mm) rolls round the edge's end or drops into a concave corner past it [m]."""
-    concave_step_off: float = CONCAVE_STEP_OFF
-    """A face move that starts on a concave edge (the pad in the corner, touching both faces) first touches its
-    face this far beyond the pad's radius in from the edge; the planner aims it from there [m]."""
     recross_shift: float = 0.006
     """A face move whose roll went round the edge's end (its normals leaning along the edge) crosses again this
     much farther inside the edge (plus how far the pad overshot the end) ... [m]"""
@@ -503,17 +499,9 @@ class PhysicsExecutor(LandingSearch):
         inplane = in_plane(d, n_a)
         if inplane is None:
             return self.invalid_result(move, "direction is not in the plane of the current face")
-        rec = seg.edges.get(st.edge) if st.edge is not None else None
-        stepped = "no"
-        if rec is not None and not rec.convex and st.face in rec.inward:
-            # the pad in a concave corner touches both faces: the trace would meet the edge it starts on at once
-            on_line = rec.at(rec.param(self.contact_point()))
-            start = on_line + (t.pad_radius + self.settings.concave_step_off) * rec.inward[st.face]
-            stepped = self._touch_face(st.face, n_a, start, pieces)  # a face narrower there: from where it is
-        if stepped != "ok":
-            status = self._ensure_on_face(st.face, pieces)
-            if status != "ok":
-                return self.failed_result(move, status, f"could not return to the current face: {self._why}")
+        status = self._ensure_on_face(st.face, pieces)
+        if status != "ok":
+            return self.failed_result(move, status, f"could not return to the current face: {self._why}")
         for attempt in range(2):
             r = t.trace_face(inplane, n_a, self.settings.max_face_trace)
             pieces.append(r)

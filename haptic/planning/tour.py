@@ -38,9 +38,9 @@ far from a missing vertex [m] (at most a quarter of the edge), so that a short e
 = 1.6 units) measures the vertex, instead of tracing the whole edge to it (§3.1: a face costs half an edge per
 cm)."""
 CONCAVE_STEP_OFF = 3e-3
-"""On the hand a face move that starts on a concave edge (the pad in the corner, touching both faces) first touches
-its face this far beyond the pad's radius in from the edge, and is aimed from there
-(:func:`haptic.planning.verify.aimed_face_moves`, ``PhysicsSettings.concave_step_off``) [m]."""
+"""On the hand a face move that starts on a concave edge starts where the pad rests in the corner, touching both
+faces: its contact on the current face lies the pad's radius in from the edge's line. The verifier aims such a
+move from there, this much farther in (:func:`haptic.planning.verify.aimed_face_moves`) [m]."""
 PROBE_INSET = 0.01
 """A verification probe aims at a point of a face this far from both edges at the missing vertex [m]: the hand's
 contact stays clear of the face's boundary (:func:`~haptic.planning.handpath.foot_near_boundary`), and an aimed

@@ -155,7 +155,8 @@ def aimed_face_moves(
     touches both faces, and the move ends on that edge), and those on the convex edges the pad's radius
     farther from the vertex (at most half the edge): nearer, the pad rolling over the edge touches the face
     across the corner too; from a concave edge the move is aimed from where it starts on the hand,
-    :data:`~haptic.planning.tour.CONCAVE_STEP_OFF` beyond the pad's radius in from the edge; and a target along
+    :data:`~haptic.planning.tour.CONCAVE_STEP_OFF` beyond the pad's radius in from the edge (the pad resting in the
+    corner touches both faces: its contact on this one lies about the pad's radius in); and a target along
     that edge is kept where the edge move toward it is refused (its end hidden: the surface falls away past it),
     else it is an edge move's business. The edge move from where such a move ends runs into the corner, which
     blocks the pad at the vertex."""

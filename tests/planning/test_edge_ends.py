@@ -67,4 +67,3 @@ def test_a_convex_edge_is_never_taken_for_a_hidden_concave_end():
     for sense in (1, -1):
         assert not hidden_concave_end(h, EdgeMove(sense), state, comps, HAND)
         assert table_conflict(h, EdgeMove(sense), state, comps, HAND) == 0.0
-

@@ -43,7 +43,7 @@ def _in_the_corner(height: float):
 
 def test_a_reflex_corners_vertex_is_aimed_at_beside_the_corner_and_an_edge_move_reaches_it():
     """From low on the concave edge (its hidden top end refused to an edge move) and from near its top, the move
-    aimed at the corner's vertex, started where the hand starts it (stepped off the concave edge), ends on the
+    aimed at the corner's vertex, started where the pad rests in the corner (its radius in from the edge), ends on the
     convex edge along the wall's top more than the pad's radius from the corner (nearer, the pad touches the wall
     across the corner and the move ends on the concave edge), and an edge move from there, not refused,
     measures the vertex."""
