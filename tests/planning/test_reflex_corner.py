@@ -103,3 +103,41 @@ def test_no_edge_or_vertex_move_starts_at_the_corners_vertex_on_the_hand():
         away = 1 if int(poly.edges[TOP_EDGE][0]) == v else -1  # the data edge runs along the model edge
         for move in (EdgeMove(away), VertexMove(1)):
             assert (table_conflict(hv, move, at, comps, hand) == 1.0) == refused, (v, move)
+
+
+def test_in_a_slot_the_move_out_of_the_corner_keeps_the_pad_off_the_far_wall():
+    """BOX01N standing on an end face with its slot upright (seed 2 of the physics benchmark): 30 mm wide for the
+    24 mm pad. From the slot's floor against one concave edge (its data point on the edge's line), the move aimed
+    at the floor's top corners, the slot's reflex corners on the top face, is aimed from where the pad rests (its
+    radius in from the edge): it heads up the floor, and the pad's centre on the way to the top edge keeps clear
+    of the far wall. Aimed from the edge's line it heads diagonally into that wall."""
+    poly = LIB["BOX01N"]
+    floor, near_edge, far_wall, top_edge = 6, 17, 7, 4
+    assert poly.edge_convexity[near_edge] < 0 < poly.edge_convexity[top_edge]
+    assert {int(poly.edge_left_face[near_edge]), int(poly.edge_right_face[near_edge])} == {floor, 5}
+    # model y (the slot's length) up, the face y = 0.08 on the table
+    pose = SE3(np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]]),
+               np.array([0.55, 0.0, TABLE_Z + 0.08]))  # fmt: skip
+    assert np.isclose(pose.apply(poly.vertices)[:, 2].min(), TABLE_Z)
+    n = pose.rotate(poly.face_normals[floor])
+    a, b = (pose.apply(poly.vertices[v]) for v in poly.edges[near_edge])
+    lo, hi = (a, b) if a[2] < b[2] else (b, a)
+    loop = poly.vertices[list(poly.faces[floor])]
+    face = DataFace(1, n, pose.apply(loop.mean(axis=0) + 0.3 * (loop - loop.mean(axis=0))), 1e-2, 1e-3)
+    edge = DataEdge(2, (hi - lo) / np.linalg.norm(hi - lo), lo, float(np.linalg.norm(hi - lo)), 1e-2, 1e-3, 1e-3)
+    h = Hypothesis("BOX01N", poly, pose, {1: floor}, {2: near_edge}, {})
+    on_line = lo + 0.03 * edge.direction  # 30 mm up from the table
+    state = SensorState(on_line, face=1, edge=2, edge_faces=(1,))
+    missing = (frozenset(), frozenset(), frozenset(int(v) for v in poly.edges[top_edge]))
+    moves = aimed_face_moves(h, state, {1: face, 2: edge}, missing, HAND)
+    assert moves
+    inward = pose.rotate(_inward(poly, near_edge, floor))
+    rest = on_line + HAND.pad_radius * inward
+    wall_n, wall_p = pose.rotate(poly.face_normals[far_wall]), pose.apply(poly.vertices[poly.faces[far_wall][0]])
+    top = pose.apply(poly.vertices[poly.edges[top_edge][0]])[2]
+    for m in moves:
+        assert m.direction[2] > 0
+        travel = (top - rest[2]) / m.direction[2]
+        path = rest + np.linspace(0.0, travel, 20)[:, None] * m.direction
+        gap = (path - wall_p) @ wall_n  # the pad centre's distance from the far wall's plane
+        assert gap.min() > HAND.pad_radius - 0.5e-3, (m.direction, gap.min())
