@@ -183,6 +183,31 @@ def test_a_roll_round_a_vertex_leans_along_the_edge_more_than_the_noise_allows()
     assert why is not None and "more than the noise allows" in why
 
 
+def test_a_roll_round_a_vertex_close_to_the_arc_between_the_faces_still_leans_one_way_on_average():
+    # a roll round a vertex whose normals follow the arc from one face's normal to the other's, bulging 1.8°
+    # along n_a × n_b on the way: its median |n · e| passes the median's test (hull_00 at 110 mm: 1.56° against
+    # 1.73°), but the normals lean to one side on average, which a roll over the edge between them does not
+    top, side = np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0])
+    edge_pt = np.array([0.0, 0.01, 0.0])
+    fa, fb = _plane(top, np.array([-0.01, 0.0, 0.0])), _plane(side, np.array([0.0, 0.0, -0.01]))
+    rng = np.random.default_rng(6)
+    seg, bounds = Segmenter(), SegmentBounds()
+    e = np.array([0.0, 1.0, 0.0])
+    for bulge_deg, is_edge in ((0.0, True), (1.8, False)):
+        roll = _roll(e, top, side, edge_pt)
+        turn = np.arccos(np.clip(roll.normal_in_world @ top, -1.0, 1.0))
+        n = roll.normal_in_world + math.radians(bulge_deg) * np.sin(np.pi * turn / (np.pi / 2))[:, None] * e
+        n = n + math.radians(1.0) * rng.normal(size=n.shape)
+        n /= np.linalg.norm(n, axis=1, keepdims=True)
+        between = (n @ top < math.cos(bounds.sample_cone)) & (n @ side < math.cos(bounds.sample_cone))
+        noise = 0.6745 * math.hypot(bounds.normal_sigma, bounds.normal_floor)
+        assert float(np.median(np.abs(n[between] @ e))) < bounds.roll_skew_sigmas * noise  # passes the median
+        traced = ContactTrace(roll.time, roll.tip_in_world, roll.hand_rotation, roll.point_in_world, n, roll.force,
+                              roll.phase)  # fmt: skip
+        why = seg.edge_inconsistency(fa, fb, True, traced)
+        assert (why is None) == is_edge, why
+
+
 def test_rows_where_the_pad_begins_to_roll_over_the_edge_do_not_tilt_the_face():
     # a stroke 10 mm across a face (z up) that ends rolling over its edge at x = 10 mm: the last rows turn
     # toward the next face by up to 3.9 degrees, inside the face cone, as on the narrow faces of an antiprism
