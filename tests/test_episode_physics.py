@@ -154,13 +154,13 @@ def test_a_concave_edge_whose_end_the_pad_rolls_past_reports_no_vertex(tmp_path)
 
 
 def test_a_face_move_that_rolls_round_a_vertex_reports_no_edge(tmp_path):
-    # bipyramid_06 of the formula corpus at 60 mm across, seed 1 when found, seed 5 since face moves prefer to cross
-    # their edges 6 mm from a vertex (perception_report.py --corpus --sizes 60): a face
+    # bipyramid_06 of the formula corpus at 60 mm across, seed 1 when found (perception_report.py --corpus
+    # --sizes 60), seed 2 since faces are fitted from their steady rows (the trajectories differ): a face
     # move rolled round the apex onto a face sharing no edge with the first; the "edge" reported between them
     # (n_a × n_b through the apex) lay 36 mm off every true edge (48 bounds) and the episode ended no-match.
     # The rolling normals leaned along that line more than the noise allows: no edge is reported (the move
     # then crosses again inside the edge, or fails).
-    ep, failed, results = _replay(tmp_path, "bipyramid_06", 0.06, 11, corpus=True, seed=5)
+    ep, failed, results = _replay(tmp_path, "bipyramid_06", 0.06, 11, corpus=True, seed=2)
     said = [r.reason for r in failed] + [x for r in results for x in (r.info or {}).get("recoveries", ())]
     assert any("more than the noise allows" in x for x in said), said
     assert _within_bounds(ep)

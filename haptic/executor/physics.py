@@ -37,6 +37,7 @@ from haptic.executor.segment import (
     face_rows,
     fit_face,
     line_from_points,
+    steady_rows,
 )
 from haptic.executor.touch_config import TouchConfig
 from haptic.executor.workspace import ReentrySearch, Workspace, admissible_moves, toward_vertex
@@ -314,6 +315,7 @@ class PhysicsExecutor(LandingSearch):
             ok = extra.in_contact
             keep = ok & (np.where(ok[:, None], extra.normal_in_world, 0.0) @ n0 > math.cos(self.bounds.face_cone))
             keep &= extra.phase != PHASES.index("roll")
+            keep = steady_rows(extra, keep, self.bounds)
             if keep.sum():
                 pts = np.vstack([pts, extra.point_in_world[keep]])
                 nrm = np.vstack([nrm, extra.normal_in_world[keep]])
@@ -322,6 +324,7 @@ class PhysicsExecutor(LandingSearch):
     def store_face(self, fid: int, trace: ContactTrace, fit: FaceFit) -> None:
         """Keep the rows of ``trace`` on data face ``fid`` (those within the face cone of its fit ``fit``)."""
         mask = face_rows(trace, fit.normal, self.bounds.face_cone, self.bounds.min_refine_rows)
+        mask = steady_rows(trace, mask, self.bounds)
         pts, nrm = trace.point_in_world[mask], trace.normal_in_world[mask]
         self._faces[fid] = _FaceData(pts, nrm, pts[-1].copy())
 

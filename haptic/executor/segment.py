@@ -96,6 +96,12 @@ class SegmentBounds:
     """A line fit of contact points along an edge (the ridge) counts with at least this many points ..."""
     min_line_spread: float = 2e-3
     """... spread (rms) at least this far along it [m]."""
+    line_spacing: float = 1e-3
+    """Contact points along an edge are not independent samples: the pad's path wanders across the ridge (and
+    its contact point with it, the more the shallower the edge) over about this length, so a line fit counts
+    one independent point per this much of its extent. Counting every control tick, a ridge trace 15 mm long
+    of 220 rows whose points lie 0.6 mm off a straight line claimed its direction to 0.5° and pulled the edge
+    2-3° off, past its bound [m]."""
     fit_agreement_sigmas: float = 5.0
     """A point fit (plane, line) is combined with the normals' estimate when they agree within this many σ ..."""
     fit_agreement_slack: float = math.radians(1.0)
@@ -126,8 +132,22 @@ class SegmentBounds:
     (0.051 on bipyramid_06 at 60 mm, whose "edge" then lay 36 mm off every true edge), though less than
     :attr:`max_roll_skew`: a median beyond this many times the noise's (``0.67 √(σn² + floor²)``) is no roll over
     the edge between the faces [-]."""
+    roll_lean_sigmas: float = 3.0
+    """The same on average: over a true edge the mean of ``n · e`` (signed) is the noise's mean over the rolling
+    rows (σn / √n) and a systematic lean of at most the normal's floor (0.02-0.35° over 63 true edges of convex
+    solids at 60-150 mm), while a roll round a vertex that follows the arc from one face's normal to the other's
+    closely enough to pass the median's test still leans one way (1.1-1.5° on 4 of 6 such rolls, whose "edges" lay
+    20-50° off every true edge). A mean beyond this many times ``√(σn² / n + floor²)`` is no roll over the edge
+    between the faces [-]."""
     min_skew_rows: int = 9
     """... tested with at least this many rolling contacts [-]."""
+    steady_window: int = 9
+    """A face's rows hold a steady normal: averaged over this many consecutive rows, the sensor's noise drops by
+    its square root, while a pad that starts to roll over an edge (the last rows of a trace across the face,
+    within :attr:`face_cone` of it for the first few degrees) turns its normal steadily to one side [-] ..."""
+    steady_sigmas: float = 3.0
+    """... and a row whose averaged normal lies more than this many of that average's σ (with
+    :attr:`normal_floor`) from the face's is dropped from the face's fit [-]."""
     max_roll_offset: float = 2e-3
     """The contact points of a roll over a convex edge lie on the edge, hence on both faces' planes; a roll
     farther than this (median) from either plane was not over the edge between them [m]."""
@@ -203,6 +223,35 @@ def face_rows(
     if mask.sum() >= min_rows:
         mask = ok & (n @ unit(n[mask].sum(axis=0)) > c)
     return mask
+
+
+def steady_rows(trace: ContactTrace, mask: np.ndarray, bounds: SegmentBounds) -> np.ndarray:
+    """Of a face's rows ``mask`` (time order), those whose normal holds steady: the running mean of
+    :attr:`~SegmentBounds.steady_window` rows lies within :attr:`~SegmentBounds.steady_sigmas` of its σ of the
+    face's normal (the mean of the rows kept, from their median). Rows where the pad began to roll over an edge
+    turn the running mean off to one side, so that a face fitted from them is tilted toward the next face (up to
+    1.3° on a narrow face, past its bound) though every row lies within the face cone. ``mask`` itself when
+    fewer rows than a window, or fewer than :attr:`~SegmentBounds.min_face_rows`, would be kept."""
+    idx = np.flatnonzero(mask)
+    w = bounds.steady_window
+    if len(idx) < max(w, bounds.min_face_rows):
+        return mask
+    n = trace.normal_in_world[idx]
+    half = w // 2
+    padded = np.concatenate([np.repeat(n[:1], half, axis=0), n, np.repeat(n[-1:], w - 1 - half, axis=0)])
+    c = np.concatenate([np.zeros((1, 3)), np.cumsum(padded, axis=0)])
+    run = c[w:] - c[:-w]
+    run /= np.linalg.norm(run, axis=1)[:, None]
+    cut = math.cos(bounds.steady_sigmas * math.sqrt(bounds.normal_sigma**2 / w + bounds.normal_floor**2))
+    centre = unit(np.median(run, axis=0))
+    for _ in range(2):
+        keep = run @ centre >= cut
+        if keep.sum() < bounds.min_face_rows:
+            return mask
+        centre = unit(n[keep].sum(axis=0))
+    out = np.zeros_like(mask)
+    out[idx[keep]] = True
+    return out
 
 
 def fit_face(points: np.ndarray, normals: np.ndarray, bounds: SegmentBounds) -> FaceFit:
@@ -289,7 +338,9 @@ def line_from_points(
         if length_rms > bounds.min_line_spread:
             b_fit = vt[0] if vt[0] @ b > 0 else -vt[0]
             resid = math.hypot(sv[1], sv[2]) / math.sqrt(len(points))
-            s_fit = max(resid, bounds.point_sigma) / (length_rms * math.sqrt(len(points)))
+            # independent points: one per line_spacing of the points' extent (rms × √12 for an even spread)
+            n_eff = min(len(points), max(2.0, length_rms * math.sqrt(12.0) / bounds.line_spacing))
+            s_fit = max(resid, bounds.point_sigma) / (length_rms * math.sqrt(n_eff))
             if bounds.agree(b_fit, b, math.hypot(s_fit, s_b)):
                 w1, w2 = 1.0 / s_b**2, 1.0 / s_fit**2
                 b = unit(w1 * b + w2 * b_fit)
@@ -393,7 +444,8 @@ class Segmenter:
         spread = float(np.sqrt(np.mean(np.sum((normals - mean) ** 2, axis=1))))  # rms angle [rad]
         if spread > self.bounds.max_spread_sigmas * self.bounds.normal_sigma + self.bounds.spread_slack:
             return None  # the rows do not come from one plane (a roll, a vertex)
-        return fit_face(trace.point_in_world[mask], normals, self.bounds)
+        mask = steady_rows(trace, mask, self.bounds)
+        return fit_face(trace.point_in_world[mask], trace.normal_in_world[mask], self.bounds)
 
     def add_face(self, fit: FaceFit, adjacent: tuple[int, ...] = ()) -> DataFace:
         b = self.bounds
@@ -498,6 +550,12 @@ class Segmenter:
         if between.sum() >= b.min_skew_rows and skew > b.roll_skew_sigmas * noise:
             return (f"the rolling normals lean {math.degrees(skew):.1f}° along the edge between the faces, more than "
                     "the noise allows (a roll round a vertex)")  # fmt: skip
+        lean = abs(float(np.mean(n[between] @ e)))
+        if between.sum() >= b.min_skew_rows and lean > b.roll_lean_sigmas * math.hypot(
+            b.normal_sigma / math.sqrt(float(between.sum())), b.normal_floor
+        ):
+            return (f"the rolling normals lean {math.degrees(lean):.1f}° along the edge between the faces on average, "
+                    "more than the noise allows (a roll round a vertex)")  # fmt: skip
         if convex:
             q = pts[between]
             off = max(float(np.median(np.abs(q @ fit_a.normal - fit_a.offset))),
