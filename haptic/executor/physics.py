@@ -322,7 +322,8 @@ class PhysicsExecutor(LandingSearch):
         return fit_face(pts, nrm, self.bounds)
 
     def store_face(self, fid: int, trace: ContactTrace, fit: FaceFit) -> None:
-        """Keep the rows of ``trace`` on data face ``fid`` (those within the face cone of its fit ``fit``)."""
+        """Keep the rows of ``trace`` on data face ``fid`` (those within the face cone of its fit ``fit`` whose
+        normal holds steady, :func:`~haptic.executor.segment.steady_rows`)."""
         mask = face_rows(trace, fit.normal, self.bounds.face_cone, self.bounds.min_refine_rows)
         mask = steady_rows(trace, mask, self.bounds)
         pts, nrm = trace.point_in_world[mask], trace.normal_in_world[mask]
