@@ -167,9 +167,11 @@ def _line_angle(a: np.ndarray, b: np.ndarray) -> float:
 _LOOPS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
-def _face_loop(poly: Polyhedron, face: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """A face's sides as arrays (cached per model): start vertices ``a`` (K, 3), side vectors (K, 3), edge ids
-    and the faces beyond them (K,), in loop order (as :func:`~haptic.geometry.tracing.trace_face` walks them)."""
+def _face_loop(poly: Polyhedron, face: int) -> tuple[np.ndarray, ...]:
+    """A face's sides as arrays (cached per model), in loop order (as :func:`~haptic.geometry.tracing.trace_face`
+    walks them): start vertices ``a`` (K, 3), side vectors (K, 3), edge ids and the faces beyond them (K,); then,
+    per side, its edge's direction and source point (K, 3) and length (K,), the signed dihedral angle from this
+    face to the one beyond (:func:`_signed_dihedral`) and the side's length (K,)."""
     per = _LOOPS.setdefault(poly, {})
     if face not in per:
         loop = poly.faces[face]
@@ -177,7 +179,10 @@ def _face_loop(poly: Polyhedron, face: int) -> tuple[np.ndarray, np.ndarray, np.
         seg = np.roll(a, -1, axis=0) - a
         edges = np.asarray(poly.face_edges[face], dtype=np.int64)
         beyond = np.where(poly.edge_left_face[edges] == face, poly.edge_right_face[edges], poly.edge_left_face[edges])
-        per[face] = (a, seg, edges, beyond)
+        dihedral = np.array([_signed_dihedral(poly, face, int(g), int(e)) for e, g in zip(edges, beyond, strict=True)])
+        side = np.array([math.sqrt(float(s.dot(s))) for s in seg])
+        per[face] = (a, seg, edges, beyond, poly.edge_directions[edges], poly.edge_points[edges],
+                     poly.edge_lengths[edges], dihedral, side)  # fmt: skip
     return per[face]
 
 
@@ -258,7 +263,7 @@ def _first_crossings(start, d, n, a, seg, real, loops, index):
         seg_len = math.sqrt(float(sj.dot(sj)))  # np.linalg.norm's arithmetic (a row: contiguous)
         if min(u[j, b], 1 - u[j, b]) * seg_len < 1e-6:
             continue
-        _, _, edges, beyond = loops[j]
+        _, _, edges, beyond = loops[j][:4]
         tj = float(t[j, b])
         yield int(index[j]), FaceHit(edge=int(edges[b]), distance=tj, point=start[j] + tj * d[j],
                                      next_face=int(beyond[b]))  # fmt: skip
@@ -363,15 +368,20 @@ def predict(
             if isinstance(move, FaceMove):
                 reach = got[:, 1]
                 edge_only = got[:, 2] if config.max_undercut is not None else None
-    costs_arr = np.array(costs, dtype=float)
-    if np.isnan(costs_arr).all():
-        costs_arr[:] = 1.0
+    return _prediction(move, np.array(rows), np.array(costs, dtype=float), np.array(clear, dtype=float), table, reach,
+                       edge_only, noise)  # fmt: skip
+
+
+def _prediction(
+    move: Move, outcomes: np.ndarray, costs: np.ndarray, clear: np.ndarray, table, reach, edge_only, noise: SensorNoise
+) -> Prediction:
+    """The :class:`Prediction`, a cost no hypothesis can say replaced by the mean of those that can (1 when none
+    can)."""
+    if np.isnan(costs).all():
+        costs = np.ones_like(costs)
     else:
-        costs_arr = np.where(np.isnan(costs_arr), np.nanmean(costs_arr), costs_arr)
-    return Prediction(
-        move, np.array(rows), outcome_bounds(noise)[move.kind], costs_arr, np.array(clear, dtype=float), table,
-        reach, edge_only,
-    )
+        costs = np.where(np.isnan(costs), np.nanmean(costs), costs)
+    return Prediction(move, outcomes, outcome_bounds(noise)[move.kind], costs, clear, table, reach, edge_only)
 
 
 def predict_moves(
@@ -382,7 +392,94 @@ def predict_moves(
     noise: SensorNoise,
     config: PlannerConfig,
 ) -> list[Prediction]:
-    """:func:`predict` for each of ``moves``, the face moves traced together (:func:`trace_moves`)."""
+    """:func:`predict` for each of ``moves``; the face moves' outcomes, costs and clearances in every hypothesis
+    at once (:func:`face_outcomes`), their traces (:func:`trace_moves`) only where a table asks for them."""
     faces = [m for m in moves if isinstance(m, FaceMove)]
-    traced = dict(zip(map(id, faces), trace_moves(hypotheses, faces, state), strict=True))
-    return [predict(hypotheses, m, state, components, noise, config, traced.get(id(m))) for m in moves]
+    if config.table_z is not None:
+        traced = dict(zip(map(id, faces), trace_moves(hypotheses, faces, state), strict=True))
+        return [predict(hypotheses, m, state, components, noise, config, traced.get(id(m))) for m in moves]
+    stacked = dict(zip(map(id, faces), face_outcomes(hypotheses, faces, state, config), strict=True))
+    return [
+        _prediction(m, *stacked[id(m)], None, None, None, noise) if id(m) in stacked
+        else predict(hypotheses, m, state, components, noise, config)
+        for m in moves
+    ]  # fmt: skip
+
+
+def face_outcomes(
+    hypotheses: Sequence[Hypothesis], moves: Sequence[FaceMove], state: SensorState, config: PlannerConfig
+) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """Every face move's predicted outcome attributes (N, 3), cost (N,) and crossing clearance (N,) in every
+    hypothesis (NaN where it cannot say), as :func:`predict` forms them from :func:`trace_moves`: the crossings of
+    every move with every side of every hypothesis's current face solved in one array operation over
+    (moves, hypotheses, sides), and the attributes gathered from per-side tables of each model face
+    (:func:`_face_loop`), with no step per hypothesis."""
+    n_h, n_m = len(hypotheses), len(moves)
+    outcomes = np.full((n_m, n_h, 3), np.nan)
+    costs = np.full((n_m, n_h), np.nan)
+    clear = np.full((n_m, n_h), np.nan)
+    rows, starts, rots, normals, loops = [], [], [], [], []
+    for i, h in enumerate(hypotheses):
+        f_m = h.faces.get(state.face)
+        if h.world_from_model is None or f_m is None:
+            continue
+        poly, p_m = h.poly, h.model_from_world.apply(state.position)
+        n = poly.face_normals[f_m]
+        rows.append(i)
+        starts.append(p_m - (p_m @ n - poly.face_offsets[f_m]) * n)
+        rots.append(h.world_from_model.rotation)
+        normals.append(n)
+        loops.append(_face_loop(poly, f_m))
+    if rows and n_m:
+        k = max(len(lp[2]) for lp in loops)
+        m = len(rows)
+        a_all, seg_all = np.zeros((m, k, 3)), np.zeros((m, k, 3))
+        b_all, p_all = np.zeros((m, k, 3)), np.zeros((m, k, 3))
+        len_all, dih_all, seg_len = np.ones((m, k)), np.zeros((m, k)), np.zeros((m, k))
+        real = np.zeros((m, k), dtype=bool)
+        for j, lp in enumerate(loops):
+            s = slice(0, len(lp[2]))
+            a_all[j, s], seg_all[j, s], real[j, s] = lp[0], lp[1], True
+            b_all[j, s], p_all[j, s], len_all[j, s], dih_all[j, s], seg_len[j, s] = lp[4:9]
+        start, n_all = np.array(starts), np.array(normals)
+        dirs = np.array([mv.direction for mv in moves], dtype=float)
+        d_raw = (dirs[:, None, None, :] @ np.array(rots)[None])[:, :, 0]  # (M, m, 3): SE3.rotate's arithmetic
+        d_in = d_raw - (d_raw[..., None, :] @ n_all[None, :, :, None])[..., 0] * n_all[None]
+        norm = np.linalg.norm(d_in, axis=2)
+        use = norm >= 1e-9
+        d = d_in / np.where(use, norm, 1.0)[..., None]
+        # start + t d = a + u seg in the face's plane, for every (move, hypothesis, side)
+        r = a_all - start[:, None]
+        den = np.einsum("Mmkc,mc->Mmk", cross(d[:, :, None], seg_all[None]), n_all)
+        safe = np.where(np.abs(den) > 1e-15, den, 1.0)
+        t = np.einsum("mkc,mc->mk", cross(r, seg_all), n_all)[None] / safe
+        u = np.einsum("Mmkc,mc->Mmk", cross(r[None], d[:, :, None]), n_all) / safe
+        miss = start[None, :, None] + t[..., None] * d[:, :, None] - (a_all + u[..., None] * seg_all)
+        ok = real[None] & (np.abs(den) > 1e-15) & (t > 1e-12) & (u >= -1e-12) & (u <= 1 + 1e-12)
+        ok &= np.linalg.norm(miss, axis=3) <= 1e-7
+        t_ok = np.where(ok, t, np.inf)
+        best = np.argmin(t_ok, axis=2)[..., None]
+        tb = np.take_along_axis(t_ok, best, 2)[..., 0]
+        ub = np.take_along_axis(u, best, 2)[..., 0]
+        hit = use & np.isfinite(tb)
+        hit &= np.minimum(ub, 1 - ub) * np.take_along_axis(np.broadcast_to(seg_len, t.shape), best, 2)[..., 0] >= 1e-6
+
+        def at_best(x: np.ndarray) -> np.ndarray:  # the hit side's entry of a per-side table (m, k[, 3])
+            full = np.broadcast_to(x, (n_m, *x.shape))
+            idx = best if x.ndim == 2 else best[..., None]
+            return np.take_along_axis(full, idx, 2)[:, :, 0]
+
+        b_hit = at_best(b_all)
+        dot = np.abs(np.einsum("Mmc,Mmc->Mm", b_hit, d_raw))
+        cos = dot / (np.sqrt(np.einsum("Mmc,Mmc->Mm", b_hit, b_hit)) * np.sqrt(np.einsum("Mmc,Mmc->Mm", d_raw, d_raw)))
+        point = start[None] + np.where(hit, tb, 0.0)[..., None] * d
+        s_hit = np.einsum("Mmc,Mmc->Mm", point - at_best(p_all), b_hit)
+        c = config.costs
+        mi, hj = np.nonzero(hit)
+        cols = np.array(rows)[hj]
+        outcomes[mi, cols, 0] = tb[mi, hj]
+        outcomes[mi, cols, 1] = np.arccos(np.clip(cos[mi, hj], 0.0, 1.0))
+        outcomes[mi, cols, 2] = at_best(dih_all)[mi, hj]
+        costs[mi, cols] = c.c_f * tb[mi, hj] + c.c_j + c.c_b + c.c_n
+        clear[mi, cols] = np.minimum(s_hit, at_best(len_all) - s_hit)[mi, hj]
+    return [(outcomes[i], costs[i], clear[i]) for i in range(n_m)]

@@ -120,3 +120,53 @@ def test_trace_all_equals_trace_in_for_each_hypothesis():
                 assert abs(a.hit.distance - b.hit.distance) < 1e-12
                 assert np.allclose(a.hit.point, b.hit.point, atol=1e-12)
     assert met > 500
+
+
+def test_face_outcomes_equal_the_predictions_one_hypothesis_at_a_time():
+    """The face moves' outcomes, costs and clearances stacked over (moves, hypotheses, sides) are each hypothesis's
+    own prediction (:func:`predict` from its :func:`trace_in`), hypotheses that cannot say included."""
+    from haptic.geometry import tracing
+    from haptic.geometry.generate import generate_library
+    from haptic.planning.moves import FaceMove, SensorState
+    from haptic.planning.hypothesis import trace_in
+    from haptic.planning.predict import face_outcomes, predict_moves
+
+    models = generate_library(12, seed=5)
+    rng = np.random.default_rng(1)
+    pos = np.array([0.01, 0.02, 0.03])
+    hyps = []
+    for _ in range(120):
+        m = models[int(rng.integers(len(models)))]
+        f = int(rng.integers(m.n_faces))
+        q = tracing.random_face_point(m, f, rng, margin=0.002)
+        r = SE3.random(rng).rotation
+        hyps.append(Hypothesis(m.name, m, SE3(r, pos - r @ q), {0: f}, {}, {}))
+    hyps.insert(7, Hypothesis("none", models[0], None, {0: 0}, {}, {}))
+    hyps.insert(9, Hypothesis("unmatched", models[1], hyps[0].world_from_model, {}, {}, {}))
+    state = SensorState(position=pos, face=0)
+    config = PlannerConfig()
+    moves = []
+    for _ in range(6):
+        d = rng.normal(size=3)
+        moves.append(FaceMove(d / np.linalg.norm(d)))
+    said = 0
+    for move, (out, cost, clear) in zip(moves, face_outcomes(hyps, moves, state, config), strict=True):
+        for i, h in enumerate(hyps):
+            one, c1 = predict_one(h, move, state, {}, config)
+            assert np.array_equal(np.isnan(out[i]), np.isnan(one))
+            assert np.allclose(out[i], one, rtol=0, atol=1e-12, equal_nan=True)
+            assert np.isclose(cost[i], c1, rtol=0, atol=1e-12, equal_nan=True)
+            tr = trace_in(h, move, state)
+            assert (tr is None) == np.isnan(clear[i])
+            if tr is not None:
+                assert abs(clear[i] - tr.clearance(h.poly)) < 1e-12
+                said += 1
+    assert said > 300
+    # the predictions predict_moves forms from them are those of predict, move by move
+    from haptic.planning.predict import predict
+
+    for p in predict_moves(hyps, moves, state, {}, SensorNoise(), config):
+        q = predict(hyps, p.move, state, {}, SensorNoise(), config)
+        assert np.allclose(p.outcomes, q.outcomes, rtol=0, atol=1e-12, equal_nan=True)
+        assert np.allclose(p.costs, q.costs, rtol=0, atol=1e-12) and np.array_equal(p.bounds, q.bounds)
+        assert np.allclose(p.clearance, q.clearance, rtol=0, atol=1e-12, equal_nan=True)
