@@ -148,3 +148,72 @@ def test_pose_grouping_with_the_centroids_placed_once_is_the_same():
         _same_pose_as(a, rot, trans, poly, tol), _same_pose_as(a, rot, trans, poly, tol, placed)
     )
     assert _same_pose_as(a, rot, trans, poly, tol).sum() >= 2
+
+
+def test_pose_classes_from_all_pairs_at_once_are_those_of_one_class_at_a_time(monkeypatch):
+    """The grouping that compares every pair of a model's poses in one array gives the classes that comparing each
+    class's first pose with the poses left gives (the same members in the same order), symmetric models, near
+    poses and poses equal up to a symmetry included."""
+    import haptic.matching.recognition as recognition
+    from haptic.geometry import load_library
+    from haptic.geometry.se3 import SE3
+
+    lib = load_library()
+    models = [lib["BOX01"], lib["WEDGE01"], lib["TETRA01L"]]
+    rng = np.random.default_rng(9)
+    merged = 0
+    for _ in range(20):
+        n = int(rng.integers(2, 60))
+        index = rng.integers(0, len(models), size=n)
+        poses = []
+        for i in range(n):
+            if i and rng.random() < 0.4:  # a pose of an earlier one, moved a little or by a symmetry
+                j = int(rng.integers(i))
+                index[i] = index[j]
+                sym = recognition.model_symmetries(models[index[i]])
+                p = poses[j] @ sym[int(rng.integers(len(sym)))]
+                from haptic.matching.batch_poses import exp_so3
+
+                small = exp_so3(rng.normal(size=3) * float(rng.choice([1e-3, 0.05])))
+                turn = SE3(small, rng.normal(size=3) * 1e-3)
+                poses.append(turn @ p)
+            else:
+                poses.append(SE3(random_rotation(rng), rng.normal(size=3) * 0.02))
+        tol = PoseTolerance(np.deg2rad(3.0), 0.003)
+        per_model = [models[k] for k in index]
+        pairs = recognition._group(per_model, index, poses, tol)
+        monkeypatch.setattr(recognition, "MAX_PAIRS", 0)
+        one_by_one = recognition._group(per_model, index, poses, tol)
+        monkeypatch.undo()
+        assert pairs == one_by_one
+        merged += n - len(pairs)
+    assert merged > 20  # poses did share classes
+
+
+def test_poses_from_the_kept_problems_of_every_leaf_equal_poses_built_afresh(small_library):
+    """The matcher's verdict poses every leaf and then refines one per class from the problems of every leaf it
+    keeps: the same poses, to the last bit, as a tree that builds each request's problems afresh."""
+    from haptic.matching.recognition import recognize
+
+    env = ExploreEnv(models=small_library, verify="none")
+    checked = 0
+    for seed in range(1, 30):
+        env.reset(seed=seed)
+        ctx = env.context
+        if ctx is None or ctx.tree is None or not ctx.tree.count:
+            continue
+        tree = ctx.tree
+        fresh = tree.copy()
+        fresh._stacked = fresh._build_stacked  # no problems kept
+        rec = recognize(tree, max_interpretations=4000)
+        leaves = [c.leaves[0] for c in rec.classes]
+        for refine in (False, True):
+            kept = tree.poses(range(tree.count) if not refine else leaves, refine=refine)
+            new = fresh.poses(range(tree.count) if not refine else leaves, refine=refine)
+            for a, b in zip(kept, new, strict=True):
+                assert (a is None) == (b is None)
+                if a is not None:
+                    np.testing.assert_array_equal(a.rotation, b.rotation)
+                    np.testing.assert_array_equal(a.translation, b.translation)
+                    checked += 1
+    assert checked > 50

@@ -138,17 +138,51 @@ def _same_pose_as(
     return near.any(axis=0)
 
 
+MAX_PAIRS = 2_000_000
+"""Most (pose, symmetry, pose) triples of one model that :func:`_group` compares in one array; a model with more
+poses than that allows is grouped one class at a time."""
+
+
+def _same_pose_pairs(
+    rot: np.ndarray, trans: np.ndarray, placed: np.ndarray, model: Polyhedron, tol: PoseTolerance
+) -> np.ndarray:
+    """``same[i, j]``: pose ``j`` equals pose ``i`` up to a symmetry of the model (:func:`_same_pose_as` of pose
+    ``i`` and every pose, for every ``i`` at once); ``rot`` (N, 3, 3), ``trans`` (N, 3) and ``placed`` (N, 3), the
+    centroid placed by each pose."""
+    c = model.centroid
+    s_rot, s_trans = _symmetry_arrays(model)
+    r_as = rot[:, None] @ s_rot[None]  # (N, S, 3, 3): pose i ∘ symmetry s
+    c_as = r_as @ c + s_trans @ np.swapaxes(rot, -1, -2) + trans[:, None]
+    cos = (np.einsum("isab,jab->isj", r_as, rot) - 1.0) / 2.0
+    near = np.arccos(np.clip(cos, -1.0, 1.0)) <= tol.angle
+    near &= np.linalg.norm(c_as[:, :, None] - placed[None, None], axis=3) <= tol.distance
+    return near.any(axis=1)
+
+
 def _group(models: Sequence[Polyhedron], model_index: np.ndarray, poses: Sequence[SE3], tol: PoseTolerance):
     """Positions of the poses grouped into pose classes, in the order of each class's first member: each pose
-    joins the first earlier class of its model whose first pose it equals up to a symmetry (vectorised over the
-    poses of each model)."""
+    joins the first earlier class of its model whose first pose it equals up to a symmetry (every pair of a model's
+    poses compared in one array operation, :func:`_same_pose_pairs`, or, past :data:`MAX_PAIRS`, each class's first
+    pose against the poses left)."""
     rot = np.stack([p.rotation for p in poses])
     trans = np.stack([p.translation for p in poses])
     groups: list[list[int]] = []
     for m in dict.fromkeys(model_index.tolist()):
         left = np.flatnonzero(model_index == m)
+        model = models[int(left[0])]
         placed = np.empty_like(trans)  # each pose's centroid, computed once per model (the same bits)
-        placed[left] = trans[left] + rot[left] @ models[int(left[0])].centroid
+        placed[left] = trans[left] + rot[left] @ model.centroid
+        if len(left) ** 2 * len(_symmetry_arrays(model)[0]) <= MAX_PAIRS:
+            same = _same_pose_pairs(rot[left], trans[left], placed[left], model, tol)
+            alive = np.ones(len(left), dtype=bool)
+            while alive.any():
+                k = int(np.argmax(alive))
+                members = alive & same[k]
+                members[k] = False
+                groups.append([int(left[k]), *left[members].tolist()])
+                alive &= ~members
+                alive[k] = False
+            continue
         while len(left):
             rep, rest = int(left[0]), left[1:]
             same = _same_pose_as(poses[rep], rot[rest], trans[rest], models[rep], tol, placed[rest])

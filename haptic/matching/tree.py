@@ -224,6 +224,9 @@ class InterpretationTree:
         """Number of interpretations after each ``add`` (re-reported edges included)."""
         self._pose_cache: dict[tuple[bool, int], SE3 | None] = {}
         """Poses by (refined, leaf) of the current leaves, emptied by every ``add`` and renumbered by ``retain``."""
+        self._stack: StackedPoses | None = None
+        """The least-squares problems of every current leaf, once built (:meth:`_stacked`); emptied by every ``add``
+        and ``retain``."""
 
     # ------------------------------------------------------------------------------------------ state
 
@@ -298,6 +301,7 @@ class InterpretationTree:
             self._model, self._assign, self._sense = self._model[ok], assign[ok], sense[ok]
         self.counts.append(self.count)
         self._pose_cache.clear()  # poses are of the data before this add
+        self._stack = None
         return self.count
 
     def add_all(self, components: Iterable[DataComponent]) -> list[int]:
@@ -314,6 +318,7 @@ class InterpretationTree:
         self._model, self._assign, self._sense = self._model[keep], self._assign[keep], self._sense[keep]
         renumber = np.cumsum(keep) - 1  # a kept leaf's new index; its pose (same data) stays valid
         self._pose_cache = {(r, int(renumber[i])): p for (r, i), p in self._pose_cache.items() if keep[i]}
+        self._stack = None
         if self.counts:
             self.counts[-1] = self.count
         return self.count
@@ -638,7 +643,18 @@ class InterpretationTree:
         return [self._pose_cache[(refine, i)] for i in leaves]
 
     def _stacked(self, rows: np.ndarray) -> StackedPoses:
-        """The stacked least-squares problems of the leaves ``rows`` (global ids gathered from the library)."""
+        """The stacked least-squares problems of the leaves ``rows`` (global ids gathered from the library). Those of
+        every leaf, once built for a request of all of them (the matcher's verdict poses every leaf, then refines
+        one per pose class), are kept until the data or the leaves change, and a later request takes its rows from
+        them (:meth:`~haptic.matching.batch_poses.StackedPoses.subset`: the same arrays row by row)."""
+        if self._stack is not None:
+            return self._stack.subset(rows)
+        prob = self._build_stacked(rows)
+        if len(rows) == self.count and bool((rows == np.arange(self.count)).all()):
+            self._stack = prob
+        return prob
+
+    def _build_stacked(self, rows: np.ndarray) -> StackedPoses:
         lib, kinds = self.library, np.array(self._data.kinds, dtype=np.int64)
         fids, eids, vids = (np.flatnonzero(kinds == k) for k in (FACE, EDGE, VERTEX))
         a = self._assign[rows]
