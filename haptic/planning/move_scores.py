@@ -23,7 +23,7 @@ from haptic.planning.moves import FaceMove, Move, ProbeMove, SensorState
 from haptic.planning.predict import Prediction, candidate_moves, crossed_edge, predict_moves
 from haptic.planning.probe_lines import ProbeConfig, candidate_probes
 from haptic.planning.probe_prediction import ProbePrediction, predict_probes
-from haptic.planning.simulate import simulate
+from haptic.planning.simulate import circled_vertex
 from haptic.planning.table import descent_risk
 
 PROBE_RISK = 0.25
@@ -248,7 +248,7 @@ def fresh_moves(ctx: Context) -> list[Move]:
         if any(same_move(move, bad) for bad in ctx.avoid):
             continue
         if move.kind == "vertex" and ctx.hypotheses and all(
-            simulate(h, move, ctx.state, ctx.components, ctx.config) is None for h in ctx.hypotheses
+            circled_vertex(h, move, ctx.state, ctx.config) is None for h in ctx.hypotheses
         ):
             continue
         if isinstance(move, FaceMove) and any(_same_crossing(move, bad, ctx) for bad in failed_face):

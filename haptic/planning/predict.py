@@ -377,10 +377,11 @@ def _prediction(
 ) -> Prediction:
     """The :class:`Prediction`, a cost no hypothesis can say replaced by the mean of those that can (1 when none
     can)."""
-    if np.isnan(costs).all():
+    nan = np.isnan(costs)
+    if nan.all():
         costs = np.ones_like(costs)
-    else:
-        costs = np.where(np.isnan(costs), np.nanmean(costs), costs)
+    elif nan.any():
+        costs = np.where(nan, np.nanmean(costs), costs)
     return Prediction(move, outcomes, outcome_bounds(noise)[move.kind], costs, clear, table, reach, edge_only)
 
 
@@ -399,11 +400,52 @@ def predict_moves(
         traced = dict(zip(map(id, faces), trace_moves(hypotheses, faces, state), strict=True))
         return [predict(hypotheses, m, state, components, noise, config, traced.get(id(m))) for m in moves]
     stacked = dict(zip(map(id, faces), face_outcomes(hypotheses, faces, state, config), strict=True))
+    edges = [m for m in moves if isinstance(m, EdgeMove)]
+    stacked.update(zip(map(id, edges), edge_outcomes(hypotheses, edges, state, components, config), strict=True))
     return [
         _prediction(m, *stacked[id(m)], None, None, None, noise) if id(m) in stacked
         else predict(hypotheses, m, state, components, noise, config)
         for m in moves
     ]  # fmt: skip
+
+
+def edge_outcomes(
+    hypotheses: Sequence[Hypothesis],
+    moves: Sequence[EdgeMove],
+    state: SensorState,
+    components: Mapping[int, DataComponent],
+    config: PlannerConfig,
+) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """Every edge move's predicted outcome (the distance to the vertex, (N, 1)), cost (N,) and clearance (NaN, (N,))
+    in every hypothesis at once, as :func:`predict` forms them (:func:`~haptic.geometry.tracing.trace_edge` in each
+    hypothesis's world along its model edge, in the sense that pairs with the data edge's)."""
+    n_h = len(hypotheses)
+    out = [(np.full((n_h, 1), np.nan), np.full(n_h, np.nan), np.full(n_h, np.nan)) for _ in moves]
+    data_edge = components.get(state.edge) if state.edge is not None else None
+    rows, edges, rots, starts = [], [], [], []
+    for i, h in enumerate(hypotheses):
+        e_m = h.edges.get(state.edge) if state.edge is not None else None
+        if h.world_from_model is None or e_m is None:
+            continue
+        rows.append(i)
+        edges.append((h.poly, e_m))
+        rots.append(h.world_from_model.rotation)
+        starts.append(h.model_from_world.apply(state.position))
+    if not rows or not moves:
+        return out
+    b = np.array([p.edge_directions[e] for p, e in edges])
+    p0 = np.array([p.edge_points[e] for p, e in edges])
+    length = np.array([p.edge_lengths[e] for p, e in edges])
+    b_world = (b[:, None, :] @ np.swapaxes(np.array(rots), -1, -2))[:, 0]  # SE3.rotate's arithmetic
+    along = b_world @ data_edge.direction > 0
+    s = np.clip(np.einsum("mc,mc->m", np.array(starts) - p0, b), 0.0, length)
+    c = config.costs
+    for k, move in enumerate(moves):
+        forward = along if move.sense > 0 else ~along
+        dist = np.where(forward, length - s, s)
+        out[k][0][rows, 0] = dist
+        out[k][1][rows] = c.c_e * dist + c.c_k
+    return out
 
 
 def face_outcomes(

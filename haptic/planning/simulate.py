@@ -18,7 +18,7 @@ import numpy as np
 
 from haptic.geometry.raycast import line_hits
 from haptic.geometry.se3 import cross
-from haptic.geometry.tracing import circle_vertex, trace_edge
+from haptic.geometry.tracing import VertexHit, circle_vertex, trace_edge
 from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex, SensorNoise
 from haptic.planning.config import PlannerConfig
 from haptic.planning.hypothesis import Hypothesis, trace_in
@@ -28,6 +28,24 @@ STEP_ONTO = 0.003
 """How far onto the next face a simulated face or vertex move steps for its normal [m]."""
 EDGE_PROBE = 0.004
 """Length of edge explored when an edge is first met [m]."""
+
+
+def circled_vertex(h: Hypothesis, move: VertexMove, state: SensorState, config: PlannerConfig) -> VertexHit | None:
+    """Where vertex move ``move`` leaves the vertex in hypothesis ``h``'s world (the edge and face beyond it); None
+    when ``h`` cannot say (no pose, the edge, vertex or face not matched, no such corner), or when the move would
+    only circle back to an edge and face already explored (:func:`simulate` is None for it then)."""
+    if h.world_from_model is None:
+        return None
+    e0, v_m, a_m = (h.edges.get(state.edge), h.vertices.get(state.vertex), h.faces.get(move.across_face))
+    if e0 is None or v_m is None or a_m is None:
+        return None
+    try:
+        vh = circle_vertex(h.poly, v_m, e0, a_m, config.vertex_radius)
+    except ValueError:
+        return None
+    if vh.edge in h.edges.values() and vh.next_face in h.faces.values():
+        return None
+    return vh
 
 
 def simulate(
@@ -69,18 +87,13 @@ def simulate(
                 return None
             e_m, g_m, at_m, from_face = tr.hit.edge, tr.hit.next_face, tr.hit.point, state.face
         else:
-            e0, v_m, a_m = (h.edges.get(state.edge), h.vertices.get(state.vertex), h.faces.get(move.across_face))
-            if e0 is None or v_m is None or a_m is None:
-                return None
-            try:
-                vh = circle_vertex(poly, v_m, e0, a_m, config.vertex_radius)
-            except ValueError:
-                return None
+            vh = circled_vertex(h, move, state, config)
+            if vh is None:
+                return None  # cannot say, or circles back to an edge and face already explored
+            v_m = h.vertices[state.vertex]
             e_m, g_m, from_face = vh.edge, vh.next_face, move.across_face
             away = poly.edge_directions[e_m] * (1.0 if poly.edges[e_m, 0] == v_m else -1.0)
             at_m = poly.vertices[v_m] + config.vertex_radius * away
-        if e_m in h.edges.values() and g_m in h.faces.values() and isinstance(move, VertexMove):
-            return None  # circles back to an edge and face already explored: nothing new to see
         b_m = poly.edge_directions[e_m]
         s = float(np.clip((at_m - poly.edge_points[e_m]) @ b_m, 0.0, poly.edge_lengths[e_m]))
         lo = max(0.0, s - EDGE_PROBE / 2)

@@ -170,3 +170,39 @@ def test_face_outcomes_equal_the_predictions_one_hypothesis_at_a_time():
         assert np.allclose(p.outcomes, q.outcomes, rtol=0, atol=1e-12, equal_nan=True)
         assert np.allclose(p.costs, q.costs, rtol=0, atol=1e-12) and np.array_equal(p.bounds, q.bounds)
         assert np.allclose(p.clearance, q.clearance, rtol=0, atol=1e-12, equal_nan=True)
+
+
+def test_edge_outcomes_equal_the_predictions_one_hypothesis_at_a_time():
+    """The edge moves' distances and costs in every hypothesis at once are each hypothesis's own prediction
+    (:func:`predict_one`), for both senses, with hypotheses that cannot say (no pose, the edge not matched)."""
+    from haptic.geometry.generate import generate_library
+    from haptic.matching.components import DataEdge
+    from haptic.planning.moves import EdgeMove, SensorState
+    from haptic.planning.predict import edge_outcomes
+
+    models = generate_library(12, seed=6)
+    rng = np.random.default_rng(2)
+    pos = np.array([0.01, 0.02, 0.03])
+    direction = np.array([0.0, 0.6, 0.8])
+    hyps = []
+    for _ in range(80):
+        m = models[int(rng.integers(len(models)))]
+        e = int(rng.integers(m.n_edges))
+        q = m.edge_points[e] + rng.uniform(0.1, 0.9) * m.edge_lengths[e] * m.edge_directions[e]
+        r = SE3.random(rng).rotation
+        hyps.append(Hypothesis(m.name, m, SE3(r, pos - r @ q), {0: 0}, {1: e}, {}))
+    hyps.insert(3, Hypothesis("none", models[0], None, {0: 0}, {1: 0}, {}))
+    hyps.insert(5, Hypothesis("unmatched", models[1], hyps[0].world_from_model, {0: 0}, {}, {}))
+    comps = {1: DataEdge(1, direction, pos - 0.01 * direction, 0.02, 0.01, 0.001, 0.001)}
+    state = SensorState(position=pos, face=0, edge=1)
+    config = PlannerConfig()
+    moves = [EdgeMove(1), EdgeMove(-1)]
+    said = 0
+    for move, (out, cost, clear) in zip(moves, edge_outcomes(hyps, moves, state, comps, config), strict=True):
+        assert np.isnan(clear).all()
+        for i, h in enumerate(hyps):
+            one, c1 = predict_one(h, move, state, comps, config)
+            assert np.allclose(out[i], one, rtol=0, atol=1e-15, equal_nan=True)
+            assert np.isclose(cost[i], c1, rtol=0, atol=1e-13, equal_nan=True)
+            said += not np.isnan(one[0])
+    assert said == 2 * 80
