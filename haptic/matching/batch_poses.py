@@ -248,4 +248,12 @@ _FD_ROT = exp_so3(_FD_XI[:, :3])
 """The six perturbations of the Jacobian and their rotations, computed once."""
 
 
-__all__ = ["GN_ITERATIONS", "GN_TOLERANCE", "MIN_CONDITION", "MIN_SPREAD", "StackedPoses", "exp_so3", "proper_rotations"]
+__all__ = [
+    "GN_ITERATIONS",
+    "GN_TOLERANCE",
+    "MIN_CONDITION",
+    "MIN_SPREAD",
+    "StackedPoses",
+    "exp_so3",
+    "proper_rotations",
+]

@@ -127,8 +127,8 @@ def test_face_outcomes_equal_the_predictions_one_hypothesis_at_a_time():
     own prediction (:func:`predict` from its :func:`trace_in`), hypotheses that cannot say included."""
     from haptic.geometry import tracing
     from haptic.geometry.generate import generate_library
-    from haptic.planning.moves import FaceMove, SensorState
     from haptic.planning.hypothesis import trace_in
+    from haptic.planning.moves import FaceMove, SensorState
     from haptic.planning.predict import face_outcomes, predict_moves
 
     models = generate_library(12, seed=5)
