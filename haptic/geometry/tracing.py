@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from haptic.geometry.polyhedron import Polyhedron
-from haptic.geometry.se3 import plane_basis
+from haptic.geometry.se3 import cross, plane_basis
 
 
 @dataclass(frozen=True, eq=False)
@@ -77,9 +77,20 @@ def trace_face(
     start = start - (start @ n - poly.face_offsets[face]) * n
     best = None
     loop = poly.faces[face]
-    off = poly.vertices[list(loop)] @ n - poly.face_offsets[face]
-    corners = poly.vertices[list(loop)] - off[:, None] * n
+    corners, sides = _plane_corners(poly, face)
+    # which sides the trace can meet, from the crossing solved for every side at once; only those are solved
+    # exactly one by one below (a side it misses by a margin far above the arithmetic's error is not: the same sides
+    # are then met, with the same numbers)
+    rel = corners - start
+    den = _in_plane_cross(d, sides, n)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t_all = _in_plane_cross(rel, sides, n) / den
+        u_all = _in_plane_cross(rel, d, n) / den
+    steady = np.abs(den) > _STEADY * np.sqrt(np.einsum("ki,ki->k", sides, sides))
+    skip = steady & ((t_all < -_MARGIN) | (u_all < -_MARGIN) | (u_all > 1 + _MARGIN))
     for k, e in enumerate(poly.face_edges[face]):
+        if skip[k]:
+            continue
         a = corners[k]
         b = corners[(k + 1) % len(loop)]
         seg = b - a
@@ -100,6 +111,34 @@ def trace_face(
         return None
     other = poly.edge_right_face[e] if poly.edge_left_face[e] == face else poly.edge_left_face[e]
     return FaceHit(edge=int(e), distance=float(t), point=start + t * d, next_face=int(other))
+
+
+_STEADY = 1e-3
+"""A side whose crossing with the trace is solved for all sides at once (:func:`trace_face`) counts when the sine of
+the angle between them is above this: the crossing's parameters are then within far less than :data:`_MARGIN` of
+the least-squares solution."""
+_MARGIN = 1e-6
+"""A side whose crossing lies this far behind the start, or beyond either end of the side (in units of its length),
+is one the trace does not meet."""
+_PLANE_CORNERS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _plane_corners(poly: Polyhedron, face: int) -> tuple[np.ndarray, np.ndarray]:
+    """A face's corners moved onto its plane (K, 3), in loop order, and its sides from each to the next (K, 3)
+    (cached per model)."""
+    per = _PLANE_CORNERS.setdefault(poly, {})
+    if face not in per:
+        n = poly.face_normals[face]
+        loop = list(poly.faces[face])
+        off = poly.vertices[loop] @ n - poly.face_offsets[face]
+        corners = poly.vertices[loop] - off[:, None] * n
+        per[face] = (corners, np.roll(corners, -1, axis=0) - corners)
+    return per[face]
+
+
+def _in_plane_cross(a: np.ndarray, b: np.ndarray, n: np.ndarray) -> np.ndarray:
+    """``(a × b) · n`` along the last axis (broadcast)."""
+    return cross(a, b) @ n
 
 
 def trace_edge(poly: Polyhedron, edge: int, start: np.ndarray, sense: int) -> EdgeHit:
