@@ -217,3 +217,17 @@ def test_poses_from_the_kept_problems_of_every_leaf_equal_poses_built_afresh(sma
                     np.testing.assert_array_equal(a.translation, b.translation)
                     checked += 1
     assert checked > 50
+
+
+def test_one_start_cost_table_for_many_sensor_positions_is_start_costs_each_time():
+    from haptic.geometry import load_library
+    from haptic.planning.tour import StartCosts
+
+    legs = LegCosts.of(PlannerConfig(moves="all"))
+    rng = np.random.default_rng(10)
+    poly = load_library()["LBLOCK01"]
+    targets = np.flatnonzero(rng.random(len(features(poly).kinds)) < 0.5)
+    table = StartCosts(poly, targets, legs)
+    for face, edge in ((0, None), (1, 0), (None, None), (2, poly.n_edges - 1), (3, 2)):
+        p = poly.vertices.mean(axis=0) + rng.normal(size=3) * 0.01
+        np.testing.assert_array_equal(table(p, face, edge), start_costs(poly, p, face, edge, targets, legs))

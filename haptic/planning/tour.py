@@ -185,17 +185,35 @@ def start_costs(
     """Cost of measuring each target first from a sensor at ``position`` (model frame) on model ``face`` and,
     when known, model ``edge``: by tracing (along the edge to a vertex at its end, or across the face, or over
     faces) or by a probe; shape (n,) [units]."""
-    feats = features(poly)
-    p, kinds = feats.points[targets], feats.kinds[targets]
-    d = np.linalg.norm(p - np.asarray(position), axis=1)
-    cofacial = feats.on_face[targets, face] if face is not None else np.zeros(len(targets), dtype=bool)
-    fin = legs.finish(kinds)
-    cost = np.minimum(legs.by_tracing(d, kinds, cofacial, fin), legs.by_probe(d, kinds, fin))
-    if edge is not None:
-        a, b = feats.kinds.size - poly.n_vertices + poly.edges[edge]
-        at_end = (targets == a) | (targets == b)
-        cost = np.where(at_end, np.minimum(cost, legs.edge_rate * d + legs.vertex_event), cost)
-    return cost
+    return StartCosts(poly, targets, legs)(position, face, edge)
+
+
+class StartCosts:
+    """:func:`start_costs` of fixed targets from wherever the sensor is: what depends on the targets alone (their
+    points, kinds, faces and the cost of finishing each) gathered once, for a verification decision that prices
+    the tour from where each of its candidate moves would end."""
+
+    def __init__(self, poly: Polyhedron, targets: np.ndarray, legs: LegCosts) -> None:
+        feats = features(poly)
+        self.poly, self.targets, self.legs = poly, targets, legs
+        self.points, self.kinds = feats.points[targets], feats.kinds[targets]
+        self.on_face = feats.on_face[targets]
+        self.finish = legs.finish(self.kinds)
+        self.vertex_base = feats.kinds.size - poly.n_vertices
+        """Feature index of the model's vertex 0."""
+
+    def __call__(self, position: np.ndarray, face: int | None, edge: int | None) -> np.ndarray:
+        """The costs from a sensor at ``position`` (model frame) on model ``face`` and, when known, ``edge``,
+        shape (n,) [units]."""
+        legs, kinds, fin = self.legs, self.kinds, self.finish
+        d = np.linalg.norm(self.points - np.asarray(position), axis=1)
+        cofacial = self.on_face[:, face] if face is not None else np.zeros(len(self.targets), dtype=bool)
+        cost = np.minimum(legs.by_tracing(d, kinds, cofacial, fin), legs.by_probe(d, kinds, fin))
+        if edge is not None:
+            a, b = self.vertex_base + self.poly.edges[edge]
+            at_end = (self.targets == a) | (self.targets == b)
+            cost = np.where(at_end, np.minimum(cost, legs.edge_rate * d + legs.vertex_event), cost)
+        return cost
 
 
 @dataclass(frozen=True)
@@ -303,6 +321,7 @@ __all__ = [
     "VERTEX",
     "Features",
     "LegCosts",
+    "StartCosts",
     "Tour",
     "features",
     "leg_matrix",

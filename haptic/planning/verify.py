@@ -38,10 +38,10 @@ from haptic.planning.tour import (
     PROBE_INSET,
     VERTEX,
     LegCosts,
+    StartCosts,
     Tour,
     features,
     plan_tour,
-    start_costs,
     tour_lower_bound,
 )
 
@@ -400,7 +400,8 @@ def plan_verification_move(
     poly, legs = h.poly, _legs(config)
     keys = features(poly).index(missing)
     tour = plan_tour(poly, keys, legs, previous)
-    here = _start_costs(h, state, keys, legs)
+    table = StartCosts(poly, keys, legs)
+    here = _start_costs(h, state, table)
     now = tour.cost_from(here)
     first = _moves(h, state, components, noise, config, avoid, missing)
     probes = verification_probes(h, state, components, _entries(poly, tour, here, keys), noise, config, avoid, probed,
@@ -419,7 +420,7 @@ def plan_verification_move(
         new = _new_features(h, h1)
         measured = frozenset(int(k) for k in features(poly).index(tuple(  # type: ignore[arg-type]
             frozenset(n & x) for n, x in zip(new, missing, strict=True))))  # fmt: skip
-        score = c / max(1.0 - r, 1e-9) + tour.cost_from(_start_costs(h1, s1, keys, legs), measured)
+        score = c / max(1.0 - r, 1e-9) + tour.cost_from(_start_costs(h1, s1, table), measured)
         if score < best_score:
             best, best_score = m, score
         ends.append((m, h.world_from_model.inverse().apply(s1.position), c))
@@ -441,11 +442,11 @@ def _legs(config: PlannerConfig) -> LegCosts:
     return LegCosts.of(config, probes=MAX_VERIFY_PROBES > 0)
 
 
-def _start_costs(h: Hypothesis, state: SensorState, keys: np.ndarray, legs: LegCosts) -> np.ndarray:
-    """:func:`~haptic.planning.tour.start_costs` of the targets ``keys`` (sorted feature indices) from the sensor
+def _start_costs(h: Hypothesis, state: SensorState, table: StartCosts) -> np.ndarray:
+    """:func:`~haptic.planning.tour.start_costs` of the targets of ``table`` (sorted feature indices) from the sensor
     in ``state``, in hypothesis ``h``'s world."""
     edge = h.edges.get(state.edge) if state.edge is not None else None
-    return start_costs(h.poly, h.model_from_world.apply(state.position), h.faces.get(state.face), edge, keys, legs)
+    return table(h.model_from_world.apply(state.position), h.faces.get(state.face), edge)
 
 
 def _entries(
