@@ -88,24 +88,32 @@ def test_predicted_eliminations_agree_with_the_matcher():
     assert agree / total > 0.95
 
 
-def test_trace_all_equals_trace_in_for_each_hypothesis():
-    """The batched face trace gives each hypothesis the trace of its own world."""
+def _hypotheses_on_faces(library_seed: int, seed: int, n: int):
+    """``n`` hypotheses of a generated library, each with the sensor (at a fixed point) on a random point of a random
+    face of its model at a random rotation: (models, the generator, the sensor's position, the hypotheses)."""
     from haptic.geometry import tracing
     from haptic.geometry.generate import generate_library
-    from haptic.planning.hypothesis import trace_in
-    from haptic.planning.moves import FaceMove, SensorState
-    from haptic.planning.predict import trace_all
 
-    models = generate_library(12, seed=4)
-    rng = np.random.default_rng(0)
+    models = generate_library(12, seed=library_seed)
+    rng = np.random.default_rng(seed)
     pos = np.array([0.01, 0.02, 0.03])
     hyps = []
-    for _ in range(200):
+    for _ in range(n):
         m = models[int(rng.integers(len(models)))]
         f = int(rng.integers(m.n_faces))
         q = tracing.random_face_point(m, f, rng, margin=0.002)
         r = SE3.random(rng).rotation
         hyps.append(Hypothesis(m.name, m, SE3(r, pos - r @ q), {0: f}, {}, {}))
+    return models, rng, pos, hyps
+
+
+def test_trace_all_equals_trace_in_for_each_hypothesis():
+    """The batched face trace gives each hypothesis the trace of its own world."""
+    from haptic.planning.hypothesis import trace_in
+    from haptic.planning.moves import FaceMove, SensorState
+    from haptic.planning.predict import trace_all
+
+    models, rng, pos, hyps = _hypotheses_on_faces(4, 0, 200)
     hyps.append(Hypothesis("none", models[0], None, {0: 0}, {}, {}))
     state = SensorState(position=pos, face=0)
     met = 0
@@ -125,22 +133,11 @@ def test_trace_all_equals_trace_in_for_each_hypothesis():
 def test_face_outcomes_equal_the_predictions_one_hypothesis_at_a_time():
     """The face moves' outcomes, costs and clearances stacked over (moves, hypotheses, sides) are each hypothesis's
     own prediction (:func:`predict` from its :func:`trace_in`), hypotheses that cannot say included."""
-    from haptic.geometry import tracing
-    from haptic.geometry.generate import generate_library
     from haptic.planning.hypothesis import trace_in
     from haptic.planning.moves import FaceMove, SensorState
     from haptic.planning.predict import face_outcomes, predict_moves
 
-    models = generate_library(12, seed=5)
-    rng = np.random.default_rng(1)
-    pos = np.array([0.01, 0.02, 0.03])
-    hyps = []
-    for _ in range(120):
-        m = models[int(rng.integers(len(models)))]
-        f = int(rng.integers(m.n_faces))
-        q = tracing.random_face_point(m, f, rng, margin=0.002)
-        r = SE3.random(rng).rotation
-        hyps.append(Hypothesis(m.name, m, SE3(r, pos - r @ q), {0: f}, {}, {}))
+    models, rng, pos, hyps = _hypotheses_on_faces(5, 1, 120)
     hyps.insert(7, Hypothesis("none", models[0], None, {0: 0}, {}, {}))
     hyps.insert(9, Hypothesis("unmatched", models[1], hyps[0].world_from_model, {}, {}, {}))
     state = SensorState(position=pos, face=0)
