@@ -307,6 +307,14 @@ class Coverage:
     """Model edges that count."""
     reachable_vertices: frozenset[int]
     """Model vertices that count."""
+    pins: tuple[frozenset[int], ...] = ()
+    """Under ``full``, per model vertex that rests on the table out of the pad's reach: its reachable edges that
+    rise from the table. The table gives such a vertex's height and nothing else; one of these edges measured
+    gives its place on the table (the edge's line meets the table there), so each set must meet :attr:`edges`."""
+
+    def unpinned(self) -> tuple[frozenset[int], ...]:
+        """The :attr:`pins` none of whose edges is measured yet."""
+        return tuple(p for p in self.pins if not p & self.edges)
 
     def fractions(self) -> tuple[float, float, float]:
         """Measured fraction of the reachable faces, edges and vertices (1 when none is reachable)."""
@@ -323,9 +331,10 @@ class Coverage:
     def missing(self, mode: str) -> tuple[frozenset[int], frozenset[int], frozenset[int]]:
         """The reachable faces, edges and vertices still to be measured for ``mode``'s target."""
         tf, te, tv = TARGETS[mode]
+        pinning = frozenset().union(*self.unpinned()) if tv > 0 else frozenset()
         return (
             self.reachable_faces - self.faces if tf > 0 else frozenset(),
-            self.reachable_edges - self.edges if te > 0 else frozenset(),
+            (self.reachable_edges - self.edges if te > 0 else frozenset()) | pinning,
             self.reachable_vertices - self.vertices if tv > 0 else frozenset(),
         )
 
@@ -334,16 +343,18 @@ class Coverage:
         edges under ``fast``)."""
         tf, te, tv = TARGETS[mode]
         return ((len(self.reachable_faces) if tf > 0 else 0) + (len(self.reachable_edges) if te > 0 else 0)
-                + (len(self.reachable_vertices) if tv > 0 else 0))  # fmt: skip
+                + (len(self.reachable_vertices) + len(self.pins) if tv > 0 else 0))  # fmt: skip
 
     def measured(self) -> int:
         """Number of reachable features measured (faces, edges and vertices together)."""
         return (len(self.faces & self.reachable_faces) + len(self.edges & self.reachable_edges)
-                + len(self.vertices & self.reachable_vertices))  # fmt: skip
+                + len(self.vertices & self.reachable_vertices) + len(self.pins) - len(self.unpinned()))  # fmt: skip
 
     def met(self, mode: str) -> bool:
         """Whether ``mode``'s coverage target is met."""
         got = self.fractions()
+        if TARGETS[mode][2] > 0 and self.unpinned():
+            return False
         return all(g >= t - 1e-12 for g, t in zip(got, TARGETS[mode], strict=True))
 
     def record(self, model: Polyhedron) -> dict:
@@ -362,9 +373,10 @@ def coverage(
     model: Polyhedron,
     it: Interpretation,
     reachable: tuple[frozenset[int], frozenset[int], frozenset[int]] | None = None,
+    pins: tuple[frozenset[int], ...] = (),
 ) -> Coverage:
     """What interpretation ``it`` has measured of ``model``; ``reachable``: the faces, edges and vertices that
-    count (default: all)."""
+    count (default: all); ``pins``: :attr:`Coverage.pins`."""
     if reachable is None:
         reachable = (frozenset(range(model.n_faces)), frozenset(range(model.n_edges)),
                      frozenset(range(model.n_vertices)))  # fmt: skip
@@ -373,6 +385,7 @@ def coverage(
         frozenset(int(e) for e in it.edges.values()),
         frozenset(int(v) for v in it.vertices.values()),
         *reachable,
+        pins,
     )
 
 

@@ -114,6 +114,30 @@ TABLE_CONTACT = 2e-3
 off by the noise of its data, about 1 mm on the simulated hand)."""
 
 
+def table_pins(
+    poly: Polyhedron, world_from_model: SE3, reach: tuple[frozenset[int], frozenset[int], frozenset[int]],
+    config: PlannerConfig,
+) -> tuple[tuple[frozenset[int], ...], list[int]]:
+    """For the vertices of ``poly`` that rest on the table (within :data:`TABLE_CONTACT`) out of the pad's reach:
+    the reachable edges rising from each (:attr:`~haptic.matching.acceptance.Coverage.pins`), and the vertices
+    with none, whose place on the table nothing the hand can touch gives. Without a table, none."""
+    if config.table_z is None:
+        return (), []
+    z = world_from_model.apply(poly.vertices)[:, 2] - config.table_z
+    pins, unpinnable = [], []
+    for v in range(poly.n_vertices):
+        if z[v] > TABLE_CONTACT or v in reach[2]:
+            continue
+        rising = frozenset(
+            int(e) for e in reach[1] if v in poly.edges[e] and z[int(sum(poly.edges[e])) - v] > TABLE_CONTACT
+        )
+        if rising:
+            pins.append(rising)
+        else:
+            unpinnable.append(v)
+    return tuple(pins), unpinnable
+
+
 def hidden_vertices(poly: Polyhedron, world_from_model: SE3, cov, config: PlannerConfig) -> list[int]:
     """Vertices of ``poly`` that the verification can neither measure (not in ``cov``'s reachable vertices) nor
     take from the table (farther than :data:`TABLE_CONTACT` above it): a vertex under an overhang, or on a face
@@ -508,10 +532,13 @@ class Verifier:
         self.coverage = None
         self._hyp: Hypothesis | None = None
         self.hidden: list[int] = []
-        """Model vertices out of the hand's reach and off the table (:func:`hidden_vertices`)."""
+        """Model vertices out of the hand's reach and off the table (:func:`hidden_vertices`), and those on the table
+        with no edge rising from them in reach (:func:`table_pins`)."""
         self._model_name: str | None = None
         self._model: Polyhedron | None = None
         self._reach: dict[str, tuple[frozenset[int], frozenset[int], frozenset[int]]] = {}
+        self._pins: dict[str, tuple[tuple[frozenset[int], ...], list[int]]] = {}
+        """Per model: :func:`table_pins` at the pose its reachable features were found for."""
         self._tour: Tour | None = None
         self._tour_model: Polyhedron | None = None
         self.tour_planned: float | None = None
@@ -547,13 +574,16 @@ class Verifier:
                                len(cls.leaves), tuple(cls.leaves))  # fmt: skip
         if self.check.world_from_model is not None:
             if cls.name not in self._reach:
-                self._reach[cls.name] = reachable_features(cls.model, self.check.world_from_model, self.config)
-            self.coverage = coverage(cls.model, it, self._reach[cls.name])
+                reach = reachable_features(cls.model, self.check.world_from_model, self.config)
+                self._reach[cls.name] = reach
+                self._pins[cls.name] = table_pins(cls.model, self.check.world_from_model, reach, self.config)
+            self.coverage = coverage(cls.model, it, self._reach[cls.name], self._pins[cls.name][0])
         self._model_name, self._model = cls.name, cls.model
         if not self.check.ok:
             self.status = "mismatch"
         elif self.coverage is not None and self.coverage.met(self.mode):
             self.hidden = hidden_vertices(cls.model, self.check.world_from_model, self.coverage, self.config)
+            self.hidden += [v for v in self._pins[cls.name][1] if v not in self.hidden]
             self.status = "incomplete" if self.mode == "full" and self.hidden else "confirmed"
         else:
             self.status = "verifying"
@@ -596,7 +626,8 @@ class Verifier:
                     f"(chi-square, {a.dof} dof)")  # fmt: skip
         if self.status == "incomplete" and self.hidden:
             return (f"verification incomplete: {len(self.hidden)} vertices of {self._model_name} out of the hand's "
-                    "reach and off the table (a difference there cannot be measured)")  # fmt: skip
+                    "reach, off the table or with no edge rising from them in reach (a difference there cannot be "
+                    "measured)")  # fmt: skip
         if self.status == "incomplete" and self.coverage is not None:
             f, e, v = (len(x) for x in self.coverage.missing(self.mode))
             return (f"verification incomplete after {self.moves} moves: {f} faces, {e} edges, {v} vertices of "

@@ -104,3 +104,41 @@ def test_a_vertex_the_pad_cannot_touch_clear_of_the_table_is_hidden():
     assert len(low) == len(high) == 4
     assert set(low.tolist()) <= set(hidden) and not set(low.tolist()) & set(v)
     assert set(high.tolist()) & set(v)
+
+
+def test_a_vertex_resting_on_the_table_counts_once_an_edge_rising_from_it_is_measured():
+    """TETRA01L resting on a face: its apex is the only vertex the pad can touch, and the table gives the other
+    three vertices' height only (a base vertex moved 4 mm, a base 3 % wider, fits the apex and the table as well).
+    Each is pinned by its edge rising to the apex, whose line meets the table there: full verification asks for
+    one such edge per base vertex; without a table, for nothing more than every vertex."""
+    from dataclasses import replace
+
+    from haptic.matching.acceptance import Coverage
+    from haptic.planning.verify import reachable_features, table_pins
+
+    poly = LIB["TETRA01L"]
+    n = poly.face_normals[0]
+    axis = np.cross(n, [0.0, 0.0, -1.0])
+    s, c = np.linalg.norm(axis), float(n @ [0.0, 0.0, -1.0])
+    if s < 1e-9:  # the face already looks down (or up: turn it over about x)
+        rot = np.eye(3) if c > 0 else np.diag([1.0, -1.0, -1.0])
+    else:
+        k = axis / s
+        kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+        rot = np.eye(3) + s * kx + (1 - c) * kx @ kx
+    low = (poly.vertices @ rot.T)[:, 2].min()
+    pose = SE3(rot, np.array([0.55, 0.0, 0.35 - low]))
+    table = replace(PlannerConfig(), table_z=0.35)
+    f, e, v = reachable_features(poly, pose, table)
+    pins, unpinnable = table_pins(poly, pose, (f, e, v), table)
+    base = [int(x) for x in poly.faces[0]]
+    assert len(pins) == len(base) == 3 and unpinnable == []
+    for p in pins:
+        assert len(p) == 1
+        (edge,) = p
+        assert len(set(poly.edges[edge].tolist()) & set(base)) == 1  # rises from one base vertex to the apex
+    cov = Coverage(frozenset(), frozenset(), frozenset(v), f, e, v, pins)
+    assert not cov.met("full") and cov.missing("full")[1] == frozenset().union(*pins)
+    done = Coverage(frozenset(), frozenset().union(*pins), frozenset(v), f, e, v, pins)
+    assert done.met("full") and done.missing("full") == (frozenset(), frozenset(), frozenset())
+    assert table_pins(poly, pose, (f, e, v), PlannerConfig()) == ((), [])
