@@ -307,14 +307,15 @@ class Coverage:
     """Model edges that count."""
     reachable_vertices: frozenset[int]
     """Model vertices that count."""
-    pins: tuple[frozenset[int], ...] = ()
+    pins: tuple[tuple[frozenset[int], frozenset[int]], ...] = ()
     """Under ``full``, per model vertex that rests on the table out of the pad's reach: its reachable edges that
-    rise from the table. The table gives such a vertex's height and nothing else; one of these edges measured
-    gives its place on the table (the edge's line meets the table there), so each set must meet :attr:`edges`."""
+    rise from the table, and its reachable faces off the table. The table gives such a vertex's height and nothing
+    else; one of these edges measured gives its place on the table (the edge's line meets the table there), and
+    so do two of these faces (their planes and the table's meet there)."""
 
-    def unpinned(self) -> tuple[frozenset[int], ...]:
-        """The :attr:`pins` none of whose edges is measured yet."""
-        return tuple(p for p in self.pins if not p & self.edges)
+    def unpinned(self) -> tuple[tuple[frozenset[int], frozenset[int]], ...]:
+        """The :attr:`pins` not yet given by a measured edge or two measured faces."""
+        return tuple((e, f) for e, f in self.pins if not e & self.edges and len(f & self.faces) < 2)
 
     def fractions(self) -> tuple[float, float, float]:
         """Measured fraction of the reachable faces, edges and vertices (1 when none is reachable)."""
@@ -331,7 +332,7 @@ class Coverage:
     def missing(self, mode: str) -> tuple[frozenset[int], frozenset[int], frozenset[int]]:
         """The reachable faces, edges and vertices still to be measured for ``mode``'s target."""
         tf, te, tv = TARGETS[mode]
-        pinning = frozenset().union(*self.unpinned()) if tv > 0 else frozenset()
+        pinning = frozenset().union(*(e for e, _ in self.unpinned())) if tv > 0 else frozenset()
         return (
             self.reachable_faces - self.faces if tf > 0 else frozenset(),
             (self.reachable_edges - self.edges if te > 0 else frozenset()) | pinning,

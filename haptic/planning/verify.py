@@ -119,8 +119,9 @@ def table_pins(
     config: PlannerConfig,
 ) -> tuple[tuple[frozenset[int], ...], list[int]]:
     """For the vertices of ``poly`` that rest on the table (within :data:`TABLE_CONTACT`) out of the pad's reach:
-    the reachable edges rising from each (:attr:`~haptic.matching.acceptance.Coverage.pins`), and the vertices
-    with none, whose place on the table nothing the hand can touch gives. Without a table, none."""
+    the reachable edges rising from each and its reachable faces (:attr:`~haptic.matching.acceptance.Coverage.pins`),
+    and the vertices with neither an edge nor two faces, whose place on the table nothing the hand can touch
+    gives. Without a table, none."""
     if config.table_z is None:
         return (), []
     z = world_from_model.apply(poly.vertices)[:, 2] - config.table_z
@@ -131,8 +132,9 @@ def table_pins(
         rising = frozenset(
             int(e) for e in reach[1] if v in poly.edges[e] and z[int(sum(poly.edges[e])) - v] > TABLE_CONTACT
         )
-        if rising:
-            pins.append(rising)
+        faces = frozenset(int(f) for f in poly.vertex_faces[v] if int(f) in reach[0])
+        if rising or len(faces) >= 2:
+            pins.append((rising, faces))
         else:
             unpinnable.append(v)
     return tuple(pins), unpinnable

@@ -109,8 +109,9 @@ def test_a_vertex_the_pad_cannot_touch_clear_of_the_table_is_hidden():
 def test_a_vertex_resting_on_the_table_counts_once_an_edge_rising_from_it_is_measured():
     """TETRA01L resting on a face: its apex is the only vertex the pad can touch, and the table gives the other
     three vertices' height only (a base vertex moved 4 mm, a base 3 % wider, fits the apex and the table as well).
-    Each is pinned by its edge rising to the apex, whose line meets the table there: full verification asks for
-    one such edge per base vertex; without a table, for nothing more than every vertex."""
+    Each is pinned by its edge rising to the apex, whose line meets the table there, or by its two side faces:
+    full verification asks for one such edge or both faces per base vertex; without a table, for nothing more
+    than every vertex."""
     from dataclasses import replace
 
     from haptic.matching.acceptance import Coverage
@@ -133,12 +134,17 @@ def test_a_vertex_resting_on_the_table_counts_once_an_edge_rising_from_it_is_mea
     pins, unpinnable = table_pins(poly, pose, (f, e, v), table)
     base = [int(x) for x in poly.faces[0]]
     assert len(pins) == len(base) == 3 and unpinnable == []
-    for p in pins:
-        assert len(p) == 1
-        (edge,) = p
+    edges = frozenset()
+    for rising, faces in pins:
+        assert len(rising) == 1 and len(faces) == 2  # its edge to the apex, between its two side faces
+        (edge,) = rising
         assert len(set(poly.edges[edge].tolist()) & set(base)) == 1  # rises from one base vertex to the apex
+        edges |= rising
     cov = Coverage(frozenset(), frozenset(), frozenset(v), f, e, v, pins)
-    assert not cov.met("full") and cov.missing("full")[1] == frozenset().union(*pins)
-    done = Coverage(frozenset(), frozenset().union(*pins), frozenset(v), f, e, v, pins)
+    assert not cov.met("full") and cov.missing("full")[1] == edges
+    done = Coverage(frozenset(), edges, frozenset(v), f, e, v, pins)
     assert done.met("full") and done.missing("full") == (frozenset(), frozenset(), frozenset())
+    # or by two faces through each: the three side faces measured pin every base vertex
+    assert Coverage(frozenset(f), frozenset(), frozenset(v), f, e, v, pins).met("full")
+    assert not Coverage(frozenset(list(f)[:1]), frozenset(), frozenset(v), f, e, v, pins).met("full")
     assert table_pins(poly, pose, (f, e, v), PlannerConfig()) == ((), [])
