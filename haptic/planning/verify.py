@@ -25,6 +25,7 @@ import numpy as np
 from haptic.geometry.polyhedron import Polyhedron
 from haptic.geometry.se3 import SE3
 from haptic.matching.components import DataComponent, DataEdge, DataFace, SensorNoise
+from haptic.matching.acceptance import TablePin
 from haptic.planning.config import PlannerConfig
 from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import EdgeMove, FaceMove, Move, SensorState
@@ -114,14 +115,20 @@ TABLE_CONTACT = 2e-3
 off by the noise of its data, about 1 mm on the simulated hand)."""
 
 
+PIN_SPAN = 5e-3
+"""Three measured vertices give their face's plane for pinning a vertex on the table when they span at least this
+much across (the second singular value of their offsets) [m]: a thinner triangle tilts the plane by more than a
+vertex's bound over its height."""
+
+
 def table_pins(
     poly: Polyhedron, world_from_model: SE3, reach: tuple[frozenset[int], frozenset[int], frozenset[int]],
     config: PlannerConfig,
-) -> tuple[tuple[frozenset[int], ...], list[int]]:
+) -> tuple[tuple[TablePin, ...], list[int]]:
     """For the vertices of ``poly`` that rest on the table (within :data:`TABLE_CONTACT`) out of the pad's reach:
-    the reachable edges rising from each and its reachable faces (:attr:`~haptic.matching.acceptance.Coverage.pins`),
-    and the vertices with neither an edge nor two faces, whose place on the table nothing the hand can touch
-    gives. Without a table, none."""
+    what would give each one's place on the table (:class:`~haptic.matching.acceptance.TablePin`), and the vertices
+    that nothing the hand can measure would place: no rising edge in reach, and fewer than two of its faces either
+    in reach or spanned by three vertices in reach. Without a table, none."""
     if config.table_z is None:
         return (), []
     z = world_from_model.apply(poly.vertices)[:, 2] - config.table_z
@@ -132,9 +139,16 @@ def table_pins(
         rising = frozenset(
             int(e) for e in reach[1] if v in poly.edges[e] and z[int(sum(poly.edges[e])) - v] > TABLE_CONTACT
         )
-        faces = frozenset(int(f) for f in poly.vertex_faces[v] if int(f) in reach[0])
-        if rising or len(faces) >= 2:
-            pins.append((rising, faces))
+        faces = []
+        for f in poly.vertex_faces[v]:
+            loop = list(poly.faces[int(f)])
+            if np.all(z[loop] <= TABLE_CONTACT):
+                continue
+            ids = tuple(int(u) for u in loop if int(u) in reach[2])
+            faces.append((int(f), ids, poly.vertices[list(ids)].reshape(-1, 3)))
+        pin = TablePin(v, rising, tuple(faces), tol=PIN_SPAN)
+        if pin.given(reach[0], reach[1], reach[2]):
+            pins.append(pin)
         else:
             unpinnable.append(v)
     return tuple(pins), unpinnable
@@ -539,7 +553,7 @@ class Verifier:
         self._model_name: str | None = None
         self._model: Polyhedron | None = None
         self._reach: dict[str, tuple[frozenset[int], frozenset[int], frozenset[int]]] = {}
-        self._pins: dict[str, tuple[tuple[frozenset[int], ...], list[int]]] = {}
+        self._pins: dict[str, tuple[tuple[TablePin, ...], list[int]]] = {}
         """Per model: :func:`table_pins` at the pose its reachable features were found for."""
         self._tour: Tour | None = None
         self._tour_model: Polyhedron | None = None
@@ -597,7 +611,8 @@ class Verifier:
             if self.moves >= self.move_budget():
                 self.status = "incomplete"
         if self.status in ("confirmed", "incomplete"):  # the final word: the statistical acceptance test
-            self.accept = acceptance(cls.model, tree.data, it, self.check.world_from_model, k_sigma=self.k_sigma)
+            self.accept = acceptance(cls.model, tree.data, it, self.check.world_from_model, k_sigma=self.k_sigma,
+                                     table_z=self.config.table_z)  # fmt: skip
             if not self.accept.ok:
                 self.status = "rejected"
         return self.status
@@ -673,6 +688,8 @@ class Verifier:
         if self.accept is not None:
             out.update(chi2=round(self.accept.statistic, 3), chi2_dof=self.accept.dof,
                        chi2_threshold=round(self.accept.threshold, 3))  # fmt: skip
+            if self.accept.table_residual is not None:
+                out["table_residual_mm"] = round(self.accept.table_residual * 1000.0, 3)
         if self.tour_planned is not None:
             out["tour_planned"] = round(self.tour_planned, 6)
         if self.tour_bound is not None:
