@@ -548,8 +548,9 @@ class Verifier:
         self.coverage = None
         self._hyp: Hypothesis | None = None
         self.hidden: list[int] = []
-        """Model vertices out of the hand's reach and off the table (:func:`hidden_vertices`), and those on the table
-        with no edge rising from them in reach (:func:`table_pins`)."""
+        """Model vertices out of the hand's reach and off the table (:func:`hidden_vertices`)."""
+        self.unpinnable: list[int] = []
+        """Model vertices on the table whose place on it nothing in the hand's reach gives (:func:`table_pins`)."""
         self._model_name: str | None = None
         self._model: Polyhedron | None = None
         self._reach: dict[str, tuple[frozenset[int], frozenset[int], frozenset[int]]] = {}
@@ -599,8 +600,8 @@ class Verifier:
             self.status = "mismatch"
         elif self.coverage is not None and self.coverage.met(self.mode):
             self.hidden = hidden_vertices(cls.model, self.check.world_from_model, self.coverage, self.config)
-            self.hidden += [v for v in self._pins[cls.name][1] if v not in self.hidden]
-            self.status = "incomplete" if self.mode == "full" and self.hidden else "confirmed"
+            self.unpinnable = [v for v in self._pins[cls.name][1] if v not in self.hidden]
+            self.status = "incomplete" if self.mode == "full" and (self.hidden or self.unpinnable) else "confirmed"
         else:
             self.status = "verifying"
             got = self.coverage.measured() if self.coverage is not None else 0
@@ -641,10 +642,13 @@ class Verifier:
             a = self.accept
             return (f"verification: residuals {a.statistic:.1f} over the noise model's {a.threshold:.1f} "
                     f"(chi-square, {a.dof} dof)")  # fmt: skip
-        if self.status == "incomplete" and self.hidden:
-            return (f"verification incomplete: {len(self.hidden)} vertices of {self._model_name} out of the hand's "
-                    "reach, off the table or with no edge rising from them in reach (a difference there cannot be "
-                    "measured)")  # fmt: skip
+        if self.status == "incomplete" and (self.hidden or self.unpinnable):
+            where = [f"{len(self.hidden)} out of the hand's reach off the table"] if self.hidden else []
+            if self.unpinnable:
+                where.append(f"{len(self.unpinnable)} on the table with neither an edge rising from them nor two of "
+                             "their faces in reach")  # fmt: skip
+            return (f"verification incomplete: vertices of {self._model_name} {' and '.join(where)} (a difference "
+                    "there cannot be measured)")  # fmt: skip
         if self.status == "incomplete" and self.coverage is not None:
             f, e, v = (len(x) for x in self.coverage.missing(self.mode))
             return (f"verification incomplete after {self.moves} moves: {f} faces, {e} edges, {v} vertices of "
@@ -697,5 +701,5 @@ class Verifier:
         if self.coverage is not None:
             out["move_budget"] = self.move_budget()
             out.update(self.coverage.record(self._model))
-            out["vertices_hidden"] = len(self.hidden)
+            out["vertices_hidden"] = len(self.hidden) + len(self.unpinnable)
         return out
