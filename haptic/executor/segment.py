@@ -358,6 +358,13 @@ AT_END = 1e-9
 """A vertex's parameter within this of an end of an edge's explored interval is at that end (round-off) [m]."""
 
 
+def _end_vertices(rec: EdgeRecord) -> tuple[list[int], list[int]]:
+    """The data vertices at the start and at the end of an edge's explored interval."""
+    lo, hi = rec.interval
+    return ([v for v, s in rec.vertices.items() if abs(s - lo) < AT_END],
+            [v for v, s in rec.vertices.items() if abs(s - hi) < AT_END])  # fmt: skip
+
+
 # ----------------------------------------------------------------------------------------------------------- book
 
 
@@ -634,12 +641,16 @@ class Segmenter:
             b_dir = -b_dir
         old_ends = [rec.at(s) for s in rec.interval]
         old_v = {v: rec.at(s) for v, s in rec.vertices.items()}
+        starts, stops = _end_vertices(rec)
         line = line_from_points(ridge_points, b_dir, s_b, self.bounds)
         rec.point, rec.direction = line.point, line.direction
         rec.direction_sigma, rec.position_sigma = line.direction_sigma, line.position_sigma
         ends = [rec.param(w) for w in old_ends] + list(line.s_range)
-        rec.interval = (min(ends), max(ends))
         rec.vertices = {v: rec.param(w) for v, w in old_v.items()}
+        # an end at a vertex stays there: ridge contacts past it lie on the next edge, turning little from this one
+        lo = rec.vertices[starts[0]] if starts else min(ends)
+        hi = rec.vertices[stops[0]] if stops else max(ends)
+        rec.interval = (lo, hi)
 
     def extend_edge(
         self, eid: int, s_from: float, s_vertex: float, vertex_sigma: float, sense: int
@@ -655,15 +666,20 @@ class Segmenter:
         b = self.bounds
         vid = self._id()
         lo, hi = rec.interval
+        starts, stops = _end_vertices(rec)
+        # the end the move started from stays at its vertex where one is known (the move may start from a contact
+        # past it, on the next edge turning little from this one)
         if sense > 0:
             hi_new = s_vertex
-            lo_new = min(lo, s_from, s_vertex)
+            known = [rec.vertices[v] for v in starts if rec.vertices[v] < s_vertex]
+            lo_new = known[0] if known else min(lo, s_from, s_vertex)
             for v, s in list(rec.vertices.items()):
                 if s > hi_new:
                     del rec.vertices[v]
         else:
             lo_new = s_vertex
-            hi_new = max(hi, s_from, s_vertex)
+            known = [rec.vertices[v] for v in stops if rec.vertices[v] > s_vertex]
+            hi_new = known[0] if known else max(hi, s_from, s_vertex)
             for v, s in list(rec.vertices.items()):
                 if s < lo_new:
                     del rec.vertices[v]

@@ -27,7 +27,7 @@ from __future__ import annotations
 import math
 import weakref
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -234,12 +234,15 @@ class Acceptance:
     """Degrees of freedom: the quantities' dimensions less the 6 of the fitted pose."""
     threshold: float
     """The χ² quantile at ``1 − ACCEPT_ALPHA`` for ``dof`` (inf when ``dof`` ≤ 0)."""
+    table_residual: float | None = None
+    """With a table: the fitted model's lowest point above the table top [m] (negative: through it)."""
 
 
 def acceptance(
     model: Polyhedron, data: Sequence[DataComponent], it: Interpretation, world_from_model: SE3,
     alpha: float = ACCEPT_ALPHA,
     k_sigma: float = K_SIGMA,
+    table_z: float | None = None,
 ) -> Acceptance:
     """The statistical acceptance test of a fitted pose (after Grimson & Huttenlocher 1989: a threshold from the
     noise model and the number of measured features, not an ad-hoc fraction).
@@ -253,7 +256,13 @@ def acceptance(
     point from the model edge's line (2), each vertex's position (3). A systematic discrepancy that each
     component's hard bound (:func:`pose_check`, 2 × ``k σ``) allows — a height 1.8 mm off seen at four
     vertices, each within its own bound — adds up here: the statistic grows with the number of components that
-    see it, the threshold only with their square root."""
+    see it, the threshold only with their square root.
+
+    With a table (``table_z``, the top's height in the world) the object rests on it, and the table is a datum: the
+    fitted model's lowest point is one more quantity (1 dimension), its σ that of the data's median position
+    bound (the fitted pose is off by about the noise of the data it is fitted to). An object that differs from the
+    model in height alone (a tetrahedron 3 % smaller, whose measured side faces all pass through the apex) fits the
+    measured features at a pose that sinks the model into the table or lifts it off."""
     from scipy.stats import chi2
 
     inv = world_from_model.inverse()
@@ -286,9 +295,50 @@ def acceptance(
         d = float(np.linalg.norm(inv.apply(c.position) - model.vertices[v]))
         total += (d * k_sigma / (np.hypot(c.position_bound, mb.position) + ROUND_OFF)) ** 2
         dims += 3
+    rest = None
+    if table_z is not None and len(data):
+        rest = float(world_from_model.apply(model.vertices)[:, 2].min()) - table_z
+        bound = float(np.median([c.position_bound for c in data]))
+        total += (rest * k_sigma / (np.hypot(bound, mb.position) + ROUND_OFF)) ** 2
+        dims += 1
     dof = dims - 6
     threshold = float(chi2.ppf(1.0 - alpha, dof)) if dof > 0 else float("inf")
-    return Acceptance(bool(total <= threshold), float(total), int(dof), threshold)
+    return Acceptance(bool(total <= threshold), float(total), int(dof), threshold, rest)
+
+
+@dataclass(frozen=True)
+class TablePin:
+    """A model vertex resting on the table out of the pad's reach. The table gives its height and nothing else; its
+    place on the table is given by one of its rising edges measured (the edge's line meets the table there), or by
+    the planes of two of its faces (their planes and the table's meet there). A face's plane is known when the face
+    is measured, or when three of its measured vertices span it (a planar face through them)."""
+
+    vertex: int
+    """The model vertex."""
+    edges: frozenset[int]
+    """Its edges that rise from the table and the hand can measure."""
+    faces: tuple[tuple[int, tuple[int, ...], np.ndarray], ...] = field(compare=False)
+    """Its faces off the table: each as (face, its vertices the hand can measure, their model points (k, 3))."""
+    tol: float = 1e-4
+    """Three vertices span a plane when the triangle's height is above this [m]."""
+
+    def plane_known(self, i: int, faces: frozenset[int], vertices: frozenset[int]) -> bool:
+        """Whether the plane of the ``i``-th of :attr:`faces` is given by a measured face or measured vertices."""
+        f, ids, points = self.faces[i]
+        if f in faces:
+            return True
+        got = [k for k, v in enumerate(ids) if v in vertices]
+        if len(got) < 3:
+            return False
+        p = points[got] - points[got[0]]
+        s = np.linalg.svd(p, compute_uv=False)
+        return bool(s[1] > self.tol)
+
+    def given(self, faces: frozenset[int], edges: frozenset[int], vertices: frozenset[int]) -> bool:
+        """Whether measured ``faces``, ``edges`` and ``vertices`` give this vertex's place on the table."""
+        if self.edges & edges:
+            return True
+        return sum(self.plane_known(i, faces, vertices) for i in range(len(self.faces))) >= 2
 
 
 @dataclass(frozen=True)
@@ -307,6 +357,12 @@ class Coverage:
     """Model edges that count."""
     reachable_vertices: frozenset[int]
     """Model vertices that count."""
+    pins: tuple[TablePin, ...] = ()
+    """Under ``full``, the model vertices that rest on the table out of the pad's reach (:class:`TablePin`)."""
+
+    def unpinned(self) -> tuple[TablePin, ...]:
+        """The :attr:`pins` whose place on the table the data do not give yet."""
+        return tuple(p for p in self.pins if not p.given(self.faces, self.edges, self.vertices))
 
     def fractions(self) -> tuple[float, float, float]:
         """Measured fraction of the reachable faces, edges and vertices (1 when none is reachable)."""
@@ -321,12 +377,21 @@ class Coverage:
         )
 
     def missing(self, mode: str) -> tuple[frozenset[int], frozenset[int], frozenset[int]]:
-        """The reachable faces, edges and vertices still to be measured for ``mode``'s target."""
+        """The reachable faces, edges and vertices still to be measured for ``mode``'s target. Under ``full``, once
+        every reachable vertex is measured (measured vertices fix faces' planes, and so may pin a vertex resting on
+        the table), the rising edges and the faces of the vertices on the table still unpinned."""
         tf, te, tv = TARGETS[mode]
+        vertices = self.reachable_vertices - self.vertices if tv > 0 else frozenset()
+        pin_edges: frozenset[int] = frozenset()
+        pin_faces: frozenset[int] = frozenset()
+        if tv > 0 and not vertices:
+            for p in self.unpinned():
+                pin_edges |= p.edges
+                pin_faces |= frozenset(f for f, _, _ in p.faces) & self.reachable_faces
         return (
-            self.reachable_faces - self.faces if tf > 0 else frozenset(),
-            self.reachable_edges - self.edges if te > 0 else frozenset(),
-            self.reachable_vertices - self.vertices if tv > 0 else frozenset(),
+            (self.reachable_faces - self.faces if tf > 0 else frozenset()) | (pin_faces - self.faces),
+            (self.reachable_edges - self.edges if te > 0 else frozenset()) | (pin_edges - self.edges),
+            vertices,
         )
 
     def target_size(self, mode: str) -> int:
@@ -334,16 +399,18 @@ class Coverage:
         edges under ``fast``)."""
         tf, te, tv = TARGETS[mode]
         return ((len(self.reachable_faces) if tf > 0 else 0) + (len(self.reachable_edges) if te > 0 else 0)
-                + (len(self.reachable_vertices) if tv > 0 else 0))  # fmt: skip
+                + (len(self.reachable_vertices) + len(self.pins) if tv > 0 else 0))  # fmt: skip
 
     def measured(self) -> int:
         """Number of reachable features measured (faces, edges and vertices together)."""
         return (len(self.faces & self.reachable_faces) + len(self.edges & self.reachable_edges)
-                + len(self.vertices & self.reachable_vertices))  # fmt: skip
+                + len(self.vertices & self.reachable_vertices) + len(self.pins) - len(self.unpinned()))  # fmt: skip
 
     def met(self, mode: str) -> bool:
         """Whether ``mode``'s coverage target is met."""
         got = self.fractions()
+        if TARGETS[mode][2] > 0 and self.unpinned():
+            return False
         return all(g >= t - 1e-12 for g, t in zip(got, TARGETS[mode], strict=True))
 
     def record(self, model: Polyhedron) -> dict:
@@ -362,9 +429,10 @@ def coverage(
     model: Polyhedron,
     it: Interpretation,
     reachable: tuple[frozenset[int], frozenset[int], frozenset[int]] | None = None,
+    pins: tuple[TablePin, ...] = (),
 ) -> Coverage:
     """What interpretation ``it`` has measured of ``model``; ``reachable``: the faces, edges and vertices that
-    count (default: all)."""
+    count (default: all); ``pins``: :attr:`Coverage.pins`."""
     if reachable is None:
         reachable = (frozenset(range(model.n_faces)), frozenset(range(model.n_edges)),
                      frozenset(range(model.n_vertices)))  # fmt: skip
@@ -373,6 +441,7 @@ def coverage(
         frozenset(int(e) for e in it.edges.values()),
         frozenset(int(v) for v in it.vertices.values()),
         *reachable,
+        pins,
     )
 
 
@@ -382,6 +451,7 @@ __all__ = [
     "K_SIGMA",
     "K_SIGMA_PHYSICS",
     "Acceptance",
+    "TablePin",
     "acceptance",
     "POSE_SAFETY",
     "TARGETS",

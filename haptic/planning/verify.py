@@ -25,6 +25,7 @@ import numpy as np
 from haptic.geometry.polyhedron import Polyhedron
 from haptic.geometry.se3 import SE3
 from haptic.matching.components import DataComponent, DataEdge, DataFace, SensorNoise
+from haptic.matching.acceptance import TablePin
 from haptic.planning.config import PlannerConfig
 from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import EdgeMove, FaceMove, Move, SensorState
@@ -112,6 +113,45 @@ def reachable_features(
 TABLE_CONTACT = 2e-3
 """A model vertex within this of the table's plane at the fitted pose rests on the table [m] (the fitted pose is
 off by the noise of its data, about 1 mm on the simulated hand)."""
+
+
+PIN_SPAN = 5e-3
+"""Three measured vertices give their face's plane for pinning a vertex on the table when they span at least this
+much across (the second singular value of their offsets) [m]: a thinner triangle tilts the plane by more than a
+vertex's bound over its height."""
+
+
+def table_pins(
+    poly: Polyhedron, world_from_model: SE3, reach: tuple[frozenset[int], frozenset[int], frozenset[int]],
+    config: PlannerConfig,
+) -> tuple[tuple[TablePin, ...], list[int]]:
+    """For the vertices of ``poly`` that rest on the table (within :data:`TABLE_CONTACT`) out of the pad's reach:
+    what would give each one's place on the table (:class:`~haptic.matching.acceptance.TablePin`), and the vertices
+    that nothing the hand can measure would place: no rising edge in reach, and fewer than two of its faces either
+    in reach or spanned by three vertices in reach. Without a table, none."""
+    if config.table_z is None:
+        return (), []
+    z = world_from_model.apply(poly.vertices)[:, 2] - config.table_z
+    pins, unpinnable = [], []
+    for v in range(poly.n_vertices):
+        if z[v] > TABLE_CONTACT or v in reach[2]:
+            continue
+        rising = frozenset(
+            int(e) for e in reach[1] if v in poly.edges[e] and z[int(sum(poly.edges[e])) - v] > TABLE_CONTACT
+        )
+        faces = []
+        for f in poly.vertex_faces[v]:
+            loop = list(poly.faces[int(f)])
+            if np.all(z[loop] <= TABLE_CONTACT):
+                continue
+            ids = tuple(int(u) for u in loop if int(u) in reach[2])
+            faces.append((int(f), ids, poly.vertices[list(ids)].reshape(-1, 3)))
+        pin = TablePin(v, rising, tuple(faces), tol=PIN_SPAN)
+        if pin.given(reach[0], reach[1], reach[2]):
+            pins.append(pin)
+        else:
+            unpinnable.append(v)
+    return tuple(pins), unpinnable
 
 
 def hidden_vertices(poly: Polyhedron, world_from_model: SE3, cov, config: PlannerConfig) -> list[int]:
@@ -510,9 +550,13 @@ class Verifier:
         self._hyp: Hypothesis | None = None
         self.hidden: list[int] = []
         """Model vertices out of the hand's reach and off the table (:func:`hidden_vertices`)."""
+        self.unpinnable: list[int] = []
+        """Model vertices on the table whose place on it nothing in the hand's reach gives (:func:`table_pins`)."""
         self._model_name: str | None = None
         self._model: Polyhedron | None = None
         self._reach: dict[str, tuple[frozenset[int], frozenset[int], frozenset[int]]] = {}
+        self._pins: dict[str, tuple[tuple[TablePin, ...], list[int]]] = {}
+        """Per model: :func:`table_pins` at the pose its reachable features were found for."""
         self._tour: Tour | None = None
         self._tour_model: Polyhedron | None = None
         self.tour_planned: float | None = None
@@ -548,14 +592,17 @@ class Verifier:
                                len(cls.leaves), tuple(cls.leaves))  # fmt: skip
         if self.check.world_from_model is not None:
             if cls.name not in self._reach:
-                self._reach[cls.name] = reachable_features(cls.model, self.check.world_from_model, self.config)
-            self.coverage = coverage(cls.model, it, self._reach[cls.name])
+                reach = reachable_features(cls.model, self.check.world_from_model, self.config)
+                self._reach[cls.name] = reach
+                self._pins[cls.name] = table_pins(cls.model, self.check.world_from_model, reach, self.config)
+            self.coverage = coverage(cls.model, it, self._reach[cls.name], self._pins[cls.name][0])
         self._model_name, self._model = cls.name, cls.model
         if not self.check.ok:
             self.status = "mismatch"
         elif self.coverage is not None and self.coverage.met(self.mode):
             self.hidden = hidden_vertices(cls.model, self.check.world_from_model, self.coverage, self.config)
-            self.status = "incomplete" if self.mode == "full" and self.hidden else "confirmed"
+            self.unpinnable = [v for v in self._pins[cls.name][1] if v not in self.hidden]
+            self.status = "incomplete" if self.mode == "full" and (self.hidden or self.unpinnable) else "confirmed"
         else:
             self.status = "verifying"
             got = self.coverage.measured() if self.coverage is not None else 0
@@ -566,7 +613,8 @@ class Verifier:
             if self.moves >= self.move_budget():
                 self.status = "incomplete"
         if self.status in ("confirmed", "incomplete"):  # the final word: the statistical acceptance test
-            self.accept = acceptance(cls.model, tree.data, it, self.check.world_from_model, k_sigma=self.k_sigma)
+            self.accept = acceptance(cls.model, tree.data, it, self.check.world_from_model, k_sigma=self.k_sigma,
+                                     table_z=self.config.table_z)  # fmt: skip
             if not self.accept.ok:
                 self.status = "rejected"
         return self.status
@@ -595,9 +643,13 @@ class Verifier:
             a = self.accept
             return (f"verification: residuals {a.statistic:.1f} over the noise model's {a.threshold:.1f} "
                     f"(chi-square, {a.dof} dof)")  # fmt: skip
-        if self.status == "incomplete" and self.hidden:
-            return (f"verification incomplete: {len(self.hidden)} vertices of {self._model_name} out of the hand's "
-                    "reach and off the table (a difference there cannot be measured)")  # fmt: skip
+        if self.status == "incomplete" and (self.hidden or self.unpinnable):
+            where = [f"{len(self.hidden)} out of the hand's reach off the table"] if self.hidden else []
+            if self.unpinnable:
+                where.append(f"{len(self.unpinnable)} on the table with neither an edge rising from them nor two of "
+                             "their faces in reach")  # fmt: skip
+            return (f"verification incomplete: vertices of {self._model_name} {' and '.join(where)} (a difference "
+                    "there cannot be measured)")  # fmt: skip
         if self.status == "incomplete" and self.coverage is not None:
             f, e, v = (len(x) for x in self.coverage.missing(self.mode))
             return (f"verification incomplete after {self.moves} moves: {f} faces, {e} edges, {v} vertices of "
@@ -641,6 +693,8 @@ class Verifier:
         if self.accept is not None:
             out.update(chi2=round(self.accept.statistic, 3), chi2_dof=self.accept.dof,
                        chi2_threshold=round(self.accept.threshold, 3))  # fmt: skip
+            if self.accept.table_residual is not None:
+                out["table_residual_mm"] = round(self.accept.table_residual * 1000.0, 3)
         if self.tour_planned is not None:
             out["tour_planned"] = round(self.tour_planned, 6)
         if self.tour_bound is not None:
@@ -648,5 +702,5 @@ class Verifier:
         if self.coverage is not None:
             out["move_budget"] = self.move_budget()
             out.update(self.coverage.record(self._model))
-            out["vertices_hidden"] = len(self.hidden)
+            out["vertices_hidden"] = len(self.hidden) + len(self.unpinnable)
         return out

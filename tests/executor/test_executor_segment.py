@@ -241,3 +241,22 @@ def test_a_ridge_of_many_rows_claims_no_more_than_its_length_allows():
     line = line_from_points(pts, np.array([0.0, 1.0, 0.0]), math.radians(0.5), bounds)
     err = math.acos(min(1.0, abs(float(line.direction[1]))))
     assert err < bounds.bound(line.direction_sigma, bounds.direction_floor)
+
+
+def test_an_edge_move_from_past_a_known_vertex_keeps_the_edge_starting_there():
+    """trapezohedron_11 at 110 mm: an edge move toward the edge's far vertex set off from a contact 4.4 mm before its
+    near one (the pad on the next edge, turning little from this one), and the interval ran past that vertex: the
+    edge's extent off by 1.46 bounds and its start vertex forgotten. The end at a known vertex stays there."""
+    seg = Segmenter(SegmentBounds())
+    line = LineFit(np.zeros(3), np.array([1.0, 0.0, 0.0]), 1e-3, 1e-4, (0.003, 0.004))
+    top, side = np.array([0.0, 0.0, 1.0]), np.array([0.0, 1.0, 0.0])
+    edge = seg.add_edge(line, (0, 1), True, (top, side), adjacent=(0,))
+    _, near = seg.extend_edge(edge.id, 0.003, 0.0, 1e-4, -1)
+    far_edge, far = seg.extend_edge(edge.id, -0.0044, 0.0126, 1e-4, +1)
+    assert far_edge.start_vertex == near.id and far_edge.end_vertex == far.id
+    assert abs(far_edge.length - 0.0126) < 1e-9 and abs(far_edge.point[0]) < 1e-9
+    # the ridge contacts of that move refine the line; they too reach past the near vertex, and the end stays there
+    ridge = np.column_stack([np.linspace(-0.004, 0.0126, 40), np.zeros(40), np.zeros(40)])
+    seg.refine_edge(edge.id, ridge, (_plane(top, np.zeros(3)), _plane(side, np.zeros(3))))
+    rec = seg.edges[edge.id]
+    assert abs(rec.at(rec.interval[0])[0]) < 1e-6 and abs(rec.at(rec.interval[1])[0] - 0.0126) < 1e-6

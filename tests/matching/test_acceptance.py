@@ -25,7 +25,7 @@ from haptic.matching.acceptance import (
     coverage,
     pose_check,
 )
-from haptic.matching.components import SensorNoise, from_json
+from haptic.matching.components import DataFace, DataVertex, SensorNoise, from_json
 from haptic.matching.library import LibraryArrays
 from haptic.matching.tree import InterpretationTree
 
@@ -156,3 +156,40 @@ def test_acceptance_catches_a_systematic_difference_within_every_bound():
             passed += 1
             caught += not any(acceptance(box, tree.data, it, it.world_from_model).ok for it in ok)
     assert passed >= 3 and caught >= 3, (passed, caught)
+
+
+def test_the_table_is_a_datum_of_the_acceptance_test():
+    """TETRA01L 3 % smaller, resting on the table: the hand touches its apex and its three side faces. Shrunk about
+    the apex, those fit the model exactly (each side plane passes through the apex), so without the table the test
+    passes it; at that pose the model's base lies 2 mm below the table top the object rests on, and with the table
+    as a datum the test turns it away. The model itself passes either way."""
+    from tests.planning.test_verify_moves import _resting_on
+
+    tetra = LIB["TETRA01L"]
+    pose, table = _resting_on(tetra, 0)
+    base = frozenset(int(v) for v in tetra.faces[0])
+    (apex,) = frozenset(range(tetra.n_vertices)) - base
+    normal_bound, position_bound = np.deg2rad(0.8), 1.25e-3  # the hand's bounds
+
+    def data(scale: float):
+        """The apex and the three side faces of the model shrunk by ``scale`` about its base's centre, exact."""
+        world = pose.apply(tetra.vertices)
+        centre = world[list(base)].mean(axis=0)
+        world = centre + scale * (world - centre)
+        comps = [DataVertex(0, world[apex], position_bound)]
+        for f in range(1, tetra.n_faces):
+            corners = world[list(tetra.faces[f])]
+            points = corners.mean(axis=0) + 0.3 * (corners - corners.mean(axis=0))
+            comps.append(DataFace(f, pose.rotate(tetra.face_normals[f]), points, normal_bound, position_bound))
+        return comps
+
+    for scale, passes in ((1.0, True), (0.97, False)):
+        tree = InterpretationTree({"TETRA01L": tetra})
+        tree.add_all(data(scale))
+        its = [tree.interpretation(i, with_pose=True, refine=True) for i in range(tree.count)]
+        its = [it for it in its if it.world_from_model is not None and pose_check(tetra, tree.data, it).ok]
+        assert its, scale
+        assert all(acceptance(tetra, tree.data, it, it.world_from_model, k_sigma=K_SIGMA_PHYSICS).ok for it in its)
+        with_table = [acceptance(tetra, tree.data, it, it.world_from_model, k_sigma=K_SIGMA_PHYSICS, table_z=table.table_z)
+                      for it in its]  # fmt: skip
+        assert all(a.ok == passes for a in with_table), (scale, with_table)

@@ -104,3 +104,78 @@ def test_a_vertex_the_pad_cannot_touch_clear_of_the_table_is_hidden():
     assert len(low) == len(high) == 4
     assert set(low.tolist()) <= set(hidden) and not set(low.tolist()) & set(v)
     assert set(high.tolist()) & set(v)
+
+
+def _resting_on(poly, face: int):
+    """A pose of ``poly`` with ``face`` on a table at z = 0.35 m, and a planner configuration with that table."""
+    from dataclasses import replace
+
+    n = poly.face_normals[face]
+    axis = np.cross(n, [0.0, 0.0, -1.0])
+    s, c = np.linalg.norm(axis), float(n @ [0.0, 0.0, -1.0])
+    if s < 1e-9:  # the face already looks down (or up: turn it over about x)
+        rot = np.eye(3) if c > 0 else np.diag([1.0, -1.0, -1.0])
+    else:
+        k = axis / s
+        kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+        rot = np.eye(3) + s * kx + (1 - c) * kx @ kx
+    low = (poly.vertices @ rot.T)[:, 2].min()
+    return SE3(rot, np.array([0.55, 0.0, 0.35 - low])), replace(PlannerConfig(), table_z=0.35)
+
+
+def test_a_vertex_resting_on_the_table_counts_once_an_edge_rising_from_it_is_measured():
+    """TETRA01L resting on a face: its apex is the only vertex the pad can touch, and the table gives the other
+    three vertices' height only (a base vertex moved 4 mm, a base 3 % wider, fits the apex and the table as well).
+    Each is pinned by its edge rising to the apex, whose line meets the table there, or by its two side faces:
+    full verification asks for one such edge or both faces per base vertex; without a table, for nothing more
+    than every vertex."""
+    from haptic.matching.acceptance import Coverage
+    from haptic.planning.verify import reachable_features, table_pins
+
+    poly = LIB["TETRA01L"]
+    pose, table = _resting_on(poly, 0)
+    f, e, v = reachable_features(poly, pose, table)
+    pins, unpinnable = table_pins(poly, pose, (f, e, v), table)
+    base = [int(x) for x in poly.faces[0]]
+    assert len(pins) == len(base) == 3 and unpinnable == []
+    edges = frozenset()
+    for pin in pins:
+        assert len(pin.edges) == 1 and len(pin.faces) == 2  # its edge to the apex, between its two side faces
+        (edge,) = pin.edges
+        assert len(set(poly.edges[edge].tolist()) & set(base)) == 1  # rises from one base vertex to the apex
+        edges |= pin.edges
+    cov = Coverage(frozenset(), frozenset(), frozenset(v), f, e, v, pins)
+    assert not cov.met("full") and cov.missing("full")[1] == edges and cov.missing("full")[0] == f
+    # the rising edges and side faces are asked for only once every vertex in reach is measured
+    assert Coverage(frozenset(), frozenset(), frozenset(), f, e, v, pins).missing("full") == (
+        frozenset(), frozenset(), v)
+    done = Coverage(frozenset(), edges, frozenset(v), f, e, v, pins)
+    assert done.met("full") and done.missing("full") == (frozenset(), frozenset(), frozenset())
+    # or by two faces through each: the three side faces measured pin every base vertex
+    assert Coverage(frozenset(f), frozenset(), frozenset(v), f, e, v, pins).met("full")
+    assert not Coverage(frozenset(list(f)[:1]), frozenset(), frozenset(v), f, e, v, pins).met("full")
+    assert table_pins(poly, pose, (f, e, v), PlannerConfig()) == ((), [])
+
+
+def test_a_face_spanned_by_measured_vertices_helps_pin_a_vertex_on_the_table():
+    """HEXPRISM01 lying on a side: each vertex on the table lies on a hexagonal end face and on a slanted side face.
+    The end face's plane is given by its four upper vertices once they are measured, so that face need not be
+    touched; with only two of them measured, it must be."""
+    from haptic.matching.acceptance import Coverage
+    from haptic.planning.verify import reachable_features, table_pins
+
+    poly = LIB["HEXPRISM01"]
+    side = next(i for i, loop in enumerate(poly.faces) if len(loop) == 4)
+    pose, table = _resting_on(poly, side)
+    f, e, v = reachable_features(poly, pose, table)
+    pins, unpinnable = table_pins(poly, pose, (f, e, v), table)
+    assert len(pins) == 4 and unpinnable == []
+    hexes = frozenset(i for i, loop in enumerate(poly.faces) if len(loop) == 6)
+    sides = frozenset(f) - hexes
+    assert Coverage(sides, frozenset(), frozenset(v), f, e, v, pins).met("full")
+    end = next(iter(hexes))
+    upper = [int(u) for u in poly.faces[end] if int(u) in v]
+    assert len(upper) == 4
+    fewer = frozenset(v) - frozenset(upper[:2])
+    cov = Coverage(sides, frozenset(), fewer, f, e, v, pins)
+    assert not cov.met("full") and len(cov.unpinned()) == 2
