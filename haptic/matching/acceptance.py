@@ -285,6 +285,37 @@ def _slide(
     return PoseCheck(bool(w <= POSE_SAFETY), float(w), cid, what, shifted)
 
 
+OWN_BOUNDS_LEAVES = 64
+"""Most interpretations :func:`own_bounds_keep` pose-checks (more: none eliminated)."""
+
+
+def own_bounds_keep(tree, k_sigma: float | None = None) -> np.ndarray | None:
+    """Which interpretations of ``tree`` (:class:`~haptic.matching.tree.InterpretationTree`) pass the pose check
+    (:func:`pose_check`) and the acceptance test (:func:`acceptance`, σ = bound / ``k_sigma``) with their own
+    model's bounds, shape (N,) bool; None when there is nothing to tell: the library holds no learned model, one
+    model is left, or more than :data:`OWN_BOUNDS_LEAVES` interpretations.
+
+    With a learned model in the library the tree widens every data component by the learned models' bounds
+    (:func:`~haptic.matching.tree.learned_widening`), for every model at once: an object a few millimetres from a
+    library model, learned, then keeps both the learned model's interpretation and its source's, which the tree's
+    tests no longer tell apart and no move would. The pose check and the acceptance test hold each model to its
+    own bounds (none added for an exact model); an interpretation that fails them is no interpretation of the
+    data, as when it is the last one left (the verification's mismatch or rejection). A leaf whose pose the data
+    do not fix yet is kept."""
+    k_sigma = K_SIGMA if k_sigma is None else k_sigma
+    if tree.widen is None or tree.count > OWN_BOUNDS_LEAVES or len(tree.models_alive()) < 2:
+        return None
+    keep = np.ones(tree.count, dtype=bool)
+    poses = tree.poses(range(tree.count), refine=True)
+    data = tree.data
+    for i, pose in enumerate(poses):
+        if pose is not None:
+            it = tree.interpretation(i, with_pose=True, refine=True)
+            chk = pose_check(it.model, data, it)
+            keep[i] = chk.ok and acceptance(it.model, data, it, chk.world_from_model, k_sigma=k_sigma).ok
+    return keep
+
+
 ACCEPT_ALPHA = 1e-3
 """False-alarm probability of the acceptance test (:func:`acceptance`) on an object that is the model, under the
 noise model: the chance that a true recognition is turned away as no-match."""
@@ -468,6 +499,7 @@ __all__ = [
     "PoseCheck",
     "check_verify_mode",
     "coverage",
+    "own_bounds_keep",
     "pose_check",
     "residual_ratios",
 ]
