@@ -108,7 +108,6 @@ class ClosureMoves(MoveSource):
         self.boundary: BoundaryEstimate | None = None
         """The traced boundary (once the object is known not to be convex)."""
         self.components: dict[int, DataComponent] = {}
-        self._asked: Move | None = None
         self._seen = -1
         self._best: tuple = ()
         self._since = 0
@@ -188,7 +187,6 @@ class ClosureMoves(MoveSource):
                 return None
             walk = BoundaryWalk(self.boundary, self.components, view.config)
             move = walk.best_move(view.sensor, tuple(view.failed_here), turn=self.moves + len(view.failed_here))
-            self._asked = move
             return move
         if self.estimate is None:
             return None
@@ -196,11 +194,12 @@ class ClosureMoves(MoveSource):
         if plan is None:
             return None
         move = plan.best_move(view.sensor, tuple(view.failed_here), self.settings.depth)
-        self._asked = move
         return move
 
     def on_result(self, view: EpisodeState, move: Move, result: MoveResult) -> None:
-        if not self.active or move is not self._asked:
+        """Every move made while the learning is under way counts against its budget, whichever source chose it
+        (when none of the learning's measures anything new, the episode's other sources move on)."""
+        if not self.active:
             return
         self.moves += 1
         self.cost += result.cost
@@ -253,11 +252,21 @@ class ClosurePlan:
     def of(cls, est: ConvexEstimate, components: Mapping[int, DataComponent], config: PlannerConfig):
         """The plan of estimate ``est`` over ``components``; None when its solid is no valid model (noise)."""
         poly = est.polytope
-        order = sorted(poly.loops)
+        vertices, loops, group = poly.vertices, poly.loops, est.group_of()
+        vertex_of = dict(est.vertex_data)
         try:
-            model = Polyhedron.from_faces(poly.vertices, [poly.loops[j] for j in order], name="estimate")
+            model = Polyhedron.from_faces(vertices, [loops[j] for j in sorted(loops)], name="estimate")
         except ModelError:
-            return None
+            # planes through one point in fours (a fold through a corner) leave the half-space intersection
+            # vertices a round-off apart: the estimate's vertex groups as the model's vertices
+            vertices, loops = grouped_loops(poly, group, len(est.groups))
+            vertex_of = {d: group[k] for d, k in vertex_of.items()}
+            group = {g: g for g in range(len(est.groups))}
+            try:
+                model = Polyhedron.from_faces(vertices, [loops[j] for j in sorted(loops)], name="estimate")
+            except ModelError:
+                return None
+        order = sorted(loops)
         face_of_plane = {j: i for i, j in enumerate(order)}
         plane_of = {f: k for k, p in enumerate(est.planes) for f in p.faces}
         faces = {f: face_of_plane[k] for f, k in plane_of.items() if k in face_of_plane}
@@ -268,8 +277,6 @@ class ClosurePlan:
             pair = frozenset(faces[f] for f in fs if f in faces)
             if len(pair) == 2 and pair in edge_of:
                 edges[eid] = edge_of[pair]
-        vertices = dict(est.vertex_data)
-        group = est.group_of()
         unmeasured = frozenset(est.unmeasured_vertices())
         traced = set(edges.values())
         un_edges = frozenset(
@@ -277,8 +284,8 @@ class ClosurePlan:
             if e not in traced and (group[int(model.edges[e, 0])] in unmeasured or group[int(model.edges[e, 1])]
                                     in unmeasured)
         )  # fmt: skip
-        open_faces = frozenset(face_of_plane[j] for j in est.open_faces())
-        h = Hypothesis("estimate", model, SE3.identity(), faces, edges, vertices)
+        open_faces = frozenset(face_of_plane[j] for j in est.open_faces() if j in face_of_plane)
+        h = Hypothesis("estimate", model, SE3.identity(), faces, edges, vertex_of)
         return cls(h, open_faces, un_edges, group, unmeasured, config, dict(components))
 
     def gain(self, before: Hypothesis, after: Hypothesis, counted: set) -> float:
@@ -372,6 +379,26 @@ class ClosurePlan:
                 if level + 1 < depth and not met_open:
                     stack.append((h1, s1, c1, g, c, f, level + 1, frozenset(seen)))
         return best_rate, best_move
+
+
+def grouped_loops(poly, group: Mapping[int, int], n_groups: int) -> tuple[np.ndarray, dict[int, list[int]]]:
+    """The vertices of polytope ``poly`` merged by ``group`` (each group's mean) and its faces' loops over them
+    (a vertex repeated in a row dropped; a face left with fewer than three, dropped)."""
+    members: list[list[int]] = [[] for _ in range(n_groups)]
+    for k, g in group.items():
+        members[g].append(k)
+    vertices = np.array([poly.vertices[ks].mean(axis=0) for ks in members])
+    loops: dict[int, list[int]] = {}
+    for j, loop in poly.loops.items():
+        out: list[int] = []
+        for k in loop:
+            if not out or out[-1] != group[k]:
+                out.append(group[k])
+        while len(out) > 1 and out[0] == out[-1]:
+            out.pop()
+        if len(out) >= 3:
+            loops[j] = out
+    return vertices, loops
 
 
 def learning_endings(source: ClosureMoves):

@@ -13,6 +13,7 @@ import numpy as np
 
 from haptic.episode.perception import on_the_table, touched_points
 from haptic.geometry import Polyhedron
+from haptic.matching.acceptance import own_bounds_keep
 from haptic.matching.components import DataComponent, SensorNoise
 from haptic.matching.free_space import FreeSegment, apply_probes
 from haptic.matching.recognition import RECOGNIZED, Recognition, recognize
@@ -158,6 +159,10 @@ class EpisodeState:
             self.probed.append(result.move)
         if self.free:  # after every add: poses tighten, and leaves unposed or too many before become testable
             apply_probes(self.tree, self.free, self.probe_faces)
+        if self.verifier is not None:  # with learned models in the library: each model held to its own bounds
+            keep = own_bounds_keep(self.tree, self.verifier.k_sigma)
+            if keep is not None and not keep.all():
+                self.tree.retain(keep)
         if self.config.touch_evidence:
             self.touched.append(touched_points(result, self.config))
         self.cost += result.cost

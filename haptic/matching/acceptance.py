@@ -196,7 +196,9 @@ def residual_ratios(
 
 def pose_check(model: Polyhedron, data: Sequence[DataComponent], it: Interpretation) -> PoseCheck:
     """Whether interpretation ``it``'s least-squares pose (``it.world_from_model``, refined over all its
-    pairings) explains every data component within ``POSE_SAFETY`` times its bounds."""
+    pairings) explains every data component within ``POSE_SAFETY`` times its bounds — or, where the data leave
+    the pose's translation free along some direction (:func:`free_directions`), the pose shifted along it that
+    explains them best (:func:`_slide`)."""
     pose = it.world_from_model
     if pose is None:
         return PoseCheck(False, float("inf"), None, "pose undetermined", None)
@@ -204,7 +206,114 @@ def pose_check(model: Polyhedron, data: Sequence[DataComponent], it: Interpretat
     if not ratios:
         return PoseCheck(True, 0.0, None, "", pose)
     worst, cid, what = max(ratios, key=lambda r: r[0])
+    if worst > POSE_SAFETY and what not in ("face normal", "edge direction"):  # what a shift may change
+        free = free_directions(data, it)
+        if len(free):
+            slid = _slide(model, data, it, pose, free)
+            if slid is not None:
+                return slid
     return PoseCheck(bool(worst <= POSE_SAFETY), float(worst), cid, what, pose)
+
+
+FREE_SINGULAR = 0.25
+"""A translation direction ``u`` is left free by the data when ``√Σ (a·u)²`` over the unit directions ``a`` their
+positions constrain (a face's normal, the two normals of an edge's line, any direction at a vertex) is below
+this: a shift along it moves no face plane or edge line by more than a quarter of the shift, so the least-squares
+pose is not determined along it by more than its bounds over this [-]."""
+SLIDE_STEPS = (41, 15)
+"""Shifts tried along one free direction, and along each of two, over the model's diameter either way, before the
+best is refined."""
+
+
+def free_directions(data: Sequence[DataComponent], it: Interpretation) -> np.ndarray:
+    """Unit translation directions (world frame) that the positions of ``it``'s paired data leave free
+    (:data:`FREE_SINGULAR`): the axis of a prism whose side faces alone were touched, the plane of one face
+    touched alone. Shape (k, 3), k ≤ 3."""
+    rows: list[np.ndarray] = []
+    for i in it.faces:
+        rows.append(np.asarray(data[i].normal, float))
+    for i in it.edges:
+        b = np.asarray(data[i].direction, float)
+        u = np.cross(b, np.eye(3)[int(np.argmin(np.abs(b)))])
+        u /= np.linalg.norm(u)
+        rows += [u, np.cross(b, u)]
+    if it.vertices:
+        return np.zeros((0, 3))
+    if not rows:
+        return np.eye(3)
+    _, sv, vt = np.linalg.svd(np.array(rows))
+    sv = np.concatenate([sv, np.zeros(3 - len(sv))])
+    return vt[sv < FREE_SINGULAR]
+
+
+def _slide(
+    model: Polyhedron, data: Sequence[DataComponent], it: Interpretation, pose: SE3, free: np.ndarray
+) -> PoseCheck | None:
+    """The pose shifted along the ``free`` directions (one or two) that makes the largest residual ratio least (a
+    grid of :data:`SLIDE_STEPS` over the model's diameter either way, then bounded refinement along each), checked
+    as :func:`pose_check` does; None when the data leave more than two directions free."""
+    from scipy.optimize import minimize_scalar
+
+    if len(free) > 2:
+        return None
+    span = float(np.linalg.norm(np.ptp(model.vertices, axis=0)))
+
+    def at(shift: np.ndarray) -> SE3:
+        return SE3(pose.rotation, pose.translation + shift @ free)
+
+    def worst(shift: np.ndarray) -> float:
+        return max(r[0] for r in residual_ratios(model, data, it, at(shift)))
+
+    grid = np.linspace(-span, span, SLIDE_STEPS[len(free) - 1])
+    points = np.array(np.meshgrid(*([grid] * len(free)), indexing="ij")).reshape(len(free), -1).T
+    best = min(points, key=worst)
+    step = grid[1] - grid[0]
+    for k in range(len(free)):
+
+        def along(x: float, k: int = k, base: np.ndarray = best) -> float:
+            s = base.copy()
+            s[k] = x
+            return worst(s)
+
+        res = minimize_scalar(along, bounds=(best[k] - step, best[k] + step), method="bounded",
+                              options={"xatol": 1e-5})  # fmt: skip
+        if res.fun <= along(best[k]):
+            best = best.copy()
+            best[k] = res.x
+    shifted = at(best)
+    w, cid, what = max(residual_ratios(model, data, it, shifted), key=lambda r: r[0])
+    return PoseCheck(bool(w <= POSE_SAFETY), float(w), cid, what, shifted)
+
+
+OWN_BOUNDS_LEAVES = 64
+"""Most interpretations :func:`own_bounds_keep` pose-checks (more: none eliminated)."""
+
+
+def own_bounds_keep(tree, k_sigma: float | None = None) -> np.ndarray | None:
+    """Which interpretations of ``tree`` (:class:`~haptic.matching.tree.InterpretationTree`) pass the pose check
+    (:func:`pose_check`) and the acceptance test (:func:`acceptance`, σ = bound / ``k_sigma``) with their own
+    model's bounds, shape (N,) bool; None when there is nothing to tell: the library holds no learned model, one
+    model is left, or more than :data:`OWN_BOUNDS_LEAVES` interpretations.
+
+    With a learned model in the library the tree widens every data component by the learned models' bounds
+    (:func:`~haptic.matching.tree.learned_widening`), for every model at once: an object a few millimetres from a
+    library model, learned, then keeps both the learned model's interpretation and its source's, which the tree's
+    tests no longer tell apart and no move would. The pose check and the acceptance test hold each model to its
+    own bounds (none added for an exact model); an interpretation that fails them is no interpretation of the
+    data, as when it is the last one left (the verification's mismatch or rejection). A leaf whose pose the data
+    do not fix yet is kept."""
+    k_sigma = K_SIGMA if k_sigma is None else k_sigma
+    if tree.widen is None or tree.count > OWN_BOUNDS_LEAVES or len(tree.models_alive()) < 2:
+        return None
+    keep = np.ones(tree.count, dtype=bool)
+    poses = tree.poses(range(tree.count), refine=True)
+    data = tree.data
+    for i, pose in enumerate(poses):
+        if pose is not None:
+            it = tree.interpretation(i, with_pose=True, refine=True)
+            chk = pose_check(it.model, data, it)
+            keep[i] = chk.ok and acceptance(it.model, data, it, chk.world_from_model, k_sigma=k_sigma).ok
+    return keep
 
 
 ACCEPT_ALPHA = 1e-3
@@ -460,6 +569,7 @@ __all__ = [
     "PoseCheck",
     "check_verify_mode",
     "coverage",
+    "own_bounds_keep",
     "pose_check",
     "residual_ratios",
 ]

@@ -24,6 +24,7 @@ from haptic.matching.acceptance import (
     check_verify_mode,
     coverage,
     pose_check,
+    residual_ratios,
 )
 from haptic.matching.components import DataFace, DataVertex, SensorNoise, from_json
 from haptic.matching.library import LibraryArrays
@@ -193,3 +194,42 @@ def test_the_table_is_a_datum_of_the_acceptance_test():
         with_table = [acceptance(tetra, tree.data, it, it.world_from_model, k_sigma=K_SIGMA_PHYSICS, table_z=table.table_z)
                       for it in its]  # fmt: skip
         assert all(a.ok == passes for a in with_table), (scale, with_table)
+
+
+def _prism_data(shift_along_axis: float, off_plane: float = 0.0):
+    """HEXPRISM01 with three of its side faces touched near one cap (one point each, the last ``off_plane`` off
+    its plane), and the interpretation pairing them with those faces at the true pose shifted along the prism's
+    axis by ``shift_along_axis`` (the side faces do not fix it)."""
+    from haptic.matching.components import DataFace
+    from haptic.matching.tree import Interpretation
+
+    model = LIB["HEXPRISM01"]
+    cap = next(f for f in range(model.n_faces) if len(model.faces[f]) == 6)
+    axis = model.face_normals[cap]
+    sides = [f for f in range(model.n_faces) if abs(model.face_normals[f] @ axis) < 1e-6][:3]
+    data = []
+    for i, f in enumerate(sides):
+        loop = model.vertices[list(model.faces[f])]
+        near_cap = loop[np.argsort(loop @ axis)[-2:]].mean(axis=0)  # the middle of its edge on the top cap
+        p = near_cap - 3e-3 * axis + (off_plane if i == 2 else 0.0) * model.face_normals[f]
+        data.append(DataFace(i, model.face_normals[f], p[None], 0.0157, 0.6e-3))
+    pose = SE3(np.eye(3), shift_along_axis * axis)
+    it = Interpretation(model, 0, {i: f for i, f in enumerate(sides)}, {}, {}, {}, pose, 0)
+    return model, data, it, axis
+
+
+def test_pose_check_slides_the_pose_along_what_the_data_leave_free():
+    """Side faces of a prism leave its pose free along the axis: a least-squares pose 12 mm off along it puts the
+    touched points beyond their faces, yet the data fit the model; the check finds the shift that explains them.
+    A point 3 mm off its face's plane still fails: a shift along the axis cannot move it onto the plane."""
+    from haptic.matching.acceptance import free_directions
+
+    model, data, it, axis = _prism_data(-12e-3)
+    assert max(r[0] for r in residual_ratios(model, data, it, it.world_from_model)) > 5  # 9 mm beyond the cap
+    free = free_directions(data, it)
+    assert len(free) == 1 and abs(free[0] @ axis) > 0.999
+    chk = pose_check(model, data, it)
+    assert chk.ok and chk.worst <= POSE_SAFETY, chk
+    assert (chk.world_from_model.translation - it.world_from_model.translation) @ axis > 7e-3
+    model, data, it, _ = _prism_data(-12e-3, off_plane=3e-3)
+    assert not pose_check(model, data, it).ok

@@ -1,0 +1,50 @@
+"""Knowing a learned object again when the model it is a few millimetres from is in the library too: the tree,
+which widens every data component by the learned model's bounds, keeps both; each model held to its own bounds
+(the pose check and the acceptance test) tells them apart."""
+
+import shutil
+
+import numpy as np
+import pytest
+
+from haptic.episode.spec import EpisodeSpec
+from haptic.episode.worlds import run_episode
+from haptic.geometry import DEFAULT_LIBRARY, Polyhedron, model_files, save_model
+
+# TETRA01L with its vertex 1 moved 2 mm
+MOVED = Polyhedron.from_faces(
+    np.array([[0.0, 0.0, 0.0], [0.101703543, -0.000799432, -0.000677384], [0.025, 0.08, 0.0], [0.035, 0.025, 0.07]]),
+    [[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]], name="TETRA01L_MOVED",
+)  # fmt: skip
+NAME = "learned_TETRA01L__v1_2mm"
+"""The learned model's name as the bench names it (the library's order of names is the tree's)."""
+
+
+@pytest.fixture(scope="module")
+def learned(tmp_path_factory):
+    """The library with the moved tetrahedron learned into it (one learning episode), and the object's file."""
+    root = tmp_path_factory.mktemp("reid")
+    lib = root / "lib"
+    lib.mkdir()
+    for f in model_files(DEFAULT_LIBRARY):
+        shutil.copy2(f, lib / f.name)
+    obj = root / "TETRA01L_MOVED.json"
+    save_model(MOVED, obj)
+    rec = run_episode(EpisodeSpec(model=str(obj), seed=586626705, noise=1.0, learn=str(lib), learn_name=NAME))
+    assert rec.learned["status"] == "closed"
+    return lib, obj
+
+
+@pytest.mark.parametrize("seed", [242172740, 206666331, 1039756388])
+def test_the_learned_object_is_told_from_its_source(learned, seed):
+    """Seeds that ran out of the episode's 40 moves with TETRA01L and the learned model both left."""
+    lib, obj = learned
+    rec = run_episode(EpisodeSpec(model=str(obj), seed=seed, noise=1.0, models=str(lib)))
+    assert (rec.outcome, rec.recognized) == ("recognized", NAME)
+
+
+def test_the_source_is_not_taken_for_the_learned_object(learned):
+    lib, _ = learned
+    for seed in range(1000, 1006):
+        rec = run_episode(EpisodeSpec(model="TETRA01L", seed=seed, noise=1.0, models=str(lib)))
+        assert rec.recognized != NAME
