@@ -24,8 +24,8 @@ import numpy as np
 
 from haptic.geometry.polyhedron import Polyhedron
 from haptic.geometry.se3 import SE3
-from haptic.matching.components import DataComponent, DataEdge, DataFace, SensorNoise
 from haptic.matching.acceptance import TablePin
+from haptic.matching.components import DataComponent, DataEdge, DataFace, SensorNoise
 from haptic.planning.config import PlannerConfig
 from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import EdgeMove, FaceMove, Move, SensorState

@@ -191,7 +191,8 @@ def test_the_table_is_a_datum_of_the_acceptance_test():
         its = [it for it in its if it.world_from_model is not None and pose_check(tetra, tree.data, it).ok]
         assert its, scale
         assert all(acceptance(tetra, tree.data, it, it.world_from_model, k_sigma=K_SIGMA_PHYSICS).ok for it in its)
-        with_table = [acceptance(tetra, tree.data, it, it.world_from_model, k_sigma=K_SIGMA_PHYSICS, table_z=table.table_z)
+        table_z = table.table_z
+        with_table = [acceptance(tetra, tree.data, it, it.world_from_model, k_sigma=K_SIGMA_PHYSICS, table_z=table_z)
                       for it in its]  # fmt: skip
         assert all(a.ok == passes for a in with_table), (scale, with_table)
 
