@@ -417,6 +417,12 @@ def acceptance(
     return Acceptance(bool(total <= threshold), float(total), int(dof), threshold, rest)
 
 
+PIN_SPAN = 5e-3
+"""Three measured vertices give their face's plane, for placing a vertex on the table, when they spread at least this
+far across (the second singular value of their offsets) [m]: a thinner triangle tilts the plane by more than a
+vertex's bound over its height."""
+
+
 @dataclass(frozen=True)
 class TablePin:
     """A model vertex resting on the table out of the pad's reach. The table gives its height and nothing else; its
@@ -430,8 +436,8 @@ class TablePin:
     """Its edges that rise from the table and the hand can measure."""
     faces: tuple[tuple[int, tuple[int, ...], np.ndarray], ...] = field(compare=False)
     """Its faces off the table: each as (face, its vertices the hand can measure, their model points (k, 3))."""
-    tol: float = 1e-4
-    """Three vertices span a plane when the triangle's height is above this [m]."""
+    span: float = PIN_SPAN
+    """Measured vertices span their face's plane when they spread at least this far across (:data:`PIN_SPAN`) [m]."""
 
     def plane_known(self, i: int, faces: frozenset[int], vertices: frozenset[int]) -> bool:
         """Whether the plane of the ``i``-th of :attr:`faces` is given by a measured face or measured vertices."""
@@ -443,7 +449,7 @@ class TablePin:
             return False
         p = points[got] - points[got[0]]
         s = np.linalg.svd(p, compute_uv=False)
-        return bool(s[1] > self.tol)
+        return bool(s[1] > self.span)
 
     def given(self, faces: frozenset[int], edges: frozenset[int], vertices: frozenset[int]) -> bool:
         """Whether measured ``faces``, ``edges`` and ``vertices`` give this vertex's place on the table."""
@@ -564,6 +570,7 @@ __all__ = [
     "Acceptance",
     "TablePin",
     "acceptance",
+    "PIN_SPAN",
     "POSE_SAFETY",
     "TARGETS",
     "VERIFY_MODES",

@@ -115,12 +115,6 @@ TABLE_CONTACT = 2e-3
 off by the noise of its data, about 1 mm on the simulated hand)."""
 
 
-PIN_SPAN = 5e-3
-"""Three measured vertices give their face's plane for pinning a vertex on the table when they span at least this
-much across (the second singular value of their offsets) [m]: a thinner triangle tilts the plane by more than a
-vertex's bound over its height."""
-
-
 def table_pins(
     poly: Polyhedron, world_from_model: SE3, reach: tuple[frozenset[int], frozenset[int], frozenset[int]],
     config: PlannerConfig,
@@ -146,7 +140,7 @@ def table_pins(
                 continue
             ids = tuple(int(u) for u in loop if int(u) in reach[2])
             faces.append((int(f), ids, poly.vertices[list(ids)].reshape(-1, 3)))
-        pin = TablePin(v, rising, tuple(faces), tol=PIN_SPAN)
+        pin = TablePin(v, rising, tuple(faces))
         if pin.given(reach[0], reach[1], reach[2]):
             pins.append(pin)
         else:
