@@ -17,6 +17,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from haptic.geometry.se3 import cross
 from haptic.matching.components import DataComponent
 
 MIN_SPREAD = 0.05
@@ -139,6 +140,7 @@ class StackedPoses:
         self.pt_m = np.asarray(vertex_position, float).reshape(n, -1, 3)
         self.pt_d = np.array([c.position for c in verts], dtype=float).reshape(-1, 3)
         self.pt_w = np.array([1.0 / max(c.position_bound, 1e-7) for c in verts], dtype=float)
+        self._rows: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
 
     def subset(self, rows: np.ndarray) -> StackedPoses:
         """The problems of some interpretations only (``rows`` indexes the leading axis)."""
@@ -147,6 +149,7 @@ class StackedPoses:
         for name in ("dirs_m", "dirs_wt", "dirs_known", "_dirs_sw", "plane_n", "plane_d", "line_p", "line_b", "pt_m"):
             setattr(out, name, getattr(self, name)[rows])
         out.n = len(rows)
+        out._rows = None if self._rows is None else tuple(a if a.ndim == 2 else a[rows] for a in self._rows)
         return out
 
     def rotations(self) -> tuple[np.ndarray, np.ndarray]:
@@ -216,29 +219,104 @@ class StackedPoses:
             ok[idx] = ok_t
         return r, t, ok
 
+    def _position_rows(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The plane, line and point rows in one form, built once per problem: the data points ``x`` (K, 3), a
+        point ``c`` (N, K, 3) of each paired model feature and a weighted projector ``M`` (N, K, 3, 3), such that
+        the block's residual vector at a pose is ``M (Rᵀ (x − t) − c)``. A plane row's projector is ``w n nᵀ``
+        (a vector along the normal whose length is the weighted plane residual ``w (n · Rᵀ (x − t) − d)``, with
+        ``c = d n``), a line row's ``w (I − b bᵀ)``, a point row's ``w I``: the same sum of squares as
+        :meth:`residuals`, in a third of the array operations."""
+        if self._rows is not None:
+            return self._rows
+        n = self.n
+        eye = np.eye(3)
+        x, c, m = [], [], []
+        if len(self.plane_q):
+            nrm = self.plane_n
+            x.append(self.plane_q)
+            c.append(nrm * self.plane_d[..., None])
+            m.append(self.plane_w[:, None, None] * (nrm[..., :, None] * nrm[..., None, :]))
+        if len(self.line_x):
+            b = self.line_b
+            x.append(self.line_x)
+            c.append(self.line_p)
+            m.append(self.line_w[:, None, None] * (eye - b[..., :, None] * b[..., None, :]))
+        if len(self.pt_d):
+            x.append(self.pt_d)
+            c.append(self.pt_m)
+            m.append(np.broadcast_to(self.pt_w[:, None, None] * eye, (n, len(self.pt_d), 3, 3)))
+        if not x:
+            self._rows = (np.zeros((0, 3)), np.zeros((n, 0, 3)), np.zeros((n, 0, 3, 3)))
+        else:
+            self._rows = (np.concatenate(x), np.concatenate(c, axis=1), np.concatenate(m, axis=1))
+        return self._rows
+
+    def _residuals_and_jacobian(self, r: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The residual vectors (N, rows) with the sum of squares of :meth:`residuals` at poses ``r`` (N, 3, 3),
+        ``t`` (N, 3), and their Jacobian (N, rows, 6) for the pose perturbed on the left, ``(R, t) ↦ (E R, E t +
+        v)`` with ``E = exp([ω]×)``, by rotation vector ω and translation v. Directions as ``√w (Rᵀ a − u)`` (the
+        length of ``√w (a − R u)``): ``∂/∂ω = √w Rᵀ [a]×``; positions as :meth:`_position_rows`, ``M (Rᵀ (x − t)
+        − c)``: ``∂/∂ω = M Rᵀ [x]×``, ``∂/∂v = −M Rᵀ`` (each row of ``B [x]×`` is that row of B crossed with x)."""
+        n = self.n
+        x, c, m = self._position_rows()
+        sw = self._dirs_sw[..., None]
+        f_dirs = (self.dirs_w @ r - self.dirs_m) * sw  # (N, D, 3)
+        # √w Rᵀ [a]×: row i is √w (column i of R) × a
+        cols = np.swapaxes(r, -1, -2)[:, None] * sw[..., None]  # (N, D, 3 rows, 3)
+        j_dirs = np.concatenate([cross(cols, self.dirs_w[None, :, None]), np.zeros_like(cols)], axis=-1)
+        if not len(x):
+            return f_dirs.reshape(n, -1), j_dirs.reshape(n, -1, 6)
+        a = m @ np.swapaxes(r, -1, -2)[:, None]  # M Rᵀ (N, K, 3, 3)
+        f_pos = (a @ (x - t[:, None, :])[..., None])[..., 0] - (m @ c[..., None])[..., 0]
+        j_pos = np.concatenate([cross(a, x[None, :, None]), -a], axis=-1)
+        f = np.concatenate([f_dirs.reshape(n, -1), f_pos.reshape(n, -1)], axis=1)
+        return f, np.concatenate([j_dirs.reshape(n, -1, 6), j_pos.reshape(n, -1, 6)], axis=1)
+
     def refine(self, r: np.ndarray, t: np.ndarray, iterations: int = GN_ITERATIONS) -> tuple[np.ndarray, np.ndarray]:
         """Gauss–Newton on the weighted residuals of every interpretation at once, perturbing each pose on the
-        left (world frame); a problem whose step falls below :data:`GN_TOLERANCE` stops there."""
+        left (world frame), with the Jacobians in closed form (:meth:`_residuals_and_jacobian`); a problem whose
+        step falls below :data:`GN_TOLERANCE` stops there (its later steps are not applied), and the iterations
+        end when every problem has stopped."""
         r, t = np.array(r, dtype=float), np.array(t, dtype=float)
-        active = np.arange(len(r))
+        if not len(r):
+            return r, t
+        active = np.ones(len(r), bool)
         for _ in range(iterations):
-            if not len(active):
+            f, jac = self._residuals_and_jacobian(r, t)
+            step = _normal_step(jac, f)
+            step[~active] = 0.0
+            dr = _cayley(step[:, :3])
+            r, t = dr @ r, (dr @ t[..., None])[..., 0] + step[:, 3:]
+            active &= np.sqrt(np.einsum("ni,ni->n", step, step)) >= GN_TOLERANCE
+            if not active.any():
                 break
-            prob = self if len(active) == self.n else self.subset(active)
-            ra, ta = r[active], t[active]
-            # the pose and its six perturbations at once, leading axis 7
-            r7 = np.concatenate([ra[None], _FD_ROT[:, None] @ ra])
-            t7 = np.concatenate([ta[None], np.einsum("jab,nb->jna", _FD_ROT, ta) + _FD_XI[:, None, 3:]])
-            f = prob.residuals(r7, t7)
-            f0 = f[0]
-            jac = ((f[1:] - f0) / _FD_STEP).transpose(1, 2, 0)
-            step = _gauss_newton_step(jac, f0)
-            dr = exp_so3(step[:, :3])
-            ra, ta = dr @ ra, (dr @ ta[..., None])[..., 0] + step[:, 3:]
-            u, _, vt = np.linalg.svd(ra)
-            r[active], t[active] = u @ vt, ta
-            active = active[np.linalg.norm(step, axis=1) >= GN_TOLERANCE]
         return r, t
+
+
+def _normal_step(jac: np.ndarray, f0: np.ndarray) -> np.ndarray:
+    """The Gauss–Newton steps (N, 6) minimising ``‖J x + f₀‖`` for Jacobians ``jac`` (N, rows, 6), by the normal
+    equations, or by the SVD least squares where those are singular."""
+    jt = np.swapaxes(jac, -1, -2)
+    try:
+        return np.linalg.solve(jt @ jac, -(jt @ f0[..., None]))[..., 0]
+    except np.linalg.LinAlgError:
+        return _lstsq(jac, -f0)[0]
+
+
+_HAT_HALF = np.zeros((3, 9))
+_HAT_HALF[2, 1], _HAT_HALF[1, 2], _HAT_HALF[0, 5] = -0.5, 0.5, -0.5
+_HAT_HALF[2, 3], _HAT_HALF[1, 6], _HAT_HALF[0, 7] = 0.5, -0.5, 0.5
+"""``w @ _HAT_HALF`` is the skew matrix ``[w / 2]×`` of each rotation vector, flattened row-major."""
+
+
+def _cayley(w: np.ndarray) -> np.ndarray:
+    """The rotations (N, 3, 3) of the Cayley map of rotation vectors ``w`` (N, 3): ``I + 2 ([v]× + [v]×²) / (1 +
+    |v|²)`` with ``v = w / 2``, a proper rotation that agrees with ``exp([w]×)`` to second order (to within
+    ``|w|³ / 12``), in a third of the array operations of :func:`exp_so3`: the Gauss–Newton update, whose steps the
+    next iteration corrects."""
+    k = (w @ _HAT_HALF).reshape(-1, 3, 3)
+    s = 2.0 / (1.0 + 0.25 * np.einsum("ni,ni->n", w, w))[:, None, None]
+    return np.eye(3) + s * (k + k @ k)
 
 
 _FD_STEP = 1e-7

@@ -160,35 +160,62 @@ def _same_pose_pairs(
 
 
 def _group(models: Sequence[Polyhedron], model_index: np.ndarray, poses: Sequence[SE3], tol: PoseTolerance):
-    """Positions of the poses grouped into pose classes, in the order of each class's first member: each pose
-    joins the first earlier class of its model whose first pose it equals up to a symmetry (every pair of a model's
-    poses compared in one array operation, :func:`_same_pose_pairs`, or, past :data:`MAX_PAIRS`, each class's first
-    pose against the poses left)."""
+    """Positions of the poses grouped into pose classes (:func:`_group_arrays` of the poses stacked; ``models``: the
+    model of each pose)."""
+    model_of = {int(m): models[i] for i, m in enumerate(np.asarray(model_index).tolist())}
     rot = np.stack([p.rotation for p in poses])
     trans = np.stack([p.translation for p in poses])
+    return _group_arrays(model_of, np.asarray(model_index), rot, trans, tol)
+
+
+def _group_arrays(model_of, model_index: np.ndarray, rot: np.ndarray, trans: np.ndarray, tol: PoseTolerance):
+    """Positions of the poses ``(rot (N, 3, 3), trans (N, 3))`` grouped into pose classes, in the order of each
+    class's first member: each pose joins the first earlier class of its model whose first pose it equals up to a
+    symmetry (every pair of a model's poses compared in one array operation, :func:`_same_pose_pairs`, the classes
+    then taken in one pass over the pairs as bit sets; or, past :data:`MAX_PAIRS`, each class's first pose against
+    the poses left). ``model_of[m]`` is the model of model index ``m``."""
     groups: list[list[int]] = []
     for m in dict.fromkeys(model_index.tolist()):
         left = np.flatnonzero(model_index == m)
-        model = models[int(left[0])]
-        placed = np.empty_like(trans)  # each pose's centroid, computed once per model (the same bits)
-        placed[left] = trans[left] + rot[left] @ model.centroid
+        model = model_of[m]
+        placed = trans[left] + rot[left] @ model.centroid  # each pose's centroid, computed once per model
         if len(left) ** 2 * len(_symmetry_arrays(model)[0]) <= MAX_PAIRS:
-            same = _same_pose_pairs(rot[left], trans[left], placed[left], model, tol)
-            alive = np.ones(len(left), dtype=bool)
-            while alive.any():
-                k = int(np.argmax(alive))
-                members = alive & same[k]
-                members[k] = False
-                groups.append([int(left[k]), *left[members].tolist()])
-                alive &= ~members
-                alive[k] = False
+            same = _same_pose_pairs(rot[left], trans[left], placed, model, tol)
+            groups.extend(_first_classes(same, left.tolist()))
             continue
+        full = np.empty_like(trans)
+        full[left] = placed
         while len(left):
             rep, rest = int(left[0]), left[1:]
-            same = _same_pose_as(poses[rep], rot[rest], trans[rest], models[rep], tol, placed[rest])
+            same = _same_pose_as(SE3(rot[rep], trans[rep]), rot[rest], trans[rest], model, tol, full[rest])
             groups.append([rep, *rest[same].tolist()])
             left = rest[~same]
     return sorted(groups)
+
+
+def _first_classes(same: np.ndarray, names: list[int]) -> list[list[int]]:
+    """The classes of a pairwise relation ``same`` (L, L): the first member left opens a class, which takes every
+    member left that ``same`` relates to it; members named by ``names``. Each row is a bit set (an int), so a class
+    costs a few integer operations."""
+    n = len(names)
+    if n == 1:
+        return [[names[0]]]
+    packed = np.packbits(same, axis=1, bitorder="little")
+    rows = [int.from_bytes(b, "little") for b in map(bytes, packed)]
+    out = []
+    alive = (1 << n) - 1
+    while alive:
+        low = alive & -alive
+        k = low.bit_length() - 1
+        members = alive & rows[k] & ~low
+        alive &= ~(members | low)
+        group = [names[k]]
+        while members:
+            bit = members & -members
+            group.append(names[bit.bit_length() - 1])
+            members ^= bit
+        out.append(group)
+    return out
 
 
 def group_pose_classes(interpretations: list[Interpretation], tol: PoseTolerance) -> list[PoseClass] | None:
@@ -223,15 +250,15 @@ def recognize(tree: InterpretationTree, max_interpretations: int = 64, tol: Pose
     if n > max_interpretations:
         return Recognition(EXPLORING, None, None, (), n, models)
     tol = tol if tol is not None else PoseTolerance.from_data(tree.data)
-    poses = tree.poses(range(n), refine=False)
-    if any(p is None for p in poses):
+    rot, trans, ok = tree.initial_poses()
+    if not ok.all():
         return Recognition(EXPLORING, None, None, (), n, models)
     lib = tree.library
     model_index = tree.model_indices
-    groups = _group([lib.models[i] for i in model_index], model_index, poses, tol)
+    groups = _group_arrays(lib.models, model_index, rot, trans, tol)
     refined = tree.poses([g[0] for g in groups], refine=True)
     classes = [
-        PoseClass(lib.models[model_index[g[0]]], tuple(g), r if r is not None else poses[g[0]])
+        PoseClass(lib.models[model_index[g[0]]], tuple(g), r if r is not None else SE3(rot[g[0]], trans[g[0]]))
         for g, r in zip(groups, refined, strict=True)
     ]
     if len(classes) == 1:

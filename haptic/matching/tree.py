@@ -224,6 +224,9 @@ class InterpretationTree:
         """Number of interpretations after each ``add`` (re-reported edges included)."""
         self._pose_cache: dict[tuple[bool, int], SE3 | None] = {}
         """Poses by (refined, leaf) of the current leaves, emptied by every ``add`` and renumbered by ``retain``."""
+        self._initial: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+        """The closed-form poses of every leaf as arrays (:meth:`initial_poses`), emptied by every ``add`` and
+        renumbered by ``retain``."""
         self._stack: StackedPoses | None = None
         """The least-squares problems of every current leaf, once built (:meth:`_stacked`); emptied by every ``add``
         and ``retain``."""
@@ -301,6 +304,7 @@ class InterpretationTree:
             self._model, self._assign, self._sense = self._model[ok], assign[ok], sense[ok]
         self.counts.append(self.count)
         self._pose_cache.clear()  # poses are of the data before this add
+        self._initial = None
         self._stack = None
         return self.count
 
@@ -318,6 +322,8 @@ class InterpretationTree:
         self._model, self._assign, self._sense = self._model[keep], self._assign[keep], self._sense[keep]
         renumber = np.cumsum(keep) - 1  # a kept leaf's new index; its pose (same data) stays valid
         self._pose_cache = {(r, int(renumber[i])): p for (r, i), p in self._pose_cache.items() if keep[i]}
+        if self._initial is not None:
+            self._initial = tuple(a[keep] for a in self._initial)
         self._stack = None
         if self.counts:
             self.counts[-1] = self.count
@@ -618,26 +624,46 @@ class InterpretationTree:
             leaf=leaf,
         )
 
+    def initial_poses(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The closed-form (unrefined) poses of every leaf as arrays: ``(R (N, 3, 3), t (N, 3), ok (N,))``, ``ok``
+        False where the data do not determine a pose yet (:meth:`~haptic.matching.batch_poses.StackedPoses.initial`,
+        all leaves in one batch). Computed once per data update; :meth:`poses` with ``refine=False`` gives the same
+        poses as :class:`~haptic.geometry.se3.SE3`."""
+        if self._initial is None:
+            n = self.count
+            if n == 0:
+                self._initial = (np.zeros((0, 3, 3)), np.zeros((0, 3)), np.zeros(0, bool))
+            else:
+                self._initial = self._stacked(np.arange(n)).initial()
+        return self._initial
+
     def poses(self, leaves: Sequence[int], refine: bool = True) -> list[SE3 | None]:
         """Poses ``world_from_model`` of some leaves (None where the data do not determine one yet), least-squares
         refined unless ``refine`` is False: all of them in one batch
         (:class:`~haptic.matching.batch_poses.StackedPoses`), from the unrefined ones for a refinement. Poses are kept
-        until the next ``add``, so a leaf is posed once per data update."""
+        until the next ``add``, so a leaf is posed once per data update (the unrefined ones of every leaf at once,
+        :meth:`initial_poses`, once asked for all)."""
         leaves = [int(i) for i in leaves]
         todo = sorted({i for i in leaves if (refine, i) not in self._pose_cache})
         if todo:
             rows = np.array(todo, dtype=np.int64)
-            prob = self._stacked(rows)
-            if refine:
-                start = self.poses(todo, refine=False)
-                ok = np.array([p is not None for p in start])
-                r = np.stack([p.rotation if p is not None else np.eye(3) for p in start])
-                t = np.stack([p.translation if p is not None else np.zeros(3) for p in start])
+            if not refine and (self._initial is not None or len(todo) == self.count):
+                r, t, ok = (a[rows] for a in self.initial_poses())
+            elif refine:
+                prob = self._stacked(rows)
+                if self._initial is not None:
+                    r, t, ok = (a[rows] for a in self._initial)
+                else:
+                    start = self.poses(todo, refine=False)
+                    ok = np.array([p is not None for p in start])
+                    r = np.stack([p.rotation if p is not None else np.eye(3) for p in start])
+                    t = np.stack([p.translation if p is not None else np.zeros(3) for p in start])
                 idx = np.flatnonzero(ok)
                 if len(idx):
+                    r, t = r.copy(), t.copy()
                     r[idx], t[idx] = prob.subset(idx).refine(r[idx], t[idx])
             else:
-                r, t, ok = prob.initial()
+                r, t, ok = self._stacked(rows).initial()
             for j, leaf in enumerate(todo):
                 self._pose_cache[(refine, leaf)] = SE3(r[j], t[j]) if ok[j] else None
         return [self._pose_cache[(refine, i)] for i in leaves]
