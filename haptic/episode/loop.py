@@ -12,9 +12,10 @@ here only to place the object (for the geometric executor) and, at the end, to s
 
 from __future__ import annotations
 
+import copy
 import time
 from collections.abc import Callable, Generator, Sequence
-from dataclasses import asdict, dataclass, field, fields
+from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Protocol
 
@@ -86,7 +87,23 @@ class EpisodeRecord:
     no learning)."""
 
     def to_json(self) -> dict:
-        return asdict(self)
+        """The record as a dict of plain values (what :func:`dataclasses.asdict` gives: lists and dicts copied, at
+        a fraction of its cost; every value is a number, string, bool, None, or a list, tuple or dict of them)."""
+        return {f.name: _plain(getattr(self, f.name)) for f in _RECORD_FIELDS}
+
+
+def _plain(value):
+    """A copy of a JSON-like value: containers copied, immutable leaves shared."""
+    if isinstance(value, dict):
+        return {k: _plain(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return type(value)(_plain(v) for v in value)
+    if isinstance(value, int | float | str | bool | None):
+        return value
+    return copy.deepcopy(value)
+
+
+_RECORD_FIELDS = fields(EpisodeRecord)
 
 
 @dataclass

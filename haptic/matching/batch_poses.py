@@ -141,6 +141,7 @@ class StackedPoses:
         self.pt_d = np.array([c.position for c in verts], dtype=float).reshape(-1, 3)
         self.pt_w = np.array([1.0 / max(c.position_bound, 1e-7) for c in verts], dtype=float)
         self._rows: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+        self._normal: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
 
     def subset(self, rows: np.ndarray) -> StackedPoses:
         """The problems of some interpretations only (``rows`` indexes the leading axis)."""
@@ -150,6 +151,7 @@ class StackedPoses:
             setattr(out, name, getattr(self, name)[rows])
         out.n = len(rows)
         out._rows = None if self._rows is None else tuple(a if a.ndim == 2 else a[rows] for a in self._rows)
+        out._normal = None if self._normal is None else tuple(a[rows] for a in self._normal)
         return out
 
     def rotations(self) -> tuple[np.ndarray, np.ndarray]:
@@ -168,30 +170,35 @@ class StackedPoses:
 
     def translations(self, r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``(t (N, 3), ok (N,))``: the translation by linear least squares on planes, lines and vertices given
-        the rotations, where that system is well conditioned."""
+        the rotations, where that system is well conditioned (its smallest singular value at least
+        :data:`MIN_CONDITION` times its largest).
+
+        With the rows of :meth:`_position_rows` (``M (Rᵀ (x − t) − c)``, ``Q = MᵀM`` per row), the normal
+        equations are ``R (Σ Q) Rᵀ t = R Σ Q (Rᵀ x − c)``, so ``t = R (Σ Q)⁻¹ Σ Q (Rᵀ x − c)``: the system's matrix
+        is the model-frame ``Σ Q`` turned, and its singular values (the square roots of ``Σ Q``'s eigenvalues) do
+        not depend on the rotation."""
         n_rows = len(self.plane_q) + 3 * len(self.line_x) + 3 * len(self.pt_d)
         if n_rows < 3:
             return np.zeros((self.n, 3)), np.zeros(self.n, bool)
-        rt = np.swapaxes(r, -1, -2)
-        rows, rhs = [], []  # (an empty block adds no row: left out, it costs no array operations)
-        if len(self.plane_q):
-            nrm = self.plane_n @ rt  # rotated normals, one per touched point
-            rows.append(self.plane_w[:, None] * nrm)
-            rhs.append(self.plane_w * (np.einsum("nij,ij->ni", nrm, self.plane_q) - self.plane_d))
-        if len(self.line_x):
-            b = self.line_b @ rt
-            perp = np.eye(3) - b[..., :, None] * b[..., None, :]  # (N, L, 3, 3)
-            rows.append((self.line_w[:, None, None] * perp).reshape(self.n, -1, 3))
-            rel = self.line_x - self.line_p @ rt
-            rhs.append((self.line_w[:, None] * np.einsum("nlij,nlj->nli", perp, rel)).reshape(self.n, -1))
-        if len(self.pt_d):
-            pt_rows = (self.pt_w[:, None, None] * np.eye(3)).reshape(-1, 3)
-            rows.append(np.broadcast_to(pt_rows, (self.n, *pt_rows.shape)))
-            rhs.append((self.pt_w[:, None] * (self.pt_d - self.pt_m @ rt)).reshape(self.n, -1))
-        a = np.concatenate(rows, axis=1)
-        y = np.concatenate(rhs, axis=1)
-        t, s = _lstsq(a, y)
-        return t, s[:, -1] >= MIN_CONDITION * s[:, 0]
+        x, c, m = self._position_rows()
+        q, total, ok = self._normal_matrices()
+        v = np.einsum("nkij,nkj->ni", q, x @ r - c)
+        safe = np.where(ok[:, None, None], total, np.eye(3))
+        t = (r @ np.linalg.solve(safe, v[..., None]))[..., 0]
+        return t, ok
+
+    def _normal_matrices(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``Q = MᵀM`` of each position row (N, K, 3, 3) (``w²`` times its projector), their sum per problem (N, 3,
+        3), and whether that sum is well conditioned (its eigenvalues within :data:`MIN_CONDITION`² of each other,
+        :func:`_symmetric_eigenvalues`); built once per problem."""
+        if self._normal is None:
+            x, c, m = self._position_rows()
+            w = np.concatenate([self.plane_w, self.line_w, self.pt_w])
+            q = w[:, None, None] * m  # M is w times a projector P: MᵀM = w² P
+            total = q.sum(axis=1)
+            lam = _symmetric_eigenvalues(total)
+            self._normal = (q, total, lam[:, 0] >= MIN_CONDITION**2 * lam[:, 2])
+        return self._normal
 
     def residuals(self, r: np.ndarray, t: np.ndarray) -> np.ndarray:
         """All weighted residuals at poses ``r`` (..., N, 3, 3), ``t`` (..., N, 3): shape (..., N, rows)."""
@@ -307,6 +314,25 @@ _HAT_HALF = np.zeros((3, 9))
 _HAT_HALF[2, 1], _HAT_HALF[1, 2], _HAT_HALF[0, 5] = -0.5, 0.5, -0.5
 _HAT_HALF[2, 3], _HAT_HALF[1, 6], _HAT_HALF[0, 7] = 0.5, -0.5, 0.5
 """``w @ _HAT_HALF`` is the skew matrix ``[w / 2]×`` of each rotation vector, flattened row-major."""
+
+
+def _symmetric_eigenvalues(a: np.ndarray) -> np.ndarray:
+    """Eigenvalues of symmetric 3 × 3 matrices (N, 3, 3), ascending (N, 3), in closed form (the trigonometric
+    solution of the characteristic cubic): absolute errors of the order of the arithmetic's relative error times
+    the largest eigenvalue."""
+    a00, a11, a22 = a[:, 0, 0], a[:, 1, 1], a[:, 2, 2]
+    a01, a02, a12 = a[:, 0, 1], a[:, 0, 2], a[:, 1, 2]
+    q = (a00 + a11 + a22) / 3.0
+    b00, b11, b22 = a00 - q, a11 - q, a22 - q
+    p2 = b00 * b00 + b11 * b11 + b22 * b22 + 2.0 * (a01 * a01 + a02 * a02 + a12 * a12)
+    p = np.sqrt(p2 / 6.0)
+    det = b00 * (b11 * b22 - a12 * a12) - a01 * (a01 * b22 - a12 * a02) + a02 * (a01 * a12 - b11 * a02)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        half = np.clip(np.where(p > 0, det / (2.0 * p**3), 0.0), -1.0, 1.0)
+    phi = np.arccos(half) / 3.0
+    hi = q + 2.0 * p * np.cos(phi)
+    lo = q + 2.0 * p * np.cos(phi + 2.0 * np.pi / 3.0)
+    return np.stack([lo, 3.0 * q - hi - lo, hi], axis=1)
 
 
 def _cayley(w: np.ndarray) -> np.ndarray:
