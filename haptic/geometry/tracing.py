@@ -6,6 +6,7 @@ interpretation's model to predict a move's outcome. Pure geometry: no noise, no 
 
 from __future__ import annotations
 
+import math
 import weakref
 from dataclasses import dataclass
 
@@ -76,7 +77,6 @@ def trace_face(
     # plane by up to its precision, and a point stepped over from a neighbouring face is off by as much
     start = start - (start @ n - poly.face_offsets[face]) * n
     best = None
-    loop = poly.faces[face]
     corners, sides = _plane_corners(poly, face)
     # which sides the trace can meet, from the crossing solved for every side at once; only those are solved
     # exactly one by one below (a side it misses by a margin far above the arithmetic's error is not: the same sides
@@ -88,22 +88,30 @@ def trace_face(
         u_all = _in_plane_cross(rel, d, n) / den
     steady = np.abs(den) > _STEADY * np.sqrt(np.einsum("ki,ki->k", sides, sides))
     skip = steady & ((t_all < -_MARGIN) | (u_all < -_MARGIN) | (u_all > 1 + _MARGIN))
+    dx, dy, dz = d.tolist()
+    sx, sy, sz = start.tolist()
     for k, e in enumerate(poly.face_edges[face]):
         if skip[k]:
             continue
-        a = corners[k]
-        b = corners[(k + 1) % len(loop)]
-        seg = b - a
-        # solve start + t d = a + u seg in the plane (least squares in 3-D, exact when coplanar)
-        m = np.column_stack([d, -seg])
-        sol, *_ = np.linalg.lstsq(m, a - start, rcond=None)
-        t, u = sol
+        ax, ay, az = corners[k].tolist()
+        gx, gy, gz = sides[k].tolist()
+        # solve start + t d = a + u seg in the plane: least squares in 3-D (exact when coplanar) by the 2 × 2
+        # normal equations, in scalars (d is a unit vector)
+        rx, ry, rz = ax - sx, ay - sy, az - sz
+        dg, gg = dx * gx + dy * gy + dz * gz, gx * gx + gy * gy + gz * gz
+        dr, gr = dx * rx + dy * ry + dz * rz, gx * rx + gy * ry + gz * rz
+        det = gg - dg * dg
+        if det <= 1e-24 * gg:
+            continue  # parallel
+        t = (gg * dr - dg * gr) / det
+        u = (dg * dr - gr) / det
         if t <= 1e-12 or u < -1e-12 or u > 1 + 1e-12:
             continue
-        if np.linalg.norm(start + t * d - (a + u * seg)) > 1e-7:
-            continue  # parallel or off-plane
+        ex, ey, ez = sx + t * dx - (ax + u * gx), sy + t * dy - (ay + u * gy), sz + t * dz - (az + u * gz)
+        if math.sqrt(ex * ex + ey * ey + ez * ez) > 1e-7:
+            continue  # off-plane
         if best is None or t < best[0]:
-            best = (t, e, u, np.linalg.norm(seg))
+            best = (t, e, u, math.sqrt(gg))
     if best is None:
         return None
     t, e, u, seg_len = best
