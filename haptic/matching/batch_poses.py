@@ -189,14 +189,14 @@ class StackedPoses:
 
     def _normal_matrices(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``Q = MᵀM`` of each position row (N, K, 3, 3) (``w²`` times its projector), their sum per problem (N, 3,
-        3), and whether that sum is well conditioned (its eigenvalues within :data:`MIN_CONDITION`² of each other,
-        :func:`_symmetric_eigenvalues`); built once per problem."""
+        3), and whether that sum is well conditioned (its eigenvalues within :data:`MIN_CONDITION`² of each other);
+        built once per problem."""
         if self._normal is None:
             x, c, m = self._position_rows()
             w = np.concatenate([self.plane_w, self.line_w, self.pt_w])
             q = w[:, None, None] * m  # M is w times a projector P: MᵀM = w² P
             total = q.sum(axis=1)
-            lam = _symmetric_eigenvalues(total)
+            lam = np.linalg.eigvalsh(total)
             self._normal = (q, total, lam[:, 0] >= MIN_CONDITION**2 * lam[:, 2])
         return self._normal
 
@@ -314,25 +314,6 @@ _HAT_HALF = np.zeros((3, 9))
 _HAT_HALF[2, 1], _HAT_HALF[1, 2], _HAT_HALF[0, 5] = -0.5, 0.5, -0.5
 _HAT_HALF[2, 3], _HAT_HALF[1, 6], _HAT_HALF[0, 7] = 0.5, -0.5, 0.5
 """``w @ _HAT_HALF`` is the skew matrix ``[w / 2]×`` of each rotation vector, flattened row-major."""
-
-
-def _symmetric_eigenvalues(a: np.ndarray) -> np.ndarray:
-    """Eigenvalues of symmetric 3 × 3 matrices (N, 3, 3), ascending (N, 3), in closed form (the trigonometric
-    solution of the characteristic cubic): absolute errors of the order of the arithmetic's relative error times
-    the largest eigenvalue."""
-    a00, a11, a22 = a[:, 0, 0], a[:, 1, 1], a[:, 2, 2]
-    a01, a02, a12 = a[:, 0, 1], a[:, 0, 2], a[:, 1, 2]
-    q = (a00 + a11 + a22) / 3.0
-    b00, b11, b22 = a00 - q, a11 - q, a22 - q
-    p2 = b00 * b00 + b11 * b11 + b22 * b22 + 2.0 * (a01 * a01 + a02 * a02 + a12 * a12)
-    p = np.sqrt(p2 / 6.0)
-    det = b00 * (b11 * b22 - a12 * a12) - a01 * (a01 * b22 - a12 * a02) + a02 * (a01 * a12 - b11 * a02)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        half = np.clip(np.where(p > 0, det / (2.0 * p**3), 0.0), -1.0, 1.0)
-    phi = np.arccos(half) / 3.0
-    hi = q + 2.0 * p * np.cos(phi)
-    lo = q + 2.0 * p * np.cos(phi + 2.0 * np.pi / 3.0)
-    return np.stack([lo, 3.0 * q - hi - lo, hi], axis=1)
 
 
 def _cayley(w: np.ndarray) -> np.ndarray:
