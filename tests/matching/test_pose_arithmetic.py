@@ -93,7 +93,8 @@ def test_the_closed_form_jacobian_is_the_finite_difference_one(problems):
 def test_one_residual_form_has_the_sum_of_squares_of_the_seeds_residuals(problems):
     rng = np.random.default_rng(2)
     for prob, r, t in problems:
-        for rot, tr in ((r, t), (np.stack([random_rotation(rng) for _ in range(len(r))]), t + rng.normal(size=t.shape))):
+        turned = np.stack([random_rotation(rng) for _ in range(len(r))])
+        for rot, tr in ((r, t), (turned, t + rng.normal(size=t.shape))):
             plain = (prob.residuals(rot, tr) ** 2).sum(axis=-1)
             fused = (prob._residuals_and_jacobian(rot, tr)[0] ** 2).sum(axis=-1)
             np.testing.assert_allclose(fused, plain, rtol=1e-9, atol=1e-18)
