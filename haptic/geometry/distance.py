@@ -22,21 +22,30 @@ def surface_distance(poly: Polyhedron, points: np.ndarray) -> np.ndarray:
 
 def point_triangle_distance(p: np.ndarray, tri: np.ndarray) -> np.ndarray:
     """Distances (P, T) from points to triangles (closest point by barycentric clamping over the regions)."""
-    a, b, c = tri[None, :, 0], tri[None, :, 1], tri[None, :, 2]
-    q = p[:, None, :]
+    return _distance(p[:, None, :], tri[None, :, 0], tri[None, :, 1], tri[None, :, 2])
+
+
+def paired_point_triangle_distance(p: np.ndarray, tri: np.ndarray) -> np.ndarray:
+    """Distances (M,) from each point ``p[i]`` (M, 3) to its own triangle ``tri[i]`` (M, 3, 3): the entries of
+    :func:`point_triangle_distance` that a caller needs, without the rest of the matrix."""
+    return _distance(p, tri[:, 0], tri[:, 1], tri[:, 2])
+
+
+def _distance(q: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """Distances from points ``q`` to triangles ``(a, b, c)``, all (..., 3) and broadcast together."""
     ab, ac = b - a, c - a
     n = cross(ab, ac)
-    nn = np.einsum("ptk,ptk->pt", n, n) + 1e-30
+    nn = np.einsum("...k,...k->...", n, n) + 1e-30
     # projection onto the plane and its barycentric coordinates
     w = q - a
-    dist_plane = np.einsum("ptk,ptk->pt", w, n) / np.sqrt(nn)
-    proj = q - (np.einsum("ptk,ptk->pt", w, n) / nn)[..., None] * n
+    dist_plane = np.einsum("...k,...k->...", w, n) / np.sqrt(nn)
+    proj = q - (np.einsum("...k,...k->...", w, n) / nn)[..., None] * n
     v0, v1, v2 = ab, ac, proj - a
-    d00 = np.einsum("ptk,ptk->pt", v0, v0)
-    d01 = np.einsum("ptk,ptk->pt", v0, v1)
-    d11 = np.einsum("ptk,ptk->pt", v1, v1)
-    d20 = np.einsum("ptk,ptk->pt", v2, v0)
-    d21 = np.einsum("ptk,ptk->pt", v2, v1)
+    d00 = np.einsum("...k,...k->...", v0, v0)
+    d01 = np.einsum("...k,...k->...", v0, v1)
+    d11 = np.einsum("...k,...k->...", v1, v1)
+    d20 = np.einsum("...k,...k->...", v2, v0)
+    d21 = np.einsum("...k,...k->...", v2, v1)
     den = d00 * d11 - d01 * d01 + 1e-30
     s = (d11 * d20 - d01 * d21) / den
     t = (d00 * d21 - d01 * d20) / den
@@ -45,8 +54,8 @@ def point_triangle_distance(p: np.ndarray, tri: np.ndarray) -> np.ndarray:
 
     def seg(x, y):
         xy = y - x
-        h = np.clip(np.einsum("ptk,ptk->pt", q - x, xy) / (np.einsum("ptk,ptk->pt", xy, xy) + 1e-30), 0.0, 1.0)
-        return np.linalg.norm(q - (x + h[..., None] * xy), axis=2)
+        h = np.clip(np.einsum("...k,...k->...", q - x, xy) / (np.einsum("...k,...k->...", xy, xy) + 1e-30), 0.0, 1.0)
+        return np.linalg.norm(q - (x + h[..., None] * xy), axis=-1)
 
     d_edge = np.minimum(np.minimum(seg(a, b), seg(b, c)), seg(c, a))
     return np.where(inside, d_in, d_edge)

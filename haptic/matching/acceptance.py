@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from haptic.geometry.distance import point_triangle_distance
+from haptic.geometry.distance import paired_point_triangle_distance
 from haptic.geometry.polyhedron import LearnedBounds, Polyhedron
 from haptic.geometry.se3 import SE3
 from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex, SensorNoise
@@ -149,9 +149,11 @@ def _face_point_distances(
         return np.zeros(0)
     pts = [model_from_world.apply(np.atleast_2d(data[i].points)) for i, _ in pairs]
     owner = np.repeat(np.arange(len(pairs)), [len(p) for p in pts])
-    d = point_triangle_distance(np.concatenate(pts), model.vertices[model.triangles])
     allowed = _plane_triangles(model)[np.array([f for _, f in pairs])][owner]
-    nearest = np.where(allowed, d, np.inf).min(axis=1)
+    # only the (point, triangle) pairs that count: every point has its own face's triangles
+    point, tri = np.nonzero(allowed)
+    d = paired_point_triangle_distance(np.concatenate(pts)[point], model.vertices[model.triangles][tri])
+    nearest = np.minimum.reduceat(d, np.flatnonzero(np.diff(point, prepend=-1)))
     out = np.full(len(pairs), -np.inf)
     np.maximum.at(out, owner, nearest)
     return out

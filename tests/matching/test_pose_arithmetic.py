@@ -161,17 +161,21 @@ def test_pose_classes_as_bit_sets_are_those_of_the_array_loop():
         assert _first_classes(same, names) == want
 
 
-def test_the_unrefined_poses_kept_as_arrays_are_the_poses(small_library):
+def _first_trees(small_library, seeds):
+    """The tree at the first decision of each episode that has one with interpretations."""
     env = ExploreEnv(models=small_library, verify="none")
-    checked = 0
-    for seed in range(1, 15):
+    for seed in seeds:
         env.reset(seed=seed)
-        ctx = env.context
-        if ctx is None or ctx.tree is None or not ctx.tree.count:
-            continue
-        fresh = ctx.tree.copy()  # no poses kept
+        if env.context is not None and env.context.tree is not None and env.context.tree.count:
+            yield env.context.tree
+
+
+def test_the_unrefined_poses_kept_as_arrays_are_the_poses(small_library):
+    checked = 0
+    for tree in _first_trees(small_library, range(1, 15)):
+        fresh = tree.copy()  # no poses kept
         r, t, ok = fresh.initial_poses()
-        poses = ctx.tree.copy().poses(range(fresh.count), refine=False)
+        poses = tree.copy().poses(range(fresh.count), refine=False)
         for i, p in enumerate(poses):
             assert (p is None) == (not ok[i])
             if p is not None:
