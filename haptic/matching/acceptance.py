@@ -162,40 +162,61 @@ def _face_point_distances(
 def residual_ratios(
     model: Polyhedron, data: Sequence[DataComponent], it: Interpretation, world_from_model: SE3
 ) -> list[tuple[float, int, str]]:
-    """``(residual / bound, data id, what)`` of every measured quantity of interpretation ``it`` at a pose."""
+    """``(residual / bound, data id, what)`` of every measured quantity of interpretation ``it`` at a pose (each kind
+    of component's in one array operation; per face its normal then its points, per edge its direction when its
+    sense is known, its line at either end and its extent, per vertex its position)."""
     inv = world_from_model.inverse()
+    rot_t, shift = inv.rotation.T, inv.translation
     mb = _model_bounds(model)
     out: list[tuple[float, int, str]] = []
-    farthest = _face_point_distances(model, data, it, inv)
-    for (i, f), d in zip(it.faces.items(), farthest, strict=True):
-        c = data[i]
-        assert isinstance(c, DataFace)
-        n_m = model.face_normals[f]
-        out.append((_angle(inv.rotate(c.normal), n_m) / (np.hypot(c.normal_bound, mb.normal) + ROUND_OFF), i,
-                    "face normal"))  # fmt: skip
-        out.append((float(d) / (np.hypot(c.position_bound, mb.position) + ROUND_OFF), i, "face point"))
-    for i, e in it.edges.items():
-        c = data[i]
-        assert isinstance(c, DataEdge)
-        p_m, b_m, l_m = model.edge_points[e], model.edge_directions[e], float(model.edge_lengths[e])
-        s = it.edge_senses.get(i, 0)
-        if s != 0:
-            turn = _angle(inv.rotate(c.direction), s * b_m)
-            out.append((turn / (np.hypot(c.direction_bound, mb.direction) + ROUND_OFF), i, "edge direction"))
-        ends = inv.apply(np.array([c.point, c.end_point])) - p_m
-        along = ends @ b_m
-        perp = np.linalg.norm(ends - along[:, None] * b_m, axis=1)
-        rho = np.hypot(c.position_bound, mb.position) + ROUND_OFF
-        out.append((float(perp[0]) / rho, i, "edge line"))
-        out.append((float(perp[1]) / (rho + c.length * np.hypot(c.direction_bound, mb.direction)), i, "edge line"))
-        beyond = float(np.maximum(-along, along - l_m).max())
-        out.append((max(beyond, 0.0) / (np.hypot(c.length_bound, mb.position) + ROUND_OFF), i, "edge extent"))
-    for i, v in it.vertices.items():
-        c = data[i]
-        assert isinstance(c, DataVertex)
-        d = float(np.linalg.norm(inv.apply(c.position) - model.vertices[v]))
-        out.append((d / (np.hypot(c.position_bound, mb.position) + ROUND_OFF), i, "vertex"))
+    faces = list(it.faces.items())
+    if faces:
+        fc = [data[i] for i, _ in faces]
+        assert all(isinstance(c, DataFace) for c in fc)
+        turn = _angles(np.array([c.normal for c in fc]) @ rot_t, model.face_normals[[f for _, f in faces]])
+        normal = turn / (np.hypot([c.normal_bound for c in fc], mb.normal) + ROUND_OFF)
+        point = _face_point_distances(model, data, it, inv) / (
+            np.hypot([c.position_bound for c in fc], mb.position) + ROUND_OFF)  # fmt: skip
+        for k, (i, _) in enumerate(faces):
+            out += [(float(normal[k]), i, "face normal"), (float(point[k]), i, "face point")]
+    edges = list(it.edges.items())
+    if edges:
+        ec = [data[i] for i, _ in edges]
+        assert all(isinstance(c, DataEdge) for c in ec)
+        em = [e for _, e in edges]
+        b_m, l_m = model.edge_directions[em], model.edge_lengths[em]
+        senses = np.array([it.edge_senses.get(i, 0) for i, _ in edges])
+        beta = np.hypot([c.direction_bound for c in ec], mb.direction)
+        direction = _angles(np.array([c.direction for c in ec]) @ rot_t, senses[:, None] * b_m) / (beta + ROUND_OFF)
+        ends = np.array([(c.point, c.end_point) for c in ec]) @ rot_t + shift - model.edge_points[em][:, None]
+        along = np.einsum("eak,ek->ea", ends, b_m)
+        perp = np.linalg.norm(ends - along[..., None] * b_m[:, None], axis=2)
+        rho = np.hypot([c.position_bound for c in ec], mb.position) + ROUND_OFF
+        start = perp[:, 0] / rho
+        end = perp[:, 1] / (rho + np.array([c.length for c in ec]) * beta)
+        beyond = np.maximum(np.maximum(-along, along - l_m[:, None]).max(axis=1), 0.0)
+        extent = beyond / (np.hypot([c.length_bound for c in ec], mb.position) + ROUND_OFF)
+        for k, (i, _) in enumerate(edges):
+            if senses[k] != 0:
+                out.append((float(direction[k]), i, "edge direction"))
+            out += [(float(start[k]), i, "edge line"), (float(end[k]), i, "edge line"),
+                    (float(extent[k]), i, "edge extent")]  # fmt: skip
+    vertices = list(it.vertices.items())
+    if vertices:
+        vc = [data[i] for i, _ in vertices]
+        assert all(isinstance(c, DataVertex) for c in vc)
+        off = np.array([c.position for c in vc]) @ rot_t + shift - model.vertices[[v for _, v in vertices]]
+        ratio = np.linalg.norm(off, axis=1) / (np.hypot([c.position_bound for c in vc], mb.position) + ROUND_OFF)
+        out += [(float(ratio[k]), i, "vertex") for k, (i, _) in enumerate(vertices)]
     return out
+
+
+def _angles(u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Angles between rows of two (K, 3) arrays [rad]: ``arccos(clip(u·v / (‖u‖ ‖v‖), −1, 1))``."""
+    num = np.einsum("ki,ki->k", u, v)
+    den = np.sqrt(np.einsum("ki,ki->k", u, u)) * np.sqrt(np.einsum("ki,ki->k", v, v))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.arccos(np.clip(num / den, -1.0, 1.0))
 
 
 def pose_check(model: Polyhedron, data: Sequence[DataComponent], it: Interpretation) -> PoseCheck:
