@@ -113,26 +113,51 @@ def depth_samples_many(
 ) -> list[tuple[np.ndarray, np.ndarray]]:
     """:func:`depth_samples` of several segments at once (shapes (S, 3), (S, 3), (S,)): the same points and
     depths per segment, from one crossing test, one inside test and one distance computation for all of them."""
+    samples = sample_inside_many(poly, starts, directions, lengths)
+    counts = [len(x) for x, _ in samples]
+    depth = surface_distance(poly, np.concatenate([x for x, _ in samples])) if sum(counts) else np.zeros(0)
+    bounds = np.cumsum([0, *counts])
+    return [(samples[k][0], depth[bounds[k] : bounds[k + 1]]) for k in range(len(samples))]
+
+
+def sample_inside_many(
+    poly: Polyhedron, starts: np.ndarray, directions: np.ndarray, lengths: np.ndarray
+) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The points :func:`depth_samples_many` takes on each segment (unit ``directions``), each with a bound its depth
+    cannot exceed: the distance along the segment to an end of its inside interval where the line crosses the
+    surface (plus :data:`CROSSING_SLACK`; inf when neither end is a crossing, an interval clipped at both ends of
+    the segment). The surface passes through such an end, so no point is farther from the surface than from it."""
     starts = np.atleast_2d(np.asarray(starts, dtype=float))
     directions = np.atleast_2d(np.asarray(directions, dtype=float))
     hits = line_hits(poly, starts, directions)
-    cuts, mids = [], []
+    cuts, mids, crossings = [], [], []
     for k, length in enumerate(np.asarray(lengths, dtype=float)):
         ts = hits.params[k]
-        ts = np.unique(np.clip(ts[np.isfinite(ts)], 0.0, length))
+        ts = ts[np.isfinite(ts)]
+        crossings.append(ts[(ts >= 0.0) & (ts <= length)])
+        ts = np.unique(np.clip(ts, 0.0, length))
         c = np.unique(np.concatenate([[0.0], ts, [float(length)]]))
         cuts.append(c)
         mids.append(starts[k] + (0.5 * (c[:-1] + c[1:]))[:, None] * directions[k])
     inside = poly.contains(np.concatenate(mids)) if sum(len(m) for m in mids) else np.zeros(0, dtype=bool)
-    samples, at = [], 0
+    out, at = [], 0
     for k, c in enumerate(cuts):
         spans, at = _inside_spans(c, inside[at : at + len(c) - 1]), at + len(c) - 1
         ts = np.concatenate([np.linspace(lo, hi, DEPTH_SAMPLES) for lo, hi in spans]) if spans else np.zeros(0)
-        samples.append(starts[k] + ts[:, None] * directions[k])
-    counts = [len(x) for x in samples]
-    depth = surface_distance(poly, np.concatenate(samples)) if sum(counts) else np.zeros(0)
-    bounds = np.cumsum([0, *counts])
-    return [(samples[k], depth[bounds[k] : bounds[k + 1]]) for k in range(len(samples))]
+        upper = np.full(len(ts), np.inf)
+        for j, (lo, hi) in enumerate(spans):
+            piece = slice(j * DEPTH_SAMPLES, (j + 1) * DEPTH_SAMPLES)
+            if np.isin(lo, crossings[k]):
+                upper[piece] = np.minimum(upper[piece], ts[piece] - lo)
+            if np.isin(hi, crossings[k]):
+                upper[piece] = np.minimum(upper[piece], hi - ts[piece])
+        out.append((starts[k] + ts[:, None] * directions[k], upper + CROSSING_SLACK))
+    return out
+
+
+CROSSING_SLACK = 1e-9
+"""Added to the distance from a crossing in :func:`sample_inside_many`'s depth bound: the crossing lies on the
+surface only to within the arithmetic's error, far below this [m]."""
 
 
 def segment_depth(poly: Polyhedron, start: np.ndarray, direction: np.ndarray, length: float) -> float:
@@ -151,6 +176,7 @@ __all__ = [
     "LineHits",
     "depth_samples",
     "depth_samples_many",
+    "sample_inside_many",
     "inside_intervals",
     "line_hits",
     "segment_depth",

@@ -94,3 +94,25 @@ def test_many_segments_at_once_sample_as_one_at_a_time():
             assert np.allclose(pts, one_pts) and np.allclose(depth, one_depth)
             inside += len(depth) > 0
         assert inside >= 2, name
+
+
+def test_each_samples_depth_is_within_its_bound_from_the_crossings():
+    """:func:`sample_inside_many` takes the samples of :func:`depth_samples_many`, and no sample lies deeper than
+    its distance along the segment from a crossing of the surface (a bound that is finite wherever an inside
+    interval ends at a crossing)."""
+    from haptic.geometry.raycast import depth_samples_many, sample_inside_many
+
+    rng = np.random.default_rng(6)
+    finite = 0
+    for name in ("BOX01", "LBLOCK01", "FRAME01", "WEDGE01"):
+        poly = load_library()[name]
+        starts = poly.centroid + rng.normal(scale=0.05, size=(40, 3))
+        dirs = rng.normal(size=(40, 3))
+        dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
+        lengths = rng.uniform(0.005, 0.2, size=40)
+        for (pts, depth), (pts2, upper) in zip(depth_samples_many(poly, starts, dirs, lengths),
+                                               sample_inside_many(poly, starts, dirs, lengths), strict=True):
+            np.testing.assert_array_equal(pts, pts2)
+            assert (depth <= upper).all()
+            finite += int(np.isfinite(upper).sum())
+    assert finite > 100

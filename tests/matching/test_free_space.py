@@ -252,3 +252,37 @@ def test_position_span_says_when_the_data_fix_a_position_in_every_direction():
     assert position_span(axes[:2]) == 0.0  # two planes leave a line
     flat = [face(0, [1, 0, 0]), face(1, [0, 1, 0]), face(2, [1, 1, 0.1])]  # nearly coplanar normals
     assert position_span(flat) < MIN_SPAN <= position_span(axes)
+
+
+def test_segments_whose_samples_are_bounded_within_their_margins_are_not_measured_and_the_verdict_is_the_same():
+    """The free-space check measures only the samples whose depth bound exceeds their margin: the verdict of
+    measuring every sample, for poses near and far from the truth."""
+    from haptic.geometry.raycast import depth_samples_many
+    from haptic.matching.free_space import free_margin, free_segments_consistent
+
+    def every_sample(model, pose, free, tol):
+        inv = pose.inverse()
+        samples = depth_samples_many(model, inv.apply(np.array([s.start for s in free])),
+                                     inv.rotate(np.array([s.direction for s in free])),
+                                     np.array([s.length for s in free]))  # fmt: skip
+        return all(not len(d) or (d <= free_margin(s, tol, pose, model, pose.apply(p))).all()
+                   for s, (p, d) in zip(free, samples, strict=True))  # fmt: skip
+
+    rng = np.random.default_rng(11)
+    tol = PoseTolerance()
+    verdicts = set()
+    for name in ("BOX01", "LBLOCK01", "FRAME01", "WEDGE01"):
+        model = LIB[name]
+        for _ in range(40):
+            pose = SE3.random(rng, 0.05)
+            c = pose.apply(model.centroid)
+            free = []
+            for _ in range(int(rng.integers(1, 5))):
+                u = rng.normal(size=3)
+                u /= np.linalg.norm(u)
+                start = c - u * rng.uniform(0.03, 0.15) + rng.normal(scale=0.02, size=3)
+                free.append(FreeSegment(start, u, float(rng.uniform(0.01, 0.2)), 1e-3))
+            want = every_sample(model, pose, free, tol)
+            assert free_segments_consistent(model, pose, free, tol) == want
+            verdicts.add(want)
+    assert verdicts == {True, False}
