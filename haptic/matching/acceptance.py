@@ -240,6 +240,17 @@ def pose_check(model: Polyhedron, data: Sequence[DataComponent], it: Interpretat
     return PoseCheck(bool(worst <= POSE_SAFETY), float(worst), cid, what, pose)
 
 
+def leaf_pose_check(tree, leaf: int) -> PoseCheck:
+    """:func:`pose_check` of the tree's interpretation at ``leaf`` (its refined pose) on the tree's data, computed
+    once per data update (kept in ``tree.leaf_memo``: the free-space check and the verification ask the same
+    leaf)."""
+    key = ("pose check", int(leaf))
+    if key not in tree.leaf_memo:
+        it = tree.interpretation(leaf, with_pose=True, refine=True)
+        tree.leaf_memo[key] = pose_check(it.model, tree.data, it)
+    return tree.leaf_memo[key]
+
+
 FREE_SINGULAR = 0.25
 """A translation direction ``u`` is left free by the data when ``√Σ (a·u)²`` over the unit directions ``a`` their
 positions constrain (a face's normal, the two normals of an edge's line, any direction at a vertex) is below
@@ -603,5 +614,6 @@ __all__ = [
     "coverage",
     "own_bounds_keep",
     "pose_check",
+    "leaf_pose_check",
     "residual_ratios",
 ]

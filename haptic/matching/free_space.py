@@ -32,7 +32,7 @@ from haptic.geometry.distance import surface_distance
 from haptic.geometry.polyhedron import Polyhedron
 from haptic.geometry.raycast import depth_samples, sample_inside_many
 from haptic.geometry.se3 import SE3
-from haptic.matching.acceptance import pose_check
+from haptic.matching.acceptance import leaf_pose_check
 from haptic.matching.components import DataFace, readonly_vector
 from haptic.matching.recognition import PoseTolerance
 from haptic.matching.tree import InterpretationTree
@@ -168,14 +168,13 @@ def consistent_leaves(
     if n > max_posed or (not free and not hits) or position_span(tree.data) < MIN_SPAN:
         return keep
     tol = tol if tol is not None else PoseTolerance.from_data(tree.data)
-    data = tree.data
     tree.poses(range(n), refine=True)  # every leaf's pose in one batch; interpretation() reads them back
     for leaf in range(n):
         it = tree.interpretation(leaf, with_pose=True, refine=True)
         pose = it.world_from_model
         if pose is None:
             continue
-        if hits & set(it.faces) and not pose_check(it.model, data, it).ok:
+        if hits & set(it.faces) and not leaf_pose_check(tree, leaf).ok:
             keep[leaf] = False
             continue
         keep[leaf] = free_segments_consistent(it.model, pose, free, tol)

@@ -224,6 +224,9 @@ class InterpretationTree:
         """Number of interpretations after each ``add`` (re-reported edges included)."""
         self._pose_cache: dict[tuple[bool, int], SE3 | None] = {}
         """Poses by (refined, leaf) of the current leaves, emptied by every ``add`` and renumbered by ``retain``."""
+        self.leaf_memo: dict[tuple[str, int], object] = {}
+        """Results computed from one leaf and the data so far, by ``(what, leaf)`` (the pose check of
+        :func:`~haptic.matching.acceptance.leaf_pose_check`), emptied by every ``add`` and renumbered by ``retain``."""
         self._initial: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
         """The closed-form poses of every leaf as arrays (:meth:`initial_poses`), emptied by every ``add`` and
         renumbered by ``retain``."""
@@ -304,6 +307,7 @@ class InterpretationTree:
             self._model, self._assign, self._sense = self._model[ok], assign[ok], sense[ok]
         self.counts.append(self.count)
         self._pose_cache.clear()  # poses are of the data before this add
+        self.leaf_memo.clear()
         self._initial = None
         self._stack = None
         return self.count
@@ -322,6 +326,7 @@ class InterpretationTree:
         self._model, self._assign, self._sense = self._model[keep], self._assign[keep], self._sense[keep]
         renumber = np.cumsum(keep) - 1  # a kept leaf's new index; its pose (same data) stays valid
         self._pose_cache = {(r, int(renumber[i])): p for (r, i), p in self._pose_cache.items() if keep[i]}
+        self.leaf_memo = {(w, int(renumber[i])): v for (w, i), v in self.leaf_memo.items() if keep[i]}
         if self._initial is not None:
             self._initial = tuple(a[keep] for a in self._initial)
         self._stack = None

@@ -564,7 +564,7 @@ class Verifier:
     def verdict(self, tree, rec, cost: float) -> str:
         """"confirmed", "mismatch", "incomplete" or "verifying" for a recognition ``rec`` (status recognized)
         of ``tree``, at path cost ``cost``."""
-        from haptic.matching.acceptance import acceptance, coverage, pose_check
+        from haptic.matching.acceptance import acceptance, coverage, leaf_pose_check
 
         cls = rec.classes[0]
         if self.started_at is None:
@@ -574,7 +574,7 @@ class Verifier:
         best = None
         for leaf in cls.leaves[:MAX_CHECKED_LEAVES]:
             cand = tree.interpretation(leaf, with_pose=True, refine=True)
-            chk = pose_check(cls.model, tree.data, cand)
+            chk = leaf_pose_check(tree, leaf)
             if best is None or chk.worst < best[1].worst:
                 best = (cand, chk)
             if chk.ok:

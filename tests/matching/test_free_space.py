@@ -286,3 +286,33 @@ def test_segments_whose_samples_are_bounded_within_their_margins_are_not_measure
             assert free_segments_consistent(model, pose, free, tol) == want
             verdicts.add(want)
     assert verdicts == {True, False}
+
+
+def test_a_leafs_pose_check_kept_for_the_data_is_a_fresh_one_and_follows_retain():
+    """The pose check the free-space test and the verification share (kept per leaf until the next add) equals a
+    fresh :func:`~haptic.matching.acceptance.pose_check`, also after ``retain`` renumbers the leaves."""
+    from haptic.matching.acceptance import leaf_pose_check, pose_check
+
+    rng = np.random.default_rng(12)
+    ex = GeometricExecutor(LIB["LBLOCK01"], SE3.random(rng, 0.1), SensorNoise(), rng)
+    random_walk(ex, 3, rng)
+    tree = InterpretationTree(LIB)
+    checked = 0
+    for c in ex.components:
+        tree.add(c)
+        n = min(tree.count, 30)
+        if n < 2:
+            continue
+        kept = [leaf_pose_check(tree, leaf) for leaf in range(n)]
+        assert all(leaf_pose_check(tree, leaf) is k for leaf, k in enumerate(kept))  # kept, not recomputed
+        keep = np.ones(tree.count, dtype=bool)
+        keep[0] = False
+        tree.retain(keep)
+        for leaf in range(n - 1):
+            it = tree.interpretation(leaf, with_pose=True, refine=True)
+            fresh = pose_check(it.model, tree.data, it)
+            got = leaf_pose_check(tree, leaf)
+            assert got is kept[leaf + 1]
+            assert (got.ok, got.worst, got.component, got.what) == (fresh.ok, fresh.worst, fresh.component, fresh.what)
+            checked += 1
+    assert checked > 10
