@@ -294,13 +294,11 @@ def test_a_leafs_pose_check_kept_for_the_data_is_a_fresh_one_and_follows_retain(
     from haptic.matching.acceptance import leaf_pose_check, pose_check
 
     rng = np.random.default_rng(12)
-    ex = GeometricExecutor(LIB["LBLOCK01"], SE3.random(rng, 0.1), SensorNoise(), rng)
-    random_walk(ex, 3, rng)
-    tree = InterpretationTree(LIB)
-    checked = 0
-    for c in ex.components:
-        tree.add(c)
-        n = min(tree.count, 30)
+    walk = GeometricExecutor(LIB["LBLOCK01"], SE3.random(rng, 0.1), SensorNoise(), rng)
+    random_walk(walk, 3, rng)
+    tree, checked = InterpretationTree(LIB), 0
+    for count in map(tree.add, walk.components):
+        n = min(count, 30)
         if n < 2:
             continue
         kept = [leaf_pose_check(tree, leaf) for leaf in range(n)]
