@@ -122,6 +122,10 @@ class Plane:
     """The largest error bound of its faces' normals [rad]."""
     position_bound: float
     """The largest error bound of its faces' points [m]."""
+    points: np.ndarray | None = None
+    """The points it is fitted to: its faces' touched points, the edge ends and vertices on it, shape (P, 3) [m]."""
+    through_edge: bool = False
+    """Whether it is fitted through a measured edge's line (a fold, :func:`face_planes`)."""
 
     def distance(self, points: np.ndarray) -> np.ndarray:
         """Signed distance of ``points`` from the plane (positive outside) [m]."""
@@ -273,7 +277,7 @@ def face_planes(components: Mapping[int, DataComponent]) -> list[Plane]:
         nb = max(x.normal_bound for x in g)
         pb = max(x.position_bound for x in g)
         n, d = fit_plane(pts, np.array([x.normal for x in g]), pb, nb)
-        planes.append(Plane(n, d, tuple(x.id for x in g), nb, pb))
+        planes.append(Plane(n, d, tuple(x.id for x in g), nb, pb, pts))
         fits.append((pts, np.array([x.normal for x in g])))
     # a fold: two planes a data edge divides at an angle their normals' bounds hardly tell apart (a vertex moved
     # almost in its face's plane) meet, fitted each on its own, wherever their small errors put the line, far from
@@ -298,7 +302,7 @@ def face_planes(components: Mapping[int, DataComponent]) -> list[Plane]:
         for k in (a, b):
             n = _plane_through_line(fits[k][0], fits[k][1], centre, vt[0], planes[k].position_bound,
                                     planes[k].normal_bound)  # fmt: skip
-            planes[k] = replace(planes[k], normal=n, offset=float(centre @ n))
+            planes[k] = replace(planes[k], normal=n, offset=float(centre @ n), through_edge=True)
             held.add(k)
     return planes
 
@@ -324,6 +328,26 @@ def _plane_through_line(points: np.ndarray, normals: np.ndarray, centre: np.ndar
     if n @ normals.sum(axis=0) < 0:
         n = -n
     return n / np.linalg.norm(n)
+
+
+def anchored(planes: list[Plane], components: Mapping[int, DataComponent],
+             anchors: Mapping[int, Iterable[np.ndarray]]) -> list[Plane]:
+    """The planes fitted again with the measured vertices found on them (``anchors``: plane index → vertex
+    positions). A data vertex joins the fit of the planes its data edges lie between only (:func:`face_planes`);
+    a plane touched near one corner, and met at its far corners by vertices reached along other faces' edges, is
+    otherwise held there by its measured normals alone, whose error over the face's size puts its far vertices
+    further off than the bounds the learned model carries. Planes fitted through a fold's edge stay as they are."""
+    out = list(planes)
+    for k, extra in anchors.items():
+        extra = [np.asarray(x, float) for x in extra]
+        p = planes[k]
+        if not extra or p.through_edge or p.points is None:
+            continue
+        pts = np.vstack([p.points, np.array(extra)])
+        normals = np.array([components[f].normal for f in p.faces])
+        n, d = fit_plane(pts, normals, p.position_bound, p.normal_bound)
+        out[k] = replace(p, normal=n, offset=d, points=pts)
+    return out
 
 
 def convexity_violation(components: Mapping[int, DataComponent], planes: list[Plane], bounds: LearnBounds):
@@ -483,6 +507,24 @@ def convex_estimate(components: Mapping[int, DataComponent], bounds: LearnBounds
     planes = face_planes(components)
     if not planes:
         raise LearnError("no face measured")
+    est = _estimate(planes, components, bounds)
+    # every measured vertex joins the fit of each plane through the estimate's vertex it measures
+    anchors: dict[int, list[np.ndarray]] = {}
+    gof = est.group_of()
+    for vid, k in est.vertex_data.items():
+        pos = components[vid].position
+        through = set().union(*(est.polytope.vertex_planes[m] for m in est.groups[gof[k]]))
+        for j in through:
+            if j < len(planes) and planes[j].points is not None and not (planes[j].points == pos).all(axis=1).any():
+                anchors.setdefault(j, []).append(pos)
+    if not anchors:
+        return est
+    return _estimate(anchored(planes, components, anchors), components, bounds)
+
+
+def _estimate(planes: list[Plane], components: Mapping[int, DataComponent], bounds: LearnBounds) -> ConvexEstimate:
+    """The :class:`ConvexEstimate` of ``planes``: their solid in the box round the data, its vertices matched to
+    the data vertices and grouped."""
     pts = data_points(components.values())
     bn, bd = box_planes(pts)
     normals = np.vstack([np.array([p.normal for p in planes]), bn])

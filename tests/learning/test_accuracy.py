@@ -1,0 +1,34 @@
+"""A learned model is as accurate as the bounds it carries: every measured vertex holds each plane through the
+estimate's vertex it measures, not only the planes its data edges lie between."""
+
+import numpy as np
+
+from haptic.episode.spec import EpisodeSpec
+from haptic.episode.worlds import run_episode
+from haptic.geometry import Polyhedron, load_model, save_model
+from haptic.geometry.se3 import quat_to_matrix
+
+# TETRA01R with its vertex 1 moved 2 mm
+MOVED = Polyhedron.from_faces(
+    np.array([[0.0, 0.0, 0.0], [-0.101703543, -0.000799432, -0.000677384], [-0.025, 0.08, 0.0], [-0.035, 0.025, 0.07]]),
+    [[1, 2, 0], [3, 1, 0], [3, 2, 1], [3, 0, 2]], name="TETRA01R_MOVED",
+)  # fmt: skip
+
+
+def test_a_plane_touched_near_one_corner_is_held_by_the_vertices_measured_on_it(tmp_path):
+    """Seed 1858836761 closes the surface in the recognition episode itself; one face was touched along a strip
+    4 mm wide, and the vertex at its far corner was reached along the other two faces' edges. Fitted without
+    it, that face tilted 0.5 degrees and put the vertex 1.36 mm off the truth; the learned file says 0.6 mm."""
+    obj = tmp_path / "TETRA01R_MOVED.json"
+    save_model(MOVED, obj)
+    lib = tmp_path / "lib"
+    lib.mkdir()
+    rec = run_episode(EpisodeSpec(model=str(obj), seed=1858836761, noise=1.0, learn=str(lib), learn_name="L"))
+    assert rec.learned["status"] == "closed"
+    learned = load_model(rec.learned["path"])
+    r, t = quat_to_matrix(np.array(rec.pose["quat_wxyz"])), np.array(rec.pose["translation_m"])
+    truth = np.asarray(MOVED.vertices) @ r.T + t
+    off = np.linalg.norm(np.asarray(learned.vertices)[:, None] - truth[None], axis=2).min(axis=1)
+    assert off.max() < 1e-3
+    again = run_episode(EpisodeSpec(model=str(obj), seed=1723552086, noise=1.0, models=str(lib)))
+    assert again.recognized == "L"
