@@ -124,8 +124,9 @@ class Plane:
     """The largest error bound of its faces' points [m]."""
     points: np.ndarray | None = None
     """The points it is fitted to: its faces' touched points, the edge ends and vertices on it, shape (P, 3) [m]."""
-    through_edge: bool = False
-    """Whether it is fitted through a measured edge's line (a fold, :func:`face_planes`)."""
+    fold_line: tuple[np.ndarray, np.ndarray] | None = None
+    """The measured edge's line it is fitted through, a point and a unit direction (a fold, :func:`face_planes`);
+    None when free."""
 
     def distance(self, points: np.ndarray) -> np.ndarray:
         """Signed distance of ``points`` from the plane (positive outside) [m]."""
@@ -197,11 +198,12 @@ def fit_plane(points: np.ndarray, normals: np.ndarray, position_bound: float, no
     return n / np.linalg.norm(n), float(centre @ n)
 
 
-def face_planes(components: Mapping[int, DataComponent]) -> list[Plane]:
+def face_planes(components: Mapping[int, DataComponent], fold_vertices: bool = False) -> list[Plane]:
     """The object's planes: the data faces grouped by agreement (in order of acquisition, each joining the plane
     it agrees with best, by normal, but never one that holds a face a data edge divides it from: two faces that
     meet at an edge are two planes, however small the angle between them), each group fitted to its points,
-    edge ends and vertices (:func:`fit_plane`)."""
+    edge ends and vertices (:func:`fit_plane`). A fold's two planes are fitted through the line of the edge between
+    them, and with ``fold_vertices`` through the vertices measured at that edge's ends too (:func:`_fold_vertices`)."""
     faces = [c for c in components.values() if isinstance(c, DataFace)]
     faces.sort(key=lambda c: c.id)
     ef = edge_faces(components)
@@ -288,6 +290,8 @@ def face_planes(components: Mapping[int, DataComponent]) -> list[Plane]:
         if len(ks) == 2:
             e = components[eid]
             folds.setdefault((ks[0], ks[1]), []).extend((e.point, e.end_point))
+    if fold_vertices:
+        _fold_vertices(folds, components, ef, plane_of)
     held: set[int] = set()
     for (a, b), ends in sorted(folds.items(), key=lambda kv: -float(np.ptp(np.array(kv[1]), axis=0).max())):
         pa, pb_ = planes[a], planes[b]
@@ -302,9 +306,36 @@ def face_planes(components: Mapping[int, DataComponent]) -> list[Plane]:
         for k in (a, b):
             n = _plane_through_line(fits[k][0], fits[k][1], centre, vt[0], planes[k].position_bound,
                                     planes[k].normal_bound)  # fmt: skip
-            planes[k] = replace(planes[k], normal=n, offset=float(centre @ n), through_edge=True)
+            planes[k] = replace(planes[k], normal=n, offset=float(centre @ n), fold_line=(centre, vt[0]))
             held.add(k)
     return planes
+
+
+def _fold_vertices(folds: dict[tuple[int, int], list[np.ndarray]], components: Mapping[int, DataComponent],
+                   ef: Mapping[int, set[int]], plane_of: Mapping[int, int]) -> None:
+    """Each fold's line points (``folds``: plane pair → its data edges' ends) joined by the data vertices at those
+    edges that lie on the edges' own line within the bounds: the vertices span the edge end to end, where its
+    data edges, measured over a few centimetres, tilt it by their direction's error over the edge's length."""
+    at_edge: dict[int, list[DataVertex]] = {}
+    for vid, es in vertex_edges(components).items():
+        for e in es:
+            at_edge.setdefault(e, []).append(components[vid])
+    fold_edges: dict[tuple[int, int], list[DataEdge]] = {}
+    for eid, fs in ef.items():
+        ks = sorted({plane_of[f] for f in fs if f in plane_of})
+        if len(ks) == 2:
+            fold_edges.setdefault((ks[0], ks[1]), []).append(components[eid])
+    for pair, es in fold_edges.items():
+        ends = folds[pair]
+        line = np.array(ends)
+        centre = line.mean(axis=0)
+        u = np.linalg.svd(line - centre)[2][0]
+        for e in es:
+            for v in at_edge.get(e.id, ()):
+                r = v.position - centre
+                off = float(np.linalg.norm(r - (r @ u) * u))
+                if off <= v.position_bound + e.position_bound + abs(float(r @ u)) * np.sin(e.direction_bound):
+                    ends.append(v.position)
 
 
 FOLD_FACTOR = 2.0
@@ -336,16 +367,22 @@ def anchored(planes: list[Plane], components: Mapping[int, DataComponent],
     positions). A data vertex joins the fit of the planes its data edges lie between only (:func:`face_planes`);
     a plane touched near one corner, and met at its far corners by vertices reached along other faces' edges, is
     otherwise held there by its measured normals alone, whose error over the face's size puts its far vertices
-    further off than the bounds the learned model carries. Planes fitted through a fold's edge stay as they are."""
+    further off than the bounds the learned model carries. A plane fitted through a fold's edge stays through
+    it."""
     out = list(planes)
     for k, extra in anchors.items():
         extra = [np.asarray(x, float) for x in extra]
         p = planes[k]
-        if not extra or p.through_edge or p.points is None:
+        if not extra or p.points is None:
             continue
         pts = np.vstack([p.points, np.array(extra)])
         normals = np.array([components[f].normal for f in p.faces])
-        n, d = fit_plane(pts, normals, p.position_bound, p.normal_bound)
+        if p.fold_line is None:
+            n, d = fit_plane(pts, normals, p.position_bound, p.normal_bound)
+        else:
+            centre, direction = p.fold_line
+            n = _plane_through_line(pts, normals, centre, direction, p.position_bound, p.normal_bound)
+            d = float(centre @ n)
         out[k] = replace(p, normal=n, offset=d, points=pts)
     return out
 
