@@ -127,6 +127,15 @@ class Plane:
     fold_line: tuple[np.ndarray, np.ndarray] | None = None
     """The measured edge's line it is fitted through, a point and a unit direction (a fold, :func:`face_planes`);
     None when free."""
+    table: bool = False
+    """Whether it is the table's top, which the object rests on (:func:`table_plane`): no data face on it."""
+
+    @classmethod
+    def table_top(cls, table_z: float) -> Plane:
+        """The table's top at height ``table_z`` [m] as a plane of an object resting on it (outward normal down).
+        The pad cannot touch within a few millimetres of the table, so the face the object rests on is never
+        measured; it is where the table is."""
+        return cls(np.array([0.0, 0.0, -1.0]), -float(table_z), (), BOUND_FLOOR, BOUND_FLOOR, table=True)
 
     def distance(self, points: np.ndarray) -> np.ndarray:
         """Signed distance of ``points`` from the plane (positive outside) [m]."""
@@ -538,12 +547,17 @@ def _polytope_edges(poly: Polytope) -> set[tuple[int, int]]:
     return out
 
 
-def convex_estimate(components: Mapping[int, DataComponent], bounds: LearnBounds | None = None) -> ConvexEstimate:
-    """The :class:`ConvexEstimate` of the data so far (a :class:`LearnError` when they bound no solid)."""
+def convex_estimate(components: Mapping[int, DataComponent], bounds: LearnBounds | None = None,
+                    table_z: float | None = None) -> ConvexEstimate:
+    """The :class:`ConvexEstimate` of the data so far (a :class:`LearnError` when they bound no solid). With a
+    table (``table_z``, its top's height [m]) the object rests on it: the table's top is one of its planes, and a
+    vertex on it is measured when the other planes through it are (:meth:`Plane.table_top`)."""
     bounds = bounds or LearnBounds.of(components.values())
     planes = face_planes(components)
     if not planes:
         raise LearnError("no face measured")
+    if table_z is not None:
+        planes.append(Plane.table_top(table_z))
     est = _estimate(planes, components, bounds)
     # every measured vertex joins the fit of each plane through the estimate's vertex it measures
     anchors: dict[int, list[np.ndarray]] = {}
@@ -599,7 +613,10 @@ def _estimate(planes: list[Plane], components: Mapping[int, DataComponent], boun
     for k in range(len(poly.vertices)):
         groups.setdefault(find(k), []).append(k)
     est.groups = list(groups.values())
-    est.measured = {k for k in range(len(poly.vertices)) if near[k]}
+    # a vertex on the table, where the pad cannot reach, placed by the table and measured planes alone
+    table = {j for j, p in enumerate(planes) if p.table}
+    on_table = {k for k in real if poly.vertex_planes[k] & table}
+    est.measured = {k for k in range(len(poly.vertices)) if near[k] or k in on_table}
     return est
 
 

@@ -107,3 +107,22 @@ def test_a_convex_object_shows_no_violation():
     comps, _, _ = walk(load_library()["HEXPRISM01"], 4, 120, at_bounds=True)
     est = convex_estimate(comps)
     assert convexity_violation(comps, est.planes, est.bounds) is None
+
+
+def test_on_the_table_the_face_it_rests_on_is_the_table():
+    """A pyramid resting on its base, its side faces and apex measured (the pad reaches no lower): with the table,
+    closed, and the model is the pyramid; without it, open where the base would be."""
+    model = load_library()["PYR01"]
+    low = float(model.vertices[:, 2].min())
+    pose = SE3(np.eye(3), np.array([0.3, 0.1, 0.75 - low]))
+    base = int(np.argmin(model.face_normals[:, 2]))
+    comps = exact_components(model, pose, with_vertices=False)
+    del comps[base]
+    apex = int(np.argmax(model.vertices[:, 2]))
+    comps[len(model.faces)] = DataVertex(len(model.faces), pose.apply(model.vertices[apex]), 0.0)
+    assert not convex_estimate(comps).closed
+    est = convex_estimate(comps, table_z=0.75)
+    assert est.closed
+    learned = learned_model(est)
+    assert (learned.n_vertices, learned.n_edges, learned.n_faces) == (model.n_vertices, model.n_edges, model.n_faces)
+    assert nearest_distances(learned.vertices, pose.apply(model.vertices)).max() < 1e-7
