@@ -603,19 +603,29 @@ def _estimate(planes: list[Plane], components: Mapping[int, DataComponent], boun
     def length(ab: tuple[int, int]) -> float:
         return float(np.linalg.norm(poly.vertices[ab[0]] - poly.vertices[ab[1]]))
 
+    # a vertex on the table, where the pad cannot reach, placed by the table and measured planes alone
+    table = {j for j, p in enumerate(planes) if p.table}
+    on_table = {k for k in real if poly.vertex_planes[k] & table}
+
+    def apart(x: int, y: int) -> bool:
+        """Whether data vertices ``x`` and ``y`` are farther apart than their bounds: two vertices."""
+        vx, vy = components[x], components[y]
+        return float(np.linalg.norm(vx.position - vy.position)) > vx.position_bound + vy.position_bound
+
     for a, b in sorted(_polytope_edges(poly), key=length):
-        if length((a, b)) >= bounds.merge_length or not (near[a] & near[b]):
+        if length((a, b)) >= bounds.merge_length:
             continue
-        if near[a] - near[b] and near[b] - near[a]:
-            continue  # a data vertex at each end alone: two vertices
+        only_a, only_b = near[a] - near[b], near[b] - near[a]
+        if any(apart(x, y) for x in only_a for y in only_b):
+            continue  # a data vertex at each end alone, apart: two vertices
+        if not (near[a] & near[b]) and not any(not apart(x, y) for x in only_a for y in only_b) \
+                and not {a, b} <= on_table:
+            continue  # no data vertex measures both ends, nor the table both
         parent[find(a)] = find(b)
     groups: dict[int, list[int]] = {}
     for k in range(len(poly.vertices)):
         groups.setdefault(find(k), []).append(k)
     est.groups = list(groups.values())
-    # a vertex on the table, where the pad cannot reach, placed by the table and measured planes alone
-    table = {j for j, p in enumerate(planes) if p.table}
-    on_table = {k for k in real if poly.vertex_planes[k] & table}
     est.measured = {k for k in range(len(poly.vertices)) if near[k] or k in on_table}
     return est
 
