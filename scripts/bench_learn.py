@@ -235,6 +235,7 @@ def main(argv: list[str] | None = None) -> int:
             q, t = rec["pose"]["quat_wxyz"], rec["pose"]["translation_m"]
             pose = (quat_to_matrix(np.array(q)), np.array(t))
             row = {"object": Path(it["path"]).stem, "family": it["family"], "size": it["size"], "base": it["base"],
+                   "seed": rec["seed"], "learn_detail": learned.get("detail") or rec["detail"],
                    "outcome": rec["outcome"], "learned_status": learned.get("status"),
                    "learn_moves": learned.get("moves", 0), "learn_cost": learned.get("path_cost", 0.0),
                    "learn_wall_s": learned.get("wall_time_s", 0.0), "episode_moves": rec["moves"],
