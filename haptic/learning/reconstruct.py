@@ -619,8 +619,8 @@ def _estimate(planes: list[Plane], components: Mapping[int, DataComponent], boun
         if any(apart(x, y) for x in only_a for y in only_b):
             continue  # a data vertex at each end alone, apart: two vertices
         if not (near[a] & near[b]) and not any(not apart(x, y) for x in only_a for y in only_b) \
-                and not {a, b} <= on_table:
-            continue  # no data vertex measures both ends, nor the table both
+                and not ({a, b} & on_table and not (only_a and only_b)):
+            continue  # no data vertex measures both ends, nor the table one end with no data vertex at the other
         parent[find(a)] = find(b)
     groups: dict[int, list[int]] = {}
     for k in range(len(poly.vertices)):
