@@ -14,8 +14,12 @@ was met by the sensor, for a face that the data miss would cut off at least one 
 
 Where noisy planes meet at a vertex of more than three faces they do not meet in one point but along an edge
 too short for the data to tell from a point; such edges (shorter than :meth:`LearnBounds.merge_length`, and not
-split by two data vertices) are contracted (:func:`learned_model`). The result passes the validation of an
-imported model file, at the precision the data support.
+split by two data vertices farther apart than their bounds) are contracted (:func:`learned_model`). The result
+passes the validation of an imported model file, at the precision the data support.
+
+Each plane's fit holds the measured vertices of the estimate's vertices on it (:func:`anchored`), not only those
+its data edges reach. On the table (the simulated hand), the table's top is the plane of the face the object rests
+on, which the pad never touches (:meth:`Plane.table_top`); a vertex on it is placed by the planes through it.
 
 Tolerances come from the data's own error bounds (:class:`LearnBounds`). Pure numpy and scipy.
 """
@@ -128,7 +132,7 @@ class Plane:
     """The measured edge's line it is fitted through, a point and a unit direction (a fold, :func:`face_planes`);
     None when free."""
     table: bool = False
-    """Whether it is the table's top, which the object rests on (:func:`table_plane`): no data face on it."""
+    """Whether it is the table's top, which the object rests on (:meth:`table_top`): no data face on it."""
 
     @classmethod
     def table_top(cls, table_z: float) -> Plane:
