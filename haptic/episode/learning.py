@@ -128,7 +128,7 @@ class ClosureMoves(MoveSource):
             self._update_boundary()
             return
         try:
-            est = convex_estimate(self.components)
+            est = convex_estimate(self.components, table_z=view.config.table_z)
         except LearnError as exc:  # the measured planes bound no convex solid: the object is not convex
             self.estimate, self.convex, self.nonconvex = None, False, str(exc)
             self._update_boundary()

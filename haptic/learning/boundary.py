@@ -36,6 +36,7 @@ from haptic.learning.reconstruct import (
     LearnBounds,
     LearnError,
     Plane,
+    anchored,
     edge_faces,
     face_planes,
     validated_model,
@@ -184,7 +185,7 @@ def _line(planes: list[Plane], pair: tuple[int, int], data: list[DataEdge]) -> t
 def boundary_estimate(components: Mapping[int, DataComponent], bounds: LearnBounds | None = None) -> BoundaryEstimate:
     """The :class:`BoundaryEstimate` of the data so far (a :class:`LearnError` when no face was measured)."""
     bounds = bounds or LearnBounds.of(components.values())
-    planes = face_planes(components)
+    planes = face_planes(components, fold_vertices=True)
     if not planes:
         raise LearnError("no face measured")
     plane_of = {f: k for k, p in enumerate(planes) for f in p.faces}
@@ -248,6 +249,13 @@ def boundary_estimate(components: Mapping[int, DataComponent], bounds: LearnBoun
     for be in edges:
         for v in be.vertices:
             vplanes[v].update(be.planes)
+    # every measured vertex joins the fit of each plane of its edges (reconstruct.anchored)
+    anchors: dict[int, list[np.ndarray]] = {}
+    for v in dverts:
+        for k in vplanes[vertex_of[v.id]]:
+            if planes[k].points is not None and not (planes[k].points == v.position).all(axis=1).any():
+                anchors.setdefault(k, []).append(v.position)
+    planes = anchored(planes, components, anchors)
     positions = np.zeros((n_v, 3))
     for g in range(n_v):
         members = [v for v in dverts if vertex_of[v.id] == g]

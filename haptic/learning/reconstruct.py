@@ -14,8 +14,12 @@ was met by the sensor, for a face that the data miss would cut off at least one 
 
 Where noisy planes meet at a vertex of more than three faces they do not meet in one point but along an edge
 too short for the data to tell from a point; such edges (shorter than :meth:`LearnBounds.merge_length`, and not
-split by two data vertices) are contracted (:func:`learned_model`). The result passes the validation of an
-imported model file, at the precision the data support.
+split by two data vertices farther apart than their bounds) are contracted (:func:`learned_model`). The result
+passes the validation of an imported model file, at the precision the data support.
+
+Each plane's fit holds the measured vertices of the estimate's vertices on it (:func:`anchored`), not only those
+its data edges reach. On the table (the simulated hand), the table's top is the plane of the face the object rests
+on, which the pad never touches (:meth:`Plane.table_top`); a vertex on it is placed by the planes through it.
 
 Tolerances come from the data's own error bounds (:class:`LearnBounds`). Pure numpy and scipy.
 """
@@ -122,6 +126,20 @@ class Plane:
     """The largest error bound of its faces' normals [rad]."""
     position_bound: float
     """The largest error bound of its faces' points [m]."""
+    points: np.ndarray | None = None
+    """The points it is fitted to: its faces' touched points, the edge ends and vertices on it, shape (P, 3) [m]."""
+    fold_line: tuple[np.ndarray, np.ndarray] | None = None
+    """The measured edge's line it is fitted through, a point and a unit direction (a fold, :func:`face_planes`);
+    None when free."""
+    table: bool = False
+    """Whether it is the table's top, which the object rests on (:meth:`table_top`): no data face on it."""
+
+    @classmethod
+    def table_top(cls, table_z: float) -> Plane:
+        """The table's top at height ``table_z`` [m] as a plane of an object resting on it (outward normal down).
+        The pad cannot touch within a few millimetres of the table, so the face the object rests on is never
+        measured; it is where the table is."""
+        return cls(np.array([0.0, 0.0, -1.0]), -float(table_z), (), BOUND_FLOOR, BOUND_FLOOR, table=True)
 
     def distance(self, points: np.ndarray) -> np.ndarray:
         """Signed distance of ``points`` from the plane (positive outside) [m]."""
@@ -193,11 +211,12 @@ def fit_plane(points: np.ndarray, normals: np.ndarray, position_bound: float, no
     return n / np.linalg.norm(n), float(centre @ n)
 
 
-def face_planes(components: Mapping[int, DataComponent]) -> list[Plane]:
+def face_planes(components: Mapping[int, DataComponent], fold_vertices: bool = False) -> list[Plane]:
     """The object's planes: the data faces grouped by agreement (in order of acquisition, each joining the plane
     it agrees with best, by normal, but never one that holds a face a data edge divides it from: two faces that
     meet at an edge are two planes, however small the angle between them), each group fitted to its points,
-    edge ends and vertices (:func:`fit_plane`)."""
+    edge ends and vertices (:func:`fit_plane`). A fold's two planes are fitted through the line of the edge between
+    them, and with ``fold_vertices`` through the vertices measured at that edge's ends too (:func:`_fold_vertices`)."""
     faces = [c for c in components.values() if isinstance(c, DataFace)]
     faces.sort(key=lambda c: c.id)
     ef = edge_faces(components)
@@ -273,7 +292,7 @@ def face_planes(components: Mapping[int, DataComponent]) -> list[Plane]:
         nb = max(x.normal_bound for x in g)
         pb = max(x.position_bound for x in g)
         n, d = fit_plane(pts, np.array([x.normal for x in g]), pb, nb)
-        planes.append(Plane(n, d, tuple(x.id for x in g), nb, pb))
+        planes.append(Plane(n, d, tuple(x.id for x in g), nb, pb, pts))
         fits.append((pts, np.array([x.normal for x in g])))
     # a fold: two planes a data edge divides at an angle their normals' bounds hardly tell apart (a vertex moved
     # almost in its face's plane) meet, fitted each on its own, wherever their small errors put the line, far from
@@ -284,6 +303,8 @@ def face_planes(components: Mapping[int, DataComponent]) -> list[Plane]:
         if len(ks) == 2:
             e = components[eid]
             folds.setdefault((ks[0], ks[1]), []).extend((e.point, e.end_point))
+    if fold_vertices:
+        _fold_vertices(folds, components, ef, plane_of)
     held: set[int] = set()
     for (a, b), ends in sorted(folds.items(), key=lambda kv: -float(np.ptp(np.array(kv[1]), axis=0).max())):
         pa, pb_ = planes[a], planes[b]
@@ -298,9 +319,36 @@ def face_planes(components: Mapping[int, DataComponent]) -> list[Plane]:
         for k in (a, b):
             n = _plane_through_line(fits[k][0], fits[k][1], centre, vt[0], planes[k].position_bound,
                                     planes[k].normal_bound)  # fmt: skip
-            planes[k] = replace(planes[k], normal=n, offset=float(centre @ n))
+            planes[k] = replace(planes[k], normal=n, offset=float(centre @ n), fold_line=(centre, vt[0]))
             held.add(k)
     return planes
+
+
+def _fold_vertices(folds: dict[tuple[int, int], list[np.ndarray]], components: Mapping[int, DataComponent],
+                   ef: Mapping[int, set[int]], plane_of: Mapping[int, int]) -> None:
+    """Each fold's line points (``folds``: plane pair → its data edges' ends) joined by the data vertices at those
+    edges that lie on the edges' own line within the bounds: the vertices span the edge end to end, where its
+    data edges, measured over a few centimetres, tilt it by their direction's error over the edge's length."""
+    at_edge: dict[int, list[DataVertex]] = {}
+    for vid, es in vertex_edges(components).items():
+        for e in es:
+            at_edge.setdefault(e, []).append(components[vid])
+    fold_edges: dict[tuple[int, int], list[DataEdge]] = {}
+    for eid, fs in ef.items():
+        ks = sorted({plane_of[f] for f in fs if f in plane_of})
+        if len(ks) == 2:
+            fold_edges.setdefault((ks[0], ks[1]), []).append(components[eid])
+    for pair, es in fold_edges.items():
+        ends = folds[pair]
+        line = np.array(ends)
+        centre = line.mean(axis=0)
+        u = np.linalg.svd(line - centre)[2][0]
+        for e in es:
+            for v in at_edge.get(e.id, ()):
+                r = v.position - centre
+                off = float(np.linalg.norm(r - (r @ u) * u))
+                if off <= v.position_bound + e.position_bound + abs(float(r @ u)) * np.sin(e.direction_bound):
+                    ends.append(v.position)
 
 
 FOLD_FACTOR = 2.0
@@ -324,6 +372,32 @@ def _plane_through_line(points: np.ndarray, normals: np.ndarray, centre: np.ndar
     if n @ normals.sum(axis=0) < 0:
         n = -n
     return n / np.linalg.norm(n)
+
+
+def anchored(planes: list[Plane], components: Mapping[int, DataComponent],
+             anchors: Mapping[int, Iterable[np.ndarray]]) -> list[Plane]:
+    """The planes fitted again with the measured vertices found on them (``anchors``: plane index → vertex
+    positions). A data vertex joins the fit of the planes its data edges lie between only (:func:`face_planes`);
+    a plane touched near one corner, and met at its far corners by vertices reached along other faces' edges, is
+    otherwise held there by its measured normals alone, whose error over the face's size puts its far vertices
+    further off than the bounds the learned model carries. A plane fitted through a fold's edge stays through
+    it."""
+    out = list(planes)
+    for k, extra in anchors.items():
+        extra = [np.asarray(x, float) for x in extra]
+        p = planes[k]
+        if not extra or p.points is None:
+            continue
+        pts = np.vstack([p.points, np.array(extra)])
+        normals = np.array([components[f].normal for f in p.faces])
+        if p.fold_line is None:
+            n, d = fit_plane(pts, normals, p.position_bound, p.normal_bound)
+        else:
+            centre, direction = p.fold_line
+            n = _plane_through_line(pts, normals, centre, direction, p.position_bound, p.normal_bound)
+            d = float(centre @ n)
+        out[k] = replace(p, normal=n, offset=d, points=pts)
+    return out
 
 
 def convexity_violation(components: Mapping[int, DataComponent], planes: list[Plane], bounds: LearnBounds):
@@ -477,12 +551,35 @@ def _polytope_edges(poly: Polytope) -> set[tuple[int, int]]:
     return out
 
 
-def convex_estimate(components: Mapping[int, DataComponent], bounds: LearnBounds | None = None) -> ConvexEstimate:
-    """The :class:`ConvexEstimate` of the data so far (a :class:`LearnError` when they bound no solid)."""
+def convex_estimate(components: Mapping[int, DataComponent], bounds: LearnBounds | None = None,
+                    table_z: float | None = None) -> ConvexEstimate:
+    """The :class:`ConvexEstimate` of the data so far (a :class:`LearnError` when they bound no solid). With a
+    table (``table_z``, its top's height [m]) the object rests on it: the table's top is one of its planes, and a
+    vertex on it is measured when the other planes through it are (:meth:`Plane.table_top`)."""
     bounds = bounds or LearnBounds.of(components.values())
     planes = face_planes(components)
     if not planes:
         raise LearnError("no face measured")
+    if table_z is not None:
+        planes.append(Plane.table_top(table_z))
+    est = _estimate(planes, components, bounds)
+    # every measured vertex joins the fit of each plane through the estimate's vertex it measures
+    anchors: dict[int, list[np.ndarray]] = {}
+    gof = est.group_of()
+    for vid, k in est.vertex_data.items():
+        pos = components[vid].position
+        through = set().union(*(est.polytope.vertex_planes[m] for m in est.groups[gof[k]]))
+        for j in through:
+            if j < len(planes) and planes[j].points is not None and not (planes[j].points == pos).all(axis=1).any():
+                anchors.setdefault(j, []).append(pos)
+    if not anchors:
+        return est
+    return _estimate(anchored(planes, components, anchors), components, bounds)
+
+
+def _estimate(planes: list[Plane], components: Mapping[int, DataComponent], bounds: LearnBounds) -> ConvexEstimate:
+    """The :class:`ConvexEstimate` of ``planes``: their solid in the box round the data, its vertices matched to
+    the data vertices and grouped."""
     pts = data_points(components.values())
     bn, bd = box_planes(pts)
     normals = np.vstack([np.array([p.normal for p in planes]), bn])
@@ -510,17 +607,30 @@ def convex_estimate(components: Mapping[int, DataComponent], bounds: LearnBounds
     def length(ab: tuple[int, int]) -> float:
         return float(np.linalg.norm(poly.vertices[ab[0]] - poly.vertices[ab[1]]))
 
+    # a vertex on the table, where the pad cannot reach, placed by the table and measured planes alone
+    table = {j for j, p in enumerate(planes) if p.table}
+    on_table = {k for k in real if poly.vertex_planes[k] & table}
+
+    def apart(x: int, y: int) -> bool:
+        """Whether data vertices ``x`` and ``y`` are farther apart than their bounds: two vertices."""
+        vx, vy = components[x], components[y]
+        return float(np.linalg.norm(vx.position - vy.position)) > vx.position_bound + vy.position_bound
+
     for a, b in sorted(_polytope_edges(poly), key=length):
-        if length((a, b)) >= bounds.merge_length or not (near[a] & near[b]):
+        if length((a, b)) >= bounds.merge_length:
             continue
-        if near[a] - near[b] and near[b] - near[a]:
-            continue  # a data vertex at each end alone: two vertices
+        only_a, only_b = near[a] - near[b], near[b] - near[a]
+        if any(apart(x, y) for x in only_a for y in only_b):
+            continue  # a data vertex at each end alone, apart: two vertices
+        if not (near[a] & near[b]) and not any(not apart(x, y) for x in only_a for y in only_b) \
+                and not ({a, b} & on_table and not (only_a and only_b)):
+            continue  # no data vertex measures both ends, nor the table one end with no data vertex at the other
         parent[find(a)] = find(b)
     groups: dict[int, list[int]] = {}
     for k in range(len(poly.vertices)):
         groups.setdefault(find(k), []).append(k)
     est.groups = list(groups.values())
-    est.measured = {k for k in range(len(poly.vertices)) if near[k]}
+    est.measured = {k for k in range(len(poly.vertices)) if near[k] or k in on_table}
     return est
 
 

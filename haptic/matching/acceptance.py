@@ -286,13 +286,18 @@ def _slide(
     model: Polyhedron, data: Sequence[DataComponent], it: Interpretation, pose: SE3, free: np.ndarray
 ) -> PoseCheck | None:
     """The pose shifted along the ``free`` directions (one or two) that makes the largest residual ratio least (a
-    grid of :data:`SLIDE_STEPS` over the model's diameter either way, then bounded refinement along each), checked
-    as :func:`pose_check` does; None when the data leave more than two directions free."""
+    grid of :data:`SLIDE_STEPS` over the model's diameter either way of the shift that brings the model's
+    centroid level with the measured points' along them -- the least-squares pose may lie anywhere along a free
+    direction, metres off -- then bounded refinement along each), checked as :func:`pose_check` does; None when
+    the data leave more than two directions free."""
     from scipy.optimize import minimize_scalar
 
     if len(free) > 2:
         return None
     span = float(np.linalg.norm(np.ptp(model.vertices, axis=0)))
+    pts = [p for c in data for p in (np.atleast_2d(c.points) if isinstance(c, DataFace) else
+                                     (c.point, c.end_point) if isinstance(c, DataEdge) else (c.position,))]
+    centre = (np.mean(pts, axis=0) - pose.apply(model.centroid)) @ free.T if pts else np.zeros(len(free))
 
     def at(shift: np.ndarray) -> SE3:
         return SE3(pose.rotation, pose.translation + shift @ free)
@@ -301,7 +306,7 @@ def _slide(
         return max(r[0] for r in residual_ratios(model, data, it, at(shift)))
 
     grid = np.linspace(-span, span, SLIDE_STEPS[len(free) - 1])
-    points = np.array(np.meshgrid(*([grid] * len(free)), indexing="ij")).reshape(len(free), -1).T
+    points = np.array(np.meshgrid(*([grid] * len(free)), indexing="ij")).reshape(len(free), -1).T + centre
     best = min(points, key=worst)
     step = grid[1] - grid[0]
     for k in range(len(free)):
@@ -348,7 +353,9 @@ def own_bounds_keep(tree, k_sigma: float | None = None) -> np.ndarray | None:
         if pose is not None:
             it = tree.interpretation(i, with_pose=True, refine=True)
             chk = pose_check(it.model, data, it)
-            keep[i] = chk.ok and acceptance(it.model, data, it, chk.world_from_model, k_sigma=k_sigma).ok
+            # the test at the least-squares pose, or at the pose slid along what the data leave free
+            keep[i] = chk.ok and any(acceptance(it.model, data, it, p, k_sigma=k_sigma).ok
+                                     for p in dict.fromkeys((pose, chk.world_from_model)))
     return keep
 
 

@@ -107,3 +107,53 @@ def test_a_convex_object_shows_no_violation():
     comps, _, _ = walk(load_library()["HEXPRISM01"], 4, 120, at_bounds=True)
     est = convex_estimate(comps)
     assert convexity_violation(comps, est.planes, est.bounds) is None
+
+
+def test_on_the_table_the_face_it_rests_on_is_the_table():
+    """A pyramid resting on its base, its side faces and apex measured (the pad reaches no lower): with the table,
+    closed, and the model is the pyramid; without it, open where the base would be."""
+    model = load_library()["PYR01"]
+    low = float(model.vertices[:, 2].min())
+    pose = SE3(np.eye(3), np.array([0.3, 0.1, 0.75 - low]))
+    base = int(np.argmin(model.face_normals[:, 2]))
+    comps = exact_components(model, pose, with_vertices=False)
+    del comps[base]
+    apex = int(np.argmax(model.vertices[:, 2]))
+    comps[len(model.faces)] = DataVertex(len(model.faces), pose.apply(model.vertices[apex]), 0.0)
+    assert not convex_estimate(comps).closed
+    est = convex_estimate(comps, table_z=0.75)
+    assert est.closed
+    learned = learned_model(est)
+    assert (learned.n_vertices, learned.n_edges, learned.n_faces) == (model.n_vertices, model.n_edges, model.n_faces)
+    assert nearest_distances(learned.vertices, pose.apply(model.vertices)).max() < 1e-7
+
+
+@pytest.mark.parametrize("out", [3e-4, -3e-4])
+def test_a_vertex_on_the_table_where_noisy_planes_meet_is_one_vertex(out):
+    """PYR01 lying on a side face, its apex on the table, one of the faces through the apex measured 0.3 mm out
+    (or in): the four planes there meet along a ridge a fraction of a millimetre long, both its ends on the table
+    or one of them just above it, which no data vertex measures (the pad does not reach the table): one vertex,
+    and the model is the pyramid."""
+    model = load_library()["PYR01"]
+    apex = int(np.argmax(model.vertices[:, 2]))
+    side = next(f for f in range(model.n_faces) if apex in model.faces[f])
+    n = model.face_normals[side]
+    down = np.array([0.0, 0.0, -1.0])
+    axis = np.cross(n, down)
+    angle = float(np.arccos(np.clip(n @ down, -1.0, 1.0)))
+    k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]]) / np.linalg.norm(axis)
+    rot = np.eye(3) + np.sin(angle) * k + (1 - np.cos(angle)) * k @ k
+    low = float((model.vertices @ rot.T)[:, 2].min())
+    pose = SE3(rot, np.array([0.6, 0.0, 0.75 - low]))
+    comps = exact_components(model, pose, with_vertices=False)
+    del comps[side]
+    other = next(f for f in range(model.n_faces) if f != side and apex in model.faces[f])
+    c = comps[other]
+    comps[other] = DataFace(c.id, c.normal, c.points + out * c.normal, 6e-4, 6e-4)
+    for i, v in enumerate(model.vertices):
+        if i != apex and float(pose.apply(v)[2]) > 0.75 + 1e-6:
+            comps[100 + i] = DataVertex(100 + i, pose.apply(v), 6e-4)
+    est = convex_estimate(comps, table_z=0.75)
+    assert est.closed and len(est.polytope.vertices) > model.n_vertices
+    learned = learned_model(est)
+    assert (learned.n_vertices, learned.n_edges, learned.n_faces) == (model.n_vertices, model.n_edges, model.n_faces)
