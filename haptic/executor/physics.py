@@ -238,6 +238,7 @@ class PhysicsExecutor(LandingSearch):
         """The data face the pad is known to rest on (None: not known)."""
         self._finger = finger
         self._why = ""  # detail of the last repositioning failure
+        self._met: PrimitiveResult | None = None  # the last crossing a link of the finger stopped
         self._links_until: float | None = None  # sim time of the last hand-link sample reported
 
     @property
@@ -270,6 +271,28 @@ class PhysicsExecutor(LandingSearch):
                           links=links, sim_time=self.robot.time - t0, wall_time=time.perf_counter() - w0,
                           free_space=res.free_space,
                           info={**res.info, "recoveries": list(self.recoveries)} if self.recoveries else res.info)
+
+    def _tilt_away(self, met: PrimitiveResult, fid: int, target: np.ndarray, pieces: list[PrimitiveResult]) -> bool:
+        """After a link of the finger met the object (``met``, event ``"hand"``): tilt the hand, the finger leaning
+        away from that contact, by the first of :attr:`TouchConfig.tilt_angles` at which the pad still reaches data
+        face ``fid`` and the arm reaches ``target`` on it, and touch the face there. True when the pad rests on the
+        face, tilted."""
+        t = self.toucher
+        n = self.segmenter.faces[fid].component.normal
+        above = target + (t.config.lift + t.pad_radius) * n
+        for a in t.config.tilt_angles:
+            rot = t.tilted(met.info["link_normal"], a)
+            if rot is None:
+                return False
+            if not t.reaches(n, rot) or not self.robot.reachable(t.finger, above, rot).reachable:
+                continue
+            t.hand_rotation = rot
+            if self._touch_face(fid, n, target, pieces) == "ok":
+                self.recoveries.append(f"the finger's {met.info['link']} met the object: the hand tilted "
+                                       f"{math.degrees(a):.0f}° away")  # fmt: skip
+                return True
+            return False
+        return False
 
     def _hand_links(self) -> HandLinks:
         """The hand's link poses sampled during the move (the robot's own forward kinematics), for
@@ -394,8 +417,14 @@ class PhysicsExecutor(LandingSearch):
         if self.workspace.pad_clearance(target, n) < self.settings.pad_clearance:
             self._why = "the touch would put the pad on the table"
             return "unreachable"
-        r = t.lift_and_approach(target, n, floor_z=TABLE_TOP_Z + t.pad_radius + self.settings.table_margin)
+        floor = TABLE_TOP_Z + t.pad_radius + self.settings.table_margin
+        r = t.lift_and_approach(target, n, floor_z=floor)
         pieces.append(r)
+        if not r.ok and r.status != "unstable" and not np.array_equal(t.hand_rotation, t.config.hand_rotation):
+            # tilted away from where a link met the object, the hand may not reach here: upright again
+            t.hand_rotation = np.array(t.config.hand_rotation, dtype=float)
+            r = t.lift_and_approach(target, n, floor_z=floor)
+            pieces.append(r)
         if not r.ok:
             self._why = f"{r.status}/{r.event}"
             return r.status
@@ -417,6 +446,10 @@ class PhysicsExecutor(LandingSearch):
         r = t.cross_edge(kind, n_a, direction)
         pieces.append(r)
         if not r.ok:
+            if r.event == "hand":
+                self._met = r
+                return "hand", f"crossing the {kind} edge: the finger's {r.info['link']} met the object", None, \
+                    None, None
             if r.event == "undercut":
                 return "undercut", f"crossing the {kind} edge: the next face leans under, out of the pad's reach", \
                     r.trace, None, None
@@ -454,6 +487,8 @@ class PhysicsExecutor(LandingSearch):
         e = unit(np.cross(n_a, d))
         sign = 1.0 if kind == "convex" else -1.0
         guesses = [] if n_roll is None else [unit(n_roll - float(n_roll @ e) * e)]
+        # a face past the edge turns from n_a toward the travel: a roll that settled in a corner can point back
+        guesses = [g for g in guesses if sign * float(g @ d) > 0]
         guesses += [math.cos(a) * n_a + sign * math.sin(a) * d for a in s.reacquire_turns]
         floor = TABLE_TOP_Z + t.pad_radius + s.table_margin
         tried: list[np.ndarray] = []
@@ -506,9 +541,16 @@ class PhysicsExecutor(LandingSearch):
         status = self._ensure_on_face(st.face, pieces)
         if status != "ok":
             return self.failed_result(move, status, f"could not return to the current face: {self._why}")
-        for attempt in range(2):
+        recrossed = tilted = False
+        while True:
             r = t.trace_face(inplane, n_a, self.settings.max_face_trace)
             pieces.append(r)
+            if r.event == "hand":
+                why = f"trace across the face: the finger's {r.info['link']} met the object"
+                if tilted or not self._tilt_away(r, st.face, self._last_on(r.trace, st.face, inplane), pieces):
+                    return self.failed_result(move, r, why)
+                tilted = True
+                continue
             if not r.ok:
                 if r.event == "table":
                     return self.failed_result(move, r, "the finger would meet the table before an edge")
@@ -521,12 +563,17 @@ class PhysicsExecutor(LandingSearch):
                                                                           r.info["direction"], pieces)  # fmt: skip
             if status == "undercut":
                 return self._edge_only(move, r, roll, reason, pieces)
+            if status == "hand" and not tilted:
+                tilted = True
+                if self._tilt_away(self._met, st.face, corner - self.settings.recross_back * inplane, pieces):
+                    continue
             if status != "ok":
                 return self.failed_result(move, status, reason)
             fit_a, line, why = self._edge_between(st.face, r.trace, "face", roll, fit_b, kind, corner)
             if line is not None:
                 break
-            shift = self._away_from_vertex(fit_a.normal, fit_b.normal, roll) if attempt == 0 else None
+            shift = self._away_from_vertex(fit_a.normal, fit_b.normal, roll) if not recrossed else None
+            recrossed = True
             if shift is None:
                 return self.failed_result(move, "unreachable", why)
             # the roll went round the edge's end: cross again farther along the edge, inside it
@@ -544,6 +591,15 @@ class PhysicsExecutor(LandingSearch):
                                  edge_faces=(st.face, face.id))  # fmt: skip
         return MoveResult(move=move, status="ok", components=(edge, face), distance=r.distance,
                           cost=self.costs.face_move(r.distance), state=self.state, info={"kind": kind})  # fmt: skip
+
+    def _last_on(self, trace: ContactTrace, fid: int, d: np.ndarray) -> np.ndarray:
+        """Where to touch data face ``fid`` again after a slide along ``d`` that a link of the finger stopped:
+        ``recross_back`` back from the slide's last contact on the face (its anchor when there is none)."""
+        n = self.segmenter.faces[fid].component.normal
+        nn = np.where(trace.in_contact[:, None], trace.normal_in_world, 0.0)
+        ok = np.flatnonzero(nn @ n > math.cos(self.bounds.face_cone))
+        last = trace.point_in_world[ok[-1]] if len(ok) else self._faces[fid].anchor
+        return last - self.settings.recross_back * d
 
     def _away_from_vertex(self, n_a: np.ndarray, n_b: np.ndarray, roll: ContactTrace) -> np.ndarray | None:
         """After a roll whose normals leaned along the edge between faces ``n_a`` and ``n_b`` (the pad rolled

@@ -307,3 +307,42 @@ def test_a_face_move_whose_crossing_loses_the_next_face_touches_it_afresh(monkey
     edge = r.components[0]
     assert score.errors("edge", "position").max() < 2.0
     assert edge.kind == "edge"
+
+
+def test_a_face_move_whose_finger_meets_the_object_tilts_the_hand_away_and_goes_on(monkeypatch):
+    """A link of the finger that meets the object lifts the pad off the face it traces (the phalanx on the rim
+    of a hole, a face leaning over the one traced): no edge is there. The hand tilts, the finger leaning away
+    from the link's contact, touches the face again a little back and traces on; the edge and the next face
+    come out within their bounds, and the hand stays tilted for the moves that follow."""
+    from haptic.executor.primitives import PrimitiveResult
+    from haptic.matching.trace import empty_trace
+
+    poly, sim = _setup("BOX01", 3)
+    ex = PhysicsExecutor(RobotInterface(sim), rng=np.random.default_rng(3))
+    assert ex.start().ok
+    real = ex.toucher.trace_face
+    calls = {"n": 0}
+
+    def first_met(direction, *a, **k):
+        if k.get("phase", "face") != "face" or calls["n"]:
+            return real(direction, *a, **k)
+        calls["n"] += 1
+        rows = real(direction, a[0], 0.01, **k)  # a little of the face, then a link meets the object ahead
+        away = -np.asarray(direction, dtype=float)
+        away[2] = 0.0
+        return PrimitiveResult("unreachable", "hand", rows.trace, rows.distance,
+                               {"link": "index_distal", "link_normal": away / np.linalg.norm(away)})
+
+    monkeypatch.setattr(ex.toucher, "trace_face", first_met)
+    r = ex.execute(ex.admissible_moves(np.random.default_rng(4), 1)[0])
+    assert calls["n"] == 1
+    assert r.ok, r.reason
+    assert any("index_distal met the object: the hand tilted 30° away" in why for why in r.info["recoveries"])
+    back = -(ex.toucher.hand_rotation @ [0.0, 0.0, 1.0])
+    assert abs(np.degrees(np.arccos(back[2])) - 30.0) < 1e-6  # tilted from the upright posture, and kept
+    assert [c.kind for c in r.components] == ["edge", "face"]
+    truth = SE3.from_matrix(sim.ground_truth().world_from_object)
+    score = score_components(ex.components, poly, truth, [r])
+    assert score.spurious == 0 and score.missed == 0
+    assert np.radians(score.errors("face", "angle")).max() < r.components[1].normal_bound
+    assert score.errors("edge", "position").max() < 2.0
