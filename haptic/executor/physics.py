@@ -839,20 +839,34 @@ class PhysicsExecutor(LandingSearch):
         if status != "ok":
             return self.failed_result(move, status, f"could not reach the face next to the vertex: {self._why}")
         tangent = math.sin(beta) * u + math.cos(beta) * w_f
-        r = t.circle_vertex(vtx, n_f, tangent, rho, max_sweep=sweep)
-        pieces.append(r)
-        if not r.ok:
-            if r.event == "table":
-                return self.failed_result(move, r,
-                                          "circling the vertex: no edge before the circle would meet the table")
-            return self.failed_result(move, r, f"circling the vertex: {r.event}")
-        kind = r.info["kind"]
-        corner = self.contact_point()
-        status, reason, roll, stroke, fit_g = self._cross_and_acquire(
-            kind, r.info["face_normal"], r.info["direction"], pieces, away_from=vtx
-        )
-        if status != "ok":
-            return self.failed_result(move, status, reason)
+        tilted = False
+        while True:
+            r = t.circle_vertex(vtx, n_f, tangent, rho, max_sweep=sweep)
+            pieces.append(r)
+            if r.event == "hand" and not tilted:  # a link of the finger lifted the pad off: tilted, circle again
+                tilted = True
+                if self._tilt_away(r, f, p0, pieces):
+                    continue
+            if not r.ok:
+                if r.event == "table":
+                    return self.failed_result(move, r,
+                                              "circling the vertex: no edge before the circle would meet the table")
+                if r.event == "hand":
+                    return self.failed_result(move, r, f"circling the vertex: the finger's {r.info['link']} met the "
+                                                       "object")  # fmt: skip
+                return self.failed_result(move, r, f"circling the vertex: {r.event}")
+            kind = r.info["kind"]
+            corner = self.contact_point()
+            status, reason, roll, stroke, fit_g = self._cross_and_acquire(
+                kind, r.info["face_normal"], r.info["direction"], pieces, away_from=vtx
+            )
+            if status == "hand" and not tilted:
+                tilted = True
+                if self._tilt_away(self._met, f, p0, pieces):
+                    continue
+            if status != "ok":
+                return self.failed_result(move, status, reason)
+            break
         fit_f, line, why = self._edge_between(f, r.trace, "circle", roll, fit_g, kind, corner)
         if line is None:
             return self.failed_result(move, "unreachable", why)

@@ -315,7 +315,6 @@ def test_a_face_move_whose_finger_meets_the_object_tilts_the_hand_away_and_goes_
     from the link's contact, touches the face again a little back and traces on; the edge and the next face
     come out within their bounds, and the hand stays tilted for the moves that follow."""
     from haptic.executor.primitives import PrimitiveResult
-    from haptic.matching.trace import empty_trace
 
     poly, sim = _setup("BOX01", 3)
     ex = PhysicsExecutor(RobotInterface(sim), rng=np.random.default_rng(3))
@@ -346,3 +345,37 @@ def test_a_face_move_whose_finger_meets_the_object_tilts_the_hand_away_and_goes_
     assert score.spurious == 0 and score.missed == 0
     assert np.radians(score.errors("face", "angle")).max() < r.components[1].normal_bound
     assert score.errors("edge", "position").max() < 2.0
+
+
+def test_a_vertex_move_whose_finger_meets_the_object_tilts_the_hand_and_circles_again(monkeypatch):
+    """The circle round a vertex that a link of the finger ends (the pad lifted off) is made again from its start
+    with the hand tilted away from the link's contact; the move reports the next edge and face."""
+    from haptic.executor.primitives import PrimitiveResult
+
+    poly, sim = _setup("BOX01", 3)
+    ex, results = _start_and_face_move(sim, 3)
+    for sense in (1, -1):
+        if ex.execute(EdgeMove(sense)).ok:
+            break
+    assert ex.state.vertex is not None
+    real = ex.toucher.circle_vertex
+    calls = {"n": 0}
+
+    def first_met(vertex, normal, start_direction, *a, **k):
+        calls["n"] += 1
+        if calls["n"] > 1:
+            return real(vertex, normal, start_direction, *a, **k)
+        away = np.asarray(start_direction, dtype=float).copy()
+        away[2] = 0.0
+        return PrimitiveResult("unreachable", "hand", ex.toucher.take_trace(), 0.0,
+                               {"link": "index_medial", "link_normal": -away / np.linalg.norm(away)})
+
+    monkeypatch.setattr(ex.toucher, "circle_vertex", first_met)
+    r = ex.execute(VertexMove(ex.state.edge_faces[0]))
+    assert calls["n"] == 2
+    assert r.ok, r.reason
+    assert any("index_medial met the object: the hand tilted" in why for why in r.info["recoveries"])
+    assert [c.kind for c in r.components] == ["edge", "face"]
+    truth = SE3.from_matrix(sim.ground_truth().world_from_object)
+    score = score_components(ex.components, poly, truth, [r])
+    assert score.spurious == 0 and score.missed == 0
