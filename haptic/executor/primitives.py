@@ -18,7 +18,9 @@ than 10° for 3 samples (convex when it tilts towards the direction of travel --
 concave when it tilts against it -- the finger is blocked) or, as a backup, when the force stays below
 0.3 F for 20 ms (the surface fell away) or progress stalls (blocked); a vertex while following an edge when
 the filtered normal gains a component along the edge above sin 15°, or contact is lost once the normal leaned
-along the edge (pitfall 8; lost before, the pad was lifted off the edge, and the move fails).
+along the edge (pitfall 8; lost before, the pad was lifted off the edge, and the move fails). Contact lost on a face,
+in a roll or round a vertex while a link of the hand other than the pad touches the object is event ``"hand"``
+(``unreachable``): that link lifted the pad off, and no edge is there.
 Ridge following presses along the sensed normal and servos sideways to keep it on the bisector of the two
 face normals.
 """
