@@ -275,23 +275,30 @@ class PhysicsExecutor(LandingSearch):
     def _tilt_away(self, met: PrimitiveResult, fid: int, target: np.ndarray, pieces: list[PrimitiveResult]) -> bool:
         """After a link of the finger met the object (``met``, event ``"hand"``): tilt the hand, the finger leaning
         away from that contact, by the first of :attr:`TouchConfig.tilt_angles` at which the pad still reaches data
-        face ``fid`` and the arm reaches ``target`` on it, and touch the face there. True when the pad rests on the
-        face, tilted."""
+        face ``fid`` and touches it at ``target``. True when the pad rests on the face, tilted; else the hand is
+        upright again."""
         t = self.toucher
         n = self.segmenter.faces[fid].component.normal
         above = target + (t.config.lift + t.pad_radius) * n
-        for a in t.config.tilt_angles:
-            rot = t.tilted(met.info["link_normal"], a)
-            if rot is None:
-                return False
-            if not t.reaches(n, rot) or not self.robot.reachable(t.finger, above, rot).reachable:
-                continue
-            t.hand_rotation = rot
-            if self._touch_face(fid, n, target, pieces) == "ok":
-                self.recoveries.append(f"the finger's {met.info['link']} met the object: the hand tilted "
-                                       f"{math.degrees(a):.0f}° away")  # fmt: skip
-                return True
-            return False
+        floor = TABLE_TOP_Z + t.pad_radius + self.settings.table_margin
+        if self.workspace.pad_clearance(target, n) >= self.settings.pad_clearance:
+            for a in t.config.tilt_angles:
+                rot = t.tilted(met.info["link_normal"], a)
+                if rot is None:
+                    break
+                if not t.reaches(n, rot) or not self.robot.reachable(t.finger, above, rot).reachable:
+                    continue
+                t.hand_rotation = rot
+                r = t.lift_and_approach(target, n, floor_z=floor)
+                pieces.append(r)
+                if r.ok and angle(r.info["normal"], n) <= self.bounds.retouch_cone:
+                    self.on_face = fid
+                    self.recoveries.append(f"the finger's {met.info['link']} met the object: the hand tilted "
+                                           f"{math.degrees(a):.0f}° away")  # fmt: skip
+                    return True
+                if r.status == "unstable":
+                    break
+        t.hand_rotation = np.array(t.config.hand_rotation, dtype=float)
         return False
 
     def _hand_links(self) -> HandLinks:

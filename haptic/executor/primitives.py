@@ -45,6 +45,8 @@ OPPOSED = 1e-6
 """Two unit normals whose sum is shorter than this (squared) are opposed: they have no bisector [-]."""
 AT_CENTRE = 1e-6
 """A contact this close to the vertex circle's centre has no radial direction [m]."""
+STOPS = ("table", "hand")
+"""Events that end a leg of a stroke without failing the stroke (the table ahead, a finger link on the object)."""
 FAILURES = ("no-contact", "unreachable", "timeout", "unstable")
 """Failure statuses of a primitive (the move statuses of :class:`~haptic.planning.moves.MoveResult`)."""
 
@@ -220,10 +222,11 @@ class Toucher:
                 best = c
         return best
 
-    def _lost(self, status: str, event: str, **info) -> PrimitiveResult:
+    def _lost(self, status: str, event: str, met=None, **info) -> PrimitiveResult:
         """Contact lost: event ``"hand"`` (``unreachable``; ``info``: ``link``, its contact's ``link_normal``) when
-        a link of the hand meets the object -- it lifted the pad off, and no edge is there --, else ``event``."""
-        link = self.link_touch()
+        a link of the hand meets the object now, or met it (``met``, the link's contact) when the contact was lost
+        -- it lifted the pad off, and no edge is there --, else ``event``."""
+        link = self.link_touch() or met
         if link is not None:
             return self._result("unreachable", "hand", 0.0, link=link.link, link_normal=link.normal_in_world.copy())
         return self._result(status, event, 0.0, **info)
@@ -568,6 +571,7 @@ class Toucher:
         travelled = 0.0
         last = self.tip.copy()
         lost = 0
+        met = None  # a link of the finger on the object when the contact was lost
         for _ in range(int(cfg.roll_max / cfg.roll_speed * 2.0 / self.dt)):
             n = self.normal if self.normal is not None else n_a
             if angle(n, n_a) > self.bounds.sample_cone:
@@ -587,8 +591,10 @@ class Toucher:
             last = self.tip.copy()
             if self.contact[1] is None:
                 lost += 1
+                if lost == 1:  # a link that lifted the pad off may have left the object by the time the roll gives up
+                    met = self.link_touch()
                 if lost * self.dt > cfg.roll_loss_time:
-                    return self._lost("no-contact", "lost")
+                    return self._lost("no-contact", "lost", met)
                 continue
             lost = 0
             hist.append((travelled, self.normal.copy()))
@@ -619,9 +625,9 @@ class Toucher:
         other way if an edge comes first). ``info["normal"]``: mean sensed normal on the face.
 
         A leg heading down that would bring the pad onto the table (event ``"table"``: a face leaning under,
-        next to the table) ends there without failing the stroke: the step in is skipped, the stroke turns
-        back the other way; the rows recorded still tell the face (the caller's fit judges whether they are
-        enough)."""
+        next to the table), or one whose pad a link of the finger lifted off (``"hand"``), ends there without
+        failing the stroke: the step in is skipped, the stroke turns back the other way; the rows recorded still
+        tell the face (the caller's fit judges whether they are enough)."""
         cfg = self.config
         n_f = unit(np.asarray(normal, dtype=float))
         # out of a concave corner the force is shared by both faces: press on the new one alone before sliding
@@ -630,10 +636,10 @@ class Toucher:
             return self._result("unstable", "nan", 0.0)
         self.take_trace()  # rows in place, not of the stroke
         pieces = [self.trace_face(away, n_f, cfg.step_in if step_in is None else step_in, phase="stroke")]
-        if not pieces[-1].ok and pieces[-1].event != "table":
+        if not pieces[-1].ok and pieces[-1].event not in STOPS:
             return pieces[-1]
         pieces.append(self.trace_face(along, n_f, cfg.stroke, phase="stroke"))
-        if (pieces[-1].ok and pieces[-1].event != "done") or pieces[-1].event == "table":
+        if (pieces[-1].ok and pieces[-1].event != "done") or pieces[-1].event in STOPS:
             back = self.trace_face(-along, n_f, cfg.stroke * 2.0, phase="stroke", from_edge=True)
             pieces.append(back)
         # the first leg starts where the roll settled, next to the edge and maybe a corner, the pad still touching
@@ -644,7 +650,7 @@ class Toucher:
         trace = rest if narrow else ContactTrace.concatenate([p.trace for p in pieces])
         ok_rows = trace.in_contact & (trace.phase == PHASES.index("stroke"))
         n_mean = dominant_normal(trace.normal_in_world[ok_rows], n_f, self.bounds.face_cone / 2.0, cfg.edge_angle)
-        failed = [p for p in pieces if not p.ok and p.event != "table"]
+        failed = [p for p in pieces if not p.ok and p.event not in STOPS]
         status = failed[-1].status if failed else "ok"
         event = failed[-1].event if failed else "done"
         return PrimitiveResult(status, event, trace, sum(p.distance for p in pieces), {"normal": n_mean})

@@ -165,3 +165,32 @@ def test_a_link_touching_the_object_is_told_from_one_on_the_table_and_tilts_the_
     under = np.array([np.cos(np.radians(40.0)), 0.0, -np.sin(np.radians(40.0))])  # leans 40° under, facing +x
     assert not t.reaches(under) and t.reaches(under, rot)
     assert t.tilted(np.array([0.0, 0.0, 1.0]), np.radians(30.0)) is None  # nothing to lean away from
+
+
+def test_a_stroke_leg_that_a_finger_link_stops_ends_there_without_failing_the_stroke(monkeypatch):
+    """A leg of an L stroke whose pad a link of the finger lifted off (event ``hand``) ends there, like one that
+    meets an edge: the stroke turns back the other way and its rows still measure the face."""
+    from haptic.executor.primitives import PrimitiveResult
+
+    sim = _box_sim()
+    t = Toucher(RobotInterface(sim))
+    top = CENTRE[2] + HALF[2]
+    assert t.move_free(np.array([CENTRE[0], CENTRE[1], top + 0.03])).ok
+    a = t.approach(np.array([0.0, 0.0, -1.0]), 0.05)
+    assert a.ok
+    real = t.trace_face
+    legs: list = []
+
+    def second_met(direction, normal, distance, **k):
+        r = real(direction, normal, distance if len(legs) != 1 else 0.002, **k)
+        if len(legs) == 1:
+            r = PrimitiveResult("unreachable", "hand", r.trace, r.distance,
+                                {"link": "index_distal", "link_normal": -np.asarray(direction, dtype=float)})
+        legs.append(r)
+        return r
+
+    monkeypatch.setattr(t, "trace_face", second_met)
+    s = t.stroke(a.info["normal"], np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0]))
+    assert [leg.event for leg in legs][1] == "hand" and len(legs) == 3  # turned back the other way
+    assert s.ok, (s.status, s.event)
+    assert np.degrees(np.arccos(s.info["normal"] @ [0.0, 0.0, 1.0])) < 1.0
