@@ -43,6 +43,29 @@ def _start_and_face_move(sim: Simulation, seed: int):
     return ex, results
 
 
+def _at_a_vertex():
+    """BOX01 at the pose of seed 3, the executor after a face move and an edge move to a vertex."""
+    poly, sim = _setup("BOX01", 3)
+    ex, _ = _start_and_face_move(sim, 3)
+    for sense in (1, -1):
+        if ex.execute(EdgeMove(sense)).ok:
+            break
+    assert ex.state.vertex is not None
+    return poly, sim, ex
+
+
+def _recovered(r, what: str, ex, sim, poly):
+    """Assert that move result ``r`` succeeded with a recovery naming ``what`` and reported an edge and a face that
+    match the truth (nothing spurious, nothing missed); the score."""
+    assert r.ok, r.reason
+    assert any(what in why for why in r.info["recoveries"]), r.info.get("recoveries")
+    assert [c.kind for c in r.components] == ["edge", "face"]
+    truth = SE3.from_matrix(sim.ground_truth().world_from_object)
+    score = score_components(ex.components, poly, truth, [r])
+    assert score.spurious == 0 and score.missed == 0
+    return score
+
+
 @pytest.fixture(scope="module")
 def box_run():
     poly, sim = _setup("BOX01", 3)
@@ -253,12 +276,7 @@ def test_a_vertex_move_whose_next_face_leans_under_fails_as_unreachable(monkeypa
     from haptic.executor.primitives import PrimitiveResult
     from haptic.matching.trace import empty_trace
 
-    poly, sim = _setup("BOX01", 3)
-    ex, results = _start_and_face_move(sim, 3)
-    for sense in (1, -1):
-        if ex.execute(EdgeMove(sense)).ok:
-            break
-    assert ex.state.vertex is not None
+    poly, sim, ex = _at_a_vertex()
     undercut = PrimitiveResult("unreachable", "undercut", empty_trace(), 0.0)
     monkeypatch.setattr(ex.toucher, "cross_edge", lambda *args, **kwargs: undercut)
     r = ex.execute(VertexMove(ex.state.edge_faces[0]))
@@ -296,12 +314,7 @@ def test_a_face_move_whose_crossing_loses_the_next_face_touches_it_afresh(monkey
         if calls["n"]:  # the move that met the edge, and the failure
             break
     assert calls["n"] >= 1
-    assert r.ok, r.reason
-    assert any("touched afresh" in why for why in r.info["recoveries"])
-    assert [c.kind for c in r.components] == ["edge", "face"]
-    truth = SE3.from_matrix(sim.ground_truth().world_from_object)
-    score = score_components(ex.components, poly, truth, [r])
-    assert score.spurious == 0 and score.missed == 0
+    score = _recovered(r, "touched afresh", ex, sim, poly)
     face = r.components[1]
     assert np.radians(score.errors("face", "angle")).max() < face.normal_bound
     edge = r.components[0]
@@ -335,14 +348,9 @@ def test_a_face_move_whose_finger_meets_the_object_tilts_the_hand_away_and_goes_
     monkeypatch.setattr(ex.toucher, "trace_face", first_met)
     r = ex.execute(ex.admissible_moves(np.random.default_rng(4), 1)[0])
     assert calls["n"] == 1
-    assert r.ok, r.reason
-    assert any("index_distal met the object: the hand tilted 30° away" in why for why in r.info["recoveries"])
+    score = _recovered(r, "index_distal met the object: the hand tilted 30° away", ex, sim, poly)
     back = -(ex.toucher.hand_rotation @ [0.0, 0.0, 1.0])
     assert abs(np.degrees(np.arccos(back[2])) - 30.0) < 1e-6  # tilted from the upright posture, and kept
-    assert [c.kind for c in r.components] == ["edge", "face"]
-    truth = SE3.from_matrix(sim.ground_truth().world_from_object)
-    score = score_components(ex.components, poly, truth, [r])
-    assert score.spurious == 0 and score.missed == 0
     assert np.radians(score.errors("face", "angle")).max() < r.components[1].normal_bound
     assert score.errors("edge", "position").max() < 2.0
 
@@ -352,12 +360,7 @@ def test_a_vertex_move_whose_finger_meets_the_object_tilts_the_hand_and_circles_
     with the hand tilted away from the link's contact; the move reports the next edge and face."""
     from haptic.executor.primitives import PrimitiveResult
 
-    poly, sim = _setup("BOX01", 3)
-    ex, results = _start_and_face_move(sim, 3)
-    for sense in (1, -1):
-        if ex.execute(EdgeMove(sense)).ok:
-            break
-    assert ex.state.vertex is not None
+    poly, sim, ex = _at_a_vertex()
     real = ex.toucher.circle_vertex
     calls = {"n": 0}
 
@@ -373,9 +376,4 @@ def test_a_vertex_move_whose_finger_meets_the_object_tilts_the_hand_and_circles_
     monkeypatch.setattr(ex.toucher, "circle_vertex", first_met)
     r = ex.execute(VertexMove(ex.state.edge_faces[0]))
     assert calls["n"] == 2
-    assert r.ok, r.reason
-    assert any("index_medial met the object: the hand tilted" in why for why in r.info["recoveries"])
-    assert [c.kind for c in r.components] == ["edge", "face"]
-    truth = SE3.from_matrix(sim.ground_truth().world_from_object)
-    score = score_components(ex.components, poly, truth, [r])
-    assert score.spurious == 0 and score.missed == 0
+    _recovered(r, "index_medial met the object: the hand tilted", ex, sim, poly)
