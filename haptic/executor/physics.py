@@ -494,8 +494,6 @@ class PhysicsExecutor(LandingSearch):
         e = unit(np.cross(n_a, d))
         sign = 1.0 if kind == "convex" else -1.0
         guesses = [] if n_roll is None else [unit(n_roll - float(n_roll @ e) * e)]
-        # a face past the edge turns from n_a toward the travel: a roll that settled in a corner can point back
-        guesses = [g for g in guesses if sign * float(g @ d) > 0]
         guesses += [math.cos(a) * n_a + sign * math.sin(a) * d for a in s.reacquire_turns]
         floor = TABLE_TOP_Z + t.pad_radius + s.table_margin
         tried: list[np.ndarray] = []
