@@ -256,6 +256,8 @@ class PhysicsExecutor(LandingSearch):
             self.toucher.sample_links()
         try:
             res = body(pieces)
+            if not np.array_equal(self.toucher.hand_rotation, self.toucher.config.hand_rotation):
+                self._upright(pieces)
         except (HapticError, FloatingPointError, ValueError, np.linalg.LinAlgError) as exc:
             self.on_face = None
             res = MoveResult(move=move, status="unstable", state=self.state, reason=str(exc))
@@ -271,6 +273,19 @@ class PhysicsExecutor(LandingSearch):
                           links=links, sim_time=self.robot.time - t0, wall_time=time.perf_counter() - w0,
                           free_space=res.free_space,
                           info={**res.info, "recoveries": list(self.recoveries)} if self.recoveries else res.info)
+
+    def _upright(self, pieces: list[PrimitiveResult]) -> None:
+        """After a move made with the hand tilted: lift the pad off along the sensed normal and turn the hand back
+        to the tracing posture there; the pad no longer rests on a face (the next move touches it again). Kept
+        tilted, later rolls onto faces leaning under ended elsewhere than upright, and the edges taken from them
+        lay outside their bounds (hull_05 and trapezohedron_07 of the formula corpus)."""
+        t, cfg = self.toucher, self.toucher.config
+        n = t.normal if t.normal is not None else np.array([0.0, 0.0, 1.0])
+        lifted = t.tip + cfg.lift * n
+        pieces.append(t.move_free(lifted, timeout=cfg.lift_timeout, tol=cfg.lift_tol, retry=False))
+        t.hand_rotation = np.array(cfg.hand_rotation, dtype=float)
+        pieces.append(t.move_free(t.tip.copy(), timeout=cfg.via_timeout, tol=cfg.via_tol))
+        self.on_face = None
 
     def _tilt_away(self, met: PrimitiveResult, fid: int, target: np.ndarray, pieces: list[PrimitiveResult]) -> bool:
         """After a link of the finger met the object (``met``, event ``"hand"``): tilt the hand, the finger leaning
