@@ -238,6 +238,7 @@ class PhysicsExecutor(LandingSearch):
         """The data face the pad is known to rest on (None: not known)."""
         self._finger = finger
         self._why = ""  # detail of the last repositioning failure
+        self._met: PrimitiveResult | None = None  # the last crossing a link of the finger stopped
         self._links_until: float | None = None  # sim time of the last hand-link sample reported
 
     @property
@@ -255,6 +256,8 @@ class PhysicsExecutor(LandingSearch):
             self.toucher.sample_links()
         try:
             res = body(pieces)
+            if not np.array_equal(self.toucher.hand_rotation, self.toucher.config.hand_rotation):
+                self._upright(pieces)
         except (HapticError, FloatingPointError, ValueError, np.linalg.LinAlgError) as exc:
             self.on_face = None
             res = MoveResult(move=move, status="unstable", state=self.state, reason=str(exc))
@@ -270,6 +273,48 @@ class PhysicsExecutor(LandingSearch):
                           links=links, sim_time=self.robot.time - t0, wall_time=time.perf_counter() - w0,
                           free_space=res.free_space,
                           info={**res.info, "recoveries": list(self.recoveries)} if self.recoveries else res.info)
+
+    def _upright(self, pieces: list[PrimitiveResult]) -> None:
+        """After a move made with the hand tilted: lift the pad off along the sensed normal and turn the hand back
+        to the tracing posture there; the pad no longer rests on a face (the next move touches it again). Kept
+        tilted, later rolls onto faces leaning under ended elsewhere than upright, and the edges taken from them
+        lay outside their bounds (hull_05 and trapezohedron_07 of the formula corpus)."""
+        t, cfg = self.toucher, self.toucher.config
+        n = t.normal if t.normal is not None else np.array([0.0, 0.0, 1.0])
+        lifted = t.tip + cfg.lift * n
+        pieces.append(t.move_free(lifted, timeout=cfg.lift_timeout, tol=cfg.lift_tol, retry=False))
+        t.hand_rotation = np.array(cfg.hand_rotation, dtype=float)
+        pieces.append(t.move_free(t.tip.copy(), timeout=cfg.via_timeout, tol=cfg.via_tol))
+        self.on_face = None
+
+    def _tilt_away(self, met: PrimitiveResult, fid: int, target: np.ndarray, pieces: list[PrimitiveResult]) -> bool:
+        """After a link of the finger met the object (``met``, event ``"hand"``): tilt the hand, the finger leaning
+        away from that contact, by the first of :attr:`TouchConfig.tilt_angles` at which the pad still reaches data
+        face ``fid`` and touches it at ``target``. True when the pad rests on the face, tilted; else the hand is
+        upright again."""
+        t = self.toucher
+        n = self.segmenter.faces[fid].component.normal
+        above = target + (t.config.lift + t.pad_radius) * n
+        floor = TABLE_TOP_Z + t.pad_radius + self.settings.table_margin
+        if self.workspace.pad_clearance(target, n) >= self.settings.pad_clearance:
+            for a in t.config.tilt_angles:
+                rot = t.tilted(met.info["link_normal"], a)
+                if rot is None:
+                    break
+                if not t.reaches(n, rot) or not self.robot.reachable(t.finger, above, rot).reachable:
+                    continue
+                t.hand_rotation = rot
+                r = t.lift_and_approach(target, n, floor_z=floor)
+                pieces.append(r)
+                if r.ok and angle(r.info["normal"], n) <= self.bounds.retouch_cone:
+                    self.on_face = fid
+                    self.recoveries.append(f"the finger's {met.info['link']} met the object: the hand tilted "
+                                           f"{math.degrees(a):.0f}° away")  # fmt: skip
+                    return True
+                if r.status == "unstable":
+                    break
+        t.hand_rotation = np.array(t.config.hand_rotation, dtype=float)
+        return False
 
     def _hand_links(self) -> HandLinks:
         """The hand's link poses sampled during the move (the robot's own forward kinematics), for
@@ -394,8 +439,14 @@ class PhysicsExecutor(LandingSearch):
         if self.workspace.pad_clearance(target, n) < self.settings.pad_clearance:
             self._why = "the touch would put the pad on the table"
             return "unreachable"
-        r = t.lift_and_approach(target, n, floor_z=TABLE_TOP_Z + t.pad_radius + self.settings.table_margin)
+        floor = TABLE_TOP_Z + t.pad_radius + self.settings.table_margin
+        r = t.lift_and_approach(target, n, floor_z=floor)
         pieces.append(r)
+        if not r.ok and r.status != "unstable" and not np.array_equal(t.hand_rotation, t.config.hand_rotation):
+            # tilted away from where a link met the object, the hand may not reach here: upright again
+            t.hand_rotation = np.array(t.config.hand_rotation, dtype=float)
+            r = t.lift_and_approach(target, n, floor_z=floor)
+            pieces.append(r)
         if not r.ok:
             self._why = f"{r.status}/{r.event}"
             return r.status
@@ -417,6 +468,10 @@ class PhysicsExecutor(LandingSearch):
         r = t.cross_edge(kind, n_a, direction)
         pieces.append(r)
         if not r.ok:
+            if r.event == "hand":
+                self._met = r
+                return "hand", f"crossing the {kind} edge: the finger's {r.info['link']} met the object", None, \
+                    None, None
             if r.event == "undercut":
                 return "undercut", f"crossing the {kind} edge: the next face leans under, out of the pad's reach", \
                     r.trace, None, None
@@ -506,9 +561,16 @@ class PhysicsExecutor(LandingSearch):
         status = self._ensure_on_face(st.face, pieces)
         if status != "ok":
             return self.failed_result(move, status, f"could not return to the current face: {self._why}")
-        for attempt in range(2):
+        recrossed = tilted = False
+        while True:
             r = t.trace_face(inplane, n_a, self.settings.max_face_trace)
             pieces.append(r)
+            if r.event == "hand":
+                why = f"trace across the face: the finger's {r.info['link']} met the object"
+                if tilted or not self._tilt_away(r, st.face, self._last_on(r.trace, st.face, inplane), pieces):
+                    return self.failed_result(move, r, why)
+                tilted = True
+                continue
             if not r.ok:
                 if r.event == "table":
                     return self.failed_result(move, r, "the finger would meet the table before an edge")
@@ -521,12 +583,17 @@ class PhysicsExecutor(LandingSearch):
                                                                           r.info["direction"], pieces)  # fmt: skip
             if status == "undercut":
                 return self._edge_only(move, r, roll, reason, pieces)
+            if status == "hand" and not tilted:
+                tilted = True
+                if self._tilt_away(self._met, st.face, corner - self.settings.recross_back * inplane, pieces):
+                    continue
             if status != "ok":
                 return self.failed_result(move, status, reason)
             fit_a, line, why = self._edge_between(st.face, r.trace, "face", roll, fit_b, kind, corner)
             if line is not None:
                 break
-            shift = self._away_from_vertex(fit_a.normal, fit_b.normal, roll) if attempt == 0 else None
+            shift = self._away_from_vertex(fit_a.normal, fit_b.normal, roll) if not recrossed else None
+            recrossed = True
             if shift is None:
                 return self.failed_result(move, "unreachable", why)
             # the roll went round the edge's end: cross again farther along the edge, inside it
@@ -544,6 +611,15 @@ class PhysicsExecutor(LandingSearch):
                                  edge_faces=(st.face, face.id))  # fmt: skip
         return MoveResult(move=move, status="ok", components=(edge, face), distance=r.distance,
                           cost=self.costs.face_move(r.distance), state=self.state, info={"kind": kind})  # fmt: skip
+
+    def _last_on(self, trace: ContactTrace, fid: int, d: np.ndarray) -> np.ndarray:
+        """Where to touch data face ``fid`` again after a slide along ``d`` that a link of the finger stopped:
+        ``recross_back`` back from the slide's last contact on the face (its anchor when there is none)."""
+        n = self.segmenter.faces[fid].component.normal
+        nn = np.where(trace.in_contact[:, None], trace.normal_in_world, 0.0)
+        ok = np.flatnonzero(nn @ n > math.cos(self.bounds.face_cone))
+        last = trace.point_in_world[ok[-1]] if len(ok) else self._faces[fid].anchor
+        return last - self.settings.recross_back * d
 
     def _away_from_vertex(self, n_a: np.ndarray, n_b: np.ndarray, roll: ContactTrace) -> np.ndarray | None:
         """After a roll whose normals leaned along the edge between faces ``n_a`` and ``n_b`` (the pad rolled
@@ -783,20 +859,34 @@ class PhysicsExecutor(LandingSearch):
         if status != "ok":
             return self.failed_result(move, status, f"could not reach the face next to the vertex: {self._why}")
         tangent = math.sin(beta) * u + math.cos(beta) * w_f
-        r = t.circle_vertex(vtx, n_f, tangent, rho, max_sweep=sweep)
-        pieces.append(r)
-        if not r.ok:
-            if r.event == "table":
-                return self.failed_result(move, r,
-                                          "circling the vertex: no edge before the circle would meet the table")
-            return self.failed_result(move, r, f"circling the vertex: {r.event}")
-        kind = r.info["kind"]
-        corner = self.contact_point()
-        status, reason, roll, stroke, fit_g = self._cross_and_acquire(
-            kind, r.info["face_normal"], r.info["direction"], pieces, away_from=vtx
-        )
-        if status != "ok":
-            return self.failed_result(move, status, reason)
+        tilted = False
+        while True:
+            r = t.circle_vertex(vtx, n_f, tangent, rho, max_sweep=sweep)
+            pieces.append(r)
+            if r.event == "hand" and not tilted:  # a link of the finger lifted the pad off: tilted, circle again
+                tilted = True
+                if self._tilt_away(r, f, p0, pieces):
+                    continue
+            if not r.ok:
+                if r.event == "table":
+                    return self.failed_result(move, r,
+                                              "circling the vertex: no edge before the circle would meet the table")
+                if r.event == "hand":
+                    return self.failed_result(move, r, f"circling the vertex: the finger's {r.info['link']} met the "
+                                                       "object")  # fmt: skip
+                return self.failed_result(move, r, f"circling the vertex: {r.event}")
+            kind = r.info["kind"]
+            corner = self.contact_point()
+            status, reason, roll, stroke, fit_g = self._cross_and_acquire(
+                kind, r.info["face_normal"], r.info["direction"], pieces, away_from=vtx
+            )
+            if status == "hand" and not tilted:
+                tilted = True
+                if self._tilt_away(self._met, f, p0, pieces):
+                    continue
+            if status != "ok":
+                return self.failed_result(move, status, reason)
+            break
         fit_f, line, why = self._edge_between(f, r.trace, "circle", roll, fit_g, kind, corner)
         if line is None:
             return self.failed_result(move, "unreachable", why)

@@ -18,7 +18,9 @@ than 10° for 3 samples (convex when it tilts towards the direction of travel --
 concave when it tilts against it -- the finger is blocked) or, as a backup, when the force stays below
 0.3 F for 20 ms (the surface fell away) or progress stalls (blocked); a vertex while following an edge when
 the filtered normal gains a component along the edge above sin 15°, or contact is lost once the normal leaned
-along the edge (pitfall 8; lost before, the pad was lifted off the edge, and the move fails).
+along the edge (pitfall 8; lost before, the pad was lifted off the edge, and the move fails). Contact lost on a face,
+in a roll or round a vertex while a link of the hand other than the pad touches the object is event ``"hand"``
+(``unreachable``): that link lifted the pad off, and no edge is there.
 Ridge following presses along the sensed normal and servos sideways to keep it on the bisector of the two
 face normals.
 """
@@ -43,6 +45,8 @@ OPPOSED = 1e-6
 """Two unit normals whose sum is shorter than this (squared) are opposed: they have no bisector [-]."""
 AT_CENTRE = 1e-6
 """A contact this close to the vertex circle's centre has no radial direction [m]."""
+STOPS = ("table", "hand")
+"""Events that end a leg of a stroke without failing the stroke (the table ahead, a finger link on the object)."""
 FAILURES = ("no-contact", "unreachable", "timeout", "unstable")
 """Failure statuses of a primitive (the move statuses of :class:`~haptic.planning.moves.MoveResult`)."""
 
@@ -97,6 +101,9 @@ class Toucher:
         tip, rot = robot.fingertip_pose()
         self.tip = tip
         self.rotation = rot
+        self.hand_rotation = np.array(self.config.hand_rotation, dtype=float)
+        """The hand's rotation ``world_from_hand`` every command holds (3, 3): the config's tracing posture, or
+        that posture tilted away from where a finger link met the object (:meth:`tilt_away`)."""
         self.home_q = robot.arm_posture()
         """The arm's joint angles when the toucher was made (its posture family: a free move that ran away is
         brought back to it)."""
@@ -182,7 +189,7 @@ class Toucher:
 
     def _press(self, velocity: np.ndarray, hint: np.ndarray | None = None) -> None:
         cfg = self.config
-        self.robot.set_hybrid(cfg.force, velocity, normal_hint=hint, rotation_in_world=cfg.hand_rotation)
+        self.robot.set_hybrid(cfg.force, velocity, normal_hint=hint, rotation_in_world=self.hand_rotation)
         self.hybrid = True
 
     def _settle(self, phase: str = "settle") -> bool:
@@ -199,6 +206,52 @@ class Toucher:
             if good >= need:
                 break
         return True
+
+    def link_touch(self):
+        """The strongest sensed contact of a link of the hand other than the pads (a phalanx, the palm) with
+        anything but the table top (a contact below :attr:`floor_z` with an upward normal), from the links'
+        contact readout; None when there is none."""
+        best = None
+        for c in self.robot.link_contacts():
+            on_table = float(c.normal_in_world[2]) > self.config.table_link_cos and (
+                self.floor_z is None or float(c.point_in_world[2]) < self.floor_z
+            )
+            if on_table or c.normal_force <= self.threshold:
+                continue
+            if best is None or c.normal_force > best.normal_force:
+                best = c
+        return best
+
+    def _lost(self, status: str, event: str, met=None, **info) -> PrimitiveResult:
+        """Contact lost: event ``"hand"`` (``unreachable``; ``info``: ``link``, its contact's ``link_normal``) when
+        a link of the hand meets the object now, or met it (``met``, the link's contact) when the contact was lost
+        -- it lifted the pad off, and no edge is there --, else ``event``."""
+        link = self.link_touch() or met
+        if link is not None:
+            return self._result("unreachable", "hand", 0.0, link=link.link, link_normal=link.normal_in_world.copy())
+        return self._result(status, event, 0.0, **info)
+
+    def tilted(self, away: np.ndarray, angle_: float) -> np.ndarray | None:
+        """The hand's rotation tilted by ``angle_`` [rad] so that the finger's axis, pointing up from the pad,
+        leans toward the horizontal part of ``away`` (the sensed normal of a link's contact: out of the object
+        toward the link) -- the finger's links clear the object there; None when ``away`` is near vertical. The
+        tilt is from the config's tracing posture (tilts do not add up)."""
+        upright = np.asarray(self.config.hand_rotation, dtype=float)
+        back = -(upright @ np.array([0.0, 0.0, 1.0]))
+        m = np.asarray(away, dtype=float) - float(np.asarray(away, dtype=float) @ back) * back
+        if float(m @ m) < self.config.tilt_min_sin**2:
+            return None
+        axis = unit(np.cross(back, m))
+        k = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
+        rot = np.eye(3) + math.sin(angle_) * k + (1.0 - math.cos(angle_)) * (k @ k)
+        return rot @ upright
+
+    def reaches(self, normal: np.ndarray, rotation: np.ndarray | None = None) -> bool:
+        """Whether the pad can touch a face of ``normal`` with the hand at ``rotation`` (default: as held): the
+        face leans back against the finger's axis at most :attr:`TouchConfig.max_undercut`."""
+        rot = self.hand_rotation if rotation is None else rotation
+        back = -(rot @ np.array([0.0, 0.0, 1.0]))
+        return float(np.asarray(normal, dtype=float) @ back) >= -math.sin(self.config.max_undercut)
 
     def below_floor(self, heading: np.ndarray | None = None) -> bool:
         """The pad's lowest point is below :attr:`floor_z` (and ``heading``, when given, points down)."""
@@ -223,7 +276,7 @@ class Toucher:
         start = self.tip.copy()
         self.hybrid = False
         self.normal = None
-        if not self.robot.reachable(self.finger, point, cfg.hand_rotation).reachable:
+        if not self.robot.reachable(self.finger, point, self.hand_rotation).reachable:
             return self._result("unreachable", "limit", 0.0, target=point)
         dist = float(np.linalg.norm(point - start))
         n_ticks = max(1, int(dist / cfg.free_speed / self.dt))
@@ -231,7 +284,7 @@ class Toucher:
         length2 = float(path @ path)
         for k in range(1, int(timeout / self.dt)):
             s = min(1.0, k / n_ticks)
-            self.robot.move_fingertip(start + s * (point - start), cfg.hand_rotation)
+            self.robot.move_fingertip(start + s * (point - start), self.hand_rotation)
             self.tick("free")
             if self._unhealthy:
                 return self._result("unstable", "nan", 0.0)
@@ -252,7 +305,7 @@ class Toucher:
         when there is none or the arm does not get there."""
         cfg = self.config
         above = np.array([self.tip[0], self.tip[1], max(float(self.tip[2]), float(point[2])) + cfg.overpass])
-        ik = self.robot.reachable(self.finger, above, cfg.hand_rotation, arm_q0=self.home_q)
+        ik = self.robot.reachable(self.finger, above, self.hand_rotation, arm_q0=self.home_q)
         if not ik.reachable:
             return False
         self.robot.hold_posture(ik.arm_q)
@@ -281,7 +334,7 @@ class Toucher:
         self.hybrid = False
         self.normal = None
         self.contact_ticks = 0
-        if not self.robot.reachable(self.finger, target, cfg.hand_rotation).reachable:
+        if not self.robot.reachable(self.finger, target, self.hand_rotation).reachable:
             return self._result("unreachable", "limit", 0.0, target=target)
         dist = float(np.linalg.norm(target - start))
         u = (target - start) / dist if dist > 0 else np.zeros(3)
@@ -293,23 +346,23 @@ class Toucher:
         for k in range(1, int(timeout / self.dt)):
             s = min(1.0, k / n_ticks)
             command = start + s * (target - start)
-            self.robot.move_fingertip(command, cfg.hand_rotation)
+            self.robot.move_fingertip(command, self.hand_rotation)
             self.tick(phase)
             if self._unhealthy:
                 return self._result("unstable", "nan", 0.0)
             travel = float((self.tip - start) @ u)
             if self.touching:
-                self.robot.move_fingertip(self.tip.copy(), cfg.hand_rotation)
+                self.robot.move_fingertip(self.tip.copy(), self.hand_rotation)
                 return self._result("ok", "contact", 0.0, finger=self.finger, point=self.contact[2].copy(),
                                     normal=self.normal.copy(), travel=travel)  # fmt: skip
             for f in others:
                 c = self.robot.sense_contact(f)
                 if c.normal_force > self.threshold and c.normal_in_world is not None:
-                    self.robot.move_fingertip(self.tip.copy(), cfg.hand_rotation)
+                    self.robot.move_fingertip(self.tip.copy(), self.hand_rotation)
                     return self._result("ok", "contact", 0.0, finger=f, point=c.point_in_world.copy(),
                                         normal=c.normal_in_world.copy(), travel=travel)  # fmt: skip
             if float(np.linalg.norm(self.tip - command)) > max_lag and s < 1.0:
-                self.robot.move_fingertip(self.tip.copy(), cfg.hand_rotation)
+                self.robot.move_fingertip(self.tip.copy(), self.hand_rotation)
                 return self._result("unreachable", "blocked", 0.0, travel=travel)
             if s >= 1.0 and (np.linalg.norm(self.tip - target) < cfg.free_tol or k > n_ticks + settle_ticks):
                 return self._result("ok", "done", 0.0, travel=travel)
@@ -339,7 +392,7 @@ class Toucher:
         for _ in range(int(timeout / self.dt)):
             if float((target - start) @ d) < max_distance:
                 target = target + step * d
-            self.robot.move_fingertip(target, cfg.hand_rotation)
+            self.robot.move_fingertip(target, self.hand_rotation)
             self.tick("approach")
             if self._unhealthy:
                 return self._result("unstable", "nan", 0.0)
@@ -351,7 +404,7 @@ class Toucher:
         if not touched:
             return self._result("timeout", "limit", 0.0)
         if not settle:  # a probe: stop where it touched
-            self.robot.move_fingertip(self.tip.copy(), cfg.hand_rotation)
+            self.robot.move_fingertip(self.tip.copy(), self.hand_rotation)
             return self._result("ok", "contact", 0.0, normal=self.normal.copy(), point=self.contact[2].copy())
         self._press(np.zeros(3), hint=-d)
         if not self._settle():
@@ -475,8 +528,8 @@ class Toucher:
             if self.below_floor(d):
                 return self._result("unreachable", "table", 0.0, face_normal=n_run, direction=d)
             if self.weak_ticks * self.dt >= cfg.loss_time:
-                return self._result("ok", "convex-edge", 0.0, face_normal=unit(n_sum) if n_sum.any() else n_run,
-                                    direction=d, kind="convex", lost=True)  # fmt: skip
+                return self._lost("ok", "convex-edge", face_normal=unit(n_sum) if n_sum.any() else n_run,
+                                  direction=d, kind="convex", lost=True)  # fmt: skip
             n = self.normal
             if from_edge and n is not None and (angle(n, n_f) <= cfg.edge_angle or travelled > cfg.leave_edge):
                 from_edge = False  # off the ridge: its rows (the pad on the edge, not the face) are not the face's
@@ -513,11 +566,12 @@ class Toucher:
         if e @ e < cfg.roll_axis_sin2:
             e = unit(np.cross(n_a, d))
         sign = -1.0 if kind == "convex" else 1.0
-        back = -(np.asarray(cfg.hand_rotation, dtype=float) @ np.array([0.0, 0.0, 1.0]))  # up the finger
+        back = -(self.hand_rotation @ np.array([0.0, 0.0, 1.0]))  # up the finger
         hist: list[tuple[float, np.ndarray]] = []
         travelled = 0.0
         last = self.tip.copy()
         lost = 0
+        met = None  # a link of the finger on the object when the contact was lost
         for _ in range(int(cfg.roll_max / cfg.roll_speed * 2.0 / self.dt)):
             n = self.normal if self.normal is not None else n_a
             if angle(n, n_a) > self.bounds.sample_cone:
@@ -537,8 +591,10 @@ class Toucher:
             last = self.tip.copy()
             if self.contact[1] is None:
                 lost += 1
+                if lost == 1:  # a link that lifted the pad off may have left the object by the time the roll gives up
+                    met = self.link_touch()
                 if lost * self.dt > cfg.roll_loss_time:
-                    return self._result("no-contact", "lost", 0.0)
+                    return self._lost("no-contact", "lost", met)
                 continue
             lost = 0
             hist.append((travelled, self.normal.copy()))
@@ -569,9 +625,9 @@ class Toucher:
         other way if an edge comes first). ``info["normal"]``: mean sensed normal on the face.
 
         A leg heading down that would bring the pad onto the table (event ``"table"``: a face leaning under,
-        next to the table) ends there without failing the stroke: the step in is skipped, the stroke turns
-        back the other way; the rows recorded still tell the face (the caller's fit judges whether they are
-        enough)."""
+        next to the table), or one whose pad a link of the finger lifted off (``"hand"``), ends there without
+        failing the stroke: the step in is skipped, the stroke turns back the other way; the rows recorded still
+        tell the face (the caller's fit judges whether they are enough)."""
         cfg = self.config
         n_f = unit(np.asarray(normal, dtype=float))
         # out of a concave corner the force is shared by both faces: press on the new one alone before sliding
@@ -580,10 +636,10 @@ class Toucher:
             return self._result("unstable", "nan", 0.0)
         self.take_trace()  # rows in place, not of the stroke
         pieces = [self.trace_face(away, n_f, cfg.step_in if step_in is None else step_in, phase="stroke")]
-        if not pieces[-1].ok and pieces[-1].event != "table":
+        if not pieces[-1].ok and pieces[-1].event not in STOPS:
             return pieces[-1]
         pieces.append(self.trace_face(along, n_f, cfg.stroke, phase="stroke"))
-        if (pieces[-1].ok and pieces[-1].event != "done") or pieces[-1].event == "table":
+        if (pieces[-1].ok and pieces[-1].event != "done") or pieces[-1].event in STOPS:
             back = self.trace_face(-along, n_f, cfg.stroke * 2.0, phase="stroke", from_edge=True)
             pieces.append(back)
         # the first leg starts where the roll settled, next to the edge and maybe a corner, the pad still touching
@@ -594,7 +650,7 @@ class Toucher:
         trace = rest if narrow else ContactTrace.concatenate([p.trace for p in pieces])
         ok_rows = trace.in_contact & (trace.phase == PHASES.index("stroke"))
         n_mean = dominant_normal(trace.normal_in_world[ok_rows], n_f, self.bounds.face_cone / 2.0, cfg.edge_angle)
-        failed = [p for p in pieces if not p.ok and p.event != "table"]
+        failed = [p for p in pieces if not p.ok and p.event not in STOPS]
         status = failed[-1].status if failed else "ok"
         event = failed[-1].event if failed else "done"
         return PrimitiveResult(status, event, trace, sum(p.distance for p in pieces), {"normal": n_mean})
@@ -760,8 +816,8 @@ class Toucher:
             if (swept > max_sweep and max_sweep < full) or self.below_floor(t):
                 return self._result("unreachable", "table", 0.0, arc=swept)
             if self.weak_ticks * self.dt >= cfg.loss_time:
-                return self._result("ok", "convex-edge", 0.0, face_normal=n_run, direction=t, kind="convex",
-                                    arc=swept, lost=True)  # fmt: skip
+                return self._lost("ok", "convex-edge", face_normal=n_run, direction=t, kind="convex", arc=swept,
+                                  lost=True)  # fmt: skip
             n = self.normal
             if n is not None and self.contact[1] is not None:
                 a = angle(n, n_run)

@@ -68,6 +68,14 @@ class TouchConfig:
     """The pad reaches a surface whose normal leans at most this far back against the finger's axis (past
     perpendicular to it); beyond, the finger's phalanx meets the object first and the pad loses contact. A
     roll over a convex edge stops there (event ``"undercut"``) [rad]."""
+    tilt_angles: tuple[float, ...] = (math.radians(30.0), math.radians(15.0))
+    """A move whose pad a link of the finger lifted off the object (the phalanx meeting the rim of a hole, a face
+    leaning over the one traced) tilts the hand, the finger leaning away from that contact, by the first of these
+    the arm reaches, and tries again [rad] ..."""
+    tilt_min_sin: float = 0.2
+    """... unless the link's contact normal is within asin of this of the finger's axis (no side to lean to) [-]."""
+    table_link_cos: float = 0.95
+    """A link's contact below the floor with a normal whose vertical component exceeds this is the table's [-]."""
     roll_max: float = 0.04
     """Longest pad travel while rolling over or climbing onto an edge [m]."""
     roll_loss_time: float = 0.15

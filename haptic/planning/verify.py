@@ -130,22 +130,39 @@ def table_pins(
     for v in range(poly.n_vertices):
         if z[v] > TABLE_CONTACT or v in reach[2]:
             continue
-        rising = frozenset(
-            int(e) for e in reach[1] if v in poly.edges[e] and z[int(sum(poly.edges[e])) - v] > TABLE_CONTACT
-        )
-        faces = []
-        for f in poly.vertex_faces[v]:
-            loop = list(poly.faces[int(f)])
-            if np.all(z[loop] <= TABLE_CONTACT):
-                continue
-            ids = tuple(int(u) for u in loop if int(u) in reach[2])
-            faces.append((int(f), ids, poly.vertices[list(ids)].reshape(-1, 3)))
-        pin = TablePin(v, rising, tuple(faces))
+        pin = _table_pin(poly, z, v, reach[1], reach[2])
         if pin.given(reach[0], reach[1], reach[2]):
             pins.append(pin)
         else:
             unpinnable.append(v)
     return tuple(pins), unpinnable
+
+
+def _table_pin(poly: Polyhedron, z: np.ndarray, v: int, edges, vertices) -> TablePin:
+    """The :class:`TablePin` of vertex ``v`` of ``poly`` (model vertices' heights above the table ``z``) by its
+    rising edges among ``edges`` and its faces off the table, with their vertices among ``vertices``."""
+    rising = frozenset(int(e) for e in edges if v in poly.edges[e] and z[int(sum(poly.edges[e])) - v] > TABLE_CONTACT)
+    faces = []
+    for f in poly.vertex_faces[v]:
+        loop = list(poly.faces[int(f)])
+        if np.all(z[loop] <= TABLE_CONTACT):
+            continue
+        ids = tuple(int(u) for u in loop if int(u) in vertices)
+        faces.append((int(f), ids, poly.vertices[list(ids)].reshape(-1, 3)))
+    return TablePin(v, rising, tuple(faces))
+
+
+def placed_by_data(poly: Polyhedron, world_from_model: SE3, vertices: Sequence[int], cov, config: PlannerConfig
+                   ) -> list[int]:  # fmt: skip
+    """Of ``vertices`` (resting on the table, that nothing predicted in reach would place), those that what ``cov``
+    measured places all the same: a rising edge, or two of their faces' planes, measured although predicted out of
+    reach (the hand tilted away from the object reaches faces leaning under farther than the prediction's pad)."""
+    if config.table_z is None:
+        return []
+    z = world_from_model.apply(poly.vertices)[:, 2] - config.table_z
+    every_edge, every_vertex = range(poly.n_edges), frozenset(range(poly.n_vertices))
+    return [v for v in vertices
+            if _table_pin(poly, z, v, every_edge, every_vertex).given(cov.faces, cov.edges, cov.vertices)]  # fmt: skip
 
 
 def hidden_vertices(poly: Polyhedron, world_from_model: SE3, cov, config: PlannerConfig) -> list[int]:
@@ -595,7 +612,9 @@ class Verifier:
             self.status = "mismatch"
         elif self.coverage is not None and self.coverage.met(self.mode):
             self.hidden = hidden_vertices(cls.model, self.check.world_from_model, self.coverage, self.config)
-            self.unpinnable = [v for v in self._pins[cls.name][1] if v not in self.hidden]
+            unpinned = [v for v in self._pins[cls.name][1] if v not in self.hidden]
+            placed = placed_by_data(cls.model, self.check.world_from_model, unpinned, self.coverage, self.config)
+            self.unpinnable = [v for v in unpinned if v not in placed]
             self.status = "incomplete" if self.mode == "full" and (self.hidden or self.unpinnable) else "confirmed"
         else:
             self.status = "verifying"

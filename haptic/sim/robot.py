@@ -17,6 +17,7 @@ from haptic.sim.physics import (
     LINK_CHAINS,
     LINK_NAMES,
     ContactSummary,
+    LinkContact,
     LinkGeom,
     SensorReading,
     Simulation,
@@ -51,6 +52,11 @@ class RobotInterface:
     def sense_contact(self, finger: str) -> ContactSummary:
         """Aggregated contact of one fingertip (total normal force, mean normal and point), noise applied."""
         return self._sim.contact_summary(self._ctl_finger_index(finger))
+
+    def link_contacts(self) -> tuple[LinkContact, ...]:
+        """The contacts of the robot's links other than the fingertip pads (:attr:`SensorReading.link_contacts`)
+        alone, noise applied, without reading the other sensors (no noise drawn when there are none)."""
+        return self._sim.link_contacts()
 
     @property
     def time(self) -> float:

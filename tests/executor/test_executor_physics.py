@@ -43,6 +43,29 @@ def _start_and_face_move(sim: Simulation, seed: int):
     return ex, results
 
 
+def _at_a_vertex():
+    """BOX01 at the pose of seed 3, the executor after a face move and an edge move to a vertex."""
+    poly, sim = _setup("BOX01", 3)
+    ex, _ = _start_and_face_move(sim, 3)
+    for sense in (1, -1):
+        if ex.execute(EdgeMove(sense)).ok:
+            break
+    assert ex.state.vertex is not None
+    return poly, sim, ex
+
+
+def _recovered(r, what: str, ex, sim, poly):
+    """Assert that move result ``r`` succeeded with a recovery naming ``what`` and reported an edge and a face that
+    match the truth (nothing spurious, nothing missed); the score."""
+    assert r.ok, r.reason
+    assert any(what in why for why in r.info["recoveries"]), r.info.get("recoveries")
+    assert [c.kind for c in r.components] == ["edge", "face"]
+    truth = SE3.from_matrix(sim.ground_truth().world_from_object)
+    score = score_components(ex.components, poly, truth, [r])
+    assert score.spurious == 0 and score.missed == 0
+    return score
+
+
 @pytest.fixture(scope="module")
 def box_run():
     poly, sim = _setup("BOX01", 3)
@@ -253,12 +276,7 @@ def test_a_vertex_move_whose_next_face_leans_under_fails_as_unreachable(monkeypa
     from haptic.executor.primitives import PrimitiveResult
     from haptic.matching.trace import empty_trace
 
-    poly, sim = _setup("BOX01", 3)
-    ex, results = _start_and_face_move(sim, 3)
-    for sense in (1, -1):
-        if ex.execute(EdgeMove(sense)).ok:
-            break
-    assert ex.state.vertex is not None
+    poly, sim, ex = _at_a_vertex()
     undercut = PrimitiveResult("unreachable", "undercut", empty_trace(), 0.0)
     monkeypatch.setattr(ex.toucher, "cross_edge", lambda *args, **kwargs: undercut)
     r = ex.execute(VertexMove(ex.state.edge_faces[0]))
@@ -296,14 +314,66 @@ def test_a_face_move_whose_crossing_loses_the_next_face_touches_it_afresh(monkey
         if calls["n"]:  # the move that met the edge, and the failure
             break
     assert calls["n"] >= 1
-    assert r.ok, r.reason
-    assert any("touched afresh" in why for why in r.info["recoveries"])
-    assert [c.kind for c in r.components] == ["edge", "face"]
-    truth = SE3.from_matrix(sim.ground_truth().world_from_object)
-    score = score_components(ex.components, poly, truth, [r])
-    assert score.spurious == 0 and score.missed == 0
+    score = _recovered(r, "touched afresh", ex, sim, poly)
     face = r.components[1]
     assert np.radians(score.errors("face", "angle")).max() < face.normal_bound
     edge = r.components[0]
     assert score.errors("edge", "position").max() < 2.0
     assert edge.kind == "edge"
+
+
+def test_a_face_move_whose_finger_meets_the_object_tilts_the_hand_away_and_goes_on(monkeypatch):
+    """A link of the finger that meets the object lifts the pad off the face it traces (the phalanx on the rim
+    of a hole, a face leaning over the one traced): no edge is there. The hand tilts, the finger leaning away
+    from the link's contact, touches the face again a little back and traces on; the edge and the next face
+    come out within their bounds, and the hand is upright again after the move."""
+    from haptic.executor.primitives import PrimitiveResult
+
+    poly, sim = _setup("BOX01", 3)
+    ex = PhysicsExecutor(RobotInterface(sim), rng=np.random.default_rng(3))
+    assert ex.start().ok
+    real = ex.toucher.trace_face
+    calls = {"n": 0}
+
+    def first_met(direction, *a, **k):
+        if k.get("phase", "face") != "face" or calls["n"]:
+            return real(direction, *a, **k)
+        calls["n"] += 1
+        rows = real(direction, a[0], 0.01, **k)  # a little of the face, then a link meets the object ahead
+        away = -np.asarray(direction, dtype=float)
+        away[2] = 0.0
+        return PrimitiveResult("unreachable", "hand", rows.trace, rows.distance,
+                               {"link": "index_distal", "link_normal": away / np.linalg.norm(away)})
+
+    monkeypatch.setattr(ex.toucher, "trace_face", first_met)
+    r = ex.execute(ex.admissible_moves(np.random.default_rng(4), 1)[0])
+    assert calls["n"] == 1
+    score = _recovered(r, "index_distal met the object: the hand tilted 30° away", ex, sim, poly)
+    np.testing.assert_array_equal(ex.toucher.hand_rotation, ex.toucher.config.hand_rotation)  # upright again
+    assert ex.on_face is None  # the next move touches its face again
+    assert np.radians(score.errors("face", "angle")).max() < r.components[1].normal_bound
+    assert score.errors("edge", "position").max() < 2.0
+
+
+def test_a_vertex_move_whose_finger_meets_the_object_tilts_the_hand_and_circles_again(monkeypatch):
+    """The circle round a vertex that a link of the finger ends (the pad lifted off) is made again from its start
+    with the hand tilted away from the link's contact; the move reports the next edge and face."""
+    from haptic.executor.primitives import PrimitiveResult
+
+    poly, sim, ex = _at_a_vertex()
+    real = ex.toucher.circle_vertex
+    calls = {"n": 0}
+
+    def first_met(vertex, normal, start_direction, *a, **k):
+        calls["n"] += 1
+        if calls["n"] > 1:
+            return real(vertex, normal, start_direction, *a, **k)
+        away = np.asarray(start_direction, dtype=float).copy()
+        away[2] = 0.0
+        return PrimitiveResult("unreachable", "hand", ex.toucher.take_trace(), 0.0,
+                               {"link": "index_medial", "link_normal": -away / np.linalg.norm(away)})
+
+    monkeypatch.setattr(ex.toucher, "circle_vertex", first_met)
+    r = ex.execute(VertexMove(ex.state.edge_faces[0]))
+    assert calls["n"] == 2
+    _recovered(r, "index_medial met the object: the hand tilted", ex, sim, poly)

@@ -137,3 +137,60 @@ def test_a_strokes_normal_is_the_faces_cluster_even_from_a_guess_degrees_off():
     assert np.degrees(np.arccos(np.clip(mean @ face, -1, 1))) > 0.5
     # no row near the guess: the guess
     assert np.allclose(dominant_normal(rows, -face, np.radians(2.0), np.radians(10.0)), -face)
+
+
+def test_a_link_touching_the_object_is_told_from_one_on_the_table_and_tilts_the_finger_away(monkeypatch):
+    """A slide whose pad loses contact while a link of the finger touches the object ends ``hand`` (no edge), one
+    whose link rests on the table does not; the tilt leans the finger's axis away from the link's contact by the
+    angle asked, from the upright posture, and a face leaning under past the reach stays out of it."""
+    from haptic.sim.physics import LinkContact
+
+    sim = _box_sim()
+    t = Toucher(RobotInterface(sim))
+    t.floor_z = TABLE_TOP_Z + 0.002
+    table = LinkContact("index_medial", np.array([0.5, 0.0, TABLE_TOP_Z]), np.array([0.0, 0.0, 1.0]), 2.0)
+    rim = LinkContact("index_distal", np.array([0.5, 0.0, TABLE_TOP_Z + 0.05]), np.array([0.6, 0.0, -0.8]), 1.0)
+    seen: list = [(table,)]
+    monkeypatch.setattr(RobotInterface, "link_contacts", lambda self: seen[-1])
+    assert t.link_touch() is None
+    assert t._lost("ok", "convex-edge", lost=True).event == "convex-edge"
+    seen.append((table, rim))
+    assert t.link_touch() is rim
+    r = t._lost("ok", "convex-edge", lost=True)
+    assert (r.status, r.event, r.info["link"]) == ("unreachable", "hand", "index_distal")
+    rot = t.tilted(r.info["link_normal"], np.radians(30.0))
+    back = -(rot @ [0.0, 0.0, 1.0])
+    np.testing.assert_allclose(back, [np.sin(np.radians(30.0)), 0.0, np.cos(np.radians(30.0))], atol=1e-9)
+    np.testing.assert_allclose(rot @ rot.T, np.eye(3), atol=1e-12)
+    under = np.array([np.cos(np.radians(40.0)), 0.0, -np.sin(np.radians(40.0))])  # leans 40° under, facing +x
+    assert not t.reaches(under) and t.reaches(under, rot)
+    assert t.tilted(np.array([0.0, 0.0, 1.0]), np.radians(30.0)) is None  # nothing to lean away from
+
+
+def test_a_stroke_leg_that_a_finger_link_stops_ends_there_without_failing_the_stroke(monkeypatch):
+    """A leg of an L stroke whose pad a link of the finger lifted off (event ``hand``) ends there, like one that
+    meets an edge: the stroke turns back the other way and its rows still measure the face."""
+    from haptic.executor.primitives import PrimitiveResult
+
+    sim = _box_sim()
+    t = Toucher(RobotInterface(sim))
+    top = CENTRE[2] + HALF[2]
+    assert t.move_free(np.array([CENTRE[0], CENTRE[1], top + 0.03])).ok
+    a = t.approach(np.array([0.0, 0.0, -1.0]), 0.05)
+    assert a.ok
+    real = t.trace_face
+    legs: list = []
+
+    def second_met(direction, normal, distance, **k):
+        r = real(direction, normal, distance if len(legs) != 1 else 0.002, **k)
+        if len(legs) == 1:
+            r = PrimitiveResult("unreachable", "hand", r.trace, r.distance,
+                                {"link": "index_distal", "link_normal": -np.asarray(direction, dtype=float)})
+        legs.append(r)
+        return r
+
+    monkeypatch.setattr(t, "trace_face", second_met)
+    s = t.stroke(a.info["normal"], np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0]))
+    assert [leg.event for leg in legs][1] == "hand" and len(legs) == 3  # turned back the other way
+    assert s.ok, (s.status, s.event)
+    assert np.degrees(np.arccos(s.info["normal"] @ [0.0, 0.0, 1.0])) < 1.0

@@ -179,3 +179,31 @@ def test_a_face_spanned_by_measured_vertices_helps_pin_a_vertex_on_the_table():
     fewer = frozenset(v) - frozenset(upper[:2])
     cov = Coverage(sides, frozenset(), fewer, f, e, v, pins)
     assert not cov.met("full") and len(cov.unpinned()) == 2
+
+
+def test_a_vertex_on_the_table_that_no_face_in_reach_places_is_placed_by_faces_measured_all_the_same():
+    """HEXPRISM01 lying on a side, with the two sides leaning under taken for out of reach: the vertices on the table
+    between them and the end faces have one face in reach, and nothing predicted places them. The hand tilted away
+    from the object measures those sides all the same; then their planes and the end faces' place those vertices,
+    and only then."""
+    from haptic.matching.acceptance import Coverage
+    from haptic.planning.verify import placed_by_data, reachable_features, table_pins
+
+    poly = LIB["HEXPRISM01"]
+    side = next(i for i, loop in enumerate(poly.faces) if len(loop) == 4)
+    pose, table = _resting_on(poly, side)
+    f, e, v = reachable_features(poly, pose, table)
+    nz = pose.rotate(poly.face_normals)[:, 2]
+    under = frozenset(i for i in f if -0.99 < nz[i] < -0.2)
+    assert len(under) == 2
+    f = frozenset(f) - under
+    e = frozenset(x for x in e if not {int(poly.edge_left_face[x]), int(poly.edge_right_face[x])} & under)
+    pins, unpinnable = table_pins(poly, pose, (f, e, v), table)
+    assert len(unpinnable) == 4
+    hexes = frozenset(i for i, loop in enumerate(poly.faces) if len(loop) == 6)
+    without = Coverage(hexes, frozenset(), frozenset(v), f, e, v, pins)
+    assert placed_by_data(poly, pose, unpinnable, without, table) == []
+    measured = Coverage(hexes | under, frozenset(), frozenset(v), f, e, v, pins)
+    assert placed_by_data(poly, pose, unpinnable, measured, table) == unpinnable
+    one = Coverage(hexes | frozenset(list(under)[:1]), frozenset(), frozenset(v), f, e, v, pins)
+    assert len(placed_by_data(poly, pose, unpinnable, one, table)) == 2
