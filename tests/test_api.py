@@ -9,6 +9,7 @@ from pathlib import Path
 import pytest
 
 import haptic
+from haptic.api import DEFAULT_POLICIES
 from haptic.bench.runner import episode_key, key_id
 from haptic.cli import build_parser, main
 from haptic.episode.spec import EpisodeSpec
@@ -52,7 +53,7 @@ def test_spec_defaults_are_the_command_lines(executor):
         assert getattr(args, name) == getattr(spec, name), name
     assert spec.moves == ("tracing" if executor == "physics" else "all")
     bench = _parsed("bench")
-    assert bench.policy == ",".join(haptic.api.DEFAULT_POLICIES)
+    assert bench.policy == ",".join(DEFAULT_POLICIES)
     assert (bench.seed, bench.verify, bench.max_moves, bench.executor) == (spec.seed, spec.verify, spec.max_moves,
                                                                           "geometric")  # fmt: skip
 
