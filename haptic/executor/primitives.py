@@ -35,6 +35,7 @@ import numpy as np
 from haptic.executor.segment import SegmentBounds
 from haptic.executor.touch_config import TouchConfig
 from haptic.geometry.se3 import angle, perpendicular, unit
+from haptic.matching.batch_poses import exp_so3
 from haptic.matching.trace import PHASES, ContactTrace, empty_trace
 from haptic.sim.robot import RobotInterface
 from haptic.sim.scene import PAD_RADIUS
@@ -241,10 +242,7 @@ class Toucher:
         m = np.asarray(away, dtype=float) - float(np.asarray(away, dtype=float) @ back) * back
         if float(m @ m) < self.config.tilt_min_sin**2:
             return None
-        axis = unit(np.cross(back, m))
-        k = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
-        rot = np.eye(3) + math.sin(angle_) * k + (1.0 - math.cos(angle_)) * (k @ k)
-        return rot @ upright
+        return exp_so3(angle_ * unit(np.cross(back, m))) @ upright
 
     def reaches(self, normal: np.ndarray, rotation: np.ndarray | None = None) -> bool:
         """Whether the pad can touch a face of ``normal`` with the hand at ``rotation`` (default: as held): the
