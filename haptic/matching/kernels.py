@@ -273,4 +273,152 @@ def same_pose_pairs(rot, trans, placed, centroid, s_rot, s_trans, angle, distanc
 same_pose_pairs = _compile(same_pose_pairs)
 
 
-__all__ = ["COMPILED", "closed_form_rotations", "closed_form_translations", "refine_poses", "same_pose_pairs"]
+# ------------------------------------------------------------------------------------------- edge pairs
+
+
+def _position_ok(s_d, l_d, s_m, l_m, eps, at_start, at_end):
+    """:func:`~haptic.matching.constraints.edge_position_test` of one pair."""
+    if np.isnan(s_d) or not np.isfinite(eps):
+        return True
+    lo, hi = s_d - l_d, s_m - l_m
+    ok = (hi - eps < lo) and (s_d < s_m + eps)
+    if at_start:
+        ok = ok and abs(s_d - s_m) < eps
+    if at_end:
+        ok = ok and abs(lo - hi) < eps
+    return ok
+
+
+_position_ok = _compile(_position_ok)
+
+
+def edge_pair_tests(
+    p_d1, b_d1, l_d1, p_d2, b_d2, l_d2, p_m1, b_m1, l_m1, p_m2, b_m2, l_m2,
+    beta_1, beta_2, rho_1, rho_2, lam_1, lam_2, start_1, end_1, start_2, end_2,
+    safety, angle_floor, length_floor, min_sin, cos_parallel,
+):  # fmt: skip
+    """:func:`~haptic.matching.constraints.edge_pair_tests` of one data edge (``p_d1``, ``b_d1`` (3,), ``l_d1``,
+    its bounds and vertex ends scalars) against E earlier ones (``p_d2``, ``b_d2`` (E, 3), the rest (E,)), for C
+    candidate pairings (model edge 1: ``p_m1``, ``b_m1`` (C, 3), ``l_m1`` (C,); model edges 2: (C, E, 3) and (C,
+    E)): the same tests pair by pair, shape (C, E). The constants are those of
+    :mod:`~haptic.matching.constraints`."""
+    n_c, n_e = p_m2.shape[0], p_m2.shape[1]
+    out = np.zeros((n_c, n_e), np.bool_)
+    for e in range(n_e):
+        # the data side of the pair
+        dd0, dd1, dd2 = p_d2[e, 0] - p_d1[0], p_d2[e, 1] - p_d1[1], p_d2[e, 2] - p_d1[2]
+        d_norm = np.sqrt(dd0 * dd0 + dd1 * dd1 + dd2 * dd2)
+        c_d = b_d1[0] * b_d2[e, 0] + b_d1[1] * b_d2[e, 1] + b_d1[2] * b_d2[e, 2]
+        theta_d = np.arccos(min(max(c_d, -1.0), 1.0))
+        eps_angle = beta_1 + beta_2[e] + angle_floor
+        big_beta = max(beta_1, beta_2[e])
+        eps_par = rho_1 + rho_2[e] + safety * d_norm * big_beta + length_floor
+        eps_ord = lam_1 + lam_2[e] + safety * d_norm * big_beta + length_floor
+        th = min(theta_d, np.pi - theta_d) - beta_1 - beta_2[e]
+        sin_min = np.sin(min(max(th, 0.0), np.pi / 2))
+        usable = sin_min >= min_sin
+        den = 1.0 - c_d * c_d
+        den = den if den > 1e-15 else np.nan
+        db1 = dd0 * b_d1[0] + dd1 * b_d1[1] + dd2 * b_d1[2]
+        db2 = dd0 * b_d2[e, 0] + dd1 * b_d2[e, 1] + dd2 * b_d2[e, 2]
+        s_d1 = (db1 - c_d * db2) / den
+        s_d2 = (c_d * db1 - db2) / den
+        cx = b_d1[1] * b_d2[e, 2] - b_d1[2] * b_d2[e, 1]
+        cy = b_d1[2] * b_d2[e, 0] - b_d1[0] * b_d2[e, 2]
+        cz = b_d1[0] * b_d2[e, 1] - b_d1[1] * b_d2[e, 0]
+        cn = np.sqrt(cx * cx + cy * cy + cz * cz)
+        h_d = (cx * dd0 + cy * dd1 + cz * dd2) / cn if cn > 1e-12 else np.nan
+        if usable:
+            b12 = beta_1 + beta_2[e]
+            prop = (rho_1 + rho_2[e] + abs(s_d1) * beta_1 + abs(s_d2) * beta_2[e]) / sin_min
+            prop = prop + abs(h_d) * b12 / (sin_min * sin_min)
+            eps_1 = lam_1 + safety * prop + length_floor
+            b21 = beta_2[e] + beta_1
+            prop = (rho_2[e] + rho_1 + abs(s_d2) * beta_2[e] + abs(s_d1) * beta_1) / sin_min
+            prop = prop + abs(h_d) * b21 / (sin_min * sin_min)
+            eps_2 = lam_2[e] + safety * prop + length_floor
+            eps_skew = rho_1 + rho_2[e] + safety * d_norm * b12 / sin_min + length_floor
+        for c in range(n_c):
+            m1x, m1y, m1z = b_m1[c, 0], b_m1[c, 1], b_m1[c, 2]
+            m2x, m2y, m2z = b_m2[c, e, 0], b_m2[c, e, 1], b_m2[c, e, 2]
+            c_m = m1x * m2x + m1y * m2y + m1z * m2z
+            if not abs(theta_d - np.arccos(min(max(c_m, -1.0), 1.0))) < eps_angle:
+                continue
+            dm0, dm1, dm2 = p_m2[c, e, 0] - p_m1[c, 0], p_m2[c, e, 1] - p_m1[c, 1], p_m2[c, e, 2] - p_m1[c, 2]
+            anti = c_m < -cos_parallel
+            if c_m > cos_parallel or anti:
+                sgn = -1.0 if anti else 1.0
+                ux, uy, uz = b_d1[0] + sgn * b_d2[e, 0], b_d1[1] + sgn * b_d2[e, 1], b_d1[2] + sgn * b_d2[e, 2]
+                un = max(np.sqrt(ux * ux + uy * uy + uz * uz), 1e-12)
+                ux, uy, uz = ux / un, uy / un, uz / un
+                vx, vy, vz = m1x + sgn * m2x, m1y + sgn * m2y, m1z + sgn * m2z
+                vn = max(np.sqrt(vx * vx + vy * vy + vz * vz), 1e-12)
+                vx, vy, vz = vx / vn, vy / vn, vz / vn
+                x_d = dd0 * ux + dd1 * uy + dd2 * uz
+                x_m = dm0 * vx + dm1 * vy + dm2 * vz
+                ex, ey, ez = dd0 - x_d * ux, dd1 - x_d * uy, dd2 - x_d * uz
+                fx, fy, fz = dm0 - x_m * vx, dm1 - x_m * vy, dm2 - x_m * vz
+                sep = np.sqrt(ex * ex + ey * ey + ez * ez) - np.sqrt(fx * fx + fy * fy + fz * fz)
+                if not abs(sep) < eps_par:
+                    continue
+                if anti:
+                    ok = (x_m - (l_m1[c] + l_m2[c, e]) - eps_ord < x_d - (l_d1 + l_d2[e])) and (x_d < x_m + eps_ord)
+                else:
+                    ok = (x_m - (l_m1[c] - l_d1) - eps_ord < x_d) and (x_d < x_m + (l_m2[c, e] - l_d2[e]) + eps_ord)
+                out[c, e] = ok
+                continue
+            if not usable:
+                out[c, e] = True
+                continue
+            # general position: closest approach along each model edge, and the skew distance
+            den_m = 1.0 - c_m * c_m
+            den_m = den_m if den_m > 1e-15 else np.nan
+            mb1 = dm0 * m1x + dm1 * m1y + dm2 * m1z
+            mb2 = dm0 * m2x + dm1 * m2y + dm2 * m2z
+            s_m1 = (mb1 - c_m * mb2) / den_m
+            s_m2 = (c_m * mb1 - mb2) / den_m
+            if not _position_ok(s_d1, l_d1, s_m1, l_m1[c], eps_1, start_1, end_1):
+                continue
+            if not _position_ok(s_d2, l_d2[e], s_m2, l_m2[c, e], eps_2, start_2[e], end_2[e]):
+                continue
+            gx, gy, gz = m1y * m2z - m1z * m2y, m1z * m2x - m1x * m2z, m1x * m2y - m1y * m2x
+            gn = np.sqrt(gx * gx + gy * gy + gz * gz)
+            h_m = (gx * dm0 + gy * dm1 + gz * dm2) / gn if gn > 1e-12 else np.nan
+            out[c, e] = abs(h_d - h_m) < eps_skew or np.isnan(h_d) or np.isnan(h_m) or not np.isfinite(eps_skew)
+    return out
+
+
+edge_pair_tests = _compile(edge_pair_tests)
+
+
+# ------------------------------------------------------------------------------------------- eliminations
+
+
+def distinguishable(outcomes, bounds):
+    """:func:`~haptic.planning.efficiency.distinguishable`: ``D[i, j]`` when some attribute of hypothesis ``j``'s
+    predicted outcome (``outcomes`` (N, A), NaN: none) differs from ``i``'s by more than its bound (``bounds``
+    (A,)), the same comparisons."""
+    n, n_attr = outcomes.shape
+    thr = bounds * (1 + 1e-9) + 1e-12
+    out = np.zeros((n, n), np.bool_)
+    for i in range(n):
+        for j in range(n):
+            for a in range(n_attr):
+                if abs(outcomes[i, a] - outcomes[j, a]) > thr[a]:  # False where either is NaN
+                    out[i, j] = True
+                    break
+    return out
+
+
+distinguishable = _compile(distinguishable)
+
+
+__all__ = [
+    "COMPILED",
+    "closed_form_rotations",
+    "closed_form_translations",
+    "distinguishable",
+    "edge_pair_tests",
+    "refine_poses",
+    "same_pose_pairs",
+]

@@ -38,6 +38,7 @@ from haptic.errors import MatchError
 from haptic.geometry.polyhedron import LearnedBounds, Polyhedron
 from haptic.geometry.se3 import SE3, cross
 from haptic.matching import constraints as C
+from haptic.matching import kernels
 from haptic.matching.batch_poses import StackedPoses
 from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex
 from haptic.matching.library import EDGE, FACE, KIND_INDEX, KINDS, VERTEX, LibraryArrays
@@ -544,12 +545,22 @@ class InterpretationTree:
             sj = sense[:, eids]
             mj = assign[:, eids]
             p_mj, b_mj, _ = self._aligned_edge(mj, sj)
-            res = C.edge_pair_tests(
-                p_d, b_d, l_d, ed["p"][eids], ed["b"][eids], ed["l"][eids],
-                p_m[:, None], b_m[:, None], l_m[:, None], p_mj, b_mj, lib.edge_length[mj],
-                beta, ed["beta"][eids], rho, ed["rho"][eids], lam, ed["lam"][eids],
-                start, end, ed["start"][eids], ed["end"][eids],
-            )  # fmt: skip
+            if kernels.COMPILED:
+                f = np.ascontiguousarray
+                res = kernels.edge_pair_tests(
+                    f(p_d, float), f(b_d, float), float(l_d), f(ed["p"][eids]), f(ed["b"][eids]), f(ed["l"][eids]),
+                    f(p_m, float), f(b_m, float), f(l_m, float), f(p_mj, float), f(b_mj, float),
+                    f(lib.edge_length[mj], float), float(beta), f(ed["beta"][eids]), float(rho), f(ed["rho"][eids]),
+                    float(lam), f(ed["lam"][eids]), start, end, f(ed["start"][eids]), f(ed["end"][eids]),
+                    C.SAFETY, C.ANGLE_FLOOR, C.LENGTH_FLOOR, C.MIN_SIN, float(np.cos(C.PARALLEL_MODEL)),
+                )  # fmt: skip
+            else:
+                res = C.edge_pair_tests(
+                    p_d, b_d, l_d, ed["p"][eids], ed["b"][eids], ed["l"][eids],
+                    p_m[:, None], b_m[:, None], l_m[:, None], p_mj, b_mj, lib.edge_length[mj],
+                    beta, ed["beta"][eids], rho, ed["rho"][eids], lam, ed["lam"][eids],
+                    start, end, ed["start"][eids], ed["end"][eids],
+                )  # fmt: skip
             ok &= (res | ~(known[:, None] & (sj != 0))).all(axis=1)
         fd = data.arrays(FACE)
         fids = self._others(FACE, k, width)

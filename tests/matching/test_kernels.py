@@ -146,3 +146,70 @@ def test_haptic_compiled_0_selects_the_numpy_forms():
     code = "import haptic.matching.kernels as k; print(k.COMPILED)"
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"
+
+
+def test_edge_pair_tests_are_the_numpy_forms():
+    """Random pairs of data and model edges, near and far, some model edges (anti-)parallel, some interval ends at
+    known vertices: the kernel's verdicts are those of :func:`~haptic.matching.constraints.edge_pair_tests`."""
+    from haptic.matching import constraints as C
+
+    rng = np.random.default_rng(4)
+
+    def unit(*shape):
+        v = rng.normal(size=(*shape, 3))
+        return v / np.linalg.norm(v, axis=-1, keepdims=True)
+
+    passed = total = 0
+    for _ in range(200):
+        n_c, n_e = int(rng.integers(1, 30)), int(rng.integers(1, 5))
+        p_d1, b_d1, l_d1 = rng.normal(size=3) * 0.05, unit(), float(rng.uniform(0.001, 0.1))
+        p_d2, b_d2, l_d2 = rng.normal(size=(n_e, 3)) * 0.05, unit(n_e), rng.uniform(0.001, 0.1, n_e)
+        # model edges: the data edges turned a little and moved a little, or at random; some (anti-)parallel
+        turn = 10.0 ** rng.uniform(-4, -1)
+        p_m1 = p_d1 + rng.normal(size=(n_c, 3)) * turn * 0.05
+        b_m1 = b_d1 + rng.normal(size=(n_c, 3)) * turn
+        b_m1 /= np.linalg.norm(b_m1, axis=-1, keepdims=True)
+        p_m2 = p_d2 + rng.normal(size=(n_c, n_e, 3)) * turn * 0.05
+        b_m2 = b_d2 + rng.normal(size=(n_c, n_e, 3)) * turn
+        b_m2 /= np.linalg.norm(b_m2, axis=-1, keepdims=True)
+        wild = rng.random((n_c, n_e)) < 0.2
+        b_m2[wild] = unit(int(wild.sum()))
+        par = rng.random((n_c, n_e)) < 0.2
+        b_m2[par] = (b_m1[:, None] * rng.choice([-1.0, 1.0], size=(n_c, n_e, 1)))[par]
+        if rng.random() < 0.2:  # data edges parallel as well
+            b_d2[:] = b_d1 * rng.choice([-1.0, 1.0])
+        l_m1, l_m2 = l_d1 + rng.uniform(-0.01, 0.05, n_c), l_d2 + rng.uniform(-0.01, 0.05, (n_c, n_e))
+        beta_1, beta_2 = 10.0 ** rng.uniform(-3, -1), 10.0 ** rng.uniform(-3, -1, n_e)
+        rho_1, rho_2 = 10.0 ** rng.uniform(-4, -2), 10.0 ** rng.uniform(-4, -2, n_e)
+        lam_1, lam_2 = 10.0 ** rng.uniform(-4, -2), 10.0 ** rng.uniform(-4, -2, n_e)
+        start_1, end_1 = bool(rng.random() < 0.3), bool(rng.random() < 0.3)
+        start_2, end_2 = rng.random(n_e) < 0.3, rng.random(n_e) < 0.3
+        want = C.edge_pair_tests(
+            p_d1, b_d1, l_d1, p_d2, b_d2, l_d2, p_m1[:, None], b_m1[:, None], l_m1[:, None], p_m2, b_m2, l_m2,
+            beta_1, beta_2, rho_1, rho_2, lam_1, lam_2, start_1, end_1, start_2, end_2,
+        )  # fmt: skip
+        got = kernels.edge_pair_tests(
+            p_d1, b_d1, l_d1, p_d2, b_d2, l_d2, p_m1, b_m1, l_m1, p_m2, b_m2, l_m2,
+            beta_1, beta_2, rho_1, rho_2, lam_1, lam_2, start_1, end_1, start_2, end_2,
+            C.SAFETY, C.ANGLE_FLOOR, C.LENGTH_FLOOR, C.MIN_SIN, float(np.cos(C.PARALLEL_MODEL)),
+        )  # fmt: skip
+        np.testing.assert_array_equal(got, want)
+        passed, total = passed + int(want.sum()), total + want.size
+    assert 0.1 < passed / total < 0.9  # both verdicts common
+
+
+def test_distinguishable_is_the_numpy_form(monkeypatch):
+    from haptic.planning.efficiency import distinguishable
+
+    rng = np.random.default_rng(5)
+    told = 0
+    for _ in range(300):
+        n, a = int(rng.integers(1, 40)), int(rng.integers(1, 4))
+        o = rng.normal(size=(n, a)) * 0.01
+        o[rng.random((n, a)) < 0.2] = np.nan
+        o[rng.random((n, a)) < 0.2] = o[0, 0]  # ties
+        b = rng.uniform(0, 0.01, a)
+        got, want = _both(monkeypatch, distinguishable, o, b)
+        np.testing.assert_array_equal(got, want)
+        told += int(want.sum())
+    assert told > 1000
