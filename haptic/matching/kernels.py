@@ -154,11 +154,65 @@ def refine_poses(dirs_w, dirs_m, dirs_sw, x, c, m, r, t, iterations, tol):
 refine_poses = _compile(refine_poses)
 
 
+def _wahba(h, out):
+    """The proper rotation R maximising ``trace(Rᵀ h)`` into ``out`` (3, 3): with ``h = U Σ Vᵀ`` (singular values
+    descending), ``R = U diag(1, 1, det(U Vᵀ)) Vᵀ``, which is ``u₁v₁ᵀ + u₂v₂ᵀ + det(V) (u₁ × u₂) v₃ᵀ`` and needs
+    neither ``σ₃`` nor ``u₃``. The SVD by one-sided Jacobi rotations (Hestenes): ``h V``'s columns turned in pairs
+    until orthogonal to the last bits, which keeps each singular vector as accurate as LAPACK's however far apart
+    the singular values are. False when ``h`` has rank below 2 (the caller then takes LAPACK's SVD)."""
+    w = h.copy()
+    v = np.eye(3)
+    for _ in range(30):
+        turned = False
+        for p, q in ((0, 1), (0, 2), (1, 2)):
+            alpha = w[0, p] * w[0, p] + w[1, p] * w[1, p] + w[2, p] * w[2, p]
+            beta = w[0, q] * w[0, q] + w[1, q] * w[1, q] + w[2, q] * w[2, q]
+            gamma = w[0, p] * w[0, q] + w[1, p] * w[1, q] + w[2, p] * w[2, q]
+            if abs(gamma) <= 1e-17 * np.sqrt(alpha * beta) or gamma == 0.0:
+                continue
+            turned = True
+            zeta = (beta - alpha) / (2.0 * gamma)
+            t = (1.0 if zeta >= 0.0 else -1.0) / (abs(zeta) + np.sqrt(1.0 + zeta * zeta))
+            c = 1.0 / np.sqrt(1.0 + t * t)
+            s = c * t
+            for k in range(3):
+                wp, wq = w[k, p], w[k, q]
+                w[k, p], w[k, q] = c * wp - s * wq, s * wp + c * wq
+                vp, vq = v[k, p], v[k, q]
+                v[k, p], v[k, q] = c * vp - s * vq, s * vp + c * vq
+        if not turned:
+            break
+    sig = np.empty(3)
+    for i in range(3):
+        sig[i] = np.sqrt(w[0, i] * w[0, i] + w[1, i] * w[1, i] + w[2, i] * w[2, i])
+    order = np.argsort(-sig)
+    i1, i2, i3 = order[0], order[1], order[2]
+    if sig[i1] == 0.0 or sig[i2] <= 1e-12 * sig[i1]:
+        return False
+    u1 = w[:, i1] / sig[i1]
+    u2 = w[:, i2] / sig[i2]
+    v1, v2, v3 = v[:, i1], v[:, i2], v[:, i3]
+    det_v = (v1[1] * v2[2] - v1[2] * v2[1]) * v3[0] + (v1[2] * v2[0] - v1[0] * v2[2]) * v3[1]
+    det_v += (v1[0] * v2[1] - v1[1] * v2[0]) * v3[2]
+    sign = 1.0 if det_v > 0.0 else -1.0
+    u3 = np.empty(3)
+    u3[0] = sign * (u1[1] * u2[2] - u1[2] * u2[1])
+    u3[1] = sign * (u1[2] * u2[0] - u1[0] * u2[2])
+    u3[2] = sign * (u1[0] * u2[1] - u1[1] * u2[0])
+    for i in range(3):
+        for j in range(3):
+            out[i, j] = u1[i] * v1[j] + u2[i] * v2[j] + u3[i] * v3[j]
+    return True
+
+
+_wahba = _compile(_wahba)
+
+
 def closed_form_rotations(dirs_w, dirs_m, dirs_wt, known, min_spread):
     """:meth:`~haptic.matching.batch_poses.StackedPoses.rotations` one problem at a time: whether the known
     directions span at least ``min_spread`` (the largest ``|u_i × u_j|``), and the proper rotation of Wahba's
     problem by the SVD of ``Σ w a uᵀ``, its last singular vector turned where ``det(U Vᵀ) < 0``. Returns ``(R (N,
-    3, 3), ok (N,))``; a problem that is not ok gets its SVD rotation all the same."""
+    3, 3), ok (N,))``; a problem that is not ok has no pose, and the identity in place of its rotation."""
     n_prob, n_dirs = dirs_m.shape[0], dirs_w.shape[0]
     out = np.empty((n_prob, 3, 3))
     ok = np.zeros(n_prob, np.bool_)
@@ -181,6 +235,9 @@ def closed_form_rotations(dirs_w, dirs_m, dirs_wt, known, min_spread):
                 if v > best:
                     best = v
         ok[p] = n_known >= 2 and np.sqrt(best) >= min_spread
+        if not ok[p]:  # no pose: the rotation is not used
+            out[p] = np.eye(3)
+            continue
         h[:] = 0.0
         for d in range(n_dirs):
             w = dirs_wt[p, d]
@@ -188,7 +245,9 @@ def closed_form_rotations(dirs_w, dirs_m, dirs_wt, known, min_spread):
                 wa = dirs_w[d, i] * w
                 for j in range(3):
                     h[i, j] += wa * dirs_m[p, d, j]
-        u, _, vt = np.linalg.svd(h)
+        if _wahba(h, out[p]):
+            continue
+        u, _, vt = np.linalg.svd(h)  # rank below 2: as numpy does it
         rot = u @ vt
         det = (rot[0, 0] * (rot[1, 1] * rot[2, 2] - rot[1, 2] * rot[2, 1])
                - rot[0, 1] * (rot[1, 0] * rot[2, 2] - rot[1, 2] * rot[2, 0])
