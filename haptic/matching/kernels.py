@@ -450,6 +450,77 @@ def edge_pair_tests(
 edge_pair_tests = _compile(edge_pair_tests)
 
 
+# ------------------------------------------------------------------------------------------- distances
+
+
+def _triangle_distance(q0, q1, q2, tri, k):
+    """:func:`~haptic.geometry.distance._distance` of the point ``q`` from triangle ``tri[k]``, the same formulas:
+    the distance from its plane where the projection's barycentric coordinates fall inside, else from the nearest
+    side."""
+    a0, a1, a2 = tri[k, 0, 0], tri[k, 0, 1], tri[k, 0, 2]
+    ab0, ab1, ab2 = tri[k, 1, 0] - a0, tri[k, 1, 1] - a1, tri[k, 1, 2] - a2
+    ac0, ac1, ac2 = tri[k, 2, 0] - a0, tri[k, 2, 1] - a1, tri[k, 2, 2] - a2
+    n0, n1, n2 = ab1 * ac2 - ab2 * ac1, ab2 * ac0 - ab0 * ac2, ab0 * ac1 - ab1 * ac0
+    nn = n0 * n0 + n1 * n1 + n2 * n2 + 1e-30
+    w0, w1, w2 = q0 - a0, q1 - a1, q2 - a2
+    wn = w0 * n0 + w1 * n1 + w2 * n2
+    f = wn / nn
+    v0, v1, v2 = q0 - f * n0 - a0, q1 - f * n1 - a1, q2 - f * n2 - a2
+    d00 = ab0 * ab0 + ab1 * ab1 + ab2 * ab2
+    d01 = ab0 * ac0 + ab1 * ac1 + ab2 * ac2
+    d11 = ac0 * ac0 + ac1 * ac1 + ac2 * ac2
+    d20 = v0 * ab0 + v1 * ab1 + v2 * ab2
+    d21 = v0 * ac0 + v1 * ac1 + v2 * ac2
+    den = d00 * d11 - d01 * d01 + 1e-30
+    s = (d11 * d20 - d01 * d21) / den
+    t = (d00 * d21 - d01 * d20) / den
+    if s >= 0 and t >= 0 and s + t <= 1:
+        return abs(wn / np.sqrt(nn))
+    best = np.inf
+    for i, j in ((0, 1), (1, 2), (2, 0)):
+        x0, x1, x2 = tri[k, i, 0], tri[k, i, 1], tri[k, i, 2]
+        e0, e1, e2 = tri[k, j, 0] - x0, tri[k, j, 1] - x1, tri[k, j, 2] - x2
+        h = ((q0 - x0) * e0 + (q1 - x1) * e1 + (q2 - x2) * e2) / (e0 * e0 + e1 * e1 + e2 * e2 + 1e-30)
+        h = min(max(h, 0.0), 1.0)
+        r0, r1, r2 = q0 - (x0 + h * e0), q1 - (x1 + h * e1), q2 - (x2 + h * e2)
+        d = np.sqrt(r0 * r0 + r1 * r1 + r2 * r2)
+        if d < best:
+            best = d
+    return best
+
+
+_triangle_distance = _compile(_triangle_distance)
+
+
+def paired_point_triangle_distance(points, tri):
+    """:func:`~haptic.geometry.distance.paired_point_triangle_distance`: the distance (M,) of each point (M, 3)
+    from its own triangle (M, 3, 3)."""
+    out = np.empty(points.shape[0])
+    for i in range(points.shape[0]):
+        out[i] = _triangle_distance(points[i, 0], points[i, 1], points[i, 2], tri, i)
+    return out
+
+
+paired_point_triangle_distance = _compile(paired_point_triangle_distance)
+
+
+def surface_distance(points, tri):
+    """:func:`~haptic.geometry.distance.surface_distance`: the distance (P,) of each point (P, 3) from the nearest of
+    the triangles (T, 3, 3)."""
+    out = np.empty(points.shape[0])
+    for i in range(points.shape[0]):
+        best = np.inf
+        for k in range(tri.shape[0]):
+            d = _triangle_distance(points[i, 0], points[i, 1], points[i, 2], tri, k)
+            if d < best:
+                best = d
+        out[i] = best
+    return out
+
+
+surface_distance = _compile(surface_distance)
+
+
 # ------------------------------------------------------------------------------------------- eliminations
 
 
@@ -478,6 +549,8 @@ __all__ = [
     "closed_form_translations",
     "distinguishable",
     "edge_pair_tests",
+    "paired_point_triangle_distance",
     "refine_poses",
     "same_pose_pairs",
+    "surface_distance",
 ]
