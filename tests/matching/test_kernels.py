@@ -213,3 +213,27 @@ def test_distinguishable_is_the_numpy_form(monkeypatch):
         np.testing.assert_array_equal(got, want)
         told += int(want.sum())
     assert told > 1000
+
+
+def test_without_numba_the_numpy_forms_pose_an_interpretation():
+    """With numba not importable, the kernels module says so and the matcher works on the numpy forms alone."""
+    code = (
+        "import sys; sys.modules['numba'] = None\n"
+        "import haptic.matching.kernels as k\n"
+        "from haptic.geometry import load_library\n"
+        "from haptic.matching.pose import estimate_pose\n"
+        "from haptic.matching.components import DataFace\n"
+        "import numpy as np\n"
+        "box = load_library()['BOX01']\n"
+        "pick = []\n"
+        "for f in range(box.n_faces):\n"
+        "    if all(abs(box.face_normals[f] @ box.face_normals[g]) < 0.5 for g in pick):\n"
+        "        pick.append(f)\n"
+        "faces = [DataFace(i, box.face_normals[f], box.vertices[list(box.faces[f])][:3].mean(axis=0)[None], 1e-3, 1e-4,"
+        " ()) for i, f in enumerate(pick[:3])]\n"
+        "pose = estimate_pose(box, faces, dict(enumerate(pick[:3])), {}, {}, {})\n"
+        "print(k.COMPILED, np.allclose(pose.rotation, np.eye(3)), np.allclose(pose.translation, 0, atol=1e-9))\n"
+    )
+    env = {**os.environ, "HAPTIC_COMPILED": "1"}
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
+    assert out.stdout.split() == ["False", "True", "True"]
