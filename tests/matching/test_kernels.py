@@ -237,3 +237,20 @@ def test_without_numba_the_numpy_forms_pose_an_interpretation():
     env = {**os.environ, "HAPTIC_COMPILED": "1"}
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
     assert out.stdout.split() == ["False", "True", "True"]
+
+
+def test_point_triangle_distances_are_the_numpy_forms():
+    """Points near and far from the triangles of a model (inside a triangle's prism, beyond a side, past a corner):
+    the kernels' distances are :mod:`haptic.geometry.distance`'s to the rounding."""
+    from haptic.geometry import load_library
+    from haptic.geometry.distance import paired_point_triangle_distance, surface_distance
+
+    poly = load_library()["LBLOCK01"]
+    tri = np.ascontiguousarray(poly.vertices[poly.triangles])
+    rng = np.random.default_rng(6)
+    scale = rng.choice([1e-4, 1e-2, 0.1], size=(400, 1))
+    pts = poly.vertices[rng.integers(0, len(poly.vertices), 400)] + rng.normal(size=(400, 3)) * scale
+    np.testing.assert_allclose(kernels.surface_distance(pts, tri), surface_distance(poly, pts), rtol=1e-12, atol=1e-15)
+    own = rng.integers(0, len(tri), 400)
+    got = kernels.paired_point_triangle_distance(pts, np.ascontiguousarray(tri[own]))
+    np.testing.assert_allclose(got, paired_point_triangle_distance(pts, tri[own]), rtol=1e-12, atol=1e-15)
