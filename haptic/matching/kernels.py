@@ -1,6 +1,8 @@
 """Compiled forms of the matcher's inner loops: the refinement and the closed-form poses of many interpretations
-(:mod:`haptic.matching.batch_poses`), and the grouping of poses into pose classes
-(:mod:`haptic.matching.recognition`).
+(:mod:`haptic.matching.batch_poses`), the grouping of poses into pose classes (:mod:`haptic.matching.recognition`),
+the edge-pair tests of the interpretation tree (:mod:`haptic.matching.tree`), the distances of the pose check and
+the free-space test (:mod:`haptic.matching.acceptance`, :mod:`haptic.matching.free_space`), and the planner's
+table of which hypotheses a predicted outcome tells apart (:func:`~haptic.planning.efficiency.distinguishable`).
 
 Each kernel is a plain loop over small arrays, compiled by numba (``@njit(cache=True)``: compiled on the first
 call of a checkout and kept in ``__pycache__``) and called in place of the numpy form of the same arithmetic,
@@ -9,28 +11,19 @@ of a few elements. The results agree with the numpy forms' to the rounding of su
 1e-15 relative); ``tests/matching/test_kernels.py`` checks that, and that episodes decide the same either way.
 
 :data:`COMPILED` is False, and the callers take the numpy forms, when numba is not installed or the environment
-variable ``HAPTIC_COMPILED`` is ``0``.
+variable ``HAPTIC_COMPILED`` is ``0`` (:mod:`haptic.geometry.kernels`, which holds the geometric kernels).
 """
 
 from __future__ import annotations
 
-import os
-
 import numpy as np
 
-try:
-    if os.environ.get("HAPTIC_COMPILED", "1") == "0":
-        raise ImportError("compiled kernels disabled by HAPTIC_COMPILED=0")
-    from numba import njit
-except ImportError:  # the numpy forms alone
-    njit = None
+from haptic.geometry import kernels as _geometry
 
-COMPILED = njit is not None
-"""Whether the callers use the compiled kernels (numba installed and ``HAPTIC_COMPILED`` not ``0``)."""
-
-
-def _compile(fn):
-    return njit(cache=True, nogil=True)(fn) if njit is not None else fn
+COMPILED = _geometry.COMPILED
+"""Whether the callers use the compiled kernels (numba installed and ``HAPTIC_COMPILED`` not ``0``: the switch of
+:mod:`haptic.geometry.kernels`)."""
+_compile = _geometry.compile_kernel
 
 
 # ------------------------------------------------------------------------------------------- small algebra

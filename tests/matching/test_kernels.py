@@ -1,6 +1,6 @@
-"""The compiled kernels of the matcher (:mod:`haptic.matching.kernels`) give the numpy forms' results: the same poses
-to the rounding, the same pose classes, and episodes that decide the same; ``HAPTIC_COMPILED=0`` selects the numpy
-forms."""
+"""The compiled kernels of the matcher and the tracer (:mod:`haptic.matching.kernels`, :mod:`haptic.geometry.kernels`)
+give the numpy forms' results: the same poses to the rounding, the same pose classes, the same face crossings, and
+episodes that decide the same; ``HAPTIC_COMPILED=0`` selects the numpy forms."""
 
 from __future__ import annotations
 
@@ -11,6 +11,7 @@ import sys
 import numpy as np
 import pytest
 
+import haptic.geometry.kernels as geometry_kernels
 import haptic.matching.kernels as kernels
 from haptic.env import ExploreEnv, PolicyAgent
 from haptic.matching.recognition import PoseTolerance, _same_pose_pairs, model_symmetries, recognize
@@ -38,11 +39,13 @@ def _trees(library: str, seeds=range(1, 40)):
 def _both(monkeypatch, fn, *args):
     """``fn(*args)`` with the kernels, then with the numpy forms."""
     compiled = fn(*args)
-    monkeypatch.setattr(kernels, "COMPILED", False)
+    for module in (kernels, geometry_kernels):
+        monkeypatch.setattr(module, "COMPILED", False)
     try:
         return compiled, fn(*args)
     finally:
-        monkeypatch.setattr(kernels, "COMPILED", True)
+        for module in (kernels, geometry_kernels):
+            monkeypatch.setattr(module, "COMPILED", True)
 
 
 def test_closed_form_and_refined_poses_are_the_numpy_forms(small_library, monkeypatch):
@@ -143,9 +146,9 @@ def test_episodes_decide_the_same_with_the_kernels_or_without(small_library, mon
 
 def test_haptic_compiled_0_selects_the_numpy_forms():
     env = {**os.environ, "HAPTIC_COMPILED": "0"}
-    code = "import haptic.matching.kernels as k; print(k.COMPILED)"
+    code = "import haptic.matching.kernels as k, haptic.geometry.kernels as g; print(k.COMPILED, g.COMPILED)"
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
-    assert out.stdout.strip() == "False"
+    assert out.stdout.split() == ["False", "False"]
 
 
 def test_edge_pair_tests_are_the_numpy_forms():
@@ -254,3 +257,35 @@ def test_point_triangle_distances_are_the_numpy_forms():
     own = rng.integers(0, len(tri), 400)
     got = kernels.paired_point_triangle_distance(pts, np.ascontiguousarray(tri[own]))
     np.testing.assert_allclose(got, paired_point_triangle_distance(pts, tri[own]), rtol=1e-12, atol=1e-15)
+
+
+def test_face_crossings_are_the_python_loops(monkeypatch):
+    """Traces across every face of some models, from points inside and on the boundary, in every direction (some
+    along a side, some at a corner): the compiled crossing gives the Python loop's hit, the same bits."""
+    from haptic.geometry import load_library
+    from haptic.geometry.tracing import trace_face
+
+    lib = load_library()
+    rng = np.random.default_rng(7)
+    hits = misses = 0
+    for name in ("BOX01", "LBLOCK01", "TETRA01L", "WEDGE01"):
+        poly = lib[name]
+        for f in range(poly.n_faces):
+            loop = poly.vertices[list(poly.faces[f])]
+            for _ in range(40):
+                w = rng.dirichlet(np.ones(len(loop)) * rng.choice([0.2, 1.0]))
+                start = w @ loop
+                if rng.random() < 0.3:  # along a side, or towards a corner
+                    k = int(rng.integers(len(loop)))
+                    direction = loop[(k + 1) % len(loop)] - loop[k] if rng.random() < 0.5 else loop[k] - start
+                else:
+                    direction = rng.normal(size=3)
+                a, b = _both(monkeypatch, trace_face, poly, f, start, direction)
+                assert (a is None) == (b is None)
+                if a is None:
+                    misses += 1
+                    continue
+                hits += 1
+                assert (a.edge, a.next_face, a.distance) == (b.edge, b.next_face, b.distance)
+                np.testing.assert_array_equal(a.point, b.point)
+    assert hits > 500 and misses > 10
