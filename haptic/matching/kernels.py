@@ -147,21 +147,23 @@ def refine_poses(dirs_w, dirs_m, dirs_sw, x, c, m, r, t, iterations, tol):
 refine_poses = _compile(refine_poses)
 
 
-def _wahba(h, out):
+def _wahba(h, out, w, v):
     """The proper rotation R maximising ``trace(Rᵀ h)`` into ``out`` (3, 3): with ``h = U Σ Vᵀ`` (singular values
     descending), ``R = U diag(1, 1, det(U Vᵀ)) Vᵀ``, which is ``u₁v₁ᵀ + u₂v₂ᵀ + det(V) (u₁ × u₂) v₃ᵀ`` and needs
     neither ``σ₃`` nor ``u₃``. The SVD by one-sided Jacobi rotations (Hestenes): ``h V``'s columns turned in pairs
     until orthogonal to the last bits, which keeps each singular vector as accurate as LAPACK's however far apart
-    the singular values are. False when ``h`` has rank below 2 (the caller then takes LAPACK's SVD)."""
-    w = h.copy()
-    v = np.eye(3)
+    the singular values are. ``w``, ``v``: (3, 3) scratch. False when ``h`` has rank below 2 (the caller then takes
+    LAPACK's SVD)."""
+    w[:] = h
+    v[:] = 0.0
+    v[0, 0] = v[1, 1] = v[2, 2] = 1.0
     for _ in range(30):
         turned = False
         for p, q in ((0, 1), (0, 2), (1, 2)):
             alpha = w[0, p] * w[0, p] + w[1, p] * w[1, p] + w[2, p] * w[2, p]
             beta = w[0, q] * w[0, q] + w[1, q] * w[1, q] + w[2, q] * w[2, q]
             gamma = w[0, p] * w[0, q] + w[1, p] * w[1, q] + w[2, p] * w[2, q]
-            if abs(gamma) <= 1e-17 * np.sqrt(alpha * beta) or gamma == 0.0:
+            if abs(gamma) <= 1e-15 * np.sqrt(alpha * beta):
                 continue
             turned = True
             zeta = (beta - alpha) / (2.0 * gamma)
@@ -175,26 +177,33 @@ def _wahba(h, out):
                 v[k, p], v[k, q] = c * vp - s * vq, s * vp + c * vq
         if not turned:
             break
-    sig = np.empty(3)
-    for i in range(3):
-        sig[i] = np.sqrt(w[0, i] * w[0, i] + w[1, i] * w[1, i] + w[2, i] * w[2, i])
-    order = np.argsort(-sig)
-    i1, i2, i3 = order[0], order[1], order[2]
-    if sig[i1] == 0.0 or sig[i2] <= 1e-12 * sig[i1]:
+    s0 = np.sqrt(w[0, 0] * w[0, 0] + w[1, 0] * w[1, 0] + w[2, 0] * w[2, 0])
+    s1 = np.sqrt(w[0, 1] * w[0, 1] + w[1, 1] * w[1, 1] + w[2, 1] * w[2, 1])
+    s2 = np.sqrt(w[0, 2] * w[0, 2] + w[1, 2] * w[1, 2] + w[2, 2] * w[2, 2])
+    # the columns by singular value, descending
+    i1, i2, i3 = 0, 1, 2
+    if s1 > s0:
+        i1, i2 = 1, 0
+    big, mid = (s1, s0) if s1 > s0 else (s0, s1)
+    if s2 > big:
+        i1, i2, i3 = 2, i1, i2
+        big, mid = s2, big
+    elif s2 > mid:
+        i2, i3 = 2, i2
+        mid = s2
+    if big == 0.0 or mid <= 1e-12 * big:
         return False
-    u1 = w[:, i1] / sig[i1]
-    u2 = w[:, i2] / sig[i2]
-    v1, v2, v3 = v[:, i1], v[:, i2], v[:, i3]
-    det_v = (v1[1] * v2[2] - v1[2] * v2[1]) * v3[0] + (v1[2] * v2[0] - v1[0] * v2[2]) * v3[1]
-    det_v += (v1[0] * v2[1] - v1[1] * v2[0]) * v3[2]
+    a0, a1, a2 = w[0, i1] / big, w[1, i1] / big, w[2, i1] / big
+    b0, b1, b2 = w[0, i2] / mid, w[1, i2] / mid, w[2, i2] / mid
+    det_v = (v[1, i1] * v[2, i2] - v[2, i1] * v[1, i2]) * v[0, i3]
+    det_v += (v[2, i1] * v[0, i2] - v[0, i1] * v[2, i2]) * v[1, i3]
+    det_v += (v[0, i1] * v[1, i2] - v[1, i1] * v[0, i2]) * v[2, i3]
     sign = 1.0 if det_v > 0.0 else -1.0
-    u3 = np.empty(3)
-    u3[0] = sign * (u1[1] * u2[2] - u1[2] * u2[1])
-    u3[1] = sign * (u1[2] * u2[0] - u1[0] * u2[2])
-    u3[2] = sign * (u1[0] * u2[1] - u1[1] * u2[0])
-    for i in range(3):
-        for j in range(3):
-            out[i, j] = u1[i] * v1[j] + u2[i] * v2[j] + u3[i] * v3[j]
+    c0, c1, c2 = sign * (a1 * b2 - a2 * b1), sign * (a2 * b0 - a0 * b2), sign * (a0 * b1 - a1 * b0)
+    for j in range(3):
+        out[0, j] = a0 * v[j, i1] + b0 * v[j, i2] + c0 * v[j, i3]
+        out[1, j] = a1 * v[j, i1] + b1 * v[j, i2] + c1 * v[j, i3]
+        out[2, j] = a2 * v[j, i1] + b2 * v[j, i2] + c2 * v[j, i3]
     return True
 
 
@@ -210,6 +219,8 @@ def closed_form_rotations(dirs_w, dirs_m, dirs_wt, known, min_spread):
     out = np.empty((n_prob, 3, 3))
     ok = np.zeros(n_prob, np.bool_)
     h = np.empty((3, 3))
+    w_buf = np.empty((3, 3))
+    v_buf = np.empty((3, 3))
     for p in range(n_prob):
         n_known = 0
         best = 0.0
@@ -229,7 +240,8 @@ def closed_form_rotations(dirs_w, dirs_m, dirs_wt, known, min_spread):
                     best = v
         ok[p] = n_known >= 2 and np.sqrt(best) >= min_spread
         if not ok[p]:  # no pose: the rotation is not used
-            out[p] = np.eye(3)
+            out[p] = 0.0
+            out[p, 0, 0] = out[p, 1, 1] = out[p, 2, 2] = 1.0
             continue
         h[:] = 0.0
         for d in range(n_dirs):
@@ -238,7 +250,7 @@ def closed_form_rotations(dirs_w, dirs_m, dirs_wt, known, min_spread):
                 wa = dirs_w[d, i] * w
                 for j in range(3):
                     h[i, j] += wa * dirs_m[p, d, j]
-        if _wahba(h, out[p]):
+        if _wahba(h, out[p], w_buf, v_buf):
             continue
         u, _, vt = np.linalg.svd(h)  # rank below 2: as numpy does it
         rot = u @ vt
