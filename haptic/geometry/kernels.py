@@ -71,4 +71,59 @@ def face_crossing(corners, sides, n, start, d, steady, margin):
 face_crossing = compile_kernel(face_crossing)
 
 
-__all__ = ["COMPILED", "compile_kernel", "face_crossing"]
+def line_params(starts, directions, tri, slack):
+    """The ``params`` of :func:`~haptic.geometry.raycast.line_hits`, the same Möller–Trumbore formulas: the
+    parameter ``t`` where each line ``start + t u`` (R of them) crosses each triangle (T, 3, 3), NaN where it
+    misses it (barycentric coordinates beyond ``-slack`` or ``1 + slack``, or the line parallel to it), (R, T)."""
+    n_r, n_t = starts.shape[0], tri.shape[0]
+    out = np.full((n_r, n_t), np.nan)
+    for r in range(n_r):
+        o0, o1, o2 = starts[r, 0], starts[r, 1], starts[r, 2]
+        u0, u1, u2 = directions[r, 0], directions[r, 1], directions[r, 2]
+        for k in range(n_t):
+            a0, a1, a2 = tri[k, 0, 0], tri[k, 0, 1], tri[k, 0, 2]
+            e10, e11, e12 = tri[k, 1, 0] - a0, tri[k, 1, 1] - a1, tri[k, 1, 2] - a2
+            e20, e21, e22 = tri[k, 2, 0] - a0, tri[k, 2, 1] - a1, tri[k, 2, 2] - a2
+            p0, p1, p2 = u1 * e22 - u2 * e21, u2 * e20 - u0 * e22, u0 * e21 - u1 * e20
+            det = e10 * p0 + e11 * p1 + e12 * p2
+            if not abs(det) > 1e-18:
+                continue
+            inv = 1.0 / det
+            s0, s1, s2 = o0 - a0, o1 - a1, o2 - a2
+            bu = (s0 * p0 + s1 * p1 + s2 * p2) * inv
+            q0, q1, q2 = s1 * e12 - s2 * e11, s2 * e10 - s0 * e12, s0 * e11 - s1 * e10
+            bv = (u0 * q0 + u1 * q1 + u2 * q2) * inv
+            if bu >= -slack and bv >= -slack and bu + bv <= 1.0 + slack:
+                out[r, k] = (e20 * q0 + e21 * q1 + e22 * q2) * inv
+    return out
+
+
+line_params = compile_kernel(line_params)
+
+
+def contains(points, tri):
+    """:meth:`~haptic.geometry.polyhedron.Polyhedron.contains`, the same generalised winding number: whether each
+    point (P, 3) is inside the closed surface of the triangles (T, 3, 3), (P,) bool."""
+    n_p, n_t = points.shape[0], tri.shape[0]
+    out = np.zeros(n_p, np.bool_)
+    for i in range(n_p):
+        total = 0.0
+        for k in range(n_t):
+            a0, a1, a2 = tri[k, 0, 0] - points[i, 0], tri[k, 0, 1] - points[i, 1], tri[k, 0, 2] - points[i, 2]
+            b0, b1, b2 = tri[k, 1, 0] - points[i, 0], tri[k, 1, 1] - points[i, 1], tri[k, 1, 2] - points[i, 2]
+            c0, c1, c2 = tri[k, 2, 0] - points[i, 0], tri[k, 2, 1] - points[i, 1], tri[k, 2, 2] - points[i, 2]
+            la = np.sqrt(a0 * a0 + a1 * a1 + a2 * a2)
+            lb = np.sqrt(b0 * b0 + b1 * b1 + b2 * b2)
+            lc = np.sqrt(c0 * c0 + c1 * c1 + c2 * c2)
+            num = a0 * (b1 * c2 - b2 * c1) + a1 * (b2 * c0 - b0 * c2) + a2 * (b0 * c1 - b1 * c0)
+            den = la * lb * lc + (a0 * b0 + a1 * b1 + a2 * b2) * lc
+            den = den + (b0 * c0 + b1 * c1 + b2 * c2) * la + (c0 * a0 + c1 * a1 + c2 * a2) * lb
+            total += np.arctan2(num, den)
+        out[i] = 2.0 * total / (4.0 * np.pi) > 0.5
+    return out
+
+
+contains = compile_kernel(contains)
+
+
+__all__ = ["COMPILED", "compile_kernel", "contains", "face_crossing", "line_params"]

@@ -289,3 +289,29 @@ def test_face_crossings_are_the_python_loops(monkeypatch):
                 assert (a.edge, a.next_face, a.distance) == (b.edge, b.next_face, b.distance)
                 np.testing.assert_array_equal(a.point, b.point)
     assert hits > 500 and misses > 10
+
+
+def test_line_crossings_and_inside_tests_are_the_numpy_forms():
+    """Lines through a non-convex model (some through its vertices and along its faces) and points inside, outside
+    and near its surface: the compiled crossings and inside tests of the free-space test are
+    :func:`~haptic.geometry.raycast.line_hits`'s and :meth:`~haptic.geometry.polyhedron.Polyhedron.contains`'s."""
+    from haptic.geometry import load_library
+    from haptic.geometry.raycast import BARYCENTRIC_SLACK, line_hits
+
+    poly = load_library()["LBLOCK01"]
+    tri = np.ascontiguousarray(poly.vertices[poly.triangles])
+    rng = np.random.default_rng(8)
+    centre, size = poly.vertices.mean(axis=0), float(np.ptp(poly.vertices, axis=0).max())
+    starts = centre + rng.normal(size=(300, 3)) * size
+    aims = poly.vertices[rng.integers(0, len(poly.vertices), 300)]
+    aims[::2] += rng.normal(size=(150, 3)) * size * 0.2
+    dirs = aims - starts
+    dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
+    got, want = geometry_kernels.line_params(starts, dirs, tri, BARYCENTRIC_SLACK), line_hits(poly, starts, dirs).params
+    np.testing.assert_array_equal(np.isnan(got), np.isnan(want))
+    np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-15)
+    assert np.isfinite(want).sum() > 300
+    pts = centre + rng.normal(size=(500, 3)) * size * 0.5
+    inside = poly.contains(pts)
+    np.testing.assert_array_equal(geometry_kernels.contains(pts, tri), inside)
+    assert 20 < inside.sum() < 480  # both verdicts
