@@ -349,3 +349,26 @@ def test_face_move_predictions_are_the_numpy_forms(small_library, monkeypatch):
             if terminated or truncated:
                 break
     assert said > 500 and unsaid > 10
+
+
+def test_small_solves_are_numpys_and_a_singular_system_hands_back_to_numpy():
+    """The kernels' Gaussian elimination solves what ``np.linalg.solve`` solves, and says so where a pivot is exactly
+    zero (numpy raises there); the refinement then returns False, and ``StackedPoses.refine`` takes the numpy form."""
+    rng = np.random.default_rng(9)
+    for n in (3, 6):
+        for _ in range(200):
+            a = rng.normal(size=(n, n)) * 10.0 ** rng.uniform(-3, 3, size=n)
+            b = rng.normal(size=n)
+            x = b.copy()
+            assert kernels._solve_in_place(a.copy(), x, n)
+            np.testing.assert_allclose(a @ x, b, rtol=1e-9, atol=1e-9 * np.abs(a).max())
+        a = rng.normal(size=(n, n))
+        a[:, 1] = 0.0  # singular: a zero column
+        assert not kernels._solve_in_place(a, rng.normal(size=n), n)
+    # no row constrains anything: the normal equations are zero
+    r, t = np.eye(3)[None].copy(), np.zeros((1, 3))
+    none = np.zeros((0, 3))
+    assert not kernels.refine_poses(
+        np.ones((1, 3)), np.ones((1, 1, 3)), np.zeros((1, 1)), none, np.zeros((1, 0, 3)), np.zeros((1, 0, 3, 3)),
+        r, t, 6, 1e-9,
+    )  # fmt: skip
