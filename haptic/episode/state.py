@@ -152,10 +152,11 @@ class EpisodeState:
         self.failed_here.clear()
         for c in result.components:
             self.components[c.id] = c
-            self.tree.add(c)
+        self.tree.add_move(result.components)
         self.free.extend(result.free_space)
-        if result.move is not None and result.move.kind == "probe":
+        if result.move is not None and result.move.kind in ("probe", "placement"):  # faces hit along lines
             self.probe_faces.extend(c.id for c in result.components)
+        if result.move is not None and result.move.kind == "probe":
             self.probed.append(result.move)
         if self.free:  # after every add: poses tighten, and leaves unposed or too many before become testable
             apply_probes(self.tree, self.free, self.probe_faces)
