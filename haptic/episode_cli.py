@@ -27,7 +27,7 @@ def add_parser(sub: Subcommands) -> None:
         EXECUTORS,
     )
     from haptic.matching.acceptance import DEFAULT_VERIFY, VERIFY_MODES
-    from haptic.options import add_units_option, noise_level, positive_int, seed_int
+    from haptic.options import add_fingers_option, add_units_option, noise_level, positive_int, seed_int
     from haptic.planning.moves import DEFAULT_MOVES, HAND_DEFAULT_MOVES, MOVE_SETS
     from haptic.planning.registry import POLICY_NAMES
 
@@ -65,6 +65,7 @@ def add_parser(sub: Subcommands) -> None:
         "(free-space probes alone, geometric executor; a verification traces too) or all (both, one "
         "planner ranking them)",
     )  # fmt: skip
+    add_fingers_option(p)
     p.add_argument("--learn", metavar="DIR",
                    help="after no-match, explore on until the object's surface is closed and write its model "
                    "into the library directory DIR (its own budget, reported)")
@@ -256,6 +257,7 @@ def run(args: argparse.Namespace) -> int:
         model=args.object, seed=args.seed, policy=args.policy, executor=args.executor, noise=args.noise,
         models=args.models, max_moves=args.max_moves, record=args.record, skip_invalid=args.skip_invalid,
         verify=args.verify, moves=args.moves, units=args.units, learn=args.learn, learn_name=args.learn_name,
+        fingers=args.fingers,
     )  # fmt: skip
     check_settings(settings, cli_option)
     spec = EpisodeSpec(**settings)

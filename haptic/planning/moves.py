@@ -28,6 +28,19 @@ HAND_DEFAULT_MOVES = "tracing"
 from the face a probe left the pad on, confirm fewer recognitions than after the seed's tracing (README)."""
 
 
+DEFAULT_FINGERS = 1
+"""Fingers at once unless asked for (``--fingers``), on the geometric executor (README, "Several fingers at
+once")."""
+HAND_DEFAULT_FINGERS = 1
+"""The same on the simulated hand: the index finger alone, its placements of several fingertips not yet carried
+out by the physics executor."""
+
+
+def default_fingers(executor: str) -> int:
+    """The command line's fingers at once for ``executor`` when ``--fingers`` is not given."""
+    return HAND_DEFAULT_FINGERS if executor == "physics" else DEFAULT_FINGERS
+
+
 def default_moves(executor: str) -> str:
     """The command line's move set for ``executor`` when ``--moves`` is not given."""
     return HAND_DEFAULT_MOVES if executor == "physics" else DEFAULT_MOVES
