@@ -132,6 +132,14 @@ class MovePrinter:
                               self.cost))  # fmt: skip
 
 
+def placements_line(placements: list[dict]) -> str:
+    """The placements of an episode: how many, how many failed, and their fingers' outcomes."""
+    failed = sum(p["status"] != "ok" for p in placements)
+    fingers = [f["status"] for p in placements for f in p["fingers"]]
+    told = ", ".join(f"{fingers.count(k)} {k}" for k in dict.fromkeys(fingers))
+    return f"{len(placements)}" + (f" ({failed} failed)" if failed else "") + f"; fingers: {told}"
+
+
 def budget_text(rec: dict, budget: float, max_moves: int) -> str:
     """Which budget a "budget" episode ran out of, and its value."""
     if rec["path_cost"] > budget:
@@ -195,6 +203,8 @@ def summary_lines(rec: dict, budget: float | None = None, max_moves: int | None 
     if rec.get("classes") and rec["classes"] != counts:
         lines.append("pose cl.    " + " -> ".join(str(c) for c in rec["classes"])
                      + "  (pose classes; the interpretation count where no pose is fixed yet)")  # fmt: skip
+    if rec.get("placements"):
+        lines.append("placements  " + placements_line(rec["placements"]))
     lines.append("verdict     " + verdict_line(rec))
     if rec.get("verified"):
         lines.append("verified    " + verified_line(rec))

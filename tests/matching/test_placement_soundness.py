@@ -42,10 +42,10 @@ def aimed_placement(ex: GeometricExecutor, faces, rng: np.random.Generator) -> P
 
 
 def placed(ex: GeometricExecutor, move: PlacementMove):
-    """The placement's faces and free space, each finger closing along its line as a probe does."""
-    results = [ex.execute(f.line) for f in move.fingers]
-    assert all(r.ok and r.components for r in results), [r.reason for r in results]
-    return [c for r in results for c in r.components], [s for r in results for s in r.free_space]
+    """The placement's faces and free space, carried out by the executor."""
+    result = ex.execute(move)
+    assert result.ok and all(f["status"] == "touched" for f in result.info["fingers"]), result.info
+    return list(result.components), list(result.free_space)
 
 
 def _check(name: str, seed: int, n_moves: int, fingers: int, at_bounds: bool) -> None:
