@@ -224,7 +224,9 @@ def _write_summary(out: Path, no_plot: bool, quiet: bool = False) -> None:
 
     records = read_results(out) if out.exists() else []
     probing = any(r.get("move_set", "tracing") != "tracing" for r in records)  # a column only where it tells
-    keys = ("library", "executor", "noise", "verify", *(("move_set",) if probing else ()), "policy")
+    placing = any(r.get("fingers", 1) != 1 for r in records)
+    keys = ("library", "executor", "noise", "verify", *(("move_set",) if probing else ()),
+            *(("fingers",) if placing else ()), "policy")  # fmt: skip
     rows = summary_rows(records, keys)
     atomic_write(out.with_suffix(".md"), markdown_table(rows))
     if not quiet:

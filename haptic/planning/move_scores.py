@@ -117,18 +117,21 @@ def _score_all(ctx: Context) -> list[tuple[Prediction | ProbePrediction | Placem
         refused = [(p, refusal(p, ctx.config)) for p in preds]
         refused = [(p, r) for p, r in refused if r < ctx.config.table_risk] or refused
         out = [(pred, *score_prediction(pred, weights, r, ctx.config)) for pred, r in refused]
-    probes = [s for s in (score_probe(pred, weights) for pred in predict_probe_moves(ctx)) if s is not None]
-    return out + probes + score_placements(ctx, weights)
+    lines = predict_probe_moves(ctx)
+    probes = [s for s in (score_probe(pred, weights) for pred in lines) if s is not None]
+    return out + probes + score_placements(ctx, weights, lines if ctx.config.moves != "tracing" else None)
 
 
-def score_placements(ctx: Context, weights: np.ndarray) -> list[tuple]:
+def score_placements(ctx: Context, weights: np.ndarray, lines: Sequence[ProbePrediction] | None = None) -> list[tuple]:
     """Placements of several fingertips (``config.fingers`` > 1, every hypothesis posed), scored as
     :func:`score_all` scores moves, ``(pred, efficiency, eliminations, cost, risk)``: their fingers' lines are
-    the candidate probe lines (whatever ``config.moves``; :func:`placement_lines`) and a finger predicted to fail
-    tells nothing (:class:`~haptic.planning.placements.PlacementPrediction`)."""
+    the candidate probe lines (``lines``, the probes' predictions when the move set has them, else
+    :func:`placement_lines`) and a finger predicted to fail tells nothing
+    (:class:`~haptic.planning.placements.PlacementPrediction`)."""
     if ctx.config.fingers < 2 or not ctx.hypotheses or any(h.world_from_model is None for h in ctx.hypotheses):
         return []
-    lines = [p for p in placement_lines(ctx) if p.risk(weights) < PROBE_RISK]
+    lines = placement_lines(ctx) if lines is None else lines
+    lines = [p for p in lines if p.risk(weights) < PROBE_RISK]
     avoid = [m for m in ctx.avoid if isinstance(m, PlacementMove)]
     preds = candidate_placements(lines, weights, ctx.config.fingers, ctx.state.position, ctx.config.costs,
                                  hand_start(ctx), avoid=avoid)  # fmt: skip

@@ -116,34 +116,43 @@ def placement_costs(
     closing = np.where(hit, np.nan_to_num(np.array([p.distance for p in lines])), lengths[:, None])
     s = float(np.max(transfer)) + closing.max(axis=0) + np.where(hit.any(axis=0), 0.0, float(np.min(back)))
     contacts = hit.sum(axis=0)
-    return np.array([costs.placement_move(float(x), len(lines), int(c)) for x, c in zip(s, contacts, strict=True)])
+    return np.asarray(costs.placement_move(s, len(lines), contacts), dtype=float)  # (the formula, elementwise)
 
 
-def _contact_points(p: ProbePrediction, weights: np.ndarray) -> np.ndarray | None:
-    """The weighted mean predicted contact of a line over the hypotheses predicting one (None: none do)."""
-    if not p.hit.any():
-        return None
-    w = weights[p.hit] / weights[p.hit].sum()
-    t = float(np.nan_to_num(p.distance[p.hit]) @ w)
-    return np.asarray(p.move.start) + t * np.asarray(p.move.direction)
+def _contact_points(lines: Sequence[ProbePrediction], weights: np.ndarray) -> np.ndarray:
+    """Each line's weighted mean predicted contact over the hypotheses predicting one, (L, 3) (NaN: none do)."""
+    out = np.full((len(lines), 3), np.nan)
+    for k, p in enumerate(lines):
+        if p.hit.any():
+            w = weights[p.hit] / weights[p.hit].sum()
+            t = float(np.nan_to_num(p.distance[p.hit]) @ w)
+            out[k] = np.asarray(p.move.start) + t * np.asarray(p.move.direction)
+    return out
+
+
+def compatibility(lines: Sequence[ProbePrediction], weights: np.ndarray, config: PlacementConfig) -> np.ndarray:
+    """``ok[a, b]``: whether one hand can close two fingers along lines ``a`` and ``b`` together (module
+    docstring), shape (L, L) bool, False on the diagonal."""
+    u = np.array([p.move.direction for p in lines], dtype=float)
+    spread = u @ u.T >= np.cos(config.max_spread)
+    c = _contact_points(lines, weights)
+    gap = np.linalg.norm(c[:, None] - c[None], axis=2)
+    with np.errstate(invalid="ignore"):
+        apart = (gap >= config.finger_spacing) & (gap <= config.max_span)
+    hit = np.array([p.hit for p in lines], dtype=float)  # (L, N)
+    face = np.array([p.face for p in lines])
+    both = hit * weights[None] @ hit.T  # weight predicting both to touch
+    same = np.einsum("an,bn,abn,n->ab", hit, hit, face[:, None] == face[None], weights)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        other = (both - same) / both
+    ok = spread & apart & (both > 0) & (np.nan_to_num(other) >= config.min_other_face)
+    np.fill_diagonal(ok, False)
+    return ok
 
 
 def compatible(a: ProbePrediction, b: ProbePrediction, weights: np.ndarray, config: PlacementConfig) -> bool:
-    """Whether one hand can close two fingers along ``a``'s and ``b``'s lines together (module docstring)."""
-    ua, ub = np.asarray(a.move.direction), np.asarray(b.move.direction)
-    if float(ua @ ub) < np.cos(config.max_spread):
-        return False
-    pa, pb = _contact_points(a, weights), _contact_points(b, weights)
-    if pa is None or pb is None:
-        return False
-    gap = float(np.linalg.norm(pa - pb))
-    if not config.finger_spacing <= gap <= config.max_span:
-        return False
-    both = a.hit & b.hit
-    if not both.any():
-        return False
-    other = float(weights[both & (a.face != b.face)].sum()) / float(weights[both].sum())
-    return other >= config.min_other_face
+    """Whether one hand can close two fingers along ``a``'s and ``b``'s lines together (:func:`compatibility`)."""
+    return bool(compatibility([a, b], np.asarray(weights, dtype=float) / np.sum(weights), config)[0, 1])
 
 
 def candidate_placements(
@@ -168,7 +177,7 @@ def candidate_placements(
     elim = np.array([expected_eliminated(p.eliminates(), w) for p in useful])
     order = np.argsort(-elim, kind="stable")
     pool = [useful[i] for i in order[: config.pool]]
-    ok = np.array([[i != j and compatible(a, b, w, config) for j, b in enumerate(pool)] for i, a in enumerate(pool)])
+    ok = compatibility(pool, w, config)
     out: list[PlacementPrediction] = []
     for seed in range(min(config.seeds, len(pool))):
         chosen = [seed]
@@ -224,6 +233,7 @@ __all__ = [
     "PlacementConfig",
     "PlacementPrediction",
     "candidate_placements",
+    "compatibility",
     "compatible",
     "placement_costs",
     "same_placement",
