@@ -136,7 +136,7 @@ def add_fingers_option(parser: argparse.ArgumentParser) -> None:
         "different faces in one approach join the moves, ranked by the same planner. Geometric executor only: "
         "the simulated hand does not carry placements out yet. The default is 1 there too: with the default "
         "move set the planner takes no placement (a probe tells as much for less), with --moves tracing they "
-        "save about 5%% of the path cost (README, 'Several fingers at once')",
+        "save about 6%% of the path cost (README, 'Several fingers at once')",
     )  # fmt: skip
 
 

@@ -372,7 +372,7 @@ class GeometricExecutor:
             self._pos = first_hit[0]
             self.state = self._state(face=first_hit[1])
         s = transfer + closing + (0.0 if comps else back)
-        cost = self.costs.placement_move(s, len(move.fingers), len(comps))
+        cost = self.costs.placement_move(s, len(move.fingers), 0)  # the ideal sensor has the normals at contact
         return MoveResult(move=move, status="ok", components=tuple(comps), distance=s, cost=cost, state=self.state,
                           free_space=tuple(free), info={"fingers": fingers})  # fmt: skip
 

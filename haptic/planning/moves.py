@@ -97,13 +97,15 @@ class CostModel:
         to the line's start, along it to contact or its end, and back to the surface after a miss)."""
         return self.c_p + self.c_s * s
 
-    def placement_move(self, s: float, fingers: int, contacts: int) -> float:
-        """``c_m + c_s s + fingers · c_q + contacts · c_n``: a placement of several fingertips at once (seed §5's
+    def placement_move(self, s: float, fingers: int, strokes: int) -> float:
+        """``c_m + c_s s + fingers · c_q + strokes · c_n``: a placement of several fingertips at once (seed §5's
         multi-finger move, costed in the manner of §3.1): the fixed ``c_m``, the hand's travel ``s`` through free
         space (to the placement and the longest finger's closing), each finger's closing, and the brief stroke
-        that measures the normal of each face touched. Two fingers touching cost ``5 + c_s s``, against
-        ``4 + c_s (s_1 + s_2)`` for two probes; four cost ``9 + c_s s`` against ``8 + c_s Σ s_i``."""
-        return self.c_m + self.c_s * s + fingers * self.c_q + contacts * self.c_n
+        that measures the normal of each face a pad touched (``strokes``: none for a point sensor, which has the
+        normal at contact, as its probes do). Two fingers cost ``4 + c_s s`` with a point sensor, against
+        ``4 + c_s (s_1 + s_2)`` for two probes; on the hand, touching, ``5 + c_s s`` against ``5 + c_s (s_1 + s_2)``;
+        four cost ``5 + c_s s`` against ``8 + c_s Σ s_i`` with a point sensor."""
+        return self.c_m + self.c_s * s + fingers * self.c_q + strokes * self.c_n
 
 
 @dataclass(frozen=True, eq=False)

@@ -102,7 +102,8 @@ def placement_costs(
     """Each hypothesis's cost of closing the fingers of ``lines`` in one approach: the hand's travel is its way to
     the placement (the longest of the fingers' ways to their lines' starts: the hand carries them together) and
     the longest finger's closing, to contact or its line's end, and back from there when no finger touches;
-    :meth:`~haptic.planning.moves.CostModel.placement_move` of it, with a stroke per contact."""
+    :meth:`~haptic.planning.moves.CostModel.placement_move` of it, with a stroke per contact on the hand (``hand``
+    given; a point sensor has the normal at contact)."""
     starts = np.array([p.move.start for p in lines], dtype=float)
     dirs = np.array([p.move.direction for p in lines], dtype=float)
     lengths = np.array([p.move.length for p in lines], dtype=float)
@@ -116,7 +117,8 @@ def placement_costs(
     closing = np.where(hit, np.nan_to_num(np.array([p.distance for p in lines])), lengths[:, None])
     s = float(np.max(transfer)) + closing.max(axis=0) + np.where(hit.any(axis=0), 0.0, float(np.min(back)))
     contacts = hit.sum(axis=0)
-    return np.asarray(costs.placement_move(s, len(lines), contacts), dtype=float)  # (the formula, elementwise)
+    strokes = contacts if hand is not None else 0  # a point sensor has the normal at contact
+    return np.asarray(costs.placement_move(s, len(lines), strokes), dtype=float)  # (the formula, elementwise)
 
 
 def _contact_points(lines: Sequence[ProbePrediction], weights: np.ndarray) -> np.ndarray:

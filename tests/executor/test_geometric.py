@@ -160,7 +160,7 @@ def test_a_placement_gives_a_face_per_finger_that_touches_and_a_failed_finger_fa
 
     box = load_library()["BOX01"]
     ex = GeometricExecutor(box, SE3.identity(), SensorNoise(), np.random.default_rng(0))
-    ex.start(face=0)
+    here = ex.start(face=0).state.position
     hi, lo = box.vertices.max(axis=0), box.vertices.min(axis=0)
     mid = (hi + lo) / 2
     down = FingerApproach("index", np.array([mid[0], mid[1], hi[2] + 0.02]), np.array([0.0, 0.0, -1.0]), 0.05)
@@ -175,8 +175,9 @@ def test_a_placement_gives_a_face_per_finger_that_touches_and_a_failed_finger_fa
     assert np.allclose(res.components[1].normal, [1, 0, 0], atol=0.01)
     assert len(res.free_space) == 3, "the lines of the fingers that closed, free up to contact or their end"
     assert res.state.face == res.components[0].id
-    s = 0.05 + 0.05  # the farthest line start from the sensor is beyond this; the longest closing is the miss's
-    assert res.cost > CostModel().placement_move(0.05, 4, 2) and res.cost < CostModel().placement_move(s + 0.3, 4, 2)
+    transfer = max(float(np.linalg.norm(f.start - here)) for f in (down, side, away))
+    assert res.distance == pytest.approx(transfer + 0.05), "to the farthest line, then the longest closing (the miss)"
+    assert res.cost == pytest.approx(CostModel().placement_move(res.distance, 4, 0)), "no strokes: normals at contact"
     bad = ex.execute(PlacementMove((inside, FingerApproach("index", mid, np.array([1.0, 0.0, 0.0]), 0.05))))
     assert not bad.ok and bad.status == "unreachable" and bad.components == ()
     assert "2 to 4" in ex.execute(PlacementMove((down,))).reason

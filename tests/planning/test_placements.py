@@ -41,13 +41,29 @@ def _context(names, fingers: int, seed: int = 3) -> Context:
     return Context(tuple(hyps), state, {0: face}, NOISE, PlannerConfig(fingers=fingers))
 
 
-def test_a_placement_costs_the_fixed_cost_its_travel_a_closing_per_finger_and_a_stroke_per_contact():
+def test_a_placement_costs_the_fixed_cost_its_travel_a_closing_per_finger_and_a_stroke_per_normal():
     c = CostModel()
     assert c.placement_move(0.1, 2, 2) == pytest.approx(3.0 + 20.0 * 0.1 + 2 * 0.5 + 2 * 0.5)
     assert c.placement_move(0.1, 4, 3) == pytest.approx(3.0 + 2.0 + 4 * 0.5 + 3 * 0.5)
-    # cheaper than as many probes along lines as long, from two fingers on
-    assert c.placement_move(0.1, 2, 2) < 2 * c.probe_move(0.1)
-    assert c.placement_move(0.1, 4, 4) < 4 * c.probe_move(0.05)
+    # no dearer than as many probes, each travelling as far as the hand does (a point sensor: no strokes)
+    assert c.placement_move(0.1, 2, 0) == pytest.approx(2 * c.probe_move(0.05))
+    assert c.placement_move(0.1, 4, 0) < 4 * c.probe_move(0.025)
+
+
+def test_a_point_sensor_s_placement_pays_no_stroke_the_hand_s_does():
+    from haptic.planning.handpath import HandStart
+
+    ctx = _context(["BOX01", "WEDGE01", "PYR01", "BOX01N"], fingers=2)
+    weights = class_weights([h.model for h in ctx.hypotheses])
+    lines = [p for p in placement_lines(ctx) if p.hit.all()][:2]
+    assert len(lines) == 2
+    point = placement_costs(lines, ctx.state.position, ctx.config.costs)
+    n = ctx.components[0].normal
+    hand = HandStart.at(ctx.state.position, n, ctx.state.position[None], 0.012)
+    on_hand = placement_costs(lines, ctx.state.position, ctx.config.costs, hand)
+    no_strokes = placement_costs(lines, ctx.state.position, CostModel(c_n=0.0), hand)
+    assert on_hand == pytest.approx(no_strokes + 2 * ctx.config.costs.c_n)
+    assert point.shape == on_hand.shape == weights.shape
 
 
 def test_a_placement_says_what_is_wrong_with_it():
