@@ -130,3 +130,25 @@ def test_a_failed_placement_is_not_offered_again():
     assert first
     again = Context(ctx.hypotheses, ctx.state, ctx.components, NOISE, ctx.config, avoid=(first[0],))
     assert not any(same_move(first[0], p.move) for p, *_ in score_all(again) if p.move.kind == "placement")
+
+
+def test_the_planner_predicts_what_the_ideal_sensor_does_with_a_placement():
+    """With the true pose among the hypotheses, its predicted faces touched and cost are what the geometric
+    executor then reports for each candidate placement."""
+    from haptic.executor.geometric import GeometricExecutor
+
+    rng = np.random.default_rng(2)
+    ctx = _context(["BOX01", "WEDGE01", "PYR01", "BOX01N"], fingers=4)
+    weights = class_weights([h.model for h in ctx.hypotheses])
+    preds = candidate_placements(placement_lines(ctx), weights, 4, ctx.state.position, ctx.config.costs)
+    assert preds
+    for i, h in enumerate(ctx.hypotheses):
+        for p in preds:
+            ex = GeometricExecutor(h.poly, h.world_from_model, SensorNoise(), rng)
+            ex.start(face=0, point_in_model=h.model_from_world.apply(ctx.state.position))
+            res = ex.execute(p.move)
+            assert res.ok
+            touched = [f["status"] == "touched" for f in res.info["fingers"]]
+            assert touched == [bool(q.hit[i]) for q in p.lines]
+            assert [ex.truth[c.id][1] for c in res.components] == [int(q.face[i]) for q in p.lines if q.hit[i]]
+            assert res.cost == pytest.approx(p.costs[i], abs=1e-6)
