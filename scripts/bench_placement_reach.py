@@ -8,7 +8,8 @@ from ``--seed``); its true pose is the one hypothesis the planner generates plac
 (``haptic.planning.placements``, over the lines of the simulated hand: the table, the pad, the faces the pad can
 press on). For each candidate the reach solver (``haptic.sim.reach``, on the robot and table alone) is asked for
 each finger's pad centre at its line's start, each finger pointing along its line within 10°, 30° or 60°, or
-pointing anywhere. Prints per setting how many candidates it reaches and why not.
+pointing anywhere, trying every assignment of the hand's fingers to the lines. Prints per setting how many
+candidates it reaches and why not (the last assignment's reason).
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ from __future__ import annotations
 import argparse
 import os
 from collections import Counter
+from itertools import permutations
 
 os.environ.setdefault("MUJOCO_GL", "disable")
 
@@ -28,12 +30,12 @@ from haptic.planning.config import PlannerConfig  # noqa: E402
 from haptic.planning.efficiency import class_weights  # noqa: E402
 from haptic.planning.hypothesis import Hypothesis  # noqa: E402
 from haptic.planning.move_scores import probe_config  # noqa: E402
-from haptic.planning.placements import candidate_placements  # noqa: E402
+from haptic.planning.placements import HAND_MAX_TILT, PlacementConfig, candidate_placements  # noqa: E402
 from haptic.planning.probe_lines import candidate_probes  # noqa: E402
 from haptic.planning.probe_prediction import predict_probes  # noqa: E402
 from haptic.sim import compose_scene, random_object_pose  # noqa: E402
 from haptic.sim.reach import FingertipTarget, ReachSettings, ReachSolver  # noqa: E402
-from haptic.sim.scene import PAD_RADIUS, scene_object_from_polyhedron  # noqa: E402
+from haptic.sim.scene import FINGERS, PAD_RADIUS, scene_object_from_polyhedron  # noqa: E402
 
 TOLERANCES = (10.0, 30.0, 60.0, None)
 """The pointing tolerances asked for [deg] (None: the finger may point anywhere)."""
@@ -43,6 +45,9 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seed", type=int, default=1, help="seed of the objects' poses")
     ap.add_argument("--fingers", type=int, default=2, choices=(2, 4), help="most fingers a placement takes")
+    ap.add_argument("--any-line", action="store_true",
+                    help="placements over every line of the hand's probes, not only those within HAND_MAX_TILT of "
+                    "straight down")
     args = ap.parse_args()
     scene = compose_scene(None)
     solvers = {tol: ReachSolver(scene, ReachSettings(approach_tol=np.deg2rad(tol if tol is not None else 180.0)))
@@ -64,15 +69,20 @@ def main() -> None:
         preds = predict_probes([h], lines, world_from_model.apply(poly.centroid), [], SensorNoise(), config.costs)
         weights = class_weights([name])
         cands = candidate_placements(preds, weights, args.fingers, world_from_model.apply(poly.centroid),
-                                     config.costs)  # fmt: skip
+                                     config.costs, config=PlacementConfig(max_tilt=None if args.any_line
+                                                                          else HAND_MAX_TILT))  # fmt: skip
         n_here = Counter()
         for c in cands:
             total += 1
             for tol in TOLERANCES:
-                targets = [FingertipTarget(f.finger, np.asarray(f.start) - PAD_RADIUS * np.asarray(f.direction),
-                                           None if tol is None else np.asarray(f.direction))
-                           for f in c.move.fingers]  # fmt: skip
-                r = solvers[tol].solve(targets)
+                r = None
+                for names in permutations(FINGERS, len(c.move.fingers)):  # any finger for any line
+                    targets = [FingertipTarget(name, np.asarray(f.start) - PAD_RADIUS * np.asarray(f.direction),
+                                               None if tol is None else np.asarray(f.direction))
+                               for name, f in zip(names, c.move.fingers, strict=True)]  # fmt: skip
+                    r = solvers[tol].solve(targets)
+                    if r.ok:
+                        break
                 reached[tol] += r.ok
                 n_here[tol] += r.ok
                 if not r.ok:

@@ -20,7 +20,13 @@ from haptic.planning.efficiency import class_weights, distinguishable, efficienc
 from haptic.planning.handpath import HandStart
 from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import FaceMove, Move, PlacementMove, ProbeMove, SensorState
-from haptic.planning.placements import PlacementPrediction, candidate_placements, same_placement
+from haptic.planning.placements import (
+    HAND_MAX_TILT,
+    PlacementConfig,
+    PlacementPrediction,
+    candidate_placements,
+    same_placement,
+)
 from haptic.planning.predict import Prediction, candidate_moves, crossed_edge, predict_moves
 from haptic.planning.probe_lines import ProbeConfig, candidate_probes
 from haptic.planning.probe_prediction import ProbePrediction, predict_probes
@@ -133,8 +139,9 @@ def score_placements(ctx: Context, weights: np.ndarray, lines: Sequence[ProbePre
     lines = placement_lines(ctx) if lines is None else lines
     lines = [p for p in lines if p.risk(weights) < PROBE_RISK]
     avoid = [m for m in ctx.avoid if isinstance(m, PlacementMove)]
+    cfg = PlacementConfig(max_tilt=HAND_MAX_TILT) if ctx.config.table_z is not None else PlacementConfig()
     preds = candidate_placements(lines, weights, ctx.config.fingers, ctx.state.position, ctx.config.costs,
-                                 hand_start(ctx), avoid=avoid)  # fmt: skip
+                                 hand_start(ctx), cfg, avoid)  # fmt: skip
     return [(p, *p.score(weights), p.risk(weights)) for p in preds]
 
 

@@ -63,6 +63,14 @@ class PlacementConfig:
     """Placements grow from this many of the most telling lines (by expected eliminations)."""
     pool: int = 24
     """Each finger added is one of this many most telling lines."""
+    max_tilt: float | None = None
+    """Fingers close only along lines within this of straight down (None: any line). The simulated hand's
+    (:data:`HAND_MAX_TILT`): its fingers point down, and a finger pointing across its line closes with its links
+    ahead of its pad [rad]."""
+
+
+HAND_MAX_TILT = np.deg2rad(30.0)
+"""The simulated hand's :attr:`PlacementConfig.max_tilt` [rad]."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -174,6 +182,8 @@ def candidate_placements(
     if fingers < 2 or len(lines) < 2:
         return []
     useful = [p for p in lines if float(w[p.hit].sum()) >= config.min_hit_share]
+    if config.max_tilt is not None:
+        useful = [p for p in useful if float(p.move.direction[2]) <= -np.cos(config.max_tilt)]
     if len(useful) < 2:
         return []
     elim = np.array([expected_eliminated(p.eliminates(), w) for p in useful])
@@ -231,6 +241,7 @@ def _same_line(a: ProbeMove, b: ProbeMove) -> bool:
 
 __all__ = [
     "HAND_FINGERS",
+    "HAND_MAX_TILT",
     "SAME_LINE",
     "PlacementConfig",
     "PlacementPrediction",
