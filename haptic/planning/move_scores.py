@@ -99,7 +99,8 @@ def score_all(ctx: Context) -> list[tuple[Prediction | ProbePrediction, float, f
     moves the hypotheses predict to run into it are left out and the rest discounted by that risk.
     Free-space probes join them when ``config.moves`` admits them, scored in the same form
     (:meth:`ProbePrediction.score`, on the simulated hand discounted by :meth:`ProbePrediction.risk`), so one
-    planner ranks every kind of move together; ``config.moves == "probing"`` leaves the tracing moves out.
+    planner ranks every kind of move together; ``config.moves == "probing"`` leaves the tracing moves out. With
+    ``config.fingers`` > 1, placements of several fingertips join them too (:func:`score_placements`).
 
     Computed once per decision: a context scored again (the observation of :mod:`haptic.env` and then the planner
     acting through it, at one decision) gets the same scores back while its data components are the same objects;
