@@ -243,16 +243,23 @@ def aimed_face_moves(
     along = edge.direction if isinstance(edge, DataEdge) else None
     origin = state.position
     e_m = h.edges.get(state.edge) if state.edge is not None else None
+    out_of_corner = None  # starting in a concave corner: the in-plane direction away from its edge
     if hand and e_m is not None and poly.edge_convexity[e_m] < 0 and f_m in (poly.edge_left_face[e_m],
                                                                             poly.edge_right_face[e_m]):
         p0, u = t.apply(poly.edge_points[e_m]), t.rotate(poly.edge_directions[e_m])  # the edge's line, world
         on_line = p0 + float((origin - p0) @ u) * u
-        origin = on_line + (config.pad_radius + CONCAVE_STEP_OFF) * t.rotate(_inward(poly, e_m, f_m))
+        out_of_corner = t.rotate(_inward(poly, e_m, f_m))
+        origin = on_line + (config.pad_radius + CONCAVE_STEP_OFF) * out_of_corner
     out = []
     for p, v in targets:
         if float(np.linalg.norm(_in_plane(t.apply(p) - state.position, face.normal))) < AIM_NEAR_VERTEX:
             continue  # at hand
         d = _in_plane(t.apply(p) - origin, face.normal)
+        if out_of_corner is not None and float(d @ out_of_corner) < 0:
+            # a target nearer the concave edge than the pad's radius (a short edge beside it): heading back into
+            # the corner the pad meets the face across again and ends on the same edge; along the edge instead it
+            # stays clear of that face and leaves the current face a pad's radius from the corner
+            d = d - float(d @ out_of_corner) * out_of_corner
         n = float(np.linalg.norm(d))
         if n < 1e-9:
             continue
