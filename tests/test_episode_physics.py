@@ -149,18 +149,20 @@ def test_a_concave_edge_whose_end_the_pad_rolls_past_reports_no_vertex(tmp_path)
     ep, failed, _ = _replay(tmp_path, "FRAME01", 0.04, 5)
     edges = ep.executor.segmenter.edges
     along_concave = [r for r in failed if r.move.kind == "edge" and not edges[r.state.edge].convex]
-    assert all(not r.components and "could not locate the vertex" in r.reason for r in along_concave)
+    assert all(not r.components for r in along_concave)  # some fail before the end: the table, a retouch
+    assert any("could not locate the vertex" in r.reason for r in along_concave)
     assert _within_bounds(ep)
 
 
 def test_a_face_move_that_rolls_round_a_vertex_reports_no_edge(tmp_path):
     # bipyramid_06 of the formula corpus at 60 mm across, seed 1 when found (perception_report.py --corpus
-    # --sizes 60), seed 2 since faces are fitted from their steady rows (the trajectories differ): a face
+    # --sizes 60), seed 2 since faces are fitted from their steady rows, seed 3 since the pad reaches faces
+    # leaning under by up to 35° (the trajectories differ): a face
     # move rolled round the apex onto a face sharing no edge with the first; the "edge" reported between them
     # (n_a × n_b through the apex) lay 36 mm off every true edge (48 bounds) and the episode ended no-match.
     # The rolling normals leaned along that line more than the noise allows: no edge is reported (the move
     # then crosses again inside the edge, or fails).
-    ep, failed, results = _replay(tmp_path, "bipyramid_06", 0.06, 11, corpus=True, seed=2)
+    ep, failed, results = _replay(tmp_path, "bipyramid_06", 0.06, 11, corpus=True, seed=3)
     said = [r.reason for r in failed] + [x for r in results for x in (r.info or {}).get("recoveries", ())]
     assert any("more than the noise allows" in x for x in said), said
     assert _within_bounds(ep)
