@@ -153,7 +153,9 @@ class TouchConfig:
     """A free move whose pad leaves the straight path to its target by more than this is stopped and held where
     it is by its joints (the arm met a joint limit and cannot keep the hand's orientation along the path: the
     task-space control would carry it on across the workspace); the move ends ``unreachable``, event
-    ``runaway`` [m]."""
+    ``runaway`` [m]. So does a guarded approach whose pad leaves its line by this, and a press in place (settling
+    on a contact, holding at a vertex) whose pad leaves its point by this: the force controller pushing on into
+    a contact it lost, or the arm jammed against the object and thrown off."""
     posture_tol: float = 0.02
     """A joint-space move back to the arm's home posture family ends when every arm joint is within this [rad]."""
     guarded_settle: float = 0.5
