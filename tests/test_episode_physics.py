@@ -22,6 +22,18 @@ def test_a_physics_episode_recognises_the_pyramid():
     assert p["spurious"] == 0
 
 
+def test_the_planner_counts_on_less_undercut_than_the_pad_reaches():
+    # the pad's roll stops at max_undercut (35°); the planner's reach model counts on reach_undercut, a margin
+    # short of it (31°): HEXPRISM01 lying on a side has faces leaning under 30° at any pose, which the planner
+    # then offers, and a face leaning under 33° at a pose known to a degree is not promised
+    from haptic.executor.touch_config import TouchConfig
+
+    touch = TouchConfig()
+    ep = build_episode(EpisodeSpec(model="HEXPRISM01", seed=2, executor="physics"))
+    assert ep.config.max_undercut == touch.reach_undercut < touch.max_undercut
+    assert math.radians(30.0) < ep.config.max_undercut < math.radians(33.0) < touch.max_undercut
+
+
 def test_touches_past_an_unreachable_edge_tell_the_box_family_apart():
     # BOX01P resting tilted: the moves that separate it from BOX01 and BOX01N all end stepping onto a face
     # leaning under the pad; their touches on the way still rule the look-alikes out
