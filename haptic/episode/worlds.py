@@ -154,7 +154,7 @@ class PhysicsWorld:
             ws = scene.workspace
             config = replace(
                 config, table_z=ws.table_top_z, pad_radius=ws.pad_radius, steep_descent_risk=STEEP_DESCENT_RISK,
-                max_undercut=TouchConfig().max_undercut, touch_evidence=True,
+                max_undercut=TouchConfig().reach_undercut, touch_evidence=True,
             )  # fmt: skip
         sim_noise, bounds, noise = noise_models(NoiseModel(check_noise_level(spec.noise)))
         sim = Simulation(scene, noise=sim_noise, seed=int(sim_seq.integers(2**31 - 1)))
