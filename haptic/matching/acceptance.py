@@ -99,13 +99,14 @@ class PoseCheck:
 
 def _angle(u: np.ndarray, v: np.ndarray) -> float:
     """Angle between two 3-vectors [rad]: the arithmetic of ``arccos(clip(u·v / (‖u‖ ‖v‖), −1, 1))`` with numpy
-    (the same bits) on Python floats, which the residuals' per-component loop calls many times."""
+    (the same bits) on Python floats, which the residuals' per-component loop calls many times. The arc cosine is
+    numpy's: the C library's ``acos`` differs from it in the last bit on some machines."""
     num, den = float(u @ v), math.sqrt(float(u.dot(u))) * math.sqrt(float(v.dot(v)))
     if den == 0.0:  # a zero vector: as numpy divides
         with np.errstate(divide="ignore", invalid="ignore"):
             return float(np.arccos(np.clip(np.float64(num) / den, -1.0, 1.0)))
     c = num / den
-    return math.acos(-1.0 if c < -1.0 else 1.0 if c > 1.0 else c)
+    return float(np.arccos(-1.0 if c < -1.0 else 1.0 if c > 1.0 else c))
 
 
 def _coplanar(model: Polyhedron, f: int) -> np.ndarray:

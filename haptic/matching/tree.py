@@ -313,6 +313,22 @@ class InterpretationTree:
         self._stack = None
         return self.count
 
+    def add_move(self, components: Sequence[DataComponent]) -> int:
+        """Add the components one move yielded together -- a placement's faces, one per finger -- and return the
+        number of interpretations. The move's new components must come in order of their ids, as an executor
+        numbers them. Each is paired with every admissible model component (§2.3) and tested against every
+        earlier component, the move's own before it included, so every pairwise constraint of §2.6 between the
+        move's components holds in each interpretation left: the relative positions and normals measured in one
+        hand frame apply at once, the paper's constraints unchanged (seed §5: "the matching part is essentially
+        unchanged")."""
+        fresh = list(dict.fromkeys(c.id for c in components if c.id >= len(self._data)))  # (an edge re-reported)
+        if fresh != list(range(len(self._data), len(self._data) + len(fresh))):
+            raise MatchError(f"a move's new components must have the next ids in order ({len(self._data)} on), "
+                             f"got {fresh}")  # fmt: skip
+        for c in components:
+            self.add(c)
+        return self.count
+
     def add_all(self, components: Iterable[DataComponent]) -> list[int]:
         """Add components in order; the interpretation count after each."""
         return [self.add(c) for c in components]
