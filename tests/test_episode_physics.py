@@ -34,6 +34,20 @@ def test_the_planner_counts_on_less_undercut_than_the_pad_reaches():
     assert math.radians(30.0) < ep.config.max_undercut < math.radians(33.0) < touch.max_undercut
 
 
+def test_a_face_measured_with_the_hand_tilted_is_touched_again_tilted():
+    # FRAME01 seed 2 stands on an end, its hole's axis horizontal: the pad reaches the hole's walls only with the
+    # hand tilted away from the rim above (a link of the finger meets it upright). Turned upright in the hole after
+    # such a move, the finger jammed against the rim, and every later touch of the wall ran away; now the hand
+    # backs out along the finger's axis before it turns upright, and touches such a face again tilted as it was
+    # measured. The components stay within their bounds.
+    said = []
+    obs = EpisodeObserver(on_move=lambda n, r, *a: said.extend(r.info.get("recoveries", ())))
+    ep = build_episode(EpisodeSpec(model="FRAME01", seed=2, executor="physics", verify="full"))
+    ep.run(None, obs)
+    assert any("touched again with the hand tilted" in x for x in said), said
+    assert _within_bounds(ep)
+
+
 def test_touches_past_an_unreachable_edge_tell_the_box_family_apart():
     # BOX01P resting tilted: the moves that separate it from BOX01 and BOX01N all end stepping onto a face
     # leaning under the pad; their touches on the way still rule the look-alikes out
