@@ -252,3 +252,16 @@ def test_face_moves_out_of_a_concave_corner_leave_it(tmp_path):
     assert from_corner
     assert not [c.id for e, kind, c in from_corner if kind == "concave" and same_line(e, c)]
     assert rec.outcome == "recognized" and rec.correct, rec.detail
+
+
+def test_a_verification_up_to_hidden_vertices_says_so_and_is_not_confirmed():
+    # BOX01N seed 3 rests with its slot against the table: every feature in the hand's reach is measured, and the
+    # slot's vertices are hidden. The record says the verification is complete up to them (reach_complete) and
+    # the episode ends ambiguous, never recognised: a difference under the object cannot be measured. FRAME01 seed
+    # 1, standing on an end, stalls with features in reach unmeasured: not complete in reach either.
+    rec = run_episode(EpisodeSpec(model="BOX01N", seed=3, executor="physics", verify="full"))
+    v = rec.verified
+    assert rec.outcome == "ambiguous" and v["status"] == "incomplete"
+    assert v["reach_complete"] and v["vertices_hidden"] > 0
+    rec = run_episode(EpisodeSpec(model="FRAME01", seed=1, executor="physics", verify="full"))
+    assert rec.outcome == "ambiguous" and not rec.verified["reach_complete"]
