@@ -265,3 +265,15 @@ def test_a_verification_up_to_hidden_vertices_says_so_and_is_not_confirmed():
     assert v["reach_complete"] and v["vertices_hidden"] > 0
     rec = run_episode(EpisodeSpec(model="FRAME01", seed=1, executor="physics", verify="full"))
     assert rec.outcome == "ambiguous" and not rec.verified["reach_complete"]
+
+
+def test_an_edge_move_after_a_tilted_move_returns_beside_the_last_contact():
+    # HEXPRISM01 seed 1: face moves onto the sides leaning under 30° are made with the hand tilted, which then backs
+    # out along the finger's axis, centimetres from the edge just found. The edge move after such a move touched the
+    # face again beside where the pad now was, past the edge's end, and found nothing there ("could not return
+    # next to the edge: no-contact"); it returns beside the last contact.
+    failed = []
+    obs = EpisodeObserver(on_failed_move=lambda n, r: failed.append(r.reason))
+    rec = run_episode(EpisodeSpec(model="HEXPRISM01", seed=1, executor="physics", verify="full"), observer=obs)
+    assert not [w for w in failed if "could not return next to the edge: no-contact" in w], failed
+    assert rec.outcome == "recognized" and rec.correct, rec.detail

@@ -744,7 +744,8 @@ class PhysicsExecutor(LandingSearch):
         face ``face`` when it is one of the edge's, else on the other; when that touch fails, on the other face."""
         s, seg = self.settings, self.segmenter
         first = face if face in rec.faces else rec.faces[1]
-        s0 = rec.param(self.contact_point())
+        # beside the last contact: the pad may be far off in free space (backed out after a tilted move)
+        s0 = rec.param(self.contact_point() if self.toucher.contact[2] is not None else self.state.position)
         status, why = "unreachable", "the edge next to the table is out of the pad's reach"
         for fid in (first, *(f for f in rec.faces if f != first and f in rec.inward)):
             n = seg.faces[fid].component.normal
