@@ -7,7 +7,9 @@ is scored by its predicted cost (over its chance of success: the table, a steep 
 plus the tour's cost over what it leaves to measure, from where it ends in the hypothesis's world
 (:func:`~haptic.planning.search.simulate`); the least score is taken, and the tour is planned afresh after every
 result. When no candidate can be followed in the hypothesis's world, the move that ends nearest a missing feature
-is taken.
+is taken. The tour is priced by tracing alone when no probe is offered from where the sensor is, and a move
+predicted to measure nothing along a way the verification already travelled since it last measured something is
+not taken again (:func:`outcome_key`): either kept the verification going back and forth over one edge.
 
 Where the move set admits probes (``--moves probing|all``) and the sensor is a point (no table: the geometric
 executor), a free-space probe may carry the sensor to a face beside where the tour is cheapest to enter
@@ -439,9 +441,13 @@ def plan_verification_move(
     probed: Sequence[Move] = (),
     faces_ok: frozenset[int] | None = None,
     previous: Tour | None = None,
+    travelled: frozenset[tuple] | set[tuple] = frozenset(),
 ) -> tuple[Move | None, Tour | None, float]:
     """:func:`choose_verification_move`, with the tour it planned over ``missing`` (from ``previous``'s order,
-    when given) and that tour's cost from the sensor as it is [units] (None and 0 without a pose)."""
+    when given) and that tour's cost from the sensor as it is [units] (None and 0 without a pose). A candidate
+    predicted to measure nothing missing along a way already travelled (its :func:`outcome_key` in
+    ``travelled``) is left out: the tour's estimate from where such moves end can keep them the cheapest, and the
+    verification goes back and forth over one edge until it stalls."""
     from haptic.planning.search import simulate
     from haptic.planning.simulate import simulate_probe
 
@@ -457,6 +463,15 @@ def plan_verification_move(
     first = _moves(h, state, components, noise, config, avoid, missing)
     probes = verification_probes(h, state, components, _entries(poly, tour, here, keys), noise, config, avoid, probed,
                                  faces_ok)  # fmt: skip
+    if legs.probes and not probes:
+        # no probe reaches where the tour is entered from here: priced with probes, every candidate leaves the same
+        # probe's cost, and the cheapest move wins wherever it ends (face moves back and forth over one edge);
+        # the tour is priced by tracing alone, toward what is missing
+        legs = LegCosts.of(config, probes=False)
+        tour = plan_tour(poly, keys, legs, previous)
+        table = StartCosts(poly, keys, legs)
+        here = _start_costs(h, state, table)
+        now = tour.cost_from(here)
     if not first and not probes:
         return None, tour, now
     best, best_score = None, np.inf
@@ -469,6 +484,8 @@ def plan_verification_move(
             continue
         h1, s1, _ = sim
         new = _new_features(h, h1)
+        if travelled and _gain(new, missing) == 0 and outcome_key(h, m, state, h1, s1) in travelled:
+            continue
         measured = frozenset(int(k) for k in features(poly).index(tuple(  # type: ignore[arg-type]
             frozenset(n & x) for n, x in zip(new, missing, strict=True))))  # fmt: skip
         score = c / max(1.0 - r, 1e-9) + tour.cost_from(_start_costs(h1, s1, table), measured)
@@ -486,6 +503,14 @@ def plan_verification_move(
         for k, (m, p, c) in enumerate(ends)
     ]
     return ends[min(scored)[2]][0], tour, now
+
+
+def outcome_key(h: Hypothesis, move: Move, state: SensorState, after: Hypothesis, end: SensorState) -> tuple:
+    """A move's way in hypothesis ``h``'s world, predicted from ``state`` to ``end``: its kind, the model face
+    and edge it starts on, and the model face, edge and vertex it ends at."""
+    return (move.kind, h.faces.get(state.face), h.edges.get(state.edge) if state.edge is not None else None,
+            after.faces.get(end.face), after.edges.get(end.edge) if end.edge is not None else None,
+            after.vertices.get(end.vertex) if end.vertex is not None else None)  # fmt: skip
 
 
 def _legs(config: PlannerConfig) -> LegCosts:
@@ -555,6 +580,8 @@ class Verifier:
         :func:`verify_move_budget` made: ambiguous between the model and an object outside the library),
         "verifying", or "not needed" (no pose class was ever left alone)."""
         self._progress = (-1, 0)  # (features measured, verification moves then)
+        self._travelled: set[tuple] = set()
+        """:func:`outcome_key` of the moves made since the last feature measured that were to measure nothing."""
         self.check = None
         self.accept = None
         self.coverage = None
@@ -621,6 +648,7 @@ class Verifier:
             got = self.coverage.measured() if self.coverage is not None else 0
             if got > self._progress[0]:
                 self._progress = (got, self.moves)
+                self._travelled.clear()
             elif self.moves - self._progress[1] >= STALL_MOVES:
                 self.status = "incomplete"
             if self.moves >= self.move_budget():
@@ -684,8 +712,14 @@ class Verifier:
         faces_ok = self._reach[self._model_name][0] if self._model_name in self._reach else None
         previous = self._tour if self._tour is not None and self._tour_model is h.poly else None
         move, self._tour, now = plan_verification_move(h, state, components, missing, self.noise, self.config,
-                                                       avoid, probed, faces_ok, previous)  # fmt: skip
+                                                       avoid, probed, faces_ok, previous, self._travelled)  # fmt: skip
         self._tour_model = h.poly
+        if move is not None and move.kind != "probe" and h.world_from_model is not None:
+            from haptic.planning.search import simulate
+
+            sim = simulate(h, move, state, components, self.config)
+            if sim is not None and _gain(_new_features(h, sim[0]), missing) == 0:
+                self._travelled.add(outcome_key(h, move, state, sim[0], sim[1]))
         if self.tour_planned is None and self._tour is not None:
             legs = _legs(self.config)
             keys = features(h.poly).index(missing)
