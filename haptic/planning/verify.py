@@ -393,6 +393,23 @@ def verification_probes(
     aimed_probes`) at the targets of :func:`_probe_targets` at least :data:`MIN_PROBE_TRANSFER` from the sensor,
     the :data:`MAX_VERIFY_PROBES` nearest, predicted to hit their face in ``h``'s world and not to fail there (the
     hand's checks); none after a probe failed from here (``avoid``), nor along a line probed before (``probed``)."""
+    return [(m, c, r) for m, c, r, _ in _verification_probes(h, state, components, missing, noise, config, avoid,
+                                                             probed, faces_ok)]  # fmt: skip
+
+
+LANDS_NEAR = 2 * PROBE_INSET
+"""A verification probe *lands near* what it is for when its predicted contact is within this of a missing vertex or
+edge, or on a missing face [m]."""
+
+
+def _verification_probes(
+    h: Hypothesis, state: SensorState, components: Mapping[int, DataComponent],
+    missing: tuple[frozenset[int], frozenset[int], frozenset[int]], noise: SensorNoise, config: PlannerConfig,
+    avoid: Sequence[Move] = (), probed: Sequence[Move] = (), faces_ok: frozenset[int] | None = None,
+) -> list[tuple[Move, float, float, bool]]:
+    """:func:`verification_probes`, each with whether it lands near what is missing (:data:`LANDS_NEAR`): the
+    target on a face beside a vertex lies far from it where the face's corner there is narrow, and a line aimed at
+    a point may meet the face elsewhere, past what hides the point."""
     from haptic.planning.move_scores import Context, predict_probe_moves, probe_config, same_move
     from haptic.planning.probe_lines import aimed_probes
 
@@ -403,11 +420,24 @@ def verification_probes(
     targets = [(p, f) for p, f in _probe_targets(h.poly, missing, faces_ok)
                if float(np.linalg.norm(p - here)) >= MIN_PROBE_TRANSFER]  # fmt: skip
     targets.sort(key=lambda pf: float(np.linalg.norm(pf[0] - here)))
-    lines = [(mv, targets[k][1]) for mv, k in aimed_probes(h, targets, probe_config(config))
+    lines = [(mv, targets[k]) for mv, k in aimed_probes(h, targets, probe_config(config))
              if not any(same_move(mv, done) for done in probed)][:MAX_VERIFY_PROBES]  # fmt: skip
     preds = predict_probe_moves(Context((h,), state, components, noise, config), [mv for mv, _ in lines])
-    return [(pred.move, float(pred.costs[0]), 0.0) for pred, (_, face) in zip(preds, lines, strict=True)
-            if bool(pred.hit[0]) and int(pred.face[0]) == face and pred.risk() == 0.0]  # fmt: skip
+    poly = h.poly
+    mf, me, mv = missing
+    out = []
+    for pred, (_, (_, face)) in zip(preds, lines, strict=True):
+        if not (bool(pred.hit[0]) and int(pred.face[0]) == face and pred.risk() == 0.0):
+            continue
+        move = pred.move
+        start, u = np.asarray(move.start, float), np.asarray(move.direction, float)
+        c = h.model_from_world.apply(start + float(pred.distance[0]) * u)  # the contact, model frame
+        near = face in mf or any(float(np.linalg.norm(c - poly.vertices[v])) <= LANDS_NEAR for v in mv)
+        for e in me:
+            s_ = float(np.clip((c - poly.edge_points[e]) @ poly.edge_directions[e], 0.0, poly.edge_lengths[e]))
+            near = near or float(np.linalg.norm(c - poly.edge_points[e] - s_ * poly.edge_directions[e])) <= LANDS_NEAR
+        out.append((move, float(pred.costs[0]), 0.0, near))
+    return out
 
 
 def choose_verification_move(
@@ -442,12 +472,14 @@ def plan_verification_move(
     faces_ok: frozenset[int] | None = None,
     previous: Tour | None = None,
     travelled: frozenset[tuple] | set[tuple] = frozenset(),
+    visited: Sequence[np.ndarray] = (),
 ) -> tuple[Move | None, Tour | None, float]:
     """:func:`choose_verification_move`, with the tour it planned over ``missing`` (from ``previous``'s order,
     when given) and that tour's cost from the sensor as it is [units] (None and 0 without a pose). A candidate
     predicted to measure nothing missing along a way already travelled (its :func:`outcome_key` in
-    ``travelled``) is left out: the tour's estimate from where such moves end can keep them the cheapest, and the
-    verification goes back and forth over one edge until it stalls."""
+    ``travelled``), or to end within :data:`REVISIT` of a place in ``visited`` (world), is left out: the tour's
+    estimate from where such moves end can keep them the cheapest, and the verification goes back and forth
+    until it stalls."""
     from haptic.planning.search import simulate
     from haptic.planning.simulate import simulate_probe
 
@@ -461,12 +493,13 @@ def plan_verification_move(
     here = _start_costs(h, state, table)
     now = tour.cost_from(here)
     first = _moves(h, state, components, noise, config, avoid, missing)
-    probes = verification_probes(h, state, components, _entries(poly, tour, here, keys), noise, config, avoid, probed,
-                                 faces_ok)  # fmt: skip
-    if legs.probes and not probes:
-        # no probe reaches where the tour is entered from here: priced with probes, every candidate leaves the same
-        # probe's cost, and the cheapest move wins wherever it ends (face moves back and forth over one edge);
-        # the tour is priced by tracing alone, toward what is missing
+    landing = _verification_probes(h, state, components, _entries(poly, tour, here, keys), noise, config, avoid,
+                                   probed, faces_ok)  # fmt: skip
+    probes = [(m, c, r) for m, c, r, _ in landing]
+    if legs.probes and not any(near for *_, near in landing):
+        # no probe lands near where the tour is entered from here: priced with probes, every candidate leaves the
+        # same probe's cost, and the cheapest move wins wherever it ends (face moves back and forth over one
+        # edge); the tour is priced by tracing alone, toward what is missing
         legs = LegCosts.of(config, probes=False)
         tour = plan_tour(poly, keys, legs, previous)
         table = StartCosts(poly, keys, legs)
@@ -484,7 +517,8 @@ def plan_verification_move(
             continue
         h1, s1, _ = sim
         new = _new_features(h, h1)
-        if travelled and _gain(new, missing) == 0 and outcome_key(h, m, state, h1, s1) in travelled:
+        if _gain(new, missing) == 0 and (outcome_key(h, m, state, h1, s1) in travelled or any(
+                float(np.linalg.norm(s1.position - p)) < REVISIT for p in visited)):
             continue
         measured = frozenset(int(k) for k in features(poly).index(tuple(  # type: ignore[arg-type]
             frozenset(n & x) for n, x in zip(new, missing, strict=True))))  # fmt: skip
@@ -503,6 +537,11 @@ def plan_verification_move(
         for k, (m, p, c) in enumerate(ends)
     ]
     return ends[min(scored)[2]][0], tour, now
+
+
+REVISIT = 3e-3
+"""A verification move predicted to measure nothing that ends this near a place the sensor was at since the
+verification last measured something goes back there (:func:`plan_verification_move`) [m]."""
 
 
 def outcome_key(h: Hypothesis, move: Move, state: SensorState, after: Hypothesis, end: SensorState) -> tuple:
@@ -582,6 +621,8 @@ class Verifier:
         self._progress = (-1, 0)  # (features measured, verification moves then)
         self._travelled: set[tuple] = set()
         """:func:`outcome_key` of the moves made since the last feature measured that were to measure nothing."""
+        self._visited: list[np.ndarray] = []
+        """Where the sensor was when each verification move since the last feature measured was chosen (world)."""
         self.check = None
         self.accept = None
         self.coverage = None
@@ -649,6 +690,7 @@ class Verifier:
             if got > self._progress[0]:
                 self._progress = (got, self.moves)
                 self._travelled.clear()
+                self._visited.clear()
             elif self.moves - self._progress[1] >= STALL_MOVES:
                 self.status = "incomplete"
             if self.moves >= self.move_budget():
@@ -712,7 +754,9 @@ class Verifier:
         faces_ok = self._reach[self._model_name][0] if self._model_name in self._reach else None
         previous = self._tour if self._tour is not None and self._tour_model is h.poly else None
         move, self._tour, now = plan_verification_move(h, state, components, missing, self.noise, self.config,
-                                                       avoid, probed, faces_ok, previous, self._travelled)  # fmt: skip
+                                                       avoid, probed, faces_ok, previous, self._travelled,
+                                                       self._visited)  # fmt: skip
+        self._visited.append(np.array(state.position, float))
         self._tour_model = h.poly
         if move is not None and move.kind != "probe" and h.world_from_model is not None:
             from haptic.planning.search import simulate

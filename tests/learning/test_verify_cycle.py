@@ -39,3 +39,4 @@ def test_a_verification_that_went_back_and_forth_goes_on_to_what_it_lacks(base, 
     lib, obj = learned_library(tmp_path, poly, learn_seed, f"learned_{poly.name}")
     rec = run_episode(EpisodeSpec(model=str(obj), seed=seed, noise=1.0, models=str(lib)))
     assert rec.recognized == f"learned_{poly.name}", (rec.outcome, rec.detail)
+
