@@ -10,8 +10,10 @@ per unit of path cost, looking up to :attr:`LearnSettings.depth` moves ahead in 
 outside a measured plane, planes that bound no solid, or an estimate that measured nothing new in
 :attr:`LearnSettings.stall` moves) it traces the object's boundary instead
 (:func:`~haptic.learning.boundary.boundary_estimate`), walking over it to the nearest open edge or vertex
-(:class:`~haptic.episode.boundary_walk.BoundaryWalk`). It has its own budget (:class:`LearnSettings`), reported
-in the record's ``learned``.
+(:class:`~haptic.episode.boundary_walk.BoundaryWalk`). Before either is called closed, every diagonal of each
+measured face of four or more vertices is crossed by a face move (:mod:`haptic.learning.folds`: a face folded
+along a diagonal is two faces). It has its own budget (:class:`LearnSettings`), reported in the record's
+``learned``.
 
 :func:`learning_endings` replaces the loop's ending conditions: a ``no-match`` verdict starts the learning
 instead of ending the episode, which then ends, still ``no-match``, when the surface is closed or when the
