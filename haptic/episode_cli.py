@@ -27,7 +27,7 @@ def add_parser(sub: Subcommands) -> None:
         EXECUTORS,
     )
     from haptic.matching.acceptance import DEFAULT_VERIFY, VERIFY_MODES
-    from haptic.options import add_units_option, noise_level, positive_int, seed_int
+    from haptic.options import add_fingers_option, add_units_option, noise_level, positive_int, seed_int
     from haptic.planning.moves import DEFAULT_MOVES, HAND_DEFAULT_MOVES, MOVE_SETS
     from haptic.planning.registry import POLICY_NAMES
 
@@ -65,6 +65,7 @@ def add_parser(sub: Subcommands) -> None:
         "(free-space probes alone, geometric executor; a verification traces too) or all (both, one "
         "planner ranking them)",
     )  # fmt: skip
+    add_fingers_option(p)
     p.add_argument("--learn", metavar="DIR",
                    help="after no-match, explore on until the object's surface is closed and write its model "
                    "into the library directory DIR (its own budget, reported)")
@@ -131,6 +132,14 @@ class MovePrinter:
                               self.cost))  # fmt: skip
 
 
+def placements_line(placements: list[dict]) -> str:
+    """The placements of an episode: how many, how many failed, and their fingers' outcomes."""
+    failed = sum(p["status"] != "ok" for p in placements)
+    fingers = [f["status"] for p in placements for f in p["fingers"]]
+    told = ", ".join(f"{fingers.count(k)} {k}" for k in dict.fromkeys(fingers))
+    return f"{len(placements)}" + (f" ({failed} failed)" if failed else "") + f"; fingers: {told}"
+
+
 def budget_text(rec: dict, budget: float, max_moves: int) -> str:
     """Which budget a "budget" episode ran out of, and its value."""
     if rec["path_cost"] > budget:
@@ -194,6 +203,8 @@ def summary_lines(rec: dict, budget: float | None = None, max_moves: int | None 
     if rec.get("classes") and rec["classes"] != counts:
         lines.append("pose cl.    " + " -> ".join(str(c) for c in rec["classes"])
                      + "  (pose classes; the interpretation count where no pose is fixed yet)")  # fmt: skip
+    if rec.get("placements"):
+        lines.append("placements  " + placements_line(rec["placements"]))
     lines.append("verdict     " + verdict_line(rec))
     if rec.get("verified"):
         lines.append("verified    " + verified_line(rec))
@@ -256,6 +267,7 @@ def run(args: argparse.Namespace) -> int:
         model=args.object, seed=args.seed, policy=args.policy, executor=args.executor, noise=args.noise,
         models=args.models, max_moves=args.max_moves, record=args.record, skip_invalid=args.skip_invalid,
         verify=args.verify, moves=args.moves, units=args.units, learn=args.learn, learn_name=args.learn_name,
+        fingers=args.fingers,
     )  # fmt: skip
     check_settings(settings, cli_option)
     spec = EpisodeSpec(**settings)

@@ -507,3 +507,25 @@ def test_a_decision_without_candidates_says_what_it_was():
     assert line == f"move 3: chose face +x ({UNSCORED})"
     assert "among 0" not in line and "fallback" not in line
     assert UNSCORED in decision_table(3, Decision(move))
+
+
+def test_a_placement_is_drawn_finger_by_finger_with_its_candidate_table(tmp_path):
+    """An episode where the planner places fingers (four fingers, tracing moves, no verification): each finger's
+    closings in its own colour under ``world/placements/<finger>``, and a table of the candidate placements."""
+    from haptic.recording.style import FINGER_COLORS
+
+    out = tmp_path / "placed.rrd"
+    recorder = EpisodeRecorder(out)
+    spec = EpisodeSpec(model="BOX01N", seed=1, fingers=4, moves="tracing", verify="none")
+    record = run_episode(spec, observer=recorder.observer())
+    recorder.close()
+    assert record.placements and record.placements[0]["status"] == "ok"
+    ents = load_recording(out)
+    touched = [f["finger"] for f in record.placements[0]["fingers"] if f["status"] == "touched"]
+    assert touched
+    for finger in touched:
+        packed = int(ents[f"world/placements/{finger}/contacts"].series("Points3D:colors")[1][-1][0])
+        assert tuple((packed >> s) & 255 for s in (24, 16, 8)) == FINGER_COLORS[finger]
+    assert len(set(FINGER_COLORS.values())) == len(FINGER_COLORS), "one colour per finger"
+    _, tables = ents["decision/placements"].series("TextDocument:text")
+    assert any("(chosen)" in t[0] and "placement of" in t[0] for t in tables)

@@ -23,7 +23,7 @@ def add_parser(sub: Subcommands) -> None:
     from haptic.bench import DEFAULT_EPISODES, DEFAULT_NOISES, DEFAULT_OUT, DEFAULT_POLICIES
     from haptic.episode.spec import DEFAULT_EXECUTOR, DEFAULT_MAX_MOVES, DEFAULT_SEED, EXECUTORS
     from haptic.matching.acceptance import DEFAULT_VERIFY, VERIFY_MODES
-    from haptic.options import add_units_option, noise_levels, positive_int, seed_int
+    from haptic.options import add_fingers_option, add_units_option, noise_levels, positive_int, seed_int
     from haptic.planning.moves import DEFAULT_MOVES, HAND_DEFAULT_MOVES, MOVE_SETS
     from haptic.planning.registry import POLICY_NAMES
 
@@ -66,6 +66,7 @@ def add_parser(sub: Subcommands) -> None:
         "(free-space probes alone, geometric executor; a verification traces too) or all (both, one "
         "planner ranking them)",
     )  # fmt: skip
+    add_fingers_option(p)
     p.add_argument("--out", default=DEFAULT_OUT, help="results file (JSON lines)")
     p.add_argument("--workers", type=positive_int, default=1,
                    help="worker processes (local backend); CPUs of a Ray started here (ray backend)")
@@ -131,7 +132,7 @@ def _run(args: argparse.Namespace, held: DeferredInterrupts) -> int:
         check_output_file(path, "--out (its summary beside it)", "out/bench/results.jsonl", BenchError)
     common = dict(
         executor=args.executor, models=args.models, max_moves=args.max_moves, skip_invalid=args.skip_invalid,
-        verify=args.verify, moves=args.moves, units=args.units,
+        verify=args.verify, moves=args.moves, units=args.units, fingers=args.fingers,
     )  # fmt: skip
     check_settings(common, cli_option)
     if args.learn is not None:
@@ -223,7 +224,9 @@ def _write_summary(out: Path, no_plot: bool, quiet: bool = False) -> None:
 
     records = read_results(out) if out.exists() else []
     probing = any(r.get("move_set", "tracing") != "tracing" for r in records)  # a column only where it tells
-    keys = ("library", "executor", "noise", "verify", *(("move_set",) if probing else ()), "policy")
+    placing = any(r.get("fingers", 1) != 1 for r in records)
+    keys = ("library", "executor", "noise", "verify", *(("move_set",) if probing else ()),
+            *(("fingers",) if placing else ()), "policy")  # fmt: skip
     rows = summary_rows(records, keys)
     atomic_write(out.with_suffix(".md"), markdown_table(rows))
     if not quiet:

@@ -62,6 +62,9 @@ def summary_rows(records: Sequence[dict], keys: Sequence[str] = ("library", "pol
             decision_ms_median=float(np.median(dt) * 1e3) if len(dt) else float("nan"),
             pose_error_mm_median=_median([r.get("pose_error_mm") for r in ok]),
             pose_error_deg_median=_median([r.get("pose_error_deg") for r in ok]),
+            placements=sum(len(r.get("placements", ())) for r in rs),
+            placements_ok=sum(p["status"] == "ok" for r in rs for p in r.get("placements", ())),
+            all_moves=sum(r["moves"] for r in rs),
         )
         rows.append(row)
     return rows
@@ -77,11 +80,12 @@ def markdown_table(rows: Sequence[dict]) -> str:
     if not rows:
         return "(no episodes)\n"
     group_keys = [
-        k for k in rows[0] if k in ("library", "policy", "executor", "noise", "verify", "move_set", "model")
+        k for k in rows[0] if k in ("library", "policy", "executor", "noise", "verify", "move_set", "fingers", "model")
     ]
+    placing = "fingers" in group_keys
     cols = [*group_keys, "episodes", "correct %", "wrong model", "wrong pose", "ambig.", "no-match", "budget",
             "failed", "moves mean", "moves median", "cost mean", "cost median", "cost mean (all)", "decide ms",
-            "pose mm", "pose deg"]
+            "pose mm", "pose deg", *(("placements (ok)", "placement share %") if placing else ())]
     lines = ["| " + " | ".join(cols) + " |", "|" + "|".join("---" for _ in cols) + "|"]
     for r in rows:
         vals = [str(r[k]) for k in group_keys] + [
@@ -102,6 +106,9 @@ def markdown_table(rows: Sequence[dict]) -> str:
             f"{r['pose_error_mm_median']:.3f}",
             f"{r['pose_error_deg_median']:.3f}",
         ]
+        if placing:
+            share = 100.0 * r["placements"] / r["all_moves"] if r["all_moves"] else 0.0
+            vals += [f"{r['placements']} ({r['placements_ok']})", f"{share:.1f}"]
         lines.append("| " + " | ".join(vals) + " |")
     return "\n".join(lines) + "\n"
 
@@ -112,7 +119,7 @@ def compact_table(rows: Sequence[dict]) -> str:
     recognised episodes. The markdown table (:func:`markdown_table`) has the rest."""
     if not rows:
         return "(no episodes)\n"
-    keys = [k for k in rows[0] if k in ("library", "executor", "noise", "verify", "move_set", "model")
+    keys = [k for k in rows[0] if k in ("library", "executor", "noise", "verify", "move_set", "fingers", "model")
             and len({str(r[k]) for r in rows}) > 1] + ["policy"]  # fmt: skip
     head = [*keys, "episodes", "correct", "wrong", "other", "mean cost", "mean moves"]
     body = []

@@ -82,6 +82,11 @@ class EpisodeRecord:
     """Free-space probes carried out."""
     probe_misses: int = 0
     """Of those, probes that met nothing (negative evidence)."""
+    fingers: int = 1
+    """Fingers the hand could use at once (``EpisodeSpec.fingers``; a record written before it existed: 1)."""
+    placements: list[dict] = field(default_factory=list)
+    """Each placement of several fingertips carried out or failed, in order: its ``status`` ("ok" or why it
+    failed) and ``fingers``, per finger its name and ``status`` ("touched", "missed" or why it failed)."""
     learned: dict | None = None
     """How learning the object went after ``no-match`` (``--learn DIR``: :mod:`haptic.episode.learning`; None:
     no learning)."""
@@ -398,7 +403,9 @@ def _record(
         verified=verifier.record(view.cost) if verifier is not None else None,
         move_set=spec.moves,
         probes=n_probes,
-        probe_misses=n_probes - len(view.probe_faces),
+        probe_misses=n_probes - (len(view.probe_faces) - view.placement_faces),
+        fingers=spec.fingers,
+        placements=list(view.placements),
     )
 
 

@@ -15,7 +15,7 @@ from haptic.errors import HapticError
 from haptic.geometry.io import UNITS
 from haptic.matching.acceptance import DEFAULT_VERIFY, VERIFY_MODES
 from haptic.matching.components import NOISE_LEVELS
-from haptic.planning.moves import MOVE_SETS, default_moves
+from haptic.planning.moves import FINGER_COUNTS, MOVE_SETS, default_fingers, default_moves
 
 EXECUTORS = ("geometric", "physics")
 """The executors an episode runs on: the ideal sensor with noise, the simulated hand."""
@@ -31,10 +31,10 @@ DEFAULT_BUDGET = 600.0
 DEFAULT_MAX_MOVES = 40
 """Move budget (verification moves not counted)."""
 
-LEGACY_DEFAULTS = {"verify": "none", "moves": "tracing", "units": "m"}
+LEGACY_DEFAULTS = {"verify": "none", "moves": "tracing", "units": "m", "fingers": 1}
 """What an episode written before a setting existed (or before its default changed) was run with: verification
-none, tracing moves, files read in metres. Bench keys missing a setting read as these (:func:`~haptic.bench.runner
-.key_id`)."""
+none, tracing moves, files read in metres, the index finger alone. Bench keys missing a setting read as these
+(:func:`~haptic.bench.runner.key_id`)."""
 
 
 def python_option(name: str, value) -> str:
@@ -51,7 +51,7 @@ def check_settings(values: Mapping, spell: Callable[[str, object], str] = python
     """Refuse settings no episode can run with, by a :class:`~haptic.errors.HapticError` naming the setting as
     ``spell`` writes it (:func:`python_option` or :func:`cli_option`) and what would be valid. ``values``: any of
     the fields of :class:`EpisodeSpec`."""
-    for check in (_check_choices, _check_moves, _check_counts, _check_noise, _check_budget):
+    for check in (_check_choices, _check_moves, _check_fingers, _check_counts, _check_noise, _check_budget):
         why = check(values, spell)
         if why is not None:
             name, text = why
@@ -80,6 +80,19 @@ def _check_moves(values: Mapping, spell: Callable[[str, object], str]) -> tuple[
     if moves == "probing" and executor != "geometric":
         return "moves", (f"is not available: probes alone run on the geometric executor only; valid with "
                          f"{spell('executor', executor)}: tracing, all")  # fmt: skip
+    return None
+
+
+def _check_fingers(values: Mapping, spell: Callable[[str, object], str]) -> tuple[str, str] | None:
+    fingers = values.get("fingers")
+    if fingers is None:
+        return None
+    if isinstance(fingers, bool) or fingers not in FINGER_COUNTS:
+        return "fingers", f"is not a number of fingers; valid: {', '.join(map(str, FINGER_COUNTS))}"
+    executor = values.get("executor", DEFAULT_EXECUTOR)
+    if fingers > 1 and executor != "geometric":
+        return "fingers", (f"is not available: placements of several fingertips run on the geometric executor "
+                           f"only; valid with {spell('executor', executor)}: 1")  # fmt: skip
     return None
 
 
@@ -151,6 +164,11 @@ class EpisodeSpec:
     units: str | None = None
     """Units of the library's model files that declare none ("mm", "cm" or "m"; None: the library's
     ``library.toml``, else metres). A file's own declaration comes first."""
+    fingers: int | None = None
+    """Fingers the hand may use at once (``FINGER_COUNTS``): 1, the index finger alone; 2 or 4, placements of up
+    to that many fingertips join the moves (:mod:`haptic.planning.placements`). None: the executor's default
+    (:func:`haptic.planning.moves.default_fingers`), filled in at construction. A record written before the field
+    existed was run with 1."""
     learn: str | None = None
     """Library directory a model learned after ``no-match`` is written into (``--learn DIR``: the episode explores
     on until the object's surface is closed, :mod:`haptic.episode.learning`); None: no learning."""
@@ -161,3 +179,5 @@ class EpisodeSpec:
         check_settings({k: getattr(self, k) for k in self.__dataclass_fields__})
         if self.moves is None:
             object.__setattr__(self, "moves", default_moves(self.executor))
+        if self.fingers is None:
+            object.__setattr__(self, "fingers", default_fingers(self.executor))

@@ -97,6 +97,11 @@ class EpisodeState:
     """Kind of the start's move ("start" when it reports none) and of each successful move."""
     decision_times: list[float] = field(default_factory=list)
     """Wall time of each decision a policy took [s]."""
+    placement_faces: int = 0
+    """Of :attr:`probe_faces`, those placements touched."""
+    placements: list[dict] = field(default_factory=list)
+    """Each placement of several fingertips carried out or failed: its ``status`` and, per finger, what it did
+    (the executor's ``info["fingers"]``)."""
     _hypotheses: tuple[Recognition | None, list[Hypothesis]] = (None, [])
 
     @classmethod
@@ -152,10 +157,12 @@ class EpisodeState:
         self.failed_here.clear()
         for c in result.components:
             self.components[c.id] = c
-            self.tree.add(c)
+        self.tree.add_move(result.components)
         self.free.extend(result.free_space)
-        if result.move is not None and result.move.kind == "probe":
+        if result.move is not None and result.move.kind in ("probe", "placement"):  # faces hit along lines
             self.probe_faces.extend(c.id for c in result.components)
+            self.placement_faces += len(result.components) if result.move.kind == "placement" else 0
+        if result.move is not None and result.move.kind == "probe":
             self.probed.append(result.move)
         if self.free:  # after every add: poses tighten, and leaves unposed or too many before become testable
             apply_probes(self.tree, self.free, self.probe_faces)
@@ -165,6 +172,7 @@ class EpisodeState:
                 self.tree.retain(keep)
         if self.config.touch_evidence:
             self.touched.append(touched_points(result, self.config))
+        self._placed(result)
         self.cost += result.cost
         self.rec = self.assess()
         self.sensor = result.state
@@ -173,9 +181,15 @@ class EpisodeState:
         self.cum_cost.append(self.cost)
         self.kinds.append(result.move.kind if result.move is not None else "start")
 
+    def _placed(self, result: MoveResult) -> None:
+        if result.move is not None and result.move.kind == "placement":
+            fingers = [{"finger": f["finger"], "status": f["status"]} for f in result.info.get("fingers", ())]
+            self.placements.append({"status": str(result.status), "fingers": fingers})
+
     def failed(self, move: Move, result: MoveResult) -> None:
         """Book a move that failed: its cost, where the sensor ended (when known), and its touches: when they
         set pose classes aside, the failure does not count toward those in a row."""
+        self._placed(result)
         self.failed_total += 1
         self.failed_in_a_row += 1
         self.last_failure = result.status

@@ -99,7 +99,7 @@ class GeometricWorld:
         config: PlannerConfig | None = None,
     ) -> Episode:
         library, true_model, (pose_rng, exec_rng, policy_rng, _) = _setup(spec, library)
-        config = replace(config or PlannerConfig(), moves=spec.moves)
+        config = replace(config or PlannerConfig(), moves=spec.moves, fingers=spec.fingers)
         world_from_model = SE3.random(pose_rng, translation_scale=0.1)
         noise = NoiseModel(check_noise_level(spec.noise)).fitted
         settings = GeometricSettings()
@@ -146,7 +146,7 @@ class PhysicsWorld:
         from haptic.sim.scene import scene_object_from_polyhedron
 
         library, true_model, (pose_rng, exec_rng, policy_rng, sim_seq) = _setup(spec, library)
-        config = replace(config or PlannerConfig(), moves=spec.moves)
+        config = replace(config or PlannerConfig(), moves=spec.moves, fingers=spec.fingers)
         obj = scene_object_from_polyhedron(true_model)
         pose = random_object_pose(obj, pose_rng)
         scene = compose_scene(obj, pose)
@@ -154,7 +154,7 @@ class PhysicsWorld:
             ws = scene.workspace
             config = replace(
                 config, table_z=ws.table_top_z, pad_radius=ws.pad_radius, steep_descent_risk=STEEP_DESCENT_RISK,
-                max_undercut=TouchConfig().max_undercut, touch_evidence=True,
+                max_undercut=TouchConfig().reach_undercut, touch_evidence=True,
             )  # fmt: skip
         sim_noise, bounds, noise = noise_models(NoiseModel(check_noise_level(spec.noise)))
         sim = Simulation(scene, noise=sim_noise, seed=int(sim_seq.integers(2**31 - 1)))

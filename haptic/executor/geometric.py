@@ -32,6 +32,7 @@ from haptic.planning.moves import (
     FaceMove,
     Move,
     MoveResult,
+    PlacementMove,
     ProbeMove,
     SensorState,
     VertexMove,
@@ -280,6 +281,8 @@ class GeometricExecutor:
             return self._vertex_move(move)
         if isinstance(move, ProbeMove):
             return self._probe_move(move)
+        if isinstance(move, PlacementMove):
+            return self._placement_move(move)
         return MoveResult(move=move, status="invalid", state=self.state, reason=f"unknown move {move!r}")
 
     def _probe_move(self, move: ProbeMove) -> MoveResult:
@@ -318,6 +321,60 @@ class GeometricExecutor:
         s = transfer + length + float(np.linalg.norm(move.end - here))
         return MoveResult(move=move, status="ok", distance=s, cost=self.costs.probe_move(s), state=self.state,
                           free_space=(free,), info={"contact": None})  # fmt: skip
+
+    def _placement_move(self, move: PlacementMove) -> MoveResult:
+        """Several fingertips at once (seed §5): each finger closes along its line as a probe does (:meth:`_probe_move`)
+        from one approach of the hand. Each finger that touches yields a face component (its contact point and the
+        face's normal, each with its own noise), in the order of the fingers; one that meets nothing reports its line
+        free; one whose line starts inside the object fails alone ("unreachable"), the others' components stand. The
+        sensor rests on the first face touched (where it was when none is). The move fails only when every finger
+        does. ``info["fingers"]``: per finger, its name, ``status`` ("touched", "missed" or why it failed) and the data
+        id of its face (or None)."""
+        if (problem := move.problem()) is not None:
+            return self._invalid(move, problem)
+        inv = self.world_from_model.inverse()
+        here = np.asarray(self.state.position, dtype=float)
+        rho = self.noise.k * self.noise.position_sigma
+        comps: list[DataFace] = []
+        free: list[FreeSegment] = []
+        fingers: list[dict] = []
+        transfer, closing, back = 0.0, 0.0, np.inf
+        first_hit: tuple[np.ndarray, int] | None = None
+        for f in move.fingers:
+            start, u, length = np.asarray(f.start, dtype=float), np.asarray(f.direction, dtype=float), float(f.length)
+            s_m, u_m = inv.apply(start), inv.rotate(u)
+            if bool(self.model.contains(s_m[None])[0]):
+                fingers.append({"finger": f.finger, "status": "unreachable", "component": None,
+                                "reason": "the line starts inside the object"})  # fmt: skip
+                continue
+            transfer = max(transfer, float(np.linalg.norm(start - here)))
+            hits = line_hits(self.model, s_m[None], u_m[None])
+            t_hit, face = float(hits.first[0]), int(hits.face[0])
+            if t_hit <= length:
+                free.append(FreeSegment(start + self._vec3(self.noise.position_sigma), u, t_hit, rho))
+                point_m = s_m + t_hit * u_m
+                comp = self._face(face, point_m[None], ())
+                comps.append(comp)
+                if first_hit is None:
+                    first_hit = (point_m, comp.id)
+                closing = max(closing, t_hit)
+                fingers.append({"finger": f.finger, "status": "touched", "component": comp.id, "contact": t_hit})
+            else:
+                free.append(FreeSegment(start + self._vec3(self.noise.position_sigma), u, length, rho))
+                closing = max(closing, length)
+                back = min(back, float(np.linalg.norm(start + length * u - here)))
+                fingers.append({"finger": f.finger, "status": "missed", "component": None, "contact": None})
+        if not free:
+            return MoveResult(move=move, status="unreachable", state=self.state, info={"fingers": fingers},
+                              reason="every finger's line starts inside the object")  # fmt: skip
+        self.components.extend(comps)
+        if first_hit is not None:
+            self._pos = first_hit[0]
+            self.state = self._state(face=first_hit[1])
+        s = transfer + closing + (0.0 if comps else back)
+        cost = self.costs.placement_move(s, len(move.fingers), 0)  # the ideal sensor has the normals at contact
+        return MoveResult(move=move, status="ok", components=tuple(comps), distance=s, cost=cost, state=self.state,
+                          free_space=tuple(free), info={"fingers": fingers})  # fmt: skip
 
     def _invalid(self, move: Move, reason: str) -> MoveResult:
         return MoveResult(move=move, status="invalid", state=self.state, reason=reason)

@@ -193,19 +193,38 @@ class Toucher:
         self.robot.set_hybrid(cfg.force, velocity, normal_hint=hint, rotation_in_world=self.hand_rotation)
         self.hybrid = True
 
-    def _settle(self, phase: str = "settle") -> bool:
+    def _settle(self, phase: str = "settle") -> str | None:
         """Press in place until the force has stayed within the band for ``settle_time`` (at most
-        ``settle_max``). False when the simulation became unhealthy."""
+        ``settle_max``). None when settled; ``"nan"`` when the simulation became unhealthy, ``"runaway"`` when
+        the pad ran off (:meth:`_ran_away`)."""
         cfg = self.config
         need = max(1, int(cfg.settle_time / self.dt))
         good = 0
+        start = self.tip.copy()
         for _ in range(max(need, int(cfg.settle_max / self.dt))):
             self.tick(phase)
             if self._unhealthy:
-                return False
+                return "nan"
+            if self._ran_away(start):
+                return "runaway"
             good = good + 1 if abs(self.contact[0] - cfg.force) < cfg.settle_band * cfg.force else 0
             if good >= need:
                 break
+        return None
+
+    def _ran_away(self, start: np.ndarray, along: np.ndarray | None = None) -> bool:
+        """Whether the pad, pressing in place from ``start`` (or moving from it along the unit ``along``), has
+        left that point (that line) by more than :attr:`TouchConfig.runaway`: the force controller pushing into
+        a contact it lost, or the arm jammed against the object and thrown off; the pad is then stopped and held
+        where it is by the joints."""
+        off = self.tip - start
+        if along is not None:
+            off = off - float(off @ along) * along
+        if float(off @ off) <= self.config.runaway**2:
+            return False
+        self.hybrid = False
+        self.robot.hold_posture()
+        self.tick("free")
         return True
 
     def link_touch(self):
@@ -394,6 +413,8 @@ class Toucher:
             self.tick("approach")
             if self._unhealthy:
                 return self._result("unstable", "nan", 0.0)
+            if self._ran_away(start, d):
+                return self._result("unreachable", "runaway", 0.0)
             if self.touching:
                 touched = True
                 break
@@ -405,8 +426,9 @@ class Toucher:
             self.robot.move_fingertip(self.tip.copy(), self.hand_rotation)
             return self._result("ok", "contact", 0.0, normal=self.normal.copy(), point=self.contact[2].copy())
         self._press(np.zeros(3), hint=-d)
-        if not self._settle():
-            return self._result("unstable", "nan", 0.0)
+        why = self._settle()
+        if why is not None:
+            return self._result("unstable" if why == "nan" else "unreachable", why, 0.0)
         if self.contact[1] is None:
             return self._result("no-contact", "lost", 0.0)
         return self._result("ok", "contact", 0.0, normal=self.normal.copy(), point=self.contact[2].copy())
@@ -630,8 +652,9 @@ class Toucher:
         n_f = unit(np.asarray(normal, dtype=float))
         # out of a concave corner the force is shared by both faces: press on the new one alone before sliding
         self._press(np.zeros(3), hint=n_f)
-        if not self._settle("settle"):
-            return self._result("unstable", "nan", 0.0)
+        why = self._settle("settle")
+        if why is not None:
+            return self._result("unstable" if why == "nan" else "unreachable", why, 0.0)
         self.take_trace()  # rows in place, not of the stroke
         pieces = [self.trace_face(away, n_f, cfg.step_in if step_in is None else step_in, phase="stroke")]
         if not pieces[-1].ok and pieces[-1].event not in STOPS:
@@ -752,10 +775,13 @@ class Toucher:
     def hold(self, seconds: float, phase: str = "vertex") -> PrimitiveResult:
         """Press in place (zero tangential velocity) for ``seconds``."""
         self._press(np.zeros(3))
+        start = self.tip.copy()
         for _ in range(max(1, int(seconds / self.dt))):
             self.tick(phase)
             if self._unhealthy:
                 return self._result("unstable", "nan", 0.0)
+            if self._ran_away(start):
+                return self._result("unreachable", "runaway", 0.0)
         return self._result("ok", "done", 0.0)
 
     # -- around a vertex ---------------------------------------------------------------------------------------

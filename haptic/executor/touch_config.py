@@ -64,10 +64,14 @@ class TouchConfig:
     undercut_slack: float = math.radians(3.0)
     """Rolling off a face that itself leans under near the limit, the roll ends for the undercut only once the
     normal leans this much further than the face's (not on a noisy first reading) [rad]."""
-    max_undercut: float = math.radians(30.0)
+    max_undercut: float = math.radians(35.0)
     """The pad reaches a surface whose normal leans at most this far back against the finger's axis (past
     perpendicular to it); beyond, the finger's phalanx meets the object first and the pad loses contact. A
-    roll over a convex edge stops there (event ``"undercut"``) [rad]."""
+    roll over a convex edge stops there (event ``"undercut"``) [rad] ..."""
+    undercut_margin: float = math.radians(4.0)
+    """... and the planner counts on it only this much short of the limit (:attr:`reach_undercut`): a face
+    leaning under by the limit itself, at a pose known to a degree or so, may end the roll before the pad is on
+    it [rad]."""
     tilt_angles: tuple[float, ...] = (math.radians(30.0), math.radians(15.0))
     """A move whose pad a link of the finger lifted off the object (the phalanx meeting the rim of a hole, a face
     leaning over the one traced) tilts the hand, the finger leaning away from that contact, by the first of these
@@ -149,7 +153,9 @@ class TouchConfig:
     """A free move whose pad leaves the straight path to its target by more than this is stopped and held where
     it is by its joints (the arm met a joint limit and cannot keep the hand's orientation along the path: the
     task-space control would carry it on across the workspace); the move ends ``unreachable``, event
-    ``runaway`` [m]."""
+    ``runaway`` [m]. So does a guarded approach whose pad leaves its line by this, and a press in place (settling
+    on a contact, holding at a vertex) whose pad leaves its point by this: the force controller pushing on into
+    a contact it lost, or the arm jammed against the object and thrown off."""
     posture_tol: float = 0.02
     """A joint-space move back to the arm's home posture family ends when every arm joint is within this [rad]."""
     guarded_settle: float = 0.5
@@ -182,6 +188,12 @@ class TouchConfig:
     link_every: int = 10
     """The hand's link positions (forward kinematics, for recordings) are sampled every this many ticks
     (0: never) [ticks]."""
+
+    @property
+    def reach_undercut(self) -> float:
+        """The undercut the planner's reach model takes the hand to reach: ``max_undercut`` less
+        ``undercut_margin`` [rad]."""
+        return self.max_undercut - self.undercut_margin
 
     def contact_threshold(self, force_sigma: float) -> float:
         """Sensed force above which a contact counts [N], for a force sensor of σ ``force_sigma`` [N]."""

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from haptic.geometry import kernels
 from haptic.geometry.distance import surface_distance
 from haptic.geometry.polyhedron import Polyhedron
 from haptic.geometry.se3 import cross
@@ -129,17 +130,26 @@ def sample_inside_many(
     the segment). The surface passes through such an end, so no point is farther from the surface than from it."""
     starts = np.atleast_2d(np.asarray(starts, dtype=float))
     directions = np.atleast_2d(np.asarray(directions, dtype=float))
-    hits = line_hits(poly, starts, directions)
+    if kernels.COMPILED:
+        tri = np.ascontiguousarray(poly.vertices[poly.triangles], dtype=float)
+        params = kernels.line_params(starts, directions, tri, BARYCENTRIC_SLACK)
+    else:
+        params = line_hits(poly, starts, directions).params
     cuts, mids, crossings = [], [], []
     for k, length in enumerate(np.asarray(lengths, dtype=float)):
-        ts = hits.params[k]
+        ts = params[k]
         ts = ts[np.isfinite(ts)]
         crossings.append(ts[(ts >= 0.0) & (ts <= length)])
         ts = np.unique(np.clip(ts, 0.0, length))
         c = np.unique(np.concatenate([[0.0], ts, [float(length)]]))
         cuts.append(c)
         mids.append(starts[k] + (0.5 * (c[:-1] + c[1:]))[:, None] * directions[k])
-    inside = poly.contains(np.concatenate(mids)) if sum(len(m) for m in mids) else np.zeros(0, dtype=bool)
+    if not sum(len(m) for m in mids):
+        inside = np.zeros(0, dtype=bool)
+    elif kernels.COMPILED:
+        inside = kernels.contains(np.concatenate(mids), tri)
+    else:
+        inside = poly.contains(np.concatenate(mids))
     out, at = [], 0
     for k, c in enumerate(cuts):
         spans, at = _inside_spans(c, inside[at : at + len(c) - 1]), at + len(c) - 1

@@ -63,6 +63,10 @@ def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """``np.cross`` of 3-vectors along the last axis, broadcast, with the same arithmetic (so the same bits) and
     without its axis handling, which dominates on the small arrays of the planner's inner loops."""
     a, b = np.asarray(a), np.asarray(b)
+    if a.shape == b.shape == (3,) and a.dtype == b.dtype == np.float64:  # two vectors: in Python floats, the same bits
+        a0, a1, a2 = a.tolist()
+        b0, b1, b2 = b.tolist()
+        return np.array((a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0))
     a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
     b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
     out = np.empty(np.broadcast_shapes(a.shape, b.shape), dtype=np.result_type(a, b))

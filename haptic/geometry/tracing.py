@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from haptic.geometry import kernels
 from haptic.geometry.polyhedron import Polyhedron
 from haptic.geometry.se3 import cross, plane_basis
 
@@ -76,8 +77,25 @@ def trace_face(
     # the start and the face's corners on its plane: a model read from a rounded file has its corners off the
     # plane by up to its precision, and a point stepped over from a neighbouring face is off by as much
     start = start - (start @ n - poly.face_offsets[face]) * n
-    best = None
     corners, sides = _plane_corners(poly, face)
+    if kernels.COMPILED:
+        k, t, u, seg_len = kernels.face_crossing(corners, sides, n, start, d, _STEADY, _MARGIN)
+        best = None if k < 0 else (t, poly.face_edges[face][k], u, seg_len)
+    else:
+        best = _crossing(poly, face, corners, sides, n, start, d)
+    if best is None:
+        return None
+    t, e, u, seg_len = best
+    if min(u, 1 - u) * seg_len < vertex_margin:
+        return None
+    other = poly.edge_right_face[e] if poly.edge_left_face[e] == face else poly.edge_left_face[e]
+    return FaceHit(edge=int(e), distance=float(t), point=start + t * d, next_face=int(other))
+
+
+def _crossing(poly: Polyhedron, face: int, corners, sides, n, start, d) -> tuple[float, int, float, float] | None:
+    """The first side of ``face`` that the trace from ``start`` along unit ``d`` meets, as ``(t, edge, u, side
+    length)``, or None (:func:`trace_face`; :func:`~haptic.geometry.kernels.face_crossing` is its compiled form)."""
+    best = None
     # which sides the trace can meet, from the crossing solved for every side at once; only those are solved
     # exactly one by one below (a side it misses by a margin far above the arithmetic's error is not: the same sides
     # are then met, with the same numbers)
@@ -112,13 +130,7 @@ def trace_face(
             continue  # off-plane
         if best is None or t < best[0]:
             best = (t, e, u, math.sqrt(gg))
-    if best is None:
-        return None
-    t, e, u, seg_len = best
-    if min(u, 1 - u) * seg_len < vertex_margin:
-        return None
-    other = poly.edge_right_face[e] if poly.edge_left_face[e] == face else poly.edge_left_face[e]
-    return FaceHit(edge=int(e), distance=float(t), point=start + t * d, next_face=int(other))
+    return best
 
 
 _STEADY = 1e-3

@@ -34,6 +34,7 @@ import numpy as np
 from haptic.geometry.distance import paired_point_triangle_distance
 from haptic.geometry.polyhedron import LearnedBounds, Polyhedron
 from haptic.geometry.se3 import SE3
+from haptic.matching import kernels
 from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex, SensorNoise
 from haptic.matching.tree import Interpretation
 
@@ -98,13 +99,14 @@ class PoseCheck:
 
 def _angle(u: np.ndarray, v: np.ndarray) -> float:
     """Angle between two 3-vectors [rad]: the arithmetic of ``arccos(clip(u·v / (‖u‖ ‖v‖), −1, 1))`` with numpy
-    (the same bits) on Python floats, which the residuals' per-component loop calls many times."""
+    (the same bits) on Python floats, which the residuals' per-component loop calls many times. The arc cosine is
+    numpy's: the C library's ``acos`` differs from it in the last bit on some machines."""
     num, den = float(u @ v), math.sqrt(float(u.dot(u))) * math.sqrt(float(v.dot(v)))
     if den == 0.0:  # a zero vector: as numpy divides
         with np.errstate(divide="ignore", invalid="ignore"):
             return float(np.arccos(np.clip(np.float64(num) / den, -1.0, 1.0)))
     c = num / den
-    return math.acos(-1.0 if c < -1.0 else 1.0 if c > 1.0 else c)
+    return float(np.arccos(-1.0 if c < -1.0 else 1.0 if c > 1.0 else c))
 
 
 def _coplanar(model: Polyhedron, f: int) -> np.ndarray:
@@ -125,6 +127,7 @@ def _model_bounds(model: Polyhedron) -> LearnedBounds:
 
 
 _PLANE_TRIANGLES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+_TRIANGLES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 def _plane_triangles(model: Polyhedron) -> np.ndarray:
@@ -135,6 +138,13 @@ def _plane_triangles(model: Polyhedron) -> np.ndarray:
             [np.isin(model.triangle_faces, _coplanar(model, f)) for f in range(model.n_faces)]
         ).reshape(model.n_faces, len(model.triangles))
     return _PLANE_TRIANGLES[model]
+
+
+def _triangles(model: Polyhedron) -> np.ndarray:
+    """The model's triangles' corners, shape (T, 3, 3) (computed once per model)."""
+    if model not in _TRIANGLES:
+        _TRIANGLES[model] = np.ascontiguousarray(model.vertices[model.triangles], float)
+    return _TRIANGLES[model]
 
 
 def _face_point_distances(
@@ -152,7 +162,12 @@ def _face_point_distances(
     allowed = _plane_triangles(model)[np.array([f for _, f in pairs])][owner]
     # only the (point, triangle) pairs that count: every point has its own face's triangles
     point, tri = np.nonzero(allowed)
-    d = paired_point_triangle_distance(np.concatenate(pts)[point], model.vertices[model.triangles][tri])
+    if kernels.COMPILED:
+        d = kernels.paired_point_triangle_distance(
+            np.ascontiguousarray(np.concatenate(pts)[point], float), np.ascontiguousarray(_triangles(model)[tri])
+        )
+    else:
+        d = paired_point_triangle_distance(np.concatenate(pts)[point], model.vertices[model.triangles][tri])
     nearest = np.minimum.reduceat(d, np.flatnonzero(np.diff(point, prepend=-1)))
     out = np.full(len(pairs), -np.inf)
     np.maximum.at(out, owner, nearest)

@@ -18,6 +18,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from haptic.geometry.se3 import cross
+from haptic.matching import kernels
 from haptic.matching.components import DataComponent
 
 MIN_SPREAD = 0.05
@@ -168,6 +169,27 @@ class StackedPoses:
             return np.broadcast_to(np.eye(3), (self.n, 3, 3)).copy(), ok
         return proper_rotations(self.dirs_w, self.dirs_m, self.dirs_wt), ok
 
+    def _compiled_initial(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`initial` by the compiled kernels (:mod:`haptic.matching.kernels`): the same poses to the rounding."""
+        if not self.dirs_w.shape[0]:
+            return np.broadcast_to(np.eye(3), (self.n, 3, 3)).copy(), np.zeros(self.n, bool), np.zeros((self.n, 3))
+        r, ok = kernels.closed_form_rotations(
+            self.dirs_w, np.ascontiguousarray(self.dirs_m), np.ascontiguousarray(self.dirs_wt),
+            np.ascontiguousarray(self.dirs_known), MIN_SPREAD,
+        )  # fmt: skip
+        if not ok.any():
+            return np.broadcast_to(np.eye(3), (self.n, 3, 3)).copy(), ok, np.zeros((self.n, 3))
+        if len(self.plane_q) + 3 * len(self.line_x) + 3 * len(self.pt_d) < 3:
+            return r, np.zeros(self.n, bool), np.zeros((self.n, 3))
+        x, c, _ = self._position_rows()
+        q, total, ok_t = self._normal_matrices()
+        ok &= ok_t
+        t = kernels.closed_form_translations(
+            np.ascontiguousarray(q), np.ascontiguousarray(total), ok, np.ascontiguousarray(x),
+            np.ascontiguousarray(c), r,
+        )  # fmt: skip
+        return r, ok, t
+
     def translations(self, r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``(t (N, 3), ok (N,))``: the translation by linear least squares on planes, lines and vertices given
         the rotations, where that system is well conditioned (its smallest singular value at least
@@ -217,6 +239,9 @@ class StackedPoses:
 
     def initial(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(R, t, ok)``: the closed-form poses (rotation from directions, then translation), unrefined."""
+        if kernels.COMPILED:
+            r, ok, t = self._compiled_initial()
+            return r, t, ok
         r, ok = self.rotations()
         t = np.zeros((self.n, 3))
         if ok.any():
@@ -287,6 +312,14 @@ class StackedPoses:
         r, t = np.array(r, dtype=float), np.array(t, dtype=float)
         if not len(r):
             return r, t
+        if kernels.COMPILED:
+            x, c, m = (np.ascontiguousarray(a) for a in self._position_rows())
+            r_c, t_c = r.copy(), t.copy()
+            sw = np.ascontiguousarray(self._dirs_sw)
+            if kernels.refine_poses(
+                self.dirs_w, np.ascontiguousarray(self.dirs_m), sw, x, c, m, r_c, t_c, iterations, GN_TOLERANCE
+            ):
+                return r_c, t_c
         active = np.ones(len(r), bool)
         for _ in range(iterations):
             f, jac = self._residuals_and_jacobian(r, t)

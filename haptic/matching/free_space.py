@@ -32,6 +32,7 @@ from haptic.geometry.distance import surface_distance
 from haptic.geometry.polyhedron import Polyhedron
 from haptic.geometry.raycast import depth_samples, sample_inside_many
 from haptic.geometry.se3 import SE3
+from haptic.matching import kernels
 from haptic.matching.acceptance import leaf_pose_check
 from haptic.matching.components import DataFace, readonly_vector
 from haptic.matching.recognition import PoseTolerance
@@ -143,7 +144,12 @@ def free_segments_consistent(
             margins.append(margin[need])
     if not points:
         return True
-    return bool((surface_distance(model, np.concatenate(points)) <= np.concatenate(margins)).all())
+    if kernels.COMPILED:
+        tri = np.ascontiguousarray(model.vertices[model.triangles], float)
+        depth = kernels.surface_distance(np.ascontiguousarray(np.concatenate(points), float), tri)
+    else:
+        depth = surface_distance(model, np.concatenate(points))
+    return bool((depth <= np.concatenate(margins)).all())
 
 
 def consistent_leaves(

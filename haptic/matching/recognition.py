@@ -19,6 +19,7 @@ import numpy as np
 from haptic.geometry.polyhedron import Polyhedron
 from haptic.geometry.se3 import SE3, rotation_angle
 from haptic.geometry.symmetry import congruences, symmetry_group
+from haptic.matching import kernels
 from haptic.matching.tree import Interpretation, InterpretationTree
 
 RECOGNIZED, AMBIGUOUS, NO_MATCH, EXPLORING = "recognized", "ambiguous", "no-match", "exploring"
@@ -151,6 +152,12 @@ def _same_pose_pairs(
     centroid placed by each pose."""
     c = model.centroid
     s_rot, s_trans = _symmetry_arrays(model)
+    if kernels.COMPILED:
+        f = np.ascontiguousarray
+        return kernels.same_pose_pairs(
+            f(rot, float), f(trans, float), f(placed, float), f(c, float), f(s_rot, float), f(s_trans, float),
+            float(tol.angle), float(tol.distance),
+        )  # fmt: skip
     r_as = rot[:, None] @ s_rot[None]  # (N, S, 3, 3): pose i ∘ symmetry s
     c_as = r_as @ c + s_trans @ np.swapaxes(rot, -1, -2) + trans[:, None]
     cos = (np.einsum("isab,jab->isj", r_as, rot) - 1.0) / 2.0

@@ -38,6 +38,7 @@ from haptic.errors import MatchError
 from haptic.geometry.polyhedron import LearnedBounds, Polyhedron
 from haptic.geometry.se3 import SE3, cross
 from haptic.matching import constraints as C
+from haptic.matching import kernels
 from haptic.matching.batch_poses import StackedPoses
 from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex
 from haptic.matching.library import EDGE, FACE, KIND_INDEX, KINDS, VERTEX, LibraryArrays
@@ -312,6 +313,22 @@ class InterpretationTree:
         self._stack = None
         return self.count
 
+    def add_move(self, components: Sequence[DataComponent]) -> int:
+        """Add the components one move yielded together -- a placement's faces, one per finger -- and return the
+        number of interpretations. The move's new components must come in order of their ids, as an executor
+        numbers them. Each is paired with every admissible model component (§2.3) and tested against every
+        earlier component, the move's own before it included, so every pairwise constraint of §2.6 between the
+        move's components holds in each interpretation left: the relative positions and normals measured in one
+        hand frame apply at once, the paper's constraints unchanged (seed §5: "the matching part is essentially
+        unchanged")."""
+        fresh = list(dict.fromkeys(c.id for c in components if c.id >= len(self._data)))  # (an edge re-reported)
+        if fresh != list(range(len(self._data), len(self._data) + len(fresh))):
+            raise MatchError(f"a move's new components must have the next ids in order ({len(self._data)} on), "
+                             f"got {fresh}")  # fmt: skip
+        for c in components:
+            self.add(c)
+        return self.count
+
     def add_all(self, components: Iterable[DataComponent]) -> list[int]:
         """Add components in order; the interpretation count after each."""
         return [self.add(c) for c in components]
@@ -544,12 +561,22 @@ class InterpretationTree:
             sj = sense[:, eids]
             mj = assign[:, eids]
             p_mj, b_mj, _ = self._aligned_edge(mj, sj)
-            res = C.edge_pair_tests(
-                p_d, b_d, l_d, ed["p"][eids], ed["b"][eids], ed["l"][eids],
-                p_m[:, None], b_m[:, None], l_m[:, None], p_mj, b_mj, lib.edge_length[mj],
-                beta, ed["beta"][eids], rho, ed["rho"][eids], lam, ed["lam"][eids],
-                start, end, ed["start"][eids], ed["end"][eids],
-            )  # fmt: skip
+            if kernels.COMPILED:
+                f = np.ascontiguousarray
+                res = kernels.edge_pair_tests(
+                    f(p_d, float), f(b_d, float), float(l_d), f(ed["p"][eids]), f(ed["b"][eids]), f(ed["l"][eids]),
+                    f(p_m, float), f(b_m, float), f(l_m, float), f(p_mj, float), f(b_mj, float),
+                    f(lib.edge_length[mj], float), float(beta), f(ed["beta"][eids]), float(rho), f(ed["rho"][eids]),
+                    float(lam), f(ed["lam"][eids]), start, end, f(ed["start"][eids]), f(ed["end"][eids]),
+                    C.SAFETY, C.ANGLE_FLOOR, C.LENGTH_FLOOR, C.MIN_SIN, float(np.cos(C.PARALLEL_MODEL)),
+                )  # fmt: skip
+            else:
+                res = C.edge_pair_tests(
+                    p_d, b_d, l_d, ed["p"][eids], ed["b"][eids], ed["l"][eids],
+                    p_m[:, None], b_m[:, None], l_m[:, None], p_mj, b_mj, lib.edge_length[mj],
+                    beta, ed["beta"][eids], rho, ed["rho"][eids], lam, ed["lam"][eids],
+                    start, end, ed["start"][eids], ed["end"][eids],
+                )  # fmt: skip
             ok &= (res | ~(known[:, None] & (sj != 0))).all(axis=1)
         fd = data.arrays(FACE)
         fids = self._others(FACE, k, width)

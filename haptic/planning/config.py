@@ -76,6 +76,9 @@ class PlannerConfig:
     (:mod:`haptic.planning.bound`). None: no bound. 256 is above the most pose classes the shipped libraries
     leave at a planner decision (255, look-alike library, with the loop posing up to
     ``haptic.episode.state.MAX_GROUPED_INTERPRETATIONS`` interpretations), so their decisions are unchanged."""
+    fingers: int = 1
+    """Fingers the hand may use at once (``FINGER_COUNTS``): 1, the index finger alone (no placements); 2 or 4,
+    placements of two up to that many fingertips (:mod:`haptic.planning.placements`) join the candidates."""
     moves: str = "tracing"
     """Admissible kinds of move (``MOVE_SETS``): "tracing" (face, edge and vertex moves), "probing" (free-space
     probes) or "all" (both, ranked together by one efficiency, seed §1.1)."""

@@ -19,6 +19,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from haptic.matching import kernels
+
 
 def distinguishable(outcomes: np.ndarray, bounds: np.ndarray) -> np.ndarray:
     """``D[i, j]`` is True when hypothesis ``j``'s outcome differs from ``i``'s beyond the error bounds.
@@ -30,6 +32,8 @@ def distinguishable(outcomes: np.ndarray, bounds: np.ndarray) -> np.ndarray:
     if o.ndim == 1:
         o = o[:, None]
     b = np.broadcast_to(np.asarray(bounds, dtype=float), (o.shape[1],))
+    if kernels.COMPILED:
+        return kernels.distinguishable(np.ascontiguousarray(o), np.ascontiguousarray(b))
     diff = np.abs(o[:, None, :] - o[None, :, :])  # (N, N, A)
     with np.errstate(invalid="ignore"):
         beyond = diff > b[None, None, :] * (1 + 1e-9) + 1e-12

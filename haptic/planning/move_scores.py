@@ -20,7 +20,14 @@ from haptic.planning.config import PlannerConfig
 from haptic.planning.efficiency import class_weights, distinguishable, efficiency_of, expected_eliminated
 from haptic.planning.handpath import HandStart
 from haptic.planning.hypothesis import Hypothesis, trace_in
-from haptic.planning.moves import EdgeMove, FaceMove, Move, ProbeMove, SensorState
+from haptic.planning.moves import EdgeMove, FaceMove, Move, PlacementMove, ProbeMove, SensorState
+from haptic.planning.placements import (
+    HAND_MAX_TILT,
+    PlacementConfig,
+    PlacementPrediction,
+    candidate_placements,
+    same_placement,
+)
 from haptic.planning.predict import Prediction, candidate_moves, crossed_edge, predict_moves
 from haptic.planning.probe_lines import ProbeConfig, candidate_probes
 from haptic.planning.probe_prediction import ProbePrediction, predict_probes
@@ -93,7 +100,8 @@ def score_all(ctx: Context) -> list[tuple[Prediction | ProbePrediction, float, f
     moves the hypotheses predict to run into it are left out and the rest discounted by that risk.
     Free-space probes join them when ``config.moves`` admits them, scored in the same form
     (:meth:`ProbePrediction.score`, on the simulated hand discounted by :meth:`ProbePrediction.risk`), so one
-    planner ranks every kind of move together; ``config.moves == "probing"`` leaves the tracing moves out.
+    planner ranks every kind of move together; ``config.moves == "probing"`` leaves the tracing moves out. With
+    ``config.fingers`` > 1, placements of several fingertips join them too (:func:`score_placements`).
 
     Computed once per decision: a context scored again (the observation of :mod:`haptic.env` and then the planner
     acting through it, at one decision) gets the same scores back while its data components are the same objects;
@@ -107,7 +115,8 @@ def score_all(ctx: Context) -> list[tuple[Prediction | ProbePrediction, float, f
     return out
 
 
-def _score_all(ctx: Context) -> list[tuple[Prediction | ProbePrediction, float, float, float, float]]:
+def _score_all(ctx: Context) -> list[tuple[Prediction | ProbePrediction | PlacementPrediction, float, float, float,
+                                           float]]:
     weights = class_weights([h.model for h in ctx.hypotheses])
     out: list = []
     if ctx.config.moves != "probing":
@@ -118,8 +127,9 @@ def _score_all(ctx: Context) -> list[tuple[Prediction | ProbePrediction, float, 
         refused = [(p, refusal(p, ctx.config)) for p in preds]
         refused = [(p, r) for p, r in refused if r < ctx.config.table_risk] or refused
         out = [(pred, *score_prediction(pred, weights, r, ctx.config)) for pred, r in refused]
-    probes = weak_probes(ctx, predict_probe_moves(ctx))
-    return out + [s for s in (score_probe(pred, weights) for pred in probes) if s is not None]
+    lines = weak_probes(ctx, predict_probe_moves(ctx))
+    probes = [s for s in (score_probe(pred, weights) for pred in lines) if s is not None]
+    return out + probes + score_placements(ctx, weights, lines if ctx.config.moves != "tracing" else None)
 
 
 def remeasures(ctx: Context, move: Move) -> bool:
@@ -153,6 +163,31 @@ def remeasures(ctx: Context, move: Move) -> bool:
             if tr is None or tr.hit.edge not in set(h.edges.values()) or tr.hit.next_face not in set(h.faces.values()):
                 return False
     return True
+
+
+def score_placements(ctx: Context, weights: np.ndarray, lines: Sequence[ProbePrediction] | None = None) -> list[tuple]:
+    """Placements of several fingertips (``config.fingers`` > 1, every hypothesis posed), scored as
+    :func:`score_all` scores moves, ``(pred, efficiency, eliminations, cost, risk)``: their fingers' lines are
+    the candidate probe lines (``lines``, the probes' predictions when the move set has them, else
+    :func:`placement_lines`) and a finger predicted to fail tells nothing
+    (:class:`~haptic.planning.placements.PlacementPrediction`)."""
+    if ctx.config.fingers < 2 or not ctx.hypotheses or any(h.world_from_model is None for h in ctx.hypotheses):
+        return []
+    lines = placement_lines(ctx) if lines is None else lines
+    lines = [p for p in lines if p.risk(weights) < PROBE_RISK]
+    avoid = [m for m in ctx.avoid if isinstance(m, PlacementMove)]
+    cfg = PlacementConfig(max_tilt=HAND_MAX_TILT) if ctx.config.table_z is not None else PlacementConfig()
+    preds = candidate_placements(lines, weights, ctx.config.fingers, ctx.state.position, ctx.config.costs,
+                                 hand_start(ctx), cfg, avoid)  # fmt: skip
+    return [(p, *p.score(weights), p.risk(weights)) for p in preds]
+
+
+def placement_lines(ctx: Context) -> list[ProbePrediction]:
+    """The lines a placement's fingers may close along: the candidate probe lines
+    (:func:`~haptic.planning.probe_lines.candidate_probes`), predicted in every hypothesis."""
+    cfg = probe_config(ctx.config)
+    moves = candidate_probes(ctx.hypotheses, cfg)
+    return weak_probes(ctx, predict_probe_moves(ctx, moves))
 
 
 def score_probe(pred: ProbePrediction, weights: np.ndarray) -> tuple | None:
@@ -332,6 +367,8 @@ def same_move(a: Move, b: Move) -> bool:
         return float(np.dot(a.direction, b.direction)) > 0.99
     if a.kind == "edge":
         return a.sense == b.sense
+    if a.kind == "placement":
+        return same_placement(a, b)
     if a.kind == "probe":  # one line: the same direction, starts within a probe target's spacing
         return (
             float(np.dot(a.direction, b.direction)) > 0.99

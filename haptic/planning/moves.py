@@ -28,6 +28,19 @@ HAND_DEFAULT_MOVES = "tracing"
 from the face a probe left the pad on, confirm fewer recognitions than after the seed's tracing (README)."""
 
 
+DEFAULT_FINGERS = 1
+"""Fingers at once unless asked for (``--fingers``), on the geometric executor (README, "Several fingers at
+once")."""
+HAND_DEFAULT_FINGERS = 1
+"""The same on the simulated hand: the index finger alone, its placements of several fingertips not yet carried
+out by the physics executor."""
+
+
+def default_fingers(executor: str) -> int:
+    """The command line's fingers at once for ``executor`` when ``--fingers`` is not given."""
+    return HAND_DEFAULT_FINGERS if executor == "physics" else DEFAULT_FINGERS
+
+
 def default_moves(executor: str) -> str:
     """The command line's move set for ``executor`` when ``--moves`` is not given."""
     return HAND_DEFAULT_MOVES if executor == "physics" else DEFAULT_MOVES
@@ -60,6 +73,12 @@ class CostModel:
     """Per free-space probe: leaving the surface, the guarded approach and its contact (or its end) [units]."""
     c_s: float = 20.0
     """Moving through free space, to a probe's line and along it [units/m]."""
+    c_m: float = 3.0
+    """Per placement of several fingertips at once: setting the hand's posture for all its fingers and bringing
+    it to the placement -- more than one probe's ``c_p``, less than two: the fingers close together, in one
+    approach [units]."""
+    c_q: float = 0.5
+    """Per finger of a placement: its own guarded closing to contact (or to the end of its line) [units]."""
 
     def face_move(self, s: float) -> float:
         """``c_f s + c_j + c_b + c_n`` (§4, face move)."""
@@ -77,6 +96,16 @@ class CostModel:
         """``c_p + c_s s`` (§3.1 in the manner of the tracing moves; ``s``: the distance travelled in free space,
         to the line's start, along it to contact or its end, and back to the surface after a miss)."""
         return self.c_p + self.c_s * s
+
+    def placement_move(self, s: float, fingers: int, strokes: int) -> float:
+        """``c_m + c_s s + fingers · c_q + strokes · c_n``: a placement of several fingertips at once (seed §5's
+        multi-finger move, costed in the manner of §3.1): the fixed ``c_m``, the hand's travel ``s`` through free
+        space (to the placement and the longest finger's closing), each finger's closing, and the brief stroke
+        that measures the normal of each face a pad touched (``strokes``: none for a point sensor, which has the
+        normal at contact, as its probes do). Two fingers cost ``4 + c_s s`` with a point sensor, against
+        ``4 + c_s (s_1 + s_2)`` for two probes; on the hand, touching, ``5 + c_s s`` against ``5 + c_s (s_1 + s_2)``;
+        four cost ``5 + c_s s`` against ``8 + c_s Σ s_i`` with a point sensor."""
+        return self.c_m + self.c_s * s + fingers * self.c_q + strokes * self.c_n
 
 
 @dataclass(frozen=True, eq=False)
@@ -178,7 +207,63 @@ class ProbeMove:
         return None
 
 
-Move = FaceMove | EdgeMove | VertexMove | ProbeMove
+FINGER_COUNTS = (1, 2, 4)
+"""The fingers an episode may use at once (``--fingers``): the index finger alone, or placements of up to two or
+four fingertips."""
+
+
+@dataclass(frozen=True, eq=False)
+class FingerApproach:
+    """One fingertip's part of a placement: a guarded closing along a line, as a probe's (seed §1.1), ending at
+    contact (then a brief press and stroke for the face's normal) or at the line's end (free space)."""
+
+    finger: str
+    """Which finger (a name of ``haptic.sim.scene.FINGERS``: index, middle, ring, thumb)."""
+    start: np.ndarray
+    """Start of the finger's line in the world frame, shape (3,) [m]."""
+    direction: np.ndarray
+    """Unit direction of its closing in the world frame, shape (3,)."""
+    length: float
+    """How far along the line it closes before it counts as a miss [m]."""
+
+    @property
+    def line(self) -> ProbeMove:
+        """The finger's line as a probe (:class:`ProbeMove`)."""
+        return ProbeMove(np.asarray(self.start, dtype=float), np.asarray(self.direction, dtype=float),
+                         float(self.length))  # fmt: skip
+
+    @property
+    def end(self) -> np.ndarray:
+        """``start + length · direction`` [m]."""
+        return self.line.end
+
+
+@dataclass(frozen=True, eq=False)
+class PlacementMove:
+    """Two to four fingertips placed at once, in one approach of the hand, each closing along its own line onto a
+    different predicted face (:class:`FingerApproach`); each finger that touches yields a face component (its
+    contact point and normal), and one that meets nothing its line as free space. A finger that fails does not
+    fail the others (seed §5: the multi-finger move the paper left for further work)."""
+
+    fingers: tuple[FingerApproach, ...]
+    """The fingers' approaches, at most one per finger."""
+
+    kind = "placement"
+
+    def problem(self) -> str | None:
+        """Why the placement cannot be carried out as given (an executor's "invalid" reason), or None."""
+        if not 2 <= len(self.fingers) <= 4:
+            return f"a placement takes 2 to 4 fingers, got {len(self.fingers)}"
+        if len({f.finger for f in self.fingers}) != len(self.fingers):
+            return "a placement uses each finger at most once"
+        for f in self.fingers:
+            why = f.line.problem()
+            if why is not None:
+                return f"finger {f.finger}: {why}"
+        return None
+
+
+Move = FaceMove | EdgeMove | VertexMove | ProbeMove | PlacementMove
 
 
 class MoveStatus(StrEnum):

@@ -77,6 +77,8 @@ class OptimalPolicy(Policy):
         self._planner = PlannerPolicy()
 
     def choose(self, ctx: Context, rng: np.random.Generator) -> Decision:
+        if ctx.config.fingers > 1:  # the search simulates one sensor: placements are the planner's alone
+            ctx = replace(ctx, config=replace(ctx.config, fingers=1))
         hyps = list(ctx.hypotheses)
         if len(hyps) > self.max_hypotheses or any(h.world_from_model is None for h in hyps):
             return self._planner.choose(ctx, rng)

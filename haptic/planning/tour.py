@@ -239,11 +239,10 @@ class Tour:
         if len(ring) == 1:
             return float(start[ring[0]])
         r = np.array(ring)
-        nxt = np.roll(r, -1)
-        leg = self.legs[r, nxt]
+        leg = self.legs[r, np.concatenate((r[1:], r[:1]))]  # (np.roll's values, without its axis handling)
         total = float(leg.sum())
-        drop = np.maximum(leg, np.roll(leg, 1))  # the leg after each target, or the one before it
-        return float(np.min(start[r] + total - drop))
+        drop = np.maximum(leg, np.concatenate((leg[-1:], leg[:-1])))  # the leg after each target, or the one before
+        return float((start[r] + total - drop).min())
 
 
 def _two_opt(order: np.ndarray, legs: np.ndarray) -> np.ndarray:

@@ -201,7 +201,10 @@ def aimed_face_moves(
     """Face moves across the current face aimed, in hypothesis ``h``'s world, at what of it is missing: a point
     :data:`AIM_NEAR_VERTEX` from each missing vertex of the face on either edge at it, and the midpoint of each
     missing edge of the face. The planner's fixed directions (§4.1) rarely end near a vertex; these do, so
-    that the vertex costs a short edge move rather than an edge's length.
+    that the vertex costs a short edge move rather than an edge's length. On the hand (``config.concave_end_block``
+    set) the target is the pad's radius from the vertex (at most half the edge): crossing nearer, the pad rolling
+    over the edge touches the third face at the vertex too, and the stroke on the next face measures a rim rather
+    than a face ("too few contacts on the next face").
 
     On the hand (``config.concave_end_block`` set), at a reflex corner (a missing vertex where a concave edge
     of the face ends, or whose corner of the face is reflex): no target on a concave edge (the pad in the corner
@@ -234,10 +237,12 @@ def aimed_face_moves(
                 continue  # the pad in the corner touches both faces: the move ends on the concave edge
             d = poly.vertices[nb] - poly.vertices[v]
             length = float(np.linalg.norm(d))
-            aim = AIM_NEAR_VERTEX + config.pad_radius if hand and (beside or reflex) else AIM_NEAR_VERTEX
+            if not hand:
+                aim, cap = AIM_NEAR_VERTEX, 0.25
+            else:  # the pad crossing nearer the vertex than its radius rolls onto the third face there too
+                aim, cap = (AIM_NEAR_VERTEX if beside or reflex else 0.0) + config.pad_radius, 0.5
             if length > 0:
-                targets.append((poly.vertices[v] + min(aim, 0.25 * length if aim == AIM_NEAR_VERTEX
-                                                     else 0.5 * length) * d / length, v))  # fmt: skip
+                targets.append((poly.vertices[v] + min(aim, cap * length) * d / length, v))
     for e in poly.face_edges[f_m]:
         if int(e) in missing[1]:
             targets.append((poly.edge_points[e] + 0.5 * poly.edge_lengths[e] * poly.edge_directions[e], None))
@@ -245,16 +250,23 @@ def aimed_face_moves(
     along = edge.direction if isinstance(edge, DataEdge) else None
     origin = state.position
     e_m = h.edges.get(state.edge) if state.edge is not None else None
+    out_of_corner = None  # starting in a concave corner: the in-plane direction away from its edge
     if hand and e_m is not None and poly.edge_convexity[e_m] < 0 and f_m in (poly.edge_left_face[e_m],
                                                                             poly.edge_right_face[e_m]):
         p0, u = t.apply(poly.edge_points[e_m]), t.rotate(poly.edge_directions[e_m])  # the edge's line, world
         on_line = p0 + float((origin - p0) @ u) * u
-        origin = on_line + (config.pad_radius + CONCAVE_STEP_OFF) * t.rotate(_inward(poly, e_m, f_m))
+        out_of_corner = t.rotate(_inward(poly, e_m, f_m))
+        origin = on_line + (config.pad_radius + CONCAVE_STEP_OFF) * out_of_corner
     out = []
     for p, v in targets:
         if float(np.linalg.norm(_in_plane(t.apply(p) - state.position, face.normal))) < AIM_NEAR_VERTEX:
             continue  # at hand
         d = _in_plane(t.apply(p) - origin, face.normal)
+        if out_of_corner is not None and float(d @ out_of_corner) < 0:
+            # a target nearer the concave edge than the pad's radius (a short edge beside it): heading back into
+            # the corner the pad meets the face across again and ends on the same edge; along the edge instead it
+            # stays clear of that face and leaves the current face a pad's radius from the corner
+            d = d - float(d @ out_of_corner) * out_of_corner
         n = float(np.linalg.norm(d))
         if n < 1e-9:
             continue
@@ -794,4 +806,7 @@ class Verifier:
             out["move_budget"] = self.move_budget()
             out.update(self.coverage.record(self._model))
             out["vertices_hidden"] = len(self.hidden) + len(self.unpinnable)
+            # verified up to what the hand cannot measure: every feature in its reach measured (the status says
+            # whether that was all: "incomplete" with vertices hidden is this, never "confirmed")
+            out["reach_complete"] = bool(self.coverage.met(self.mode))
         return out

@@ -68,6 +68,12 @@ def waypoints(prev: np.ndarray | None, result: MoveResult, new: np.ndarray | Non
     one: the geometric executor's path (it has no fingertip trajectory)."""
     pts: list[np.ndarray] = [prev] if prev is not None else []
     move = result.move
+    if getattr(move, "kind", None) == "placement":  # to the first finger's line, and along it to its contact
+        first = move.fingers[0]
+        start = np.asarray(first.start, dtype=float)
+        if result.components:
+            return np.array([*pts, start, np.atleast_2d(result.components[0].points)[0]])
+        return np.array([*pts, start, first.end, *pts])
     if getattr(move, "kind", None) == "probe":  # through free space to the line, along it, back after a miss
         start = np.asarray(move.start, dtype=float)
         if result.components:
@@ -253,6 +259,28 @@ def decision_table(i: int, decision: Decision) -> str:
     return "\n".join(rows)
 
 
+def placement_table(i: int, decision: Decision) -> str:
+    """Markdown: the decision's candidate placements, best first, each finger's closing direction and line."""
+    cands = [c for c in decision.candidates if getattr(c.move, "kind", None) == "placement"]
+    cands.sort(key=lambda c: -c.score if math.isfinite(c.score) else math.inf)
+    if not cands:
+        return f"**move {i}**: no placement among the candidates"
+    rows = [f"**move {i}**: {len(cands)} candidate placements", "",
+            "| placement | score | exp. cost | exp. eliminated | fingers: closing direction, line |",
+            "|---|--:|--:|--:|---|"]  # fmt: skip
+    for c in cands[:MAX_TABLE_ROWS]:
+        name = f"**{move_name(c.move)}** (chosen)" if c.move == decision.move else move_name(c.move)
+        fingers = "; ".join(
+            f"{f.finger} ({f.direction[0]:+.2f}, {f.direction[1]:+.2f}, {f.direction[2]:+.2f}) "
+            f"{100 * float(f.length):.0f} cm"
+            for f in c.move.fingers
+        )
+        rows.append(f"| {name} | {c.score:.3g} | {c.expected_cost:.2f} | {c.expected_eliminated:.2f} | {fingers} |")
+    if len(cands) > MAX_TABLE_ROWS:
+        rows.append(f"| ... {len(cands) - MAX_TABLE_ROWS} more | | | | |")
+    return "\n".join(rows)
+
+
 def move_name(move: Move) -> str:
     """The move's kind and direction: ``face (+0.92, +0.33, -0.22)`` (a world direction), ``edge +``,
     ``vertex across f2``, ``probe (+0.00, -0.71, -0.71) 12 cm`` (the approach direction and the line's length)."""
@@ -267,4 +295,6 @@ def move_name(move: Move) -> str:
     if kind == "probe":
         d = np.asarray(move.direction, dtype=float)
         return f"probe ({d[0]:+.2f}, {d[1]:+.2f}, {d[2]:+.2f}) {100 * float(move.length):.0f} cm"
+    if kind == "placement":
+        return f"placement of {len(move.fingers)} ({', '.join(f.finger for f in move.fingers)})"
     return str(move)

@@ -33,6 +33,7 @@ from haptic.recording.drawing import (
     mesh,
     move_name,
     patch,
+    placement_table,
     score_color,
     subsample,
     trace_of,
@@ -53,6 +54,7 @@ from haptic.recording.style import (
     EDGE_RADIUS,
     ESTIMATE_COLOR,
     FACE_COLOR,
+    FINGER_COLORS,
     FINGERTIP_VIEW_DISTANCE,
     INTERPRETATIONS_COLOR,
     KIND_COLORS,
@@ -128,6 +130,9 @@ class _State:
     """Probes that met the object: line start, contact and sensed normal (world) [m]."""
     probe_misses: list[np.ndarray] = field(default_factory=list)
     """Probes that met nothing: their whole line, (2, 3) [m]."""
+    placed: dict[str, list[tuple[np.ndarray, np.ndarray, np.ndarray | None]]] = field(default_factory=dict)
+    """Per finger, each of its closings in a placement: line start, contact (or the line's end) and sensed normal
+    (None: it met nothing) (world) [m]."""
     position: np.ndarray | None = None
     sim_time: float | None = None
     cost: float = 0.0
@@ -351,6 +356,8 @@ class EpisodeRecorder:
         self._log_hand(result, trace)
         if kind == "probe":
             self._log_probe(result)
+        if kind == "placement":
+            self._log_placement(result)
 
         self._log_components()
 
@@ -380,6 +387,38 @@ class EpisodeRecorder:
                 level=rr.TextLogLevel.INFO,
             ),
         )
+
+    def _log_placement(self, result: MoveResult) -> None:
+        """Every placement's fingers so far, each finger in its own colour (``world/placements/<finger>``): a
+        touch as its line from the start to the contact, the contact and its normal; a finger that met nothing as
+        its whole line; a finger that failed not at all."""
+        rec, s = self.stream, self._s
+        faces = {c.id: c for c in result.components if isinstance(c, DataFace)}
+        done = []
+        for f, what in zip(result.move.fingers, result.info.get("fingers", ()), strict=False):
+            if what.get("status") == "touched" and what.get("component") in faces:
+                face = faces[what["component"]]
+                s.placed.setdefault(f.finger, []).append(
+                    (np.asarray(f.start, dtype=float), np.atleast_2d(face.points)[0], np.asarray(face.normal)))
+            elif what.get("status") == "missed":
+                s.placed.setdefault(f.finger, []).append((np.asarray(f.start, dtype=float), f.end, None))
+            done.append(f"{f.finger} {what.get('status', '?')}")
+        for finger, closings in s.placed.items():
+            color = FINGER_COLORS.get(finger, KIND_COLORS["placement"])
+            lines = [np.array([a, b]) for a, b, _ in closings]
+            rec.log(f"world/placements/{finger}/lines",
+                    rr.LineStrips3D(lines, colors=[color], radii=PROBE_RADIUS,
+                                    labels=[finger] * len(lines), show_labels=False))  # fmt: skip
+            touched = [(b, n) for _, b, n in closings if n is not None]
+            if touched:
+                pts, nrm = np.array([b for b, _ in touched]), np.array([n for _, n in touched])
+                rec.log(f"world/placements/{finger}/contacts",
+                        rr.Points3D(pts, radii=CONTACT_RADIUS, colors=[color], labels=[finger] * len(pts),
+                                    show_labels=False))  # fmt: skip
+                rec.log(f"world/placements/{finger}/normals",
+                        rr.Arrows3D(origins=pts, vectors=nrm * NORMAL_SCALE * s.radius, colors=[color],
+                                    radii=ARROW_RADIUS))  # fmt: skip
+        rec.log("log/moves", rr.TextLog(f"placement: {', '.join(done)}", level=rr.TextLogLevel.INFO))
 
     def _log_probe(self, result: MoveResult) -> None:
         """Every probe so far: a hit as its line from the start to the contact, the contact and its normal
@@ -516,6 +555,18 @@ class EpisodeRecorder:
                             colors=[(255, 255, 255)], radii=rr.components.Radius.ui_points(2.5),
                             labels=[move_name(decision.move)], show_labels=False),
             )  # fmt: skip
+        if getattr(decision.move, "kind", None) == "placement":
+            rec.log(
+                "world/decision/chosen",
+                rr.Arrows3D(origins=[f.start for f in decision.move.fingers],
+                            vectors=[f.end - np.asarray(f.start) for f in decision.move.fingers],
+                            colors=[FINGER_COLORS.get(f.finger, (255, 255, 255)) for f in decision.move.fingers],
+                            radii=rr.components.Radius.ui_points(2.5),
+                            labels=[f.finger for f in decision.move.fingers], show_labels=False),
+            )  # fmt: skip
+        if any(getattr(c.move, "kind", None) == "placement" for c in cands):
+            rec.log("decision/placements",
+                    rr.TextDocument(placement_table(i, decision), media_type=rr.MediaType.MARKDOWN))  # fmt: skip
         s.decision_shown = True
         rec.log("decision/scores", rr.TextDocument(decision_table(i, decision), media_type=rr.MediaType.MARKDOWN))
         rec.log(

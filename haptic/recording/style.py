@@ -67,12 +67,21 @@ KIND_COLORS: dict[str, tuple[int, int, int]] = {
     "edge": (240, 150, 40),
     "vertex": (190, 90, 220),
     "probe": (235, 60, 160),
+    "placement": (40, 190, 170),
     "failed": (230, 50, 50),
 }
 """Colour of each move kind (path strips, move markers on the interpretation plot, candidates)."""
 PROBE_HIT_COLOR = KIND_COLORS["probe"]
 """A probe that met the object: its line from its start to the contact, the contact and its normal."""
 PROBE_MISS_COLOR = (40, 40, 40)
+FINGER_COLORS: dict[str, tuple[int, int, int]] = {
+    "index": (40, 190, 170),
+    "middle": (250, 210, 40),
+    "ring": (120, 220, 60),
+    "thumb": (250, 120, 90),
+}
+"""Colour of each finger of a placement: its line from its start to the contact (or its whole line, dimmed, when it
+met nothing), its contact and its normal."""
 """A probe that met nothing: its whole line (free space)."""
 PROBE_RADIUS = rr.components.Radius.ui_points(2.5)
 FACE_COLOR = (70, 130, 230, 140)

@@ -115,6 +115,36 @@ def test_a_free_move_that_runs_away_from_its_line_is_stopped_and_the_arm_brought
     assert t.move_free(target).ok  # the arm still moves where it is asked
 
 
+def test_an_approach_or_a_press_that_runs_away_is_stopped(monkeypatch):
+    """A guarded approach whose pad leaves its line by ``runaway`` (the arm jammed against the object and thrown
+    off), and a press in place whose pad leaves its point by that (the force controller pushing on into a contact
+    it lost), stop with event ``runaway`` near where they were, instead of pushing on across the workspace."""
+    sim = _box_sim()
+    robot = RobotInterface(sim)
+    t = Toucher(robot)
+    top = CENTRE[2] + HALF[2]
+    above = np.array([CENTRE[0] - 0.02, CENTRE[1], top + 0.03])
+    assert t.move_free(above).ok
+    real_move, real_press = RobotInterface.move_fingertip, RobotInterface.set_hybrid
+    drift = np.array([0.0, 0.15, 0.0])  # a controller that carries the pad sideways
+    monkeypatch.setattr(RobotInterface, "move_fingertip", lambda self, p, r="hold": real_move(self, p + drift, r))
+    r = t.approach(np.array([0.0, 0.0, -1.0]), 0.05)
+    assert r.status == "unreachable" and r.event == "runaway"
+    assert np.linalg.norm((t.tip - above)[:2]) < 0.05  # stopped near its line
+    monkeypatch.setattr(RobotInterface, "move_fingertip", real_move)
+    assert t.move_free(above).ok
+    a = t.approach(np.array([0.0, 0.0, -1.0]), 0.05)
+    assert a.ok and a.event == "contact"
+    at = t.tip.copy()
+    monkeypatch.setattr(RobotInterface, "set_hybrid",
+                        lambda self, f, v, **kw: real_press(self, f, np.asarray(v) + [0.0, 0.2, 0.0], **kw))
+    h = t.hold(2.0)
+    assert h.status == "unreachable" and h.event == "runaway"
+    assert np.linalg.norm(t.tip - at) < 0.04
+    monkeypatch.setattr(RobotInterface, "set_hybrid", real_press)
+    assert t.move_free(above).ok  # the arm still moves where it is asked
+
+
 def test_a_strokes_normal_is_the_faces_cluster_even_from_a_guess_degrees_off():
     # a face's rows share one normal (noise 0.1°); a roll's and a rim's spread over 10°: the cluster of the face
     # wins over the guess, a roll's settled normal 3.5° off it, and over the rows leaning like it

@@ -148,3 +148,36 @@ def test_random_walk_is_reproducible_from_the_generator():
         )
 
     assert np.array_equal(run(), run())
+
+
+def test_a_placement_gives_a_face_per_finger_that_touches_and_a_failed_finger_fails_alone():
+    import numpy as np
+
+    from haptic.executor.geometric import GeometricExecutor
+    from haptic.geometry import SE3, load_library
+    from haptic.matching.components import DataFace, SensorNoise
+    from haptic.planning.moves import CostModel, FingerApproach, PlacementMove
+
+    box = load_library()["BOX01"]
+    ex = GeometricExecutor(box, SE3.identity(), SensorNoise(), np.random.default_rng(0))
+    here = ex.start(face=0).state.position
+    hi, lo = box.vertices.max(axis=0), box.vertices.min(axis=0)
+    mid = (hi + lo) / 2
+    down = FingerApproach("index", np.array([mid[0], mid[1], hi[2] + 0.02]), np.array([0.0, 0.0, -1.0]), 0.05)
+    side = FingerApproach("middle", np.array([hi[0] + 0.02, mid[1], mid[2]]), np.array([-1.0, 0.0, 0.0]), 0.05)
+    away = FingerApproach("ring", np.array([hi[0] + 0.02, mid[1], hi[2] + 0.05]), np.array([-1.0, 0.0, 0.0]), 0.05)
+    inside = FingerApproach("thumb", mid, np.array([0.0, 1.0, 0.0]), 0.05)
+    res = ex.execute(PlacementMove((down, side, away, inside)))
+    assert res.ok
+    assert [f["status"] for f in res.info["fingers"]] == ["touched", "touched", "missed", "unreachable"]
+    assert len(res.components) == 2 and all(isinstance(c, DataFace) and c.adjacent == () for c in res.components)
+    assert np.allclose(res.components[0].normal, [0, 0, 1], atol=0.01)
+    assert np.allclose(res.components[1].normal, [1, 0, 0], atol=0.01)
+    assert len(res.free_space) == 3, "the lines of the fingers that closed, free up to contact or their end"
+    assert res.state.face == res.components[0].id
+    transfer = max(float(np.linalg.norm(f.start - here)) for f in (down, side, away))
+    assert res.distance == pytest.approx(transfer + 0.05), "to the farthest line, then the longest closing (the miss)"
+    assert res.cost == pytest.approx(CostModel().placement_move(res.distance, 4, 0)), "no strokes: normals at contact"
+    bad = ex.execute(PlacementMove((inside, FingerApproach("index", mid, np.array([1.0, 0.0, 0.0]), 0.05))))
+    assert not bad.ok and bad.status == "unreachable" and bad.components == ()
+    assert "2 to 4" in ex.execute(PlacementMove((down,))).reason

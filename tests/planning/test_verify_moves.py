@@ -53,6 +53,24 @@ def test_aimed_face_moves_end_beside_a_missing_vertex_and_a_short_edge_move_meas
         assert reached == set(loop), name
 
 
+def test_on_the_hand_a_vertex_is_aimed_at_a_pads_radius_from_it():
+    """The pad crossing an edge nearer a vertex than its radius rolls onto the third face there too, and its
+    stroke on the next face measures a rim: on the hand the aimed moves end a pad's radius from the vertex,
+    elsewhere :data:`AIM_NEAR_VERTEX` from it."""
+    hand = PlannerConfig(pad_radius=0.012, concave_end_block=0.2)
+    h, state, comps, _ = _on_a_face("BOX01", 0)
+    f_m = h.faces[state.face]
+    loop = [int(v) for v in h.poly.faces[f_m]]
+    missing = (frozenset(), frozenset(), frozenset(loop))
+    for config, want in ((None, AIM_NEAR_VERTEX), (hand, hand.pad_radius)):
+        moves = aimed_face_moves(h, state, comps, missing, config)
+        assert len(moves) == 2 * len(loop)
+        for m in moves:
+            h1, s1, _ = simulate(h, m, state, comps, PlannerConfig())
+            end = h.world_from_model.inverse().apply(s1.position)
+            assert abs(float(np.linalg.norm(h.poly.vertices[loop] - end, axis=1).min()) - want) < 1e-3
+
+
 def test_nothing_is_aimed_at_when_nothing_is_missing():
     h, state, comps, _ = _on_a_face("BOX01", 0)
     assert aimed_face_moves(h, state, comps, (frozenset(), frozenset(), frozenset())) == []

@@ -1,0 +1,154 @@
+"""Placements of several fingertips at once: their cost, the candidates the hypotheses give, and their scores
+beside the other moves."""
+
+import numpy as np
+import pytest
+
+from haptic.geometry import SE3, load_library
+from haptic.matching.components import DataFace, SensorNoise
+from haptic.planning.config import PlannerConfig
+from haptic.planning.efficiency import class_weights
+from haptic.planning.hypothesis import Hypothesis
+from haptic.planning.move_scores import Context, placement_lines, same_move, score_all
+from haptic.planning.moves import CostModel, FingerApproach, PlacementMove, SensorState
+from haptic.planning.placements import (
+    HAND_FINGERS,
+    PlacementConfig,
+    candidate_placements,
+    compatible,
+    placement_costs,
+)
+from haptic.planning.policies import PlannerPolicy
+
+LIB = load_library()
+NOISE = SensorNoise()
+
+
+def _context(names, fingers: int, seed: int = 3) -> Context:
+    """Pose classes of ``names`` that share data face 0: each model at one random rotation with the centre of its
+    face 0 at the sensor's point."""
+    rng = np.random.default_rng(seed)
+    base = SE3.random(rng, 0.0)
+    hyps = []
+    for name in names:
+        poly = LIB[name]
+        centre_m = poly.vertices[list(poly.faces[0])].mean(axis=0)
+        pose = base @ SE3(np.eye(3), -centre_m)
+        hyps.append(Hypothesis(model=name, poly=poly, world_from_model=pose, faces={0: 0}, edges={}, vertices={}))
+    n = hyps[0].world_from_model.rotate(hyps[0].poly.face_normals[0])
+    face = DataFace(0, n, base.translation[None, :], 0.01, 0.001)
+    state = SensorState(base.translation.copy(), 0)
+    return Context(tuple(hyps), state, {0: face}, NOISE, PlannerConfig(fingers=fingers))
+
+
+def test_a_placement_costs_the_fixed_cost_its_travel_a_closing_per_finger_and_a_stroke_per_normal():
+    c = CostModel()
+    assert c.placement_move(0.1, 2, 2) == pytest.approx(3.0 + 20.0 * 0.1 + 2 * 0.5 + 2 * 0.5)
+    assert c.placement_move(0.1, 4, 3) == pytest.approx(3.0 + 2.0 + 4 * 0.5 + 3 * 0.5)
+    # no dearer than as many probes, each travelling as far as the hand does (a point sensor: no strokes)
+    assert c.placement_move(0.1, 2, 0) == pytest.approx(2 * c.probe_move(0.05))
+    assert c.placement_move(0.1, 4, 0) < 4 * c.probe_move(0.025)
+
+
+def test_a_point_sensor_s_placement_pays_no_stroke_the_hand_s_does():
+    from haptic.planning.handpath import HandStart
+
+    ctx = _context(["BOX01", "WEDGE01", "PYR01", "BOX01N"], fingers=2)
+    weights = class_weights([h.model for h in ctx.hypotheses])
+    lines = [p for p in placement_lines(ctx) if p.hit.all()][:2]
+    assert len(lines) == 2
+    point = placement_costs(lines, ctx.state.position, ctx.config.costs)
+    n = ctx.components[0].normal
+    hand = HandStart.at(ctx.state.position, n, ctx.state.position[None], 0.012)
+    on_hand = placement_costs(lines, ctx.state.position, ctx.config.costs, hand)
+    no_strokes = placement_costs(lines, ctx.state.position, CostModel(c_n=0.0), hand)
+    assert on_hand == pytest.approx(no_strokes + 2 * ctx.config.costs.c_n)
+    assert point.shape == on_hand.shape == weights.shape
+
+
+def test_a_placement_says_what_is_wrong_with_it():
+    f = FingerApproach("index", np.zeros(3), np.array([0.0, 0.0, -1.0]), 0.1)
+    assert "2 to 4" in PlacementMove((f,)).problem()
+    assert "at most once" in PlacementMove((f, f)).problem()
+    g = FingerApproach("middle", np.zeros(3), np.array([0.0, 0.0, -2.0]), 0.1)
+    assert "middle" in PlacementMove((f, g)).problem()
+    ok = FingerApproach("middle", np.array([0.05, 0.0, 0.0]), np.array([0.0, 0.0, -1.0]), 0.1)
+    assert PlacementMove((f, ok)).problem() is None
+
+
+def test_one_finger_offers_no_placement_and_scores_as_before():
+    ctx1 = _context(["BOX01", "WEDGE01", "PYR01"], fingers=1)
+    assert not any(p.move.kind == "placement" for p, *_ in score_all(ctx1))
+
+
+@pytest.mark.parametrize("fingers", [2, 4])
+def test_candidate_placements_close_compatible_fingers_on_different_predicted_faces(fingers):
+    ctx = _context(["BOX01", "WEDGE01", "PYR01", "BOX01N"], fingers=fingers)
+    weights = class_weights([h.model for h in ctx.hypotheses])
+    lines = placement_lines(ctx)
+    cfg = PlacementConfig()
+    preds = candidate_placements(lines, weights, fingers, ctx.state.position, ctx.config.costs, config=cfg)
+    assert preds, "the hypotheses give placements"
+    sizes = {len(p.move.fingers) for p in preds}
+    assert sizes <= set(range(2, fingers + 1)) and 2 in sizes
+    for p in preds:
+        names = [f.finger for f in p.move.fingers]
+        assert names == list(HAND_FINGERS[: len(names)])
+        assert p.move.problem() is None
+        for a in range(len(p.lines)):
+            for b in range(a + 1, len(p.lines)):
+                assert compatible(p.lines[a], p.lines[b], weights, cfg)
+                ua, ub = p.move.fingers[a].direction, p.move.fingers[b].direction
+                assert float(ua @ ub) >= np.cos(cfg.max_spread) - 1e-12
+        # a hypothesis is eliminated by the placement exactly when one of its fingers' outcomes eliminates it
+        d = p.eliminates()
+        assert np.array_equal(d, np.logical_or.reduce([q.eliminates() for q in p.lines]))
+        assert p.costs == pytest.approx(placement_costs(p.lines, ctx.state.position, ctx.config.costs))
+    for i, a in enumerate(preds):  # each candidate once
+        assert not any(same_move(a.move, b.move) for b in preds[i + 1 :])
+
+
+def test_the_planner_ranks_placements_with_the_other_moves():
+    ctx = _context(["BOX01", "WEDGE01", "PYR01", "BOX01N", "BOX01P"], fingers=4)
+    scored = score_all(ctx)
+    kinds = {p.move.kind for p, *_ in scored}
+    assert "placement" in kinds and "face" in kinds
+    for p, eff, elim, cost, _risk in scored:
+        if p.move.kind == "placement":
+            e, el, co = p.score(class_weights([h.model for h in ctx.hypotheses]))
+            assert (eff, elim, cost) == pytest.approx((e, el, co))
+            assert cost >= ctx.config.costs.c_m
+    decision = PlannerPolicy().choose(ctx, np.random.default_rng(0))
+    best = max(c.score for c in decision.candidates)
+    chosen = [c for c in decision.candidates if c.move is decision.move]
+    assert chosen and chosen[0].score == pytest.approx(best)
+
+
+def test_a_failed_placement_is_not_offered_again():
+    ctx = _context(["BOX01", "WEDGE01", "PYR01", "BOX01N"], fingers=2)
+    first = [p.move for p, *_ in score_all(ctx) if p.move.kind == "placement"]
+    assert first
+    again = Context(ctx.hypotheses, ctx.state, ctx.components, NOISE, ctx.config, avoid=(first[0],))
+    assert not any(same_move(first[0], p.move) for p, *_ in score_all(again) if p.move.kind == "placement")
+
+
+def test_the_planner_predicts_what_the_ideal_sensor_does_with_a_placement():
+    """With the true pose among the hypotheses, its predicted faces touched and cost are what the geometric
+    executor then reports for each candidate placement."""
+    from haptic.executor.geometric import GeometricExecutor
+
+    rng = np.random.default_rng(2)
+    ctx = _context(["BOX01", "WEDGE01", "PYR01", "BOX01N"], fingers=4)
+    weights = class_weights([h.model for h in ctx.hypotheses])
+    preds = candidate_placements(placement_lines(ctx), weights, 4, ctx.state.position, ctx.config.costs)
+    assert preds
+    for i, h in enumerate(ctx.hypotheses):
+        for p in preds:
+            ex = GeometricExecutor(h.poly, h.world_from_model, SensorNoise(), rng)
+            ex.start(face=0, point_in_model=h.model_from_world.apply(ctx.state.position))
+            res = ex.execute(p.move)
+            assert res.ok
+            touched = [f["status"] == "touched" for f in res.info["fingers"]]
+            assert touched == [bool(q.hit[i]) for q in p.lines]
+            assert [ex.truth[c.id][1] for c in res.components] == [int(q.face[i]) for q in p.lines if q.hit[i]]
+            assert res.cost == pytest.approx(p.costs[i], abs=1e-6)
