@@ -489,7 +489,9 @@ def plan_verification_move(
     """:func:`choose_verification_move`, with the tour it planned over ``missing`` (from ``previous``'s order,
     when given) and that tour's cost from the sensor as it is [units] (None and 0 without a pose). A candidate
     predicted to measure nothing missing along a way already travelled (its :func:`outcome_key` in
-    ``travelled``), or to end within :data:`REVISIT` of a place in ``visited`` (world), is left out: the tour's
+    ``travelled``), or to end within :data:`REVISIT` of a place in ``visited`` (world), is left out without a table
+    (on the hand a move ends where the pad stops, and going back can be the way on; there it kept BOX01N's
+    verification from a vertex it then found, seed 2), unless every candidate is: the tour's
     estimate from where such moves end can keep them the cheapest, and the verification goes back and forth
     until it stalls."""
     from haptic.planning.search import simulate
@@ -521,6 +523,8 @@ def plan_verification_move(
         return None, tour, now
     best, best_score = None, np.inf
     ends: list[tuple[Move, np.ndarray | None, float]] = []
+    again: list[tuple[Move, np.ndarray | None, float]] = []  # left out as going back: the last resort
+    going_back = config.table_z is None  # the hand's moves end where the pad stops, not where predicted
     for m, c, r in [*first, *probes]:
         sim = (simulate_probe(h, m, state, components, noise) if m.kind == "probe"
                else simulate(h, m, state, components, config))  # fmt: skip
@@ -529,8 +533,9 @@ def plan_verification_move(
             continue
         h1, s1, _ = sim
         new = _new_features(h, h1)
-        if _gain(new, missing) == 0 and (outcome_key(h, m, state, h1, s1) in travelled or any(
+        if going_back and _gain(new, missing) == 0 and (outcome_key(h, m, state, h1, s1) in travelled or any(
                 float(np.linalg.norm(s1.position - p)) < REVISIT for p in visited)):
+            again.append((m, h.world_from_model.inverse().apply(s1.position), c))
             continue
         measured = frozenset(int(k) for k in features(poly).index(tuple(  # type: ignore[arg-type]
             frozenset(n & x) for n, x in zip(new, missing, strict=True))))  # fmt: skip
@@ -540,7 +545,9 @@ def plan_verification_move(
         ends.append((m, h.world_from_model.inverse().apply(s1.position), c))
     if best is not None:
         return best, tour, now
-    # no candidate can be followed in the hypothesis's world: head for the nearest missing feature
+    # no candidate can be followed in the hypothesis's world (or every one goes back): head for the nearest
+    # missing feature
+    ends = ends or again
     targets = _target_points(h.poly, missing)
     if not len(targets):
         return ends[0][0], tour, now
