@@ -483,7 +483,9 @@ def test_probes_are_drawn_hits_and_misses_apart(tmp_path):
 def test_candidate_probes_are_named_as_probes(tmp_path):
     out = tmp_path / "all.rrd"
     recorder = EpisodeRecorder(out)
-    record = run_episode(EpisodeSpec(model="WEDGE01", seed=1, moves="all", verify="none"), observer=recorder.observer())
+    # (seed 2: at seed 1 the probes are the opening's, and the planner's one before the data fixed a position, which
+    # it no longer counts on: haptic.planning.move_scores.weak_probes)
+    record = run_episode(EpisodeSpec(model="WEDGE01", seed=2, moves="all", verify="none"), observer=recorder.observer())
     recorder.close()
     assert record.probes >= 1
     ents = load_recording(out)

@@ -26,6 +26,7 @@ import numpy as np
 
 from haptic.geometry.se3 import plane_basis
 from haptic.learning.boundary import BoundaryEstimate
+from haptic.learning.folds import crosses
 from haptic.matching.components import DataComponent, DataEdge, DataFace
 from haptic.planning.config import PlannerConfig
 from haptic.planning.move_scores import same_move
@@ -268,3 +269,65 @@ class BoundaryWalk:
             if not any(same_move(move, bad) for bad in avoid):
                 return move
         return None
+
+    # ------------------------------------------------------------------------------------------ fold check
+
+    def fold_move(self, state: SensorState, avoid: tuple[Move, ...], targets: list[tuple[int, np.ndarray, np.ndarray]],
+                  turn: int = 0) -> Move | None:
+        """A face move for the fold check (:mod:`haptic.learning.folds`), ``targets`` the diagonals left to cross
+        ``(plane, one end, the other)``: on a face with some, the move across it that crosses the most of them
+        before it meets the face's boundary (aimed at each one's middle); elsewhere, toward the nearest one's
+        middle (onto the next face that way); None when no such move is left."""
+        face = self.components.get(state.face)
+        if not isinstance(face, DataFace) or not targets:
+            return None
+        p = self.est.plane_of.get(state.face)
+        n = face.normal
+        here = [(a, b) for k, a, b in targets if k == p]
+        dirs: list[np.ndarray] = []
+        if here:
+            scored = []
+            for a, b in here:
+                d = 0.5 * (a + b) - state.position
+                d = d - (d @ n) * n
+                norm = float(np.linalg.norm(d))
+                if norm < 1e-6:
+                    continue
+                u = d / norm
+                end = self._exit(state.position, u, p)
+                got = sum(crosses(state.position, end, x, y, n) for x, y in here)
+                scored.append((-got, float(np.linalg.norm(end - state.position)), len(scored), u))
+            dirs = [u for *_, u in sorted(scored, key=lambda x: x[:3])]
+        else:
+            mids = np.array([0.5 * (a + b) for _, a, b in targets]) - state.position
+            mids = mids - np.outer(mids @ n, n)
+            norms = np.linalg.norm(mids, axis=1)
+            dirs = [mids[i] / norms[i] for i in np.argsort(norms) if norms[i] > 1e-6][:1]
+        for u in dirs:
+            move = FaceMove(u)
+            if not any(same_move(move, bad) for bad in avoid):
+                return move
+        return self._face_move(state, avoid, turn)
+
+    def _exit(self, start: np.ndarray, u: np.ndarray, p: int | None) -> np.ndarray:
+        """Where the path from ``start`` along ``u`` first meets an edge of plane ``p``'s faces (the traced loops)
+        [m]; far along ``u`` when it meets none."""
+        x, y = plane_basis(self.est.planes[p].normal) if p is not None else plane_basis(u)
+        s2 = np.array([start @ x, start @ y])
+        r = np.array([u @ x, u @ y])
+        best = np.inf
+        for loop in self.est.loops.get(p, []) if p is not None else []:
+            pts = self.est.positions[loop]
+            q = np.stack([pts @ x, pts @ y], axis=1)
+            for i in range(len(q)):
+                a, b = q[i], q[(i + 1) % len(q)]
+                e = b - a
+                denom = float(r[0] * e[1] - r[1] * e[0])
+                if abs(denom) < 1e-15:
+                    continue
+                w = a - s2
+                t = float(w[0] * e[1] - w[1] * e[0]) / denom
+                v = float(w[0] * r[1] - w[1] * r[0]) / denom
+                if t > 1e-4 and -1e-9 <= v <= 1 + 1e-9:
+                    best = min(best, t)
+        return start + (best if np.isfinite(best) else 1.0) * u

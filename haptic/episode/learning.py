@@ -10,8 +10,10 @@ per unit of path cost, looking up to :attr:`LearnSettings.depth` moves ahead in 
 outside a measured plane, planes that bound no solid, or an estimate that measured nothing new in
 :attr:`LearnSettings.stall` moves) it traces the object's boundary instead
 (:func:`~haptic.learning.boundary.boundary_estimate`), walking over it to the nearest open edge or vertex
-(:class:`~haptic.episode.boundary_walk.BoundaryWalk`). It has its own budget (:class:`LearnSettings`), reported
-in the record's ``learned``.
+(:class:`~haptic.episode.boundary_walk.BoundaryWalk`). Before either is called closed, every diagonal of each
+measured face of four or more vertices is crossed by a face move (:mod:`haptic.learning.folds`: a face folded
+along a diagonal is two faces). It has its own budget (:class:`LearnSettings`), reported in the record's
+``learned``.
 
 :func:`learning_endings` replaces the loop's ending conditions: a ``no-match`` verdict starts the learning
 instead of ending the episode, which then ends, still ``no-match``, when the surface is closed or when the
@@ -42,6 +44,7 @@ from haptic.episode.state import EpisodeState
 from haptic.errors import ModelError
 from haptic.geometry import SE3, Polyhedron
 from haptic.learning.boundary import BoundaryEstimate, boundary_estimate
+from haptic.learning.folds import Stroke, crosses, unchecked_diagonals
 from haptic.learning.reconstruct import (
     ConvexEstimate,
     LearnBounds,
@@ -61,6 +64,8 @@ from haptic.planning.simulate import simulate
 
 FACE_GAIN = 2.0
 """What measuring a new plane is worth against an edge or a vertex (a plane bounds several of each) [-]."""
+FOLD_GAIN = 1.0
+"""What crossing a diagonal not crossed yet is worth, against an edge or a vertex (:mod:`haptic.learning.folds`) [-]."""
 
 
 @dataclass(frozen=True)
@@ -79,7 +84,16 @@ class LearnSettings:
     """Moves looked ahead when no single move measures anything new."""
     stall: int = 12
     """Moves after which a convex estimate that measured no new plane or vertex gives way to tracing the
-    boundary (the object is taken for non-convex)."""
+    boundary (the object is taken for non-convex); a closed one whose diagonals no move crossed in as many is
+    closed with them unchecked."""
+    fold_check: bool | None = None
+    """Whether every diagonal of each measured face of four or more vertices is crossed before the surface is
+    closed (:mod:`haptic.learning.folds`); None: without a table only (the geometric executor's face moves run
+    to the far edge; the hand's pad, resting on the table, is not asked to)."""
+
+    def checks_folds(self, table_z: float | None) -> bool:
+        """Whether the learning makes the fold check, on a world with a table at ``table_z`` (None: none)."""
+        return table_z is None if self.fold_check is None else self.fold_check
 
 
 class ClosureMoves(MoveSource):
@@ -108,6 +122,17 @@ class ClosureMoves(MoveSource):
         self.boundary: BoundaryEstimate | None = None
         """The traced boundary (once the object is known not to be convex)."""
         self.components: dict[int, DataComponent] = {}
+        self.strokes: list[Stroke] = []
+        """The face moves' paths (all the episode's, the recognition's too), for the fold check."""
+        self.folds: dict[int, list[tuple[int, int]]] = {}
+        """Of a closed surface: face (:meth:`_fold_faces`) → the inner diagonals no move crossed."""
+        self.fold_check = settings.fold_check
+        self.fold_moves = 0
+        """Learning moves made while only the fold check kept the surface open."""
+        self._folds_only = False
+        self._folds_given_up = False
+        self._fold_best: tuple[int, int] | None = None
+        self._sensor: SensorState | None = None
         self._seen = -1
         self._best: tuple = ()
         self._since = 0
@@ -116,6 +141,7 @@ class ClosureMoves(MoveSource):
 
     def start(self, view: EpisodeState) -> None:
         self.active, self.started, self.status = True, time.perf_counter(), "open"
+        self.fold_check = self.settings.checks_folds(view.config.table_z)
         self.update(view)
 
     def update(self, view: EpisodeState) -> None:
@@ -140,10 +166,10 @@ class ClosureMoves(MoveSource):
             self._update_boundary()
             return
         self.estimate = est
-        self.status = "closed" if est.closed else "open"
+        self._check_folds(est.closed, {f: k for k, p in enumerate(est.planes) for f in p.faces})
         c = est.counts()
         progress = (c["planes"], c["vertices_measured"], -c["open_faces"])
-        if progress > self._best:
+        if progress > self._best or est.closed:
             self._best, self._since = progress, self.moves
         elif self.moves - self._since >= self.settings.stall:
             # the estimate's faces and vertices are not where the moves find the object: not convex, though no
@@ -152,13 +178,51 @@ class ClosureMoves(MoveSource):
             self.nonconvex = f"the convex estimate measured nothing new in {self.settings.stall} moves"
             self._update_boundary()
 
+    def _fold_faces(self) -> tuple[np.ndarray, list[tuple[int, list[int]]], dict[int, np.ndarray]]:
+        """The closed surface's vertices, its faces ``(plane, vertex loop)`` and the planes' normals: of the
+        convex estimate over its vertex groups, or of the traced boundary."""
+        if self.convex:
+            est = self.estimate
+            vertices, loops = grouped_loops(est.polytope, est.group_of(), len(est.groups))
+            return vertices, sorted(loops.items()), {k: est.polytope.normals[k] for k in loops}
+        b = self.boundary
+        faces = [(p, loop) for p, ls in sorted(b.loops.items()) for loop in ls]
+        return b.positions, faces, {p: b.planes[p].normal for p, _ in faces}
+
+    def _check_folds(self, closed: bool, plane_of: Mapping[int, int]) -> None:
+        """The fold check of a closed surface (:attr:`folds`), and the learning's status: closed when no
+        diagonal is left to cross, or when none was crossed in :attr:`LearnSettings.stall` moves (closed with
+        those unchecked, the record says how many faces)."""
+        self.folds = {}
+        if closed:
+            vertices, faces, normals = self._fold_faces()
+            self.folds = unchecked_diagonals(vertices, faces, normals, plane_of, self.strokes)
+        left = sum(map(len, self.folds.values()))
+        self._folds_only = bool(closed and self.fold_check and left and not self._folds_given_up)
+        if not self._folds_only:
+            self._fold_best = None
+        else:
+            if self._fold_best is None or left < self._fold_best[0]:
+                self._fold_best = (left, self.moves)
+            elif self.moves - self._fold_best[1] >= self.settings.stall:
+                self._folds_only, self._folds_given_up = False, True
+        self.status = "closed" if closed and not self._folds_only else "open"
+
+    def fold_targets(self) -> list[tuple[int, np.ndarray, np.ndarray]]:
+        """While only the fold check keeps the surface open: ``(plane, one end, the other)`` of each diagonal
+        left to cross [m]."""
+        if not self._folds_only:
+            return []
+        vertices, faces, _ = self._fold_faces()
+        return [(faces[f][0], vertices[i], vertices[j]) for f, ds in sorted(self.folds.items()) for i, j in ds]
+
     def _update_boundary(self) -> None:
         try:
             self.boundary = boundary_estimate(self.components)
         except LearnError as exc:
             self.boundary, self.status, self.detail = None, "no solid", str(exc)
             return
-        self.status = "closed" if self.boundary.closed else "open"
+        self._check_folds(self.boundary.closed, self.boundary.plane_of)
 
     @property
     def bounds(self) -> LearnBounds | None:
@@ -186,11 +250,17 @@ class ClosureMoves(MoveSource):
             if self.boundary is None:
                 return None
             walk = BoundaryWalk(self.boundary, self.components, view.config)
+            if self._folds_only:
+                return walk.fold_move(view.sensor, tuple(view.failed_here), self.fold_targets(),
+                                      turn=self.moves + len(view.failed_here))  # fmt: skip
             move = walk.best_move(view.sensor, tuple(view.failed_here), turn=self.moves + len(view.failed_here))
             return move
         if self.estimate is None:
             return None
-        plan = ClosurePlan.of(self.estimate, self.components, view.config)
+        folds: dict[int, list[tuple[np.ndarray, np.ndarray]]] = {}
+        for k, a, b in self.fold_targets():
+            folds.setdefault(k, []).append((a, b))
+        plan = ClosurePlan.of(self.estimate, self.components, view.config, folds)
         if plan is None:
             return None
         move = plan.best_move(view.sensor, tuple(view.failed_here), self.settings.depth)
@@ -198,12 +268,18 @@ class ClosureMoves(MoveSource):
 
     def on_result(self, view: EpisodeState, move: Move, result: MoveResult) -> None:
         """Every move made while the learning is under way counts against its budget, whichever source chose it
-        (when none of the learning's measures anything new, the episode's other sources move on)."""
+        (when none of the learning's measures anything new, the episode's other sources move on). Every face
+        move's path is kept for the fold check."""
+        before, self._sensor = self._sensor, view.sensor
+        if isinstance(move, FaceMove) and result.ok and before is not None and result.state is not None:
+            self.strokes.append(Stroke(before.face, np.array(before.position, float),
+                                       np.array(result.state.position, float)))  # fmt: skip
         if not self.active:
             return
         self.moves += 1
         self.cost += result.cost
         self.failed += 0 if result.ok else 1
+        self.fold_moves += int(self._folds_only)
 
     def record(self) -> dict:
         """The learning's part of the episode record."""
@@ -214,6 +290,10 @@ class ClosureMoves(MoveSource):
             "budget": self.settings.budget, "max_moves": self.settings.max_moves,
         }  # fmt: skip
         out["convex"] = self.convex
+        out["fold_check"] = bool(self.fold_check)
+        out["fold_moves"] = self.fold_moves
+        if self.status == "closed":
+            out["folds_unchecked"] = len(self.folds)
         if not self.convex:
             out["not_convex"] = self.nonconvex
             if self.boundary is not None:
@@ -247,10 +327,14 @@ class ClosurePlan:
     """Costs and the vertex circle's radius."""
     components: Mapping[int, DataComponent]
     """The data the estimate was made from."""
+    folds: tuple[tuple[int, np.ndarray, np.ndarray], ...] = ()
+    """Diagonals no move crossed yet: ``(model face, one end, the other)`` [m] (the fold check)."""
 
     @classmethod
-    def of(cls, est: ConvexEstimate, components: Mapping[int, DataComponent], config: PlannerConfig):
-        """The plan of estimate ``est`` over ``components``; None when its solid is no valid model (noise)."""
+    def of(cls, est: ConvexEstimate, components: Mapping[int, DataComponent], config: PlannerConfig,
+           folds: Mapping[int, list[tuple[np.ndarray, np.ndarray]]] | None = None):
+        """The plan of estimate ``est`` over ``components``; None when its solid is no valid model (noise).
+        ``folds``: plane → the ends of its face's diagonals no move crossed yet."""
         poly = est.polytope
         vertices, loops, group = poly.vertices, poly.loops, est.group_of()
         vertex_of = dict(est.vertex_data)
@@ -286,7 +370,9 @@ class ClosurePlan:
         )  # fmt: skip
         open_faces = frozenset(face_of_plane[j] for j in est.open_faces() if j in face_of_plane)
         h = Hypothesis("estimate", model, SE3.identity(), faces, edges, vertex_of)
-        return cls(h, open_faces, un_edges, group, unmeasured, config, dict(components))
+        diag = tuple((face_of_plane[k], a, b) for k, ends in (folds or {}).items() if k in face_of_plane
+                     for a, b in ends)  # fmt: skip
+        return cls(h, open_faces, un_edges, group, unmeasured, config, dict(components), diag)
 
     def gain(self, before: Hypothesis, after: Hypothesis, counted: set) -> float:
         """What a move measures: a new plane (an open face met), edges and vertices not measured before (each
@@ -305,6 +391,19 @@ class ClosurePlan:
             if grp in self.unmeasured_groups and ("v", grp) not in counted:
                 counted.add(("v", grp))
                 g += 1.0
+        return g
+
+    def crossed(self, h: Hypothesis, move: Move, before: SensorState, after: SensorState, counted: set) -> float:
+        """What a face move's crossing of diagonals not crossed before is worth (each counted once, ``counted``)."""
+        if not self.folds or not isinstance(move, FaceMove):
+            return 0.0
+        f = h.faces.get(before.face)
+        g = 0.0
+        for i, (face, a, b) in enumerate(self.folds):
+            if face == f and ("d", i) not in counted and crosses(before.position, after.position, a, b,
+                                                                   h.poly.face_normals[f]):
+                counted.add(("d", i))
+                g += FOLD_GAIN
         return g
 
     def candidates(self, state: SensorState, components: Mapping[int, DataComponent], h: Hypothesis) -> list[Move]:
@@ -370,7 +469,7 @@ class ClosurePlan:
                     continue
                 h1, s1, c1 = out
                 seen = set(counted)
-                g = gain + self.gain(h0, h1, seen)
+                g = gain + self.gain(h0, h1, seen) + self.crossed(h0, move, s0, s1, seen)
                 c = cost + self.cost(h0, move, s0, s1)
                 f = first if first is not None else move
                 if g > 0 and g / c > best_rate:

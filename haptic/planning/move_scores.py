@@ -14,12 +14,13 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex, SensorNoise
+from haptic.matching.free_space import MIN_SPAN, position_span
 from haptic.planning.bound import reduce_hypotheses
 from haptic.planning.config import PlannerConfig
 from haptic.planning.efficiency import class_weights, distinguishable, efficiency_of, expected_eliminated
 from haptic.planning.handpath import HandStart
-from haptic.planning.hypothesis import Hypothesis
-from haptic.planning.moves import FaceMove, Move, PlacementMove, ProbeMove, SensorState
+from haptic.planning.hypothesis import Hypothesis, trace_in
+from haptic.planning.moves import EdgeMove, FaceMove, Move, PlacementMove, ProbeMove, SensorState
 from haptic.planning.placements import (
     HAND_MAX_TILT,
     PlacementConfig,
@@ -121,12 +122,47 @@ def _score_all(ctx: Context) -> list[tuple[Prediction | ProbePrediction | Placem
     if ctx.config.moves != "probing":
         preds = predict_moves(ctx.hypotheses, fresh_moves(ctx), ctx.state, ctx.components, ctx.noise, ctx.config)
         preds = [p for p in preds if p.reliable(ctx.config)] or preds
+        preds = [replace(p, outcomes=np.full_like(p.outcomes, np.nan)) if remeasures(ctx, p.move) else p
+                 for p in preds]  # fmt: skip
         refused = [(p, refusal(p, ctx.config)) for p in preds]
         refused = [(p, r) for p, r in refused if r < ctx.config.table_risk] or refused
         out = [(pred, *score_prediction(pred, weights, r, ctx.config)) for pred, r in refused]
-    lines = predict_probe_moves(ctx)
+    lines = weak_probes(ctx, predict_probe_moves(ctx))
     probes = [s for s in (score_probe(pred, weights) for pred in lines) if s is not None]
     return out + probes + score_placements(ctx, weights, lines if ctx.config.moves != "tracing" else None)
+
+
+def remeasures(ctx: Context, move: Move) -> bool:
+    """Whether ``move`` is predicted, in every hypothesis's world, to measure again what that hypothesis has
+    already paired with data: an edge move running to a model vertex paired with a data vertex, a face move
+    crossing a model edge paired with a data edge onto a model face paired with a data face. Each hypothesis has
+    been fitted to those data, so what the move measures again can differ between them only by their fit's
+    residuals, which the matcher has already let pass: the predicted outcomes tell nothing apart (else, at two
+    hypotheses that fit every measurement, a vertex moved 2 mm from its model's place, the planner measured the
+    same vertex round and round to the episode's budget)."""
+    from haptic.geometry.tracing import trace_edge
+
+    if not ctx.hypotheses or not isinstance(move, FaceMove | EdgeMove):
+        return False
+    state = ctx.state
+    for h in ctx.hypotheses:
+        if h.world_from_model is None:
+            return False
+        if isinstance(move, EdgeMove):
+            e_m = h.edges.get(state.edge) if state.edge is not None else None
+            data_edge = ctx.components.get(state.edge) if state.edge is not None else None
+            if e_m is None or not isinstance(data_edge, DataEdge):
+                return False
+            b_world = h.world_from_model.rotate(h.poly.edge_directions[e_m])
+            sense = move.sense if b_world @ data_edge.direction > 0 else -move.sense
+            hit = trace_edge(h.poly, e_m, h.model_from_world.apply(state.position), sense)
+            if hit.vertex not in set(h.vertices.values()):
+                return False
+        else:
+            tr = trace_in(h, move, state)
+            if tr is None or tr.hit.edge not in set(h.edges.values()) or tr.hit.next_face not in set(h.faces.values()):
+                return False
+    return True
 
 
 def score_placements(ctx: Context, weights: np.ndarray, lines: Sequence[ProbePrediction] | None = None) -> list[tuple]:
@@ -151,7 +187,7 @@ def placement_lines(ctx: Context) -> list[ProbePrediction]:
     (:func:`~haptic.planning.probe_lines.candidate_probes`), predicted in every hypothesis."""
     cfg = probe_config(ctx.config)
     moves = candidate_probes(ctx.hypotheses, cfg)
-    return predict_probe_moves(ctx, moves)
+    return weak_probes(ctx, predict_probe_moves(ctx, moves))
 
 
 def score_probe(pred: ProbePrediction, weights: np.ndarray) -> tuple | None:
@@ -188,6 +224,18 @@ def predict_probe_moves(ctx: Context, moves: Sequence[ProbeMove] | None = None) 
     moves = probe_moves(ctx) if moves is None else list(moves)
     return predict_probes(ctx.hypotheses, moves, ctx.state.position, ctx.components, ctx.noise, ctx.config.costs,
                           hand_start(ctx))  # fmt: skip
+
+
+def weak_probes(ctx: Context, preds: list[ProbePrediction]) -> list[ProbePrediction]:
+    """``preds`` as the matcher will take their outcomes: while the data fix a position too weakly for it to test
+    probe data against posed hypotheses (:func:`~haptic.matching.free_space.position_span` below
+    :data:`~haptic.matching.free_space.MIN_SPAN`), a probe's miss, or where it hits, eliminates none of them
+    (predicted to, probe after probe missed a re-identified L-block's three pose classes to the episode's
+    budget)."""
+    if not preds or position_span(list(ctx.components.values())) >= MIN_SPAN:
+        return preds
+    none = np.zeros((len(ctx.hypotheses), len(ctx.hypotheses)), dtype=bool)
+    return [replace(p, known=none) for p in preds]
 
 
 def hand_start(ctx: Context) -> HandStart | None:

@@ -7,7 +7,9 @@ is scored by its predicted cost (over its chance of success: the table, a steep 
 plus the tour's cost over what it leaves to measure, from where it ends in the hypothesis's world
 (:func:`~haptic.planning.search.simulate`); the least score is taken, and the tour is planned afresh after every
 result. When no candidate can be followed in the hypothesis's world, the move that ends nearest a missing feature
-is taken.
+is taken. The tour is priced by tracing alone when no probe is offered from where the sensor is, and a move
+predicted to measure nothing along a way the verification already travelled since it last measured something is
+not taken again (:func:`outcome_key`): either kept the verification going back and forth over one edge.
 
 Where the move set admits probes (``--moves probing|all``) and the sensor is a point (no table: the geometric
 executor), a free-space probe may carry the sensor to a face beside where the tour is cheapest to enter
@@ -403,6 +405,23 @@ def verification_probes(
     aimed_probes`) at the targets of :func:`_probe_targets` at least :data:`MIN_PROBE_TRANSFER` from the sensor,
     the :data:`MAX_VERIFY_PROBES` nearest, predicted to hit their face in ``h``'s world and not to fail there (the
     hand's checks); none after a probe failed from here (``avoid``), nor along a line probed before (``probed``)."""
+    return [(m, c, r) for m, c, r, _ in _verification_probes(h, state, components, missing, noise, config, avoid,
+                                                             probed, faces_ok)]  # fmt: skip
+
+
+LANDS_NEAR = 2 * PROBE_INSET
+"""A verification probe *lands near* what it is for when its predicted contact is within this of a missing vertex or
+edge, or on a missing face [m]."""
+
+
+def _verification_probes(
+    h: Hypothesis, state: SensorState, components: Mapping[int, DataComponent],
+    missing: tuple[frozenset[int], frozenset[int], frozenset[int]], noise: SensorNoise, config: PlannerConfig,
+    avoid: Sequence[Move] = (), probed: Sequence[Move] = (), faces_ok: frozenset[int] | None = None,
+) -> list[tuple[Move, float, float, bool]]:
+    """:func:`verification_probes`, each with whether it lands near what is missing (:data:`LANDS_NEAR`): the
+    target on a face beside a vertex lies far from it where the face's corner there is narrow, and a line aimed at
+    a point may meet the face elsewhere, past what hides the point."""
     from haptic.planning.move_scores import Context, predict_probe_moves, probe_config, same_move
     from haptic.planning.probe_lines import aimed_probes
 
@@ -413,11 +432,24 @@ def verification_probes(
     targets = [(p, f) for p, f in _probe_targets(h.poly, missing, faces_ok)
                if float(np.linalg.norm(p - here)) >= MIN_PROBE_TRANSFER]  # fmt: skip
     targets.sort(key=lambda pf: float(np.linalg.norm(pf[0] - here)))
-    lines = [(mv, targets[k][1]) for mv, k in aimed_probes(h, targets, probe_config(config))
+    lines = [(mv, targets[k]) for mv, k in aimed_probes(h, targets, probe_config(config))
              if not any(same_move(mv, done) for done in probed)][:MAX_VERIFY_PROBES]  # fmt: skip
     preds = predict_probe_moves(Context((h,), state, components, noise, config), [mv for mv, _ in lines])
-    return [(pred.move, float(pred.costs[0]), 0.0) for pred, (_, face) in zip(preds, lines, strict=True)
-            if bool(pred.hit[0]) and int(pred.face[0]) == face and pred.risk() == 0.0]  # fmt: skip
+    poly = h.poly
+    mf, me, mv = missing
+    out = []
+    for pred, (_, (_, face)) in zip(preds, lines, strict=True):
+        if not (bool(pred.hit[0]) and int(pred.face[0]) == face and pred.risk() == 0.0):
+            continue
+        move = pred.move
+        start, u = np.asarray(move.start, float), np.asarray(move.direction, float)
+        c = h.model_from_world.apply(start + float(pred.distance[0]) * u)  # the contact, model frame
+        near = face in mf or any(float(np.linalg.norm(c - poly.vertices[v])) <= LANDS_NEAR for v in mv)
+        for e in me:
+            s_ = float(np.clip((c - poly.edge_points[e]) @ poly.edge_directions[e], 0.0, poly.edge_lengths[e]))
+            near = near or float(np.linalg.norm(c - poly.edge_points[e] - s_ * poly.edge_directions[e])) <= LANDS_NEAR
+        out.append((move, float(pred.costs[0]), 0.0, near))
+    return out
 
 
 def choose_verification_move(
@@ -451,9 +483,17 @@ def plan_verification_move(
     probed: Sequence[Move] = (),
     faces_ok: frozenset[int] | None = None,
     previous: Tour | None = None,
+    travelled: frozenset[tuple] | set[tuple] = frozenset(),
+    visited: Sequence[np.ndarray] = (),
 ) -> tuple[Move | None, Tour | None, float]:
     """:func:`choose_verification_move`, with the tour it planned over ``missing`` (from ``previous``'s order,
-    when given) and that tour's cost from the sensor as it is [units] (None and 0 without a pose)."""
+    when given) and that tour's cost from the sensor as it is [units] (None and 0 without a pose). A candidate
+    predicted to measure nothing missing along a way already travelled (its :func:`outcome_key` in
+    ``travelled``), or to end within :data:`REVISIT` of a place in ``visited`` (world), is left out without a table
+    (on the hand a move ends where the pad stops, and going back can be the way on; there it kept BOX01N's
+    verification from a vertex it then found, seed 2), unless every candidate is: the tour's
+    estimate from where such moves end can keep them the cheapest, and the verification goes back and forth
+    until it stalls."""
     from haptic.planning.search import simulate
     from haptic.planning.simulate import simulate_probe
 
@@ -467,12 +507,24 @@ def plan_verification_move(
     here = _start_costs(h, state, table)
     now = tour.cost_from(here)
     first = _moves(h, state, components, noise, config, avoid, missing)
-    probes = verification_probes(h, state, components, _entries(poly, tour, here, keys), noise, config, avoid, probed,
-                                 faces_ok)  # fmt: skip
+    landing = _verification_probes(h, state, components, _entries(poly, tour, here, keys), noise, config, avoid,
+                                   probed, faces_ok)  # fmt: skip
+    probes = [(m, c, r) for m, c, r, _ in landing]
+    if legs.probes and not any(near for *_, near in landing):
+        # no probe lands near where the tour is entered from here: priced with probes, every candidate leaves the
+        # same probe's cost, and the cheapest move wins wherever it ends (face moves back and forth over one
+        # edge); the tour is priced by tracing alone, toward what is missing
+        legs = LegCosts.of(config, probes=False)
+        tour = plan_tour(poly, keys, legs, previous)
+        table = StartCosts(poly, keys, legs)
+        here = _start_costs(h, state, table)
+        now = tour.cost_from(here)
     if not first and not probes:
         return None, tour, now
     best, best_score = None, np.inf
     ends: list[tuple[Move, np.ndarray | None, float]] = []
+    again: list[tuple[Move, np.ndarray | None, float]] = []  # left out as going back: the last resort
+    going_back = config.table_z is None  # the hand's moves end where the pad stops, not where predicted
     for m, c, r in [*first, *probes]:
         sim = (simulate_probe(h, m, state, components, noise) if m.kind == "probe"
                else simulate(h, m, state, components, config))  # fmt: skip
@@ -481,6 +533,10 @@ def plan_verification_move(
             continue
         h1, s1, _ = sim
         new = _new_features(h, h1)
+        if going_back and _gain(new, missing) == 0 and (outcome_key(h, m, state, h1, s1) in travelled or any(
+                float(np.linalg.norm(s1.position - p)) < REVISIT for p in visited)):
+            again.append((m, h.world_from_model.inverse().apply(s1.position), c))
+            continue
         measured = frozenset(int(k) for k in features(poly).index(tuple(  # type: ignore[arg-type]
             frozenset(n & x) for n, x in zip(new, missing, strict=True))))  # fmt: skip
         score = c / max(1.0 - r, 1e-9) + tour.cost_from(_start_costs(h1, s1, table), measured)
@@ -489,7 +545,9 @@ def plan_verification_move(
         ends.append((m, h.world_from_model.inverse().apply(s1.position), c))
     if best is not None:
         return best, tour, now
-    # no candidate can be followed in the hypothesis's world: head for the nearest missing feature
+    # no candidate can be followed in the hypothesis's world (or every one goes back): head for the nearest
+    # missing feature
+    ends = ends or again
     targets = _target_points(h.poly, missing)
     if not len(targets):
         return ends[0][0], tour, now
@@ -498,6 +556,19 @@ def plan_verification_move(
         for k, (m, p, c) in enumerate(ends)
     ]
     return ends[min(scored)[2]][0], tour, now
+
+
+REVISIT = 3e-3
+"""A verification move predicted to measure nothing that ends this near a place the sensor was at since the
+verification last measured something goes back there (:func:`plan_verification_move`) [m]."""
+
+
+def outcome_key(h: Hypothesis, move: Move, state: SensorState, after: Hypothesis, end: SensorState) -> tuple:
+    """A move's way in hypothesis ``h``'s world, predicted from ``state`` to ``end``: its kind, the model face
+    and edge it starts on, and the model face, edge and vertex it ends at."""
+    return (move.kind, h.faces.get(state.face), h.edges.get(state.edge) if state.edge is not None else None,
+            after.faces.get(end.face), after.edges.get(end.edge) if end.edge is not None else None,
+            after.vertices.get(end.vertex) if end.vertex is not None else None)  # fmt: skip
 
 
 def _legs(config: PlannerConfig) -> LegCosts:
@@ -567,6 +638,10 @@ class Verifier:
         :func:`verify_move_budget` made: ambiguous between the model and an object outside the library),
         "verifying", or "not needed" (no pose class was ever left alone)."""
         self._progress = (-1, 0)  # (features measured, verification moves then)
+        self._travelled: set[tuple] = set()
+        """:func:`outcome_key` of the moves made since the last feature measured that were to measure nothing."""
+        self._visited: list[np.ndarray] = []
+        """Where the sensor was when each verification move since the last feature measured was chosen (world)."""
         self.check = None
         self.accept = None
         self.coverage = None
@@ -633,6 +708,8 @@ class Verifier:
             got = self.coverage.measured() if self.coverage is not None else 0
             if got > self._progress[0]:
                 self._progress = (got, self.moves)
+                self._travelled.clear()
+                self._visited.clear()
             elif self.moves - self._progress[1] >= STALL_MOVES:
                 self.status = "incomplete"
             if self.moves >= self.move_budget():
@@ -696,8 +773,16 @@ class Verifier:
         faces_ok = self._reach[self._model_name][0] if self._model_name in self._reach else None
         previous = self._tour if self._tour is not None and self._tour_model is h.poly else None
         move, self._tour, now = plan_verification_move(h, state, components, missing, self.noise, self.config,
-                                                       avoid, probed, faces_ok, previous)  # fmt: skip
+                                                       avoid, probed, faces_ok, previous, self._travelled,
+                                                       self._visited)  # fmt: skip
+        self._visited.append(np.array(state.position, float))
         self._tour_model = h.poly
+        if move is not None and move.kind != "probe" and h.world_from_model is not None:
+            from haptic.planning.search import simulate
+
+            sim = simulate(h, move, state, components, self.config)
+            if sim is not None and _gain(_new_features(h, sim[0]), missing) == 0:
+                self._travelled.add(outcome_key(h, move, state, sim[0], sim[1]))
         if self.tour_planned is None and self._tour is not None:
             legs = _legs(self.config)
             keys = features(h.poly).index(missing)
