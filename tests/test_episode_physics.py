@@ -34,6 +34,20 @@ def test_the_planner_counts_on_less_undercut_than_the_pad_reaches():
     assert math.radians(30.0) < ep.config.max_undercut < math.radians(33.0) < touch.max_undercut
 
 
+def test_a_face_measured_with_the_hand_tilted_is_touched_again_tilted():
+    # FRAME01 seed 2 stands on an end, its hole's axis horizontal: the pad reaches the hole's walls only with the
+    # hand tilted away from the rim above (a link of the finger meets it upright). Turned upright in the hole after
+    # such a move, the finger jammed against the rim, and every later touch of the wall ran away; now the hand
+    # backs out along the finger's axis before it turns upright, and touches such a face again tilted as it was
+    # measured. The components stay within their bounds.
+    said = []
+    obs = EpisodeObserver(on_move=lambda n, r, *a: said.extend(r.info.get("recoveries", ())))
+    ep = build_episode(EpisodeSpec(model="FRAME01", seed=2, executor="physics", verify="full"))
+    ep.run(None, obs)
+    assert any("touched again with the hand tilted" in x for x in said), said
+    assert _within_bounds(ep)
+
+
 def test_touches_past_an_unreachable_edge_tell_the_box_family_apart():
     # BOX01P resting tilted: the moves that separate it from BOX01 and BOX01N all end stepping onto a face
     # leaning under the pad; their touches on the way still rule the look-alikes out
@@ -237,4 +251,29 @@ def test_face_moves_out_of_a_concave_corner_leave_it(tmp_path):
     from_corner = [(e, kind, c) for e, kind, c in ended if not edges[e].convex]
     assert from_corner
     assert not [c.id for e, kind, c in from_corner if kind == "concave" and same_line(e, c)]
+    assert rec.outcome == "recognized" and rec.correct, rec.detail
+
+
+def test_a_verification_up_to_hidden_vertices_says_so_and_is_not_confirmed():
+    # BOX01N seed 3 rests with its slot against the table: every feature in the hand's reach is measured, and the
+    # slot's vertices are hidden. The record says the verification is complete up to them (reach_complete) and
+    # the episode ends ambiguous, never recognised: a difference under the object cannot be measured. FRAME01 seed
+    # 1, standing on an end, stalls with features in reach unmeasured: not complete in reach either.
+    rec = run_episode(EpisodeSpec(model="BOX01N", seed=3, executor="physics", verify="full"))
+    v = rec.verified
+    assert rec.outcome == "ambiguous" and v["status"] == "incomplete"
+    assert v["reach_complete"] and v["vertices_hidden"] > 0
+    rec = run_episode(EpisodeSpec(model="FRAME01", seed=1, executor="physics", verify="full"))
+    assert rec.outcome == "ambiguous" and not rec.verified["reach_complete"]
+
+
+def test_an_edge_move_after_a_tilted_move_returns_beside_the_last_contact():
+    # HEXPRISM01 seed 1: face moves onto the sides leaning under 30° are made with the hand tilted, which then backs
+    # out along the finger's axis, centimetres from the edge just found. The edge move after such a move touched the
+    # face again beside where the pad now was, past the edge's end, and found nothing there ("could not return
+    # next to the edge: no-contact"); it returns beside the last contact.
+    failed = []
+    obs = EpisodeObserver(on_failed_move=lambda n, r: failed.append(r.reason))
+    rec = run_episode(EpisodeSpec(model="HEXPRISM01", seed=1, executor="physics", verify="full"), observer=obs)
+    assert not [w for w in failed if "could not return next to the edge: no-contact" in w], failed
     assert rec.outcome == "recognized" and rec.correct, rec.detail

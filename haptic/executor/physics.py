@@ -189,6 +189,9 @@ class PhysicsSettings:
     plus ``table_margin``) [-] ..."""
     table_contact_cos: float = 0.95
     """... a fingertip's contact, as sensed during a move, when it exceeds this [-]."""
+    upright_retract: float = 0.12
+    """After a move made tilted, the pad below the highest point touched backs out along the finger's axis at
+    most this far before the hand turns upright [m]."""
 
 
 @dataclass
@@ -196,6 +199,7 @@ class _FaceData:
     points: np.ndarray
     normals: np.ndarray
     anchor: np.ndarray  # a contact point known to be on the face
+    rotation: np.ndarray | None = None  # the hand's rotation when it touched the face tilted (None: upright)
 
 
 class PhysicsExecutor(LandingSearch):
@@ -283,9 +287,21 @@ class PhysicsExecutor(LandingSearch):
         n = t.normal if t.normal is not None else np.array([0.0, 0.0, 1.0])
         lifted = t.tip + cfg.lift * n
         pieces.append(t.move_free(lifted, timeout=cfg.lift_timeout, tol=cfg.lift_tol, retry=False))
+        # below the highest point touched (in a hole, under a rim), turned upright there the finger's links would
+        # sweep through the object: first back out along the finger's own axis, through where its links are
+        back = -(t.hand_rotation @ np.array([0.0, 0.0, 1.0]))
+        rise = self._highest_touch() + t.pad_radius + cfg.lift - float(t.tip[2])
+        if rise > 0.0 and float(back[2]) > 0.5:
+            out = t.tip + min(rise / float(back[2]), self.settings.upright_retract) * back
+            pieces.append(t.move_free(out, timeout=cfg.via_timeout, tol=cfg.via_tol, retry=False))
         t.hand_rotation = np.array(cfg.hand_rotation, dtype=float)
         pieces.append(t.move_free(t.tip.copy(), timeout=cfg.via_timeout, tol=cfg.via_tol))
         self.on_face = None
+
+    def _highest_touch(self) -> float:
+        """Height of the highest contact kept on any data face [m] (the table top before any)."""
+        tops = [float(fd.points[:, 2].max()) for fd in self._faces.values() if len(fd.points)]
+        return max(tops, default=TABLE_TOP_Z)
 
     def _tilt_away(self, met: PrimitiveResult, fid: int, target: np.ndarray, pieces: list[PrimitiveResult]) -> bool:
         """After a link of the finger met the object (``met``, event ``"hand"``): tilt the hand, the finger leaning
@@ -372,7 +388,9 @@ class PhysicsExecutor(LandingSearch):
         mask = face_rows(trace, fit.normal, self.bounds.face_cone, self.bounds.min_refine_rows)
         mask = steady_rows(trace, mask, self.bounds)
         pts, nrm = trace.point_in_world[mask], trace.normal_in_world[mask]
-        self._faces[fid] = _FaceData(pts, nrm, pts[-1].copy())
+        rot = self.toucher.hand_rotation
+        tilted = None if np.array_equal(rot, self.toucher.config.hand_rotation) else rot.copy()
+        self._faces[fid] = _FaceData(pts, nrm, pts[-1].copy(), tilted)
 
     def _finger_contacts(self):
         """The exploring fingertip's sensed contacts now."""
@@ -447,6 +465,18 @@ class PhysicsExecutor(LandingSearch):
             t.hand_rotation = np.array(t.config.hand_rotation, dtype=float)
             r = t.lift_and_approach(target, n, floor_z=floor)
             pieces.append(r)
+        tilt = self._faces[fid].rotation if fid in self._faces else None
+        if not r.ok and r.status != "unstable" and tilt is not None and t.reaches(n, tilt) \
+                and np.array_equal(t.hand_rotation, t.config.hand_rotation):
+            # a face the pad reached only with the hand tilted (the wall of a hole, a link of the finger meeting the
+            # object upright): touched again tilted the same way
+            t.hand_rotation = tilt.copy()
+            r = t.lift_and_approach(target, n, floor_z=floor)
+            pieces.append(r)
+            if r.ok:
+                self.recoveries.append("the face touched again with the hand tilted as it was measured")
+            elif r.status != "unstable":
+                t.hand_rotation = np.array(t.config.hand_rotation, dtype=float)
         if not r.ok:
             self._why = f"{r.status}/{r.event}"
             return r.status
@@ -714,7 +744,8 @@ class PhysicsExecutor(LandingSearch):
         face ``face`` when it is one of the edge's, else on the other; when that touch fails, on the other face."""
         s, seg = self.settings, self.segmenter
         first = face if face in rec.faces else rec.faces[1]
-        s0 = rec.param(self.contact_point())
+        # beside the last contact: the pad may be far off in free space (backed out after a tilted move)
+        s0 = rec.param(self.contact_point() if self.toucher.contact[2] is not None else self.state.position)
         status, why = "unreachable", "the edge next to the table is out of the pad's reach"
         for fid in (first, *(f for f in rec.faces if f != first and f in rec.inward)):
             n = seg.faces[fid].component.normal

@@ -19,6 +19,7 @@ from haptic.geometry.polyhedron import Polyhedron
 from haptic.geometry.se3 import cross, plane_basis
 from haptic.geometry.tracing import FaceHit, circle_vertex, trace_edge
 from haptic.matching.components import DataComponent, DataEdge, DataFace, SensorNoise
+from haptic.planning import kernels
 from haptic.planning.config import PlannerConfig
 from haptic.planning.hypothesis import FaceTrace, Hypothesis, trace_in
 from haptic.planning.moves import EdgeMove, FaceMove, Move, SensorState, VertexMove
@@ -485,6 +486,17 @@ def face_outcomes(
             b_all[j, s], p_all[j, s], len_all[j, s], dih_all[j, s], seg_len[j, s] = lp[4:9]
         start, n_all = np.array(starts), np.array(normals)
         dirs = np.array([mv.direction for mv in moves], dtype=float)
+        if kernels.COMPILED:
+            c = config.costs
+            hit, tb, angle, dih, cost, near = kernels.face_outcomes(
+                dirs, np.array(rots, dtype=float), start, n_all, a_all, seg_all, real, b_all, p_all, len_all, dih_all,
+                seg_len, np.array([c.c_f, c.c_j, c.c_b, c.c_n], dtype=float),
+            )  # fmt: skip
+            mi, hj = np.nonzero(hit)
+            cols = np.array(rows)[hj]
+            outcomes[mi, cols, 0], outcomes[mi, cols, 1], outcomes[mi, cols, 2] = tb[mi, hj], angle[mi, hj], dih[mi, hj]
+            costs[mi, cols], clear[mi, cols] = cost[mi, hj], near[mi, hj]
+            return [(outcomes[i], costs[i], clear[i]) for i in range(n_m)]
         d_raw = (dirs[:, None, None, :] @ np.array(rots)[None])[:, :, 0]  # (M, m, 3): SE3.rotate's arithmetic
         d_in = d_raw - (d_raw[..., None, :] @ n_all[None, :, :, None])[..., 0] * n_all[None]
         norm = np.linalg.norm(d_in, axis=2)

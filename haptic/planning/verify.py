@@ -728,4 +728,7 @@ class Verifier:
             out["move_budget"] = self.move_budget()
             out.update(self.coverage.record(self._model))
             out["vertices_hidden"] = len(self.hidden) + len(self.unpinnable)
+            # verified up to what the hand cannot measure: every feature in its reach measured (the status says
+            # whether that was all: "incomplete" with vertices hidden is this, never "confirmed")
+            out["reach_complete"] = bool(self.coverage.met(self.mode))
         return out

@@ -1,6 +1,7 @@
-"""The compiled kernels of the matcher and the tracer (:mod:`haptic.matching.kernels`, :mod:`haptic.geometry.kernels`)
-give the numpy forms' results: the same poses to the rounding, the same pose classes, the same face crossings, and
-episodes that decide the same; ``HAPTIC_COMPILED=0`` selects the numpy forms."""
+"""The compiled kernels of the matcher, the tracer and the planner (:mod:`haptic.matching.kernels`,
+:mod:`haptic.geometry.kernels`, :mod:`haptic.planning.kernels`) give the numpy forms' results: the same poses to the
+rounding, the same pose classes, the same face crossings and predictions, and episodes that decide the same;
+``HAPTIC_COMPILED=0`` selects the numpy forms."""
 
 from __future__ import annotations
 
@@ -13,6 +14,7 @@ import pytest
 
 import haptic.geometry.kernels as geometry_kernels
 import haptic.matching.kernels as kernels
+import haptic.planning.kernels as planning_kernels
 from haptic.env import ExploreEnv, PolicyAgent
 from haptic.matching.recognition import PoseTolerance, _same_pose_pairs, model_symmetries, recognize
 
@@ -39,12 +41,12 @@ def _trees(library: str, seeds=range(1, 40)):
 def _both(monkeypatch, fn, *args):
     """``fn(*args)`` with the kernels, then with the numpy forms."""
     compiled = fn(*args)
-    for module in (kernels, geometry_kernels):
+    for module in (kernels, geometry_kernels, planning_kernels):
         monkeypatch.setattr(module, "COMPILED", False)
     try:
         return compiled, fn(*args)
     finally:
-        for module in (kernels, geometry_kernels):
+        for module in (kernels, geometry_kernels, planning_kernels):
             monkeypatch.setattr(module, "COMPILED", True)
 
 
@@ -315,3 +317,58 @@ def test_line_crossings_and_inside_tests_are_the_numpy_forms():
     inside = poly.contains(pts)
     np.testing.assert_array_equal(geometry_kernels.contains(pts, tri), inside)
     assert 20 < inside.sum() < 480  # both verdicts
+
+
+def test_face_move_predictions_are_the_numpy_forms(small_library, monkeypatch):
+    """The face moves' predicted outcomes, costs and clearances in every hypothesis of decisions of some episodes:
+    the compiled predictions are :func:`~haptic.planning.predict.face_outcomes`'s numpy form's, where each hypothesis
+    can say and where it cannot."""
+    from haptic.planning.moves import FaceMove
+    from haptic.planning.predict import candidate_moves, face_outcomes
+
+    env = ExploreEnv(models=small_library, verify="none")
+    agent = PolicyAgent("planner")
+    said = unsaid = 0
+    for seed in range(1, 25):
+        env.reset(seed=seed)
+        while env.context is not None:
+            ctx = env.context
+            faces = [m for m in candidate_moves(ctx.state, ctx.components, ctx.config) if isinstance(m, FaceMove)]
+            if ctx.hypotheses and faces:
+                h = ctx.hypotheses[0]  # along its face's normal: no move in its world
+                f_m = h.faces.get(ctx.state.face)
+                if h.world_from_model is not None and f_m is not None:
+                    faces.append(FaceMove(h.world_from_model.rotate(h.poly.face_normals[f_m])))
+                a, b = _both(monkeypatch, face_outcomes, ctx.hypotheses, faces, ctx.state, ctx.config)
+                for x, y in zip(a, b, strict=True):
+                    for u, v in zip(x, y, strict=True):
+                        np.testing.assert_array_equal(np.isnan(u), np.isnan(v))
+                        np.testing.assert_allclose(u, v, rtol=1e-12, atol=1e-15)
+                    said, unsaid = said + int((~np.isnan(x[1])).sum()), unsaid + int(np.isnan(x[1]).sum())
+            _, _, terminated, truncated, _ = env.step(agent.act(env))
+            if terminated or truncated:
+                break
+    assert said > 500 and unsaid > 10
+
+
+def test_small_solves_are_numpys_and_a_singular_system_hands_back_to_numpy():
+    """The kernels' Gaussian elimination solves what ``np.linalg.solve`` solves, and says so where a pivot is exactly
+    zero (numpy raises there); the refinement then returns False, and ``StackedPoses.refine`` takes the numpy form."""
+    rng = np.random.default_rng(9)
+    for n in (3, 6):
+        for _ in range(200):
+            a = rng.normal(size=(n, n)) * 10.0 ** rng.uniform(-3, 3, size=n)
+            b = rng.normal(size=n)
+            x = b.copy()
+            assert kernels._solve_in_place(a.copy(), x, n)
+            np.testing.assert_allclose(a @ x, b, rtol=1e-9, atol=1e-9 * np.abs(a).max())
+        a = rng.normal(size=(n, n))
+        a[:, 1] = 0.0  # singular: a zero column
+        assert not kernels._solve_in_place(a, rng.normal(size=n), n)
+    # no row constrains anything: the normal equations are zero
+    r, t = np.eye(3)[None].copy(), np.zeros((1, 3))
+    none = np.zeros((0, 3))
+    assert not kernels.refine_poses(
+        np.ones((1, 3)), np.ones((1, 1, 3)), np.zeros((1, 1)), none, np.zeros((1, 0, 3)), np.zeros((1, 0, 3, 3)),
+        r, t, 6, 1e-9,
+    )  # fmt: skip
