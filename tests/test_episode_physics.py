@@ -277,3 +277,15 @@ def test_an_edge_move_after_a_tilted_move_returns_beside_the_last_contact():
     rec = run_episode(EpisodeSpec(model="HEXPRISM01", seed=1, executor="physics", verify="full"), observer=obs)
     assert not [w for w in failed if "could not return next to the edge: no-contact" in w], failed
     assert rec.outcome == "recognized" and rec.correct, rec.detail
+
+
+def test_a_stroke_that_steps_onto_the_rim_of_another_edge_measures_no_face(tmp_path):
+    # BOX01N 30 mm across, seed 1 (perception_report.py --sizes 30): a face move down over the top edge onto a
+    # side 10 mm tall, above an overhang, rolled on to that side's lower edge as it stepped in; the stroke's legs
+    # then ran along that edge, the pad riding it with a steady normal 20° below the side's, and the "face" was
+    # 25 times its bound off the true one (no-match). LBLOCK01 at 30 mm, seed 1, did the same on a step 10 mm
+    # wide (12 bounds). The stroke's first leg off the edge turned its normal by 6-11° (0.1-1.9° on a face):
+    # the pad had reached the rim of another edge, and the move touches the next face afresh with an L or fails.
+    ep, failed, _ = _replay(tmp_path, "BOX01N", 0.03, 11)
+    assert _within_bounds(ep)
+    assert any("the rim of another edge" in r.reason for r in failed), [r.reason for r in failed]

@@ -517,9 +517,12 @@ class PhysicsExecutor(LandingSearch):
             along = -along
         st = t.stroke(n_b, r.info["away"], along)
         pieces.append(st)
-        fit = self.segmenter.fit_face_trace(st.trace, st.info["normal"]) if st.ok else None
+        rim = st.ok and st.info["rim"]
+        fit = self.segmenter.fit_face_trace(st.trace, st.info["normal"]) if st.ok and not rim else None
         if fit is None:
-            why = f"stroke on the next face failed: {st.event}" if not st.ok else "too few contacts on the next face"
+            why = (f"stroke on the next face failed: {st.event}" if not st.ok
+                   else "stepping onto the next face, the pad reached the rim of another edge" if rim
+                   else "too few contacts on the next face")  # fmt: skip
             if st.status == "unstable":
                 return st.status, why, None, None, None
             return self._reacquire(kind, n_a, direction, corner, r.trace, n_b, pieces, away_from, why)

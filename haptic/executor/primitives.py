@@ -668,13 +668,29 @@ class Toucher:
         # hold too few rows
         rest = ContactTrace.concatenate([p.trace for p in pieces[1:]])
         narrow = step_in is None and int(rest.in_contact.sum()) >= self.bounds.min_face_rows
+        rim = step_in is None and self._stepped_onto_rim(pieces[0])
         trace = rest if narrow else ContactTrace.concatenate([p.trace for p in pieces])
         ok_rows = trace.in_contact & (trace.phase == PHASES.index("stroke"))
         n_mean = dominant_normal(trace.normal_in_world[ok_rows], n_f, self.bounds.face_cone / 2.0, cfg.edge_angle)
         failed = [p for p in pieces if not p.ok and p.event not in STOPS]
         status = failed[-1].status if failed else "ok"
         event = failed[-1].event if failed else "done"
-        return PrimitiveResult(status, event, trace, sum(p.distance for p in pieces), {"normal": n_mean})
+        return PrimitiveResult(status, event, trace, sum(p.distance for p in pieces), {"normal": n_mean, "rim": rim})
+
+    def _stepped_onto_rim(self, step: PrimitiveResult) -> bool:
+        """Whether a stroke's first leg, off the edge just rolled over, met another edge or turned its sensed
+        normal off the face, by more than :attr:`~SegmentBounds.sample_cone` (the mean of its first
+        :attr:`~SegmentBounds.steady_window` rows against that of its last: 0.1-1.9° on a face, 4.5-10.6° where
+        the pad had rolled onto the rim of the face's far edge, over five episodes of the seed library at
+        30-150 mm). The legs along the face would then ride that rim with a steady normal turned partway round it
+        (BOX01N at 30 mm: 20° off the face's, 25 times its bound)."""
+        if step.event not in ("done", *STOPS):
+            return True
+        n = step.trace.normal_in_world[step.trace.in_contact]
+        k = self.bounds.steady_window
+        if len(n) < 2 * k:
+            return False
+        return angle(unit(n[:k].sum(axis=0)), unit(n[-k:].sum(axis=0))) > self.bounds.sample_cone
 
     # -- along an edge -----------------------------------------------------------------------------------------
     def follow_edge(
