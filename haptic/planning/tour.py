@@ -298,20 +298,45 @@ def tour_lower_bound(poly: Polyhedron, position: np.ndarray, targets: np.ndarray
     frame) [units]: each is measured by an edge move that ends at it (``c_k`` each), and the sensor's path
     passes through all of them, so it is at least their minimum spanning tree with the start, each straight
     line of length ``d`` at the cheapest way of covering it, ``min(c_f d, c_p + c_s d)`` (probes where admitted:
-    a path of traced and probed stretches costs at least that). Features that are not vertices add nothing."""
+    a path of traced and probed stretches costs at least that). Features that are not vertices add nothing.
+
+    Each vertex's edge move also starts on an edge, which the move before it brought the sensor onto
+    (:func:`arrival_costs`): every vertex but the first adds the least cost of that arrival beyond the path's
+    length at the face rate, the first (the sensor may start on its edge) nothing."""
     from scipy.sparse.csgraph import minimum_spanning_tree
 
     feats = features(poly)
-    pts = feats.points[targets[feats.kinds[targets] == VERTEX]]
+    vertex_ids = feats.ids[targets[feats.kinds[targets] == VERTEX]]
+    pts = poly.vertices[vertex_ids]
     if not len(pts):
         return 0.0
+    arrive = arrival_costs(poly, legs)[vertex_ids]
     p = np.vstack([np.asarray(position)[None], pts])
     d = np.linalg.norm(p[:, None] - p[None], axis=2)
     w = legs.face_rate * d
     if legs.probes:
         w = np.minimum(w, legs.probe_fixed + legs.probe_rate * d)
-    w = np.where(d > 0, np.maximum(w, 1e-12), 0.0)  # a zero entry is no edge to the spanning tree
-    return float(minimum_spanning_tree(w).sum()) + legs.vertex_event * len(pts)
+    # a zero (or, to scipy's dense input, a near-zero) entry is no edge of the spanning tree: coincident points are
+    # joined at a floor that the sum then leaves out
+    floor = 1e-3
+    w = np.maximum(w, floor)
+    np.fill_diagonal(w, 0.0)
+    tree = minimum_spanning_tree(w).data
+    path = float(tree[tree > floor].sum())
+    return path + legs.vertex_event * len(pts) + float(arrive.sum() - arrive.max())
+
+
+def arrival_costs(poly: Polyhedron, legs: LegCosts) -> np.ndarray:
+    """Per vertex of ``poly``, the least cost, beyond its length at the face rate, of the move that brings the sensor
+    onto an edge at the vertex before the edge move that measures it, shape (V,) [units]: a face move that ends on
+    the edge, or a vertex move onto it at its other end, detect the edge, its direction and the next face's normal
+    (``c_j + c_b + c_n``); an edge move that ends at the other end (the sensor then goes back along the edge) traces
+    the whole edge at the edge rate, ``(c_e - c_f)`` per metre more than across a face; a probe ends on a face,
+    never on an edge. The least of these, over the edges at the vertex."""
+    shortest = np.full(poly.n_vertices, np.inf)
+    np.minimum.at(shortest, poly.edges[:, 0], poly.edge_lengths)
+    np.minimum.at(shortest, poly.edges[:, 1], poly.edge_lengths)
+    return np.minimum(legs.face_events, max(legs.edge_rate - legs.face_rate, 0.0) * shortest)
 
 
 __all__ = [
@@ -322,6 +347,7 @@ __all__ = [
     "LegCosts",
     "StartCosts",
     "Tour",
+    "arrival_costs",
     "features",
     "leg_matrix",
     "plan_tour",

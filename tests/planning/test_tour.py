@@ -13,6 +13,7 @@ from haptic.planning.config import PlannerConfig
 from haptic.planning.tour import (
     VERTEX,
     LegCosts,
+    arrival_costs,
     features,
     leg_matrix,
     plan_tour,
@@ -122,3 +123,21 @@ def test_the_bound_grows_with_what_is_left_and_is_zero_without_vertices():
     assert tour_lower_bound(poly, here, keys[:0], ALL) == 0.0
     assert tour_lower_bound(poly, here, keys[:4], ALL) <= tour_lower_bound(poly, here, keys, ALL)
     assert tour_lower_bound(poly, here, keys, ALL) <= tour_lower_bound(poly, here, keys, TRACING)
+
+
+def test_every_vertex_but_the_first_adds_the_least_cost_of_getting_onto_an_edge_at_it():
+    poly = LIB["LBLOCK01"]
+    keys = _vertices(poly)
+    for legs in (ALL, TRACING):
+        arrive = arrival_costs(poly, legs)
+        for v in range(poly.n_vertices):  # a face or vertex move's events, or going back along the shortest edge
+            at = [e for e in range(poly.n_edges) if v in poly.edges[e]]
+            back = (legs.edge_rate - legs.face_rate) * min(poly.edge_lengths[e] for e in at)
+            assert arrive[v] == pytest.approx(min(legs.face_events, back))
+        # at a vertex with nothing else to measure: only its detection (the sensor may be on its edge already)
+        assert tour_lower_bound(poly, poly.vertices[0], keys[:1], legs) == pytest.approx(legs.vertex_event)
+        # two vertices, the sensor at the first: the leg between them, two detections, one arrival
+        d = float(np.linalg.norm(poly.vertices[1] - poly.vertices[0]))
+        leg = min(legs.face_rate * d, legs.probe_fixed + legs.probe_rate * d) if legs.probes else legs.face_rate * d
+        expected = leg + 2 * legs.vertex_event + min(arrive[0], arrive[1])
+        assert tour_lower_bound(poly, poly.vertices[0], keys[:2], legs) == pytest.approx(expected)
