@@ -4,28 +4,13 @@ over one edge the cheapest; each measured nothing, and the verification stalled 
 tracing when no probe is offered, and without the ways already travelled for nothing, it goes on to the vertex
 it lacks."""
 
-import shutil
-
 import pytest
 
 from haptic.episode.spec import EpisodeSpec
 from haptic.episode.worlds import run_episode
-from haptic.geometry import DEFAULT_LIBRARY, load_library, model_files, save_model
+from haptic.geometry import load_library
 from haptic.geometry.perturb import scale_dimension
-
-
-def learned_library(root, model, seed: int, name: str):
-    """A copy of the shipped library with ``model`` learned into it as ``name`` (the learning episode of
-    ``seed``, as ``scripts/bench_learn.py`` learns it), and the object's file."""
-    lib = root / "lib"
-    lib.mkdir()
-    for f in model_files(DEFAULT_LIBRARY):
-        shutil.copy2(f, lib / f.name)
-    obj = root / f"{model.name}.json"
-    save_model(model, obj)
-    rec = run_episode(EpisodeSpec(model=str(obj), seed=seed, noise=1.0, learn=str(lib), learn_name=name))
-    assert rec.learned["status"] == "closed"
-    return lib, obj
+from tests.learning.test_reidentify import learned_library
 
 
 @pytest.mark.parametrize(("base", "axis", "factor", "learn_seed", "seed"), [
