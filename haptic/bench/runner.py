@@ -298,8 +298,9 @@ def _run_ray(payload: list[dict], workers: int) -> Iterator[dict]:
                 del pending[done[0]]
                 yield ray.get(done[0])
     finally:
-        for ref in pending:
-            ray.cancel(ref, force=True)
         if started:
-            ray.shutdown()
+            ray.shutdown()  # its workers end with it; cancelling tasks first raced their completion inside Ray
+        else:
+            for ref in pending:  # a cluster's workers go on: the tasks left are cancelled
+                ray.cancel(ref, force=True)
         held.release()
