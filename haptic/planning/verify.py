@@ -613,7 +613,52 @@ def _target_points(poly: Polyhedron, missing: tuple[frozenset[int], frozenset[in
 
 
 __all__ = ["aimed_face_moves", "choose_verification_move", "hidden_vertices", "plan_verification_move",
-           "reachable_features", "verification_probes", "verify_move_budget"]
+           "face_middle", "reachable_features", "unmeasured_middles", "verification_probes", "verify_move_budget"]
+
+
+MIDDLE_REACH = 5e-3
+"""Under ``full`` with probes admitted, a face's middle (the mean of its vertices) is measured when a measured point
+lies on the face's plane within this of it [m] (:func:`unmeasured_middles`)."""
+
+
+def face_middle(poly: Polyhedron, f: int) -> np.ndarray:
+    """The middle of face ``f`` (model frame): the mean of its vertices when that lies on the face at least
+    :data:`PROBE_INSET` from its boundary, else whichever of it and the face's triangles' centroids lies on the face
+    farthest from its boundary (a face that is not convex)."""
+    from haptic.geometry.distance import point_triangle_distance
+
+    loop = poly.vertices[list(poly.faces[f])]
+    tri = poly.vertices[poly.triangles[poly.triangle_faces == f]]
+    a, b = loop, np.roll(loop, -1, axis=0)
+
+    def inside(p: np.ndarray) -> float:
+        if float(point_triangle_distance(p[None], tri).min()) > 1e-9:
+            return -1.0
+        t = np.clip(np.einsum("ij,ij->i", p - a, b - a) / np.einsum("ij,ij->i", b - a, b - a), 0.0, 1.0)
+        return float(np.linalg.norm(p - a - t[:, None] * (b - a), axis=1).min())
+
+    mid = loop.mean(axis=0)
+    if inside(mid) >= PROBE_INSET:
+        return mid
+    candidates = [mid, *tri.mean(axis=1)]
+    return candidates[int(np.argmax([inside(p) for p in candidates]))]
+
+
+def unmeasured_middles(poly: Polyhedron, world_from_model: SE3, data: Sequence[DataComponent],
+                       faces: frozenset[int]) -> list[int]:
+    """The ``faces`` of ``poly`` at pose ``world_from_model`` whose middle no measured point of ``data`` lies
+    within :data:`MIDDLE_REACH` of. Measured vertices fix a face's plane, not that the face is whole between
+    them: a slot across its middle leaves every vertex of the model in place."""
+    pts = [np.atleast_2d(c.points) for c in data if isinstance(c, DataFace) and len(c.points)]
+    pts += [np.stack([c.point, c.point + c.length * c.direction]) for c in data if isinstance(c, DataEdge)]
+    if not pts:
+        return sorted(faces)
+    p = world_from_model.inverse().apply(np.concatenate(pts))
+    out = []
+    for f in sorted(faces):
+        if float(np.linalg.norm(p - face_middle(poly, f), axis=1).min()) > MIDDLE_REACH:
+            out.append(int(f))
+    return out
 
 
 class Verifier:
@@ -664,6 +709,17 @@ class Verifier:
         None: no pose, or no vertex to measure)."""
         self.decision_times: list[float] = []
         """Wall time of each verification move's choice [s] (not in the record, which is the same on every run)."""
+        self.middles: list[int] = []
+        """Under ``full`` with probes admitted, once every vertex is measured: the reachable faces whose middle is
+        still to be probed (:func:`unmeasured_middles`); each is probed once."""
+        self._middles_tried: set[int] = set()
+        self._middles_from: float | None = None
+        """Path cost when the first face's middle was asked for [units] (None: never)."""
+        self.middles_unmeasured: list[int] = []
+        """Faces whose middle a probe did not measure (the verification is incomplete)."""
+        self.middles_unprobed: set[int] = set()
+        """Faces of :attr:`middles` that no admissible probe was predicted to reach at their middle (not asked for:
+        a slot across such a face is not caught)."""
 
     def verdict(self, tree, rec, cost: float) -> str:
         """"confirmed", "mismatch", "incomplete" or "verifying" for a recognition ``rec`` (status recognized)
@@ -703,6 +759,17 @@ class Verifier:
             placed = placed_by_data(cls.model, self.check.world_from_model, unpinned, self.coverage, self.config)
             self.unpinnable = [v for v in unpinned if v not in placed]
             self.status = "incomplete" if self.mode == "full" and (self.hidden or self.unpinnable) else "confirmed"
+            if self.status == "confirmed" and self.mode == "full" and self._probes_admitted():
+                todo = [f for f in unmeasured_middles(cls.model, self.check.world_from_model, tree.data,
+                                                      self._reach[cls.name][0]) if f not in self.middles_unprobed]
+                self.middles = [f for f in todo if f not in self._middles_tried]
+                if self.middles:
+                    self.status = "verifying"
+                    if self._middles_from is None:
+                        self._middles_from = cost
+                elif todo:
+                    self.middles_unmeasured = todo
+                    self.status = "incomplete"
         else:
             self.status = "verifying"
             got = self.coverage.measured() if self.coverage is not None else 0
@@ -720,6 +787,31 @@ class Verifier:
             if not self.accept.ok:
                 self.status = "rejected"
         return self.status
+
+    def _probes_admitted(self) -> bool:
+        return self.config.moves != "tracing" and self.config.table_z is None and MAX_VERIFY_PROBES > 0
+
+    def _middle_probe(self, h: Hypothesis, state: SensorState, components: Mapping[int, DataComponent],
+                      avoid: Sequence[Move], probed: Sequence[Move]) -> Move | None:
+        """A probe at the middle of the next face of :attr:`middles` predicted to land on it (None: none left)."""
+        from haptic.planning.move_scores import Context, predict_probe_moves, probe_config, same_move
+        from haptic.planning.probe_lines import aimed_probes
+
+        if any(m.kind == "probe" for m in avoid):  # no probe from here: the faces left are not probed
+            self.middles_unprobed.update(self.middles)
+            self._middles_tried.update(self.middles)
+            self.middles = []
+            return None
+        while self.middles:
+            f = self.middles.pop(0)
+            self._middles_tried.add(f)
+            lines = [mv for mv, _ in aimed_probes(h, [(face_middle(h.poly, f), f)], probe_config(self.config))
+                     if not any(same_move(mv, done) for done in probed)]  # fmt: skip
+            for pred in predict_probe_moves(Context((h,), state, components, self.noise, self.config), lines):
+                if bool(pred.hit[0]) and int(pred.face[0]) == f and pred.risk() == 0.0:
+                    return pred.move
+            self.middles_unprobed.add(f)
+        return None
 
     def move_budget(self) -> int:
         """The verification moves this verification may make (:func:`verify_move_budget` of the recognised
@@ -745,6 +837,9 @@ class Verifier:
             a = self.accept
             return (f"verification: residuals {a.statistic:.1f} over the noise model's {a.threshold:.1f} "
                     f"(chi-square, {a.dof} dof)")  # fmt: skip
+        if self.status == "incomplete" and self.middles_unmeasured:
+            return (f"verification incomplete: the middle of {len(self.middles_unmeasured)} faces of "
+                    f"{self._model_name} not measured (a slot across a face leaves its vertices in place)")
         if self.status == "incomplete" and (self.hidden or self.unpinnable):
             where = [f"{len(self.hidden)} out of the hand's reach off the table"] if self.hidden else []
             if self.unpinnable:
@@ -769,6 +864,10 @@ class Verifier:
         self.moves += 1
         if self._hyp is not None and self._hyp.world_from_model is not None:
             h = self._hyp
+        if self.middles and h.world_from_model is not None:
+            move = self._middle_probe(h, state, components, avoid, probed)
+            self.decision_times.append(time.perf_counter() - t0)
+            return move
         missing = self.coverage.missing(self.mode) if self.coverage is not None else (frozenset(),) * 3
         faces_ok = self._reach[self._model_name][0] if self._model_name in self._reach else None
         previous = self._tour if self._tour is not None and self._tour_model is h.poly else None
@@ -805,6 +904,9 @@ class Verifier:
                        chi2_threshold=round(self.accept.threshold, 3))  # fmt: skip
             if self.accept.table_residual is not None:
                 out["table_residual_mm"] = round(self.accept.table_residual * 1000.0, 3)
+        if self._middles_from is not None:  # the faces' middles: probes and their cost
+            out["middles_probed"] = len(self._middles_tried - self.middles_unprobed)
+            out["middles_cost"] = round(cost - self._middles_from, 6)
         if self.tour_planned is not None:
             out["tour_planned"] = round(self.tour_planned, 6)
         if self.tour_bound is not None:
