@@ -76,6 +76,13 @@ def expected_eliminated(eliminates: np.ndarray, weights=None) -> float:
     return float(d.sum(axis=1) @ _normalised(weights, len(d)))
 
 
+def move_score(eliminates: np.ndarray, costs: np.ndarray, weights=None) -> tuple[float, float, float]:
+    """A candidate's efficiency (:func:`efficiency_of`), expected eliminations (:func:`expected_eliminated`) and
+    expected cost (``costs`` per hypothesis, weighted by ``weights``; equal when None)."""
+    eff, _ = efficiency_of(eliminates, costs, weights)
+    return eff, expected_eliminated(eliminates, weights), float(costs @ _normalised(weights, len(costs)))
+
+
 def _normalised(weights, n: int) -> np.ndarray:
     return np.full(n, 1.0 / n) if weights is None else np.asarray(weights, dtype=float) / np.sum(weights)
 

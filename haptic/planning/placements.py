@@ -31,7 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from haptic.planning.efficiency import efficiency_of, expected_eliminated
+from haptic.planning.efficiency import efficiency_of, expected_eliminated, move_score
 from haptic.planning.handpath import HandStart
 from haptic.planning.moves import CostModel, FingerApproach, PlacementMove, ProbeMove
 from haptic.planning.probe_prediction import ProbePrediction
@@ -97,11 +97,7 @@ class PlacementPrediction:
 
     def score(self, weights: np.ndarray | None = None) -> tuple[float, float, float]:
         """Efficiency, expected eliminations and expected cost, as :meth:`ProbePrediction.score` gives them."""
-        d = self.eliminates()
-        eff, _ = efficiency_of(d, self.costs, weights)
-        n = len(self.costs)
-        w = np.full(n, 1.0 / n) if weights is None else np.asarray(weights, dtype=float) / np.sum(weights)
-        return eff, expected_eliminated(d, weights), float(self.costs @ w)
+        return move_score(self.eliminates(), self.costs, weights)
 
 
 def placement_costs(

@@ -37,7 +37,7 @@ from haptic.geometry.raycast import line_hits
 from haptic.matching.acceptance import POSE_SAFETY
 from haptic.matching.components import DataComponent, SensorNoise
 from haptic.matching.recognition import PoseTolerance
-from haptic.planning.efficiency import efficiency_of, expected_eliminated
+from haptic.planning.efficiency import move_score
 from haptic.planning.handpath import HandStart, foot_near_boundary, pad_touches_first, pad_touches_path
 from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import CostModel, ProbeMove
@@ -176,11 +176,7 @@ class ProbePrediction:
     def score(self, weights: np.ndarray | None = None) -> tuple[float, float, float]:
         """Efficiency (expected eliminations per expected cost, §4.1.1), expected eliminations and expected
         cost, with ``weights`` over the hypotheses (equal when None)."""
-        d = self.eliminates()
-        eff, _ = efficiency_of(d, self.costs, weights)
-        n = len(self.costs)
-        w = np.full(n, 1.0 / n) if weights is None else np.asarray(weights, dtype=float) / np.sum(weights)
-        return eff, expected_eliminated(d, weights), float(self.costs @ w)
+        return move_score(self.eliminates(), self.costs, weights)
 
 
 def predict_probes(
