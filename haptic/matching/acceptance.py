@@ -350,13 +350,15 @@ def own_bounds_keep(tree, k_sigma: float | None = None) -> np.ndarray | None:
     """Which interpretations of ``tree`` (:class:`~haptic.matching.tree.InterpretationTree`) pass the pose check
     (:func:`pose_check`) and the acceptance test (:func:`acceptance`, σ = bound / ``k_sigma``) with their own
     model's bounds, and whose model the data do not find far less likely than another's, shape (N,) bool; None when
-    there is nothing to tell: the library holds no learned model, one model is left, or more than
+    there is nothing to tell: the library holds no learned model, one interpretation is left, or more than
     :data:`OWN_BOUNDS_LEAVES` interpretations.
 
     With a learned model in the library the tree widens every data component by the learned models' bounds
     (:func:`~haptic.matching.tree.learned_widening`), for every model at once: an object a few millimetres from a
     library model, learned, then keeps both the learned model's interpretation and its source's, which the tree's
-    tests no longer tell apart and no move would. The pose check and the acceptance test hold each model to its
+    tests no longer tell apart and no move would; so are two poses of one learned model a few millimetres from
+    symmetric (PYR01 with a corner of its base moved 2 mm, learned, kept at a half turn of the pose that fits it,
+    whose statistic was 434 against a threshold of 287). The pose check and the acceptance test hold each model to its
     own bounds (none added for an exact model); an interpretation that fails them is no interpretation of the
     data, as when it is the last one left (the verification's mismatch or rejection). A leaf whose pose the data
     do not fix yet is kept.
@@ -369,7 +371,7 @@ def own_bounds_keep(tree, k_sigma: float | None = None) -> np.ndarray | None:
     whose best statistic exceeds the best model's by more than :data:`LIKELIHOOD_GAP` (the data
     ``1 / ACCEPT_ALPHA`` times less likely under it), over the same quantities, is dropped."""
     k_sigma = K_SIGMA if k_sigma is None else k_sigma
-    if tree.widen is None or tree.count > OWN_BOUNDS_LEAVES or len(tree.models_alive()) < 2:
+    if tree.widen is None or tree.count > OWN_BOUNDS_LEAVES or tree.count < 2:
         return None
     keep = np.ones(tree.count, dtype=bool)
     common = np.full(tree.count, np.inf)
