@@ -40,8 +40,9 @@ def summary(records: list[dict], sizes: dict[str, int]) -> str:
     wrong = [r for r in records if r["outcome"] == "recognized" and not r["correct"]]
     outcomes = Counter(r["outcome"] for r in records)
     statuses = Counter((r.get("verified") or {}).get("status", "-") for r in records)
-    use = [r["verified"]["moves"] / r["verified"]["move_budget"] for r in records
-           if (r.get("verified") or {}).get("move_budget")]  # fmt: skip
+    # the budget is for the vertices (verify_move_budget); the faces' middles are probed once each after them
+    use = [(r["verified"]["moves"] - r["verified"].get("middles_probed", 0)) / r["verified"]["move_budget"]
+           for r in records if (r.get("verified") or {}).get("move_budget")]  # fmt: skip
     lines = [
         f"episodes: {n}; confirmed and correct: {len(ok)} ({100.0 * len(ok) / max(n, 1):.1f} %); wrong: {len(wrong)}",
         f"outcomes: {', '.join(f'{k} {v}' for k, v in outcomes.most_common())}",
@@ -50,7 +51,8 @@ def summary(records: list[dict], sizes: dict[str, int]) -> str:
         f"max {max(r['path_cost'] for r in records):.1f} (budget {DEFAULT_BUDGET:g})",
     ]
     if use:
-        lines.append(f"verification moves / move budget: median {np.median(use):.2f}, max {max(use):.2f}")
+        lines.append(f"verification moves before the faces' middles / move budget: median {np.median(use):.2f}, "
+                     f"max {max(use):.2f}")
     big = sorted(records, key=lambda r: -sizes.get(r["model"], 0))[:3]
     lines.append("largest models: " + "; ".join(
         f"{r['model']} ({sizes.get(r['model'], 0)} vertices): {r['outcome']}, {r['moves']} moves, "
