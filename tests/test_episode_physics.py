@@ -289,3 +289,19 @@ def test_a_stroke_that_steps_onto_the_rim_of_another_edge_measures_no_face(tmp_p
     ep, failed, _ = _replay(tmp_path, "BOX01N", 0.03, 11)
     assert _within_bounds(ep)
     assert any("the rim of another edge" in r.reason for r in failed), [r.reason for r in failed]
+
+
+def test_a_start_landing_next_to_the_rim_measures_the_face_within_its_bound(tmp_path):
+    # HEXPRISM01 30 mm across, seed 2 (perception_report.py --sizes 30): the start landed 0.3 mm from the top face's
+    # rim and the L stroke began with the pad rolled on the edge, its normal 4-7° off the face. The face's rows were
+    # picked about the primitive's running normal, seeded there, and the face came out 3.1° off (3.65 times its
+    # bound; the episode ended no-match) though most of the L's rows lay on the face. Picked about the median of
+    # the L's normals, it is 0.1° off.
+    from haptic.episode.evaluate import bound_ratios
+
+    spec = EpisodeSpec(model="HEXPRISM01", seed=2, executor="physics", models=_scaled_library(tmp_path, 0.03))
+    ep = build_episode(spec)
+    r = ep.executor.start()
+    assert r.ok and [c.kind for c in r.components] == ["face"]
+    ratios = bound_ratios(r.components, ep.true_model, ep.world_from_model)
+    assert max(x.ratio for x in ratios if x.what == "face normal") < 0.5, ratios
