@@ -320,3 +320,20 @@ def test_a_start_landing_next_to_the_rim_measures_the_face_within_its_bound(tmp_
     assert r.ok and [c.kind for c in r.components] == ["face"]
     ratios = bound_ratios(r.components, ep.true_model, ep.world_from_model)
     assert max(x.ratio for x in ratios if x.what == "face normal") < 0.5, ratios
+
+
+def test_an_edge_move_that_acquires_a_parallel_ridge_reports_nothing(tmp_path):
+    # BOX01P 60 mm across, seed 1 (perception_report.py --sizes 60): the back face meets the plateau's top and the
+    # lower top along two parallel edges 12 mm apart, between faces of the same normals. A second edge move along
+    # the plateau's back edge returned next to it past its end and acquired the lower edge's ridge; its contacts
+    # moved the edge's line there and its vertex lay 12 mm below the edge's end, on no edge of the line: the true
+    # object was pruned and the episode ended no-match, though every component lay within its bounds of some
+    # feature. A ridge acquired off the edge's line is another edge: the move fails.
+    failed = []
+    obs = EpisodeObserver(on_failed_move=lambda n, r: failed.append(r.reason))
+    spec = EpisodeSpec(model="BOX01P", seed=1, executor="physics", models=_scaled_library(tmp_path, 0.06))
+    ep = build_episode(spec)
+    rec = ep.run(None, obs)
+    assert any("off the edge's line: another edge" in w for w in failed), failed
+    assert rec.outcome != "no-match", rec.detail
+    assert _within_bounds(ep)

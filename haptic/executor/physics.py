@@ -136,6 +136,10 @@ class PhysicsSettings:
     edge_reach: float = 0.03
     """An edge move starts where the pad is when it rests on one of the edge's faces within this of its line;
     farther, it returns next to the edge first [m]."""
+    ridge_offset: float = 0.002
+    """A convex edge's ridge, acquired, holds the pad's contact on the edge's line: a contact farther than this from
+    it is on another edge (one parallel to it between faces of the same normals: BOX01P's back face meets the
+    plateau's top and the lower top 12 mm apart at 60 mm) [m]."""
     vertex_hold: float = 0.05
     """At the end of an edge the pad presses in place this long before the vertex is located [s]."""
     min_vertex_rows: int = 3
@@ -788,6 +792,13 @@ class PhysicsExecutor(LandingSearch):
         pieces.append(acq)
         if not acq.ok:
             return self.failed_result(move, acq, f"acquiring the ridge: {acq.event}")
+        off = self._line_distance(rec, self.contact_point())
+        s_acq = rec.param(self.contact_point())
+        past = max(rec.interval[0] - s_acq, s_acq - rec.interval[1], 0.0)  # the line extrapolated this far
+        slack = past * math.sin(self.bounds.bound(rec.direction_sigma, self.bounds.direction_floor))
+        if rec.convex and off > s.ridge_offset + slack:
+            return self.failed_result(move, "unreachable", f"the ridge acquired lies {off * MM:.1f} mm off the "
+                                                           "edge's line: another edge")  # fmt: skip
         s_from = rec.param(self.contact_point())
         r = t.follow_edge(u, n_a, n_b, toward_a, s.max_edge_trace)
         pieces.append(r)
