@@ -246,6 +246,7 @@ class PhysicsExecutor(LandingSearch):
         """The data face the pad is known to rest on (None: not known)."""
         self._finger = finger
         self._why = ""  # detail of the last repositioning failure
+        self._stroke_blocked = False  # the last stroke on a next face met an edge along both of its legs
         self._met: PrimitiveResult | None = None  # the last crossing a link of the finger stopped
         self._links_until: float | None = None  # sim time of the last hand-link sample reported
 
@@ -521,6 +522,7 @@ class PhysicsExecutor(LandingSearch):
             along = -along
         st = t.stroke(n_b, r.info["away"], along)
         pieces.append(st)
+        self._stroke_blocked = st.ok and st.info["blocked"]
         rim = st.ok and st.info["rim"]
         fit = self.segmenter.fit_face_trace(st.trace, st.info["normal"]) if st.ok and not rim else None
         if fit is None:
@@ -616,6 +618,7 @@ class PhysicsExecutor(LandingSearch):
                 return self.failed_result(move, "unreachable", "no edge within the longest trace")
             kind = r.info["kind"]
             corner = self.contact_point()
+            self._stroke_blocked = False
             status, reason, roll, stroke, fit_b = self._cross_and_acquire(kind, r.info["face_normal"],
                                                                           r.info["direction"], pieces)  # fmt: skip
             if status == "undercut":
@@ -627,6 +630,13 @@ class PhysicsExecutor(LandingSearch):
             if status != "ok":
                 return self.failed_result(move, status, reason)
             fit_a, line, why = self._edge_between(st.face, r.trace, "face", roll, fit_b, kind, corner)
+            if line is not None and kind == "convex" and self._stroke_blocked:
+                # the next face is narrow along the edge where the pad met it: a roll round a vertex onto a face
+                # sharing only the vertex gives the same normals and contacts when the crossing is square to the
+                # line between the faces; the ridge along that line is there only over an edge
+                ridge = self._probe_ridge(line.direction, fit_a.normal, fit_b.normal, pieces)
+                if isinstance(ridge, str):
+                    line, why = None, f"no edge between the faces: {ridge}"
             if line is not None:
                 break
             shift = self._away_from_vertex(fit_a.normal, fit_b.normal, roll) if not recrossed else None
