@@ -36,6 +36,7 @@ from itertools import permutations
 from typing import Any
 
 import mink
+import mujoco
 import numpy as np
 
 from haptic.executor.physics_probe import _highest_contact, _leading_segment
@@ -58,13 +59,13 @@ class PlacementSettings:
 
     step: float = 0.001
     """The fingers close along their lines by this much per configuration [m] ..."""
-    step_ticks: int = 8
-    """... each held this many control ticks (with 5 ms ticks, 25 mm/s) [-]."""
+    step_ticks: int = 12
+    """... each held this many control ticks (with 5 ms ticks, 17 mm/s) [-]."""
     ik_iterations: int = 4
     """QP iterations of the solver per configuration of the closing and the stroke [-]."""
     press: float = 0.001
     """A finger that touched presses with its target this far past its contact, along its line [m]."""
-    lag: float = 0.006
+    lag: float = 0.008
     """A closing finger whose pad trails its target by more than this fails (its joints carry it no further) [m]."""
     settle_ticks: int = 30
     """Ticks the touched fingers press in place before they stroke, and before the normal is read [-]."""
@@ -74,8 +75,15 @@ class PlacementSettings:
     """... taken in steps of this [m] ..."""
     stroke_ticks: int = 4
     """... each held this many ticks (with 5 ms ticks, 12.5 mm/s) [-]."""
-    stroke_press: float = 0.002
-    """While stroking a pad's target lies this far under its face's plane [m]."""
+    stroke_press: float = 0.0015
+    """While stroking a pad's target starts this far under its face's plane [m] ..."""
+    press_gain: float = 0.0002
+    """... and goes this much deeper per newton the sensed force falls short of the tracing force, per step
+    [m/N] ..."""
+    max_press: float = 0.004
+    """... down to at most this [m]."""
+    dwell_steps: int = 12
+    """At the end of each leg the targets stay this many steps (the joints' servo trails them) [-]."""
     stroke_headings: int = 4
     """A finger whose stroke finds no face strokes again in up to this many headings in all, a quarter turn
     apart (its stroke may have left a narrow face)."""
@@ -468,17 +476,24 @@ def _stroke(c: _Closing, fingers: Sequence[FingerApproach], held: dict[str, np.n
         legs[f.finger] = (d1, np.cross(n, d1))
     first = {f.finger: len(c.rows[f.finger]) for f in fingers}
     steps = max(1, int(round(s.stroke / s.stroke_step)))
+    depth = {f.finger: s.stroke_press for f in fingers}
+    force = c.ex.toucher.config.force
     for leg in range(2):
-        for k in range(1, steps + 1):
+        for k in range(1, steps + 1 + s.dwell_steps):
+            k = min(k, steps)  # then dwell at the leg's end: the joints' servo trails its targets
             targets = dict(held)
             for f in fingers:
                 n, p0 = normals[f.finger], contacts[f.finger]
                 d1, d2 = legs[f.finger]
                 off = (k * s.stroke_step * d1) if leg == 0 else (s.stroke * d1 + k * s.stroke_step * d2)
-                targets[f.finger] = p0 + off + (radius[f.finger] - s.stroke_press) * n
+                targets[f.finger] = p0 + off + (radius[f.finger] - depth[f.finger]) * n
             c.hold(c.solve(targets))
             for _ in range(s.stroke_ticks):
                 c.tick("stroke")
+            for f in fingers:  # pressing: the target's depth under the face follows the force sensed
+                sensed = float(np.mean([row[5] for row in c.rows[f.finger][-s.stroke_ticks:]]))
+                depth[f.finger] = float(np.clip(depth[f.finger] + s.press_gain * (force - sensed), 0.0,
+                                                s.max_press))  # fmt: skip
     return {f.finger: c.trace(f.finger, first[f.finger]) for f in fingers}
 
 
@@ -559,16 +574,25 @@ class PlacementReach:
         return answer
 
     def _solver(self, h) -> ReachSolver:
+        """A solver with ``h``'s model in its scene, moved to ``h``'s pose (one compiled scene per model: the
+        object's body is fixed to the world, so its pose is the model's to set)."""
         from haptic.sim import compose_scene
         from haptic.sim.scene import scene_object_from_polyhedron
 
-        key = (h.model, *np.round(h.world_from_model.as_matrix()[:3].ravel(), 4))
-        if key not in self._solvers:
+        if h.model not in self._solvers:
             if len(self._solvers) >= self.cache:
                 self._solvers.pop(next(iter(self._solvers)))
             obj = scene_object_from_polyhedron(h.poly)
-            self._solvers[key] = ReachSolver(compose_scene(obj, h.world_from_model.as_matrix()), self.settings)
-        return self._solvers[key]
+            self._solvers[h.model] = ReachSolver(compose_scene(obj, np.eye(4)), self.settings)
+        solver = self._solvers[h.model]
+        m = solver.model
+        body = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "object")
+        pose = h.world_from_model.as_matrix()
+        m.body_pos[body] = pose[:3, 3]
+        quat = np.zeros(4)
+        mujoco.mju_mat2Quat(quat, np.ascontiguousarray(pose[:3, :3]).reshape(-1))
+        m.body_quat[body] = quat
+        return solver
 
 
 def _assignments(own: tuple[str, ...]):

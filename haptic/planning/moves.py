@@ -32,8 +32,8 @@ DEFAULT_FINGERS = 1
 """Fingers at once unless asked for (``--fingers``), on the geometric executor (README, "Several fingers at
 once")."""
 HAND_DEFAULT_FINGERS = 1
-"""The same on the simulated hand: the index finger alone, its placements of several fingertips not yet carried
-out by the physics executor."""
+"""The same on the simulated hand: the index finger alone (its placements of several fingertips are carried out,
+but the planner never found one more efficient than a tracing move there: README, "Several fingers at once")."""
 
 
 def default_fingers(executor: str) -> int:
