@@ -285,8 +285,7 @@ def placement_move(ex: PhysicsExecutor, move: PlacementMove, pieces: list[Primit
             return ex.failed_result(move, res, f"leaving the surface: {res.event}")
     ex.on_face = None
     z_safe = float(np.max(safe_height(_highest_contact(ex), t.pad_radius, starts, t.tip, s.clearance)))
-    if z_safe > TABLE_TOP_Z + ex.settings.max_approach_height:
-        return ex.failed_result(move, "unreachable", "the lines' starts are above the hand's reach over the region")
+    z_safe = min(z_safe, TABLE_TOP_Z + ex.settings.max_approach_height)  # the hand's reach over the region
     up = t.move_guarded(np.array([t.tip[0], t.tip[1], z_safe]), 0.15, max_lag=0.012)
     pieces.append(up)
     if not up.ok or up.event != "done":
@@ -322,6 +321,8 @@ def _place(ex: PhysicsExecutor, move: PlacementMove, c: _Closing, starts: np.nda
     for what, pts in (("above the lines", starts + np.array([0.0, 0.0, lift])), ("to the lines' starts", starts)):
         targets = [FingertipTarget(f, p, axes[f]) for f, p in zip(names, pts, strict=True)]
         reach = c.solver.solve(targets, start=c.q_now())
+        if not reach.ok and what == "above the lines":
+            continue  # (out of reach up there: straight to the starts, the way watched as every way is)
         if not reach.ok:
             return ex.failed_result(move, "unreachable", f"reaching {what}: {reach.reason} ({reach.detail})")
         why = c.follow(reach.path) or c.arrive(dict(zip(names, pts, strict=True)))
@@ -331,6 +332,10 @@ def _place(ex: PhysicsExecutor, move: PlacementMove, c: _Closing, starts: np.nda
     # 3. close
     status: dict[str, str] = {}
     travel: dict[str, float] = {}
+    normals: dict[str, np.ndarray] = {}  # each touched pad's sensed normal ...
+    contacts: dict[str, np.ndarray] = {}  # ... contact point ...
+    radius: dict[str, float] = {}  # ... and radius as sensed (the pad centre's distance from its contact)
+    faces: dict[str, int] = {}  # each finger's face component
     held: dict[str, np.ndarray] = {}
     reason: dict[str, str] = {}
     first_row = {f: len(c.rows[f]) for f in names}
@@ -372,7 +377,11 @@ def _place(ex: PhysicsExecutor, move: PlacementMove, c: _Closing, starts: np.nda
                         continue
                     status[name] = "touched"
                     travel[name] = float((tip - pad_target(f)) @ u)
-                    held[name] = tip + s.press * u
+                    rows = c.rows[name][-debounce:]
+                    contacts[name] = np.mean([x[3] for x in rows], axis=0)
+                    normals[name] = unit(np.mean([x[4] for x in rows], axis=0))
+                    radius[name] = float(np.linalg.norm(tip - contacts[name]))
+                    held[name] = contacts[name] + (radius[name] - s.press) * normals[name]
                 elif t_cmd >= float(f.length) and float((tip - pad_target(f)) @ u) >= float(f.length) - s.arrive_tol:
                     status[name], travel[name] = "missed", float(f.length)
                     held[name] = tip.copy()
@@ -387,14 +396,11 @@ def _place(ex: PhysicsExecutor, move: PlacementMove, c: _Closing, starts: np.nda
     closing = {f: c.trace(f, first_row[f]) for f in names}
     # 4. stroke: the touched fingers press in place, then an L each in its tangent plane, together
     touched = [f for f in move.fingers if status[f.finger] == "touched"]
-    normals: dict[str, np.ndarray] = {}
-    contacts: dict[str, np.ndarray] = {}
-    radius: dict[str, float] = {}  # each pad's radius as sensed (the pad centre's distance from its contact)
     if touched:
-        c.hold(c.solve(held))
         stroke_from = {f: len(c.rows[f]) for f in names}
-        for _ in range(s.settle_ticks):
-            c.tick("settle")
+        depth = {f.finger: s.press for f in touched}
+        for _ in range(max(1, s.settle_ticks // s.stroke_ticks)):
+            _pressing_step(c, touched, held, normals, contacts, radius, depth, {}, "settle")
         for f in touched:
             tr = c.trace(f.finger, stroke_from[f.finger])
             ok = tr.in_contact
@@ -404,7 +410,7 @@ def _place(ex: PhysicsExecutor, move: PlacementMove, c: _Closing, starts: np.nda
             normals[f.finger] = unit(tr.normal_in_world[ok][-10:].mean(axis=0))
             contacts[f.finger] = tr.point_in_world[ok][-10:].mean(axis=0)
             radius[f.finger] = float(np.median(np.linalg.norm(tr.tip_in_world[ok] - tr.point_in_world[ok], axis=1)))
-        stroking = [f for f in touched if f.finger in normals]
+        stroking = [f for f in touched if status[f.finger] == "touched"]
         phi0 = {f.finger: ex.rng.uniform(0.0, 2.0 * math.pi) for f in stroking}
         for heading in range(s.stroke_headings):
             if not stroking:
@@ -428,7 +434,7 @@ def _place(ex: PhysicsExecutor, move: PlacementMove, c: _Closing, starts: np.nda
                     continue
                 face = ex.segmenter.add_face(fit, ())
                 ex.store_face(face.id, tr, fit)
-                reason[f.finger] = str(face.id)
+                faces[f.finger] = face.id
                 held[f.finger] = contacts[f.finger] + (radius[f.finger] - s.stroke_press) * normals[f.finger]
             stroking = left
         for f in stroking:
@@ -446,7 +452,7 @@ def _place(ex: PhysicsExecutor, move: PlacementMove, c: _Closing, starts: np.nda
             if seg is not None:
                 free.append(seg)
         if status[name] == "touched":
-            fid = int(reason[name])
+            fid = faces[name]
             comps.append(ex.segmenter.faces[fid].component)
             info.update(component=fid, contact=travel[name], point=contacts[name].tolist())
         elif status[name] != "missed":
@@ -477,24 +483,36 @@ def _stroke(c: _Closing, fingers: Sequence[FingerApproach], held: dict[str, np.n
     first = {f.finger: len(c.rows[f.finger]) for f in fingers}
     steps = max(1, int(round(s.stroke / s.stroke_step)))
     depth = {f.finger: s.stroke_press for f in fingers}
-    force = c.ex.toucher.config.force
     for leg in range(2):
         for k in range(1, steps + 1 + s.dwell_steps):
             k = min(k, steps)  # then dwell at the leg's end: the joints' servo trails its targets
-            targets = dict(held)
+            off = {}
             for f in fingers:
-                n, p0 = normals[f.finger], contacts[f.finger]
                 d1, d2 = legs[f.finger]
-                off = (k * s.stroke_step * d1) if leg == 0 else (s.stroke * d1 + k * s.stroke_step * d2)
-                targets[f.finger] = p0 + off + (radius[f.finger] - depth[f.finger]) * n
-            c.hold(c.solve(targets))
-            for _ in range(s.stroke_ticks):
-                c.tick("stroke")
-            for f in fingers:  # pressing: the target's depth under the face follows the force sensed
-                sensed = float(np.mean([row[5] for row in c.rows[f.finger][-s.stroke_ticks:]]))
-                depth[f.finger] = float(np.clip(depth[f.finger] + s.press_gain * (force - sensed), 0.0,
-                                                s.max_press))  # fmt: skip
+                off[f.finger] = (k * s.stroke_step * d1) if leg == 0 else (s.stroke * d1 + k * s.stroke_step * d2)
+            _pressing_step(c, fingers, held, normals, contacts, radius, depth, off, "stroke")
     return {f.finger: c.trace(f.finger, first[f.finger]) for f in fingers}
+
+
+def _pressing_step(c: _Closing, fingers: Sequence[FingerApproach], held: dict[str, np.ndarray],
+                   normals: dict[str, np.ndarray], contacts: dict[str, np.ndarray], radius: dict[str, float],
+                   depth: dict[str, float], offsets: dict[str, np.ndarray], phase: str) -> None:  # fmt: skip
+    """One step of ``fingers`` pressing on their faces: each pad's target its contact moved by its offset in the
+    tangent plane, ``depth`` under the face; held for :attr:`PlacementSettings.stroke_ticks`; then each depth
+    follows the force sensed (deeper when it falls short of the tracing force). The other fingers held at
+    ``held``."""
+    s = c.s
+    targets = dict(held)
+    for f in fingers:
+        n = normals[f.finger]
+        targets[f.finger] = contacts[f.finger] + offsets.get(f.finger, 0.0) + (radius[f.finger] - depth[f.finger]) * n
+    c.hold(c.solve(targets))
+    for _ in range(s.stroke_ticks):
+        c.tick(phase)
+    force = c.ex.toucher.config.force
+    for f in fingers:
+        sensed = float(np.mean([row[5] for row in c.rows[f.finger][-s.stroke_ticks:]]))
+        depth[f.finger] = float(np.clip(depth[f.finger] + s.press_gain * (force - sensed), 0.0, s.max_press))
 
 
 def _restore(ex: PhysicsExecutor, c: _Closing, move: PlacementMove, z_safe: float,

@@ -129,7 +129,8 @@ def _score_all(ctx: Context) -> list[tuple[Prediction | ProbePrediction | Placem
         out = [(pred, *score_prediction(pred, weights, r, ctx.config)) for pred, r in refused]
     lines = weak_probes(ctx, predict_probe_moves(ctx))
     probes = [s for s in (score_probe(pred, weights) for pred in lines) if s is not None]
-    beat = max((c[1] for c in (*out, *probes)), default=-np.inf)
+    others = (*out, *probes)
+    beat = (max((c[1] for c in others), default=-np.inf), max((c[2] for c in others), default=-np.inf))
     return out + probes + score_placements(ctx, weights, lines if ctx.config.moves != "tracing" else None, beat)
 
 
@@ -167,14 +168,15 @@ def remeasures(ctx: Context, move: Move) -> bool:
 
 
 def score_placements(ctx: Context, weights: np.ndarray, lines: Sequence[ProbePrediction] | None = None,
-                     beat: float = -np.inf) -> list[tuple]:
+                     beat: tuple[float, float] = (-np.inf, -np.inf)) -> list[tuple]:
     """Placements of several fingertips (``config.fingers`` > 1, every hypothesis posed), scored as
     :func:`score_all` scores moves, ``(pred, efficiency, eliminations, cost, risk)``: their fingers' lines are
     the candidate probe lines (``lines``, the probes' predictions when the move set has them, else
     :func:`placement_lines`) and a finger predicted to fail tells nothing
     (:class:`~haptic.planning.placements.PlacementPrediction`). With the hand's reach test
-    (``config.placement_reach``) only the first placement it reaches is offered, of those more efficient than
-    ``beat`` (the best other candidate's efficiency: the only ones the planner could choose)."""
+    (``config.placement_reach``) only the first placement it reaches is offered, of those beating the best other
+    candidate's efficiency or expected eliminations (``beat``: the only ones a policy scoring either could
+    choose)."""
     if ctx.config.fingers < 2 or not ctx.hypotheses or any(h.world_from_model is None for h in ctx.hypotheses):
         return []
     lines = placement_lines(ctx) if lines is None else lines
@@ -193,7 +195,7 @@ def score_placements(ctx: Context, weights: np.ndarray, lines: Sequence[ProbePre
     # one notion of reachability: the hand's own test, asked for the most efficient first; the first reached is
     # offered (with the fingers that reach it), none that it cannot reach
     likely = [ctx.hypotheses[k] for k in np.argsort(-weights, kind="stable")]
-    better = [c for c in scored if c[1] > beat]
+    better = [c for c in scored if c[1] > beat[0] or c[2] > beat[1]]
     for item in sorted(better, key=lambda c: -c[1])[: ctx.config.placement_checks]:
         move = reach(item[0].move, likely)
         if move is not None:
