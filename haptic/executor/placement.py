@@ -88,7 +88,13 @@ class PlacementSettings:
     """A finger whose stroke finds no face strokes again in up to this many headings in all, a quarter turn
     apart (its stroke may have left a narrow face)."""
     path_ticks: int = 4
-    """Ticks per configuration of the solver's path to the lines' starts [-] ..."""
+    """Each configuration of the solver's path to the lines' starts (a joint moves at most 0.05 rad from one to the
+    next) is held at least this many ticks [-] ..."""
+    path_tol: float = 0.01
+    """... and until every arm joint is within this of it [rad] ..."""
+    path_max_ticks: int = 60
+    """... for at most this many ticks [-] (the arm's servo trails a moving target: a path followed faster leaves
+    it by centimetres) ..."""
     arrive_tol: float = 0.002
     """... then held until every pad is within this of its target [m] ..."""
     arrive_ticks: int = 200
@@ -107,6 +113,11 @@ class PlacementSettings:
 
 
 SETTINGS = PlacementSettings()
+
+REACH_CLEARANCE = ReachSettings(clearance=0.02, pads_touch=False)
+"""The planner's reach test of a placement: every link of the hand, the pads too, at least 8 mm from the
+hypothesised object and the table on the way to the lines' starts (the joints' servo trails the path by a few
+millimetres; the pads' place at the starts is the lines' standoff from every hypothesis)."""
 
 _SOLVERS: dict[tuple, ReachSolver] = {}
 """Reach solvers by scene (None: the robot and table alone) and settings, built once per process (compiling a
@@ -231,13 +242,18 @@ class _Closing:
     def follow(self, path: np.ndarray, phase: str = "free") -> str | None:
         """Hold each configuration of ``path`` in turn, watching every fingertip and link; why it stopped (a touch)
         or None."""
+        n_arm = len(ARM_HOME)
         for q in path[1:]:
             self.hold(q)
-            for _ in range(self.s.path_ticks):
-                why = self._touched_on_the_way(self.tick(phase))
+            for k in range(self.s.path_max_ticks):
+                r = self.tick(phase)
+                why = self._touched_on_the_way(r)
                 if why:
                     self.hold(self.q_now())
                     return why
+                if (k + 1 >= self.s.path_ticks and float(np.max(np.abs(r.arm_q - q[:n_arm]))) < self.s.path_tol
+                        and float(np.max(np.abs(r.hand_q - q[n_arm:]))) < 2.0 * self.s.path_tol):  # fmt: skip
+                    break
         return None
 
     def arrive(self, targets: dict[str, np.ndarray], phase: str = "free") -> str | None:
@@ -262,6 +278,13 @@ class _Closing:
         if links:
             return f"the hand's {next(iter(links.values()))} touched something"
         return None
+
+
+def _joint_path(q0: np.ndarray, q1: np.ndarray, step: float) -> np.ndarray:
+    """Configurations from ``q0`` to ``q1`` on the straight line between them in joint space, no joint moving by
+    more than ``step`` from one to the next [rad]."""
+    n = max(1, int(np.ceil(float(np.max(np.abs(q1 - q0))) / step)))
+    return q0 + np.linspace(0.0, 1.0, n + 1)[:, None] * (q1 - q0)
 
 
 def _finger_axis(finger: str) -> np.ndarray:
@@ -316,18 +339,19 @@ def _place(ex: PhysicsExecutor, move: PlacementMove, c: _Closing, starts: np.nda
     s = c.s
     names = [f.finger for f in move.fingers]
     axes = {f.finger: np.asarray(f.direction, dtype=float) for f in move.fingers}
-    # 2. above the lines' starts, then down to them
-    lift = max(0.0, z_safe - float(starts[:, 2].min())) + s.above
-    for what, pts in (("above the lines", starts + np.array([0.0, 0.0, lift])), ("to the lines' starts", starts)):
-        targets = [FingertipTarget(f, p, axes[f]) for f, p in zip(names, pts, strict=True)]
-        reach = c.solver.solve(targets, start=c.q_now())
-        if not reach.ok and what == "above the lines":
-            continue  # (out of reach up there: straight to the starts, the way watched as every way is)
-        if not reach.ok:
-            return ex.failed_result(move, "unreachable", f"reaching {what}: {reach.reason} ({reach.detail})")
-        why = c.follow(reach.path) or c.arrive(dict(zip(names, pts, strict=True)))
+    # 2. the planner's way to the lines (from the tracing posture, clear of the hypothesised object), else above the
+    # lines' starts, then down to them
+    if move.path is not None and len(move.path):
+        why = _home_then(c, np.asarray(move.path, dtype=float), pieces)
         if why:
-            return ex.failed_result(move, "unreachable", f"on the way {what}: {why}")
+            return ex.failed_result(move, "unreachable", f"on the planned way to the lines: {why}")
+        why = c.arrive(dict(zip(names, starts, strict=True)))
+        if why:
+            return ex.failed_result(move, "unreachable", f"on the planned way to the lines: {why}")
+    else:
+        why = _above_then_down(c, names, axes, starts, z_safe)
+        if why:
+            return ex.failed_result(move, "unreachable", why)
     c.posture = c.q_now()
     # 3. close
     status: dict[str, str] = {}
@@ -467,6 +491,47 @@ def _place(ex: PhysicsExecutor, move: PlacementMove, c: _Closing, starts: np.nda
                       free_space=tuple(free), info={"fingers": fingers})  # fmt: skip
 
 
+def _above_then_down(c: _Closing, names: list[str], axes: dict[str, np.ndarray], starts: np.ndarray,
+                     z_safe: float) -> str | None:
+    """Every pad above its line's start (the finger pointing along it), then down to the start, along the
+    solver's paths (the robot and table alone); why not, or None."""
+    s = c.s
+    lift = max(0.0, z_safe - float(starts[:, 2].min())) + s.above
+    for what, pts in (("above the lines", starts + np.array([0.0, 0.0, lift])), ("to the lines' starts", starts)):
+        targets = [FingertipTarget(f, p, axes[f]) for f, p in zip(names, pts, strict=True)]
+        reach = c.solver.solve(targets, start=c.q_now())
+        if not reach.ok:  # from the tracing posture, as the planner's test asks, then across to it in joint space
+            home = c.solver.solve(targets)
+            if home.ok:
+                reach = replace(home, path=_joint_path(c.q_now(), home.qpos, s.reach.max_speed * s.reach.dt))
+        if not reach.ok and what == "above the lines":
+            continue  # (out of reach up there: straight to the starts, the way watched as every way is)
+        if not reach.ok:
+            return f"reaching {what}: {reach.reason} ({reach.detail})"
+        why = c.follow(reach.path) or c.arrive(dict(zip(names, pts, strict=True)))
+        if why:
+            return f"on the way {what}: {why}"
+    return None
+
+
+def _home_then(c: _Closing, path: np.ndarray, pieces: list[PrimitiveResult]) -> str | None:
+    """The pad up and over to where it is in the path's first configuration (the tracing posture), that posture
+    taken in joint space, then the path followed; why it stopped, or None."""
+    t = c.ex.toucher
+    c.cfg.update(path[0])
+    sid = mujoco.mj_name2id(c.model, mujoco.mjtObj.mjOBJ_SITE, c.solver.site_name(t.finger))
+    above = c.cfg.data.site_xpos[sid].copy()
+    here = t.tip.copy()
+    for w in (np.array([here[0], here[1], max(here[2], above[2])]), above):
+        if float(np.linalg.norm(w - t.tip)) < t.config.target_tol:
+            continue
+        res = t.move_guarded(w, 0.15, max_lag=0.012)
+        pieces.append(res)
+        if not res.ok or res.event != "done":
+            return f"moving over to the tracing posture: {res.event}"
+    return c.follow(_joint_path(c.q_now(), path[0], c.s.reach.max_speed * c.s.reach.dt)) or c.follow(path)
+
+
 def _stroke(c: _Closing, fingers: Sequence[FingerApproach], held: dict[str, np.ndarray],
             normals: dict[str, np.ndarray], contacts: dict[str, np.ndarray], radius: dict[str, float],
             heading: dict[str, float]) -> dict[str, ContactTrace]:  # fmt: skip
@@ -550,7 +615,7 @@ class PlacementReach:
     None. Called with the planner's hypotheses (the most likely first)."""
 
     def __init__(self, settings: ReachSettings | None = None, assignments: int = 12, cache: int = 4) -> None:
-        self.settings = settings or ReachSettings()
+        self.settings = settings or REACH_CLEARANCE
         self.assignments = assignments
         self.cache = cache
         self._solvers: dict[tuple, ReachSolver] = {}
@@ -581,7 +646,8 @@ class PlacementReach:
                        for n, f in zip(names, lines, strict=True)]  # fmt: skip
             r = solver.solve(targets)
             if r.ok:
-                answer = PlacementMove(tuple(replace(f, finger=n) for n, f in zip(names, lines, strict=True)))
+                answer = PlacementMove(tuple(replace(f, finger=n) for n, f in zip(names, lines, strict=True)),
+                                       path=r.path)  # fmt: skip
                 break
             why = str(r.reason)
         if answer is None:
@@ -626,5 +692,6 @@ def reach_oracle(fingers: int) -> Callable | None:
     return PlacementReach() if fingers > 1 else None
 
 
-__all__ = ["SETTINGS", "PlacementReach", "PlacementSettings", "hand_solver", "pad_target", "placement_move",
+__all__ = ["REACH_CLEARANCE", "SETTINGS", "PlacementReach", "PlacementSettings", "hand_solver", "pad_target",
+           "placement_move",
            "reach_oracle"]

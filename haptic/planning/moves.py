@@ -247,6 +247,10 @@ class PlacementMove:
 
     fingers: tuple[FingerApproach, ...]
     """The fingers' approaches, at most one per finger."""
+    path: np.ndarray | None = None
+    """The hand's way to the fingers' lines as the planner's reach test found it, clear of the hypothesised object:
+    joint configurations (K, n) from the tracing posture to every pad at its line's start [rad]; None: the executor
+    finds its own (the ideal sensor needs none)."""
 
     kind = "placement"
 
