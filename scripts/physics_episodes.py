@@ -190,6 +190,13 @@ def print_placements(records: list[dict]) -> None:
         return
     moves = sum(len(r.get("move_results", ())) for r in records)
     ok = sum(p["status"] == "ok" for p in placed)
+    asked = sum((r.get("placement_reach") or {}).get("asked", 0) for r in records)
+    reached = sum((r.get("placement_reach") or {}).get("reached", 0) for r in records)
+    why = Counter()
+    for r in records:
+        why.update((r.get("placement_reach") or {}).get("reasons", {}))
+    print(f"the planner's reach test: {asked} placements asked about, {reached} reached"
+          + (f"; why not: {', '.join(f'{k} {v}' for k, v in why.most_common())}" if why else ""))
     print(f"placements {len(placed)} ({100 * len(placed) / max(1, moves):.1f} % of {moves} moves), {ok} succeeded")
     for p in placed:
         if p["status"] != "ok":

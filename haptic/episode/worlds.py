@@ -180,6 +180,10 @@ class PhysicsWorld:
             truth = sim.ground_truth()
             score = score_components(executor.components, true_model, SE3.from_matrix(truth.world_from_object), results)
             record.perception = _jsonable(score.summary())
+            reach = config.placement_reach
+            if reach is not None and hasattr(reach, "asked"):
+                record.placement_reach = {"asked": reach.asked, "reached": reach.reached,
+                                          "reasons": dict(reach.reasons)}  # fmt: skip
 
         world_from_model = SE3.from_matrix(pose)
         return Episode(
