@@ -120,11 +120,11 @@ FRAME_MOVED = Polyhedron.from_faces(
 NAME_F = "learned_FRAME01__v2_2mm"
 
 
-def test_a_learned_angle_and_a_data_angle_each_near_its_bound_keep_the_learned_model(tmp_path):
+def test_a_learned_edge_between_two_fitted_planes_is_bounded_by_both(tmp_path):
     """Seed 1347453898 ended no-match after 23 moves: the tree's face-edge angle test of a face of the learned
-    frame's fold (0.56° off) and an edge (0.65° off), each within the learned model's 0.9°, against a data
-    edge at its bound (0.9°) turned the angle by 2.60°, beyond the data's and the model's bounds added in quadrature
-    (2.54°). The tree's tests add angles' bounds outright, and so does its widening for a learned model."""
+    frame's fold (0.56° off) and an edge where two fitted planes meet square (0.65° off), against a data edge at its
+    bound (0.9°), turned the angle by 2.60°, beyond the data's and the learned model's declared bounds in quadrature
+    (2.54°). An edge where two planes meet is turned by each plane's tilt: its bound is √2 normal bounds."""
     lib, obj = learned_library(tmp_path, FRAME_MOVED, 74845286, NAME_F)
     rec = run_episode(EpisodeSpec(model=str(obj), seed=1347453898, noise=1.0, models=str(lib)))
     assert (rec.outcome, rec.recognized) == ("recognized", NAME_F)
