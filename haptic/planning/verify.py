@@ -681,10 +681,21 @@ MIDDLE_REACH = 5e-3
 lies on the face's plane within this of it [m] (:func:`unmeasured_middles`)."""
 
 
+_MIDDLES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
 def face_middle(poly: Polyhedron, f: int) -> np.ndarray:
     """The middle of face ``f`` (model frame): the mean of its vertices when that lies on the face at least
     :data:`PROBE_INSET` from its boundary, else whichever of it and the face's triangles' centroids lies on the face
-    farthest from its boundary (a face that is not convex)."""
+    farthest from its boundary (a face that is not convex). Computed once per model and face."""
+    middles = _MIDDLES.setdefault(poly, {})
+    if f not in middles:
+        middles[f] = _face_middle(poly, f)
+        middles[f].flags.writeable = False
+    return middles[f]
+
+
+def _face_middle(poly: Polyhedron, f: int) -> np.ndarray:
     from haptic.geometry.distance import point_triangle_distance
 
     loop = poly.vertices[list(poly.faces[f])]
