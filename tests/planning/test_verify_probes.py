@@ -187,3 +187,30 @@ def test_same_line_is_the_line_not_where_it_starts():
     assert same_line(a, ProbeMove(np.array([0.005, 0.0, 0.05]), u, 0.1))
     assert not same_line(a, ProbeMove(np.array([0.02, 0.0, 0.2]), u, 0.3))  # parallel, 2 cm across
     assert not same_line(a, ProbeMove(np.array([0.0, 0.0, 0.2]), np.array([1.0, 0.0, 0.0]), 0.3))
+
+
+def test_a_probe_may_land_at_the_middle_still_to_be_probed_of_a_face_beside_a_missing_vertex():
+    from haptic.planning.verify import MIDDLE_REACH, face_middle
+
+    for name, seed in [("BOX01", 0), ("WEDGE01", 3)]:
+        h, state, comps, ex = _on_a_face(name, seed)
+        missing = (frozenset(), frozenset(), _far_vertices(h, state))
+        beside = frozenset(int(f) for v in missing[2] for f in h.poly.vertex_faces[v])
+
+        def at_middles(probes, h=h, state=state, comps=comps, ex=ex) -> set[int]:
+            out = set()
+            for move, _, _ in probes:
+                h1, s1, _ = simulate_probe(h, move, state, comps, ex.noise)
+                f = h1.faces[s1.face]
+                if np.linalg.norm(h.model_from_world.apply(s1.position) - face_middle(h.poly, f)) <= MIDDLE_REACH:
+                    out.add(int(f))
+            return out
+
+        plain = verification_probes(h, state, comps, missing, ex.noise, ALL)
+        assert not at_middles(plain), name  # aimed beside the vertices, far from any middle
+        with_middles = verification_probes(h, state, comps, missing, ex.noise, ALL, middles=beside)
+        landed = at_middles(with_middles)
+        assert landed and landed <= beside, name
+        # a face whose middle is measured already is not a target
+        assert not at_middles(verification_probes(h, state, comps, missing, ex.noise, ALL,
+                                                  middles=frozenset(landed) ^ beside)) & landed  # fmt: skip
