@@ -58,6 +58,11 @@ class ProbeConfig:
     finger pointing down cannot press on them (its phalanx meets the object first) [rad]. None: no limit."""
 
 
+BATCHED = True
+"""Whether :func:`candidate_probes` computes a hypothesis's lines together (:func:`_probe_lines`, the same bits) rather
+than line by line (:func:`_probe_line`, the reference) where there is no table."""
+
+
 def fibonacci_directions(n: int) -> np.ndarray:
     """``n`` unit vectors spread evenly over the sphere, shape (n, 3)."""
     k = np.arange(n) + 0.5
@@ -102,12 +107,16 @@ def candidate_probes(hypotheses: Sequence[Hypothesis], config: ProbeConfig | Non
     balls = _hypothesis_balls(posed)
     seen: set[tuple] = set()
     out: list[ProbeMove] = []
+    batch = BATCHED and config.table_z is None and config.pad_radius == 0.0
     for h in posed:
         t = h.world_from_model
         targets, normals = t.apply(face_targets(h.poly)), t.rotate(h.poly.face_normals)
         facing = (dirs @ normals.T) <= -cos_max  # (D, F)
         if config.max_undercut is not None:
             facing &= (normals[:, 2] >= -np.sin(config.max_undercut))[None, :]
+        if batch:  # every line of this hypothesis at once (:func:`_probe_lines`)
+            out += _probe_lines(dirs, targets, np.nonzero(facing), seen, centre, big, balls, config)
+            continue
         for di, fi in zip(*np.nonzero(facing), strict=True):
             u, p = dirs[di], targets[fi]
             # the target's position across the direction, snapped to the grid: one candidate per cell
@@ -126,6 +135,57 @@ def candidate_probes(hypotheses: Sequence[Hypothesis], config: ProbeConfig | Non
         clear = finger_clear(posed, out, config.pad_radius)
         out = [mv for mv, ok in zip(out, clear, strict=True) if ok]
     return out
+
+
+def _probe_lines(dirs: np.ndarray, targets: np.ndarray, pairs: tuple[np.ndarray, np.ndarray], seen: set[tuple],
+                 centre: np.ndarray, big: float, balls, config: ProbeConfig) -> list[ProbeMove]:  # fmt: skip
+    """:func:`_probe_line` for each ``(direction, target)`` pair of ``pairs`` whose cell is not in ``seen`` (added
+    to it), in their order, without a table or a pad: the lines of :func:`line_through` and :func:`clip_to_balls`
+    for all the pairs in a few array operations, each in the arithmetic of its line by line form (a 3-vector's dot
+    product summed left to right, the balls' by one matrix product per line), so the same bits."""
+    di, fi = pairs
+    if not len(di):
+        return []
+    u, p = dirs[di], targets[fi]
+    pu = _dot(p, u)
+    cells = np.round((p - pu[:, None] * u) / config.target_spacing).astype(int).tolist()
+    keep = []
+    for k, (d, cell) in enumerate(zip(di.tolist(), cells, strict=True)):
+        key = (d, *cell)
+        if key not in seen:
+            seen.add(key)
+            keep.append(k)
+    if not keep:
+        return []
+    u, p = u[keep], p[keep]
+    # line_through: the chord of the region's sphere through each target
+    w = p - centre
+    b = _dot(w, u)
+    disc = b * b - (_dot(w, w) - big * big)
+    ok = disc > 0.0
+    root = np.sqrt(np.where(ok, disc, 0.0))
+    back = b + root
+    start = p - back[:, None] * u
+    length = 2.0 * root
+    ok &= ~(length <= back)
+    # clip_to_balls (union): the part of each chord within the margin of some hypothesis's ball
+    centres, radii = balls
+    wb = centres[None] - start[:, None]  # (K, N, 3)
+    bb = np.matmul(wb, u[:, :, None])[..., 0]
+    ww = (wb[..., 0] * wb[..., 0] + wb[..., 2] * wb[..., 2]) + wb[..., 1] * wb[..., 1]  # np.einsum("ij,ij->i")'s order
+    d = bb * bb - (ww - (radii + config.standoff) ** 2)
+    meets = d > 0.0
+    rb = np.sqrt(np.where(meets, d, 0.0))
+    ok &= meets.any(axis=1)
+    t0 = np.maximum(np.where(meets, bb - rb, np.inf).min(axis=1), 0.0)
+    t1 = np.minimum(np.where(meets, bb + rb, -np.inf).max(axis=1), length)
+    ok &= ~(t1 <= t0)
+    return [ProbeMove(start[k] + t0[k] * u[k], u[k], float(t1[k] - t0[k])) for k in np.flatnonzero(ok)]
+
+
+def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row by row dot products of two (K, 3) arrays, summed left to right as ``float(x @ y)`` of 3-vectors."""
+    return (a[:, 0] * b[:, 0] + a[:, 1] * b[:, 1]) + a[:, 2] * b[:, 2]
 
 
 def _probe_line(p: np.ndarray, u: np.ndarray, centre: np.ndarray, big: float, radius: float, balls,

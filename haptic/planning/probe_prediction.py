@@ -34,6 +34,7 @@ import numpy as np
 from haptic.errors import PlanningError
 from haptic.geometry.distance import surface_distance
 from haptic.geometry.raycast import line_hits
+from haptic.matching import kernels
 from haptic.matching.acceptance import POSE_SAFETY
 from haptic.matching.components import DataComponent, SensorNoise
 from haptic.matching.recognition import PoseTolerance
@@ -247,7 +248,12 @@ def predict_probes(
             lo, hi = hits.first[fin], np.minimum(t_out[fin], lens[fin])
             ts = lo[:, None] + (hi - lo)[:, None] * DEPTH_FRACTIONS
             pts = s_m[fin, None, :] + ts[..., None] * u_m[fin, None, :]
-            dep[fin] = surface_distance(poly, pts.reshape(-1, 3)).reshape(len(fin), -1).max(axis=1)
+            if kernels.COMPILED:
+                tri = np.ascontiguousarray(poly.vertices[poly.triangles], float)
+                d = kernels.surface_distance(np.ascontiguousarray(pts.reshape(-1, 3)), tri)
+            else:
+                d = surface_distance(poly, pts.reshape(-1, 3))
+            dep[fin] = d.reshape(len(fin), -1).max(axis=1)
         if hand is not None:  # where the pad would touch before its leading point meets the face
             hit_m = hits.first <= lens
             inc = np.ones(len(s_m))

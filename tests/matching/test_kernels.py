@@ -365,6 +365,36 @@ def test_inside_samples_are_the_numpy_forms(monkeypatch):
     assert 0 < sum(verdicts) < len(verdicts)  # both verdicts
 
 
+def test_probe_candidates_computed_together_are_the_line_by_line_ones(small_library, monkeypatch):
+    """The probe candidates at the decisions of some episodes: the lines computed a hypothesis at a time are those of
+    :func:`~haptic.planning.probe_lines._probe_line` line by line, the same lines in the same order, bit for bit."""
+    from haptic.planning import probe_lines
+    from haptic.planning.probe_lines import candidate_probes
+
+    env = ExploreEnv(models=small_library, verify="none")
+    agent = PolicyAgent("planner")
+    compared = 0
+    for seed in range(1, 6):
+        env.reset(seed=seed)
+        while env.context is not None:
+            hyps = [h for h in env.context.hypotheses if h.world_from_model is not None]
+            if hyps:
+                got = candidate_probes(hyps)
+                monkeypatch.setattr(probe_lines, "BATCHED", False)
+                want = candidate_probes(hyps)
+                monkeypatch.undo()
+                assert len(got) == len(want)
+                for a, b in zip(got, want, strict=True):
+                    np.testing.assert_array_equal(a.direction, b.direction)
+                    np.testing.assert_array_equal(a.start, b.start)
+                    assert a.length == b.length
+                compared += len(got)
+            _, _, terminated, truncated, _ = env.step(agent.act(env))
+            if terminated or truncated:
+                break
+    assert compared > 100
+
+
 def test_face_move_predictions_are_the_numpy_forms(small_library, monkeypatch):
     """The face moves' predicted outcomes, costs and clearances in every hypothesis of decisions of some episodes:
     the compiled predictions are :func:`~haptic.planning.predict.face_outcomes`'s numpy form's, where each hypothesis
