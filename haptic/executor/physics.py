@@ -165,11 +165,6 @@ class PhysicsSettings:
     """The planner's least distance from a face move's crossing to the nearest vertex on the hand
     (``PlannerConfig.min_vertex_clearance``, preferred where a move that keeps it exists): nearer, the pad
     (12 mm) rolls round the edge's end or drops into a concave corner past it [m]."""
-    crossing_drift: float = 0.002
-    """How far a trace across a face may run off its straight line before it meets the edge
-    (``PlannerConfig.crossing_drift``): a face move from 4 mm below an edge toward a point of that edge 60 mm
-    on met it at the vertex, 12 mm past where it was aimed (BOX01N and LBLOCK01 seed 1-2, a slide of 3-10° to
-    the edge) [m]."""
     recross_shift: float = 0.006
     """A face move whose roll went round the edge's end (its normals leaning along the edge) crosses again this
     much farther inside the edge (plus how far the pad overshot the end) ... [m]"""

@@ -46,9 +46,8 @@ OPPOSED = 1e-6
 """Two unit normals whose sum is shorter than this (squared) are opposed: they have no bisector [-]."""
 AT_CENTRE = 1e-6
 """A contact this close to the vertex circle's centre has no radial direction [m]."""
-STOPS = ("table", "hand", "blocked")
-"""Events that end a leg of a stroke without failing the stroke (the table ahead, a finger link on the object, a
-leg that stalls)."""
+STOPS = ("table", "hand")
+"""Events that end a leg of a stroke without failing the stroke (the table ahead, a finger link on the object)."""
 FAILURES = ("no-contact", "unreachable", "timeout", "unstable")
 """Failure statuses of a primitive (the move statuses of :class:`~haptic.planning.moves.MoveResult`)."""
 
@@ -573,8 +572,7 @@ class Toucher:
             if len(progress) > window and progress[-1] - progress[-1 - window] < (
                 cfg.stall_fraction * cfg.face_speed * cfg.stall_time
             ):
-                # a link of the finger on the object holds the pad back (the rim of a hole): the hand's doing
-                return self._lost("unreachable", "blocked", face_normal=n_run, direction=d)
+                return self._result("unreachable", "blocked", 0.0, face_normal=n_run, direction=d)
         return self._result("timeout", "limit", 0.0)
 
     def cross_edge(self, kind: str, n_a: np.ndarray, direction: np.ndarray) -> PrimitiveResult:

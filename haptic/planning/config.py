@@ -24,12 +24,6 @@ class PlannerConfig:
     min_vertex_clearance: float = 0.004
     """Face moves predicted to meet their edge closer than this to a vertex are not offered: a fingertip
     crossing there touches two edges at once [m]."""
-    crossing_drift: float = 0.0
-    """How far a trace may run off its predicted line across the face before it meets its edge [m]: a crossing
-    at an angle θ to the edge then lands up to this / tan θ along the edge from where it was predicted, and its
-    clearance from the vertex counts that much less (:meth:`~haptic.planning.predict.Prediction.reliable`). Set
-    for the physics executor (the pad under force control drifts by a millimetre or two over a long slide); 0:
-    none (the geometric executor)."""
     table_z: float | None = None
     """Height of the table top in the world frame, a workspace prior the robot knows (set for the physics
     executor's scene, never from the object) [m]. None: no table (the geometric executor), no table checks."""

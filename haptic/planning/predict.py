@@ -159,16 +159,6 @@ def _signed_dihedral(poly: Polyhedron, f_from: int, f_to: int, edge: int) -> flo
     return ang if poly.edge_convexity[edge] > 0 else -ang
 
 
-def _drift_along_edge(config: PlannerConfig, crossing_angle):
-    """How far along its edge a face move's crossing at ``crossing_angle`` [rad] to the edge (a float or an array)
-    may land from where it is predicted, the trace running ``config.crossing_drift`` off its line [m]. A move
-    grazing its edge (a slide from just below an edge toward that edge's far end) met it at the vertex itself on
-    the hand, 12 mm from where it was aimed, and the pad rolled round the vertex: no face past it."""
-    if config.crossing_drift <= 0.0:
-        return 0.0
-    return config.crossing_drift / np.maximum(np.tan(crossing_angle), 1e-3)
-
-
 def _line_angle(a: np.ndarray, b: np.ndarray) -> float:
     """Angle between two lines (unsigned directions), in [0, π/2] [rad]."""
     c = abs(float(a @ b)) / (math.sqrt(float(a @ a)) * math.sqrt(float(b @ b)))
@@ -319,7 +309,7 @@ def _predict_one(
                 _signed_dihedral(poly, tr.face, hit.next_face, hit.edge),
             ]
         )
-        return out, costs.face_move(hit.distance), tr.clearance(poly) - _drift_along_edge(config, out[1])
+        return out, costs.face_move(hit.distance), tr.clearance(poly)
     if isinstance(move, EdgeMove):
         e_m = h.edges.get(state.edge) if state.edge is not None else None
         if e_m is None:
@@ -506,7 +496,6 @@ def face_outcomes(
             cols = np.array(rows)[hj]
             outcomes[mi, cols, 0], outcomes[mi, cols, 1], outcomes[mi, cols, 2] = tb[mi, hj], angle[mi, hj], dih[mi, hj]
             costs[mi, cols], clear[mi, cols] = cost[mi, hj], near[mi, hj]
-            clear -= _drift_along_edge(config, outcomes[..., 1])
             return [(outcomes[i], costs[i], clear[i]) for i in range(n_m)]
         d_raw = (dirs[:, None, None, :] @ np.array(rots)[None])[:, :, 0]  # (M, m, 3): SE3.rotate's arithmetic
         d_in = d_raw - (d_raw[..., None, :] @ n_all[None, :, :, None])[..., 0] * n_all[None]
@@ -547,5 +536,4 @@ def face_outcomes(
         outcomes[mi, cols, 2] = at_best(dih_all)[mi, hj]
         costs[mi, cols] = c.c_f * tb[mi, hj] + c.c_j + c.c_b + c.c_n
         clear[mi, cols] = np.minimum(s_hit, at_best(len_all) - s_hit)[mi, hj]
-    clear -= _drift_along_edge(config, outcomes[..., 1])
     return [(outcomes[i], costs[i], clear[i]) for i in range(n_m)]

@@ -223,7 +223,7 @@ def aimed_face_moves(
         return []
     poly, t = h.poly, h.world_from_model
     loop = [int(v) for v in poly.faces[f_m]]
-    targets: list[tuple[np.ndarray, int | None, int]] = []  # (point, the missing vertex it is beside, its edge)
+    targets: list[tuple[np.ndarray, int | None]] = []  # (point, the missing vertex it is beside)
     hand = config is not None and config.concave_end_block is not None
     ids = {frozenset(int(x) for x in poly.edges[e]): int(e) for e in poly.face_edges[f_m]}
     for k, v in enumerate(loop):
@@ -243,10 +243,10 @@ def aimed_face_moves(
             else:  # the pad crossing nearer the vertex than its radius rolls onto the third face there too
                 aim, cap = (AIM_NEAR_VERTEX if beside or reflex else 0.0) + config.pad_radius, 0.5
             if length > 0:
-                targets.append((poly.vertices[v] + min(aim, cap * length) * d / length, v, ids[frozenset((v, nb))]))
+                targets.append((poly.vertices[v] + min(aim, cap * length) * d / length, v))
     for e in poly.face_edges[f_m]:
         if int(e) in missing[1]:
-            targets.append((poly.edge_points[e] + 0.5 * poly.edge_lengths[e] * poly.edge_directions[e], None, int(e)))
+            targets.append((poly.edge_points[e] + 0.5 * poly.edge_lengths[e] * poly.edge_directions[e], None))
     edge = components.get(state.edge) if state.edge is not None else None
     along = edge.direction if isinstance(edge, DataEdge) else None
     origin = state.position
@@ -259,13 +259,10 @@ def aimed_face_moves(
         out_of_corner = t.rotate(_inward(poly, e_m, f_m))
         origin = on_line + (config.pad_radius + CONCAVE_STEP_OFF) * out_of_corner
     out = []
-    for p, v, e in targets:
+    for p, v in targets:
         if float(np.linalg.norm(_in_plane(t.apply(p) - state.position, face.normal))) < AIM_NEAR_VERTEX:
             continue  # at hand
-        aim = t.apply(p)
-        if config is not None and config.crossing_drift > 0.0:
-            aim = _steep_aim(poly, t, e, aim, origin, face.normal)
-        d = _in_plane(aim - origin, face.normal)
+        d = _in_plane(t.apply(p) - origin, face.normal)
         if out_of_corner is not None and float(d @ out_of_corner) < 0:
             # a target nearer the concave edge than the pad's radius (a short edge beside it): heading back into
             # the corner the pad meets the face across again and ends on the same edge; along the edge instead it
@@ -279,31 +276,6 @@ def aimed_face_moves(
             continue  # along the edge the sensor is on: an edge move's business
         out.append(FaceMove(d / n))
     return out
-
-
-AIM_MIN_CROSSING = np.deg2rad(25.0)
-"""On the hand (``PlannerConfig.crossing_drift``) an aimed face move meets its edge at least this steeply where the
-edge allows [rad]."""
-
-
-def _steep_aim(poly: Polyhedron, t: SE3, e: int, aim: np.ndarray, origin: np.ndarray, normal: np.ndarray) -> np.ndarray:
-    """Aim point ``aim`` (world) on model edge ``e`` moved along the edge toward ``origin``'s foot on it until the
-    line from ``origin`` meets the edge at :data:`AIM_MIN_CROSSING` at least (unchanged when it already does, or when
-    the foot lies off the edge). A slide from just beside an edge toward a point of it far on meets it at a
-    grazing angle, and a millimetre of drift across the slide puts the crossing a centimetre farther: on the hand
-    such moves from 4 mm below an edge met it at the vertex 60 mm on, 12 mm past their aim, and rolled round it.
-    Crossing nearer, the edge move from there reaches the vertex."""
-    u = t.rotate(poly.edge_directions[e])
-    p0 = t.apply(poly.edge_points[e])
-    s_aim, s_foot = float((aim - p0) @ u), float((origin - p0) @ u)
-    length = float(poly.edge_lengths[e])
-    if not 0.0 <= s_foot <= length:
-        return aim
-    h = float(np.linalg.norm(_in_plane(origin - (p0 + s_foot * u), normal)))
-    run = h / np.tan(AIM_MIN_CROSSING)  # along the edge from the foot, the farthest crossing steep enough
-    if abs(s_aim - s_foot) <= run:
-        return aim
-    return p0 + (s_foot + np.copysign(run, s_aim - s_foot)) * u
 
 
 def _in_plane(d: np.ndarray, normal: np.ndarray) -> np.ndarray:

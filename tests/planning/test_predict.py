@@ -203,38 +203,3 @@ def test_edge_outcomes_equal_the_predictions_one_hypothesis_at_a_time():
             assert np.isclose(cost[i], c1, rtol=0, atol=1e-13, equal_nan=True)
             said += not np.isnan(one[0])
     assert said == 2 * 80
-
-
-@pytest.mark.parametrize("table", [False, True])
-def test_a_crossing_that_grazes_its_edge_counts_the_drift_along_it(table):
-    """With ``crossing_drift`` (the hand), a face move meeting its edge at an angle θ is predicted to land up to
-    drift / tan θ along the edge from where its line meets it, and its clearance from the vertex counts that much
-    less: a move grazing its edge loses more than a centimetre, one crossing square nothing. Without a drift (the
-    geometric executor) nothing changes."""
-    from dataclasses import replace
-
-    from haptic.planning.moves import FaceMove
-    from haptic.planning.predict import predict_moves
-
-    model = LIB["BOX01"]
-    ex = GeometricExecutor(model, SE3.identity(), noise=SensorNoise().scaled(0.0), rng=np.random.default_rng(0),
-                           costs=CostModel())  # fmt: skip
-    res = ex.start()
-    comps = {c.id: c for c in res.components}
-    h = _truth_hypothesis(ex, model)
-    n = comps[res.state.face].normal
-    u = np.cross(n, [1.0, 0.0, 0.0]) if abs(n[0]) < 0.9 else np.cross(n, [0.0, 1.0, 0.0])
-    u /= np.linalg.norm(u)
-    w = np.cross(n, u)
-    base = PlannerConfig(table_z=-1.0) if table else PlannerConfig()
-    to_side = float(predict_moves([h], [FaceMove(u)], res.state, comps, SensorNoise(), base)[0].outcomes[0, 0])
-    state = replace(res.state, position=res.state.position + (to_side - 0.003) * u)  # 3 mm from that side
-    moves = [FaceMove(u), FaceMove(np.cos(1.47) * u + np.sin(1.47) * w)]  # square to the side; 6° to it
-    before = predict_moves([h], moves, state, comps, SensorNoise(), base)
-    after = predict_moves([h], moves, state, comps, SensorNoise(), replace(base, crossing_drift=0.002))
-    lost = [float(b.clearance[0] - a.clearance[0]) for b, a in zip(before, after, strict=True)]
-    angles = [float(b.outcomes[0, 1]) for b in before]
-    for drop, angle in zip(lost, angles, strict=True):
-        assert np.isclose(drop, 0.002 / np.tan(angle), rtol=1e-9, atol=1e-12)
-    assert angles[0] == pytest.approx(np.pi / 2) and lost[0] < 1e-9
-    assert angles[1] < 0.2 and lost[1] > 0.01

@@ -225,30 +225,3 @@ def test_a_vertex_on_the_table_that_no_face_in_reach_places_is_placed_by_faces_m
     assert placed_by_data(poly, pose, unpinnable, measured, table) == unpinnable
     one = Coverage(hexes | frozenset(list(under)[:1]), frozenset(), frozenset(v), f, e, v, pins)
     assert len(placed_by_data(poly, pose, unpinnable, one, table)) == 2
-
-
-def test_on_the_hand_an_aim_grazing_its_edge_is_moved_along_it_to_cross_steeply():
-    """From 4 mm beside an edge, a point of that edge 60 mm on is met at under 4°: on the hand (``crossing_drift``)
-    the aim moves along the edge toward the sensor until the line meets it at ``AIM_MIN_CROSSING``; an aim already
-    that steep, or an edge whose line the sensor stands beside past its end, keeps its point."""
-    from haptic.planning.verify import AIM_MIN_CROSSING, _steep_aim
-
-    model = LIB["BOX01"]
-    t = SE3.identity()
-    f = 0
-    n = model.face_normals[f]
-    e = int(model.face_edges[f][0])
-    p0, u, length = model.edge_points[e], model.edge_directions[e], float(model.edge_lengths[e])
-    inward = np.cross(n, u)
-    if float((model.vertices[list(model.faces[f])].mean(axis=0) - p0) @ inward) < 0:
-        inward = -inward
-    origin = p0 + 0.02 * u + 0.004 * inward
-    far = p0 + (length - 0.01) * u
-    aim = _steep_aim(model, t, e, far, origin, n)
-    s = float((aim - p0) @ u)
-    assert np.allclose(aim, p0 + s * u) and 0.02 < s < length - 0.01
-    assert np.isclose(np.arctan2(0.004, s - 0.02), AIM_MIN_CROSSING)
-    near = p0 + 0.025 * u
-    assert np.allclose(_steep_aim(model, t, e, near, origin, n), near)
-    beyond = p0 - 0.01 * u + 0.004 * inward
-    assert np.allclose(_steep_aim(model, t, e, far, beyond, n), far)
