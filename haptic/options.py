@@ -133,10 +133,11 @@ def add_fingers_option(parser: argparse.ArgumentParser) -> None:
         "--fingers", type=int, choices=FINGER_COUNTS, default=None,
         help=f"fingers the hand may use at once (default {DEFAULT_FINGERS}; {HAND_DEFAULT_FINGERS} with --executor "
         "physics): 1, the index finger alone; 2 or 4, placements of up to that many fingertips closing on "
-        "different faces in one approach join the moves, ranked by the same planner. Geometric executor only: "
-        "the simulated hand does not carry placements out yet. The default is 1 there too: with the default "
-        "move set the planner takes no placement (a probe tells as much for less), with --moves tracing they "
-        "save about 6%% of the path cost (README, 'Several fingers at once')",
+        "different faces in one approach join the moves, ranked by the same planner (on the simulated hand, only "
+        "placements its reach solver reaches with the hypothesised object in place). The default is 1: with the "
+        "default move set the planner takes no placement (a probe tells as much for less); with --moves tracing "
+        "they save about 6%% of the path cost on the geometric executor, and on the hand none is chosen (a "
+        "tracing move eliminates more per unit cost) (README, 'Several fingers at once')",
     )  # fmt: skip
 
 

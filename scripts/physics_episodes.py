@@ -78,7 +78,7 @@ class ProbeCosts:
 
 
 def one(model: str, seed: int, policy: str, moves: str = "tracing", verify: str = "none",
-        probe_costs: bool = False, models: str | None = None) -> dict:  # fmt: skip
+        probe_costs: bool = False, models: str | None = None, fingers: int = 1) -> dict:  # fmt: skip
     """One physics episode's record as JSON (an ``error`` entry when it could not run), with the probes that
     failed (``probes_failed``) and why (``probe_failures``), and with ``probe_costs`` their predicted and
     actual costs (``probe_costs``, :class:`ProbeCosts`)."""
@@ -104,7 +104,7 @@ def one(model: str, seed: int, policy: str, moves: str = "tracing", verify: str 
     watch = ProbeCosts(make_policy(policy)) if probe_costs else None
     try:
         spec = EpisodeSpec(model=model, seed=seed, policy=policy, executor="physics", moves=moves, verify=verify,
-                           models=models)  # fmt: skip
+                           models=models, fingers=fingers)  # fmt: skip
         mine = EpisodeObserver(on_move=on_move, on_failed_move=on_failed)
         obs = chain_observers(mine, watch.observer() if watch else None)
         rec = run_episode(spec, observer=obs, policy=watch).to_json()
@@ -177,6 +177,35 @@ def print_moves(records: list[dict]) -> None:
         print(f"  {n:>4}  {k:<6} {w}")
 
 
+def _mean(records: list[dict], key: str) -> float | None:
+    v = [r[key] for r in records if r.get(key) is not None]
+    return float(np.mean(v)) if v else None
+
+
+def print_placements(records: list[dict]) -> None:
+    """Placements of several fingertips: how many, their share of the moves, how many succeeded, and each
+    finger's outcome (a failed finger's reason)."""
+    placed = [p for r in records for p in r.get("placements", ())]
+    if not any(r.get("fingers", 1) > 1 for r in records):
+        return
+    moves = sum(len(r.get("move_results", ())) for r in records)
+    ok = sum(p["status"] == "ok" for p in placed)
+    asked = sum((r.get("placement_reach") or {}).get("asked", 0) for r in records)
+    reached = sum((r.get("placement_reach") or {}).get("reached", 0) for r in records)
+    why = Counter()
+    for r in records:
+        why.update((r.get("placement_reach") or {}).get("reasons", {}))
+    print(f"the planner's reach test: {asked} placements asked about, {reached} reached"
+          + (f"; why not: {', '.join(f'{k} {v}' for k, v in why.most_common())}" if why else ""))
+    print(f"placements {len(placed)} ({100 * len(placed) / max(1, moves):.1f} % of {moves} moves), {ok} succeeded")
+    for p in placed:
+        if p["status"] != "ok":
+            print(f"  failed: {p['status']}: {p.get('reason', '')}")
+    fingers = Counter((f["status"], reason_class(f.get("reason", ""))) for p in placed for f in p["fingers"])
+    for (status, why), n in fingers.most_common():
+        print(f"  {n:>4}  finger {status}" + (f": {why}" if why else ""))
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--poses", type=int, default=3, help="random resting poses (episodes) per object")
@@ -190,6 +219,8 @@ def main(argv: list[str] | None = None) -> int:
                     help="list each probe the planner chose: predicted against actual cost")
     ap.add_argument("--verify", default="none", choices=("none", "fast", "full"),
                     help="verification before recognition (default none: the matcher's verdict)")
+    ap.add_argument("--fingers", type=int, default=1, choices=(1, 2, 4),
+                    help="fingers the hand may use at once (placements of several fingertips with 2 or 4)")
     ap.add_argument("--jobs", type=int, default=1, help="episodes run in parallel (processes)")
     ap.add_argument("--json", default=None, help="write every episode record here")
     args = ap.parse_args(argv)
@@ -203,8 +234,8 @@ def main(argv: list[str] | None = None) -> int:
             ap.error(str(exc))
     else:
         objects = list(SEED_OBJECTS)
-    jobs = [(o, args.first_seed + k, args.policy, args.moves, args.verify, args.probe_costs, args.models)
-            for o in objects for k in range(args.poses)]
+    jobs = [(o, args.first_seed + k, args.policy, args.moves, args.verify, args.probe_costs, args.models,
+             args.fingers) for o in objects for k in range(args.poses)]
     t0 = time.perf_counter()
     if args.jobs > 1:
         with ProcessPoolExecutor(args.jobs) as pool:
@@ -248,7 +279,11 @@ def main(argv: list[str] | None = None) -> int:
     print(f"correct {len(good)}/{len(records)}, wrong recognitions {wrong_total}; outcomes: "
           f"{', '.join(f'{k} {v}' for k, v in sorted(outcomes.items()))}; median wall time to recognition "
           f"{_f(float(np.median(walls)) if walls else None)} s; total {time.perf_counter() - t0:.0f} s")  # fmt: skip
+    print(f"mean over all episodes: path cost {_f(_mean(records, 'path_cost'), '.2f')}, moves "
+          f"{_f(_mean(records, 'moves'), '.2f')}, wall time {_f(_mean(records, 'wall_time_s'), '.2f')} s; over the "
+          f"correct: path cost {_f(_mean(good, 'path_cost'), '.2f')}, moves {_f(_mean(good, 'moves'), '.2f')}")
     print_moves(records)
+    print_placements(records)
     if args.probe_costs:
         _print_probe_costs(records)
     if args.json:

@@ -73,11 +73,10 @@ def bench(out: Path, *extra: str) -> int:
         (["--episodes", "0"], 2, ["--episodes"]),
         (["--models", "/nonexistent/library"], 1, ["/nonexistent/library"]),
         (["--fingers", "3"], 2, ["--fingers", "invalid choice"]),
-        (["--fingers", "2", "--executor", "physics"], 1, ["--fingers 2", "geometric executor only", "1"]),
     ],
     ids=[
         "workers-0", "noise-nan", "noise-negative", "noise-too-large", "max-moves-0", "seed-negative", "episodes-0",
-        "no-library", "fingers-3", "fingers-physics",
+        "no-library", "fingers-3",
     ],
 )
 def test_bench_bad_option_leaves_results_untouched(results, capsys, extra, expected, words):

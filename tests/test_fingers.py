@@ -16,8 +16,7 @@ def test_the_fingers_default_to_the_executor_s_and_are_checked():
     assert EpisodeSpec(model="BOX01", fingers=4).fingers == 4
     with pytest.raises(HapticError, match="fingers=3 is not a number of fingers; valid: 1, 2, 4"):
         EpisodeSpec(model="BOX01", fingers=3)
-    with pytest.raises(HapticError, match="geometric executor only"):
-        EpisodeSpec(model="BOX01", executor="physics", fingers=2)
+    assert EpisodeSpec(model="BOX01", executor="physics", fingers=2).fingers == 2
 
 
 def test_a_key_written_before_the_setting_reads_as_the_index_finger_alone():

@@ -87,6 +87,10 @@ class EpisodeRecord:
     placements: list[dict] = field(default_factory=list)
     """Each placement of several fingertips carried out or failed, in order: its ``status`` ("ok" or why it
     failed) and ``fingers``, per finger its name and ``status`` ("touched", "missed" or why it failed)."""
+    placement_reach: dict | None = None
+    """On the simulated hand with several fingers, the planner's reach test of placements
+    (:class:`haptic.executor.placement.PlacementReach`): placements ``asked`` about, ``reached``, and why the others
+    were not (``reasons``, by the solver's reason); None otherwise."""
     learned: dict | None = None
     """How learning the object went after ``no-match`` (``--learn DIR``: :mod:`haptic.episode.learning`; None:
     no learning)."""

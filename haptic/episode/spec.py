@@ -89,10 +89,6 @@ def _check_fingers(values: Mapping, spell: Callable[[str, object], str]) -> tupl
         return None
     if isinstance(fingers, bool) or fingers not in FINGER_COUNTS:
         return "fingers", f"is not a number of fingers; valid: {', '.join(map(str, FINGER_COUNTS))}"
-    executor = values.get("executor", DEFAULT_EXECUTOR)
-    if fingers > 1 and executor != "geometric":
-        return "fingers", (f"is not available: placements of several fingertips run on the geometric executor "
-                           f"only; valid with {spell('executor', executor)}: 1")  # fmt: skip
     return None
 
 

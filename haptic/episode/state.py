@@ -183,8 +183,11 @@ class EpisodeState:
 
     def _placed(self, result: MoveResult) -> None:
         if result.move is not None and result.move.kind == "placement":
-            fingers = [{"finger": f["finger"], "status": f["status"]} for f in result.info.get("fingers", ())]
-            self.placements.append({"status": str(result.status), "fingers": fingers})
+            fingers = [{"finger": f["finger"], "status": f["status"], **({"reason": f["reason"]} if f.get("reason")
+                                                                          else {})}
+                       for f in result.info.get("fingers", ())]  # fmt: skip
+            self.placements.append({"status": str(result.status), "fingers": fingers,
+                                    **({"reason": result.reason} if result.reason else {})})
 
     def failed(self, move: Move, result: MoveResult) -> None:
         """Book a move that failed: its cost, where the sensor ended (when known), and its touches: when they

@@ -156,6 +156,10 @@ class PhysicsWorld:
                 config, table_z=ws.table_top_z, pad_radius=ws.pad_radius, steep_descent_risk=STEEP_DESCENT_RISK,
                 max_undercut=TouchConfig().reach_undercut, touch_evidence=True,
             )  # fmt: skip
+        if config.fingers > 1 and config.placement_reach is None:  # placements the reach solver reaches alone
+            from haptic.executor.placement import PlacementReach
+
+            config = replace(config, placement_reach=PlacementReach())
         sim_noise, bounds, noise = noise_models(NoiseModel(check_noise_level(spec.noise)))
         sim = Simulation(scene, noise=sim_noise, seed=int(sim_seq.integers(2**31 - 1)))
         settings = PhysicsSettings()
@@ -176,6 +180,10 @@ class PhysicsWorld:
             truth = sim.ground_truth()
             score = score_components(executor.components, true_model, SE3.from_matrix(truth.world_from_object), results)
             record.perception = _jsonable(score.summary())
+            reach = config.placement_reach
+            if reach is not None and hasattr(reach, "asked"):
+                record.placement_reach = {"asked": reach.asked, "reached": reach.reached,
+                                          "reasons": dict(reach.reasons)}  # fmt: skip
 
         world_from_model = SE3.from_matrix(pose)
         return Episode(

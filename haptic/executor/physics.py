@@ -26,6 +26,7 @@ import numpy as np
 from haptic.errors import HapticError
 from haptic.executor.landing import LandingSearch
 from haptic.executor.physics_probe import probe_move
+from haptic.executor.placement import placement_move
 from haptic.executor.primitives import PrimitiveResult, Toucher
 from haptic.executor.segment import (
     AT_END,
@@ -53,6 +54,7 @@ from haptic.planning.moves import (
     Move,
     MoveResult,
     MoveStatus,
+    PlacementMove,
     ProbeMove,
     SensorState,
     Touches,
@@ -427,6 +429,8 @@ class PhysicsExecutor(LandingSearch):
             return self._run(move, lambda pieces: self._vertex_move(move, pieces))
         if isinstance(move, ProbeMove):  # the free-space probe: haptic.executor.physics_probe
             return self._run(move, lambda pieces: probe_move(self, move, pieces))
+        if isinstance(move, PlacementMove):  # several fingertips at once: haptic.executor.placement
+            return self._run(move, lambda pieces: placement_move(self, move, pieces))
         return MoveResult(move=move, status="invalid", state=self.state, reason=f"unknown move {move!r}")
 
     def invalid_result(self, move: Move, reason: str) -> MoveResult:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from haptic.planning.moves import VERTEX_RADIUS, CostModel
@@ -79,6 +80,14 @@ class PlannerConfig:
     fingers: int = 1
     """Fingers the hand may use at once (``FINGER_COUNTS``): 1, the index finger alone (no placements); 2 or 4,
     placements of two up to that many fingertips (:mod:`haptic.planning.placements`) join the candidates."""
+    placement_reach: Callable | None = None
+    """Whether the hand can take a placement up, as the episode's world knows it: called with a candidate
+    :class:`~haptic.planning.moves.PlacementMove` and the hypotheses (the most likely first), it returns the
+    placement with the fingers that reach its lines (the same lines, perhaps other fingers), or None when none do.
+    Asked for the most efficient placements of a decision in turn (at most ``placement_checks``); the first it
+    reaches is the one placement offered. None: every candidate is offered (the ideal sensor)."""
+    placement_checks: int = 3
+    """Most placements of one decision asked about (``placement_reach``)."""
     moves: str = "tracing"
     """Admissible kinds of move (``MOVE_SETS``): "tracing" (face, edge and vertex moves), "probing" (free-space
     probes) or "all" (both, ranked together by one efficiency, seed §1.1)."""

@@ -129,7 +129,9 @@ def _score_all(ctx: Context) -> list[tuple[Prediction | ProbePrediction | Placem
         out = [(pred, *score_prediction(pred, weights, r, ctx.config)) for pred, r in refused]
     lines = weak_probes(ctx, predict_probe_moves(ctx))
     probes = [s for s in (score_probe(pred, weights) for pred in lines) if s is not None]
-    return out + probes + score_placements(ctx, weights, lines if ctx.config.moves != "tracing" else None)
+    others = (*out, *probes)
+    beat = (max((c[1] for c in others), default=-np.inf), max((c[2] for c in others), default=-np.inf))
+    return out + probes + score_placements(ctx, weights, lines if ctx.config.moves != "tracing" else None, beat)
 
 
 def remeasures(ctx: Context, move: Move) -> bool:
@@ -165,21 +167,40 @@ def remeasures(ctx: Context, move: Move) -> bool:
     return True
 
 
-def score_placements(ctx: Context, weights: np.ndarray, lines: Sequence[ProbePrediction] | None = None) -> list[tuple]:
+def score_placements(ctx: Context, weights: np.ndarray, lines: Sequence[ProbePrediction] | None = None,
+                     beat: tuple[float, float] = (-np.inf, -np.inf)) -> list[tuple]:
     """Placements of several fingertips (``config.fingers`` > 1, every hypothesis posed), scored as
     :func:`score_all` scores moves, ``(pred, efficiency, eliminations, cost, risk)``: their fingers' lines are
     the candidate probe lines (``lines``, the probes' predictions when the move set has them, else
     :func:`placement_lines`) and a finger predicted to fail tells nothing
-    (:class:`~haptic.planning.placements.PlacementPrediction`)."""
+    (:class:`~haptic.planning.placements.PlacementPrediction`). With the hand's reach test
+    (``config.placement_reach``) only the first placement it reaches is offered, of those beating the best other
+    candidate's efficiency or expected eliminations (``beat``: the only ones a policy scoring either could
+    choose)."""
     if ctx.config.fingers < 2 or not ctx.hypotheses or any(h.world_from_model is None for h in ctx.hypotheses):
         return []
     lines = placement_lines(ctx) if lines is None else lines
     lines = [p for p in lines if p.risk(weights) < PROBE_RISK]
     avoid = [m for m in ctx.avoid if isinstance(m, PlacementMove)]
-    cfg = PlacementConfig(max_tilt=HAND_MAX_TILT) if ctx.config.table_z is not None else PlacementConfig()
+    # on the hand without its reach test, fingers close only along lines near straight down; with it, the test
+    # decides (each finger pointing along its line)
+    tilted = ctx.config.table_z is not None and ctx.config.placement_reach is None
+    cfg = PlacementConfig(max_tilt=HAND_MAX_TILT) if tilted else PlacementConfig()
     preds = candidate_placements(lines, weights, ctx.config.fingers, ctx.state.position, ctx.config.costs,
                                  hand_start(ctx), cfg, avoid)  # fmt: skip
-    return [(p, *p.score(weights), p.risk(weights)) for p in preds]
+    scored = [(p, *p.score(weights), p.risk(weights)) for p in preds]
+    reach = ctx.config.placement_reach
+    if reach is None:
+        return scored
+    # one notion of reachability: the hand's own test, asked for the most efficient first; the first reached is
+    # offered (with the fingers that reach it), none that it cannot reach
+    likely = [ctx.hypotheses[k] for k in np.argsort(-weights, kind="stable")]
+    better = [c for c in scored if c[1] > beat[0] or c[2] > beat[1]]
+    for item in sorted(better, key=lambda c: -c[1])[: ctx.config.placement_checks]:
+        move = reach(item[0].move, likely)
+        if move is not None:
+            return [(replace(item[0], move=move), *item[1:])]
+    return []
 
 
 def placement_lines(ctx: Context) -> list[ProbePrediction]:

@@ -32,8 +32,8 @@ DEFAULT_FINGERS = 1
 """Fingers at once unless asked for (``--fingers``), on the geometric executor (README, "Several fingers at
 once")."""
 HAND_DEFAULT_FINGERS = 1
-"""The same on the simulated hand: the index finger alone, its placements of several fingertips not yet carried
-out by the physics executor."""
+"""The same on the simulated hand: the index finger alone (its placements of several fingertips are carried out,
+but the planner never found one more efficient than a tracing move there: README, "Several fingers at once")."""
 
 
 def default_fingers(executor: str) -> int:
@@ -247,6 +247,10 @@ class PlacementMove:
 
     fingers: tuple[FingerApproach, ...]
     """The fingers' approaches, at most one per finger."""
+    path: np.ndarray | None = None
+    """The hand's way to the fingers' lines as the planner's reach test found it, clear of the hypothesised object:
+    joint configurations (K, n) from the tracing posture to every pad at its line's start [rad]; None: the executor
+    finds its own (the ideal sensor needs none)."""
 
     kind = "placement"
 

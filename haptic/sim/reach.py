@@ -72,6 +72,9 @@ class ReachSettings:
     clearance: float = 0.003
     """Least distance kept between the hand's links and the table or object [m] (the target fingers' pads are
     exempt from the object: they are meant to touch it)."""
+    pads_touch: bool = True
+    """Whether the target fingers' pads may touch the object (targets on its surface); False: they keep the
+    clearance too (targets short of it, such as a placement's lines' starts)."""
     detection: float = 0.08
     """Distance below which a pair of geoms enters the collision constraints [m]: more than a step moves any
     link, so that no step jumps past a constraint not yet active."""
@@ -262,7 +265,7 @@ class ReachSolver:
         path = [q0.copy()]
         progress: list[float] = []
         steps = 0
-        pads = {self._geom(self._pad[f]) for f in fingers}
+        pads = self._exempt(fingers)
         rest = [g for g in self._hand_geoms if g not in pads]
         clear = self._clearance(rest)
         blocked: ReachFailure | None = None
@@ -301,13 +304,17 @@ class ReachSolver:
     def _make_limits(self, fingers: Sequence[str]) -> list[mink.Limit]:
         s = self.settings
         limits: list[mink.Limit] = [mink.ConfigurationLimit(self.model), self._velocity]
-        pads = {self._geom(self._pad[f]) for f in fingers}
+        pads = self._exempt(fingers)
         pairs = [(self._hand_geoms, self._table_geoms)]
         if self._object_geoms:
             pairs.append(([g for g in self._hand_geoms if g not in pads], self._object_geoms))
         limits.append(mink.CollisionAvoidanceLimit(self.model, pairs, minimum_distance_from_collisions=s.clearance,
                                                    collision_detection_distance=s.detection))  # fmt: skip
         return limits
+
+    def _exempt(self, fingers: Sequence[str]) -> set[int]:
+        """The pads of ``fingers`` that may touch the object (none unless ``settings.pads_touch``)."""
+        return {self._geom(self._pad[f]) for f in fingers} if self.settings.pads_touch else set()
 
     def _errors(self, targets: Sequence[FingertipTarget]) -> tuple[np.ndarray, np.ndarray]:
         d = self.configuration.data
@@ -347,7 +354,7 @@ class ReachSolver:
         ``blocked``: what stopped the last step."""
         s = self.settings
         pos_err, app_err = self._errors(targets)
-        pads = {self._geom(self._pad[x.finger]) for x in targets}
+        pads = self._exempt([x.finger for x in targets])
         rest = [g for g in self._hand_geoms if g not in pads]
         table = self._distance(self._hand_geoms, self._table_geoms)
         on_object = self._distance(rest, self._object_geoms) if self._object_geoms else 1.0

@@ -1,0 +1,697 @@
+"""A placement of several fingertips at once (seed §5) on the simulated hand: :meth:`PhysicsExecutor.execute` of a
+:class:`~haptic.planning.moves.PlacementMove` (:func:`placement_move`), and the planner's test of whether the hand
+can take a placement up (:class:`PlacementReach`).
+
+Every motion is joint-space: the reach solver (:mod:`haptic.sim.reach`, on the robot and the table alone: the
+executor never sees the object) gives the arm's and the hand's joint path, and the controller holds each
+configuration of it (``hold_posture``) while every fingertip's sensed contact is watched. Step by step:
+
+1. *Leave the surface and rise*: the exploring pad lifts off along the sensed normal and rises straight up to the
+   probes' safe height (:func:`~haptic.planning.handpath.safe_height`).
+2. *Reach*: every finger's pad is brought above its line's start, the finger pointing along its line, then down to
+   the start (each the solver's path, a touch on the way fails the placement: ``unreachable``).
+3. *Close*: the fingers advance along their lines together, one :attr:`PlacementSettings.step` at a time, each
+   step a configuration the solver finds for every pad's target at once. A finger whose pad touches stops there
+   and presses (its target :attr:`PlacementSettings.press` past the contact), while the others close on; one that
+   reaches its line's end met nothing (free space); one whose link meets the object, whose pad meets the table,
+   or that lags its target (the joints cannot carry it further) fails alone and is held where it is.
+4. *Stroke*: every finger that touched strokes an L of two short legs in its tangent plane, pressing, together;
+   its contacts alone are fitted into its own face component by the segmenter (the same sensing interface as
+   every move: the fingertip's contact point, normal and force). A stroke that turns its normal (an edge or a
+   vertex under the pad) fails that finger alone.
+5. *Back*: the fingers retract along their lines, the hand rises, turns back to the tracing posture, and the
+   exploring pad touches again the first face the placement measured (the sensor state rests there).
+
+Each finger's path along its line up to its touch (or the whole line) is reported free, as a probe's. The cost is
+:meth:`~haptic.planning.moves.CostModel.placement_move` of the hand's travel (the farthest pad's way to its line's
+start and the longest closing) with a stroke per face measured.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field, replace
+from itertools import permutations
+from typing import Any
+
+import mink
+import mujoco
+import numpy as np
+
+from haptic.executor.physics_probe import _highest_contact, _leading_segment
+from haptic.executor.primitives import PrimitiveResult
+from haptic.geometry.se3 import perpendicular, unit
+from haptic.matching.trace import PHASES, ContactTrace
+from haptic.planning.handpath import CLEARANCE, LIFT, safe_height
+from haptic.planning.moves import FingerApproach, MoveResult, PlacementMove, SensorState
+from haptic.sim.reach import FingertipTarget, ReachSettings, ReachSolver
+from haptic.sim.scene import ARM_HOME, FINGERS, HAND_TRACE, PAD_RADIUS, TABLE_TOP_Z
+
+PhysicsExecutor = Any
+"""The :class:`~haptic.executor.physics.PhysicsExecutor` whose hand carries out the placement; not imported here,
+since that module dispatches to this one."""
+
+
+@dataclass(frozen=True)
+class PlacementSettings:
+    """Geometry, speeds and tolerances of a placement on the hand."""
+
+    step: float = 0.001
+    """The fingers close along their lines by this much per configuration [m] ..."""
+    step_ticks: int = 12
+    """... each held this many control ticks (with 5 ms ticks, 17 mm/s) [-]."""
+    ik_iterations: int = 4
+    """QP iterations of the solver per configuration of the closing and the stroke [-]."""
+    press: float = 0.001
+    """A finger that touched presses with its target this far past its contact, along its line [m]."""
+    lag: float = 0.008
+    """A closing finger whose pad trails its target by more than this fails (its joints carry it no further) [m]."""
+    settle_ticks: int = 30
+    """Ticks the touched fingers press in place before they stroke, and before the normal is read [-]."""
+    stroke: float = 0.004
+    """Length of each leg of a finger's L stroke [m] ..."""
+    stroke_step: float = 0.00025
+    """... taken in steps of this [m] ..."""
+    stroke_ticks: int = 4
+    """... each held this many ticks (with 5 ms ticks, 12.5 mm/s) [-]."""
+    stroke_press: float = 0.0015
+    """While stroking a pad's target starts this far under its face's plane [m] ..."""
+    press_gain: float = 0.0002
+    """... and goes this much deeper per newton the sensed force falls short of the tracing force, per step
+    [m/N] ..."""
+    max_press: float = 0.004
+    """... down to at most this [m]."""
+    dwell_steps: int = 12
+    """At the end of each leg the targets stay this many steps (the joints' servo trails them) [-]."""
+    stroke_headings: int = 4
+    """A finger whose stroke finds no face strokes again in up to this many headings in all, a quarter turn
+    apart (its stroke may have left a narrow face)."""
+    path_ticks: int = 4
+    """Each configuration of the solver's path to the lines' starts (a joint moves at most 0.05 rad from one to the
+    next) is held at least this many ticks [-] ..."""
+    path_tol: float = 0.01
+    """... and until every arm joint is within this of it [rad] ..."""
+    path_max_ticks: int = 60
+    """... for at most this many ticks [-] (the arm's servo trails a moving target: a path followed faster leaves
+    it by centimetres) ..."""
+    arrive_tol: float = 0.002
+    """... then held until every pad is within this of its target [m] ..."""
+    arrive_ticks: int = 200
+    """... for at most this many ticks [-]."""
+    lift: float = LIFT
+    """The exploring pad lifts off its face by this before rising; the fingers retract along their lines by it
+    after the stroke [m]."""
+    clearance: float = CLEARANCE
+    """The hand rises this far above the highest contact sensed so far (plus the pad radius) [m]."""
+    above: float = 0.02
+    """The pads are brought this far above their lines' starts before they go down to them [m]."""
+    posture_cost: float = 5e-3
+    """Weight of the start configuration in the closing's and the stroke's configurations [-]."""
+    reach: ReachSettings = field(default_factory=ReachSettings)
+    """The reach solver's settings (the executor's, on the robot and table alone)."""
+
+
+SETTINGS = PlacementSettings()
+
+REACH_CLEARANCE = ReachSettings(clearance=0.02, pads_touch=False)
+"""The planner's reach test of a placement: every link of the hand, the pads too, at least 8 mm from the
+hypothesised object and the table on the way to the lines' starts (the joints' servo trails the path by a few
+millimetres; the pads' place at the starts is the lines' standoff from every hypothesis)."""
+
+_SOLVERS: dict[tuple, ReachSolver] = {}
+"""Reach solvers by scene (None: the robot and table alone) and settings, built once per process (compiling a
+scene takes a while)."""
+
+
+def hand_solver(settings: ReachSettings | None = None) -> ReachSolver:
+    """The reach solver on the robot and the table alone (no object), one per process and settings."""
+    from haptic.sim import compose_scene
+
+    settings = settings or ReachSettings()
+    key = (None, settings)
+    if key not in _SOLVERS:
+        _SOLVERS[key] = ReachSolver(compose_scene(None), settings)
+    return _SOLVERS[key]
+
+
+def pad_target(f: FingerApproach, travel: float = 0.0) -> np.ndarray:
+    """Where finger ``f``'s pad centre is when its leading point (the centre plus the pad radius along the line)
+    has travelled ``travel`` along its line [m]."""
+    u = np.asarray(f.direction, dtype=float)
+    return np.asarray(f.start, dtype=float) + (travel - PAD_RADIUS) * u
+
+
+class _Closing:
+    """The joint-space servo of a placement: the solver's configuration for every pad's target, held by the
+    controller, and every finger's sensed contact recorded per tick."""
+
+    def __init__(self, ex: PhysicsExecutor, move: PlacementMove, settings: PlacementSettings) -> None:
+        self.ex, self.move, self.s = ex, move, settings
+        self.solver = hand_solver(settings.reach)
+        self.model = self.solver.model
+        self.cfg = mink.Configuration(self.model)
+        self.limits = [mink.ConfigurationLimit(self.model)]
+        self.index = {f.finger: FINGERS.index(f.finger) for f in move.fingers}
+        self.rows: dict[str, list[tuple]] = {f.finger: [] for f in move.fingers}
+        self.ticks = 0
+        self.posture = self.q_now()
+
+    def q_now(self) -> np.ndarray:
+        r = self.ex.robot.read()
+        return np.concatenate([r.arm_q, r.hand_q])
+
+    def solve(self, targets: dict[str, np.ndarray], axes: dict[str, np.ndarray] | None = None) -> np.ndarray:
+        """A configuration near the current one putting each finger's pad at its target (pointing along its
+        axis, when given)."""
+        s = self.s
+        self.cfg.update(self.q_now())
+        tasks: list[mink.Task] = []
+        for f, p in targets.items():
+            task = mink.FrameTask(self.solver.site_name(f), "site", position_cost=1.0, orientation_cost=0.0)
+            task.set_target(mink.SE3.from_translation(np.asarray(p, dtype=float)))
+            tasks.append(task)
+            if axes and f in axes:
+                align = mink.AxisAlignTask(self.solver.site_name(f), "site", axis=_finger_axis(f),
+                                           cost=s.reach.approach_cost, lm_damping=s.reach.approach_damping)  # fmt: skip
+                align.set_target(unit(axes[f]))
+                tasks.append(align)
+        posture = mink.PostureTask(self.model, cost=s.posture_cost)
+        posture.set_target(self.posture)
+        tasks.append(posture)
+        for _ in range(s.ik_iterations):
+            vel = mink.solve_ik(self.cfg, tasks, 1.0, solver="daqp", damping=s.reach.damping, limits=self.limits)
+            self.cfg.integrate_inplace(vel, 1.0)
+        return self.cfg.q.copy()
+
+    def hold(self, q: np.ndarray) -> None:
+        n_arm = len(ARM_HOME)
+        self.ex.robot.hold_posture(q[:n_arm], q[n_arm:])
+
+    def tick(self, phase: str):
+        """One control tick; each finger's row recorded; the reading returned."""
+        robot = self.ex.robot
+        robot.step(1)
+        self.ticks += 1
+        if self.ticks % self.ex.toucher.config.link_every == 0:
+            self.ex.toucher.sample_links()
+        r = robot.read()
+        thr = self.ex.toucher.threshold
+        rot = self.ex.toucher.hand_rotation
+        nan3 = (math.nan, math.nan, math.nan)
+        for f in self.rows:
+            k = self.index[f]
+            cs = [c for c in r.contacts[k] if np.all(np.isfinite(c.normal_in_world))]
+            force = float(sum(c.normal_force for c in cs))
+            if cs and force > thr:
+                w = np.array([max(c.normal_force, 0.0) for c in cs]) + 1e-12
+                p = np.average([c.point_in_world for c in cs], axis=0, weights=w)
+                n = unit(np.average([c.normal_in_world for c in cs], axis=0, weights=w))
+                self.rows[f].append((r.time, r.fingertip_in_world[k].copy(), rot, p, n, force, PHASES.index(phase)))
+            else:
+                self.rows[f].append((r.time, r.fingertip_in_world[k].copy(), rot, nan3, nan3, force,
+                                     PHASES.index(phase)))  # fmt: skip
+        return r
+
+    def trace(self, finger: str, first: int = 0) -> ContactTrace:
+        rows = self.rows[finger][first:]
+        if not rows:
+            return ContactTrace.concatenate([])
+        t, tip, rot, p, n, f, ph = zip(*rows, strict=True)
+        return ContactTrace(np.array(t), np.array(tip), np.array(rot), np.array(p, dtype=float),
+                            np.array(n, dtype=float), np.array(f), np.array(ph, dtype=int))  # fmt: skip
+
+    def touching(self, finger: str, rows: int) -> bool:
+        """The finger's last ``rows`` rows all in contact (debounced)."""
+        last = self.rows[finger][-rows:]
+        return len(last) == rows and all(math.isfinite(x[4][0]) for x in last)
+
+    def link_on_object(self, reading) -> dict[str, str]:
+        """Links other than the pads touching anything but the table: {finger or "hand": link}."""
+        t = self.ex.toucher
+        out: dict[str, str] = {}
+        for c in reading.link_contacts:
+            on_table = float(c.normal_in_world[2]) > t.config.table_link_cos and (
+                t.floor_z is None or float(c.point_in_world[2]) < t.floor_z)  # fmt: skip
+            if on_table or c.normal_force <= t.threshold:
+                continue
+            owner = next((f for f in FINGERS if c.link.startswith(f"{f}_")), "hand")
+            out.setdefault(owner, c.link)
+        return out
+
+    def follow(self, path: np.ndarray, phase: str = "free") -> str | None:
+        """Hold each configuration of ``path`` in turn, watching every fingertip and link; why it stopped (a touch)
+        or None."""
+        n_arm = len(ARM_HOME)
+        for q in path[1:]:
+            self.hold(q)
+            for k in range(self.s.path_max_ticks):
+                r = self.tick(phase)
+                why = self._touched_on_the_way(r)
+                if why:
+                    self.hold(self.q_now())
+                    return why
+                if (k + 1 >= self.s.path_ticks and float(np.max(np.abs(r.arm_q - q[:n_arm]))) < self.s.path_tol
+                        and float(np.max(np.abs(r.hand_q - q[n_arm:]))) < 2.0 * self.s.path_tol):  # fmt: skip
+                    break
+        return None
+
+    def arrive(self, targets: dict[str, np.ndarray], phase: str = "free") -> str | None:
+        """Tick until every pad is within ``arrive_tol`` of its target (or ``arrive_ticks`` pass); why it stopped
+        (a touch) or None."""
+        for _ in range(self.s.arrive_ticks):
+            r = self.tick(phase)
+            why = self._touched_on_the_way(r)
+            if why:
+                self.hold(self.q_now())
+                return why
+            if all(np.linalg.norm(r.fingertip_in_world[self.index[f]] - p) < self.s.arrive_tol
+                   for f, p in targets.items()):  # fmt: skip
+                break
+        return None
+
+    def _touched_on_the_way(self, reading) -> str | None:
+        for k, f in enumerate(FINGERS):
+            if sum(c.normal_force for c in reading.contacts[k]) > self.ex.toucher.threshold:
+                return f"the {f} fingertip touched something"
+        links = self.link_on_object(reading)
+        if links:
+            return f"the hand's {next(iter(links.values()))} touched something"
+        return None
+
+
+def _joint_path(q0: np.ndarray, q1: np.ndarray, step: float) -> np.ndarray:
+    """Configurations from ``q0`` to ``q1`` on the straight line between them in joint space, no joint moving by
+    more than ``step`` from one to the next [rad]."""
+    n = max(1, int(np.ceil(float(np.max(np.abs(q1 - q0))) / step)))
+    return q0 + np.linspace(0.0, 1.0, n + 1)[:, None] * (q1 - q0)
+
+
+def _finger_axis(finger: str) -> np.ndarray:
+    return np.array([0.0, 1.0, 0.0]) if finger == "thumb" else np.array([0.0, 0.0, 1.0])
+
+
+def placement_move(ex: PhysicsExecutor, move: PlacementMove, pieces: list[PrimitiveResult],
+                   settings: PlacementSettings = SETTINGS) -> MoveResult:  # fmt: skip
+    """Carry out ``move`` with ``ex``'s hand (module docstring); a failure is a status, never an exception."""
+    if (problem := move.problem()) is not None:
+        return ex.invalid_result(move, problem)
+    t, s = ex.toucher, settings
+    starts = np.array([pad_target(f) for f in move.fingers])
+    if np.any(starts[:, 2] - PAD_RADIUS < TABLE_TOP_Z + ex.settings.pad_clearance):
+        return ex.invalid_result(move, "a finger's line would bring its pad onto the table")
+    # 1. leave the surface and rise
+    if t.contact[1] is not None and t.normal is not None:
+        res = t.move_free(t.tip + s.lift * t.normal, timeout=t.config.lift_timeout, tol=t.config.lift_tol)
+        pieces.append(res)
+        if not res.ok:
+            return ex.failed_result(move, res, f"leaving the surface: {res.event}")
+    ex.on_face = None
+    z_safe = float(np.max(safe_height(_highest_contact(ex), t.pad_radius, starts, t.tip, s.clearance)))
+    z_safe = min(z_safe, TABLE_TOP_Z + ex.settings.max_approach_height)  # the hand's reach over the region
+    up = t.move_guarded(np.array([t.tip[0], t.tip[1], z_safe]), 0.15, max_lag=0.012)
+    pieces.append(up)
+    if not up.ok or up.event != "done":
+        return ex.failed_result(move, "unreachable", f"rising above the object: {up.event}")
+    c = _Closing(ex, move, s)
+    tip0 = {f.finger: c.ex.robot.read().fingertip_in_world[c.index[f.finger]].copy() for f in move.fingers}
+    result = _place(ex, move, c, starts, z_safe, pieces)
+    _restore(ex, c, move, z_safe, pieces)
+    if result.status != "ok":
+        return result
+    touched = [i for i in result.info["fingers"] if i["status"] == "touched"]
+    for info in touched:  # the sensor rests on the first face measured that the exploring pad touches again
+        fid = info["component"]
+        if ex._ensure_on_face(fid, pieces, near=np.asarray(info["point"])) == "ok":
+            ex.state = SensorState(position=ex.contact_point(), face=fid)
+            break
+    transfer = max(float(np.linalg.norm(starts[k] - tip0[f.finger])) for k, f in enumerate(move.fingers))
+    closing = max((i.get("travel") or 0.0) for i in result.info["fingers"])
+    dist = transfer + closing
+    cost = ex.costs.placement_move(dist, len(move.fingers), len(touched))
+    for info in result.info["fingers"]:
+        info.pop("point", None)
+    return replace(result, distance=dist, cost=cost, state=ex.state)
+
+
+def _place(ex: PhysicsExecutor, move: PlacementMove, c: _Closing, starts: np.ndarray, z_safe: float,
+           pieces: list[PrimitiveResult]) -> MoveResult:  # fmt: skip
+    s = c.s
+    names = [f.finger for f in move.fingers]
+    axes = {f.finger: np.asarray(f.direction, dtype=float) for f in move.fingers}
+    # 2. the planner's way to the lines (from the tracing posture, clear of the hypothesised object), else above the
+    # lines' starts, then down to them
+    if move.path is not None and len(move.path):
+        why = _home_then(c, np.asarray(move.path, dtype=float), pieces)
+        if why:
+            return ex.failed_result(move, "unreachable", f"on the planned way to the lines: {why}")
+        why = c.arrive(dict(zip(names, starts, strict=True)))
+        if why:
+            return ex.failed_result(move, "unreachable", f"on the planned way to the lines: {why}")
+    else:
+        why = _above_then_down(c, names, axes, starts, z_safe)
+        if why:
+            return ex.failed_result(move, "unreachable", why)
+    c.posture = c.q_now()
+    # 3. close
+    status: dict[str, str] = {}
+    travel: dict[str, float] = {}
+    normals: dict[str, np.ndarray] = {}  # each touched pad's sensed normal ...
+    contacts: dict[str, np.ndarray] = {}  # ... contact point ...
+    radius: dict[str, float] = {}  # ... and radius as sensed (the pad centre's distance from its contact)
+    faces: dict[str, int] = {}  # each finger's face component
+    held: dict[str, np.ndarray] = {}
+    reason: dict[str, str] = {}
+    first_row = {f: len(c.rows[f]) for f in names}
+    t_cmd = 0.0
+    debounce = ex.toucher.config.debounce
+    while len(status) < len(names):
+        t_cmd += s.step
+        targets = {}
+        for f in move.fingers:
+            if f.finger in status:
+                targets[f.finger] = held[f.finger]
+            else:
+                targets[f.finger] = pad_target(f, min(t_cmd, float(f.length)))
+        c.hold(c.solve(targets))
+        for _ in range(s.step_ticks):
+            r = c.tick("approach")
+            links = c.link_on_object(r)
+            if "hand" in links:
+                for f in names:
+                    if f not in status:
+                        status[f], reason[f] = "unreachable", f"the hand's {links['hand']} met the object"
+                        held[f] = r.fingertip_in_world[c.index[f]].copy()
+                break
+            for f in move.fingers:
+                name = f.finger
+                if name in status:
+                    continue
+                k = c.index[name]
+                tip = r.fingertip_in_world[k]
+                u = np.asarray(f.direction, dtype=float)
+                if name in links:
+                    status[name], reason[name] = "unreachable", f"the finger's {links[name]} met the object"
+                    held[name] = tip.copy()
+                elif c.touching(name, debounce):
+                    row = c.rows[name][-1]
+                    if ex.workspace.is_table(np.asarray(row[4]), np.asarray(row[3])):
+                        status[name], reason[name] = "unreachable", "the pad met the table"
+                        held[name] = tip.copy()
+                        continue
+                    status[name] = "touched"
+                    travel[name] = float((tip - pad_target(f)) @ u)
+                    rows = c.rows[name][-debounce:]
+                    contacts[name] = np.mean([x[3] for x in rows], axis=0)
+                    normals[name] = unit(np.mean([x[4] for x in rows], axis=0))
+                    radius[name] = float(np.linalg.norm(tip - contacts[name]))
+                    held[name] = contacts[name] + (radius[name] - s.press) * normals[name]
+                elif t_cmd >= float(f.length) and float((tip - pad_target(f)) @ u) >= float(f.length) - s.arrive_tol:
+                    status[name], travel[name] = "missed", float(f.length)
+                    held[name] = tip.copy()
+                elif float(np.linalg.norm(tip - pad_target(f, min(t_cmd, float(f.length))))) > s.lag + s.step:
+                    status[name], reason[name] = "unreachable", "the finger's joints carry it no further along its line"
+                    held[name] = tip.copy()
+        if t_cmd > max(float(f.length) for f in move.fingers) + 0.02:
+            for f in names:  # the closing timed out
+                if f not in status:
+                    status[f], reason[f] = "timeout", "the finger did not reach its line's end"
+                    held[f] = c.ex.robot.read().fingertip_in_world[c.index[f]].copy()
+    closing = {f: c.trace(f, first_row[f]) for f in names}
+    # 4. stroke: the touched fingers press in place, then an L each in its tangent plane, together
+    touched = [f for f in move.fingers if status[f.finger] == "touched"]
+    if touched:
+        stroke_from = {f: len(c.rows[f]) for f in names}
+        depth = {f.finger: s.press for f in touched}
+        for _ in range(max(1, s.settle_ticks // s.stroke_ticks)):
+            _pressing_step(c, touched, held, normals, contacts, radius, depth, {}, "settle")
+        for f in touched:
+            tr = c.trace(f.finger, stroke_from[f.finger])
+            ok = tr.in_contact
+            if ok.sum() < 3:
+                status[f.finger], reason[f.finger] = "no-contact", "contact lost pressing"
+                continue
+            normals[f.finger] = unit(tr.normal_in_world[ok][-10:].mean(axis=0))
+            contacts[f.finger] = tr.point_in_world[ok][-10:].mean(axis=0)
+            radius[f.finger] = float(np.median(np.linalg.norm(tr.tip_in_world[ok] - tr.point_in_world[ok], axis=1)))
+        stroking = [f for f in touched if status[f.finger] == "touched"]
+        phi0 = {f.finger: ex.rng.uniform(0.0, 2.0 * math.pi) for f in stroking}
+        for heading in range(s.stroke_headings):
+            if not stroking:
+                break
+            if heading:  # back to where each pad touched, pressing, before the next heading
+                targets = dict(held)
+                for f in stroking:
+                    n = normals[f.finger]
+                    targets[f.finger] = contacts[f.finger] + (radius[f.finger] - s.stroke_press) * n
+                c.hold(c.solve(targets))
+                for _ in range(s.settle_ticks):
+                    c.tick("settle")
+            traces = _stroke(c, stroking, held, normals, contacts, radius,
+                             {f: p + heading * math.pi / 2.0 for f, p in phi0.items()})  # fmt: skip
+            left = []
+            for f in stroking:
+                tr = traces[f.finger]
+                fit = ex.segmenter.fit_face_trace(tr, normals[f.finger], two_d=True) if ex.on_one_face(tr) else None
+                if fit is None or ex.workspace.is_table(fit.normal, contacts[f.finger]):
+                    left.append(f)
+                    continue
+                face = ex.segmenter.add_face(fit, ())
+                ex.store_face(face.id, tr, fit)
+                faces[f.finger] = face.id
+                held[f.finger] = contacts[f.finger] + (radius[f.finger] - s.stroke_press) * normals[f.finger]
+            stroking = left
+        for f in stroking:
+            status[f.finger], reason[f.finger] = "unreachable", "the stroke found no face (an edge or a vertex)"
+    # 5. what each finger measured
+    bound = ex.bounds.bound(ex.bounds.point_sigma, ex.bounds.position_floor)
+    comps, free, fingers = [], [], []
+    for f in move.fingers:
+        name = f.finger
+        u = np.asarray(f.direction, dtype=float)
+        info: dict = {"finger": name, "status": status[name], "component": None, "travel": travel.get(name)}
+        if status[name] in ("touched", "missed"):
+            seg = _leading_segment(closing[name].tip_in_world, u, PAD_RADIUS,
+                                   0.0 if status[name] == "missed" else 0.0015, bound)  # fmt: skip
+            if seg is not None:
+                free.append(seg)
+        if status[name] == "touched":
+            fid = faces[name]
+            comps.append(ex.segmenter.faces[fid].component)
+            info.update(component=fid, contact=travel[name], point=contacts[name].tolist())
+        elif status[name] != "missed":
+            info["reason"] = reason[name]
+        fingers.append(info)
+    pieces.append(PrimitiveResult("ok", "done", closing[names[0]], 0.0))
+    if not comps and not any(i["status"] == "missed" for i in fingers):
+        why = "; ".join(f"{i['finger']}: {i.get('reason', i['status'])}" for i in fingers)
+        return MoveResult(move=move, status="unreachable", state=ex.state, reason=f"no finger measured: {why}",
+                          info={"fingers": fingers})  # fmt: skip
+    return MoveResult(move=move, status="ok", components=tuple(comps), state=ex.state,
+                      free_space=tuple(free), info={"fingers": fingers})  # fmt: skip
+
+
+def _above_then_down(c: _Closing, names: list[str], axes: dict[str, np.ndarray], starts: np.ndarray,
+                     z_safe: float) -> str | None:
+    """Every pad above its line's start (the finger pointing along it), then down to the start, along the
+    solver's paths (the robot and table alone); why not, or None."""
+    s = c.s
+    lift = max(0.0, z_safe - float(starts[:, 2].min())) + s.above
+    for what, pts in (("above the lines", starts + np.array([0.0, 0.0, lift])), ("to the lines' starts", starts)):
+        targets = [FingertipTarget(f, p, axes[f]) for f, p in zip(names, pts, strict=True)]
+        reach = c.solver.solve(targets, start=c.q_now())
+        if not reach.ok:  # from the tracing posture, as the planner's test asks, then across to it in joint space
+            home = c.solver.solve(targets)
+            if home.ok:
+                reach = replace(home, path=_joint_path(c.q_now(), home.qpos, s.reach.max_speed * s.reach.dt))
+        if not reach.ok and what == "above the lines":
+            continue  # (out of reach up there: straight to the starts, the way watched as every way is)
+        if not reach.ok:
+            return f"reaching {what}: {reach.reason} ({reach.detail})"
+        why = c.follow(reach.path) or c.arrive(dict(zip(names, pts, strict=True)))
+        if why:
+            return f"on the way {what}: {why}"
+    return None
+
+
+def _home_then(c: _Closing, path: np.ndarray, pieces: list[PrimitiveResult]) -> str | None:
+    """The pad up and over to where it is in the path's first configuration (the tracing posture), that posture
+    taken in joint space, then the path followed; why it stopped, or None."""
+    t = c.ex.toucher
+    c.cfg.update(path[0])
+    sid = mujoco.mj_name2id(c.model, mujoco.mjtObj.mjOBJ_SITE, c.solver.site_name(t.finger))
+    above = c.cfg.data.site_xpos[sid].copy()
+    here = t.tip.copy()
+    for w in (np.array([here[0], here[1], max(here[2], above[2])]), above):
+        if float(np.linalg.norm(w - t.tip)) < t.config.target_tol:
+            continue
+        res = t.move_guarded(w, 0.15, max_lag=0.012)
+        pieces.append(res)
+        if not res.ok or res.event != "done":
+            return f"moving over to the tracing posture: {res.event}"
+    return c.follow(_joint_path(c.q_now(), path[0], c.s.reach.max_speed * c.s.reach.dt)) or c.follow(path)
+
+
+def _stroke(c: _Closing, fingers: Sequence[FingerApproach], held: dict[str, np.ndarray],
+            normals: dict[str, np.ndarray], contacts: dict[str, np.ndarray], radius: dict[str, float],
+            heading: dict[str, float]) -> dict[str, ContactTrace]:  # fmt: skip
+    """An L stroke of each of ``fingers`` together, from its contact in its tangent plane (the first leg at angle
+    ``heading`` about its normal), pressing; the other fingers held at ``held``. Each finger's rows."""
+    s = c.s
+    legs: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+    for f in fingers:
+        n = normals[f.finger]
+        a = perpendicular(n)
+        phi = heading[f.finger]
+        d1 = math.cos(phi) * a + math.sin(phi) * np.cross(n, a)
+        legs[f.finger] = (d1, np.cross(n, d1))
+    first = {f.finger: len(c.rows[f.finger]) for f in fingers}
+    steps = max(1, int(round(s.stroke / s.stroke_step)))
+    depth = {f.finger: s.stroke_press for f in fingers}
+    for leg in range(2):
+        for k in range(1, steps + 1 + s.dwell_steps):
+            k = min(k, steps)  # then dwell at the leg's end: the joints' servo trails its targets
+            off = {}
+            for f in fingers:
+                d1, d2 = legs[f.finger]
+                off[f.finger] = (k * s.stroke_step * d1) if leg == 0 else (s.stroke * d1 + k * s.stroke_step * d2)
+            _pressing_step(c, fingers, held, normals, contacts, radius, depth, off, "stroke")
+    return {f.finger: c.trace(f.finger, first[f.finger]) for f in fingers}
+
+
+def _pressing_step(c: _Closing, fingers: Sequence[FingerApproach], held: dict[str, np.ndarray],
+                   normals: dict[str, np.ndarray], contacts: dict[str, np.ndarray], radius: dict[str, float],
+                   depth: dict[str, float], offsets: dict[str, np.ndarray], phase: str) -> None:  # fmt: skip
+    """One step of ``fingers`` pressing on their faces: each pad's target its contact moved by its offset in the
+    tangent plane, ``depth`` under the face; held for :attr:`PlacementSettings.stroke_ticks`; then each depth
+    follows the force sensed (deeper when it falls short of the tracing force). The other fingers held at
+    ``held``."""
+    s = c.s
+    targets = dict(held)
+    for f in fingers:
+        n = normals[f.finger]
+        targets[f.finger] = contacts[f.finger] + offsets.get(f.finger, 0.0) + (radius[f.finger] - depth[f.finger]) * n
+    c.hold(c.solve(targets))
+    for _ in range(s.stroke_ticks):
+        c.tick(phase)
+    force = c.ex.toucher.config.force
+    for f in fingers:
+        sensed = float(np.mean([row[5] for row in c.rows[f.finger][-s.stroke_ticks:]]))
+        depth[f.finger] = float(np.clip(depth[f.finger] + s.press_gain * (force - sensed), 0.0, s.max_press))
+
+
+def _restore(ex: PhysicsExecutor, c: _Closing, move: PlacementMove, z_safe: float,
+             pieces: list[PrimitiveResult]) -> None:  # fmt: skip
+    """The fingers back along their lines, the hand up to ``z_safe`` and back to the tracing posture."""
+    s, t = c.s, ex.toucher
+    r = ex.robot.read()
+    names = [f.finger for f in move.fingers]
+    back = {f.finger: r.fingertip_in_world[c.index[f.finger]] - s.lift * np.asarray(f.direction) for f in move.fingers}
+    c.hold(c.solve(back))
+    for _ in range(s.settle_ticks):
+        c.tick("free")
+    r = ex.robot.read()
+    rise = max(0.0, z_safe - float(min(r.fingertip_in_world[c.index[f]][2] for f in names)))
+    up = {f: r.fingertip_in_world[c.index[f]] + np.array([0.0, 0.0, rise]) for f in names}
+    for _ in range(3):
+        c.hold(c.solve(up))
+        for _ in range(s.settle_ticks):
+            c.tick("free")
+    r = ex.robot.read()
+    ex.robot.hold_posture(r.arm_q, HAND_TRACE)
+    for _ in range(2 * s.settle_ticks):
+        t.tick("free")
+    t.hand_rotation = np.array(t.config.hand_rotation, dtype=float)
+    pieces.append(t.move_free(t.tip.copy(), timeout=t.config.via_timeout, tol=t.config.via_tol))
+    t.take_trace()
+
+
+# -- the planner's test of reach -------------------------------------------------------------------------------
+class PlacementReach:
+    """Whether the hand can take a placement up, asked by the planner before it offers one: the reach solver with
+    the hypothesised model at its hypothesised pose in the scene (never the true pose), each finger's pad at its
+    line's start pointing along the line, from the tracing posture. Tries the placement's own fingers, then other
+    fingers for its lines (at most :attr:`assignments` in all); the placement with the fingers that reach, or
+    None. Called with the planner's hypotheses (the most likely first)."""
+
+    def __init__(self, settings: ReachSettings | None = None, assignments: int = 12, cache: int = 4) -> None:
+        self.settings = settings or REACH_CLEARANCE
+        self.assignments = assignments
+        self.cache = cache
+        self._solvers: dict[tuple, ReachSolver] = {}
+        self._answers: dict[tuple, PlacementMove | None] = {}
+        self.asked = 0
+        """Placements asked about."""
+        self.reached = 0
+        """... of them reached."""
+        self.reasons: dict[str, int] = {}
+        """Why the others were not, by the solver's reason (the last assignment's)."""
+
+    def __call__(self, move: PlacementMove, hypotheses: Sequence) -> PlacementMove | None:
+        h = hypotheses[0]
+        key = (h.model, *np.round(h.world_from_model.as_matrix()[:3].ravel(), 3),
+               *(tuple(np.round(np.concatenate([f.start, f.direction]), 4)) for f in move.fingers))
+        if key in self._answers:
+            return self._answers[key]
+        solver = self._solver(h)
+        self.asked += 1
+        answer, why = None, ""
+        lines = list(move.fingers)
+        tried = 0
+        for names in _assignments(tuple(f.finger for f in lines)):
+            if tried >= self.assignments:
+                break
+            tried += 1
+            targets = [FingertipTarget(n, pad_target(f), np.asarray(f.direction, dtype=float))
+                       for n, f in zip(names, lines, strict=True)]  # fmt: skip
+            r = solver.solve(targets)
+            if r.ok:
+                answer = PlacementMove(tuple(replace(f, finger=n) for n, f in zip(names, lines, strict=True)),
+                                       path=r.path)  # fmt: skip
+                break
+            why = str(r.reason)
+        if answer is None:
+            self.reasons[why] = self.reasons.get(why, 0) + 1
+        else:
+            self.reached += 1
+        self._answers[key] = answer
+        return answer
+
+    def _solver(self, h) -> ReachSolver:
+        """A solver with ``h``'s model in its scene, moved to ``h``'s pose (one compiled scene per model: the
+        object's body is fixed to the world, so its pose is the model's to set)."""
+        from haptic.sim import compose_scene
+        from haptic.sim.scene import scene_object_from_polyhedron
+
+        if h.model not in self._solvers:
+            if len(self._solvers) >= self.cache:
+                self._solvers.pop(next(iter(self._solvers)))
+            obj = scene_object_from_polyhedron(h.poly)
+            self._solvers[h.model] = ReachSolver(compose_scene(obj, np.eye(4)), self.settings)
+        solver = self._solvers[h.model]
+        m = solver.model
+        body = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "object")
+        pose = h.world_from_model.as_matrix()
+        m.body_pos[body] = pose[:3, 3]
+        quat = np.zeros(4)
+        mujoco.mju_mat2Quat(quat, np.ascontiguousarray(pose[:3, :3]).reshape(-1))
+        m.body_quat[body] = quat
+        return solver
+
+
+def _assignments(own: tuple[str, ...]):
+    """The placement's own fingers first, then the others' assignments of fingers to its lines."""
+    yield own
+    for names in permutations(FINGERS, len(own)):
+        if names != own:
+            yield names
+
+
+def reach_oracle(fingers: int) -> Callable | None:
+    """The planner's placement reach test for an episode of ``fingers`` fingers at once (None for one)."""
+    return PlacementReach() if fingers > 1 else None
+
+
+__all__ = ["REACH_CLEARANCE", "SETTINGS", "PlacementReach", "PlacementSettings", "hand_solver", "pad_target",
+           "placement_move",
+           "reach_oracle"]
