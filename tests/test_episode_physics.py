@@ -354,3 +354,16 @@ def test_an_edge_move_that_acquires_a_parallel_ridge_reports_nothing(tmp_path):
     assert any("off the edge's line: another edge" in w for w in failed), failed
     assert rec.outcome != "no-match", rec.detail
     assert _within_bounds(ep)
+
+
+def test_a_stroke_leg_that_a_finger_link_stopped_does_not_measure_the_face(tmp_path):
+    # bipyramid_08 of the formula corpus at 150 mm, seed 1 (perception_report.py --corpus --sizes 150): the stroke
+    # on the next face stepped in, then slid along the edge until the finger's medial link met the object; that
+    # leg's rows alone made the face (the step's are left out, next to the edge's rims), the pad lifted and tilted
+    # by the link over its last millimetres: the face 1.55° off, 1.73 times its bound. With the step's rows the face
+    # holds.
+    from haptic.episode.evaluate import bound_ratios
+
+    ep, _, _ = _replay(tmp_path, "bipyramid_08", 0.15, 12, corpus=True, seed=1)
+    ratios = bound_ratios(ep.executor.components, ep.true_model, ep.world_from_model)
+    assert max(r.ratio for r in ratios if r.what == "face normal") <= 1.0
