@@ -14,8 +14,10 @@ noise):
 
 The table gives each policy's decision times (the policy's choices, wall time: on a loaded machine they grow).
 
-``--moves`` sets the policies' admissible moves (as ``haptic bench --moves``); the hindsight optimum searches
-tracing moves whatever it is. ``--hindsight-depth 0`` leaves the hindsight optimum out.
+``--moves`` sets the policies' admissible moves (as ``haptic bench --moves``) and the hindsight search's: with
+``tracing`` it searches tracing moves after the seed's opening; with ``all`` (or ``probing``) it starts where the
+episode's own opening leaves it and tries, at each node, the tracing moves and the best probes
+(:func:`~haptic.bench.oracle.hindsight_optimum_probing`). ``--hindsight-depth 0`` leaves the hindsight optimum out.
 """
 
 from __future__ import annotations
@@ -53,9 +55,10 @@ def _policy_run(spec: EpisodeSpec, depth: int) -> dict:
 
 
 def _hindsight_run(spec: EpisodeSpec, depth: int) -> dict:
-    from haptic.bench.oracle import hindsight_optimum
+    from haptic.bench.oracle import hindsight_optimum, hindsight_optimum_probing
 
-    o = hindsight_optimum(spec, library=_library(), max_depth=depth)
+    search = hindsight_optimum if spec.moves == "tracing" else hindsight_optimum_probing
+    o = search(spec, library=_library(), max_depth=depth)
     return {"policy": "hindsight", "seed": spec.seed, "model": spec.model, "cost": o.path_cost if o.found else None,
             "moves": o.moves, "correct": o.found, "wall_s": None}
 

@@ -39,6 +39,7 @@ same state. The totals also give the success rate of the moves that did not fail
 from __future__ import annotations
 
 import argparse
+import math
 import time
 from collections import Counter
 from pathlib import Path
@@ -383,12 +384,17 @@ def _plot(rows: list, path: str) -> None:
     from haptic.episode.evaluate import BOUND_QUANTITIES
 
     fig, axes = plt.subplots(2, 3, figsize=(12, 6), sharex=True)
-    bins = np.linspace(-3, 1.5, 46)
+    # every ratio shows: zeros (an edge's extent within its explored interval) are counted in the title, not drawn
+    # at the left edge, and the range reaches the largest ratio
+    top = max([1.5] + [math.ceil(10 * math.log10(x)) / 10 + 0.1 for x, _, _, _ in rows if x > 0])
+    bins = np.linspace(-3, top, int(round(10 * (top + 3))) + 1)
     for ax, what in zip(axes.ravel(), BOUND_QUANTITIES, strict=True):
         a = np.array([x for x, w, _, _ in rows if w == what])
-        ax.hist(np.log10(np.maximum(a, 1e-3)), bins=bins, color="tab:blue")
+        pos = a[a > 0]
+        ax.hist(np.clip(np.log10(pos), bins[0], bins[-1]), bins=bins, color="tab:blue")
         ax.axvline(0.0, color="tab:red", lw=1)
-        ax.set_title(f"{what} (n {len(a)}, {int((a > 1).sum())} > 1)", fontsize=10)
+        ax.set_yscale("log")
+        ax.set_title(f"{what} (n {len(a)}, {len(a) - len(pos)} zero, {int((a > 1).sum())} > 1)", fontsize=10)
     for ax in axes[-1]:
         ax.set_xlabel("log10 (error / bound)")
     fig.tight_layout()

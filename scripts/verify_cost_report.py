@@ -8,8 +8,9 @@ with a verification mode.
 Prints one table row (markdown): episodes, verification statuses, the mean path cost of each and their ratio, and
 the verification's cost (the record's ``verified.cost``) against its lower bound (``verified.tour_bound``) and the
 tour planned at its start (``verified.tour_planned``), as a ratio of means with the median of the per-episode
-ratios; the confirmed verifications that cost less than their bound (none, if it is one); then the episodes
-farthest above their bound, and the models by that ratio.
+ratios; the probes at the faces' middles and their cost (``verified.middles_probed``, ``middles_cost``), and the
+cost without them against the bound (which is for the vertices alone); the confirmed verifications that cost less
+than their bound (none, if it is one); then the episodes farthest above their bound, and the models by that ratio.
 """
 
 from __future__ import annotations
@@ -55,13 +56,17 @@ def main(argv: list[str] | None = None) -> int:
     bound = np.array([r["verified"]["tour_bound"] for r in v])
     plan = np.array([r["verified"].get("tour_planned", np.nan) for r in v])
     status = Counter((r.get("verified") or {}).get("status", "-") for r in both)
+    mid = np.array([r["verified"].get("middles_cost", 0.0) for r in v])
+    probes = np.mean([r["verified"].get("middles_probed", 0) for r in v])
     print("| episodes | statuses | mean path cost, none | mean path cost, verified | ratio | verification's cost | "
-          "its lower bound | cost / bound (median) | tour planned | cost / planned (median) |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
+          "its lower bound | cost / bound (median) | tour planned | cost / planned (median) | faces' middles: "
+          "probes, cost | cost less the middles / bound (median) |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     print(f"| {len(both)} | {', '.join(f'{k} {n}' for k, n in status.most_common())} | {c0:.2f} | {c1:.2f} | "
           f"{c1 / c0:.2f}× | {cost.mean():.2f} | {bound.mean():.2f} | {cost.mean() / bound.mean():.2f}× "
           f"({np.median(cost / bound):.2f}) | {np.nanmean(plan):.2f} | {cost.mean() / np.nanmean(plan):.2f}× "
-          f"({np.nanmedian(cost / plan):.2f}) |")
+          f"({np.nanmedian(cost / plan):.2f}) | {probes:.1f}, {mid.mean():.2f} | "
+          f"{(cost - mid).mean() / bound.mean():.2f}× ({np.median((cost - mid) / bound):.2f}) |")
     done = np.array([r["verified"]["status"] == "confirmed" for r in v])
     below = int(np.sum(done & (cost < bound - 1e-6)))
     print(f"\nconfirmed episodes below their bound (which is for measuring every vertex): {below} of {int(done.sum())}")

@@ -40,3 +40,20 @@ def test_a_file_that_is_not_a_record_is_one_line_of_error(tmp_path):
     bad.write_text("not json\n")
     run = _report(bad, bad)
     assert run.returncode == 2 and run.stderr.startswith("error: ") and "Traceback" not in run.stderr
+
+
+def test_the_report_splits_off_the_faces_middles(tmp_path):
+    recs = {}
+    for mode in ("none", "full"):
+        rs = [run_episode(EpisodeSpec(model="BOX01", seed=s, verify=mode, moves="all")).to_json() for s in (1, 2)]
+        recs[mode] = rs
+        (tmp_path / f"{mode}.jsonl").write_text("".join(json.dumps(r) + "\n" for r in rs))
+    run = _report(tmp_path / "none.jsonl", tmp_path / "full.jsonl")
+    assert run.returncode == 0, run.stderr
+    row = run.stdout.splitlines()[2].split("|")
+    full = [r["verified"] for r in recs["full"]]
+    probes = sum(v.get("middles_probed", 0) for v in full) / 2
+    middles = sum(v.get("middles_cost", 0.0) for v in full) / 2
+    assert probes > 0 and row[11].strip() == f"{probes:.1f}, {middles:.2f}"
+    rest = sum(v["cost"] - v.get("middles_cost", 0.0) for v in full) / sum(v["tour_bound"] for v in full)
+    assert row[12].strip().startswith(f"{rest:.2f}×")

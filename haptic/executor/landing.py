@@ -16,7 +16,7 @@ import numpy as np
 from haptic.executor.primitives import PrimitiveResult
 from haptic.executor.segment import FaceFit, normal_turn_rate
 from haptic.executor.workspace import landing_points
-from haptic.geometry.se3 import perpendicular
+from haptic.geometry.se3 import perpendicular, unit
 from haptic.matching.trace import ContactTrace
 from haptic.planning.moves import Move, MoveResult, SensorState
 from haptic.sim.scene import TABLE_TOP_Z
@@ -122,8 +122,7 @@ class LandingSearch:
                 trace = ContactTrace.concatenate([r.trace for r in legs])
                 if not self.on_one_face(trace):
                     return None, trace  # the pad rolled on an edge or a vertex: land again elsewhere
-                fit = self.segmenter.fit_face_trace(trace, legs[-1].info["face_normal"], two_d=True)
-                return fit, trace
+                return self.segmenter.fit_face_trace(trace, self.stroke_normal(trace), two_d=True), trace
             if legs[-1].status == "unstable":
                 return None, ContactTrace.concatenate([])
             # met an edge: back off the way it came and turn
@@ -138,6 +137,16 @@ class LandingSearch:
                 return None, ContactTrace.concatenate([])
             n0 = t.normal.copy()
         return None, ContactTrace.concatenate([])
+
+    @staticmethod
+    def stroke_normal(trace: ContactTrace) -> np.ndarray:
+        """The guess about which the start's face rows are picked: the median of the L stroke's sensed normals.
+        Every row lies on one face (:meth:`on_one_face`), but a landing next to the face's rim starts the L with
+        the pad on the rim, its normal turned a few degrees round the edge, and the primitive's running face
+        normal, seeded there, stays within its sample cone of it: rows picked about it were those on the rim
+        (HEXPRISM01 at 30 mm, seed 2: the face 3.1° off, 3.65 times its bound), while most rows lie on the face."""
+        ok = trace.in_contact
+        return unit(np.median(trace.normal_in_world[ok], axis=0))
 
     def on_one_face(self, trace: ContactTrace) -> bool:
         """Whether every contact row of the start's L stroke lies on one face. On a face the sensed normal does

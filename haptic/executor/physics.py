@@ -138,6 +138,10 @@ class PhysicsSettings:
     edge_reach: float = 0.03
     """An edge move starts where the pad is when it rests on one of the edge's faces within this of its line;
     farther, it returns next to the edge first [m]."""
+    ridge_offset: float = 0.002
+    """A convex edge's ridge, acquired, holds the pad's contact on the edge's line: a contact farther than this from
+    it is on another edge (one parallel to it between faces of the same normals: BOX01P's back face meets the
+    plateau's top and the lower top 12 mm apart at 60 mm) [m]."""
     vertex_hold: float = 0.05
     """At the end of an edge the pad presses in place this long before the vertex is located [s]."""
     min_vertex_rows: int = 3
@@ -244,6 +248,7 @@ class PhysicsExecutor(LandingSearch):
         """The data face the pad is known to rest on (None: not known)."""
         self._finger = finger
         self._why = ""  # detail of the last repositioning failure
+        self._stroke_blocked = False  # the last stroke on a next face met an edge along both of its legs
         self._met: PrimitiveResult | None = None  # the last crossing a link of the finger stopped
         self._links_until: float | None = None  # sim time of the last hand-link sample reported
 
@@ -521,6 +526,7 @@ class PhysicsExecutor(LandingSearch):
             along = -along
         st = t.stroke(n_b, r.info["away"], along)
         pieces.append(st)
+        self._stroke_blocked = st.ok and st.info["blocked"]
         rim = st.ok and st.info["rim"]
         fit = self.segmenter.fit_face_trace(st.trace, st.info["normal"]) if st.ok and not rim else None
         if fit is None:
@@ -616,6 +622,7 @@ class PhysicsExecutor(LandingSearch):
                 return self.failed_result(move, "unreachable", "no edge within the longest trace")
             kind = r.info["kind"]
             corner = self.contact_point()
+            self._stroke_blocked = False
             status, reason, roll, stroke, fit_b = self._cross_and_acquire(kind, r.info["face_normal"],
                                                                           r.info["direction"], pieces)  # fmt: skip
             if status == "undercut":
@@ -627,6 +634,13 @@ class PhysicsExecutor(LandingSearch):
             if status != "ok":
                 return self.failed_result(move, status, reason)
             fit_a, line, why = self._edge_between(st.face, r.trace, "face", roll, fit_b, kind, corner)
+            if line is not None and kind == "convex" and self._stroke_blocked:
+                # the next face is narrow along the edge where the pad met it: a roll round a vertex onto a face
+                # sharing only the vertex gives the same normals and contacts when the crossing is square to the
+                # line between the faces; the ridge along that line is there only over an edge
+                ridge = self._probe_ridge(line.direction, fit_a.normal, fit_b.normal, pieces)
+                if isinstance(ridge, str):
+                    line, why = None, f"no edge between the faces: {ridge}"
             if line is not None:
                 break
             shift = self._away_from_vertex(fit_a.normal, fit_b.normal, roll) if not recrossed else None
@@ -792,6 +806,13 @@ class PhysicsExecutor(LandingSearch):
         pieces.append(acq)
         if not acq.ok:
             return self.failed_result(move, acq, f"acquiring the ridge: {acq.event}")
+        off = self._line_distance(rec, self.contact_point())
+        s_acq = rec.param(self.contact_point())
+        past = max(rec.interval[0] - s_acq, s_acq - rec.interval[1], 0.0)  # the line extrapolated this far
+        slack = past * math.sin(self.bounds.bound(rec.direction_sigma, self.bounds.direction_floor))
+        if rec.convex and off > s.ridge_offset + slack:
+            return self.failed_result(move, "unreachable", f"the ridge acquired lies {off * MM:.1f} mm off the "
+                                                           "edge's line: another edge")  # fmt: skip
         s_from = rec.param(self.contact_point())
         r = t.follow_edge(u, n_a, n_b, toward_a, s.max_edge_trace)
         pieces.append(r)

@@ -675,7 +675,10 @@ class Toucher:
         failed = [p for p in pieces if not p.ok and p.event not in STOPS]
         status = failed[-1].status if failed else "ok"
         event = failed[-1].event if failed else "done"
-        return PrimitiveResult(status, event, trace, sum(p.distance for p in pieces), {"normal": n_mean, "rim": rim})
+        # both legs along the edge met another edge: the next face is narrow along it there
+        blocked = len(pieces) == 3 and all(p.ok and p.event not in ("done", *STOPS) for p in pieces[1:])
+        return PrimitiveResult(status, event, trace, sum(p.distance for p in pieces),
+                               {"normal": n_mean, "rim": rim, "blocked": blocked})  # fmt: skip
 
     def _stepped_onto_rim(self, step: PrimitiveResult) -> bool:
         """Whether a stroke's first leg, off the edge just rolled over, met another edge or turned its sensed

@@ -132,13 +132,14 @@ class SegmentBounds:
     (0.051 on bipyramid_06 at 60 mm, whose "edge" then lay 36 mm off every true edge), though less than
     :attr:`max_roll_skew`: a median beyond this many times the noise's (``0.67 √(σn² + floor²)``) is no roll over
     the edge between the faces [-]."""
-    roll_lean_sigmas: float = 3.0
+    roll_lean_sigmas: float = 2.0
     """The same on average: over a true edge the mean of ``n · e`` (signed) is the noise's mean over the rolling
     rows (σn / √n) and a systematic lean of at most the normal's floor (0.02-0.35° over 63 true edges of convex
     solids at 60-150 mm), while a roll round a vertex that follows the arc from one face's normal to the other's
     closely enough to pass the median's test still leans one way (1.1-1.5° on 4 of 6 such rolls, whose "edges" lay
-    20-50° off every true edge). A mean beyond this many times ``√(σn² / n + floor²)`` is no roll over the edge
-    between the faces [-]."""
+    20-50° off every true edge; 0.55° over 256 rows on antiprism_04 at 150 mm, its "edge" 45 bounds off, where
+    the true edges of 30 rolls on antiprisms and bipyramids at 60-150 mm leaned at most 0.34°). A mean beyond
+    this many times ``√(σn² / n + floor²)`` is no roll over the edge between the faces [-]."""
     min_skew_rows: int = 9
     """... tested with at least this many rolling contacts [-]."""
     steady_window: int = 9
@@ -295,6 +296,14 @@ def normal_turn_rate(coords: np.ndarray, normals: np.ndarray) -> float:
     return float(np.linalg.svd(sol[:-1], compute_uv=False)[0])
 
 
+def _extent(points: np.ndarray, axes: bool = False):
+    """The extent of ``points`` (k, 3) along their first two principal axes [m] (and those axes, rows of vt)."""
+    q = points - points.mean(axis=0)
+    _, _, vt = np.linalg.svd(q, full_matrices=False)
+    ext = np.ptp(q @ vt[:2].T, axis=0)
+    return (ext, vt) if axes else ext
+
+
 def angle_between(a: np.ndarray, b: np.ndarray) -> float:
     return math.acos(max(-1.0, min(1.0, float(unit(a) @ unit(b)))))
 
@@ -438,8 +447,7 @@ class Segmenter:
             return None
         tips = trace.tip_in_world[mask]
         q = tips - tips.mean(axis=0)
-        _, _, vt = np.linalg.svd(q, full_matrices=False)
-        ext = np.ptp(q @ vt[:2].T, axis=0)
+        ext, vt = _extent(tips, axes=True)
         if ext[0] < self.bounds.min_face_extent or (two_d and ext[1] < self.bounds.min_face_width):
             return None
         if normal_turn_rate(q @ vt[: 2 if ext[1] > self.bounds.two_d_extent else 1].T, trace.normal_in_world[mask]) > (
@@ -452,6 +460,10 @@ class Segmenter:
         if spread > self.bounds.max_spread_sigmas * self.bounds.normal_sigma + self.bounds.spread_slack:
             return None  # the rows do not come from one plane (a roll, a vertex)
         mask = steady_rows(trace, mask, self.bounds)
+        if two_d and _extent(trace.tip_in_world[mask])[1] < self.bounds.min_face_width:
+            # the steady rows are one leg of the L: the other's normal held elsewhere (the pad rode a rim along the
+            # first leg, its normal turned 3° round the edge), and no row measures the face across
+            return None
         return fit_face(trace.point_in_world[mask], trace.normal_in_world[mask], self.bounds)
 
     def add_face(self, fit: FaceFit, adjacent: tuple[int, ...] = ()) -> DataFace:

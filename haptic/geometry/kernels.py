@@ -101,29 +101,128 @@ def line_params(starts, directions, tri, slack):
 line_params = compile_kernel(line_params)
 
 
+def _winding_inside(x0, x1, x2, tri):
+    """Whether the point ``x`` is inside the closed surface of the triangles (T, 3, 3): the generalised winding
+    number of :meth:`~haptic.geometry.polyhedron.Polyhedron.contains`, the same arithmetic."""
+    total = 0.0
+    for k in range(tri.shape[0]):
+        a0, a1, a2 = tri[k, 0, 0] - x0, tri[k, 0, 1] - x1, tri[k, 0, 2] - x2
+        b0, b1, b2 = tri[k, 1, 0] - x0, tri[k, 1, 1] - x1, tri[k, 1, 2] - x2
+        c0, c1, c2 = tri[k, 2, 0] - x0, tri[k, 2, 1] - x1, tri[k, 2, 2] - x2
+        la = np.sqrt(a0 * a0 + a1 * a1 + a2 * a2)
+        lb = np.sqrt(b0 * b0 + b1 * b1 + b2 * b2)
+        lc = np.sqrt(c0 * c0 + c1 * c1 + c2 * c2)
+        num = a0 * (b1 * c2 - b2 * c1) + a1 * (b2 * c0 - b0 * c2) + a2 * (b0 * c1 - b1 * c0)
+        den = la * lb * lc + (a0 * b0 + a1 * b1 + a2 * b2) * lc
+        den = den + (b0 * c0 + b1 * c1 + b2 * c2) * la + (c0 * a0 + c1 * a1 + c2 * a2) * lb
+        total += np.arctan2(num, den)
+    return 2.0 * total / (4.0 * np.pi) > 0.5
+
+
+_winding_inside = compile_kernel(_winding_inside)
+
+
 def contains(points, tri):
     """:meth:`~haptic.geometry.polyhedron.Polyhedron.contains`, the same generalised winding number: whether each
     point (P, 3) is inside the closed surface of the triangles (T, 3, 3), (P,) bool."""
-    n_p, n_t = points.shape[0], tri.shape[0]
-    out = np.zeros(n_p, np.bool_)
-    for i in range(n_p):
-        total = 0.0
-        for k in range(n_t):
-            a0, a1, a2 = tri[k, 0, 0] - points[i, 0], tri[k, 0, 1] - points[i, 1], tri[k, 0, 2] - points[i, 2]
-            b0, b1, b2 = tri[k, 1, 0] - points[i, 0], tri[k, 1, 1] - points[i, 1], tri[k, 1, 2] - points[i, 2]
-            c0, c1, c2 = tri[k, 2, 0] - points[i, 0], tri[k, 2, 1] - points[i, 1], tri[k, 2, 2] - points[i, 2]
-            la = np.sqrt(a0 * a0 + a1 * a1 + a2 * a2)
-            lb = np.sqrt(b0 * b0 + b1 * b1 + b2 * b2)
-            lc = np.sqrt(c0 * c0 + c1 * c1 + c2 * c2)
-            num = a0 * (b1 * c2 - b2 * c1) + a1 * (b2 * c0 - b0 * c2) + a2 * (b0 * c1 - b1 * c0)
-            den = la * lb * lc + (a0 * b0 + a1 * b1 + a2 * b2) * lc
-            den = den + (b0 * c0 + b1 * c1 + b2 * c2) * la + (c0 * a0 + c1 * a1 + c2 * a2) * lb
-            total += np.arctan2(num, den)
-        out[i] = 2.0 * total / (4.0 * np.pi) > 0.5
+    out = np.zeros(points.shape[0], np.bool_)
+    for i in range(points.shape[0]):
+        out[i] = _winding_inside(points[i, 0], points[i, 1], points[i, 2], tri)
     return out
 
 
 contains = compile_kernel(contains)
 
 
-__all__ = ["COMPILED", "compile_kernel", "contains", "face_crossing", "line_params"]
+def inside_samples(starts, directions, lengths, tri, slack, n_samples, crossing_slack):
+    """:func:`~haptic.geometry.raycast.sample_inside_many` of every segment ``start + t u``, ``0 ≤ t ≤ length``
+    (R of them) at once, the same arithmetic: the crossings with the triangles (T, 3, 3) (:func:`line_params`), the
+    segment cut at them, the pieces whose midpoints are inside (touching pieces joined), ``n_samples`` points across
+    each (``np.linspace``'s formula) with the bound on their depth. Returns the points (P, 3), their bounds (P,) and
+    the segment of each (P,)."""
+    params = line_params(starts, directions, tri, slack)
+    n_r, n_t = params.shape
+    size = n_r * (n_t + 1) * n_samples
+    pts = np.empty((size, 3))
+    upper = np.empty(size)
+    owner = np.empty(size, np.int64)
+    at = 0
+    ts = np.empty(n_t)
+    cuts = np.empty(n_t + 2)
+    span_lo = np.empty(n_t + 1)
+    span_hi = np.empty(n_t + 1)
+    div = n_samples - 1
+    for r in range(n_r):
+        length = lengths[r]
+        n = 0
+        for k in range(n_t):
+            t = params[r, k]
+            if np.isfinite(t):
+                ts[n] = t
+                n += 1
+        # the cuts: 0, every crossing clipped to the segment, its length; sorted, repeats dropped (np.unique)
+        cuts[0] = 0.0
+        for j in range(n):
+            cuts[j + 1] = min(max(ts[j], 0.0), length)
+        cuts[n + 1] = length
+        m = n + 2
+        for i in range(1, m):
+            x = cuts[i]
+            j = i - 1
+            while j >= 0 and cuts[j] > x:
+                cuts[j + 1] = cuts[j]
+                j -= 1
+            cuts[j + 1] = x
+        u = 1
+        for i in range(1, m):
+            if cuts[i] != cuts[u - 1]:
+                cuts[u] = cuts[i]
+                u += 1
+        n_spans = 0
+        for j in range(u - 1):
+            lo, hi = cuts[j], cuts[j + 1]
+            mid = 0.5 * (lo + hi)
+            inside = _winding_inside(starts[r, 0] + mid * directions[r, 0], starts[r, 1] + mid * directions[r, 1],
+                                     starts[r, 2] + mid * directions[r, 2], tri)
+            if not inside or hi <= lo:
+                continue
+            if n_spans > 0 and abs(span_hi[n_spans - 1] - lo) < 1e-12:
+                span_hi[n_spans - 1] = hi
+            else:
+                span_lo[n_spans] = lo
+                span_hi[n_spans] = hi
+                n_spans += 1
+        for j in range(n_spans):
+            lo, hi = span_lo[j], span_hi[j]
+            lo_crosses, hi_crosses = False, False
+            for i in range(n):
+                if ts[i] >= 0.0 and ts[i] <= length:
+                    lo_crosses = lo_crosses or ts[i] == lo
+                    hi_crosses = hi_crosses or ts[i] == hi
+            delta = hi - lo
+            step = delta / div
+            for i in range(n_samples):
+                if i == div:
+                    t = hi
+                elif step == 0:
+                    t = (i / div) * delta + lo
+                else:
+                    t = i * step + lo
+                bound = np.inf
+                if lo_crosses:
+                    bound = min(bound, t - lo)
+                if hi_crosses:
+                    bound = min(bound, hi - t)
+                pts[at, 0] = starts[r, 0] + t * directions[r, 0]
+                pts[at, 1] = starts[r, 1] + t * directions[r, 1]
+                pts[at, 2] = starts[r, 2] + t * directions[r, 2]
+                upper[at] = bound + crossing_slack
+                owner[at] = r
+                at += 1
+    return pts[:at], upper[:at], owner[:at]
+
+
+inside_samples = compile_kernel(inside_samples)
+
+
+__all__ = ["COMPILED", "compile_kernel", "contains", "face_crossing", "inside_samples", "line_params"]

@@ -349,20 +349,33 @@ OWN_BOUNDS_LEAVES = 64
 def own_bounds_keep(tree, k_sigma: float | None = None) -> np.ndarray | None:
     """Which interpretations of ``tree`` (:class:`~haptic.matching.tree.InterpretationTree`) pass the pose check
     (:func:`pose_check`) and the acceptance test (:func:`acceptance`, σ = bound / ``k_sigma``) with their own
-    model's bounds, shape (N,) bool; None when there is nothing to tell: the library holds no learned model, one
-    model is left, or more than :data:`OWN_BOUNDS_LEAVES` interpretations.
+    model's bounds, and whose model the data do not find far less likely than another's, shape (N,) bool; None when
+    there is nothing to tell: the library holds no learned model, one interpretation is left, or more than
+    :data:`OWN_BOUNDS_LEAVES` interpretations.
 
     With a learned model in the library the tree widens every data component by the learned models' bounds
     (:func:`~haptic.matching.tree.learned_widening`), for every model at once: an object a few millimetres from a
     library model, learned, then keeps both the learned model's interpretation and its source's, which the tree's
-    tests no longer tell apart and no move would. The pose check and the acceptance test hold each model to its
+    tests no longer tell apart and no move would; so are two poses of one learned model a few millimetres from
+    symmetric (PYR01 with a corner of its base moved 2 mm, learned, kept at a half turn of the pose that fits it,
+    whose statistic was 434 against a threshold of 287). The pose check and the acceptance test hold each model to its
     own bounds (none added for an exact model); an interpretation that fails them is no interpretation of the
     data, as when it is the last one left (the verification's mismatch or rejection). A leaf whose pose the data
-    do not fix yet is kept."""
+    do not fix yet is kept.
+
+    Two models that both pass may still differ within their bounds (a learned model and the library model it is
+    2 mm from at one vertex, each learned model's features known to the data's bounds only): the data then tell
+    them apart by how well each fits, not by any one residual. Each kept interpretation's acceptance statistic is
+    taken again with the same bounds for every model (the tree's widening, :attr:`~InterpretationTree.widen`), at
+    which the statistics' difference is twice the log of the models' likelihood ratio under the noise model; a model
+    whose best statistic exceeds the best model's by more than :data:`LIKELIHOOD_GAP` (the data
+    ``1 / ACCEPT_ALPHA`` times less likely under it), over the same quantities, is dropped."""
     k_sigma = K_SIGMA if k_sigma is None else k_sigma
-    if tree.widen is None or tree.count > OWN_BOUNDS_LEAVES or len(tree.models_alive()) < 2:
+    if tree.widen is None or tree.count > OWN_BOUNDS_LEAVES or tree.count < 2:
         return None
     keep = np.ones(tree.count, dtype=bool)
+    common = np.full(tree.count, np.inf)
+    dof = np.full(tree.count, -1)
     poses = tree.poses(range(tree.count), refine=True)
     data = tree.data
     for i, pose in enumerate(poses):
@@ -370,14 +383,30 @@ def own_bounds_keep(tree, k_sigma: float | None = None) -> np.ndarray | None:
             it = tree.interpretation(i, with_pose=True, refine=True)
             chk = pose_check(it.model, data, it)
             # the test at the least-squares pose, or at the pose slid along what the data leave free
-            keep[i] = chk.ok and any(acceptance(it.model, data, it, p, k_sigma=k_sigma).ok
-                                     for p in dict.fromkeys((pose, chk.world_from_model)))
+            at = tuple(dict.fromkeys((pose, chk.world_from_model)))
+            keep[i] = chk.ok and any(acceptance(it.model, data, it, p, k_sigma=k_sigma).ok for p in at)
+            if keep[i]:
+                same = [acceptance(it.model, data, it, p, k_sigma=k_sigma, model_bounds=tree.widen) for p in at]
+                common[i], dof[i] = min(a.statistic for a in same), same[0].dof
+    posed = np.isfinite(common)
+    if posed.any():
+        best = int(np.argmin(common))
+        models = tree.model_indices
+        for m in np.unique(models[posed]):
+            mine = posed & (models == m)
+            if m == models[best] or (dof[mine] != dof[best]).any():
+                continue
+            if common[mine].min() > common[best] + LIKELIHOOD_GAP:
+                keep[mine] = False
     return keep
 
 
 ACCEPT_ALPHA = 1e-3
 """False-alarm probability of the acceptance test (:func:`acceptance`) on an object that is the model, under the
 noise model: the chance that a true recognition is turned away as no-match."""
+LIKELIHOOD_GAP = 2.0 * float(np.log(1.0 / ACCEPT_ALPHA))
+"""How much larger one model's acceptance statistic may be than another's, both at the same bounds, before
+:func:`own_bounds_keep` drops it: twice the log of a likelihood ratio of ``1 / ACCEPT_ALPHA`` (13.8)."""
 K_SIGMA = SensorNoise.k
 """A component's error bound is this many standard deviations (:class:`~haptic.matching.components.SensorNoise`
 ``k``): the acceptance test's σ of a residual is its bound over ``K_SIGMA``."""
@@ -411,6 +440,7 @@ def acceptance(
     alpha: float = ACCEPT_ALPHA,
     k_sigma: float = K_SIGMA,
     table_z: float | None = None,
+    model_bounds: LearnedBounds | None = None,
 ) -> Acceptance:
     """The statistical acceptance test of a fitted pose (after Grimson & Huttenlocher 1989: a threshold from the
     noise model and the number of measured features, not an ad-hoc fraction).
@@ -430,11 +460,15 @@ def acceptance(
     fitted model's lowest point is one more quantity (1 dimension), its σ that of the data's median position
     bound (the fitted pose is off by about the noise of the data it is fitted to). An object that differs from the
     model in height alone (a tetrahedron 3 % smaller, whose measured side faces all pass through the apex) fits the
-    measured features at a pose that sinks the model into the table or lifts it off."""
+    measured features at a pose that sinks the model into the table or lifts it off.
+
+    ``model_bounds``: how far the model's features are taken to be off (default: the model's own,
+    :func:`_model_bounds`); two models' statistics at the same bounds compare as their likelihoods do
+    (:func:`own_bounds_keep`)."""
     from scipy.stats import chi2
 
     inv = world_from_model.inverse()
-    mb = _model_bounds(model)
+    mb = _model_bounds(model) if model_bounds is None else model_bounds
     total, dims = 0.0, 0
     for i, f in it.faces.items():
         c = data[i]

@@ -23,14 +23,22 @@ The pose error margin is the matcher's own tolerance for "the same pose"
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
+from haptic.geometry import kernels as geometry_kernels
 from haptic.geometry.distance import surface_distance
 from haptic.geometry.polyhedron import Polyhedron
-from haptic.geometry.raycast import depth_samples, sample_inside_many
+from haptic.geometry.raycast import (
+    BARYCENTRIC_SLACK,
+    CROSSING_SLACK,
+    DEPTH_SAMPLES,
+    depth_samples,
+    sample_inside_many,
+)
 from haptic.geometry.se3 import SE3
 from haptic.matching import kernels
 from haptic.matching.acceptance import leaf_pose_check
@@ -132,7 +140,23 @@ def free_segments_consistent(
     inv = world_from_model.inverse()
     starts = inv.apply(np.array([seg.start for seg in free]))
     dirs = inv.rotate(np.array([seg.direction for seg in free]))
-    samples = sample_inside_many(model, starts, dirs, np.array([seg.length for seg in free]))
+    lengths = np.array([seg.length for seg in free])
+    if kernels.COMPILED:  # every segment's samples from one kernel, their margins in one array operation
+        tri = _triangles(model)
+        pts_m, upper, owner = geometry_kernels.inside_samples(
+            starts, dirs, lengths, tri, BARYCENTRIC_SLACK, DEPTH_SAMPLES, CROSSING_SLACK
+        )
+        if not len(pts_m):
+            return True
+        c_w = world_from_model.apply(model.centroid)
+        r = np.linalg.norm(world_from_model.apply(pts_m) - c_w, axis=1)
+        margin = np.array([seg.position_bound for seg in free])[owner] + tol.distance + tol.angle * r
+        need = upper > margin
+        if not need.any():
+            return True
+        depth = kernels.surface_distance(np.ascontiguousarray(pts_m[need]), tri)
+        return bool((depth <= margin[need]).all())
+    samples = sample_inside_many(model, starts, dirs, lengths)
     points, margins = [], []
     for seg, (pts_m, upper) in zip(free, samples, strict=True):
         if not len(pts_m):
@@ -144,12 +168,18 @@ def free_segments_consistent(
             margins.append(margin[need])
     if not points:
         return True
-    if kernels.COMPILED:
-        tri = np.ascontiguousarray(model.vertices[model.triangles], float)
-        depth = kernels.surface_distance(np.ascontiguousarray(np.concatenate(points), float), tri)
-    else:
-        depth = surface_distance(model, np.concatenate(points))
-    return bool((depth <= np.concatenate(margins)).all())
+    return bool((surface_distance(model, np.concatenate(points)) <= np.concatenate(margins)).all())
+
+
+_TRIANGLES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _triangles(model: Polyhedron) -> np.ndarray:
+    """The model's triangles' corners, shape (T, 3, 3), contiguous (computed once per model)."""
+    tri = _TRIANGLES.get(model)
+    if tri is None:
+        tri = _TRIANGLES[model] = np.ascontiguousarray(model.vertices[model.triangles], float)
+    return tri
 
 
 def consistent_leaves(
@@ -183,7 +213,17 @@ def consistent_leaves(
         if hits & set(it.faces) and not leaf_pose_check(tree, leaf).ok:
             keep[leaf] = False
             continue
-        keep[leaf] = free_segments_consistent(it.model, pose, free, tol)
+        # the segments this leaf was found clear of at this pose (the memo is cleared when the data change): a miss
+        # adds a segment and no component, and only the new segments need testing
+        key = ("free segments", leaf)
+        done, done_tol = tree.leaf_memo.get(key, ((), None))
+        if done_tol != tol or len(done) > len(free) or any(
+            a is not b for a, b in zip(done, free[: len(done)], strict=True)
+        ):
+            done = ()
+        keep[leaf] = free_segments_consistent(it.model, pose, free[len(done) :], tol)
+        if keep[leaf]:
+            tree.leaf_memo[key] = (tuple(free), tol)
     return keep
 
 

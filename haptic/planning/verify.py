@@ -25,12 +25,13 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 
 from haptic.geometry.polyhedron import Polyhedron
+from haptic.geometry.raycast import line_hits
 from haptic.geometry.se3 import SE3
 from haptic.matching.acceptance import TablePin
 from haptic.matching.components import DataComponent, DataEdge, DataFace, SensorNoise
 from haptic.planning.config import PlannerConfig
 from haptic.planning.hypothesis import Hypothesis
-from haptic.planning.moves import EdgeMove, FaceMove, Move, SensorState
+from haptic.planning.moves import EdgeMove, FaceMove, Move, ProbeMove, SensorState
 from haptic.planning.predict import candidate_moves, predict_moves
 from haptic.planning.table import _inward, descent_risk, hidden_concave_end
 from haptic.planning.tour import (
@@ -409,6 +410,40 @@ def verification_probes(
                                                              probed, faces_ok)]  # fmt: skip
 
 
+VERIFY_STANDOFF = 0.01
+"""A verification probe's line starts this far before where it meets the recognised model at its fitted pose [m]
+(:func:`close_start`), not before the sphere round the model as the recognition's lines do (several hypotheses,
+any of which may be the object): with one pose left, free space farther out tells nothing, and a probe at a face's
+middle (a box's top, 30 mm in from a sphere of 71 mm radius) travelled 4-5 cm more to start there and back. An
+object that is not the model and reaches this far beyond it along the line starts the line inside it: the
+executor reports it unreachable, and the verification goes on without probes from there."""
+
+
+def close_start(h: Hypothesis, move: ProbeMove, standoff: float = VERIFY_STANDOFF) -> ProbeMove:
+    """``move`` started ``standoff`` before its first contact with hypothesis ``h``'s posed model (its end kept);
+    ``move`` itself when the line meets the model nearer its start than that, or not at all."""
+    u = np.asarray(move.direction, float)
+    start = np.asarray(move.start, float)
+    hit = line_hits(h.poly, h.model_from_world.apply(start)[None], h.model_from_world.rotate(u)[None])
+    t = float(hit.first[0])
+    if not np.isfinite(t) or t <= standoff:
+        return move
+    cut = t - standoff
+    return ProbeMove(start + cut * u, u, float(move.length) - cut)
+
+
+def same_line(a: Move, b: Move) -> bool:
+    """Whether probes ``a`` and ``b`` run along nearly one line (directions within ~8°, the lines within a probe
+    target's spacing of each other), wherever they start; False for other moves."""
+    from haptic.planning.probe_lines import ProbeConfig
+
+    if a.kind != "probe" or b.kind != "probe" or float(np.dot(a.direction, b.direction)) <= 0.99:
+        return False
+    d = np.asarray(b.start, float) - np.asarray(a.start, float)
+    u = np.asarray(a.direction, float)
+    return float(np.linalg.norm(d - (d @ u) * u)) < ProbeConfig.target_spacing
+
+
 LANDS_NEAR = 2 * PROBE_INSET
 """A verification probe *lands near* what it is for when its predicted contact is within this of a missing vertex or
 edge, or on a missing face [m]."""
@@ -422,7 +457,7 @@ def _verification_probes(
     """:func:`verification_probes`, each with whether it lands near what is missing (:data:`LANDS_NEAR`): the
     target on a face beside a vertex lies far from it where the face's corner there is narrow, and a line aimed at
     a point may meet the face elsewhere, past what hides the point."""
-    from haptic.planning.move_scores import Context, predict_probe_moves, probe_config, same_move
+    from haptic.planning.move_scores import Context, predict_probe_moves, probe_config
     from haptic.planning.probe_lines import aimed_probes
 
     no_probes = config.moves == "tracing" or config.table_z is not None  # the hand verifies by tracing
@@ -432,8 +467,8 @@ def _verification_probes(
     targets = [(p, f) for p, f in _probe_targets(h.poly, missing, faces_ok)
                if float(np.linalg.norm(p - here)) >= MIN_PROBE_TRANSFER]  # fmt: skip
     targets.sort(key=lambda pf: float(np.linalg.norm(pf[0] - here)))
-    lines = [(mv, targets[k]) for mv, k in aimed_probes(h, targets, probe_config(config))
-             if not any(same_move(mv, done) for done in probed)][:MAX_VERIFY_PROBES]  # fmt: skip
+    lines = [(close_start(h, mv), targets[k]) for mv, k in aimed_probes(h, targets, probe_config(config))
+             if not any(same_line(mv, done) for done in probed)][:MAX_VERIFY_PROBES]  # fmt: skip
     preds = predict_probe_moves(Context((h,), state, components, noise, config), [mv for mv, _ in lines])
     poly = h.poly
     mf, me, mv = missing
@@ -621,10 +656,21 @@ MIDDLE_REACH = 5e-3
 lies on the face's plane within this of it [m] (:func:`unmeasured_middles`)."""
 
 
+_MIDDLES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
 def face_middle(poly: Polyhedron, f: int) -> np.ndarray:
     """The middle of face ``f`` (model frame): the mean of its vertices when that lies on the face at least
     :data:`PROBE_INSET` from its boundary, else whichever of it and the face's triangles' centroids lies on the face
-    farthest from its boundary (a face that is not convex)."""
+    farthest from its boundary (a face that is not convex). Computed once per model and face."""
+    middles = _MIDDLES.setdefault(poly, {})
+    if f not in middles:
+        middles[f] = _face_middle(poly, f)
+        middles[f].flags.writeable = False
+    return middles[f]
+
+
+def _face_middle(poly: Polyhedron, f: int) -> np.ndarray:
     from haptic.geometry.distance import point_triangle_distance
 
     loop = poly.vertices[list(poly.faces[f])]
@@ -794,7 +840,7 @@ class Verifier:
     def _middle_probe(self, h: Hypothesis, state: SensorState, components: Mapping[int, DataComponent],
                       avoid: Sequence[Move], probed: Sequence[Move]) -> Move | None:
         """A probe at the middle of the next face of :attr:`middles` predicted to land on it (None: none left)."""
-        from haptic.planning.move_scores import Context, predict_probe_moves, probe_config, same_move
+        from haptic.planning.move_scores import Context, predict_probe_moves, probe_config
         from haptic.planning.probe_lines import aimed_probes
 
         if any(m.kind == "probe" for m in avoid):  # no probe from here: the faces left are not probed
@@ -802,16 +848,23 @@ class Verifier:
             self._middles_tried.update(self.middles)
             self.middles = []
             return None
-        while self.middles:
-            f = self.middles.pop(0)
-            self._middles_tried.add(f)
-            lines = [mv for mv, _ in aimed_probes(h, [(face_middle(h.poly, f), f)], probe_config(self.config))
-                     if not any(same_move(mv, done) for done in probed)]  # fmt: skip
-            for pred in predict_probe_moves(Context((h,), state, components, self.noise, self.config), lines):
-                if bool(pred.hit[0]) and int(pred.face[0]) == f and pred.risk() == 0.0:
-                    return pred.move
-            self.middles_unprobed.add(f)
-        return None
+        # the cheapest of the middles left next (a tour of them by nearest neighbour): in the faces' order the
+        # probes crossed the object back and forth
+        targets = [(face_middle(h.poly, f), f) for f in self.middles]
+        lines = [(close_start(h, mv), targets[k][1]) for mv, k in aimed_probes(h, targets, probe_config(self.config))
+                 if not any(same_line(mv, done) for done in probed)]  # fmt: skip
+        preds = predict_probe_moves(Context((h,), state, components, self.noise, self.config), [m for m, _ in lines])
+        good = sorted(((float(p.costs[0]), k) for k, p in enumerate(preds)
+                       if bool(p.hit[0]) and int(p.face[0]) == lines[k][1] and p.risk() == 0.0))  # fmt: skip
+        if not good:
+            self.middles_unprobed.update(self.middles)
+            self._middles_tried.update(self.middles)
+            self.middles = []
+            return None
+        f = lines[good[0][1]][1]
+        self._middles_tried.add(f)
+        self.middles.remove(f)
+        return preds[good[0][1]].move
 
     def move_budget(self) -> int:
         """The verification moves this verification may make (:func:`verify_move_budget` of the recognised

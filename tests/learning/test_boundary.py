@@ -124,5 +124,5 @@ def test_the_matcher_widens_the_data_bounds_by_a_learned_models():
     tree.add(face)
     assert tree.widen is not None
     assert tree.data[0] is face  # the data as reported
-    assert tree._data.items[0].normal_bound == pytest.approx(np.hypot(0.01, 0.01))
+    assert tree._data.items[0].normal_bound == pytest.approx(0.02)  # angles outright, as the tests add them
     assert tree._data.items[0].position_bound == pytest.approx(0.001)

@@ -319,6 +319,52 @@ def test_line_crossings_and_inside_tests_are_the_numpy_forms():
     assert 20 < inside.sum() < 480  # both verdicts
 
 
+def test_inside_samples_are_the_numpy_forms(monkeypatch):
+    """Segments through a non-convex model (some ending inside it, some through its vertices, some of length 0): the
+    compiled samples of the free-space test, with their depth bounds, are
+    :func:`~haptic.geometry.raycast.sample_inside_many`'s numpy form's, bit for bit, and so is the verdict of
+    :func:`~haptic.matching.free_space.free_segments_consistent` on a posed model."""
+    from haptic.geometry import load_library
+    from haptic.geometry.raycast import BARYCENTRIC_SLACK, CROSSING_SLACK, DEPTH_SAMPLES, sample_inside_many
+    from haptic.geometry.se3 import SE3
+    from haptic.matching import free_space
+    from haptic.matching.free_space import FreeSegment, free_segments_consistent
+
+    poly = load_library()["LBLOCK01"]
+    tri = np.ascontiguousarray(poly.vertices[poly.triangles])
+    rng = np.random.default_rng(9)
+    centre, size = poly.vertices.mean(axis=0), float(np.ptp(poly.vertices, axis=0).max())
+    starts = centre + rng.normal(size=(200, 3)) * size
+    aims = poly.vertices[rng.integers(0, len(poly.vertices), 200)]
+    aims[::2] += rng.normal(size=(100, 3)) * size * 0.2
+    dirs = aims - starts
+    lengths = np.linalg.norm(dirs, axis=1) * rng.uniform(0.5, 2.0, 200)
+    lengths[::17] = 0.0
+    dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
+    pts, upper, owner = geometry_kernels.inside_samples(starts, dirs, lengths, tri, BARYCENTRIC_SLACK, DEPTH_SAMPLES,
+                                                        CROSSING_SLACK)  # fmt: skip
+    for compiled in (True, False):  # the crossings compiled (the same bits), or numpy's (the same to the rounding)
+        monkeypatch.setattr(geometry_kernels, "COMPILED", compiled)
+        want = sample_inside_many(poly, starts, dirs, lengths)
+        monkeypatch.undo()
+        np.testing.assert_array_equal(owner, np.repeat(np.arange(200), [len(p) for p, _ in want]))
+        check = np.testing.assert_array_equal if compiled else np.testing.assert_allclose
+        check(pts, np.concatenate([p for p, _ in want]), **({} if compiled else {"rtol": 1e-9, "atol": 1e-12}))
+        check(upper, np.concatenate([u for _, u in want]), **({} if compiled else {"rtol": 1e-9, "atol": 1e-12}))
+    assert len(pts) > 300 and np.isfinite(upper).sum() > 100
+    pose = SE3.random(rng, 0.1)
+    tol = PoseTolerance(np.deg2rad(3.0), 3e-3)
+    verdicts = []
+    for k in range(0, 200, 5):
+        segs = [FreeSegment(pose.apply(starts[j]), pose.rotate(dirs[j]), lengths[j], 1e-3) for j in range(k, k + 5)]
+        monkeypatch.setattr(free_space.kernels, "COMPILED", False)
+        reference = free_segments_consistent(poly, pose, segs, tol)
+        monkeypatch.undo()
+        assert free_segments_consistent(poly, pose, segs, tol) == reference
+        verdicts.append(reference)
+    assert 0 < sum(verdicts) < len(verdicts)  # both verdicts
+
+
 def test_face_move_predictions_are_the_numpy_forms(small_library, monkeypatch):
     """The face moves' predicted outcomes, costs and clearances in every hypothesis of decisions of some episodes:
     the compiled predictions are :func:`~haptic.planning.predict.face_outcomes`'s numpy form's, where each hypothesis
