@@ -154,6 +154,8 @@ class _Closing:
         self.limits = [mink.ConfigurationLimit(self.model)]
         self.index = {f.finger: FINGERS.index(f.finger) for f in move.fingers}
         self.rows: dict[str, list[tuple]] = {f.finger: [] for f in move.fingers}
+        self.rows.setdefault(ex.toucher.finger, [])  # the exploring fingertip's path too, for the move's trace
+        self.index.setdefault(ex.toucher.finger, FINGERS.index(ex.toucher.finger))
         self.ticks = 0
         self.posture = self.q_now()
 
@@ -482,7 +484,7 @@ def _place(ex: PhysicsExecutor, move: PlacementMove, c: _Closing, starts: np.nda
         elif status[name] != "missed":
             info["reason"] = reason[name]
         fingers.append(info)
-    pieces.append(PrimitiveResult("ok", "done", closing[names[0]], 0.0))
+    pieces.append(PrimitiveResult("ok", "done", c.trace(ex.toucher.finger), 0.0))  # the exploring pad's way
     if not comps and not any(i["status"] == "missed" for i in fingers):
         why = "; ".join(f"{i['finger']}: {i.get('reason', i['status'])}" for i in fingers)
         return MoveResult(move=move, status="unreachable", state=ex.state, reason=f"no finger measured: {why}",

@@ -152,3 +152,36 @@ def test_the_planner_predicts_what_the_ideal_sensor_does_with_a_placement():
             assert touched == [bool(q.hit[i]) for q in p.lines]
             assert [ex.truth[c.id][1] for c in res.components] == [int(q.face[i]) for q in p.lines if q.hit[i]]
             assert res.cost == pytest.approx(p.costs[i], abs=1e-6)
+
+
+def test_with_a_reach_test_only_a_placement_it_reaches_is_offered_with_its_fingers():
+    """``PlannerConfig.placement_reach``: asked for the best placements (beating every other candidate, here all of
+    them: ``beat`` at -inf), most efficient first; the first it reaches is the one offered, with the fingers it
+    gives; none when it reaches none."""
+    from dataclasses import replace
+
+    from haptic.planning.move_scores import score_placements
+
+    ctx = _context(["BOX01", "WEDGE01", "PYR01", "BOX01N"], fingers=2)
+    weights = class_weights([h.model for h in ctx.hypotheses])
+    free = score_placements(ctx, weights)
+    assert len(free) > 1
+    asked: list[PlacementMove] = []
+
+    def swap(move, hypotheses):
+        asked.append(move)
+        assert hypotheses[0] is ctx.hypotheses[int(np.argmax(weights))]
+        if len(asked) < 2:
+            return None
+        return PlacementMove(tuple(replace(f, finger=n) for f, n in zip(move.fingers, ("thumb", "ring"),
+                                                                           strict=False)))  # fmt: skip
+
+    reach_ctx = replace(ctx, config=replace(ctx.config, placement_reach=swap))
+    (offered,) = score_placements(reach_ctx, weights)
+    best = sorted(free, key=lambda c: -c[1])
+    assert [m.fingers[0].start.tolist() for m in asked] == [c[0].move.fingers[0].start.tolist() for c in best[:2]]
+    assert [f.finger for f in offered[0].move.fingers] == ["thumb", "ring"]
+    assert offered[1:] == best[1][1:]  # scored as before
+    nothing = replace(ctx, config=replace(ctx.config, placement_reach=lambda m, h: None))
+    assert score_placements(nothing, weights) == []
+    assert score_placements(reach_ctx, weights, beat=(np.inf, np.inf)) == []  # nothing beats the best other move
