@@ -121,11 +121,11 @@ class RandomPolicy(Policy):
 
 
 def _further(ctx: Context, cands: Sequence[Scored], rng: np.random.Generator, depth: int) -> Move:
+    if ctx.config.moves == "probing":  # the look-ahead simulates tracing moves only; a probe measures no vertex
+        return _cheapest_exploring(cands, rng)
     move = disagreement_move(ctx)  # look-alikes: only where they disagree tells them apart
     if move is not None:
         return move
-    if ctx.config.moves == "probing":  # the look-ahead simulates tracing moves only
-        return _cheapest_exploring(cands, rng)
     for d in range(2, depth + 1):
         move = lookahead_choice(ctx, depth=d)
         if move is not None:
