@@ -625,7 +625,8 @@ def _start_costs(h: Hypothesis, state: SensorState, table: StartCosts) -> np.nda
     """:func:`~haptic.planning.tour.start_costs` of the targets of ``table`` (sorted feature indices) from the sensor
     in ``state``, in hypothesis ``h``'s world."""
     edge = h.edges.get(state.edge) if state.edge is not None else None
-    return table(h.model_from_world.apply(state.position), h.faces.get(state.face), edge)
+    vertex = h.vertices.get(state.vertex) if state.vertex is not None else None
+    return table(h.model_from_world.apply(state.position), h.faces.get(state.face), edge, vertex)
 
 
 def _entries(
