@@ -594,13 +594,18 @@ def middle_probe_cost(poly: Polyhedron, config: PlannerConfig) -> float:
 
 
 def _passed_middles(h: Hypothesis, state: SensorState, end: SensorState, middles: Mapping[int, np.ndarray]) -> int:
-    """How many of ``middles`` (model frame) lie within :data:`MIDDLE_REACH` of the straight way from ``state`` to
-    ``end`` in hypothesis ``h``'s world."""
+    """How many of ``middles`` (model face -> its middle, model frame) lie within :data:`MIDDLE_REACH` of the
+    straight way from ``state`` to ``end`` in hypothesis ``h``'s world, from their face (the start within
+    :data:`ON_PLANE` of its plane: a face move runs over the face it starts on; where it ends, stepped onto the next
+    face, is off that plane)."""
     a, b = h.model_from_world.apply(np.stack([state.position, end.position]))
+    faces = np.array(list(middles), dtype=np.int64)
     m = np.array(list(middles.values())).reshape(-1, 3)
     d = b - a
     t = np.clip((m - a) @ d / max(float(d @ d), 1e-18), 0.0, 1.0)
-    return int(np.sum(np.linalg.norm(a + t[:, None] * d - m, axis=1) <= MIDDLE_REACH))
+    n, off = h.poly.face_normals[faces], h.poly.face_offsets[faces]
+    over = np.abs(n @ a - off) <= ON_PLANE
+    return int(np.sum((np.linalg.norm(a + t[:, None] * d - m, axis=1) <= MIDDLE_REACH) & over))
 
 
 REVISIT = 3e-3
@@ -667,6 +672,12 @@ MIDDLE_REACH = 5e-3
 lies on the face's plane within this of it [m] (:func:`unmeasured_middles`)."""
 
 
+ON_PLANE = 2e-3
+"""A traced segment runs over a face when both its ends lie this near the face's plane at the fitted pose [m] (the
+pose's error is about 1 mm): a trace over the next face that passes near a narrow face's middle tells nothing of a
+slot across that face (:func:`unmeasured_middles`)."""
+
+
 _MIDDLES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
@@ -706,9 +717,10 @@ def unmeasured_middles(poly: Polyhedron, world_from_model: SE3, data: Sequence[D
     """The ``faces`` of ``poly`` at pose ``world_from_model`` whose middle nothing measured passed within
     :data:`MIDDLE_REACH` of: no touched point of ``data``'s faces, no explored interval of its edges (the edge
     traced whole between its ends), and no segment of ``traces`` (world, shape (2, 3) each: a face move's path
-    across its face, :meth:`Verifier.observe`). Measured vertices fix a face's plane, not that the face is whole
-    between them: a slot across its middle leaves every vertex of the model in place; a move that passed over the
-    middle would have met the slot (a trace across the face ends at its wall, an edge move at its gap)."""
+    across its face, :meth:`Verifier.observe`); a segment counts for the faces it runs over (:data:`ON_PLANE`).
+    Measured vertices fix a face's plane, not that the face is whole between them: a slot across its middle leaves
+    every vertex of the model in place; a move that passed over the middle would have met the slot (a trace across
+    the face ends at its wall, an edge move at its gap)."""
     pts = [np.atleast_2d(c.points) for c in data if isinstance(c, DataFace) and len(c.points)]
     segs = [np.stack([c.point, c.end_point]) for c in data if isinstance(c, DataEdge)]
     segs += [np.asarray(s, float).reshape(2, 3) for s in traces]
@@ -724,9 +736,11 @@ def unmeasured_middles(poly: Polyhedron, world_from_model: SE3, data: Sequence[D
     for f in sorted(faces):
         m = face_middle(poly, f)
         near = len(p) and float(np.linalg.norm(p - m, axis=1).min()) <= MIDDLE_REACH
-        if not near and segs:  # the nearest point of each segment
+        if not near and segs:  # the nearest point of each segment that runs over the face (both ends in its plane)
             t = np.clip(np.einsum("ij,ij->i", m - a, d) / dd, 0.0, 1.0)
-            near = float(np.linalg.norm(a + t[:, None] * d - m, axis=1).min()) <= MIDDLE_REACH
+            gap = np.linalg.norm(a + t[:, None] * d - m, axis=1)
+            ends = np.abs(ab @ poly.face_normals[f] - poly.face_offsets[f]).max(axis=1)
+            near = bool(np.any((gap <= MIDDLE_REACH) & (ends <= ON_PLANE)))
         if not near:
             out.append(int(f))
     return out

@@ -121,3 +121,20 @@ def test_with_a_middle_to_probe_the_verification_takes_a_move_over_it_where_that
     assert middle_probe_cost(LIB["HEXPRISM01"], ALL) > ALL.costs.c_p
     assert plain == 0
     assert credited >= 3
+
+
+def test_a_trace_over_the_next_face_does_not_measure_a_narrow_faces_middle():
+    """A face 8 mm wide has its middle 4 mm from its long edges: a trace over the face beside it, 2 mm below their
+    common edge, passes within the reach of that middle but not over the face; the same trace on the face does."""
+    slab = box(0.1, 0.008, 0.06, name="slab")
+    pose = SE3.identity()
+    f = next(i for i in range(slab.n_faces) if slab.face_normals[i, 2] > 0.9)  # the top, 8 mm wide
+    m = face_middle(slab, f)
+    side = next(i for i in range(slab.n_faces) if slab.face_normals[i, 1] > 0.9)
+    edge_y = float(slab.vertices[:, 1].max())
+    on_side = np.array([[m[0] - 0.03, edge_y, m[2] - 0.002], [m[0] + 0.03, edge_y, m[2] - 0.002]])
+    assert abs(slab.face_normals[side] @ on_side[0] - slab.face_offsets[side]) < 1e-12
+    assert np.linalg.norm(on_side.mean(axis=0) - m) < MIDDLE_REACH
+    assert unmeasured_middles(slab, pose, [], frozenset({f}), [on_side]) == [f]
+    on_top = np.array([[m[0] - 0.03, m[1] + 0.003, m[2]], [m[0] + 0.03, m[1] + 0.003, m[2]]])
+    assert unmeasured_middles(slab, pose, [], frozenset({f}), [on_top]) == []
