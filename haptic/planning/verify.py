@@ -772,6 +772,8 @@ class Verifier:
         """:func:`outcome_key` of the moves made since the last feature measured that were to measure nothing."""
         self._visited: list[np.ndarray] = []
         """Where the sensor was when each verification move since the last feature measured was chosen (world)."""
+        self._failed_edges: list[tuple[int, np.ndarray]] = []
+        """Edge moves that failed during the verification: the model edge and the world direction of travel."""
         self.check = None
         self.accept = None
         self.coverage = None
@@ -972,6 +974,7 @@ class Verifier:
             self.decision_times.append(time.perf_counter() - t0)
             return move
         missing = self.coverage.missing(self.mode) if self.coverage is not None else (frozenset(),) * 3
+        avoid = (*avoid, *self._failed_along(h, state, components, avoid))
         faces_ok = self._reach[self._model_name][0] if self._model_name in self._reach else None
         previous = self._tour if self._tour is not None and self._tour_model is h.poly else None
         middles = None
@@ -997,6 +1000,26 @@ class Verifier:
             self.tour_bound = bound if bound > 0 else None
         self.decision_times.append(time.perf_counter() - t0)
         return move
+
+    def _failed_along(self, h: Hypothesis, state: SensorState, components: Mapping[int, DataComponent],
+                      avoid: Sequence[Move]) -> list[Move]:
+        """Edge moves from ``state`` not to take again: along a model edge, the way an edge move along it failed
+        earlier in the verification (the hand's failure to follow a ridge -- between two walls, under an overhang
+        -- is the edge's, not where the pad was: back on the edge after other moves, the tour's cheapest way on
+        was the same edge move, and the verification went back and forth until it stalled). Failures from here
+        (``avoid``) are remembered first."""
+        edge = components.get(state.edge) if state.edge is not None else None
+        e_m = h.edges.get(state.edge) if state.edge is not None else None
+        if not isinstance(edge, DataEdge) or e_m is None:
+            return []
+        for m in avoid:
+            if isinstance(m, EdgeMove):
+                d = m.sense * np.asarray(edge.direction, float)
+                if not any(e == e_m and float(d @ u) > 0.9 for e, u in self._failed_edges):
+                    self._failed_edges.append((e_m, d))
+        return [EdgeMove(s) for s in (1, -1)
+                if any(e == e_m and float(s * np.asarray(edge.direction, float) @ u) > 0.9
+                       for e, u in self._failed_edges)]  # fmt: skip
 
     def record(self, cost: float) -> dict:
         """What was verified: the mode, the verdict, the verification's moves and cost, the pose check's worst
