@@ -223,6 +223,24 @@ def test_a_face_move_round_a_vertex_onto_a_narrow_face_follows_the_ridge_first(t
     assert _within_bounds(ep)
 
 
+def test_a_face_move_crossing_square_round_a_vertex_follows_the_ridge_first(tmp_path):
+    # antiprism_07 of the formula corpus at 60 mm, seed 3, --verify none (perception_report.py --corpus --sizes 60
+    # --first-seed 3): the start landed on a triangle and the first face move headed into its apex, rolled round it
+    # onto a heptagon sharing only the apex, 12° off square to the line between the faces: the normals' mean lean
+    # 0.1°, the next face wide there (no leg of the stroke blocked). The "edge" reported lay 25.7 bounds off every
+    # true edge and the object was recognised as hull_01. A face move crossing within 25° of square follows the
+    # ridge before it reports the edge: there is none, and the move fails.
+    failed = []
+    obs = EpisodeObserver(on_failed_move=lambda n, r: failed.append(r.reason))
+    spec = EpisodeSpec(model="antiprism_07", seed=3, executor="physics", verify="none",
+                       models=_scaled_library(tmp_path, 0.06, corpus=True))  # fmt: skip
+    ep = build_episode(spec)
+    rec = ep.run(None, obs)
+    assert any("acquiring the ridge" in w or "no edge along the roll's axis" in w for w in failed), failed
+    assert rec.outcome != "recognized" or rec.correct, rec.recognized
+    assert _within_bounds(ep)
+
+
 def test_an_edge_move_that_goes_on_round_a_shallow_vertex_reports_no_vertex(tmp_path):
     # prism_12 of the formula corpus at 60 mm (seed 1 when found; seed 2 shows it since the moves recover): an
     # edge move along a cap edge of the 12-gon went on round its end, where the next cap edge turns by only 30°,
