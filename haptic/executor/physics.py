@@ -388,7 +388,7 @@ class PhysicsExecutor(LandingSearch):
         if extra is not None and len(extra):
             n0 = self.segmenter.faces[fid].component.normal
             ok = extra.in_contact
-            keep = ok & (np.where(ok[:, None], extra.normal_in_world, 0.0) @ n0 > math.cos(self.bounds.face_cone))
+            keep = ok & (np.where(ok[:, None], extra.normal_in_world, 0.0) @ n0 > math.cos(self.bounds.row_cone))
             keep &= extra.phase != PHASES.index("roll")
             keep = steady_rows(extra, keep, self.bounds)
             if keep.sum():
@@ -399,7 +399,7 @@ class PhysicsExecutor(LandingSearch):
     def store_face(self, fid: int, trace: ContactTrace, fit: FaceFit) -> None:
         """Keep the rows of ``trace`` on data face ``fid`` (those within the face cone of its fit ``fit`` whose
         normal holds steady, :func:`~haptic.executor.segment.steady_rows`)."""
-        mask = face_rows(trace, fit.normal, self.bounds.face_cone, self.bounds.min_refine_rows)
+        mask = face_rows(trace, fit.normal, self.bounds.row_cone, self.bounds.min_refine_rows)
         mask = steady_rows(trace, mask, self.bounds)
         pts, nrm = trace.point_in_world[mask], trace.normal_in_world[mask]
         rot = self.toucher.hand_rotation
