@@ -292,3 +292,32 @@ def test_at_noise_level_4_a_face_is_picked_about_its_own_rows_not_about_the_gues
 
 def unit_rows(a: np.ndarray) -> np.ndarray:
     return a / np.linalg.norm(a, axis=1)[:, None]
+
+
+def test_at_noise_level_4_a_step_on_a_face_is_no_rim_and_a_step_onto_a_rim_is():
+    # a stroke's step onto the next face compares the mean normal of its first 9 rows with that of its last: at σn
+    # 4° the two differ by 1.9° per axis from the noise alone, and the fixed 3° cone took most steps on a face for a
+    # step onto a rim (BOX01 at 60 mm, seed 1: the move failed); the cut is 3.5 σ of that difference there (6.6°), the
+    # 3° cone at noise level 1. A step whose normal turned 10° (a rim: 4.5-10.6° measured at level 1) is one at level
+    # 1; at level 4 one that turned 16° is (the price: a rim turning by 14° or less may go by unseen there).
+    from dataclasses import replace
+    from types import SimpleNamespace
+
+    from haptic.executor.primitives import PrimitiveResult, Toucher
+
+    def step(seed: int, turn_deg: float, sigma_deg: float) -> PrimitiveResult:
+        rng = np.random.default_rng(seed)
+        n = 40
+        turn = np.radians(np.linspace(0.0, turn_deg, n))
+        tilt = np.column_stack([np.sin(turn), np.zeros(n)]) + np.radians(sigma_deg) * rng.normal(size=(n, 2))
+        normals = unit_rows(np.column_stack([tilt, np.ones(n)]))
+        xy = np.column_stack([np.linspace(0.0, 0.0015, n), np.zeros(n), np.zeros(n)])
+        return PrimitiveResult("ok", "done", _trace(xy + R_PAD * normals, normals, xy), 0.0015)
+
+    for level, turn in ((1.0, 10.0), (4.0, 16.0)):
+        bounds = SegmentBounds().scaled(level)
+        rim = [Toucher._stepped_onto_rim(SimpleNamespace(bounds=bounds), step(s, 0.0, level)) for s in range(20)]
+        assert sum(rim) <= 1, rim
+        assert all(Toucher._stepped_onto_rim(SimpleNamespace(bounds=bounds), step(s, turn, level)) for s in range(20))
+    old = replace(SegmentBounds().scaled(4.0), rim_sigmas=0.0)
+    assert sum(Toucher._stepped_onto_rim(SimpleNamespace(bounds=old), step(s, 0.0, 4.0)) for s in range(20)) >= 5
