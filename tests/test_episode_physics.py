@@ -244,6 +244,20 @@ def test_a_face_move_crossing_square_round_a_vertex_follows_the_ridge_first(tmp_
     assert _within_bounds(ep)
 
 
+def test_a_stroke_riding_the_rims_of_a_small_face_measures_no_face(tmp_path):
+    # bipyramid_10 of the formula corpus at 30 mm, seed 3, --verify none (perception_report.py --corpus --sizes 30
+    # --first-seed 3): a face move's stroke on a triangle 9 mm across kept every contact within 1.5 mm of its edges;
+    # the rows holding one normal were those of the step in, the pad pressing in place 4° off the face, and the face
+    # fitted from them lay 2.8 bounds off (no-match without verification). Steady rows spanning less than a face's
+    # least extent measure no face: the move touches the next face afresh, or fails.
+    spec = EpisodeSpec(model="bipyramid_10", seed=3, executor="physics", verify="none",
+                       models=_scaled_library(tmp_path, 0.03, corpus=True))  # fmt: skip
+    ep = build_episode(spec)
+    rec = ep.run(None)
+    assert rec.outcome != "no-match" and (rec.outcome != "recognized" or rec.correct), rec.detail
+    assert _within_bounds(ep)
+
+
 def test_an_edge_move_that_goes_on_round_a_shallow_vertex_reports_no_vertex(tmp_path):
     # prism_12 of the formula corpus at 60 mm (seed 1 when found; seed 2 shows it since the moves recover): an
     # edge move along a cap edge of the 12-gon went on round its end, where the next cap edge turns by only 30°,

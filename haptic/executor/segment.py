@@ -474,6 +474,11 @@ class Segmenter:
         if spread > self.bounds.max_spread_sigmas * self.bounds.normal_sigma + self.bounds.spread_slack:
             return None  # the rows do not come from one plane (a roll, a vertex)
         mask = steady_rows(trace, mask, self.bounds)
+        if _extent(trace.tip_in_world[mask])[0] < self.bounds.min_face_extent:
+            # the rows that hold one normal are the pad pressing in place, the rest turning: the stroke rode a rim
+            # (bipyramid_10 at 30 mm, seed 3: every contact within 1.5 mm of the face's edges, the steady rows those
+            # of the step in, 4° off the face, spanning 1 mm, and the face 2.8 bounds off)
+            return None
         if two_d and _extent(trace.tip_in_world[mask])[1] < self.bounds.min_face_width:
             # the steady rows are one leg of the L: the other's normal held elsewhere (the pad rode a rim along the
             # first leg, its normal turned 3° round the edge), and no row measures the face across
