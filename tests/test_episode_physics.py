@@ -212,14 +212,49 @@ def test_a_face_move_round_a_vertex_onto_a_narrow_face_follows_the_ridge_first(t
     # normals' mean leaned 0.43° (true edges up to 0.34°, the test's limit 0.52°) and the "edge" reported was 33
     # bounds off every true edge (no-match). The stroke on the next face met an edge along both of its legs (the
     # face is a wedge at the apex): the move follows the ridge each way before it reports the edge, and there is none.
+    # (Since a face move crossing square to the edge follows the ridge too, this episode's moves differ: its rolls
+    # round a vertex are told by their normals or by the ridge.)
     failed = []
     obs = EpisodeObserver(on_failed_move=lambda n, r: failed.append(r.reason))
     spec = EpisodeSpec(model="bipyramid_07", seed=1, executor="physics",
                        models=_scaled_library(tmp_path, 0.06, corpus=True))  # fmt: skip
     ep = build_episode(spec)
     rec = ep.run(None, obs)
-    assert any("no edge along the roll's axis" in w for w in failed), failed
+    told = ("no edge along the roll's axis", "acquiring the ridge", "more than the noise allows")
+    assert any(x in w for w in failed for x in told), failed
     assert rec.outcome != "no-match", rec.detail
+    assert _within_bounds(ep)
+
+
+def test_a_face_move_crossing_square_round_a_vertex_follows_the_ridge_first(tmp_path):
+    # antiprism_07 of the formula corpus at 60 mm, seed 3, --verify none (perception_report.py --corpus --sizes 60
+    # --first-seed 3): the start landed on a triangle and the first face move headed into its apex, rolled round it
+    # onto a heptagon sharing only the apex, 12° off square to the line between the faces: the normals' mean lean
+    # 0.1°, the next face wide there (no leg of the stroke blocked). The "edge" reported lay 25.7 bounds off every
+    # true edge and the object was recognised as hull_01. A face move crossing within 25° of square follows the
+    # ridge before it reports the edge: there is none, and the move fails.
+    failed = []
+    obs = EpisodeObserver(on_failed_move=lambda n, r: failed.append(r.reason))
+    spec = EpisodeSpec(model="antiprism_07", seed=3, executor="physics", verify="none",
+                       models=_scaled_library(tmp_path, 0.06, corpus=True))  # fmt: skip
+    ep = build_episode(spec)
+    rec = ep.run(None, obs)
+    assert any("acquiring the ridge" in w or "no edge along the roll's axis" in w for w in failed), failed
+    assert rec.outcome != "recognized" or rec.correct, rec.recognized
+    assert _within_bounds(ep)
+
+
+def test_a_stroke_riding_the_rims_of_a_small_face_measures_no_face(tmp_path):
+    # bipyramid_10 of the formula corpus at 30 mm, seed 3, --verify none (perception_report.py --corpus --sizes 30
+    # --first-seed 3): a face move's stroke on a triangle 9 mm across kept every contact within 1.5 mm of its edges;
+    # the rows holding one normal were those of the step in, the pad pressing in place 4° off the face, and the face
+    # fitted from them lay 2.8 bounds off (no-match without verification). Steady rows spanning less than a face's
+    # least extent measure no face: the move touches the next face afresh, or fails.
+    spec = EpisodeSpec(model="bipyramid_10", seed=3, executor="physics", verify="none",
+                       models=_scaled_library(tmp_path, 0.03, corpus=True))  # fmt: skip
+    ep = build_episode(spec)
+    rec = ep.run(None)
+    assert rec.outcome != "no-match" and (rec.outcome != "recognized" or rec.correct), rec.detail
     assert _within_bounds(ep)
 
 
@@ -319,9 +354,10 @@ def test_a_stroke_that_steps_onto_the_rim_of_another_edge_measures_no_face(tmp_p
     # 25 times its bound off the true one (no-match). LBLOCK01 at 30 mm, seed 1, did the same on a step 10 mm
     # wide (12 bounds). The stroke's first leg off the edge turned its normal by 6-11° (0.1-1.9° on a face):
     # the pad had reached the rim of another edge, and the move touches the next face afresh with an L or fails.
+    # Since a face move crossing square to its edge follows the ridge first, this replay's moves differ and may not
+    # step onto a rim; whatever they meet, every component lies within its bounds.
     ep, failed, _ = _replay(tmp_path, "BOX01N", 0.03, 11)
-    assert _within_bounds(ep)
-    assert any("the rim of another edge" in r.reason for r in failed), [r.reason for r in failed]
+    assert _within_bounds(ep), [r.reason for r in failed]
 
 
 @pytest.mark.parametrize("model", ["HEXPRISM01", "PYR01"])
@@ -355,8 +391,9 @@ def test_an_edge_move_that_acquires_a_parallel_ridge_reports_nothing(tmp_path):
     spec = EpisodeSpec(model="BOX01P", seed=1, executor="physics", models=_scaled_library(tmp_path, 0.06))
     ep = build_episode(spec)
     rec = ep.run(None, obs)
-    assert any("off the edge's line: another edge" in w for w in failed), failed
-    assert rec.outcome != "no-match", rec.detail
+    # (since a face move crossing square to its edge follows the ridge first, the moves differ and the second edge
+    # move may not be made: the episode must still end other than no-match, every component within its bounds)
+    assert rec.outcome != "no-match", (rec.detail, failed)
     assert _within_bounds(ep)
 
 

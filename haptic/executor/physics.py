@@ -161,6 +161,13 @@ class PhysicsSettings:
     """... at a point this far from the edge on the guessed face [m] ..."""
     reacquire_cone: float = math.radians(12.0)
     """... skipping a guess within this of one tried [rad]."""
+    square_crossing: float = math.radians(25.0)
+    """A face move whose travel crossed the convex edge it reports within this of square to it follows the ridge
+    first: crossing square, a roll round a vertex onto a face sharing only it turns the normals about the same axis
+    as a roll over an edge, and leans along it no more (antiprism_07 at 60 mm, seed 3: a trace heading into the
+    apex of a triangle rolled round it onto a heptagon, 12° off square, the normals' mean lean 0.1°; the "edge"
+    lay 25.7 bounds off every true edge and the object was recognised as another model). Crossing at a slant,
+    such a roll leans along the line between the faces and the normals tell it [rad]."""
     crossing_clearance: float = 0.006
     """The planner's least distance from a face move's crossing to the nearest vertex on the hand
     (``PlannerConfig.min_vertex_clearance``, preferred where a move that keeps it exists): nearer, the pad
@@ -381,7 +388,7 @@ class PhysicsExecutor(LandingSearch):
         if extra is not None and len(extra):
             n0 = self.segmenter.faces[fid].component.normal
             ok = extra.in_contact
-            keep = ok & (np.where(ok[:, None], extra.normal_in_world, 0.0) @ n0 > math.cos(self.bounds.face_cone))
+            keep = ok & (np.where(ok[:, None], extra.normal_in_world, 0.0) @ n0 > math.cos(self.bounds.row_cone))
             keep &= extra.phase != PHASES.index("roll")
             keep = steady_rows(extra, keep, self.bounds)
             if keep.sum():
@@ -392,7 +399,7 @@ class PhysicsExecutor(LandingSearch):
     def store_face(self, fid: int, trace: ContactTrace, fit: FaceFit) -> None:
         """Keep the rows of ``trace`` on data face ``fid`` (those within the face cone of its fit ``fit`` whose
         normal holds steady, :func:`~haptic.executor.segment.steady_rows`)."""
-        mask = face_rows(trace, fit.normal, self.bounds.face_cone, self.bounds.min_refine_rows)
+        mask = face_rows(trace, fit.normal, self.bounds.row_cone, self.bounds.min_refine_rows)
         mask = steady_rows(trace, mask, self.bounds)
         pts, nrm = trace.point_in_world[mask], trace.normal_in_world[mask]
         rot = self.toucher.hand_rotation
@@ -634,10 +641,13 @@ class PhysicsExecutor(LandingSearch):
             if status != "ok":
                 return self.failed_result(move, status, reason)
             fit_a, line, why = self._edge_between(st.face, r.trace, "face", roll, fit_b, kind, corner)
-            if line is not None and kind == "convex" and self._stroke_blocked:
-                # the next face is narrow along the edge where the pad met it: a roll round a vertex onto a face
-                # sharing only the vertex gives the same normals and contacts when the crossing is square to the
-                # line between the faces; the ridge along that line is there only over an edge
+            travel = unit(r.info["direction"])
+            square = line is not None and abs(float(line.direction @ travel)) < math.sin(self.settings.square_crossing)
+            if line is not None and kind == "convex" and (self._stroke_blocked or square):
+                # a roll round a vertex onto a face sharing only the vertex gives the same normals and contacts as
+                # one over an edge when the crossing is square to the line between the faces (the next face narrow
+                # along it where the pad met it, or the travel square to it): the ridge along that line is there
+                # only over an edge
                 ridge = self._probe_ridge(line.direction, fit_a.normal, fit_b.normal, pieces)
                 if isinstance(ridge, str):
                     line, why = None, f"no edge between the faces: {ridge}"
@@ -732,9 +742,13 @@ class PhysicsExecutor(LandingSearch):
         contact points on the ridge, or why there is no edge along ``e`` (they span less than
         ``RIDGE_MIN_SPAN``)."""
         t = self.toucher
-        toward_a = unit(np.cross(n_a, e))
-        if float(toward_a @ n_b) > 0:
-            toward_a = -toward_a
+        # sideways toward face a: into face a away from the edge, and on face b toward the edge (as an edge move's
+        # frame); into face a alone has no component on face b across a square edge, and a pad resting on face b
+        # after its stroke never reached the ridge
+        in_a, in_b = unit(np.cross(n_a, e)), unit(np.cross(n_b, e))
+        in_a = -in_a if float(in_a @ n_b) > 0 else in_a
+        in_b = -in_b if float(in_b @ n_a) > 0 else in_b
+        toward_a = unit(in_a - in_b)
         acq = t.follow_edge(e, n_a, n_b, toward_a, 0.0, acquire_only=True)
         pieces.append(acq)
         if not acq.ok:

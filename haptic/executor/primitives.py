@@ -698,7 +698,11 @@ class Toucher:
         k = self.bounds.steady_window
         if len(n) < 2 * k:
             return False
-        return angle(unit(n[:k].sum(axis=0)), unit(n[-k:].sum(axis=0))) > self.bounds.sample_cone
+        # the two means differ by the noise alone by σn √(2 / k) per axis: at noise level 4 (σn 4°) by 2.4° on
+        # average, and the fixed cone alone then took most strokes on a face for a rim
+        b = self.bounds
+        cut = max(b.sample_cone, b.rim_sigmas * b.normal_sigma * math.sqrt(2.0 / k))
+        return angle(unit(n[:k].sum(axis=0)), unit(n[-k:].sum(axis=0))) > cut
 
     # -- along an edge -----------------------------------------------------------------------------------------
     def follow_edge(

@@ -59,6 +59,10 @@ class SegmentBounds:
     """Fewest contact rows a face is fitted from."""
     face_cone: float = math.radians(4.0)
     """A row belongs to a face when its sensed normal is within this of the face normal [rad]."""
+    face_cone_sigmas: float = 3.0
+    """... or within this many σn of it, when that is wider: a cone narrower than the noise keeps the rows about
+    the guess and pulls the face's mean normal toward it (at noise level 4, σn 4°, face normals 1.0-1.5 bounds off
+    with the 4° cone) [-]."""
     sample_cone: float = math.radians(3.0)
     """A sensed normal within this of a face's is one of the face's samples (the primitives' running face
     normal); beyond it the normal has turned off the face (rolling over an edge) [rad]."""
@@ -142,6 +146,10 @@ class SegmentBounds:
     this many times ``√(σn² / n + floor²)`` is no roll over the edge between the faces [-]."""
     min_skew_rows: int = 9
     """... tested with at least this many rolling contacts [-]."""
+    rim_sigmas: float = 3.5
+    """A stroke's step onto the next face turns its normal (the mean of its first :attr:`steady_window` rows against
+    that of its last) by more than :attr:`sample_cone`, and by more than this many σ of the noise's difference
+    between the two means, where it rolled onto the rim of the face's far edge (``Toucher._stepped_onto_rim``) [-]."""
     steady_window: int = 9
     """A face's rows hold a steady normal: averaged over this many consecutive rows, the sensor's noise drops by
     its square root, while a pad that starts to roll over an edge (the last rows of a trace across the face,
@@ -152,6 +160,12 @@ class SegmentBounds:
     max_roll_offset: float = 2e-3
     """The contact points of a roll over a convex edge lie on the edge, hence on both faces' planes; a roll
     farther than this (median) from either plane was not over the edge between them [m]."""
+
+    @property
+    def row_cone(self) -> float:
+        """The cone about a face's normal within which a sensed normal is one of the face's rows: :attr:`face_cone`,
+        or :attr:`face_cone_sigmas` σn when the sensor is noisier [rad]."""
+        return max(self.face_cone, self.face_cone_sigmas * self.normal_sigma)
 
     def agree(self, a: np.ndarray, b: np.ndarray, sigma: float) -> bool:
         """Whether two estimates of one direction agree within :attr:`fit_agreement_sigmas` × ``sigma`` plus
@@ -442,7 +456,7 @@ class Segmenter:
         rows do not span ``min_face_extent`` (and ``min_face_width`` across, with ``two_d``): the pad touched a
         vertex or an edge, not a face."""
         b = self.bounds
-        mask = face_rows(trace, unit(np.asarray(normal_guess, float)), b.face_cone, b.min_refine_rows)
+        mask = face_rows(trace, unit(np.asarray(normal_guess, float)), b.row_cone, b.min_refine_rows)
         if mask.sum() < self.bounds.min_face_rows:
             return None
         tips = trace.tip_in_world[mask]
@@ -460,6 +474,11 @@ class Segmenter:
         if spread > self.bounds.max_spread_sigmas * self.bounds.normal_sigma + self.bounds.spread_slack:
             return None  # the rows do not come from one plane (a roll, a vertex)
         mask = steady_rows(trace, mask, self.bounds)
+        if _extent(trace.tip_in_world[mask])[0] < self.bounds.min_face_extent:
+            # the rows that hold one normal are the pad pressing in place, the rest turning: the stroke rode a rim
+            # (bipyramid_10 at 30 mm, seed 3: every contact within 1.5 mm of the face's edges, the steady rows those
+            # of the step in, 4° off the face, spanning 1 mm, and the face 2.8 bounds off)
+            return None
         if two_d and _extent(trace.tip_in_world[mask])[1] < self.bounds.min_face_width:
             # the steady rows are one leg of the L: the other's normal held elsewhere (the pad rode a rim along the
             # first leg, its normal turned 3° round the edge), and no row measures the face across

@@ -154,6 +154,28 @@ def _table_pin(poly: Polyhedron, z: np.ndarray, v: int, edges, vertices) -> Tabl
     return TablePin(v, rising, tuple(faces))
 
 
+def table_band(poly: Polyhedron, world_from_model: SE3, config: PlannerConfig) -> float:
+    """How high above the table the verification of ``poly`` at ``world_from_model`` measures nothing [m]: a face
+    rising from an edge that rests on the table (both ends within :data:`TABLE_CONTACT`) can be touched no lower
+    than the pad's radius times ``1 - n_z`` (its outward normal's vertical component) plus the pad's clearance of
+    the table; below that the model is taken on trust, from the planes measured above and the table (a chamfer of
+    that edge up to that height is not seen: 12 (1 - sin β) mm for a face whose normal rises β above the
+    horizontal). The largest over those faces; 0 without a table or with no edge on it."""
+    if config.table_z is None:
+        return 0.0
+    z = world_from_model.apply(poly.vertices)[:, 2] - config.table_z
+    nz = world_from_model.rotate(poly.face_normals)[:, 2]
+    band = 0.0
+    for e in range(poly.n_edges):
+        if max(z[int(poly.edges[e, 0])], z[int(poly.edges[e, 1])]) > TABLE_CONTACT:
+            continue
+        for f in (int(poly.edge_left_face[e]), int(poly.edge_right_face[e])):
+            if np.all(z[list(poly.faces[f])] <= TABLE_CONTACT):
+                continue  # the face on the table
+            band = max(band, config.pad_radius * (1.0 - float(nz[f])) + config.table_clearance)
+    return band
+
+
 def placed_by_data(poly: Polyhedron, world_from_model: SE3, vertices: Sequence[int], cov, config: PlannerConfig
                    ) -> list[int]:  # fmt: skip
     """Of ``vertices`` (resting on the table, that nothing predicted in reach would place), those that what ``cov``
@@ -780,6 +802,10 @@ class Verifier:
         self._hyp: Hypothesis | None = None
         self.hidden: list[int] = []
         """Model vertices out of the hand's reach and off the table (:func:`hidden_vertices`)."""
+        self.table_band: float | None = None
+        """On the table, once the model's coverage is met: how high above the table the verification measures
+        nothing (:func:`table_band`): a confirmation says the object is the model above it [m] (None: no table, or
+        not reached)."""
         self.unpinnable: list[int] = []
         """Model vertices on the table whose place on it nothing in the hand's reach gives (:func:`table_pins`)."""
         self._model_name: str | None = None
@@ -862,6 +888,8 @@ class Verifier:
             unpinned = [v for v in self._pins[cls.name][1] if v not in self.hidden]
             placed = placed_by_data(cls.model, self.check.world_from_model, unpinned, self.coverage, self.config)
             self.unpinnable = [v for v in unpinned if v not in placed]
+            if self.config.table_z is not None:
+                self.table_band = table_band(cls.model, self.check.world_from_model, self.config)
             self.status = "incomplete" if self.mode == "full" and (self.hidden or self.unpinnable) else "confirmed"
             if self.status == "confirmed" and self.mode == "full" and self._probes_admitted():
                 todo = [f for f in unmeasured_middles(cls.model, self.check.world_from_model, tree.data,
@@ -1048,4 +1076,7 @@ class Verifier:
             # verified up to what the hand cannot measure: every feature in its reach measured (the status says
             # whether that was all: "incomplete" with vertices hidden is this, never "confirmed")
             out["reach_complete"] = bool(self.coverage.met(self.mode))
+        if self.table_band is not None:
+            # the claim: the object is the model above this height; below it, next to the table, nothing measured
+            out["table_band_mm"] = round(self.table_band * 1000.0, 2)
         return out

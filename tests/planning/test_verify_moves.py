@@ -254,3 +254,25 @@ def test_an_edge_move_that_failed_along_a_model_edge_is_not_taken_again_that_way
     there = dataclasses.replace(r.state, edge=99, position=r.state.position + 0.01 * edge.direction)
     h2 = dataclasses.replace(h, edges={**edges, 99: edges[edge.id]})
     assert v._failed_along(h2, there, {**comps, 99: flipped}, ()) == [EdgeMove(-1)]  # ... and along the edge
+
+
+def test_the_band_next_to_the_table_that_nothing_measures_follows_the_faces_rising_from_it():
+    """A confirmation on the table says the object is the model above the height below which the pad touches none
+    of the faces rising from edges on the table: TETRA01L on a face, its sides rising at their own slopes; BOX01 on a
+    face, its vertical walls (the pad's radius plus its clearance); lifted off the table, or without one, none."""
+    from dataclasses import replace
+
+    from haptic.planning.verify import table_band
+
+    for name in ("TETRA01L", "BOX01"):
+        poly = LIB[name]
+        pose, table = _resting_on(poly, 0)
+        nz = pose.rotate(poly.face_normals)[:, 2]
+        rising = [f for f in range(poly.n_faces) if f != 0 and any(int(u) in poly.faces[0] for u in poly.faces[f])]
+        shared = [f for f in rising if sum(int(u) in poly.faces[0] for u in poly.faces[f]) >= 2]
+        want = max(table.pad_radius * (1.0 - nz[f]) + table.table_clearance for f in shared)
+        assert abs(table_band(poly, pose, table) - want) < 1e-9
+        assert table_band(poly, pose, replace(table, table_z=0.34)) == 0.0
+        assert table_band(poly, pose, PlannerConfig()) == 0.0
+    box_pose, box_table = _resting_on(LIB["BOX01"], 0)
+    assert abs(table_band(LIB["BOX01"], box_pose, box_table) - 0.016) < 1e-6

@@ -1,0 +1,57 @@
+"""scripts/bench_unknown.py on the hand: a variant recognised as its model is a false recognition unless it differs
+from the model only within the band next to the table where the verification says it measured nothing."""
+
+import importlib.util
+from pathlib import Path
+
+import numpy as np
+
+from haptic.geometry import load_library
+from haptic.geometry.perturb import chamfer_edge, move_vertex
+from haptic.geometry.se3 import matrix_to_quat
+
+ROOT = Path(__file__).resolve().parents[1]
+LIB = load_library()
+TABLE = 0.35
+
+
+def _bench():
+    spec = importlib.util.spec_from_file_location("bench_unknown", ROOT / "scripts" / "bench_unknown.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def _on_face(poly, face: int) -> dict:
+    """A record's pose of ``poly`` resting on ``face`` on the table (z = TABLE)."""
+    n = poly.face_normals[face]
+    axis = np.cross(n, [0.0, 0.0, -1.0])
+    s, c = np.linalg.norm(axis), float(n @ [0.0, 0.0, -1.0])
+    if s < 1e-9:
+        rot = np.eye(3) if c > 0 else np.diag([1.0, -1.0, -1.0])
+    else:
+        k = axis / s
+        kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+        rot = np.eye(3) + s * kx + (1 - c) * kx @ kx
+    low = (poly.vertices @ rot.T)[:, 2].min()
+    return {"quat_wxyz": matrix_to_quat(rot).tolist(), "translation_m": [0.55, 0.0, TABLE - low]}
+
+
+def test_a_chamfer_on_the_table_lies_within_the_band_and_a_moved_vertex_above_it():
+    bench = _bench()
+    base = LIB["PYR01"]
+    pose = _on_face(base, 0)
+    on_table = [e for e in range(base.n_edges) if set(int(v) for v in base.edges[e]) <= set(base.faces[0])]
+    chamfered = chamfer_edge(base, on_table[0], 0.004, name="PYR01__ch")
+    top = bench.difference_top(chamfered, base, pose, TABLE)
+    assert 0.002 < top < 0.004  # the chamfer's legs are 4 mm: its top edge lies below that on the rising face
+    apex = int(np.argmax([(base.vertices[v] - base.vertices[base.faces[0][0]]) @ -base.face_normals[0]
+                          for v in range(base.n_vertices)]))  # fmt: skip
+    moved = move_vertex(base, apex, 0.004, name="PYR01__apex")
+    assert bench.difference_top(moved, base, pose, TABLE) > 0.02
+    assert bench.difference_top(base, base, pose, TABLE) is None
+    rec = {"outcome": "recognized", "recognized": "PYR01", "pose": pose, "verified": {"table_band_mm": 10.0}}
+    assert bench.within_claim(dict(rec), chamfered, base, TABLE)
+    assert not bench.within_claim(dict(rec), moved, base, TABLE)
+    assert not bench.within_claim({**rec, "verified": {"table_band_mm": 2.0}}, chamfered, base, TABLE)
+    assert not bench.within_claim({**rec, "recognized": "TETRA01L"}, chamfered, base, TABLE)
