@@ -120,7 +120,13 @@ TIP_TABLE_CLEARANCE = 0.008
 other links need to come. Measured (``scripts/bench_placement_physics.py --seeds 1,2,3 --fingers 2``): 3 mm and 8 mm
 offer the same 26 placements of 121 (20 mm: 21), so the larger, for the servo's lag."""
 
-REACH_CLEARANCE = ReachSettings(clearance=0.02, pads_touch=False, tip_table_clearance=TIP_TABLE_CLEARANCE)
+HOLD_CLEARANCE = 0.01
+"""The reach test's path keeps its clearances to within this [m] (``ReachSettings.hold_clearance``): without it the
+solver's linearised limits let links pass within a millimetre of the hypothesised object, and the hand, trailing
+the path by a few millimetres, touched it on the way."""
+
+REACH_CLEARANCE = ReachSettings(clearance=0.02, pads_touch=False, tip_table_clearance=TIP_TABLE_CLEARANCE,
+                                hold_clearance=HOLD_CLEARANCE)  # fmt: skip
 """The planner's reach test of a placement: every link of the hand, the pads too, at least 20 mm from the
 hypothesised object on the way to the lines' starts, and from the table but for the fingertips
 (:data:`TIP_TABLE_CLEARANCE`) (the joints' servo trails the path by a few millimetres; the pads' place at the
@@ -756,5 +762,5 @@ def reach_oracle(fingers: int) -> Callable | None:
     return PlacementReach() if fingers > 1 else None
 
 
-__all__ = ["REACH_CLEARANCE", "SETTINGS", "TIP_TABLE_CLEARANCE", "PlacementReach", "PlacementSettings", "hand_solver",
-           "pad_target", "placement_move", "reach_oracle"]
+__all__ = ["HOLD_CLEARANCE", "REACH_CLEARANCE", "SETTINGS", "TIP_TABLE_CLEARANCE", "PlacementReach",
+           "PlacementSettings", "hand_solver", "pad_target", "placement_move", "reach_oracle"]

@@ -79,6 +79,11 @@ class ReachSettings:
     """Least distance kept between the target fingers' fingertips (distal link and pad) and the table [m], in
     place of ``clearance`` there: a pad sent to a face near the table comes closer to it than the hand's other
     links need to. None: ``clearance`` for every link."""
+    hold_clearance: float | None = None
+    """With it, a step that would bring a link nearer the table or the object than its clearance less this (and
+    nearer than before) is not taken either, as a step into them is not (shorter steps, then the solver stops
+    there): the path keeps the clearance to within this, where the linearised limits alone let links graze the
+    object [m]. None: only steps into the table or object are refused."""
     detection: float = 0.08
     """Distance below which a pair of geoms enters the collision constraints [m]: more than a step moves any
     link, so that no step jumps past a constraint not yet active."""
@@ -271,7 +276,8 @@ class ReachSolver:
         steps = 0
         pads = self._exempt(fingers)
         rest = [g for g in self._hand_geoms if g not in pads]
-        clear = self._clearance(rest)
+        sets = self._table_sets(fingers)
+        clear, margin = self._clearance(rest), self._margins(rest, sets)
         blocked: ReachFailure | None = None
         dt = s.dt
         while steps < s.max_iters:
@@ -279,15 +285,21 @@ class ReachSolver:
             vel = mink.solve_ik(cfg, tasks, dt, solver="daqp", damping=s.damping, limits=limits)
             cfg.integrate_inplace(vel, dt)
             now = self._clearance(rest)
-            if now < 0.0 and now < clear:  # the linearised limits let a step through: not taken; shorter steps
-                table = self._distance(self._hand_geoms, self._table_geoms)
-                blocked = ReachFailure.TABLE if table <= now else ReachFailure.OBJECT
+            near = self._margins(rest, sets)
+            into = now < 0.0 and now < clear
+            grazing = s.hold_clearance is not None and min(near) < -s.hold_clearance and min(near) < min(margin)
+            if into or grazing:  # the linearised limits let a step through: not taken; shorter steps
+                if into:
+                    table = self._distance(self._hand_geoms, self._table_geoms)
+                    blocked = ReachFailure.TABLE if table <= now else ReachFailure.OBJECT
+                else:
+                    blocked = ReachFailure.TABLE if near[0] <= near[1] else ReachFailure.OBJECT
                 cfg.update(path[-1])
                 if dt < s.dt / 2**s.step_halvings:
                     break
                 dt /= 2
                 continue
-            clear = now
+            clear, margin = now, near
             path.append(cfg.q.copy())
             pos_err, app_err = self._errors(targets)
             if np.all(pos_err < s.position_tol) and np.all(app_err < s.approach_tol):
@@ -328,6 +340,19 @@ class ReachSolver:
             return list(self._hand_geoms), []
         tips = [g for g in self._hand_geoms if self._tip_of(g) in fingers]
         return [g for g in self._hand_geoms if g not in tips], tips
+
+    def _margins(self, rest: Sequence[int], sets: tuple[list[int], list[int]]) -> tuple[float, float]:
+        """How far beyond its clearance the hand is from the table and ``rest`` from the object at the current
+        configuration [m] (negative: nearer than the clearance); only with ``hold_clearance`` (else zeros)."""
+        s = self.settings
+        if s.hold_clearance is None:
+            return 0.0, 0.0
+        body, tips = sets
+        table = self._distance(body, self._table_geoms) - s.clearance
+        if tips:
+            table = min(table, self._distance(tips, self._table_geoms) - s.tip_table_clearance)
+        obj = self._distance(rest, self._object_geoms) - s.clearance if self._object_geoms else 1.0
+        return table, obj
 
     def _tip_of(self, g: int) -> str | None:
         """The finger whose fingertip (distal link, its pad included) geom ``g`` belongs to, or None."""

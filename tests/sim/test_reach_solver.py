@@ -133,3 +133,23 @@ def test_the_fingertips_may_come_nearer_the_table_than_the_other_links():
         assert tips._distance(near, table) > 0.003 - 1e-3
     tips.configuration.update(r.qpos)
     assert tips._distance(near, table) < 0.02  # the fingertip came nearer than the others may
+
+
+def test_with_hold_clearance_the_path_keeps_its_clearance_from_the_object():
+    """Two pads sent to either side of a hypothesised box, 25 mm off its sides, from the tracing posture above it:
+    with ``hold_clearance`` no configuration of the path brings a link nearer the box than its clearance less that
+    (the linearised limits alone let links pass within millimetres of it)."""
+    box = scene_object_from_parts("box", box_parts())
+    settings = ReachSettings(clearance=0.02, pads_touch=False, hold_clearance=0.005)
+    solver = ReachSolver(compose_scene(box, box_pose()), settings)
+    side = BOX_CENTRE + [0.0, 0.0, 0.01]
+    targets = [FingertipTarget("index", side + [0.0, 0.065, 0.0], np.array([0.0, -1.0, 0.0])),
+               FingertipTarget("thumb", side + [0.0, -0.065, 0.0], np.array([0.0, 1.0, 0.0]))]  # fmt: skip
+    r = solver.solve(targets)
+    assert len(r.path) > 5
+    obj = solver._object_geoms
+    least = []
+    for q in r.path:
+        solver.configuration.update(q)
+        least.append(solver._distance(solver._hand_geoms, obj))
+    assert min(least) >= 0.02 - 0.005 - 1e-3, f"{min(least) * 1000:.1f} mm"
