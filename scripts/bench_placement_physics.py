@@ -2,14 +2,15 @@
 library resting on the table, executed and its fingers' faces scored against the truth.
 
     .venv/bin/python scripts/bench_placement_physics.py [--seeds 1,2,3] [--fingers 2] [--objects A,B]
-        [--tip-clearance MM|none] [--record R.rrd --objects A --seeds S]
+        [--tip-clearance MM|none] [--hold-clearance MM|none] [--record R.rrd --objects A --seeds S]
 
 Each object rests at the pose of the physics episode of that seed (``EpisodeSpec(model, seed, executor="physics")``);
 the benchmark, not the executor, reads it: the true pose is the one hypothesis the planner generates placements from
 (``haptic.planning.placements``, as ``scripts/bench_placement_reach.py``), and the hand's reach test
 (``haptic.executor.placement.PlacementReach``, the reach solver with that model at that pose) decides which are
 offered, with which fingers (``--tip-clearance``: the placement's fingertips' least distance from the table there,
-in mm, or ``none`` for the 20 mm of every other link). After the episode's start (the landing), every offered
+in mm, or ``none`` for the 20 mm of every other link; ``--hold-clearance``: how far within its clearances the path
+may come, in mm, or ``none`` for as near as touching). After the episode's start (the landing), every offered
 placement is carried out in turn (``PhysicsExecutor.execute``). Prints, per object and seed, the candidates, those
 offered, and each placement's outcome, its cost and the hand's way (to the lines, closing, back); then the placements
 that succeeded (at least one finger measured a face or free space), each finger's outcome by reason, and the faces
@@ -31,7 +32,12 @@ import numpy as np  # noqa: E402
 
 from haptic.episode.spec import EpisodeSpec  # noqa: E402
 from haptic.episode.worlds import build_episode  # noqa: E402
-from haptic.executor.placement import REACH_CLEARANCE, TIP_TABLE_CLEARANCE, PlacementReach  # noqa: E402
+from haptic.executor.placement import (  # noqa: E402
+    HOLD_CLEARANCE,
+    REACH_CLEARANCE,
+    TIP_TABLE_CLEARANCE,
+    PlacementReach,
+)
 from haptic.geometry import load_library  # noqa: E402
 from haptic.matching.components import DataFace, SensorNoise  # noqa: E402
 from haptic.planning.efficiency import class_weights  # noqa: E402
@@ -90,15 +96,21 @@ def main() -> None:
     ap.add_argument("--objects", default=None, help="comma-separated model names (default: the seed library)")
     ap.add_argument("--tip-clearance", default=f"{TIP_TABLE_CLEARANCE * 1000:g}", metavar="MM|none",
                     help="the fingertips' least distance from the table in the reach test [mm]")
+    ap.add_argument("--hold-clearance", default=f"{HOLD_CLEARANCE * 1000:g}", metavar="MM|none",
+                    help="how far within its clearances the reach test's path may come [mm]")
     ap.add_argument("--record", default=None, metavar="R.rrd", help="record the start and the placements here")
     args = ap.parse_args()
     objects = args.objects.split(",") if args.objects else sorted(load_library())
     seeds = [int(s) for s in args.seeds.split(",")]
-    try:
-        tip = None if args.tip_clearance == "none" else float(args.tip_clearance) / 1000.0
-    except ValueError:
-        ap.error(f"--tip-clearance {args.tip_clearance!r}: give millimetres (such as 3) or none")
-    reach = PlacementReach(replace(REACH_CLEARANCE, tip_table_clearance=tip))
+    mm = {}
+    for name in ("tip_clearance", "hold_clearance"):
+        value = getattr(args, name)
+        try:
+            mm[name] = None if value == "none" else float(value) / 1000.0
+        except ValueError:
+            ap.error(f"--{name.replace('_', '-')} {value!r}: give millimetres (such as 8) or none")
+    reach = PlacementReach(replace(REACH_CLEARANCE, tip_table_clearance=mm["tip_clearance"],
+                                   hold_clearance=mm["hold_clearance"]))  # fmt: skip
     outcomes: Counter = Counter()
     fingers: Counter = Counter()
     faces = [0, 0]  # within bounds, measured
