@@ -134,8 +134,9 @@ def placement_path_costs(
     ``lines``: the exploring pad lifts off its face, rises to the safe height and goes over to its place at the
     path's start (``home``); the fingers' pads go along the path (``travel``, the farthest of them) to their lines'
     starts and close, the longest to contact or its line's end; then the fingers retract, the hand rises straight
-    up to the safe height and its exploring pad goes over and down to the first face a finger touched (when none
-    did, to the face it left). :meth:`~haptic.planning.moves.CostModel.placement_move` of that way, with a stroke
+    up to the height it went over at (the safe height, or the path's start where higher: the way back to the
+    tracing posture) and its exploring pad goes over and down to the first face a finger touched (when none did,
+    to the face it left). :meth:`~haptic.planning.moves.CostModel.placement_move` of that way, with a stroke
     per contact on the hand."""
     if move.travel is None or move.home is None:
         return placement_costs(lines, position, costs, hand)
