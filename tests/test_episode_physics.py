@@ -200,9 +200,11 @@ def test_a_verification_face_move_round_a_vertex_along_the_arc_reports_no_edge(t
     # verification face move rolled round a vertex onto a face sharing only that vertex with the first, its normals
     # following the arc between the faces' closely (their median lean 0.84°, under the noise's 1.74°); the "edge"
     # reported was 45 bounds off every true edge and the episode ended no-match. The rolling normals still leaned
-    # 0.55° to one side on average (true edges: at most 0.34° over 30 rolls): no edge between the faces.
+    # 0.55° to one side on average (true edges: at most 0.34° over 30 rolls): no edge between the faces. (Since the
+    # segmentation picks a face's rows about its own normal and a square crossing follows the ridge first, this
+    # episode's rolls round the vertex lean more than the noise allows at once, not only on average: either is told.)
     ep, failed, _ = _replay(tmp_path, "antiprism_04", 0.15, 6, corpus=True, seed=1)
-    assert any("on average" in r.reason for r in failed), [r.reason for r in failed]
+    assert any("(a roll round a vertex)" in r.reason for r in failed), [r.reason for r in failed]
     assert _within_bounds(ep)
 
 
