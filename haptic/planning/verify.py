@@ -341,7 +341,7 @@ def _moves(
     The planner's face moves in fixed directions are left out when moves are aimed at something of the current
     face, and always with ``fixed_faces`` False (the second move of a look-ahead): what they can measure the
     aimed moves measure more cheaply, and each costs a prediction."""
-    from haptic.planning.policies import refusal, same_move
+    from haptic.planning.move_scores import refusal, same_move
 
     out = []
     aimed = aimed_face_moves(h, state, components, missing, config) if missing is not None else []
