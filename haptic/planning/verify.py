@@ -548,7 +548,7 @@ def plan_verification_move(
     keys = features(poly).index(missing)
     tour = plan_tour(poly, keys, legs, previous)
     table = StartCosts(poly, keys, legs)
-    here = _start_costs(h, state, table)
+    here = _start_costs(h, state, table, config)
     now = tour.cost_from(here)
     through = _through_middles(h, state, components, middles)
     first = _moves(h, state, components, noise, config, avoid, missing, extra=through)
@@ -562,7 +562,7 @@ def plan_verification_move(
         legs = LegCosts.of(config, probes=False)
         tour = plan_tour(poly, keys, legs, previous)
         table = StartCosts(poly, keys, legs)
-        here = _start_costs(h, state, table)
+        here = _start_costs(h, state, table, config)
         now = tour.cost_from(here)
     if not first and not probes:
         return None, tour, now
@@ -584,7 +584,7 @@ def plan_verification_move(
             continue
         measured = frozenset(int(k) for k in features(poly).index(tuple(  # type: ignore[arg-type]
             frozenset(n & x) for n, x in zip(new, missing, strict=True))))  # fmt: skip
-        score = c / max(1.0 - r, 1e-9) + tour.cost_from(_start_costs(h1, s1, table), measured)
+        score = c / max(1.0 - r, 1e-9) + tour.cost_from(_start_costs(h1, s1, table, config), measured)
         if middles and m.kind != "probe":
             passed = _passed_middles(h, state, s1, middles)
             if not passed and any(m is x for x in through):
@@ -648,11 +648,13 @@ def _legs(config: PlannerConfig) -> LegCosts:
     return LegCosts.of(config, probes=MAX_VERIFY_PROBES > 0)
 
 
-def _start_costs(h: Hypothesis, state: SensorState, table: StartCosts) -> np.ndarray:
+def _start_costs(h: Hypothesis, state: SensorState, table: StartCosts, config: PlannerConfig) -> np.ndarray:
     """:func:`~haptic.planning.tour.start_costs` of the targets of ``table`` (sorted feature indices) from the sensor
-    in ``state``, in hypothesis ``h``'s world."""
+    in ``state``, in hypothesis ``h``'s world; at a model vertex, from the vertex (every face at it, any edge from
+    it) without a table: on the hand, where a vertex move rolls the pad round the vertex and the verification
+    traces, the tour is priced from the face and edge the pad is on."""
     edge = h.edges.get(state.edge) if state.edge is not None else None
-    vertex = h.vertices.get(state.vertex) if state.vertex is not None else None
+    vertex = h.vertices.get(state.vertex) if state.vertex is not None and config.table_z is None else None
     return table(h.model_from_world.apply(state.position), h.faces.get(state.face), edge, vertex)
 
 
