@@ -410,3 +410,18 @@ def test_a_stroke_leg_that_a_finger_link_stopped_does_not_measure_the_face(tmp_p
     ep, _, _ = _replay(tmp_path, "bipyramid_08", 0.15, 12, corpus=True, seed=1)
     ratios = bound_ratios(ep.executor.components, ep.true_model, ep.world_from_model)
     assert max(r.ratio for r in ratios if r.what == "face normal") <= 1.0
+
+
+def test_a_next_face_met_near_its_end_is_touched_again_along_the_edge():
+    # BOX01 seed 2: after an edge move to a top vertex, a face move across a side 4 mm under its top edge crossed
+    # the vertical edge next to the vertex; the stroke on the next face rode the top rim, and so did every touch of
+    # it afresh, their normals leaning 8° up along the edge: "too few contacts on the next face", the move failed.
+    # The face touched past the edge but measured too little is touched again 7 mm down the edge, clear of its end.
+    results = []
+    obs = EpisodeObserver(on_move=lambda n, r, *a: results.append(r), on_failed_move=lambda n, r: results.append(r))
+    ep = build_episode(EpisodeSpec(model="BOX01", seed=2, executor="physics", verify="full"))
+    rec = ep.run(None, obs)
+    shifted = [r for r in results if any("clear of its end" in s for s in r.info.get("recoveries", ()))]
+    assert shifted and all(r.ok for r in shifted)
+    assert not [r for r in results if "too few contacts" in r.reason]
+    assert rec.outcome == "recognized" and rec.correct, rec.detail

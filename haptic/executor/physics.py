@@ -550,9 +550,12 @@ class PhysicsExecutor(LandingSearch):
         """The next face after a crossing that lost it (``why``): lifted off, touch it afresh a little past the
         edge at ``corner``, its normal guessed as turned about the edge (the roll's settled normal ``n_roll``
         first, then :attr:`PhysicsSettings.reacquire_turns`); a touched normal that turned about the edge is the
-        next face's, and an L stroke on it measures it. Returns what :meth:`_cross_and_acquire` returns; the
-        failure ``why`` when no guess gives the face."""
-        t, s, seg = self.toucher, self.settings, self.segmenter
+        next face's, and an L stroke on it measures it. An L that measures too little of a face touched past the
+        edge (met near its end, the pad rides the rim of the face beyond that end too) is made again
+        :attr:`PhysicsSettings.recross_shift` (plus the touched normal's lean times the pad's radius) farther along
+        the edge, away from where that normal leans first, once. Returns what :meth:`_cross_and_acquire` returns;
+        the failure ``why`` when no guess gives the face."""
+        t, s = self.toucher, self.settings
         d = in_plane(np.asarray(direction, dtype=float), n_a)
         if d is None:
             return "unreachable", why, None, None, None
@@ -560,8 +563,8 @@ class PhysicsExecutor(LandingSearch):
         sign = 1.0 if kind == "convex" else -1.0
         guesses = [] if n_roll is None else [unit(n_roll - float(n_roll @ e) * e)]
         guesses += [math.cos(a) * n_a + sign * math.sin(a) * d for a in s.reacquire_turns]
-        floor = TABLE_TOP_Z + t.pad_radius + s.table_margin
         tried: list[np.ndarray] = []
+        shifted = False
         for n_b in guesses:
             if any(angle(n_b, m) < s.reacquire_cone for m in tried):
                 continue
@@ -574,30 +577,64 @@ class PhysicsExecutor(LandingSearch):
             target = corner + s.reacquire_inset * away_b
             if self.workspace.pad_clearance(target, n_b) < s.pad_clearance:
                 continue
-            r = t.lift_and_approach(target, n_b, floor_z=floor)
-            pieces.append(r)
-            if not r.ok:
+            out = self._touch_next(kind, n_a, d, corner, target, n_b, pieces, away_from)
+            if isinstance(out, str):
+                if out == "table":
+                    return "unreachable", "the edge lies on the table", None, None, None
                 continue
-            n = r.info["normal"]
-            # a face past the edge: turned from n_a toward the travel (a convex edge met at a slant turns it about
-            # another axis than n_a x d; the edge's line then comes from the two planes)
-            if sign * float(n @ d) <= 0 or angle(n, n_a) < seg.bounds.min_edge_angle:
-                continue
-            if self.workspace.is_table(n, t.contact[2]):
-                return "unreachable", "the edge lies on the table", None, None, None
-            e_n = unit(np.cross(n_a, n))
-            away = unit(np.cross(n, e_n))
-            if float(away @ (t.tip - corner)) < 0:
-                away = -away
-            along = e_n if away_from is None or float((t.tip - away_from) @ e_n) >= 0 else -e_n
-            # an L as wide as long enough to tell a face from a ridge (along an edge the normal holds too)
-            st = t.stroke(n, away, along, step_in=s.reacquire_step_in)
-            pieces.append(st)
-            fit = seg.fit_face_trace(st.trace, st.info["normal"], two_d=True) if st.ok else None
+            n, fit, st = out
+            if fit is None and not shifted:
+                # the face is there but the L measured too little of it: the pad touched the rim of the face
+                # beyond the edge's end too (met near a vertex). Touched again farther along the edge, away from
+                # where the touched normal leans first
+                shifted = True
+                lean = float(n @ e)
+                step = s.recross_shift + t.pad_radius * abs(lean)
+                for k in (1.0, -1.0):
+                    moved = target - k * math.copysign(step, lean) * e
+                    if self.workspace.pad_clearance(moved, n) < s.pad_clearance:
+                        continue
+                    again = self._touch_next(kind, n_a, d, corner, moved, n, pieces, away_from)
+                    if again == "table":
+                        return "unreachable", "the edge lies on the table", None, None, None
+                    if not isinstance(again, str) and again[1] is not None and angle(again[0], n) <= s.reacquire_cone:
+                        self.recoveries.append(f"{why}: the next face touched afresh {step * 1000:.0f} mm along the "
+                                               "edge, clear of its end")  # fmt: skip
+                        return "ok", "", roll, again[2].trace, again[1]
             if fit is not None:
                 self.recoveries.append(f"{why}: the next face touched afresh")
                 return "ok", "", roll, st.trace, fit
         return "unreachable", why, None, None, None
+
+    def _touch_next(self, kind: str, n_a: np.ndarray, d: np.ndarray, corner: np.ndarray, target: np.ndarray,
+                    n_guess: np.ndarray, pieces: list[PrimitiveResult], away_from):  # fmt: skip
+        """For :meth:`_reacquire`: lifted off, touch the face past the edge at ``target`` (its normal guessed
+        ``n_guess``) and measure it by an L. "miss" when nothing past the edge was touched, "table" when the
+        table was; else the touched normal, the face's fit (None: the L measured too little) and the stroke."""
+        t, s, seg = self.toucher, self.settings, self.segmenter
+        floor = TABLE_TOP_Z + t.pad_radius + s.table_margin
+        sign = 1.0 if kind == "convex" else -1.0
+        r = t.lift_and_approach(target, n_guess, floor_z=floor)
+        pieces.append(r)
+        if not r.ok:
+            return "miss"
+        n = r.info["normal"]
+        # a face past the edge: turned from n_a toward the travel (a convex edge met at a slant turns it about
+        # another axis than n_a x d; the edge's line then comes from the two planes)
+        if sign * float(n @ d) <= 0 or angle(n, n_a) < seg.bounds.min_edge_angle:
+            return "miss"
+        if self.workspace.is_table(n, t.contact[2]):
+            return "table"
+        e_n = unit(np.cross(n_a, n))
+        away = unit(np.cross(n, e_n))
+        if float(away @ (t.tip - corner)) < 0:
+            away = -away
+        along = e_n if away_from is None or float((t.tip - away_from) @ e_n) >= 0 else -e_n
+        # an L as wide as long enough to tell a face from a ridge (along an edge the normal holds too)
+        st = t.stroke(n, away, along, step_in=s.reacquire_step_in)
+        pieces.append(st)
+        fit = seg.fit_face_trace(st.trace, st.info["normal"], two_d=True) if st.ok else None
+        return n, fit, st
 
     def _face_move(self, move: FaceMove, pieces: list[PrimitiveResult]) -> MoveResult:
         st, t, seg = self.state, self.toucher, self.segmenter
