@@ -114,10 +114,25 @@ class PlacementSettings:
 
 SETTINGS = PlacementSettings()
 
-REACH_CLEARANCE = ReachSettings(clearance=0.02, pads_touch=False)
-"""The planner's reach test of a placement: every link of the hand, the pads too, at least 8 mm from the
-hypothesised object and the table on the way to the lines' starts (the joints' servo trails the path by a few
-millimetres; the pads' place at the starts is the lines' standoff from every hypothesis)."""
+TIP_TABLE_CLEARANCE = 0.008
+"""Least distance of the placement's fingertips (distal links and pads) from the table in the planner's reach test
+[m], where every other link keeps 20 mm: a line closing on a face near the table starts nearer it than the hand's
+other links need to come. Measured (``scripts/bench_placement_physics.py --seeds 1,2,3 --fingers 2``): 3 mm and 8 mm
+offer the same 26 placements of 121 (20 mm: 21), so the larger, for the servo's lag."""
+
+HOLD_CLEARANCE = 0.015
+"""The reach test's path keeps its clearances to within this [m] (``ReachSettings.hold_clearance``): without it the
+solver's linearised limits let links pass within a millimetre of the hypothesised object, and the hand, trailing
+the path by a few millimetres, touched it on the way. Measured (``scripts/bench_placement_physics.py --seeds 1,2,3
+--fingers 2 --hold-clearance MM``): 15 mm offers 21 placements of 121 and 10 mm 18, every one carried out; none,
+26, of which 3 touched the object on the way."""
+
+REACH_CLEARANCE = ReachSettings(clearance=0.02, pads_touch=False, tip_table_clearance=TIP_TABLE_CLEARANCE,
+                                hold_clearance=HOLD_CLEARANCE)  # fmt: skip
+"""The planner's reach test of a placement: every link of the hand, the pads too, at least 20 mm from the
+hypothesised object on the way to the lines' starts, and from the table but for the fingertips
+(:data:`TIP_TABLE_CLEARANCE`) (the joints' servo trails the path by a few millimetres; the pads' place at the
+starts is the lines' standoff from every hypothesis)."""
 
 _SOLVERS: dict[tuple, ReachSolver] = {}
 """Reach solvers by scene (None: the robot and table alone) and settings, built once per process (compiling a
@@ -158,6 +173,14 @@ class _Closing:
         self.index.setdefault(ex.toucher.finger, FINGERS.index(ex.toucher.finger))
         self.ticks = 0
         self.posture = self.q_now()
+        self.closing_from: dict[str, int] | None = None
+        """Each finger's first row of the closing (None before it)."""
+        self.back_from: dict[str, int] | None = None
+        """Each finger's first row of the way back (None before it)."""
+        self.own: set[int] = set()
+        """The pieces made of these rows (not counted again in :meth:`way`)."""
+        self.pieces_at_back: int | None = None
+        """The pieces of the move before the way back (None before it)."""
 
     def q_now(self) -> np.ndarray:
         r = self.ex.robot.read()
@@ -223,6 +246,11 @@ class _Closing:
         return ContactTrace(np.array(t), np.array(tip), np.array(rot), np.array(p, dtype=float),
                             np.array(n, dtype=float), np.array(f), np.array(ph, dtype=int))  # fmt: skip
 
+    def way(self, finger: str, first: int = 0, last: int | None = None) -> float:
+        """The length of ``finger``'s pad centre's path over its rows ``first`` to ``last`` [m]."""
+        tips = np.array([row[1] for row in self.rows[finger][first:last]], dtype=float).reshape(-1, 3)
+        return float(np.linalg.norm(np.diff(tips, axis=0), axis=1).sum()) if len(tips) > 1 else 0.0
+
     def touching(self, finger: str, rows: int) -> bool:
         """The finger's last ``rows`` rows all in contact (debounced)."""
         last = self.rows[finger][-rows:]
@@ -275,7 +303,8 @@ class _Closing:
     def _touched_on_the_way(self, reading) -> str | None:
         for k, f in enumerate(FINGERS):
             if sum(c.normal_force for c in reading.contacts[k]) > self.ex.toucher.threshold:
-                return f"the {f} fingertip touched something"
+                where = "the table" if self.ex.workspace.touching_table(reading.contacts[k]) else "something"
+                return f"the {f} fingertip touched {where}"
         links = self.link_on_object(reading)
         if links:
             return f"the hand's {next(iter(links.values()))} touched something"
@@ -309,6 +338,7 @@ def placement_move(ex: PhysicsExecutor, move: PlacementMove, pieces: list[Primit
         if not res.ok:
             return ex.failed_result(move, res, f"leaving the surface: {res.event}")
     ex.on_face = None
+    first_piece = len(pieces) - 1 if t.contact[1] is not None and t.normal is not None else len(pieces)
     z_safe = float(np.max(safe_height(_highest_contact(ex), t.pad_radius, starts, t.tip, s.clearance)))
     z_safe = min(z_safe, TABLE_TOP_Z + ex.settings.max_approach_height)  # the hand's reach over the region
     up = t.move_guarded(np.array([t.tip[0], t.tip[1], z_safe]), 0.15, max_lag=0.012)
@@ -316,7 +346,6 @@ def placement_move(ex: PhysicsExecutor, move: PlacementMove, pieces: list[Primit
     if not up.ok or up.event != "done":
         return ex.failed_result(move, "unreachable", f"rising above the object: {up.event}")
     c = _Closing(ex, move, s)
-    tip0 = {f.finger: c.ex.robot.read().fingertip_in_world[c.index[f.finger]].copy() for f in move.fingers}
     result = _place(ex, move, c, starts, z_safe, pieces)
     _restore(ex, c, move, z_safe, pieces)
     if result.status != "ok":
@@ -327,13 +356,30 @@ def placement_move(ex: PhysicsExecutor, move: PlacementMove, pieces: list[Primit
         if ex._ensure_on_face(fid, pieces, near=np.asarray(info["point"])) == "ok":
             ex.state = SensorState(position=ex.contact_point(), face=fid)
             break
-    transfer = max(float(np.linalg.norm(starts[k] - tip0[f.finger])) for k, f in enumerate(move.fingers))
-    closing = max((i.get("travel") or 0.0) for i in result.info["fingers"])
-    dist = transfer + closing
+    way = _travel(c, move, pieces, first_piece, max((i.get("travel") or 0.0) for i in result.info["fingers"]))
+    dist = float(sum(way.values()))
     cost = ex.costs.placement_move(dist, len(move.fingers), len(touched))
     for info in result.info["fingers"]:
         info.pop("point", None)
-    return replace(result, distance=dist, cost=cost, state=ex.state)
+    return replace(result, distance=dist, cost=cost, state=ex.state,
+                   info={**result.info, "travel": {k: round(v, 4) for k, v in way.items()}})  # fmt: skip
+
+
+def _travel(c: _Closing, move: PlacementMove, pieces: list[PrimitiveResult], first: int,
+            closing: float) -> dict[str, float]:  # fmt: skip
+    """The hand's way through free space in a placement, as it went [m]: ``to`` the lines' starts (the exploring
+    pad's lift, rise and way over to the path's start, then the farthest of the fingers' pads' ways along the
+    path), the longest ``closing`` along a line (given), and ``back``: the exploring pad's way as the fingers
+    retract, the hand rises and turns back to the tracing posture, and the pad goes to the face it rests on."""
+    names = [f.finger for f in move.fingers]
+    ends = c.closing_from or {f: len(c.rows[f]) for f in c.rows}
+    back = c.back_from or ends
+    split = c.pieces_at_back if c.pieces_at_back is not None else len(pieces)
+    before = [p for p in pieces[first:split] if id(p) not in c.own]
+    after = [p for p in pieces[split:] if id(p) not in c.own]
+    to = sum(p.distance for p in before) + max(c.way(f, 0, ends[f]) for f in names)
+    home = c.way(c.ex.toucher.finger, back[c.ex.toucher.finger]) + sum(p.distance for p in after)
+    return {"to": to, "closing": closing, "back": home}
 
 
 def _place(ex: PhysicsExecutor, move: PlacementMove, c: _Closing, starts: np.ndarray, z_safe: float,
@@ -365,6 +411,7 @@ def _place(ex: PhysicsExecutor, move: PlacementMove, c: _Closing, starts: np.nda
     held: dict[str, np.ndarray] = {}
     reason: dict[str, str] = {}
     first_row = {f: len(c.rows[f]) for f in names}
+    c.closing_from = {f: len(c.rows[f]) for f in c.rows}
     t_cmd = 0.0
     debounce = ex.toucher.config.debounce
     while len(status) < len(names):
@@ -485,6 +532,7 @@ def _place(ex: PhysicsExecutor, move: PlacementMove, c: _Closing, starts: np.nda
             info["reason"] = reason[name]
         fingers.append(info)
     pieces.append(PrimitiveResult("ok", "done", c.trace(ex.toucher.finger), 0.0))  # the exploring pad's way
+    c.own.add(id(pieces[-1]))
     if not comps and not any(i["status"] == "missed" for i in fingers):
         why = "; ".join(f"{i['finger']}: {i.get('reason', i['status'])}" for i in fingers)
         return MoveResult(move=move, status="unreachable", state=ex.state, reason=f"no finger measured: {why}",
@@ -586,6 +634,8 @@ def _restore(ex: PhysicsExecutor, c: _Closing, move: PlacementMove, z_safe: floa
              pieces: list[PrimitiveResult]) -> None:  # fmt: skip
     """The fingers back along their lines, the hand up to ``z_safe`` and back to the tracing posture."""
     s, t = c.s, ex.toucher
+    c.back_from = {f: len(c.rows[f]) for f in c.rows}
+    c.pieces_at_back = len(pieces)
     r = ex.robot.read()
     names = [f.finger for f in move.fingers]
     back = {f.finger: r.fingertip_in_world[c.index[f.finger]] - s.lift * np.asarray(f.direction) for f in move.fingers}
@@ -613,11 +663,15 @@ class PlacementReach:
     """Whether the hand can take a placement up, asked by the planner before it offers one: the reach solver with
     the hypothesised model at its hypothesised pose in the scene (never the true pose), each finger's pad at its
     line's start pointing along the line, from the tracing posture. Tries the placement's own fingers, then other
-    fingers for its lines (at most :attr:`assignments` in all); the placement with the fingers that reach, or
-    None. Called with the planner's hypotheses (the most likely first)."""
+    fingers for its lines (at most :attr:`assignments` in all); the placement with the fingers that reach, the
+    path and the ways the pads go along it (``PlacementMove.travel``, ``home``: the planner's cost of it), or None.
+    Called with the planner's hypotheses (the most likely first)."""
 
-    def __init__(self, settings: ReachSettings | None = None, assignments: int = 12, cache: int = 4) -> None:
+    def __init__(self, settings: ReachSettings | None = None, assignments: int = 12, cache: int = 4,
+                 explorer: str = "index") -> None:
         self.settings = settings or REACH_CLEARANCE
+        self.explorer = explorer
+        """The exploring finger, whose pad goes to the path's start before the hand follows it."""
         self.assignments = assignments
         self.cache = cache
         self._solvers: dict[tuple, ReachSolver] = {}
@@ -648,8 +702,9 @@ class PlacementReach:
                        for n, f in zip(names, lines, strict=True)]  # fmt: skip
             r = solver.solve(targets)
             if r.ok:
+                travel, home = _path_ways(solver, r.path, names, self.explorer)
                 answer = PlacementMove(tuple(replace(f, finger=n) for n, f in zip(names, lines, strict=True)),
-                                       path=r.path)  # fmt: skip
+                                       path=r.path, travel=travel, home=home)  # fmt: skip
                 break
             why = str(r.reason)
         if answer is None:
@@ -681,6 +736,21 @@ class PlacementReach:
         return solver
 
 
+def _path_ways(solver: ReachSolver, path: np.ndarray, fingers: Sequence[str],
+               explorer: str) -> tuple[float, np.ndarray]:  # fmt: skip
+    """The farthest way of the ``fingers``' pads along the joint ``path`` (each pad centre's polyline through its
+    configurations) [m], and the ``explorer``'s pad centre at its start."""
+    d = solver.configuration.data
+    sites = {f: mujoco.mj_name2id(solver.model, mujoco.mjtObj.mjOBJ_SITE, solver.site_name(f))
+             for f in {*fingers, explorer}}  # fmt: skip
+    pads = []
+    for q in path:
+        solver.configuration.update(q)
+        pads.append({f: d.site_xpos[k].copy() for f, k in sites.items()})
+    travel = max(sum(float(np.linalg.norm(b[f] - a[f])) for a, b in zip(pads, pads[1:], strict=False)) for f in fingers)
+    return travel, pads[0][explorer]
+
+
 def _assignments(own: tuple[str, ...]):
     """The placement's own fingers first, then the others' assignments of fingers to its lines."""
     yield own
@@ -694,6 +764,5 @@ def reach_oracle(fingers: int) -> Callable | None:
     return PlacementReach() if fingers > 1 else None
 
 
-__all__ = ["REACH_CLEARANCE", "SETTINGS", "PlacementReach", "PlacementSettings", "hand_solver", "pad_target",
-           "placement_move",
-           "reach_oracle"]
+__all__ = ["HOLD_CLEARANCE", "REACH_CLEARANCE", "SETTINGS", "TIP_TABLE_CLEARANCE", "PlacementReach",
+           "PlacementSettings", "hand_solver", "pad_target", "placement_move", "reach_oracle"]

@@ -26,6 +26,7 @@ from haptic.planning.placements import (
     PlacementConfig,
     PlacementPrediction,
     candidate_placements,
+    placement_path_costs,
     same_placement,
 )
 from haptic.planning.predict import Prediction, candidate_moves, crossed_edge, predict_moves
@@ -176,7 +177,7 @@ def score_placements(ctx: Context, weights: np.ndarray, lines: Sequence[ProbePre
     (:class:`~haptic.planning.placements.PlacementPrediction`). With the hand's reach test
     (``config.placement_reach``) only the first placement it reaches is offered, of those beating the best other
     candidate's efficiency or expected eliminations (``beat``: the only ones a policy scoring either could
-    choose)."""
+    choose), costed along the way the test found (:func:`~haptic.planning.placements.placement_path_costs`)."""
     if ctx.config.fingers < 2 or not ctx.hypotheses or any(h.world_from_model is None for h in ctx.hypotheses):
         return []
     lines = placement_lines(ctx) if lines is None else lines
@@ -198,8 +199,10 @@ def score_placements(ctx: Context, weights: np.ndarray, lines: Sequence[ProbePre
     better = [c for c in scored if c[1] > beat[0] or c[2] > beat[1]]
     for item in sorted(better, key=lambda c: -c[1])[: ctx.config.placement_checks]:
         move = reach(item[0].move, likely)
-        if move is not None:
-            return [(replace(item[0], move=move), *item[1:])]
+        if move is not None:  # costed along the way the test found (the hand's way there and back)
+            costs = placement_path_costs(item[0].lines, move, ctx.state.position, ctx.config.costs, hand_start(ctx))
+            pred = replace(item[0], move=move, costs=costs)
+            return [(pred, *pred.score(weights), pred.risk(weights))]
     return []
 
 

@@ -251,6 +251,12 @@ class PlacementMove:
     """The hand's way to the fingers' lines as the planner's reach test found it, clear of the hypothesised object:
     joint configurations (K, n) from the tracing posture to every pad at its line's start [rad]; None: the executor
     finds its own (the ideal sensor needs none)."""
+    travel: float | None = None
+    """The farthest way a finger's pad goes along ``path`` (the longest of the placement's fingers' pads' ways,
+    each its pad centre's polyline through the path's configurations) [m]; None without a path."""
+    home: np.ndarray | None = None
+    """Where the exploring pad's centre is at the path's start (the tracing posture), shape (3,) [m]: the hand
+    goes there from its face before it follows the path; None without a path."""
 
     kind = "placement"
 

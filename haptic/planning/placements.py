@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from haptic.planning.efficiency import efficiency_of, expected_eliminated, move_score
-from haptic.planning.handpath import HandStart
+from haptic.planning.handpath import LIFT, HandStart, safe_height
 from haptic.planning.moves import CostModel, FingerApproach, PlacementMove, ProbeMove
 from haptic.planning.probe_prediction import ProbePrediction
 
@@ -123,6 +123,51 @@ def placement_costs(
     contacts = hit.sum(axis=0)
     strokes = contacts if hand is not None else 0  # a point sensor has the normal at contact
     return np.asarray(costs.placement_move(s, len(lines), strokes), dtype=float)  # (the formula, elementwise)
+
+
+def placement_path_costs(
+    lines: Sequence[ProbePrediction], move: PlacementMove, position: np.ndarray, costs: CostModel,
+    hand: HandStart | None = None,
+) -> np.ndarray:
+    """Each hypothesis's cost of the placement ``move`` along the way the hand's reach test found for it
+    (``move.travel`` and ``move.home``; :func:`placement_costs` without them), the fingers closing along
+    ``lines``: the exploring pad lifts off its face, rises to the safe height and goes over to its place at the
+    path's start (``home``); the fingers' pads go along the path (``travel``, the farthest of them) to their lines'
+    starts and close, the longest to contact or its line's end; then the fingers retract, the hand rises straight
+    up to the height it went over at (the safe height, or the path's start where higher: the way back to the
+    tracing posture) and its exploring pad goes over and down to the first face a finger touched (when none did,
+    to the face it left). :meth:`~haptic.planning.moves.CostModel.placement_move` of that way, with a stroke
+    per contact on the hand."""
+    if move.travel is None or move.home is None:
+        return placement_costs(lines, position, costs, hand)
+    starts = np.array([p.move.start for p in lines], dtype=float)
+    dirs = np.array([p.move.direction for p in lines], dtype=float)
+    lengths = np.array([p.move.length for p in lines], dtype=float)
+    home = np.asarray(move.home, dtype=float)
+    if hand is None:
+        here, r, top = np.asarray(position, dtype=float), 0.0, float(np.asarray(position)[2])
+        lifted = here
+    else:
+        here, r, top = hand.tip, hand.pad_radius, hand.highest
+        lifted = hand.tip + LIFT * np.asarray(hand.normal, dtype=float)
+    c0 = starts - r * dirs
+    z_safe = max(float(np.max(safe_height(top, r, c0, here))), float(home[2]))
+    to_home = (float(np.linalg.norm(lifted - here)) + (z_safe - float(lifted[2]))
+               + float(np.linalg.norm(home - np.array([lifted[0], lifted[1], z_safe]))))  # fmt: skip
+    hit = np.array([p.hit for p in lines])  # (K, N)
+    depth = np.nan_to_num(np.array([p.distance for p in lines]))
+    closing = np.where(hit, depth, lengths[:, None])  # (K, N)
+    # back: the fingers retract and the hand rises straight up to the safe height; the exploring pad goes over,
+    # from above the fingers' contacts, and down to the first face touched (else to the face it left)
+    ends = c0[:, None, :] + closing[..., None] * dirs[:, None, :]  # (K, N, 3) each pad's place at its closing's end
+    first = np.argmax(hit, axis=0)  # (N,) the first finger touching in each world (0 when none)
+    touched = np.where(hit.any(axis=0)[:, None], ends[first, np.arange(hit.shape[1])], lifted[None])  # (N, 3)
+    low = ends[..., 2].min(axis=0)  # (N,)
+    over = np.linalg.norm(ends.mean(axis=0)[:, :2] - touched[:, :2], axis=1)
+    back = LIFT + (z_safe - low) + over + (z_safe - touched[:, 2])
+    s = to_home + move.travel + closing.max(axis=0) + back
+    strokes = hit.sum(axis=0) if hand is not None else 0
+    return np.asarray(costs.placement_move(s, len(lines), strokes), dtype=float)
 
 
 def _contact_points(lines: Sequence[ProbePrediction], weights: np.ndarray) -> np.ndarray:
@@ -245,5 +290,6 @@ __all__ = [
     "compatibility",
     "compatible",
     "placement_costs",
+    "placement_path_costs",
     "same_placement",
 ]

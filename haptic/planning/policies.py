@@ -19,6 +19,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from haptic.errors import PlanningError
+from haptic.planning.disagree import disagreement_move
 from haptic.planning.move_scores import (  # noqa: F401 -- Context, Decision, refusal, same_move: re-exported
     Context,
     Decision,
@@ -46,8 +47,9 @@ class Policy:
 
 class _ScoringPolicy(Policy):
     """The best-scoring candidate; when no candidate scores above zero (what separates the hypotheses is
-    further away), the first move of the most efficient sequence of ``lookahead`` moves, failing that the
-    cheapest move that reaches a new edge and face."""
+    further away), toward where look-alike hypotheses disagree (:func:`~haptic.planning.disagree.disagreement_move`),
+    else the first move of the most efficient sequence of ``lookahead`` moves, failing that the cheapest move that
+    reaches a new edge and face."""
 
     def __init__(self, lookahead: int = 3) -> None:
         self.lookahead = lookahead
@@ -119,8 +121,11 @@ class RandomPolicy(Policy):
 
 
 def _further(ctx: Context, cands: Sequence[Scored], rng: np.random.Generator, depth: int) -> Move:
-    if ctx.config.moves == "probing":  # the look-ahead simulates tracing moves only
+    if ctx.config.moves == "probing":  # the look-ahead simulates tracing moves only; a probe measures no vertex
         return _cheapest_exploring(cands, rng)
+    move = disagreement_move(ctx)  # look-alikes: only where they disagree tells them apart
+    if move is not None:
+        return move
     for d in range(2, depth + 1):
         move = lookahead_choice(ctx, depth=d)
         if move is not None:

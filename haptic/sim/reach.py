@@ -75,6 +75,15 @@ class ReachSettings:
     pads_touch: bool = True
     """Whether the target fingers' pads may touch the object (targets on its surface); False: they keep the
     clearance too (targets short of it, such as a placement's lines' starts)."""
+    tip_table_clearance: float | None = None
+    """Least distance kept between the target fingers' fingertips (distal link and pad) and the table [m], in
+    place of ``clearance`` there: a pad sent to a face near the table comes closer to it than the hand's other
+    links need to. None: ``clearance`` for every link."""
+    hold_clearance: float | None = None
+    """With it, a step that would bring a link nearer the table or the object than its clearance less this (and
+    nearer than before) is not taken either, as a step into them is not (shorter steps, then the solver stops
+    there): the path keeps the clearance to within this, where the linearised limits alone let links graze the
+    object [m]. None: only steps into the table or object are refused."""
     detection: float = 0.08
     """Distance below which a pair of geoms enters the collision constraints [m]: more than a step moves any
     link, so that no step jumps past a constraint not yet active."""
@@ -267,7 +276,8 @@ class ReachSolver:
         steps = 0
         pads = self._exempt(fingers)
         rest = [g for g in self._hand_geoms if g not in pads]
-        clear = self._clearance(rest)
+        sets = self._table_sets(fingers)
+        clear, margin = self._clearance(rest), self._margins(rest, sets)
         blocked: ReachFailure | None = None
         dt = s.dt
         while steps < s.max_iters:
@@ -275,15 +285,21 @@ class ReachSolver:
             vel = mink.solve_ik(cfg, tasks, dt, solver="daqp", damping=s.damping, limits=limits)
             cfg.integrate_inplace(vel, dt)
             now = self._clearance(rest)
-            if now < 0.0 and now < clear:  # the linearised limits let a step through: not taken; shorter steps
-                table = self._distance(self._hand_geoms, self._table_geoms)
-                blocked = ReachFailure.TABLE if table <= now else ReachFailure.OBJECT
+            near = self._margins(rest, sets)
+            into = now < 0.0 and now < clear
+            grazing = s.hold_clearance is not None and min(near) < -s.hold_clearance and min(near) < min(margin)
+            if into or grazing:  # the linearised limits let a step through: not taken; shorter steps
+                if into:
+                    table = self._distance(self._hand_geoms, self._table_geoms)
+                    blocked = ReachFailure.TABLE if table <= now else ReachFailure.OBJECT
+                else:
+                    blocked = ReachFailure.TABLE if near[0] <= near[1] else ReachFailure.OBJECT
                 cfg.update(path[-1])
                 if dt < s.dt / 2**s.step_halvings:
                     break
                 dt /= 2
                 continue
-            clear = now
+            clear, margin = now, near
             path.append(cfg.q.copy())
             pos_err, app_err = self._errors(targets)
             if np.all(pos_err < s.position_tol) and np.all(app_err < s.approach_tol):
@@ -305,12 +321,55 @@ class ReachSolver:
         s = self.settings
         limits: list[mink.Limit] = [mink.ConfigurationLimit(self.model), self._velocity]
         pads = self._exempt(fingers)
-        pairs = [(self._hand_geoms, self._table_geoms)]
+        body, tips = self._table_sets(fingers)
+        pairs = [(body, self._table_geoms)]
         if self._object_geoms:
             pairs.append(([g for g in self._hand_geoms if g not in pads], self._object_geoms))
         limits.append(mink.CollisionAvoidanceLimit(self.model, pairs, minimum_distance_from_collisions=s.clearance,
                                                    collision_detection_distance=s.detection))  # fmt: skip
+        if tips:
+            limits.append(mink.CollisionAvoidanceLimit(self.model, [(tips, self._table_geoms)],
+                                                       minimum_distance_from_collisions=s.tip_table_clearance,
+                                                       collision_detection_distance=s.detection))  # fmt: skip
         return limits
+
+    def _table_sets(self, fingers: Sequence[str]) -> tuple[list[int], list[int]]:
+        """The hand's geoms that keep ``clearance`` from the table, and those of the ``fingers``' fingertips that
+        keep ``tip_table_clearance`` (none without it)."""
+        if self.settings.tip_table_clearance is None:
+            return list(self._hand_geoms), []
+        tips = [g for g in self._hand_geoms if self._tip_of(g) in fingers]
+        return [g for g in self._hand_geoms if g not in tips], tips
+
+    def _margins(self, rest: Sequence[int], sets: tuple[list[int], list[int]]) -> tuple[float, float]:
+        """How far beyond its clearance the hand is from the table and ``rest`` from the object at the current
+        configuration [m] (negative: nearer than the clearance); only with ``hold_clearance`` (else zeros)."""
+        s = self.settings
+        if s.hold_clearance is None:
+            return 0.0, 0.0
+        body, tips = sets
+        table = self._distance(body, self._table_geoms) - s.clearance
+        if tips:
+            table = min(table, self._distance(tips, self._table_geoms) - s.tip_table_clearance)
+        obj = self._distance(rest, self._object_geoms) - s.clearance if self._object_geoms else 1.0
+        return table, obj
+
+    def _tip_of(self, g: int) -> str | None:
+        """The finger whose fingertip (distal link, its pad included) geom ``g`` belongs to, or None."""
+        m = self.model
+        name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, int(m.geom_bodyid[g])) or ""
+        return next((f for f in FINGERS if name == f"{HAND_PREFIX}{FINGER_PREFIX[f]}_distal"), None)
+
+    def table_margin(self, fingers: Sequence[str] = ()) -> float:
+        """Least distance at the current configuration of the hand's links from the table beyond what each must
+        keep (``clearance``, or ``tip_table_clearance`` for the ``fingers``' fingertips) [m]: negative where a
+        link is nearer than it may be."""
+        s = self.settings
+        body, tips = self._table_sets(fingers)
+        margin = self._distance(body, self._table_geoms) - s.clearance
+        if tips:
+            margin = min(margin, self._distance(tips, self._table_geoms) - s.tip_table_clearance)
+        return margin
 
     def _exempt(self, fingers: Sequence[str]) -> set[int]:
         """The pads of ``fingers`` that may touch the object (none unless ``settings.pads_touch``)."""
@@ -369,7 +428,7 @@ class ReachSolver:
         miss = f"{t.finger} {pos_err[worst] * MM:.1f} mm from its target, {np.rad2deg(app_err[worst]):.0f}° off"
         if blocked is not None:
             return blocked, f"{miss}: the next step would enter {blocked}"
-        if table < s.clearance + s.position_tol:
+        if self.table_margin([x.finger for x in targets]) < s.position_tol:
             return ReachFailure.TABLE, f"{miss}: the hand is held off the table"
         if on_object < s.clearance + s.position_tol:
             return ReachFailure.OBJECT, f"{miss}: the hand is held off the object"

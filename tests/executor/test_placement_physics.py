@@ -95,3 +95,20 @@ def test_a_failed_finger_does_not_fail_the_other(one_fails):
     assert face.id == touched[0]["component"]
     ang, dist = _true_face(ep, face)
     assert ang <= face.normal_bound and dist <= face.position_bound
+
+
+def test_a_placement_is_costed_along_the_way_the_hand_went(two_faces):
+    """The hand's way as it went: to the lines' starts (no shorter than the farthest pad's straight way from the
+    path's start to its line's start, and than the planned path's farthest pad's way), the longest closing, and back
+    to the face the sensor rests on; the cost is the placement's of their sum."""
+    from haptic.executor.placement import pad_target
+
+    ep, move, res, _ = two_faces
+    way = res.info["travel"]
+    assert set(way) == {"to", "closing", "back"} and all(v > 0.0 for v in way.values()), way
+    assert res.distance == pytest.approx(sum(way.values()), abs=1e-3)
+    assert way["to"] >= move.travel - 0.01  # the path's way, followed (the servo within a centimetre)
+    starts = np.array([pad_target(f) for f in move.fingers])
+    assert way["to"] >= float(np.linalg.norm(starts - move.home, axis=1).min())
+    assert way["closing"] == pytest.approx(max(i["travel"] for i in res.info["fingers"]), abs=1e-3)
+    assert res.cost == pytest.approx(ep.executor.costs.placement_move(res.distance, 2, 2))

@@ -185,3 +185,41 @@ def test_with_a_reach_test_only_a_placement_it_reaches_is_offered_with_its_finge
     nothing = replace(ctx, config=replace(ctx.config, placement_reach=lambda m, h: None))
     assert score_placements(nothing, weights) == []
     assert score_placements(reach_ctx, weights, beat=(np.inf, np.inf)) == []  # nothing beats the best other move
+
+
+def test_a_placement_the_reach_test_reaches_is_costed_along_its_way():
+    """The placement offered is costed along the way the reach test found: the hand to the path's start (its
+    exploring pad's place there, ``home``), the farthest pad's way along the path (``travel``), the closing and the
+    way back; each metre more of the path's way costs ``c_s`` more, and its efficiency is scored from that cost."""
+    from dataclasses import replace
+
+    from haptic.planning.move_scores import hand_start, score_placements
+    from haptic.planning.placements import placement_costs, placement_path_costs
+
+    ctx = _context(["BOX01", "WEDGE01", "PYR01", "BOX01N"], fingers=2)
+    weights = class_weights([h.model for h in ctx.hypotheses])
+    home = np.asarray(ctx.state.position, dtype=float) + np.array([0.0, 0.0, 0.15])
+
+    def along(travel):
+        def reach(move, hypotheses):
+            return replace(move, path=np.zeros((2, 3)), travel=travel, home=home)
+        return reach
+
+    offered = {}
+    for travel in (0.1, 0.3):
+        (offered[travel],) = score_placements(replace(ctx, config=replace(ctx.config, placement_reach=along(travel))),
+                                              weights)  # fmt: skip
+    near, far = offered[0.1], offered[0.3]
+    assert near[0].move.travel == 0.1 and far[0].move.travel == 0.3
+    assert far[0].costs == pytest.approx(near[0].costs + ctx.config.costs.c_s * 0.2)
+    lines, hand = near[0].lines, hand_start(ctx)
+    assert near[0].costs == pytest.approx(placement_path_costs(lines, near[0].move, ctx.state.position,
+                                                               ctx.config.costs, hand))  # fmt: skip
+    # the way through the path's start costs more than the straight way the estimate before the test assumes
+    assert np.all(near[0].costs > placement_costs(lines, ctx.state.position, ctx.config.costs, hand))
+    assert far[3] > near[3] and far[1] <= near[1]  # dearer, no more efficient
+    assert near[1:4] == pytest.approx(near[0].score(weights))
+    # without the way (an executor finding its own), the estimate before the test stands
+    bare = replace(near[0].move, travel=None, home=None)
+    assert np.array_equal(placement_path_costs(lines, bare, ctx.state.position, ctx.config.costs, hand),
+                          placement_costs(lines, ctx.state.position, ctx.config.costs, hand))  # fmt: skip

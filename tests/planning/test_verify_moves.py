@@ -227,6 +227,35 @@ def test_a_vertex_on_the_table_that_no_face_in_reach_places_is_placed_by_faces_m
     assert len(placed_by_data(poly, pose, unpinnable, one, table)) == 2
 
 
+def test_an_edge_move_that_failed_along_a_model_edge_is_not_taken_again_that_way():
+    """On the hand, an edge move that failed along a model edge (the ridge of a slot's floor between its walls) is
+    the edge's failure, not the place's: back on that edge later -- on another data edge, measured the other way
+    round -- the verifier does not offer the same way along it again, and still offers the other."""
+    import dataclasses
+
+    from haptic.planning.moves import FaceMove
+    from haptic.planning.verify import Verifier
+
+    h, state, comps, ex = _on_a_face("BOX01", 0)
+    n = comps[state.face].normal
+    d = np.cross(n, [0.0, 0.0, 1.0] if abs(n[2]) < 0.9 else [1.0, 0.0, 0.0])
+    r = ex.execute(FaceMove(d / np.linalg.norm(d)))
+    assert r.ok and r.state.edge is not None
+    comps = {**comps, **{c.id: c for c in r.components}}
+    faces = {**h.faces, **{c.id: ex.truth[c.id][1] for c in r.components if ex.truth[c.id][0] == "face"}}
+    edges = {c.id: ex.truth[c.id][1] for c in r.components if ex.truth[c.id][0] == "edge"}
+    h = dataclasses.replace(h, faces=faces, edges=edges)
+    v = Verifier("full", SensorNoise(), PlannerConfig())
+    edge = comps[r.state.edge]
+    assert v._failed_along(h, r.state, comps, ()) == []
+    assert v._failed_along(h, r.state, comps, (EdgeMove(1),)) == [EdgeMove(1)]
+    assert v._failed_along(h, r.state, comps, ()) == [EdgeMove(1)]  # remembered, here ...
+    flipped = dataclasses.replace(edge, id=99, direction=-edge.direction)
+    there = dataclasses.replace(r.state, edge=99, position=r.state.position + 0.01 * edge.direction)
+    h2 = dataclasses.replace(h, edges={**edges, 99: edges[edge.id]})
+    assert v._failed_along(h2, there, {**comps, 99: flipped}, ()) == [EdgeMove(-1)]  # ... and along the edge
+
+
 def test_the_band_next_to_the_table_that_nothing_measures_follows_the_faces_rising_from_it():
     """A confirmation on the table says the object is the model above the height below which the pad touches none
     of the faces rising from edges on the table: TETRA01L on a face, its sides rising at their own slopes; BOX01 on a

@@ -9,7 +9,7 @@ import pytest
 from conftest import BOX_CENTRE, box_parts, box_pose
 
 from haptic.errors import SceneError
-from haptic.sim.reach import FingertipTarget, ReachFailure, ReachSolver
+from haptic.sim.reach import FingertipTarget, ReachFailure, ReachSettings, ReachSolver
 from haptic.sim.scene import FINGERS, TABLE_TOP_Z, compose_scene, scene_object_from_parts
 
 DOWN = np.array([0.0, 0.0, -1.0])
@@ -110,3 +110,46 @@ def test_without_an_object_the_solver_knows_none(solver):
 def test_bad_targets_are_named(solver, targets, message):
     with pytest.raises(SceneError, match=message):
         solver.solve(targets)
+
+
+def test_the_fingertips_may_come_nearer_the_table_than_the_other_links():
+    """A pad 8 mm over the table: refused where every link keeps 20 mm from it, reached where the target finger's
+    fingertip (its distal link and pad) keeps 3 mm, with every other link still 20 mm clear along the path."""
+    from haptic.sim.scene import PAD_RADIUS
+
+    target = [FingertipTarget("index", np.array([0.60, 0.05, TABLE_TOP_Z + PAD_RADIUS + 0.008]), DOWN)]
+    strict = ReachSolver(compose_scene(None), ReachSettings(clearance=0.02))
+    r = strict.solve(target)
+    assert not r.ok and r.reason is ReachFailure.TABLE, r.detail
+    tips = ReachSolver(compose_scene(None), ReachSettings(clearance=0.02, tip_table_clearance=0.003))
+    r = tips.solve(target)
+    assert r.ok, r.detail
+    body, near = tips._table_sets(["index"])
+    assert len(near) == 2  # the index finger's distal link and pad
+    table = tips._table_geoms
+    for q in r.path:
+        tips.configuration.update(q)
+        assert tips._distance(body, table) > 0.02 - 1e-3
+        assert tips._distance(near, table) > 0.003 - 1e-3
+    tips.configuration.update(r.qpos)
+    assert tips._distance(near, table) < 0.02  # the fingertip came nearer than the others may
+
+
+def test_with_hold_clearance_the_path_keeps_its_clearance_from_the_object():
+    """Two pads sent to either side of a hypothesised box, 25 mm off its sides, from the tracing posture above it:
+    with ``hold_clearance`` no configuration of the path brings a link nearer the box than its clearance less that
+    (the linearised limits alone let links pass within millimetres of it)."""
+    box = scene_object_from_parts("box", box_parts())
+    settings = ReachSettings(clearance=0.02, pads_touch=False, hold_clearance=0.005)
+    solver = ReachSolver(compose_scene(box, box_pose()), settings)
+    side = BOX_CENTRE + [0.0, 0.0, 0.01]
+    targets = [FingertipTarget("index", side + [0.0, 0.065, 0.0], np.array([0.0, -1.0, 0.0])),
+               FingertipTarget("thumb", side + [0.0, -0.065, 0.0], np.array([0.0, 1.0, 0.0]))]  # fmt: skip
+    r = solver.solve(targets)
+    assert len(r.path) > 5
+    obj = solver._object_geoms
+    least = []
+    for q in r.path:
+        solver.configuration.update(q)
+        least.append(solver._distance(solver._hand_geoms, obj))
+    assert min(least) >= 0.02 - 0.005 - 1e-3, f"{min(least) * 1000:.1f} mm"
