@@ -260,6 +260,22 @@ def test_a_stroke_riding_the_rims_of_a_small_face_measures_no_face(tmp_path):
     assert _within_bounds(ep)
 
 
+def test_an_edge_move_that_sets_off_past_the_edges_other_end_reports_no_vertex(tmp_path):
+    # BOX01N at 60 mm, seed 2, --verify none (perception_report.py --sizes 60 --first-seed 2): an edge move along +e
+    # returned next to the edge 23 mm behind its explored interval, past the edge's other end, and located that end's
+    # vertex 0.2 mm behind its start; reported as the end it ran toward, the interval collapsed onto it and the edge's
+    # two ends were one vertex: every component within its bounds, the true object pruned (no-match). A vertex
+    # behind the move's start is not the end it ran toward: the move fails.
+    spec = EpisodeSpec(model="BOX01N", seed=2, executor="physics", verify="none",
+                       models=_scaled_library(tmp_path, 0.06))  # fmt: skip
+    ep = build_episode(spec)
+    rec = ep.run(None)
+    edges = [c for c in ep.executor.components if c.kind == "edge"]
+    assert all(e.start_vertex is None or e.start_vertex != e.end_vertex for e in edges)
+    assert rec.outcome != "no-match", rec.detail
+    assert _within_bounds(ep)
+
+
 def test_an_edge_move_that_goes_on_round_a_shallow_vertex_reports_no_vertex(tmp_path):
     # prism_12 of the formula corpus at 60 mm (seed 1 when found; seed 2 shows it since the moves recover): an
     # edge move along a cap edge of the 12-gon went on round its end, where the next cap edge turns by only 30°,

@@ -882,6 +882,15 @@ class PhysicsExecutor(LandingSearch):
             why = ("could not locate the vertex (no contact there, a concave edge's end, which its faces run past, or "
                    "contacts off the edge's line, on an edge turning little from it)")  # fmt: skip
             return self.failed_result(move, "unreachable", why)
+        # the vertex lies ahead of everything behind the move: the explored interval's back end and the start (BOX01N
+        # at 60 mm, seed 2: a move along +e set off 23 mm behind the interval, past the edge's other end, and located
+        # that end's vertex behind its start; reported as the end it ran toward, with the interval collapsed onto it,
+        # the edge's two ends were one vertex and the true object was pruned)
+        sign = 1.0 if float(u @ rec.direction) > 0 else -1.0
+        back = min(rec.interval[0], s_from) if sign > 0 else max(rec.interval[1], s_from)
+        if sign * (s_v - back) < seg.bounds.length_floor:
+            return self.failed_result(move, "unreachable", "the vertex located lies behind the move's start, at the "
+                                                           "edge's other end (the pad set off past it)")  # fmt: skip
         # refine the line with the ridge contacts (convex edges), then extend it to the vertex
         ridge = self._on_ridge(rows, u)
         w_v, w_from = rec.at(s_v), rec.at(s_from)

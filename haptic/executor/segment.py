@@ -495,7 +495,9 @@ class Segmenter:
             normal=fit.normal,
             points=pts,
             normal_bound=b.bound(fit.normal_sigma, b.normal_floor),
-            position_bound=b.bound(fit.offset_sigma, b.position_floor),
+            # the points are single samples, each off the face by σp per axis: within the floor at noise level 1,
+            # beyond it at level 4 (σp 0.8 mm: touched points next to an edge lay 1.1-2.1 bounds past it)
+            position_bound=b.bound(fit.offset_sigma, max(b.position_floor, b.point_sigma)),
             adjacent=adjacent,
         )
         self.faces[comp.id] = FaceRecord(fit, comp)

@@ -321,3 +321,15 @@ def test_at_noise_level_4_a_step_on_a_face_is_no_rim_and_a_step_onto_a_rim_is():
         assert all(Toucher._stepped_onto_rim(SimpleNamespace(bounds=bounds), step(s, turn, level)) for s in range(20))
     old = replace(SegmentBounds().scaled(4.0), rim_sigmas=0.0)
     assert sum(Toucher._stepped_onto_rim(SimpleNamespace(bounds=old), step(s, 0.0, 4.0)) for s in range(20)) >= 5
+
+
+def test_a_faces_position_bound_covers_one_sample_of_the_sensor():
+    # a data face's points are single samples: its position bound covers σp where σp exceeds the floor (noise level
+    # 4), and is the floor's at level 1
+    fit = FaceFit(np.array([0.0, 0.0, 1.0]), 0.0, np.zeros((6, 3)), 1e-3, 5e-5, 30)
+    for level in (1.0, 4.0):
+        b = SegmentBounds().scaled(level)
+        face = Segmenter(b).add_face(fit)
+        assert face.position_bound >= b.k * max(b.point_sigma, b.position_floor)
+        assert abs(face.position_bound - b.bound(5e-5, max(b.position_floor, b.point_sigma))) < 1e-12
+    assert SegmentBounds().point_sigma < SegmentBounds().position_floor
