@@ -332,13 +332,13 @@ def placement_move(ex: PhysicsExecutor, move: PlacementMove, pieces: list[Primit
     if np.any(starts[:, 2] - PAD_RADIUS < TABLE_TOP_Z + ex.settings.pad_clearance):
         return ex.invalid_result(move, "a finger's line would bring its pad onto the table")
     # 1. leave the surface and rise
+    first_piece = len(pieces)  # the placement's way starts here (:func:`_travel`)
     if t.contact[1] is not None and t.normal is not None:
         res = t.move_free(t.tip + s.lift * t.normal, timeout=t.config.lift_timeout, tol=t.config.lift_tol)
         pieces.append(res)
         if not res.ok:
             return ex.failed_result(move, res, f"leaving the surface: {res.event}")
     ex.on_face = None
-    first_piece = len(pieces) - 1 if t.contact[1] is not None and t.normal is not None else len(pieces)
     z_safe = float(np.max(safe_height(_highest_contact(ex), t.pad_radius, starts, t.tip, s.clearance)))
     z_safe = min(z_safe, TABLE_TOP_Z + ex.settings.max_approach_height)  # the hand's reach over the region
     up = t.move_guarded(np.array([t.tip[0], t.tip[1], z_safe]), 0.15, max_lag=0.012)
