@@ -173,8 +173,6 @@ class EpisodeState:
         if self.config.touch_evidence:
             self.touched.append(touched_points(result, self.config))
         self._placed(result)
-        if self.verifier is not None:
-            self.verifier.observe(self.sensor, result)
         self.cost += result.cost
         self.rec = self.assess()
         self.sensor = result.state

@@ -180,14 +180,12 @@ def leg_matrix(poly: Polyhedron, targets: np.ndarray, legs: LegCosts) -> np.ndar
 
 
 def start_costs(
-    poly: Polyhedron, position: np.ndarray, face: int | None, edge: int | None, targets: np.ndarray, legs: LegCosts,
-    vertex: int | None = None,
+    poly: Polyhedron, position: np.ndarray, face: int | None, edge: int | None, targets: np.ndarray, legs: LegCosts
 ) -> np.ndarray:
     """Cost of measuring each target first from a sensor at ``position`` (model frame) on model ``face`` and,
-    when known, model ``edge`` and model ``vertex``: by tracing (along the edge to a vertex at its end, or across
-    the face, or over faces; at a vertex, across any face at it, or along any edge from it as the leg matrix
-    has it) or by a probe; shape (n,) [units]."""
-    return StartCosts(poly, targets, legs)(position, face, edge, vertex)
+    when known, model ``edge``: by tracing (along the edge to a vertex at its end, or across the face, or over
+    faces) or by a probe; shape (n,) [units]."""
+    return StartCosts(poly, targets, legs)(position, face, edge)
 
 
 class StartCosts:
@@ -204,22 +202,13 @@ class StartCosts:
         self.vertex_base = feats.kinds.size - poly.n_vertices
         """Feature index of the model's vertex 0."""
 
-    def __call__(self, position: np.ndarray, face: int | None, edge: int | None, vertex: int | None = None
-                 ) -> np.ndarray:  # fmt: skip
-        """The costs from a sensor at ``position`` (model frame) on model ``face`` and, when known, ``edge`` and
-        ``vertex`` (the sensor at that model vertex), shape (n,) [units]. At a vertex the sensor is on every face
-        at it, and a vertex move takes it onto any edge from it (the leg matrix's way along an edge,
-        :func:`leg_matrix`): priced from the sensor on one face and edge only, the tour from a vertex just
-        measured cost more than from a point of its edge before it, with the vertex still to measure."""
+    def __call__(self, position: np.ndarray, face: int | None, edge: int | None) -> np.ndarray:
+        """The costs from a sensor at ``position`` (model frame) on model ``face`` and, when known, ``edge``,
+        shape (n,) [units]."""
         legs, kinds, fin = self.legs, self.kinds, self.finish
         d = np.linalg.norm(self.points - np.asarray(position), axis=1)
         cofacial = self.on_face[:, face] if face is not None else np.zeros(len(self.targets), dtype=bool)
-        if vertex is not None:
-            cofacial = cofacial | self.on_face[:, list(self.poly.vertex_faces[vertex])].any(axis=1)
         cost = np.minimum(legs.by_tracing(d, kinds, cofacial, fin), legs.by_probe(d, kinds, fin))
-        if vertex is not None:
-            joined = features(self.poly).edge_between[self.vertex_base + vertex, self.targets] >= 0
-            cost = np.where(joined, np.minimum(cost, legs.turn + legs.edge_rate * d + legs.vertex_event), cost)
         if edge is not None:
             a, b = self.vertex_base + self.poly.edges[edge]
             at_end = (self.targets == a) | (self.targets == b)

@@ -299,20 +299,6 @@ def aimed_face_moves(
     return out
 
 
-def _through_middles(h: Hypothesis, state: SensorState, components: Mapping[int, DataComponent],
-                     middles: Mapping[int, np.ndarray] | None) -> list[FaceMove]:
-    """A face move across the current face toward its middle, when that face is among ``middles`` (model face ->
-    its middle, model frame: the middles still to be measured) and the middle is farther than
-    :data:`MIDDLE_REACH` from the sensor: it passes over the middle and ends on the edge beyond."""
-    face = components.get(state.face)
-    f_m = h.faces.get(state.face)
-    if not middles or not isinstance(face, DataFace) or f_m not in middles or h.world_from_model is None:
-        return []
-    d = _in_plane(h.world_from_model.apply(middles[f_m]) - state.position, face.normal)
-    n = float(np.linalg.norm(d))
-    return [FaceMove(d / n)] if n > MIDDLE_REACH else []
-
-
 def _in_plane(d: np.ndarray, normal: np.ndarray) -> np.ndarray:
     return d - (d @ normal) * normal
 
@@ -334,10 +320,9 @@ def _moves(
     config: PlannerConfig, avoid: Sequence[Move],
     missing: tuple[frozenset[int], frozenset[int], frozenset[int]] | None = None,
     fixed_faces: bool = True,
-    extra: Sequence[Move] = (),
 ) -> list[tuple[Move, float, float]]:
-    """Fresh candidate moves (the planner's, those aimed at ``missing``, and ``extra``) with their predicted cost
-    and risk (as the planner scores them), reliable and not predicted to run into the table (unless no other is left).
+    """Fresh candidate moves (the planner's, and those aimed at ``missing``) with their predicted cost and risk
+    (as the planner scores them), reliable and not predicted to run into the table (unless no other is left).
     The planner's face moves in fixed directions are left out when moves are aimed at something of the current
     face, and always with ``fixed_faces`` False (the second move of a look-ahead): what they can measure the
     aimed moves measure more cheaply, and each costs a prediction."""
@@ -346,7 +331,6 @@ def _moves(
     out = []
     aimed = aimed_face_moves(h, state, components, missing, config) if missing is not None else []
     fixed_faces = fixed_faces and not aimed
-    aimed += list(extra)
     planner = [m for m in candidate_moves(state, components, config) if fixed_faces or m.kind != "face"]
     fresh = [m for m in planner + aimed if not any(same_move(m, bad) for bad in avoid)]
     for m, pred in zip(fresh, predict_moves([h], fresh, state, components, noise, config), strict=True):
@@ -523,7 +507,6 @@ def plan_verification_move(
     previous: Tour | None = None,
     travelled: frozenset[tuple] | set[tuple] = frozenset(),
     visited: Sequence[np.ndarray] = (),
-    middles: Mapping[int, np.ndarray] | None = None,
 ) -> tuple[Move | None, Tour | None, float]:
     """:func:`choose_verification_move`, with the tour it planned over ``missing`` (from ``previous``'s order,
     when given) and that tour's cost from the sensor as it is [units] (None and 0 without a pose). A candidate
@@ -532,12 +515,7 @@ def plan_verification_move(
     (on the hand a move ends where the pad stops, and going back can be the way on; there it kept BOX01N's
     verification from a vertex it then found, seed 2), unless every candidate is: the tour's
     estimate from where such moves end can keep them the cheapest, and the verification goes back and forth
-    until it stalls.
-
-    ``middles`` (model face -> its middle, model frame): the faces' middles still to be probed once the vertices
-    are measured (:func:`unmeasured_middles`); a tracing move predicted to pass within :data:`MIDDLE_REACH` of one
-    measures it, and its score is less by the probe it saves (:func:`middle_probe_cost`); a face move toward the
-    current face's middle (:func:`_through_middles`) joins the candidates where it is predicted to pass over it."""
+    until it stalls."""
     from haptic.planning.search import simulate
     from haptic.planning.simulate import simulate_probe
 
@@ -548,10 +526,9 @@ def plan_verification_move(
     keys = features(poly).index(missing)
     tour = plan_tour(poly, keys, legs, previous)
     table = StartCosts(poly, keys, legs)
-    here = _start_costs(h, state, table, config)
+    here = _start_costs(h, state, table)
     now = tour.cost_from(here)
-    through = _through_middles(h, state, components, middles)
-    first = _moves(h, state, components, noise, config, avoid, missing, extra=through)
+    first = _moves(h, state, components, noise, config, avoid, missing)
     landing = _verification_probes(h, state, components, _entries(poly, tour, here, keys), noise, config, avoid,
                                    probed, faces_ok)  # fmt: skip
     probes = [(m, c, r) for m, c, r, _ in landing]
@@ -562,7 +539,7 @@ def plan_verification_move(
         legs = LegCosts.of(config, probes=False)
         tour = plan_tour(poly, keys, legs, previous)
         table = StartCosts(poly, keys, legs)
-        here = _start_costs(h, state, table, config)
+        here = _start_costs(h, state, table)
         now = tour.cost_from(here)
     if not first and not probes:
         return None, tour, now
@@ -584,12 +561,7 @@ def plan_verification_move(
             continue
         measured = frozenset(int(k) for k in features(poly).index(tuple(  # type: ignore[arg-type]
             frozenset(n & x) for n, x in zip(new, missing, strict=True))))  # fmt: skip
-        score = c / max(1.0 - r, 1e-9) + tour.cost_from(_start_costs(h1, s1, table, config), measured)
-        if middles and m.kind != "probe":
-            passed = _passed_middles(h, state, s1, middles)
-            if not passed and any(m is x for x in through):
-                continue  # toward the middle, it ends before it (the face is not convex)
-            score -= middle_probe_cost(poly, config) * passed
+        score = c / max(1.0 - r, 1e-9) + tour.cost_from(_start_costs(h1, s1, table), measured)
         if score < best_score:
             best, best_score = m, score
         ends.append((m, h.world_from_model.inverse().apply(s1.position), c))
@@ -606,28 +578,6 @@ def plan_verification_move(
         for k, (m, p, c) in enumerate(ends)
     ]
     return ends[min(scored)[2]][0], tour, now
-
-
-def middle_probe_cost(poly: Polyhedron, config: PlannerConfig) -> float:
-    """What probing a face's middle costs, estimated [units]: ``c_p``, and ``c_s`` over the diameter of the sphere
-    round the model (a verification probe's line starts outside it)."""
-    radius = float(np.linalg.norm(poly.vertices - poly.vertices.mean(axis=0), axis=1).max())
-    return config.costs.c_p + config.costs.c_s * 2.0 * radius
-
-
-def _passed_middles(h: Hypothesis, state: SensorState, end: SensorState, middles: Mapping[int, np.ndarray]) -> int:
-    """How many of ``middles`` (model face -> its middle, model frame) lie within :data:`MIDDLE_REACH` of the
-    straight way from ``state`` to ``end`` in hypothesis ``h``'s world, from their face (the start within
-    :data:`ON_PLANE` of its plane: a face move runs over the face it starts on; where it ends, stepped onto the next
-    face, is off that plane)."""
-    a, b = h.model_from_world.apply(np.stack([state.position, end.position]))
-    faces = np.array(list(middles), dtype=np.int64)
-    m = np.array(list(middles.values())).reshape(-1, 3)
-    d = b - a
-    t = np.clip((m - a) @ d / max(float(d @ d), 1e-18), 0.0, 1.0)
-    n, off = h.poly.face_normals[faces], h.poly.face_offsets[faces]
-    over = np.abs(n @ a - off) <= ON_PLANE
-    return int(np.sum((np.linalg.norm(a + t[:, None] * d - m, axis=1) <= MIDDLE_REACH) & over))
 
 
 REVISIT = 3e-3
@@ -648,14 +598,11 @@ def _legs(config: PlannerConfig) -> LegCosts:
     return LegCosts.of(config, probes=MAX_VERIFY_PROBES > 0)
 
 
-def _start_costs(h: Hypothesis, state: SensorState, table: StartCosts, config: PlannerConfig) -> np.ndarray:
+def _start_costs(h: Hypothesis, state: SensorState, table: StartCosts) -> np.ndarray:
     """:func:`~haptic.planning.tour.start_costs` of the targets of ``table`` (sorted feature indices) from the sensor
-    in ``state``, in hypothesis ``h``'s world; at a model vertex, from the vertex (every face at it, any edge from
-    it) without a table: on the hand, where a vertex move rolls the pad round the vertex and the verification
-    traces, the tour is priced from the face and edge the pad is on."""
+    in ``state``, in hypothesis ``h``'s world."""
     edge = h.edges.get(state.edge) if state.edge is not None else None
-    vertex = h.vertices.get(state.vertex) if state.vertex is not None and config.table_z is None else None
-    return table(h.model_from_world.apply(state.position), h.faces.get(state.face), edge, vertex)
+    return table(h.model_from_world.apply(state.position), h.faces.get(state.face), edge)
 
 
 def _entries(
@@ -696,12 +643,6 @@ MIDDLE_REACH = 5e-3
 lies on the face's plane within this of it [m] (:func:`unmeasured_middles`)."""
 
 
-ON_PLANE = 2e-3
-"""A traced segment runs over a face when both its ends lie this near the face's plane at the fitted pose [m] (the
-pose's error is about 1 mm): a trace over the next face that passes near a narrow face's middle tells nothing of a
-slot across that face (:func:`unmeasured_middles`)."""
-
-
 _MIDDLES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
@@ -737,35 +678,18 @@ def _face_middle(poly: Polyhedron, f: int) -> np.ndarray:
 
 
 def unmeasured_middles(poly: Polyhedron, world_from_model: SE3, data: Sequence[DataComponent],
-                       faces: frozenset[int], traces: Sequence[np.ndarray] = ()) -> list[int]:
-    """The ``faces`` of ``poly`` at pose ``world_from_model`` whose middle nothing measured passed within
-    :data:`MIDDLE_REACH` of: no touched point of ``data``'s faces, no explored interval of its edges (the edge
-    traced whole between its ends), and no segment of ``traces`` (world, shape (2, 3) each: a face move's path
-    across its face, :meth:`Verifier.observe`); a segment counts for the faces it runs over (:data:`ON_PLANE`).
-    Measured vertices fix a face's plane, not that the face is whole between them: a slot across its middle leaves
-    every vertex of the model in place; a move that passed over the middle would have met the slot (a trace across
-    the face ends at its wall, an edge move at its gap)."""
+                       faces: frozenset[int]) -> list[int]:
+    """The ``faces`` of ``poly`` at pose ``world_from_model`` whose middle no measured point of ``data`` lies
+    within :data:`MIDDLE_REACH` of. Measured vertices fix a face's plane, not that the face is whole between
+    them: a slot across its middle leaves every vertex of the model in place."""
     pts = [np.atleast_2d(c.points) for c in data if isinstance(c, DataFace) and len(c.points)]
-    segs = [np.stack([c.point, c.end_point]) for c in data if isinstance(c, DataEdge)]
-    segs += [np.asarray(s, float).reshape(2, 3) for s in traces]
-    if not pts and not segs:
+    pts += [np.stack([c.point, c.point + c.length * c.direction]) for c in data if isinstance(c, DataEdge)]
+    if not pts:
         return sorted(faces)
-    inv = world_from_model.inverse()
-    p = inv.apply(np.concatenate(pts)) if pts else np.zeros((0, 3))
-    if segs:
-        ab = inv.apply(np.concatenate(segs)).reshape(-1, 2, 3)
-        a, d = ab[:, 0], ab[:, 1] - ab[:, 0]
-        dd = np.maximum(np.einsum("ij,ij->i", d, d), 1e-18)
+    p = world_from_model.inverse().apply(np.concatenate(pts))
     out = []
     for f in sorted(faces):
-        m = face_middle(poly, f)
-        near = len(p) and float(np.linalg.norm(p - m, axis=1).min()) <= MIDDLE_REACH
-        if not near and segs:  # the nearest point of each segment that runs over the face (both ends in its plane)
-            t = np.clip(np.einsum("ij,ij->i", m - a, d) / dd, 0.0, 1.0)
-            gap = np.linalg.norm(a + t[:, None] * d - m, axis=1)
-            ends = np.abs(ab @ poly.face_normals[f] - poly.face_offsets[f]).max(axis=1)
-            near = bool(np.any((gap <= MIDDLE_REACH) & (ends <= ON_PLANE)))
-        if not near:
+        if float(np.linalg.norm(p - face_middle(poly, f), axis=1).min()) > MIDDLE_REACH:
             out.append(int(f))
     return out
 
@@ -835,23 +759,6 @@ class Verifier:
         self.middles_unprobed: set[int] = set()
         """Faces of :attr:`middles` that no admissible probe was predicted to reach at their middle (not asked for:
         a slot across such a face is not caught)."""
-        self.traces: list[np.ndarray] = []
-        """Each face move's path across its face, from where it started to where it met the edge (world, shape
-        (2, 3)): a face's middle it passed over is measured (:func:`unmeasured_middles`)."""
-
-    def observe(self, before: SensorState | None, result) -> None:
-        """Book a move that succeeded (a :class:`~haptic.planning.moves.MoveResult`) from the sensor state
-        ``before`` it: a face move's path across its face, from where it started to the point of the edge it met
-        (where the sensor ends, stepped onto the next face, taken back onto the edge's line), into
-        :attr:`traces`."""
-        if before is None or result.move is None or result.move.kind != "face":
-            return
-        edge = next((c for c in result.components if isinstance(c, DataEdge)), None)
-        if edge is None or result.state is None:
-            return
-        end = np.asarray(result.state.position, float) - edge.point
-        hit = edge.point + float(end @ edge.direction) * edge.direction
-        self.traces.append(np.stack([np.asarray(before.position, float), hit]))
 
     def verdict(self, tree, rec, cost: float) -> str:
         """"confirmed", "mismatch", "incomplete" or "verifying" for a recognition ``rec`` (status recognized)
@@ -895,8 +802,7 @@ class Verifier:
             self.status = "incomplete" if self.mode == "full" and (self.hidden or self.unpinnable) else "confirmed"
             if self.status == "confirmed" and self.mode == "full" and self._probes_admitted():
                 todo = [f for f in unmeasured_middles(cls.model, self.check.world_from_model, tree.data,
-                                                      self._reach[cls.name][0], self.traces)
-                        if f not in self.middles_unprobed]  # fmt: skip
+                                                      self._reach[cls.name][0]) if f not in self.middles_unprobed]
                 self.middles = [f for f in todo if f not in self._middles_tried]
                 if self.middles:
                     self.status = "verifying"
@@ -1007,13 +913,9 @@ class Verifier:
         avoid = (*avoid, *self._failed_along(h, state, components, avoid))
         faces_ok = self._reach[self._model_name][0] if self._model_name in self._reach else None
         previous = self._tour if self._tour is not None and self._tour_model is h.poly else None
-        middles = None
-        if self.mode == "full" and self._probes_admitted() and faces_ok is not None and h.world_from_model is not None:
-            middles = {f: face_middle(h.poly, f) for f in unmeasured_middles(
-                h.poly, h.world_from_model, list(components.values()), faces_ok, self.traces)}  # fmt: skip
         move, self._tour, now = plan_verification_move(h, state, components, missing, self.noise, self.config,
                                                        avoid, probed, faces_ok, previous, self._travelled,
-                                                       self._visited, middles)  # fmt: skip
+                                                       self._visited)  # fmt: skip
         self._visited.append(np.array(state.position, float))
         self._tour_model = h.poly
         if move is not None and move.kind != "probe" and h.world_from_model is not None:
