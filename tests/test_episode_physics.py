@@ -261,9 +261,9 @@ def test_a_stroke_riding_the_rims_of_a_small_face_measures_no_face(tmp_path):
 
 
 @pytest.mark.xfail(strict=True, reason=(
-    "merged with the hand's moves of the same day (a next face met near its end is touched again along the edge) "
-    "the replay's moves differ and one component lies outside its bounds: not yet looked at (no edge's two ends are "
-    "one vertex, and it ends other than no-match)"))
+    "with the moves and the segmentation merged since it was written the replay's moves differ and one component "
+    "lies outside its bounds: not yet looked at (no edge's two ends are one vertex, and it ends other than "
+    "no-match)"))
 def test_an_edge_move_that_sets_off_past_the_edges_other_end_reports_no_vertex(tmp_path):
     # BOX01N at 60 mm, seed 2, --verify none (perception_report.py --sizes 60 --first-seed 2): an edge move along +e
     # returned next to the edge 23 mm behind its explored interval, past the edge's other end, and located that end's
@@ -306,10 +306,9 @@ def test_a_vertex_move_whose_circle_meets_an_edge_of_another_vertex_reports_no_e
 
 
 @pytest.mark.xfail(strict=True, reason=(
-    "no face move stays in the corner, but with the tour's price from a model vertex kept off the hand and the next "
-    "face touched again along the edge, the episode ends incomplete, 2 vertices "
-    "short after 35 verification moves: the tour, pricing the way to the arm's far corner in a straight line across "
-    "the slot, keeps heading for it from the slot's side until the stall rule ends it"))
+    "no face move stays in the corner, but with the next face touched again along the edge and the segmentation's "
+    "changes merged, the episode ends incomplete, vertices short: the tour, pricing the way to the arm's far corner "
+    "in a straight line across the slot, keeps heading for it from the slot's side until the stall rule ends it"))
 def test_face_moves_out_of_a_concave_corner_leave_it(tmp_path):
     # BOX01N seed 2 stands on an end with its slot upright, 30 mm wide for the 24 mm pad. Verifying it, face moves
     # started from the slot's concave edges, traced from the corner where the pad rested touching both faces: each
