@@ -9,10 +9,11 @@ import numpy as np
 from haptic.geometry import load_library
 from haptic.geometry.perturb import chamfer_edge, move_vertex
 from haptic.geometry.se3 import matrix_to_quat
+from tests.planning.test_verify_moves import _resting_on
 
 ROOT = Path(__file__).resolve().parents[1]
 LIB = load_library()
-TABLE = 0.35
+TABLE = 0.35  # the table of _resting_on
 
 
 def _bench():
@@ -24,17 +25,8 @@ def _bench():
 
 def _on_face(poly, face: int) -> dict:
     """A record's pose of ``poly`` resting on ``face`` on the table (z = TABLE)."""
-    n = poly.face_normals[face]
-    axis = np.cross(n, [0.0, 0.0, -1.0])
-    s, c = np.linalg.norm(axis), float(n @ [0.0, 0.0, -1.0])
-    if s < 1e-9:
-        rot = np.eye(3) if c > 0 else np.diag([1.0, -1.0, -1.0])
-    else:
-        k = axis / s
-        kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
-        rot = np.eye(3) + s * kx + (1 - c) * kx @ kx
-    low = (poly.vertices @ rot.T)[:, 2].min()
-    return {"quat_wxyz": matrix_to_quat(rot).tolist(), "translation_m": [0.55, 0.0, TABLE - low]}
+    pose, _ = _resting_on(poly, face)
+    return {"quat_wxyz": matrix_to_quat(pose.rotation).tolist(), "translation_m": pose.translation.tolist()}
 
 
 def test_a_chamfer_on_the_table_lies_within_the_band_and_a_moved_vertex_above_it():
