@@ -57,19 +57,25 @@ def look_alikes(ctx: Context) -> bool:
     hyps = list(ctx.hypotheses)
     if len(hyps) < 2 or any(h.world_from_model is None for h in hyps):
         return False
-    far = _far(ctx, hyps)
-    return all(1.0 - far[i][j].mean() > MOST for i in range(len(hyps)) for j in range(len(hyps)) if i != j)
+    return _alike(_far(ctx, hyps))
 
 
-def disagreeing_vertices(ctx: Context) -> list[tuple[Hypothesis, frozenset[int]]]:
+def _alike(far: list[list[np.ndarray]]) -> bool:
+    """Whether every two hypotheses are look-alikes, from their :func:`_far` table."""
+    n = len(far)
+    return all(1.0 - far[i][j].mean() > MOST for i in range(n) for j in range(n) if i != j)
+
+
+def disagreeing_vertices(ctx: Context, far: list[list[np.ndarray]] | None = None
+                         ) -> list[tuple[Hypothesis, frozenset[int]]]:  # fmt: skip
     """For each hypothesis of ``ctx`` (every one posed), the model vertices not paired with data that have no
     counterpart within :data:`DISAGREE` bounds in at least one other hypothesis; on the table, only those the
     verification can measure (:func:`~haptic.planning.verify.reachable_features`). Hypotheses with none are left
-    out."""
+    out. ``far``: their :func:`_far` table, when already computed."""
     from haptic.planning.verify import reachable_features
 
     hyps = list(ctx.hypotheses)
-    far = _far(ctx, hyps)
+    far = _far(ctx, hyps) if far is None else far
     out = []
     for i, h in enumerate(hyps):
         paired = set(h.vertices.values())
@@ -89,10 +95,14 @@ def disagreement_move(ctx: Context) -> Move | None:
     move toward it."""
     from haptic.planning.verify import plan_verification_move
 
-    if not look_alikes(ctx):
+    hyps = list(ctx.hypotheses)
+    if len(hyps) < 2 or any(h.world_from_model is None for h in hyps):
+        return None
+    far = _far(ctx, hyps)
+    if not _alike(far):
         return None
     best, best_cost = None, np.inf
-    for h, ids in disagreeing_vertices(ctx):
+    for h, ids in disagreeing_vertices(ctx, far):
         missing = (frozenset(), frozenset(), ids)
         move, _, cost = plan_verification_move(h, ctx.state, ctx.components, missing, ctx.noise, ctx.config,
                                                ctx.avoid)  # fmt: skip
