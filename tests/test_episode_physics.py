@@ -260,10 +260,10 @@ def test_a_stroke_riding_the_rims_of_a_small_face_measures_no_face(tmp_path):
     assert _within_bounds(ep)
 
 
-@pytest.mark.xfail(strict=True, reason=(
+@pytest.mark.xfail(strict=False, reason=(
     "with the moves and the segmentation merged since it was written the replay's moves differ and one component "
-    "lies outside its bounds: not yet looked at (no edge's two ends are one vertex, and it ends other than "
-    "no-match)"))
+    "lies outside its bounds on some machines and not on others (the replay's contacts differ in their last bits "
+    "between CPUs): not yet looked at (no edge's two ends are one vertex, and it ends other than no-match)"))
 def test_an_edge_move_that_sets_off_past_the_edges_other_end_reports_no_vertex(tmp_path):
     # BOX01N at 60 mm, seed 2, --verify none (perception_report.py --sizes 60 --first-seed 2): an edge move along +e
     # returned next to the edge 23 mm behind its explored interval, past the edge's other end, and located that end's
