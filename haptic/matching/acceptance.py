@@ -456,56 +456,143 @@ def acceptance(
     vertices, each within its own bound — adds up here: the statistic grows with the number of components that
     see it, the threshold only with their square root.
 
-    With a table (``table_z``, the top's height in the world) the object rests on it, and the table is a datum: the
-    fitted model's lowest point is one more quantity (1 dimension), its σ that of the data's median position
-    bound (the fitted pose is off by about the noise of the data it is fitted to). An object that differs from the
-    model in height alone (a tetrahedron 3 % smaller, whose measured side faces all pass through the apex) fits the
-    measured features at a pose that sinks the model into the table or lifts it off.
+    With a table (``table_z``, the top's height in the world) the object rests on it, and the table is a datum
+    (:func:`resting_vertices`): the model rests on the facet of its convex hull that faces down at the pose, and
+    each vertex of that facet lies on the table plane -- one more quantity each (1 dimension: its height), σ that
+    of the data's median position bound. A face on the table fixes the model's tilt and height as a touched face
+    would: a tetrahedron 3 % taller than the model, of which the hand measures the apex and the side faces, fits
+    them at a pose that tilts the model's base off the table or lifts it. The pose the data were fitted at knows
+    nothing of the table; the statistic is taken at the pose refitted to the data and the table together
+    (:func:`_refit`), the least-squares pose its χ² law is for (or at the given pose where that is less).
 
     ``model_bounds``: how far the model's features are taken to be off (default: the model's own,
     :func:`_model_bounds`); two models' statistics at the same bounds compare as their likelihoods do
     (:func:`own_bounds_keep`)."""
     from scipy.stats import chi2
 
-    inv = world_from_model.inverse()
     mb = _model_bounds(model) if model_bounds is None else model_bounds
-    total, dims = 0.0, 0
-    for i, f in it.faces.items():
-        c = data[i]
-        assert isinstance(c, DataFace)
-        n_m = model.face_normals[f]
-        total += (_angle(inv.rotate(c.normal), n_m) * k_sigma / (np.hypot(c.normal_bound, mb.normal) + ROUND_OFF)) ** 2
-        off = float(np.mean(inv.apply(c.points) @ n_m - model.face_offsets[f]))
-        total += (off * k_sigma / (np.hypot(c.position_bound, mb.position) + ROUND_OFF)) ** 2
-        dims += 3
-    for i, e in it.edges.items():
-        c = data[i]
-        assert isinstance(c, DataEdge)
-        p_m, b_m = model.edge_points[e], model.edge_directions[e]
-        s = it.edge_senses.get(i, 0)
-        if s != 0:
-            turn = _angle(inv.rotate(c.direction), s * b_m)
-            total += (turn * k_sigma / (np.hypot(c.direction_bound, mb.direction) + ROUND_OFF)) ** 2
-            dims += 2
-        q = inv.apply(c.point) - p_m
-        perp = float(np.linalg.norm(q - (q @ b_m) * b_m))
-        total += (perp * k_sigma / (np.hypot(c.position_bound, mb.position) + ROUND_OFF)) ** 2
-        dims += 2
-    for i, v in it.vertices.items():
-        c = data[i]
-        assert isinstance(c, DataVertex)
-        d = float(np.linalg.norm(inv.apply(c.position) - model.vertices[v]))
-        total += (d * k_sigma / (np.hypot(c.position_bound, mb.position) + ROUND_OFF)) ** 2
-        dims += 3
-    rest = None
+    resting = None
     if table_z is not None and len(data):
-        rest = float(world_from_model.apply(model.vertices)[:, 2].min()) - table_z
-        bound = float(np.median([c.position_bound for c in data]))
-        total += (rest * k_sigma / (np.hypot(bound, mb.position) + ROUND_OFF)) ** 2
-        dims += 1
-    dof = dims - 6
+        resting = resting_vertices(model, world_from_model)
+    terms = _StatisticTerms(model, data, it, k_sigma, mb, table_z, resting)
+    pose, total = world_from_model, terms.total(world_from_model)
+    if resting is not None:
+        refit = _refit(terms, world_from_model)
+        if refit is not None and terms.total(refit) < total:
+            pose, total = refit, terms.total(refit)
+    rest = None
+    if resting is not None:
+        rest = float(pose.apply(model.vertices)[:, 2].min()) - table_z
+    dof = terms.dims - 6
     threshold = float(chi2.ppf(1.0 - alpha, dof)) if dof > 0 else float("inf")
     return Acceptance(bool(total <= threshold), float(total), int(dof), threshold, rest)
+
+
+@dataclass
+class _StatisticTerms:
+    """The quantities of :func:`acceptance` for one interpretation, summed at any pose (:meth:`total`)."""
+
+    model: Polyhedron
+    data: Sequence[DataComponent]
+    it: Interpretation
+    k_sigma: float
+    mb: LearnedBounds
+    table_z: float | None
+    resting: np.ndarray | None
+    """Model vertices on the table (:func:`resting_vertices`), None without a table."""
+
+    @property
+    def dims(self) -> int:
+        """The quantities' dimensions."""
+        n = 3 * len(self.it.faces) + sum(2 + 2 * (self.it.edge_senses.get(i, 0) != 0) for i in self.it.edges)
+        n += 3 * len(self.it.vertices)
+        return n + (len(self.resting) if self.resting is not None else 0)
+
+    def total(self, world_from_model: SE3) -> float:
+        """Σ (residual / σ)² over every quantity at ``world_from_model``."""
+        model, data, it, k_sigma, mb = self.model, self.data, self.it, self.k_sigma, self.mb
+        inv = world_from_model.inverse()
+        total = 0.0
+        for i, f in it.faces.items():
+            c = data[i]
+            assert isinstance(c, DataFace)
+            n_m = model.face_normals[f]
+            turn = _angle(inv.rotate(c.normal), n_m)
+            total += (turn * k_sigma / (np.hypot(c.normal_bound, mb.normal) + ROUND_OFF)) ** 2
+            off = float(np.mean(inv.apply(c.points) @ n_m - model.face_offsets[f]))
+            total += (off * k_sigma / (np.hypot(c.position_bound, mb.position) + ROUND_OFF)) ** 2
+        for i, e in it.edges.items():
+            c = data[i]
+            assert isinstance(c, DataEdge)
+            p_m, b_m = model.edge_points[e], model.edge_directions[e]
+            s = it.edge_senses.get(i, 0)
+            if s != 0:
+                turn = _angle(inv.rotate(c.direction), s * b_m)
+                total += (turn * k_sigma / (np.hypot(c.direction_bound, mb.direction) + ROUND_OFF)) ** 2
+            q = inv.apply(c.point) - p_m
+            perp = float(np.linalg.norm(q - (q @ b_m) * b_m))
+            total += (perp * k_sigma / (np.hypot(c.position_bound, mb.position) + ROUND_OFF)) ** 2
+        for i, v in it.vertices.items():
+            c = data[i]
+            assert isinstance(c, DataVertex)
+            d = float(np.linalg.norm(inv.apply(c.position) - model.vertices[v]))
+            total += (d * k_sigma / (np.hypot(c.position_bound, mb.position) + ROUND_OFF)) ** 2
+        if self.resting is not None and len(self.resting):
+            height = world_from_model.apply(model.vertices[self.resting])[:, 2] - self.table_z
+            bound = float(np.median([c.position_bound for c in data]))
+            total += float(np.sum((height * k_sigma / (np.hypot(bound, mb.position) + ROUND_OFF)) ** 2))
+        return total
+
+
+def _refit(terms: _StatisticTerms, world_from_model: SE3) -> SE3 | None:
+    """The pose near ``world_from_model`` that makes ``terms``' statistic least: turned about the data's centroid
+    and shifted (parameters in mrad and mm, so that both are of the order of the bounds); None when the search
+    fails."""
+    from scipy.optimize import minimize
+    from scipy.spatial.transform import Rotation
+
+    pts = [p for c in terms.data for p in (np.atleast_2d(c.points) if isinstance(c, DataFace) else
+                                           (c.point,) if isinstance(c, DataEdge) else (c.position,))]  # fmt: skip
+    centre = np.mean(pts, axis=0)
+
+    def at(x: np.ndarray) -> SE3:
+        turn = Rotation.from_rotvec(1e-3 * x[:3]).as_matrix()
+        return SE3(turn @ world_from_model.rotation,
+                   turn @ (world_from_model.translation - centre) + centre + 1e-3 * x[3:])  # fmt: skip
+
+    res = minimize(lambda x: terms.total(at(x)), np.zeros(6), method="BFGS", options={"gtol": 1e-6})
+    return at(res.x) if np.all(np.isfinite(res.x)) else None
+
+
+_HULL_FACETS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _hull_facets(model: Polyhedron) -> tuple[np.ndarray, list[np.ndarray]]:
+    """The facets of the model's convex hull: their outward unit normals (P, 3) (model frame) and each one's model
+    vertices (those in its plane, to a millionth of the model's size); computed once per model."""
+    if model not in _HULL_FACETS:
+        from scipy.spatial import ConvexHull
+
+        v = np.asarray(model.vertices, float)
+        tol = 1e-6 * float(np.linalg.norm(np.ptp(v, axis=0)))
+        normals, members = [], []
+        for eq in ConvexHull(v).equations:
+            n, d = eq[:3], eq[3]
+            if any(float(n @ m) > 1.0 - 1e-9 for m in normals):
+                continue
+            normals.append(n)
+            members.append(np.flatnonzero(np.abs(v @ n + d) <= tol))
+        _HULL_FACETS[model] = (np.array(normals), members)
+    return _HULL_FACETS[model]
+
+
+def resting_vertices(model: Polyhedron, world_from_model: SE3) -> np.ndarray:
+    """The model vertices that rest on the table at ``world_from_model``: those of the facet of the model's convex
+    hull whose outward normal points most nearly down (an object on a table rests on a facet of its hull: a face,
+    or for a non-convex model the facet spanning the vertices it stands on)."""
+    normals, members = _hull_facets(model)
+    down = world_from_model.inverse().rotate(np.array([0.0, 0.0, -1.0]))
+    return members[int(np.argmax(normals @ down))]
 
 
 PIN_SPAN = 5e-3
