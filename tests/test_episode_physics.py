@@ -469,3 +469,16 @@ def test_a_tetrahedron_taller_than_the_model_is_not_confirmed_with_its_base_on_t
     assert rec.outcome != "recognized", (rec.recognized, rec.verified)
     rec = run_episode(EpisodeSpec(model="TETRA01R", seed=1777477784, executor="physics", verify="full"))
     assert rec.outcome == "recognized" and rec.correct, rec.detail
+
+
+def test_a_vertex_at_noise_level_4_is_located_where_the_pad_rolls_on_it(tmp_path):
+    # BOX01 at 150 mm, seed 1, noise level 4 (perception_report.py --sizes 150 --noise 4): an edge move ran to the
+    # edge's end and located the vertex at the median of the rows whose normal leaned 5° along the edge. With σn 4°
+    # a sixth of the rows on the ridge leaned that far by noise alone, and the vertex lay 14 mm short of the end
+    # (2.55 times its bound; no-match). A lean within 3 σn of the sensor is noise on the ridge: the vertex is where
+    # the pad rolls on it, within its bound.
+    spec = EpisodeSpec(model="BOX01", seed=1, executor="physics", noise=4.0, models=_scaled_library(tmp_path, 0.15))
+    ep = build_episode(spec)
+    ep.run(None)
+    assert [c for c in ep.executor.components if c.kind == "vertex"]
+    assert _within_bounds(ep)
