@@ -526,6 +526,9 @@ class PhysicsExecutor(LandingSearch):
             if r.event == "undercut":
                 return "undercut", f"crossing the {kind} edge: the next face leans under, out of the pad's reach", \
                     r.trace, None, None
+            if r.event == "table":
+                return r.status, f"crossing the {kind} edge: the pad reached the table's clearance before the next " \
+                    "face", None, None, None
             if r.event != "lost":  # the roll went on turning (limit), or the state is bad: nothing to touch afresh
                 return r.status, f"crossing the {kind} edge: {r.event}", None, None, None
             return self._reacquire(kind, n_a, direction, corner, r.trace, None, pieces, away_from,

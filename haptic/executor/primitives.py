@@ -618,6 +618,14 @@ class Toucher:
                 continue
             lost = 0
             hist.append((travelled, self.normal.copy()))
+            if kind == "convex" and self.below_floor():
+                # rolling down round the edge the pad reached the table's clearance: it cannot go on round to the
+                # next face (leaning under next to the table), and the normal it settles at is the edge's, the pad
+                # resting on the edge above the table (prism_08 at 100 mm: 28° below the horizontal between a side
+                # and a face leaning under at 45°, the "face" stroked there 43 bounds off)
+                self._press(np.zeros(3))
+                self.tick("roll")
+                return self._result("unreachable", "table", 0.0)
             # leaning under past the limit, and further than face a (from a face near the limit, noise alone
             # must not end the roll)
             limit = min(-math.sin(cfg.max_undercut), float(n_a @ back) - math.sin(cfg.undercut_slack))
