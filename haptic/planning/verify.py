@@ -80,7 +80,7 @@ def reachable_features(
     allf = frozenset(range(poly.n_faces))
     if config.table_z is None:
         return allf, frozenset(range(poly.n_edges)), frozenset(range(poly.n_vertices))
-    from haptic.planning.reach import SPACING, TRACE_ROOM, touchable
+    from haptic.planning.reach import MEASURE_ROOM, SPACING, touchable
 
     faces = set()
     for f in range(poly.n_faces):  # interior sample points of the face's triangles
@@ -97,7 +97,7 @@ def reachable_features(
             continue
         nrm = np.broadcast_to(poly.face_normals[f], p.shape)
         ok = touchable(poly, world_from_model, world_from_model.apply(p), world_from_model.rotate(nrm), config,
-                        TRACE_ROOM)  # fmt: skip
+                        MEASURE_ROOM)  # fmt: skip
         if int(ok.sum()) >= MIN_SAMPLES:
             faces.add(f)
     edges = {e for e in range(poly.n_edges) if {int(poly.edge_left_face[e]), int(poly.edge_right_face[e])} <= faces}

@@ -276,3 +276,25 @@ def test_the_band_next_to_the_table_that_nothing_measures_follows_the_faces_risi
         assert table_band(poly, pose, PlannerConfig()) == 0.0
     box_pose, box_table = _resting_on(LIB["BOX01"], 0)
     assert abs(table_band(LIB["BOX01"], box_pose, box_table) - 0.016) < 1e-6
+
+
+def test_the_sides_of_a_short_prism_count_in_reach_down_to_the_pads_clearance_of_the_table():
+    """prism_05 of the formula corpus scaled to 34 mm across stands 20 mm tall on a pentagon: its sides can be
+    touched only in their top few millimetres (the 12 mm pad's lowest point at the table's clearance). The
+    verification measures their top vertices there, at the ends of edge moves along the rim; asking a trace's room
+    besides, it counted the sides out of reach, the five top vertices hidden and the five on the table unpinned,
+    and every such episode ended incomplete without a move."""
+    from haptic.geometry.corpus import corpus_solids
+    from haptic.geometry.perturb import scaled_to
+    from haptic.planning.verify import reachable_features, table_pins
+
+    poly = scaled_to(next(p for s, p in corpus_solids() if s.name == "prism_05"), 0.034)
+    pose, table = _resting_on(poly, 0)
+    z = pose.apply(poly.vertices)[:, 2] - 0.35
+    assert 0.015 < z.max() < 0.025
+    f, e, v = reachable_features(poly, pose, table)
+    top = set(np.flatnonzero(z > 0.01).tolist())
+    assert len(top) == 5 and top <= set(v)
+    assert len(f) == 6  # all but the face on the table
+    pins, unpinnable = table_pins(poly, pose, (f, e, v), table)
+    assert len(pins) == 5 and unpinnable == []
