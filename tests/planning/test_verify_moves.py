@@ -298,3 +298,32 @@ def test_the_sides_of_a_short_prism_count_in_reach_down_to_the_pads_clearance_of
     assert len(f) == 6  # all but the face on the table
     pins, unpinnable = table_pins(poly, pose, (f, e, v), table)
     assert len(pins) == 5 and unpinnable == []
+
+
+def test_a_vertex_whose_edges_the_pad_cannot_follow_to_it_clear_of_the_table_is_hidden():
+    """prism_10 of the formula corpus lying on a side (the pose of its corpus episode, 95 mm across here): the corners
+    of its upright ends 17 mm up. The pad touching an end by such a corner clears the table, so they counted in
+    reach; but a vertex is located at the end of an edge move, and on the ridge of either edge the hand can follow
+    to it (the end's edge up to the next side, leaning under 18°) the pad comes within the table's clearance: the
+    planner refuses that move, and the verification's face moves toward the corner were stopped by the table 8 times
+    (40 verification moves, then incomplete). Hidden: the verification says so at once. The corners 45 mm up are
+    reached."""
+    from haptic.geometry.corpus import corpus_solids
+    from haptic.geometry.perturb import scaled_to
+    from haptic.matching.acceptance import Coverage
+    from haptic.planning.verify import hidden_vertices, reachable_features
+
+    poly = scaled_to(next(p for s, p in corpus_solids() if s.name == "prism_10"), 0.095)
+    side = next(f for f in range(poly.n_faces) if len(poly.faces[f]) == 4)
+    pose, table = _resting_on(poly, side)
+    z = pose.apply(poly.vertices)[:, 2] - 0.35
+    low = np.flatnonzero((z > 0.016) & (z < 0.019))
+    assert len(low) == 4
+    f, e, v = reachable_features(poly, pose, table)
+    cov = Coverage(frozenset(), frozenset(), frozenset(), f, e, v)
+    hidden = hidden_vertices(poly, pose, cov, table)
+    assert set(low.tolist()) <= set(hidden)
+    assert set(np.flatnonzero((z > 0.03) & (z < 0.06)).tolist()) <= set(v)
+    # measured all the same, a vertex is not hidden
+    measured = Coverage(frozenset(), frozenset(), frozenset(low.tolist()), f, e, v)
+    assert not set(low.tolist()) & set(hidden_vertices(poly, pose, measured, table))
