@@ -38,9 +38,9 @@ from haptic.errors import PlanningError
 from haptic.matching.components import DataComponent
 from haptic.planning.efficiency import class_weights
 from haptic.planning.hypothesis import Hypothesis
-from haptic.planning.move_scores import Context, Decision, Scored, same_move, score_all, score_probe
+from haptic.planning.move_scores import Context, Decision, Scored, bounded, same_move, score_all, score_probe
 from haptic.planning.moves import Move, ProbeMove, SensorState
-from haptic.planning.policies import PlannerPolicy, Policy
+from haptic.planning.policies import GreedyPolicy, PlannerPolicy, Policy
 from haptic.planning.predict import Prediction
 from haptic.planning.probe_prediction import ProbePrediction
 from haptic.planning.search import Branch, branches, probe_branches
@@ -99,26 +99,102 @@ class OptimalPolicy(Policy):
 
 
 class LookaheadPolicy(OptimalPolicy):
-    """The roll-out policy: every candidate move's predicted outcomes (its branches) valued by their cost plus the
-    efficiency planner's cost to recognition from each, simulated ``rollout_moves`` moves on
-    (:class:`OptimalPolicy` searched one move deep); the least expected total wins. With more than
-    ``max_hypotheses`` pose classes, or any without a pose, it decides as the planner does."""
+    """The roll-out policy over the ``base`` policy (greedy by default, the best myopic policy with every kind of
+    move): the base policy's choice and each other candidate move valued by its predicted outcomes (its branches),
+    each branch by its cost plus the cost to recognition from there of following the ``rollouts`` policies
+    (the least of them), simulated ``rollout_moves`` moves on (:class:`OptimalPolicy` searched one move deep). The
+    base policy's choice stands unless another is expected to cost less by the share ``margin`` of its own value:
+    the model is exact only within its predictions (the matcher may eliminate more, and what is unresolved at a
+    roll-out's end is priced at ``unresolved_cost``), so a small expected gain is not worth a move away from the
+    base policy, whose measured cost is what the roll-out improves on.
+
+    A candidate whose least predicted cost alone is not that far below the base choice's value is never simulated
+    (its value is at least that): at most a few are, and the decision stays cheap. With more than
+    ``max_hypotheses`` pose classes, any without a pose, or nothing one move is expected to eliminate, it decides
+    as the base policy."""
 
     name = "lookahead"
 
     def __init__(
-        self, rollout_moves: int = 4, unresolved_cost: float = 20.0, max_hypotheses: int = 30, max_probes: int = 2
+        self,
+        rollout_moves: int = 4,
+        unresolved_cost: float = 20.0,
+        max_hypotheses: int = 30,
+        max_probes: int = 2,
+        base: str = "greedy",
+        margin: float = 0.05,
+        rollouts: tuple[str, ...] = ("greedy",),
     ) -> None:
+        for b in (base, *rollouts):
+            if b not in BASES:
+                raise PlanningError(f"lookahead policy: unknown base policy {b!r}; valid: {', '.join(BASES)}")
+        if not 0.0 <= margin < 1.0:
+            raise PlanningError(f"lookahead policy: margin must be in [0, 1), got {margin}")
         super().__init__(1, rollout_moves, unresolved_cost, max_hypotheses, max_probes)
+        self.base = base
+        self.rollouts = tuple(rollouts)
+        self.margin = margin
+        self._base_policy = GreedyPolicy() if base == "greedy" else PlannerPolicy()
+
+    def choose(self, ctx: Context, rng: np.random.Generator) -> Decision:
+        ctx = bounded(ctx)
+        decision = self._base_policy.choose(ctx, rng)
+        hyps = list(ctx.hypotheses)
+        if len(hyps) > self.max_hypotheses or any(h.world_from_model is None for h in hyps):
+            return decision
+        root = [c for c in score_all(ctx) if isinstance(c[0], Prediction | ProbePrediction)]
+        chosen = next((c for c in root if c[0].move is decision.move), None)
+        if chosen is None or chosen[2] <= 0.0:
+            return decision  # a placement, or the base policy's own look-ahead: nothing to compare it with
+        one = ctx if ctx.config.fingers <= 1 else replace(ctx, config=replace(ctx.config, fingers=1))
+        weights = class_weights([h.model for h in hyps])
+        probed = tuple(m for m in ctx.avoid if isinstance(m, ProbeMove))
+        search = _Search(one, self.rollout_moves, self.unresolved_cost, self.max_probes, root, self.rollouts)
+        q_base = search.q(hyps, weights, chosen[0], ctx.state, ctx.components, 1, probed)
+        if q_base is None:
+            return decision
+        bar = q_base * (1.0 - self.margin)
+        best, best_q = chosen, q_base
+        scored = [Scored(chosen[0].move, -q_base, chosen[3], chosen[2], chosen[4])]
+        for cand in sorted(search.expanded(root), key=_least_cost):
+            if cand is chosen or not _least_cost(cand) < min(bar, best_q):
+                continue  # its value is at least its cost in the world where it costs least
+            q = search.q(hyps, weights, cand[0], ctx.state, ctx.components, 1, probed)
+            if q is None:
+                continue
+            scored.append(Scored(cand[0].move, -q, cand[3], cand[2], cand[4]))
+            if q < best_q:
+                best, best_q = cand, q
+        if best is chosen or not best_q < bar:
+            return Decision(decision.move, tuple(scored))
+        return Decision(best[0].move, tuple(scored))
+
+
+def _least_cost(cand: tuple) -> float:
+    """A lower bound of a scored candidate's value: its least predicted cost over the hypotheses (every branch's
+    cost is a weighted mean of these)."""
+    costs = np.asarray(cand[0].costs, dtype=float)
+    return float(np.nanmin(costs)) if np.isfinite(costs).any() else np.inf
+
+
+BASES = ("greedy", "planner")
+"""The policies a roll-out can follow: :class:`_Search` picks their move at each node of a roll-out."""
 
 
 class _Search:
     """Expected cost to recognition within the planner's model, from one decision's context."""
 
     def __init__(
-        self, ctx: Context, rollout_moves: int, unresolved_cost: float, max_probes: int = MAX_PROBES, root=None
+        self,
+        ctx: Context,
+        rollout_moves: int,
+        unresolved_cost: float,
+        max_probes: int = MAX_PROBES,
+        root=None,
+        bases: tuple[str, ...] = ("planner",),
     ) -> None:
         self.ctx = ctx
+        self.bases = bases
         self.rollout_moves = rollout_moves
         self.unresolved_cost = unresolved_cost
         self.max_probes = max_probes
@@ -195,7 +271,9 @@ class _Search:
         if len(hyps) <= 1:
             return 0.0
         if depth <= 0:
-            return self.rollout(hyps, weights, state, components, self.rollout_moves, probed)
+            return min(
+                self.rollout(hyps, weights, state, components, self.rollout_moves, probed, base) for base in self.bases
+            )
         best = np.inf
         for cand in self.expanded(self._moves(hyps, state, components, probed)):
             q = self.q(hyps, weights, cand[0], state, components, depth, probed)
@@ -205,9 +283,31 @@ class _Search:
             return self.unresolved_cost
         return best
 
-    def rollout(self, hyps, weights, state, components, moves_left: int, probed: tuple[ProbeMove, ...] = ()) -> float:
-        """Expected cost to recognition following the efficiency planner over every candidate, probes too
-        (deterministic ties: first best; with nothing to eliminate, the cheapest face or vertex move)."""
+    def _base_move(self, cands: list[tuple], base: str) -> Prediction | ProbePrediction | None:
+        """The base policy's choice among scored candidates: the planner's highest efficiency (ties: the first), or
+        greedy's most expected eliminations (ties: the cheaper, then the first); None when none eliminates
+        anything."""
+        key = np.array([c[2] if base == "greedy" else c[1] for c in cands])
+        if not key.max() > 0:
+            return None
+        if base != "greedy":
+            return cands[int(np.argmax(key))][0]
+        top = np.flatnonzero(key >= key.max() * (1 - 1e-9))
+        costs = np.array([cands[k][3] for k in top])
+        return cands[int(top[int(np.argmin(costs))])][0]
+
+    def rollout(
+        self,
+        hyps,
+        weights,
+        state,
+        components,
+        moves_left: int,
+        probed: tuple[ProbeMove, ...] = (),
+        base: str = "planner",
+    ) -> float:
+        """Expected cost to recognition following the ``base`` policy (:meth:`_base_move`) over every candidate,
+        probes too (with nothing to eliminate, the cheapest face or vertex move)."""
         if len(hyps) <= 1:
             return 0.0
         if moves_left <= 0:
@@ -215,10 +315,8 @@ class _Search:
         cands = self._moves(hyps, state, components, probed)
         if not cands:
             return self.unresolved_cost
-        effs = np.array([c[1] for c in cands])
-        if effs.max() > 0:
-            pred = cands[int(np.argmax(effs))][0]
-        else:
+        pred = self._base_move(cands, base)
+        if pred is None:
             pool = [c for c in cands if c[0].move.kind in ("face", "vertex")] or cands
             costs = np.array([c[3] for c in pool])
             costs = np.where(np.isfinite(costs), costs, np.inf)
@@ -228,7 +326,8 @@ class _Search:
             return self.unresolved_cost
         after = _after(probed, pred.move)
         return _expected(
-            brs, lambda b: self.rollout(list(b.hypotheses), b.weights, b.state, b.components, moves_left - 1, after)
+            brs,
+            lambda b: self.rollout(list(b.hypotheses), b.weights, b.state, b.components, moves_left - 1, after, base),
         )
 
 

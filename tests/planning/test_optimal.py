@@ -79,20 +79,55 @@ def test_optimal_is_deterministic_and_named():
         make_policy("optimal", depth=0)
 
 
-def test_lookahead_expects_no_more_than_the_planner_and_recognizes():
+def test_lookahead_expects_no_more_than_greedy_and_recognizes():
     """The roll-out policy's choice at each decision has an expected cost (within the planner's model) no more than
-    following the planner from there, and its episodes recognise the right model."""
+    following the greedy policy from there, and its episodes recognise the right model."""
     from haptic.planning.optimal import LookaheadPolicy
 
     policy = make_policy("lookahead")
-    assert isinstance(policy, LookaheadPolicy) and policy.depth == 1
+    assert isinstance(policy, LookaheadPolicy) and policy.depth == 1 and policy.base == "greedy"
+    checked = 0
     for ctx in _contexts(4)[:6]:
         hyps = list(ctx.hypotheses)
         w = class_weights([h.model for h in hyps])
-        search = _Search(ctx, rollout_moves=policy.rollout_moves, unresolved_cost=policy.unresolved_cost)
-        planned = search.rollout(hyps, w, ctx.state, ctx.components, policy.rollout_moves)
+        search = _Search(ctx, policy.rollout_moves, policy.unresolved_cost, bases=("greedy",))
+        greedy = search.rollout(hyps, w, ctx.state, ctx.components, policy.rollout_moves + 1, base="greedy")
         decision = policy.choose(ctx, np.random.default_rng(0))
-        assert -max(c.score for c in decision.candidates) <= planned + 1e-9
+        if decision.candidates:
+            checked += 1
+            assert -max(c.score for c in decision.candidates) <= greedy + 1e-9
+    assert checked
     for s in plan_sweep(SMALL, 4, seed=11, policies=["lookahead"], verify="none", moves="tracing"):
         r = run_episode(s, library=LIB, policy=policy)
         assert r.correct, (s.model, r.outcome)
+
+
+def test_lookahead_prunes_only_what_could_not_win():
+    """Without its margin the roll-out policy picks the least expected cost of every candidate it expands, as
+    valuing each of them would: the candidates it leaves unvalued (their least predicted cost above the best value
+    found) could not have won."""
+    from haptic.planning.move_scores import score_all
+    from haptic.planning.optimal import LookaheadPolicy
+
+    policy = LookaheadPolicy(margin=0.0)
+    compared = 0
+    for ctx in _contexts(4)[:6]:
+        decision = policy.choose(ctx, np.random.default_rng(0))
+        if not decision.candidates:
+            continue
+        hyps = list(ctx.hypotheses)
+        w = class_weights([h.model for h in hyps])
+        search = _Search(ctx, policy.rollout_moves, policy.unresolved_cost, policy.max_probes, bases=policy.rollouts)
+        qs = [search.q(hyps, w, c[0], ctx.state, ctx.components, 1) for c in search.expanded(score_all(ctx))]
+        best = min(q for q in qs if q is not None)
+        assert -max(c.score for c in decision.candidates) == pytest.approx(best, rel=1e-9)
+        assert len(decision.candidates) <= len(qs)
+        compared += 1
+    assert compared
+
+
+def test_lookahead_options_are_checked():
+    with pytest.raises(HapticError, match="base policy"):
+        make_policy("lookahead", base="random")
+    with pytest.raises(HapticError, match="margin"):
+        make_policy("lookahead", margin=1.0)
