@@ -38,8 +38,17 @@ from haptic.errors import PlanningError
 from haptic.matching.components import DataComponent
 from haptic.planning.efficiency import class_weights
 from haptic.planning.hypothesis import Hypothesis
-from haptic.planning.move_scores import Context, Decision, Scored, bounded, same_move, score_all, score_probe
-from haptic.planning.moves import Move, ProbeMove, SensorState
+from haptic.planning.move_scores import (
+    PROBE_RISK,
+    Context,
+    Decision,
+    Scored,
+    bounded,
+    same_move,
+    score_all,
+    score_probe,
+)
+from haptic.planning.moves import CostModel, Move, ProbeMove, SensorState
 from haptic.planning.policies import GreedyPolicy, PlannerPolicy, Policy
 from haptic.planning.predict import Prediction
 from haptic.planning.probe_prediction import ProbePrediction
@@ -99,19 +108,18 @@ class OptimalPolicy(Policy):
 
 
 class LookaheadPolicy(OptimalPolicy):
-    """The roll-out policy over the ``base`` policy (greedy by default, the best myopic policy with every kind of
-    move): the base policy's choice and each other candidate move valued by its predicted outcomes (its branches),
-    each branch by its cost plus the cost to recognition from there of following the ``rollouts`` policies
-    (the least of them), simulated ``rollout_moves`` moves on (:class:`OptimalPolicy` searched one move deep). The
-    base policy's choice stands unless another is expected to cost less by the share ``margin`` of its own value:
-    the model is exact only within its predictions (the matcher may eliminate more, and what is unresolved at a
-    roll-out's end is priced at ``unresolved_cost``), so a small expected gain is not worth a move away from the
-    base policy, whose measured cost is what the roll-out improves on.
+    """The roll-out policy over a ``base`` policy, by default the greedy one (the best myopic policy measured by
+    ``scripts/bench_optimal.py``). The base policy's choice and each other candidate move are valued by their
+    predicted outcomes (their branches), each branch by its cost plus the base policy's cost to recognition from
+    there, simulated ``rollout_moves`` moves on (:class:`OptimalPolicy` searched one move deep, its roll-outs the
+    base policy's). The base policy's choice stands unless another is expected to cost less by the share
+    ``margin`` of its own value: the model is exact only within its predictions (the matcher may eliminate more,
+    and what is unresolved at a roll-out's end is priced at ``unresolved_cost``), so a small expected gain is not
+    worth a move away from the base policy, whose measured cost is what the roll-out improves on.
 
     A candidate whose least predicted cost alone is not that far below the base choice's value is never simulated
-    (its value is at least that): at most a few are, and the decision stays cheap. With more than
-    ``max_hypotheses`` pose classes, any without a pose, or nothing one move is expected to eliminate, it decides
-    as the base policy."""
+    (its value is at least that): few are, and the decision stays cheap. With more than ``max_hypotheses`` pose
+    classes, any without a pose, or nothing one move is expected to eliminate, it decides as the base policy."""
 
     name = "lookahead"
 
@@ -123,16 +131,13 @@ class LookaheadPolicy(OptimalPolicy):
         max_probes: int = 2,
         base: str = "greedy",
         margin: float = 0.05,
-        rollouts: tuple[str, ...] = ("greedy",),
     ) -> None:
-        for b in (base, *rollouts):
-            if b not in BASES:
-                raise PlanningError(f"lookahead policy: unknown base policy {b!r}; valid: {', '.join(BASES)}")
+        if base not in BASES:
+            raise PlanningError(f"lookahead policy: unknown base policy {base!r}; valid: {', '.join(BASES)}")
         if not 0.0 <= margin < 1.0:
             raise PlanningError(f"lookahead policy: margin must be in [0, 1), got {margin}")
         super().__init__(1, rollout_moves, unresolved_cost, max_hypotheses, max_probes)
         self.base = base
-        self.rollouts = tuple(rollouts)
         self.margin = margin
         self._base_policy = GreedyPolicy() if base == "greedy" else PlannerPolicy()
 
@@ -149,7 +154,7 @@ class LookaheadPolicy(OptimalPolicy):
         one = ctx if ctx.config.fingers <= 1 else replace(ctx, config=replace(ctx.config, fingers=1))
         weights = class_weights([h.model for h in hyps])
         probed = tuple(m for m in ctx.avoid if isinstance(m, ProbeMove))
-        search = _Search(one, self.rollout_moves, self.unresolved_cost, self.max_probes, root, self.rollouts)
+        search = _Search(one, self.rollout_moves, self.unresolved_cost, self.max_probes, root, self.base)
         q_base = search.q(hyps, weights, chosen[0], ctx.state, ctx.components, 1, probed)
         if q_base is None:
             return decision
@@ -191,10 +196,10 @@ class _Search:
         unresolved_cost: float,
         max_probes: int = MAX_PROBES,
         root=None,
-        bases: tuple[str, ...] = ("planner",),
+        base: str = "planner",
     ) -> None:
         self.ctx = ctx
-        self.bases = bases
+        self.base = base
         self.rollout_moves = rollout_moves
         self.unresolved_cost = unresolved_cost
         self.max_probes = max_probes
@@ -204,6 +209,7 @@ class _Search:
         root = score_all(ctx) if root is None and ctx.config.moves != "tracing" else (root or [])
         self._probes = [c[0] for c in root if isinstance(c[0], ProbePrediction)]
         self._index = {id(h.world_from_model): k for k, h in enumerate(ctx.hypotheses)}
+        self._probe_table: _ProbeTable | None = None
 
     def expanded(self, scored: list) -> list:
         """The candidates a node expands: every tracing move, and the ``max_probes`` probes of highest planner
@@ -225,7 +231,9 @@ class _Search:
         eliminations, cost, risk), less the probes carried out on the way there. The probes are the decision's
         own candidates, predicted for the node's hypotheses (:meth:`ProbePrediction.subset`: the costs from the
         node's sensor position, the free segment's margins of the decision's data): regenerating and
-        predicting them at every node of the search would take most of its time."""
+        predicting them at every node of the search would take most of its time. Of those, only the ones a policy
+        could take from the node are predicted and returned (:meth:`_ProbeTable.contenders`, all scored at once):
+        the ``max_probes`` of highest efficiency that a node expands, the base policy's choice and the cheapest."""
         config = self.ctx.config
         if config.moves == "tracing":
             return score_all(Context(hyps, state, components, self.ctx.noise, config, avoid=probed))
@@ -236,14 +244,22 @@ class _Search:
         if config.moves != "probing":
             tracing = replace(config, moves="tracing")
             out = score_all(Context(hyps, state, components, self.ctx.noise, tracing))
+        table = self._table()
+        if table is None:
+            return out
+        done = np.array([any(same_move(p.move, m) for m in probed) for p in self._probes], dtype=bool)
         weights = class_weights([h.model for h in hyps])
-        for root in self._probes:
-            if any(same_move(root.move, done) for done in probed):
-                continue
-            scored = score_probe(root.subset(idx, state.position, config.costs), weights)
+        for k in table.contenders(idx, state.position, weights, ~done, self.max_probes, self.base):
+            scored = score_probe(self._probes[k].subset(idx, state.position, config.costs), weights)
             if scored is not None:
                 out.append(scored)
         return out
+
+    def _table(self) -> _ProbeTable | None:
+        """The decision's probe candidates as arrays (built once per search), None without any."""
+        if self._probe_table is None and self._probes:
+            self._probe_table = _ProbeTable(self._probes, self.ctx.config.costs or CostModel())
+        return self._probe_table
 
     def q(
         self,
@@ -271,9 +287,7 @@ class _Search:
         if len(hyps) <= 1:
             return 0.0
         if depth <= 0:
-            return min(
-                self.rollout(hyps, weights, state, components, self.rollout_moves, probed, base) for base in self.bases
-            )
+            return self.rollout(hyps, weights, state, components, self.rollout_moves, probed)
         best = np.inf
         for cand in self.expanded(self._moves(hyps, state, components, probed)):
             q = self.q(hyps, weights, cand[0], state, components, depth, probed)
@@ -283,31 +297,22 @@ class _Search:
             return self.unresolved_cost
         return best
 
-    def _base_move(self, cands: list[tuple], base: str) -> Prediction | ProbePrediction | None:
+    def _base_move(self, cands: list[tuple]) -> Prediction | ProbePrediction | None:
         """The base policy's choice among scored candidates: the planner's highest efficiency (ties: the first), or
         greedy's most expected eliminations (ties: the cheaper, then the first); None when none eliminates
         anything."""
-        key = np.array([c[2] if base == "greedy" else c[1] for c in cands])
+        key = np.array([c[2] if self.base == "greedy" else c[1] for c in cands])
         if not key.max() > 0:
             return None
-        if base != "greedy":
+        if self.base != "greedy":
             return cands[int(np.argmax(key))][0]
         top = np.flatnonzero(key >= key.max() * (1 - 1e-9))
         costs = np.array([cands[k][3] for k in top])
         return cands[int(top[int(np.argmin(costs))])][0]
 
-    def rollout(
-        self,
-        hyps,
-        weights,
-        state,
-        components,
-        moves_left: int,
-        probed: tuple[ProbeMove, ...] = (),
-        base: str = "planner",
-    ) -> float:
-        """Expected cost to recognition following the ``base`` policy (:meth:`_base_move`) over every candidate,
-        probes too (with nothing to eliminate, the cheapest face or vertex move)."""
+    def rollout(self, hyps, weights, state, components, moves_left: int, probed: tuple[ProbeMove, ...] = ()) -> float:
+        """Expected cost to recognition following the base policy (:meth:`_base_move`) over every candidate, probes
+        too (with nothing to eliminate, the cheapest face or vertex move)."""
         if len(hyps) <= 1:
             return 0.0
         if moves_left <= 0:
@@ -315,7 +320,7 @@ class _Search:
         cands = self._moves(hyps, state, components, probed)
         if not cands:
             return self.unresolved_cost
-        pred = self._base_move(cands, base)
+        pred = self._base_move(cands)
         if pred is None:
             pool = [c for c in cands if c[0].move.kind in ("face", "vertex")] or cands
             costs = np.array([c[3] for c in pool])
@@ -326,9 +331,60 @@ class _Search:
             return self.unresolved_cost
         after = _after(probed, pred.move)
         return _expected(
-            brs,
-            lambda b: self.rollout(list(b.hypotheses), b.weights, b.state, b.components, moves_left - 1, after, base),
+            brs, lambda b: self.rollout(list(b.hypotheses), b.weights, b.state, b.components, moves_left - 1, after)
         )
+
+
+class _ProbeTable:
+    """A decision's probe predictions stacked, to score them all at once for the hypotheses of a node of the search
+    (as :meth:`ProbePrediction.subset` and :func:`~haptic.planning.move_scores.score_probe` score one)."""
+
+    def __init__(self, preds: Sequence[ProbePrediction], costs: CostModel) -> None:
+        self.costs_model = costs
+        self.eliminates = np.stack([p.eliminates() for p in preds])
+        self.hit = np.stack([p.hit for p in preds])
+        self.distance = np.nan_to_num(np.stack([p.distance for p in preds]))
+        self.start = np.array([p.move.start for p in preds], dtype=float)
+        self.end = np.array([p.move.end for p in preds], dtype=float)
+        self.length = np.array([p.move.length for p in preds], dtype=float)
+        hand = [p.fails is not None for p in preds]
+        self.fails = np.stack([p.fails for p in preds]) if all(hand) else None
+        self.costs = np.stack([p.costs for p in preds]) if all(hand) else None
+
+    def scores(self, idx, position: np.ndarray, weights: np.ndarray) -> tuple[np.ndarray, ...]:
+        """Per probe, for hypotheses ``idx`` with the sensor at ``position``: efficiency, expected eliminations,
+        expected cost and risk, undiscounted by the risk."""
+        idx = np.asarray(idx, dtype=int)
+        w = np.asarray(weights, dtype=float) / np.sum(weights)
+        eliminated = self.eliminates[:, idx][:, :, idx].sum(axis=2).astype(float)
+        if self.costs is None:  # a point sensor: to the line's start, along it, back to the surface after a miss
+            here = np.asarray(position, dtype=float)
+            transfer = np.linalg.norm(self.start - here, axis=1)[:, None]
+            back = np.linalg.norm(self.end - here, axis=1)[:, None]
+            free = transfer + np.where(self.hit[:, idx], self.distance[:, idx], self.length[:, None] + back)
+            costs = self.costs_model.c_p + self.costs_model.c_s * free
+        else:  # the hand's path from where the decision's prediction was made
+            costs = self.costs[:, idx]
+        risk = self.fails[:, idx].astype(float) @ w if self.fails is not None else np.zeros(len(self.hit))
+        return (eliminated / np.maximum(costs, 1e-12)) @ w, eliminated @ w, costs @ w, risk
+
+    def contenders(self, idx, position, weights, allowed: np.ndarray, max_probes: int, base: str) -> list[int]:
+        """Indices, in order, of the probes a policy could take from the node (of those ``allowed`` and offered,
+        risk under :data:`~haptic.planning.move_scores.PROBE_RISK`): the ``max_probes`` of highest efficiency
+        (first best on ties), the ``base`` policy's choice (greedy: most eliminations, the cheapest of those; the
+        planner: the highest efficiency) and the cheapest, each as scored after the risk's discount."""
+        eff, elim, cost, risk = self.scores(idx, position, weights)
+        ok = allowed & (risk < PROBE_RISK)
+        if not ok.any():
+            return []
+        eff, elim = eff * (1.0 - risk), elim * (1.0 - risk)
+        live = np.flatnonzero(ok)
+        keep = set(live[np.argsort(-eff[live], kind="stable")[: max(max_probes, 1)]].tolist())
+        if base == "greedy":
+            top = live[elim[live] >= elim[live].max() * (1 - 1e-9)]
+            keep.add(int(top[np.argmin(cost[top])]))
+        keep.add(int(live[np.argmin(np.where(np.isfinite(cost[live]), cost[live], np.inf))]))
+        return sorted(keep)
 
 
 def _after(probed: tuple[ProbeMove, ...], move: Move) -> tuple[ProbeMove, ...]:
