@@ -18,6 +18,11 @@ The table gives each policy's decision times (the policy's choices, wall time: o
 ``tracing`` it searches tracing moves after the seed's opening; with ``all`` (or ``probing``) it starts where the
 episode's own opening leaves it and tries, at each node, the tracing moves and the best probes
 (:func:`~haptic.bench.oracle.hindsight_optimum_probing`). ``--hindsight-depth 0`` leaves the hindsight optimum out.
+
+``--reuse FILE`` takes the rows of an earlier ``--json FILE`` of the same episodes (``--episodes``, ``--seed``,
+``--moves``) for the policies and the hindsight optimum it holds, and runs only the rest: a new policy is compared
+on the same episodes without searching the hindsight optimum again. The reused rows are what the code of that run
+gave.
 """
 
 from __future__ import annotations
@@ -63,6 +68,14 @@ def _hindsight_run(spec: EpisodeSpec, depth: int) -> dict:
             "moves": o.moves, "correct": o.found, "wall_s": None}
 
 
+def _reused(path: str, policies: list[str], seeds: set[int]) -> list[dict]:
+    """The rows of an earlier run's JSON lines for ``policies`` (the hindsight optimum as "hindsight") on the
+    episodes of ``seeds``."""
+    with open(path) as f:
+        rows = [json.loads(line) for line in f if line.strip()]
+    return [r for r in rows if r["policy"] in policies and r["seed"] in seeds]
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--episodes", type=int, default=60)
@@ -73,15 +86,18 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--moves", choices=MOVE_SETS, default="tracing", help="admissible moves of the policies")
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--json", help="write one JSON line per episode and policy here")
+    ap.add_argument("--reuse", help="an earlier --json of the same episodes: its rows are not run again")
     args = ap.parse_args(argv)
     policies = args.policies.split(",")
     specs = plan_sweep(SMALL, args.episodes, args.seed, policies, moves=args.moves, verify="none")
     draws = {s.seed: s for s in specs} if args.hindsight_depth > 0 else {}
     t0 = time.perf_counter()
-    rows: list[dict] = []
+    rows = _reused(args.reuse, policies + ["hindsight"], {s.seed for s in specs}) if args.reuse else []
+    done = {(r["policy"], r["seed"]) for r in rows}
     with ProcessPoolExecutor(max_workers=args.jobs) as pool:
-        futs = [pool.submit(_policy_run, s, args.depth) for s in specs]
-        futs += [pool.submit(_hindsight_run, s, args.hindsight_depth) for s in draws.values()]
+        futs = [pool.submit(_policy_run, s, args.depth) for s in specs if (s.policy, s.seed) not in done]
+        hind = [s for s in draws.values() if ("hindsight", s.seed) not in done]
+        futs += [pool.submit(_hindsight_run, s, args.hindsight_depth) for s in hind]
         for f in tqdm(futs, desc="episodes", unit="ep"):
             rows.append(f.result())
     wall = time.perf_counter() - t0

@@ -15,7 +15,10 @@ against library size, log-log, with the fitted growth exponent); prints the tabl
 
     .venv/bin/python scripts/bench_scale.py [--sizes 10,30,100,300,1000] [--episodes 200] [--workers 2]
         [--seed 1] [--library-seed 0] [--libraries out/bench_scale/libraries] [--out out/bench_scale]
-        [--compare-bound SIZE] [--bound N] [--max-grouped N]
+        [--compare-bound SIZE] [--bound N] [--max-grouped N] [--policy planner] [--moves tracing]
+
+It also prints the policy's choice alone (CPU time of each decision, the matcher update left out) as 50th, 90th
+and 99th percentiles.
 
 ``--compare-bound SIZE`` runs the episodes of library SIZE a second time with no bound on the planner's
 hypotheses (``PlannerConfig.max_hypotheses=None``) and reports the change in path cost and outcomes; ``--bound N``
@@ -35,6 +38,8 @@ from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
+
+from haptic.planning.moves import MOVE_SETS
 
 _TIMES: dict = {}
 
@@ -171,6 +176,7 @@ def _summary(size: int, results: list[dict], wall: float, workers: int, build: d
         "decision_cpu_median_s": q(total_cpu, 50), "decision_cpu_p95_s": q(total_cpu, 95),
         "update_median_s": q(d[:, 0], 50), "update_p95_s": q(d[:, 0], 95),
         "choose_median_s": q(d[:, 2], 50), "choose_p95_s": q(d[:, 2], 95),
+        "choose_cpu_p50_s": q(d[:, 3], 50), "choose_cpu_p90_s": q(d[:, 3], 90), "choose_cpu_p99_s": q(d[:, 3], 99),
         "episode_wall_median_s": q([r["wall_s"] for r in results], 50),
         "episode_wall_p95_s": q([r["wall_s"] for r in results], 95),
         "episodes_per_min": 60.0 * n / wall, "workers": workers, "sweep_wall_s": wall,
@@ -243,6 +249,7 @@ def main(argv=None) -> int:
     ap.add_argument("--seed", type=int, default=1, help="seed of the sweep (models and poses)")
     ap.add_argument("--library-seed", type=int, default=0, help="seed of the generated libraries")
     ap.add_argument("--policy", default="planner")
+    ap.add_argument("--moves", choices=MOVE_SETS, default="tracing", help="admissible moves of the episodes")
     ap.add_argument("--libraries", default="out/bench_scale/libraries")
     ap.add_argument("--out", default="out/bench_scale")
     ap.add_argument("--compare-bound", type=int, default=None, metavar="SIZE")
@@ -273,13 +280,16 @@ def main(argv=None) -> int:
         names = sorted(load_library(lib_dir))
         specs = [
             {"model": s.model, "seed": s.seed, "policy": s.policy, "models": str(lib_dir), "verify": "none",
-             "moves": "tracing"}  # the seed's episodes: what this script's figures were measured with
+             "moves": args.moves}  # tracing by default: the seed's episodes, what the figures were measured with
             for s in plan_sweep(names, args.episodes, args.seed, [args.policy])
         ]
         results, wall = _run(specs, args.workers, args.bound, args.max_grouped)
         row = _summary(size, results, wall, args.workers, build)
         rows.append(row)
         print(json.dumps(row), flush=True)
+        print(f"{size} models, --policy {args.policy} --moves {args.moves}: the policy's choice, CPU ms p50 / p90 / "
+              f"p99 over {row['decisions']} decisions: {1e3 * row['choose_cpu_p50_s']:.1f} / "
+              f"{1e3 * row['choose_cpu_p90_s']:.1f} / {1e3 * row['choose_cpu_p99_s']:.1f}", flush=True)
         if args.compare_bound == size:
             free, wall_free = _run(specs, args.workers, None, args.max_grouped)
             paired = [(a, b) for a, b in zip(results, free, strict=True)]

@@ -9,8 +9,9 @@ as a model file and explored as ``--object FILE`` against the library: the right
 recognised as only within the band next to the table where the verification says it measured nothing (its
 ``table_band_mm``: a chamfer of an edge on the table, below the pad's reach), counted apart (``within_claim``,
 with the highest point of the difference, ``difference_top_mm``). The table gives them by perturbation and size,
-per verification mode; with ``--baseline N`` it also runs N library objects (the planner's usual episodes) per mode
-and reports the mean path cost of each mode over that without verification.
+per verification mode; with ``--baseline N`` it also runs N library objects (the policy's usual episodes) per mode
+and reports the mean path cost of each mode over that without verification. ``--policy`` sets every episode's
+policy (default: the default policy).
 
     .venv/bin/python scripts/bench_unknown.py --verify none,fast,full --episodes 2 --workers 2
     .venv/bin/python scripts/bench_unknown.py --models assets/libraries/lookalike --episodes 1 --verify full \
@@ -33,12 +34,13 @@ from pathlib import Path
 import numpy as np
 
 from haptic.bench.runner import plan_sweep, run_sweep
-from haptic.episode.spec import EpisodeSpec
+from haptic.episode.spec import DEFAULT_POLICY, EpisodeSpec
 from haptic.errors import HapticError, ModelError
 from haptic.geometry import Polyhedron, are_congruent, load_library, save_model
 from haptic.geometry.io import atomic_write
 from haptic.geometry.perturb import chamfer_edge, move_vertex, scale_dimension
 from haptic.planning.moves import MOVE_SETS, CostModel, default_moves
+from haptic.planning.registry import POLICY_NAMES
 
 SCALES = (0.97, 1.03, 1.05, 1.10)
 VERTEX_MM = (2.0, 4.0, 8.0)
@@ -202,6 +204,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--max-moves", type=int, default=40)
     ap.add_argument("--moves", choices=MOVE_SETS, default=None,
                     help="admissible kinds of move (default: the command line's for the executor)")
+    ap.add_argument("--policy", default=DEFAULT_POLICY, choices=POLICY_NAMES, help="the policy of every episode")
     ap.add_argument("--out", default="out/unknown", help="output directory")
     args = ap.parse_args(argv)
     moves = args.moves or default_moves(args.executor)
@@ -233,11 +236,12 @@ def main(argv: list[str] | None = None) -> int:
                         specs.append(EpisodeSpec(
                             model=str(path), seed=int(s), executor=args.executor, noise=args.noise,
                             models=args.models, max_moves=args.max_moves, verify=mode, moves=moves,
+                            policy=args.policy,
                         ))  # fmt: skip
                         meta.append((name, kind, size))
         if args.baseline:
             for mode in [m for m in args.baseline_verify.split(",") if m] or modes:
-                for s in plan_sweep(names, args.baseline, args.seed + 1, ["planner"], (args.noise,),
+                for s in plan_sweep(names, args.baseline, args.seed + 1, [args.policy], (args.noise,),
                                     executor=args.executor, models=args.models, max_moves=args.max_moves,
                                     verify=mode, moves=moves):  # fmt: skip
                     specs.append(s)

@@ -361,6 +361,21 @@ def test_a_verification_up_to_hidden_vertices_says_so_and_is_not_confirmed():
     assert rec.outcome == "ambiguous" and not rec.verified["reach_complete"]
 
 
+def test_a_stalled_verification_relocates_over_the_object_and_measures_what_is_in_reach():
+    # BOX01P seed 1 stands upright, its tab 30 mm high on a side. The traced verification measured the top and the
+    # tab's upper corners; the tour, pricing the way to the tab's lower corners as a straight line, then kept the pad
+    # tracing the top's edges and measuring vertices it had, until the stall rule ended it with 4 vertices in reach
+    # not measured. After moves that measure nothing the hand now relocates: a probe carries the pad over the
+    # object onto a face beside what is missing, and every vertex in reach is measured (the episode stays
+    # ambiguous: vertices under the tab and on the table are out of the hand's reach).
+    kinds = []
+    obs = EpisodeObserver(on_move=lambda n, r, count, rec: kinds.append(r.move.kind))
+    rec = run_episode(EpisodeSpec(model="BOX01P", seed=1, executor="physics", verify="full"), observer=obs)
+    assert "probe" in kinds
+    assert rec.verified["reach_complete"], rec.detail
+    assert rec.outcome in ("recognized", "ambiguous") and rec.recognized in ("BOX01P", None)
+
+
 def test_an_edge_move_after_a_tilted_move_returns_beside_the_last_contact():
     # HEXPRISM01 seed 1: face moves onto the sides leaning under 30° are made with the hand tilted, which then backs
     # out along the finger's axis, centimetres from the edge just found. The edge move after such a move touched the

@@ -845,7 +845,7 @@ class Toucher:
         r0 = p0 - vtx
         r0 = unit(r0 - (r0 @ n_f) * n_f)
         t0 = unit(start_direction - (start_direction @ n_f) * n_f)
-        axis = np.cross(r0, t0)  # ± n_f: the sense of the circle
+        axis = unit(np.cross(r0, t0))  # ± n_f: the sense of the circle
         over = 0
         swept = 0.0
         prev = r0
@@ -871,7 +871,10 @@ class Toucher:
                 return self._result("unstable", "nan", 0.0)
             path += float(np.linalg.norm(self.tip - prev_tip))
             progress_t.append(path)
-            swept += angle(prev, rh)
+            # signed about the circle's axis: the contact point's noise turns ``rh`` back and forth by a degree a
+            # tick at the circle's radius, and unsigned turns summed that noise (trapezohedron_12 at 77 mm: a circle
+            # that gave up after "sweeping" 342° had gone 137° round its vertex, short of the next edge)
+            swept += math.atan2(float(axis @ np.cross(prev, rh)), float(prev @ rh))
             prev = rh
             if (swept > max_sweep and max_sweep < full) or self.below_floor(t):
                 return self._result("unreachable", "table", 0.0, arc=swept)

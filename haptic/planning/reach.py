@@ -38,6 +38,12 @@ MARGIN = 0.0005
 TRACE_ROOM = 0.006
 """Room a trace needs: a point the pad could touch only within this of its limit above the table counts as
 out of reach (a face move there would be refused as too close to the table) [m]."""
+MEASURE_ROOM = 0.0
+"""Room the verification asks of a face, beyond the pad's clearance of the table, to count it in reach
+(:func:`haptic.planning.verify.reachable_features`): none. Its vertices are measured at the ends of edge moves along
+ridges and by circles high on the face, not by traces across it (prism_05 of the formula corpus at 34 mm, 20 mm tall
+lying on an end: with :data:`TRACE_ROOM` its sides counted as out of reach and its top vertices as hidden, and the
+verification ended incomplete at once; the hand measures every one of them) [m]."""
 
 
 def surface_samples(poly: Polyhedron, spacing: float = SPACING) -> tuple[np.ndarray, np.ndarray]:

@@ -21,6 +21,7 @@ from __future__ import annotations
 import time
 import weakref
 from collections.abc import Mapping, Sequence
+from dataclasses import replace
 
 import numpy as np
 
@@ -50,7 +51,19 @@ from haptic.planning.tour import (
 
 STALL_MOVES = 8
 """Verification moves in a row that measure no missing feature after which the verification ends with what it
-has measured (status "incomplete": the episode ends as ambiguous, its record says what was not measured)."""
+has measured (status "incomplete": the episode ends as ambiguous, its record says what was not measured); on the
+hand counted from the last relocation too (:data:`RELOCATE_AFTER`), which puts the pad somewhere new."""
+RELOCATE_PROBES = 6
+"""Probe lines a relocation weighs, to the missing features nearest the sensor first (:func:`_verification_probes`):
+on the hand many are refused (the table, the finger's way down), and the tour's two cheapest entries are often
+where the traced moves stalled."""
+CROSSING_FAILURES = 2
+"""On the hand, face moves that failed to cross one model edge from one model face after which the verification does
+not ask that crossing again (:meth:`Verifier._fail_crossings`)."""
+RELOCATE_AFTER = 3
+"""On the hand, verification moves in a row that measure nothing missing after which the next is a relocation: a
+free-space probe onto a face beside where the tour is cheapest to enter, where one is predicted to land near what
+is missing (:func:`plan_verification_move`); again after as many more."""
 MOVES_PER_FEATURE = 3
 """Verification moves allowed per feature of the coverage target (:func:`verify_move_budget`): a vertex costs about
 two moves (an aimed face move and a short edge move, or a vertex move and an edge trace), and getting from one to
@@ -76,11 +89,12 @@ def reachable_features(
 ) -> tuple[frozenset[int], frozenset[int], frozenset[int]]:
     """The faces, edges and vertices of ``poly`` at ``world_from_model`` that a verification can measure: all of
     them without a table; on the table (``config.table_z``), the faces the pad can touch
-    (:mod:`haptic.planning.reach`), the edges between two of them and the vertices of two of them."""
+    (:mod:`haptic.planning.reach`), the edges between two of them and the vertices at the ends of those edges that an
+    edge move reaches clear of the table."""
     allf = frozenset(range(poly.n_faces))
     if config.table_z is None:
         return allf, frozenset(range(poly.n_edges)), frozenset(range(poly.n_vertices))
-    from haptic.planning.reach import SPACING, TRACE_ROOM, touchable
+    from haptic.planning.reach import MEASURE_ROOM, SPACING, touchable
 
     faces = set()
     for f in range(poly.n_faces):  # interior sample points of the face's triangles
@@ -97,18 +111,22 @@ def reachable_features(
             continue
         nrm = np.broadcast_to(poly.face_normals[f], p.shape)
         ok = touchable(poly, world_from_model, world_from_model.apply(p), world_from_model.rotate(nrm), config,
-                        TRACE_ROOM)  # fmt: skip
+                        MEASURE_ROOM)  # fmt: skip
         if int(ok.sum()) >= MIN_SAMPLES:
             faces.add(f)
     edges = {e for e in range(poly.n_edges) if {int(poly.edge_left_face[e]), int(poly.edge_right_face[e])} <= faces}
-    vertices = [v for v in range(poly.n_vertices) if sum(f in faces for f in poly.vertex_faces[v]) >= 2]
-    # ... where the pad touching the vertex from one of them stays clear of the table: an edge move run down to a
-    # vertex nearer the table is stopped by the table, which locates no vertex
+    # ... at the end of one of those edges where the pad following it (on its ridge, the normal between its faces')
+    # stays clear of the table: an edge move locates a vertex, and one run down to a vertex nearer the table is
+    # stopped by the table and locates none (the planner refuses it: :func:`~haptic.planning.table.edge_end_on_table`).
+    # The pad touching one face by the vertex may clear the table where the ridge does not (prism_10 of the formula
+    # corpus at 117 mm on its side: its end's corners 17 mm up, counted in reach from the upright end, drew 40
+    # verification moves that the table stopped)
     r = config.pad_radius
     low = config.table_z + config.table_clearance
     z = world_from_model.apply(poly.vertices)[:, 2]
-    nz = world_from_model.rotate(poly.face_normals)[:, 2]
-    vertices = [v for v in vertices if any(z[v] + r * nz[f] - r >= low for f in poly.vertex_faces[v] if f in faces)]
+    ridge = poly.face_normals[poly.edge_left_face] + poly.face_normals[poly.edge_right_face]
+    ridge_z = world_from_model.rotate(ridge / np.maximum(np.linalg.norm(ridge, axis=1, keepdims=True), 1e-12))[:, 2]
+    vertices = {int(v) for e in edges for v in poly.edges[e] if z[v] + r * ridge_z[e] - r >= low}
     return frozenset(faces), frozenset(edges), frozenset(vertices)
 
 
@@ -194,11 +212,13 @@ def hidden_vertices(poly: Polyhedron, world_from_model: SE3, cov, config: Planne
     take from the table (farther than :data:`TABLE_CONTACT` above it): a vertex under an overhang, or on a face
     turned to the table that rests on other vertices. An object that differs from the model there (a corner
     moved 4 mm) is not told apart by anything the hand can touch, so a verification with one is incomplete, not
-    confirmed. Without a table every vertex is reachable and none is hidden."""
+    confirmed. A vertex measured all the same (the hand reached what the prediction counted out of reach) is not
+    hidden. Without a table every vertex is reachable and none is hidden."""
     if config.table_z is None:
         return []
     z = world_from_model.apply(poly.vertices)[:, 2] - config.table_z
-    return [v for v in range(poly.n_vertices) if v not in cov.reachable_vertices and z[v] > TABLE_CONTACT]
+    return [v for v in range(poly.n_vertices)
+            if v not in cov.reachable_vertices and v not in cov.vertices and z[v] > TABLE_CONTACT]  # fmt: skip
 
 
 def _new_features(before: Hypothesis, after: Hypothesis) -> tuple[set[int], set[int], set[int]]:
@@ -440,6 +460,7 @@ def _verification_probes(
     h: Hypothesis, state: SensorState, components: Mapping[int, DataComponent],
     missing: tuple[frozenset[int], frozenset[int], frozenset[int]], noise: SensorNoise, config: PlannerConfig,
     avoid: Sequence[Move] = (), probed: Sequence[Move] = (), faces_ok: frozenset[int] | None = None,
+    relocate: bool = False, most: int = MAX_VERIFY_PROBES,
 ) -> list[tuple[Move, float, float, bool]]:
     """:func:`verification_probes`, each with whether it lands near what is missing (:data:`LANDS_NEAR`): the
     target on a face beside a vertex lies far from it where the face's corner there is narrow, and a line aimed at
@@ -447,7 +468,7 @@ def _verification_probes(
     from haptic.planning.move_scores import Context, predict_probe_moves, probe_config, same_move
     from haptic.planning.probe_lines import aimed_probes
 
-    no_probes = config.moves == "tracing" or config.table_z is not None  # the hand verifies by tracing
+    no_probes = not (relocate or (config.moves != "tracing" and config.table_z is None))
     if no_probes or h.world_from_model is None or any(m.kind == "probe" for m in avoid):
         return []
     here = h.model_from_world.apply(state.position)
@@ -455,7 +476,7 @@ def _verification_probes(
                if float(np.linalg.norm(p - here)) >= MIN_PROBE_TRANSFER]  # fmt: skip
     targets.sort(key=lambda pf: float(np.linalg.norm(pf[0] - here)))
     lines = [(mv, targets[k]) for mv, k in aimed_probes(h, targets, probe_config(config))
-             if not any(same_move(mv, done) for done in probed)][:MAX_VERIFY_PROBES]  # fmt: skip
+             if not any(same_move(mv, done) for done in probed)][:most]  # fmt: skip
     preds = predict_probe_moves(Context((h,), state, components, noise, config), [mv for mv, _ in lines])
     poly = h.poly
     mf, me, mv = missing
@@ -507,6 +528,8 @@ def plan_verification_move(
     previous: Tour | None = None,
     travelled: frozenset[tuple] | set[tuple] = frozenset(),
     visited: Sequence[np.ndarray] = (),
+    relocate: bool = False,
+    failed_crossings: frozenset[tuple[int, int]] | set[tuple[int, int]] = frozenset(),
 ) -> tuple[Move | None, Tour | None, float]:
     """:func:`choose_verification_move`, with the tour it planned over ``missing`` (from ``previous``'s order,
     when given) and that tour's cost from the sensor as it is [units] (None and 0 without a pose). A candidate
@@ -515,7 +538,13 @@ def plan_verification_move(
     (on the hand a move ends where the pad stops, and going back can be the way on; there it kept BOX01N's
     verification from a vertex it then found, seed 2), unless every candidate is: the tour's
     estimate from where such moves end can keep them the cheapest, and the verification goes back and forth
-    until it stalls."""
+    until it stalls.
+
+    With ``relocate`` (on the hand, where the verification has stalled: :meth:`Verifier._relocate`) probes are
+    offered whatever the move set, and when one is predicted to land near where the tour is entered only such
+    probes are: the next move carries the pad over the object to there. A face move predicted to cross a model
+    edge from a model face where face moves failed to cross before (``failed_crossings``, :func:`_crossing`) is
+    left out, after those going back."""
     from haptic.planning.search import simulate
     from haptic.planning.simulate import simulate_probe
 
@@ -523,15 +552,24 @@ def plan_verification_move(
         first = _moves(h, state, components, noise, config, avoid, missing)
         return (first[0][0] if first else None), None, 0.0
     poly, legs = h.poly, _legs(config)
+    if relocate:
+        legs = replace(legs, probes=True)
     keys = features(poly).index(missing)
     tour = plan_tour(poly, keys, legs, previous)
     table = StartCosts(poly, keys, legs)
     here = _start_costs(h, state, table)
     now = tour.cost_from(here)
     first = _moves(h, state, components, noise, config, avoid, missing)
-    landing = _verification_probes(h, state, components, _entries(poly, tour, here, keys), noise, config, avoid,
-                                   probed, faces_ok)  # fmt: skip
+    if relocate:  # any missing feature, the nearest first
+        landing = _verification_probes(h, state, components, missing, noise, config, avoid, probed, faces_ok, True,
+                                       RELOCATE_PROBES)  # fmt: skip
+    else:
+        landing = _verification_probes(h, state, components, _entries(poly, tour, here, keys), noise, config, avoid,
+                                       probed, faces_ok)  # fmt: skip
     probes = [(m, c, r) for m, c, r, _ in landing]
+    if relocate:  # a relocation, where a probe lands near what is missing; else the traced moves as ever
+        near = [(m, c, r) for m, c, r, near in landing if near]
+        first, probes = (first, []) if not near else ([], near)
     if legs.probes and not any(near for *_, near in landing):
         # no probe lands near where the tour is entered from here: priced with probes, every candidate leaves the
         # same probe's cost, and the cheapest move wins wherever it ends (face moves back and forth over one
@@ -546,6 +584,7 @@ def plan_verification_move(
     best, best_score = None, np.inf
     ends: list[tuple[Move, np.ndarray | None, float]] = []
     again: list[tuple[Move, np.ndarray | None, float]] = []  # left out as going back: the last resort
+    refused: list[tuple[Move, np.ndarray | None, float]] = []  # crossings that failed: after the last resort
     going_back = config.table_z is None  # the hand's moves end where the pad stops, not where predicted
     for m, c, r in [*first, *probes]:
         sim = (simulate_probe(h, m, state, components, noise) if m.kind == "probe"
@@ -554,6 +593,9 @@ def plan_verification_move(
             ends.append((m, None, c))
             continue
         h1, s1, _ = sim
+        if m.kind == "face" and _crossing(h, state, h1, s1) in failed_crossings:
+            refused.append((m, h.world_from_model.inverse().apply(s1.position), c))
+            continue
         new = _new_features(h, h1)
         if going_back and _gain(new, missing) == 0 and (outcome_key(h, m, state, h1, s1) in travelled or any(
                 float(np.linalg.norm(s1.position - p)) < REVISIT for p in visited)):
@@ -569,7 +611,7 @@ def plan_verification_move(
         return best, tour, now
     # no candidate can be followed in the hypothesis's world (or every one goes back): head for the nearest
     # missing feature
-    ends = ends or again
+    ends = ends or again or refused
     targets = _target_points(h.poly, missing)
     if not len(targets):
         return ends[0][0], tour, now
@@ -578,6 +620,14 @@ def plan_verification_move(
         for k, (m, p, c) in enumerate(ends)
     ]
     return ends[min(scored)[2]][0], tour, now
+
+
+def _crossing(h: Hypothesis, state: SensorState, after: Hypothesis, end: SensorState) -> tuple[int, int] | None:
+    """The model face a face move starts on and the model edge it is predicted to end on, in hypothesis ``h``'s
+    world (None when either is unknown)."""
+    f = h.faces.get(state.face)
+    e = after.edges.get(end.edge) if end.edge is not None else None
+    return None if f is None or e is None else (int(f), int(e))
 
 
 REVISIT = 3e-3
@@ -716,6 +766,13 @@ class Verifier:
         :func:`verify_move_budget` made: ambiguous between the model and an object outside the library),
         "verifying", or "not needed" (no pose class was ever left alone)."""
         self._progress = (-1, 0)  # (features measured, verification moves then)
+        self._relocated = 0
+        self._failed_crossings: set[tuple[int, int]] = set()
+        """On the hand, the (model face, model edge) that face moves failed to cross :data:`CROSSING_FAILURES`
+        times (:meth:`_fail_crossings`)."""
+        self._crossing_failures: dict[tuple[int, int], int] = {}
+        self._failures_seen: set[tuple[int, ...]] = set()
+        """Verification moves made when the last relocation (:meth:`_relocate`) was chosen."""
         self._travelled: set[tuple] = set()
         """:func:`outcome_key` of the moves made since the last feature measured that were to measure nothing."""
         self._visited: list[np.ndarray] = []
@@ -818,7 +875,7 @@ class Verifier:
                 self._progress = (got, self.moves)
                 self._travelled.clear()
                 self._visited.clear()
-            elif self.moves - self._progress[1] >= STALL_MOVES:
+            elif self.moves - max(self._progress[1], self._relocated) >= STALL_MOVES:
                 self.status = "incomplete"
             if self.moves >= self.move_budget():
                 self.status = "incomplete"
@@ -911,11 +968,15 @@ class Verifier:
             return move
         missing = self.coverage.missing(self.mode) if self.coverage is not None else (frozenset(),) * 3
         avoid = (*avoid, *self._failed_along(h, state, components, avoid))
+        relocate = self._relocate()
+        self._fail_crossings(h, state, components, avoid)
         faces_ok = self._reach[self._model_name][0] if self._model_name in self._reach else None
         previous = self._tour if self._tour is not None and self._tour_model is h.poly else None
         move, self._tour, now = plan_verification_move(h, state, components, missing, self.noise, self.config,
                                                        avoid, probed, faces_ok, previous, self._travelled,
-                                                       self._visited)  # fmt: skip
+                                                       self._visited, relocate, self._failed_crossings)  # fmt: skip
+        if relocate and move is not None and move.kind == "probe":
+            self._relocated = self.moves
         self._visited.append(np.array(state.position, float))
         self._tour_model = h.poly
         if move is not None and move.kind != "probe" and h.world_from_model is not None:
@@ -932,6 +993,46 @@ class Verifier:
             self.tour_bound = bound if bound > 0 else None
         self.decision_times.append(time.perf_counter() - t0)
         return move
+
+    def _fail_crossings(self, h: Hypothesis, state: SensorState, components: Mapping[int, DataComponent],
+                        avoid: Sequence[Move]) -> None:
+        """On the hand, count the crossings of the face moves that failed from here (``avoid``): the model face
+        each started on and the model edge it was predicted to cross (:func:`_crossing`). After
+        :data:`CROSSING_FAILURES` such failures the crossing is not asked again: the hand's failure to cross an
+        edge -- the pad rolling onto a slot's floor between its walls, onto a face under an overhang -- is the
+        edge's, not where the pad was (from elsewhere on the face the verification chose the same crossing
+        again, and it failed again); a single failure may be the pad's place (a roll too near a vertex), and a
+        second try elsewhere succeeds."""
+        if self.config.table_z is None or h.world_from_model is None:
+            return
+        from haptic.planning.search import simulate
+
+        for m in avoid:
+            if m.kind != "face":
+                continue
+            seen = (*np.round(np.asarray(state.position, float) * 1e4).astype(int),
+                    *np.round(np.asarray(m.direction, float) * 1e3).astype(int))  # fmt: skip
+            if seen in self._failures_seen:  # failed from here: asked about again at each decision from here
+                continue
+            self._failures_seen.add(seen)
+            sim = simulate(h, m, state, components, self.config)
+            key = _crossing(h, state, sim[0], sim[1]) if sim is not None else None
+            if key is not None:
+                self._crossing_failures[key] = self._crossing_failures.get(key, 0) + 1
+                if self._crossing_failures[key] >= CROSSING_FAILURES:
+                    self._failed_crossings.add(key)
+
+    def _relocate(self) -> bool:
+        """Whether the next move is to relocate on the hand (:func:`plan_verification_move`): the last
+        :data:`RELOCATE_AFTER` verification moves measured nothing missing, none of them a relocation. Traced
+        moves reach a feature along the faces, and where the hand cannot go that way (across a slot or a notch,
+        out of a hole, to a face below an overhang) the tour's straight-line estimate keeps them heading there
+        until the stall rule ends the verification; a probe carries the pad over the object onto a face beside
+        the tour's entry. Without a table (a point sensor) tracing goes anywhere, and none."""
+        if self.config.table_z is None:
+            return False
+        # self.moves counts this decision already
+        return self.moves - 1 - max(self._progress[1], self._relocated) >= RELOCATE_AFTER
 
     def _failed_along(self, h: Hypothesis, state: SensorState, components: Mapping[int, DataComponent],
                       avoid: Sequence[Move]) -> list[Move]:

@@ -224,3 +224,33 @@ def test_a_stroke_leg_that_a_finger_link_stops_ends_there_without_failing_the_st
     assert [leg.event for leg in legs][1] == "hand" and len(legs) == 3  # turned back the other way
     assert s.ok, (s.status, s.event)
     assert np.degrees(np.arccos(s.info["normal"] @ [0.0, 0.0, 1.0])) < 1.0
+
+
+def _net_turn(trace, centre: np.ndarray) -> float:
+    """How far the contacts of ``trace`` went round ``centre`` on the box's top face (unwrapped) [rad]."""
+    p = trace.point_in_world[trace.in_contact] - centre
+    th = np.unwrap(np.arctan2(p[:, 1], p[:, 0]))
+    return float(abs(th[-1] - th[0]))
+
+
+def test_the_vertex_circle_measures_how_far_it_went_round_despite_the_contacts_noise():
+    """A circle about a point in the middle of the box's top face meets no edge: it must go round the whole of
+    ``circle_max_sweep`` before giving up, and stop after ``max_sweep`` when one is given. Summing the unsigned turns
+    of the noisy contact point between ticks, the circle gave up having gone about 40 % of the way round (a vertex
+    whose faces meet at more than that was never circled to its next edge)."""
+    sim = _box_sim(seed=5)
+    t = Toucher(RobotInterface(sim))
+    top = CENTRE[2] + HALF[2]
+    centre = np.array([CENTRE[0], CENTRE[1], top])
+    radius = 0.008
+    assert t.move_free(centre + [-radius, 0.0, 0.03]).ok
+    assert t.approach(np.array([0.0, 0.0, -1.0]), 0.05).ok
+    up = np.array([0.0, 0.0, 1.0])
+    full = t.config.circle_max_sweep
+    r = t.circle_vertex(centre, up, np.array([0.0, 1.0, 0.0]), radius)
+    assert r.event == "limit"
+    assert r.info["arc"] >= full
+    assert _net_turn(r.trace, centre) > 0.9 * full
+    r = t.circle_vertex(centre, up, np.array([0.0, 1.0, 0.0]), radius, max_sweep=np.pi / 2)
+    assert r.event == "table"  # given up where the circle would meet the table
+    assert abs(_net_turn(r.trace, centre) - np.pi / 2) < 0.2 * np.pi / 2

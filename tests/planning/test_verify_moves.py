@@ -276,3 +276,54 @@ def test_the_band_next_to_the_table_that_nothing_measures_follows_the_faces_risi
         assert table_band(poly, pose, PlannerConfig()) == 0.0
     box_pose, box_table = _resting_on(LIB["BOX01"], 0)
     assert abs(table_band(LIB["BOX01"], box_pose, box_table) - 0.016) < 1e-6
+
+
+def test_the_sides_of_a_short_prism_count_in_reach_down_to_the_pads_clearance_of_the_table():
+    """prism_05 of the formula corpus scaled to 34 mm across stands 20 mm tall on a pentagon: its sides can be
+    touched only in their top few millimetres (the 12 mm pad's lowest point at the table's clearance). The
+    verification measures their top vertices there, at the ends of edge moves along the rim; asking a trace's room
+    besides, it counted the sides out of reach, the five top vertices hidden and the five on the table unpinned,
+    and every such episode ended incomplete without a move."""
+    from haptic.geometry.corpus import corpus_solids
+    from haptic.geometry.perturb import scaled_to
+    from haptic.planning.verify import reachable_features, table_pins
+
+    poly = scaled_to(next(p for s, p in corpus_solids() if s.name == "prism_05"), 0.034)
+    pose, table = _resting_on(poly, 0)
+    z = pose.apply(poly.vertices)[:, 2] - 0.35
+    assert 0.015 < z.max() < 0.025
+    f, e, v = reachable_features(poly, pose, table)
+    top = set(np.flatnonzero(z > 0.01).tolist())
+    assert len(top) == 5 and top <= set(v)
+    assert len(f) == 6  # all but the face on the table
+    pins, unpinnable = table_pins(poly, pose, (f, e, v), table)
+    assert len(pins) == 5 and unpinnable == []
+
+
+def test_a_vertex_whose_edges_the_pad_cannot_follow_to_it_clear_of_the_table_is_hidden():
+    """prism_10 of the formula corpus lying on a side (the pose of its corpus episode, 95 mm across here): the corners
+    of its upright ends 17 mm up. The pad touching an end by such a corner clears the table, so they counted in
+    reach; but a vertex is located at the end of an edge move, and on the ridge of either edge the hand can follow
+    to it (the end's edge up to the next side, leaning under 18°) the pad comes within the table's clearance: the
+    planner refuses that move, and the verification's face moves toward the corner were stopped by the table 8 times
+    (40 verification moves, then incomplete). Hidden: the verification says so at once. The corners 45 mm up are
+    reached."""
+    from haptic.geometry.corpus import corpus_solids
+    from haptic.geometry.perturb import scaled_to
+    from haptic.matching.acceptance import Coverage
+    from haptic.planning.verify import hidden_vertices, reachable_features
+
+    poly = scaled_to(next(p for s, p in corpus_solids() if s.name == "prism_10"), 0.095)
+    side = next(f for f in range(poly.n_faces) if len(poly.faces[f]) == 4)
+    pose, table = _resting_on(poly, side)
+    z = pose.apply(poly.vertices)[:, 2] - 0.35
+    low = np.flatnonzero((z > 0.016) & (z < 0.019))
+    assert len(low) == 4
+    f, e, v = reachable_features(poly, pose, table)
+    cov = Coverage(frozenset(), frozenset(), frozenset(), f, e, v)
+    hidden = hidden_vertices(poly, pose, cov, table)
+    assert set(low.tolist()) <= set(hidden)
+    assert set(np.flatnonzero((z > 0.03) & (z < 0.06)).tolist()) <= set(v)
+    # measured all the same, a vertex is not hidden
+    measured = Coverage(frozenset(), frozenset(), frozenset(low.tolist()), f, e, v)
+    assert not set(low.tolist()) & set(hidden_vertices(poly, pose, measured, table))
