@@ -507,13 +507,11 @@ def test_a_roll_that_reaches_the_tables_clearance_measures_no_face(tmp_path):
     # lying on a side, the octagon's faces next to the table lean under at 45°. A face move down a side rolled over
     # the edge to such a face and the pad reached the table's clearance (2 mm) with its normal 28° below the
     # horizontal, no longer turning: the roll "settled", and the stroke there rode the edge, a face 43.6 bounds off
-    # (no-match). A roll that reaches the table's clearance has not reached the next face: the crossing fails.
-    failed = []
-    obs = EpisodeObserver(on_failed_move=lambda n, r: failed.append(r.reason))
+    # (no-match). A roll that reaches the table's clearance has not reached the next face: the edge is reported
+    # alone from the roll, as over a face leaning under out of reach, or the move fails.
     spec = EpisodeSpec(model="prism_08", seed=3, executor="physics",
                        models=_scaled_library(tmp_path, 0.10, corpus=True))  # fmt: skip
     ep = build_episode(spec)
-    rec = ep.run(None, obs)
-    assert any("table's clearance before the next face" in w for w in failed), failed
+    rec = ep.run(None)
     assert rec.outcome != "no-match", rec.detail
     assert _within_bounds(ep)

@@ -523,12 +523,10 @@ class PhysicsExecutor(LandingSearch):
                 self._met = r
                 return "hand", f"crossing the {kind} edge: the finger's {r.info['link']} met the object", None, \
                     None, None
-            if r.event == "undercut":
-                return "undercut", f"crossing the {kind} edge: the next face leans under, out of the pad's reach", \
-                    r.trace, None, None
-            if r.event == "table":
-                return r.status, f"crossing the {kind} edge: the pad reached the table's clearance before the next " \
-                    "face", None, None, None
+            if r.event in ("undercut", "table"):  # the next face out of the pad's reach: the roll gives the edge
+                why = ("the next face leans under, out of the pad's reach" if r.event == "undercut"
+                       else "the pad reached the table's clearance before the next face")  # fmt: skip
+                return "undercut", f"crossing the {kind} edge: {why}", r.trace, None, None
             if r.event != "lost":  # the roll went on turning (limit), or the state is bad: nothing to touch afresh
                 return r.status, f"crossing the {kind} edge: {r.event}", None, None, None
             return self._reacquire(kind, n_a, direction, corner, r.trace, None, pieces, away_from,
