@@ -540,6 +540,11 @@ class PhysicsExecutor(LandingSearch):
         st = t.stroke(n_b, r.info["away"], along)
         pieces.append(st)
         self._stroke_blocked = st.ok and st.info["blocked"]
+        if kind == "convex" and st.ok and st.info["at_table"]:
+            # the table may have stopped the roll short of the next face (one leaning under, the edge low): the pad
+            # settled on the ridge, its normal partway round (bipyramid_06 at 60 mm: 7-9° short of the face, the pad
+            # 1 mm above the table), and the legs along the edge, never off it, rode the ridge with that normal
+            return "unreachable", "stepping onto the next face, the pad met the table at the edge", None, None, None
         rim = st.ok and st.info["rim"]
         fit = self.segmenter.fit_face_trace(st.trace, st.info["normal"]) if st.ok and not rim else None
         if fit is None:

@@ -650,7 +650,8 @@ class Toucher:
     def stroke(self, normal: np.ndarray, away: np.ndarray, along: np.ndarray, step_in: float | None = None
                ) -> PrimitiveResult:  # fmt: skip
         """A short L on a face for its normal: ``step_in`` along ``away``, then ``stroke`` along ``along`` (the
-        other way if an edge comes first). ``info["normal"]``: mean sensed normal on the face.
+        other way if an edge comes first). ``info["normal"]``: mean sensed normal on the face; ``info["at_table"]``:
+        the step in (``step_in`` not given) was stopped by the table, and the pad did not leave the edge.
 
         A leg heading down that would bring the pad onto the table (event ``"table"``: a face leaning under,
         next to the table), or one whose pad a link of the finger lifted off (``"hand"``), ends there without
@@ -682,6 +683,9 @@ class Toucher:
         rest = ContactTrace.concatenate([p.trace for p in clean if p is not pieces[0]])
         narrow = step_in is None and int(rest.in_contact.sum()) >= self.bounds.min_face_rows
         rim = step_in is None and self._stepped_onto_rim(pieces[0])
+        # the step in off the edge just rolled over stopped by the table: the pad stays where the roll settled, which
+        # the table too may have stopped short of the face (the legs along the edge then ride its ridge)
+        at_table = step_in is None and pieces[0].event == "table"
         trace = rest if narrow else ContactTrace.concatenate([p.trace for p in clean])
         ok_rows = trace.in_contact & (trace.phase == PHASES.index("stroke"))
         n_mean = dominant_normal(trace.normal_in_world[ok_rows], n_f, self.bounds.face_cone / 2.0, cfg.edge_angle)
@@ -691,7 +695,7 @@ class Toucher:
         # both legs along the edge met another edge: the next face is narrow along it there
         blocked = len(pieces) == 3 and all(p.ok and p.event not in ("done", *STOPS) for p in pieces[1:])
         return PrimitiveResult(status, event, trace, sum(p.distance for p in pieces),
-                               {"normal": n_mean, "rim": rim, "blocked": blocked})  # fmt: skip
+                               {"normal": n_mean, "rim": rim, "blocked": blocked, "at_table": at_table})  # fmt: skip
 
     def _stepped_onto_rim(self, step: PrimitiveResult) -> bool:
         """Whether a stroke's first leg, off the edge just rolled over, met another edge or turned its sensed
