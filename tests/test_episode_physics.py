@@ -309,9 +309,9 @@ def test_a_vertex_move_whose_circle_meets_an_edge_of_another_vertex_reports_no_e
 
 
 @pytest.mark.xfail(strict=True, reason=(
-    "no face move stays in the corner, but with the next face touched again along the edge and the segmentation's "
-    "changes merged, the episode ends incomplete, vertices short: the tour, pricing the way to the arm's far corner "
-    "in a straight line across the slot, keeps heading for it from the slot's side until the stall rule ends it"))
+    "no face move stays in the corner, but the episode ends incomplete at its move budget, one corner of the slot's "
+    "floor not measured: the face moves up the 20 mm wall beside it fail at its rim (the ridge there, between the "
+    "floor and the wall's far end, spans too little to follow: 'no edge along the roll's axis')"))
 def test_face_moves_out_of_a_concave_corner_leave_it(tmp_path):
     # BOX01N seed 2 stands on an end with its slot upright, 30 mm wide for the 24 mm pad. Verifying it, face moves
     # started from the slot's concave edges, traced from the corner where the pad rested touching both faces: each
