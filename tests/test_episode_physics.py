@@ -515,3 +515,30 @@ def test_a_roll_that_reaches_the_tables_clearance_measures_no_face(tmp_path):
     rec = ep.run(None)
     assert rec.outcome != "no-match", rec.detail
     assert _within_bounds(ep)
+
+
+def _sized_corpus(directory, lo: float = 0.03, hi: float = 0.15) -> str:
+    """The formula corpus as ``scripts/make_corpus.py OUT --sizes 30:150 --encodings obj6`` writes it: each solid
+    scaled about its centroid to a size (its largest vertex distance) drawn from ``lo`` to ``hi`` [m]; the obj6
+    library's directory."""
+    from haptic.geometry import Polyhedron
+    from haptic.geometry.corpus import corpus_solids, write_corpus
+
+    rng = np.random.default_rng(0)
+    solids = []
+    for spec, poly in corpus_solids(seed=0):
+        v = poly.vertices
+        k = rng.uniform(lo, hi) / float(np.linalg.norm(v[:, None] - v[None], axis=2).max())
+        c = poly.centroid
+        solids.append((spec, Polyhedron.from_faces(c + k * (v - c), poly.faces, name=poly.name)))
+    return str(write_corpus(directory, seed=0, solids=solids, encodings=("obj6",))["obj6"])
+
+
+def test_an_edge_move_that_locates_the_end_it_set_off_past_does_not_turn_the_object_away(tmp_path):
+    # trapezohedron_12 of the sized formula corpus (77 mm), seed 1, default options: during the verification an edge
+    # move set off 2 mm past one end of a 9 mm edge toward the other and located a vertex 0.3 mm from the end it
+    # left. Reported as the end it ran toward, the edge's interval collapsed onto it, its two ends were one vertex,
+    # the matcher pruned every interpretation and the true object was turned away (no-match).
+    rec = run_episode(EpisodeSpec(model="trapezohedron_12", seed=1, executor="physics",
+                                  models=_sized_corpus(tmp_path)))  # fmt: skip
+    assert rec.outcome != "no-match", rec.detail

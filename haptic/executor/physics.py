@@ -902,6 +902,16 @@ class PhysicsExecutor(LandingSearch):
         if sign * (s_v - back) < seg.bounds.length_floor:
             return self.failed_result(move, "unreachable", "the vertex located lies behind the move's start, at the "
                                                            "edge's other end (the pad set off past it)")  # fmt: skip
+        # ... nor is it, within its bound, the vertex known at the edge's end behind the move: the pad set off past
+        # that end and located it as it came onto the edge (trapezohedron_12 of the formula corpus at 77 mm, seed 1: a
+        # move set off 2 mm past one end of a 9 mm edge toward the other and put a vertex 0.3 mm from the end it
+        # left; reported as the end it ran toward, the edge's interval collapsed onto it, its two ends were one vertex
+        # and the true object was pruned: no-match)
+        middle = 0.5 * (rec.interval[0] + rec.interval[1])
+        for vid, s_known in rec.vertices.items():
+            if sign * (s_known - middle) < 0 and abs(s_v - s_known) <= seg.vertices[vid].position_bound:
+                return self.failed_result(move, "unreachable", "the vertex located is the edge's other end, which the "
+                                                               "move set off past")  # fmt: skip
         # refine the line with the ridge contacts (convex edges), then extend it to the vertex
         ridge = self._on_ridge(rows, u)
         w_v, w_from = rec.at(s_v), rec.at(s_from)

@@ -377,3 +377,30 @@ def test_a_vertex_move_whose_finger_meets_the_object_tilts_the_hand_and_circles_
     r = ex.execute(VertexMove(ex.state.edge_faces[0]))
     assert calls["n"] == 2
     _recovered(r, "index_medial met the object: the hand tilted", ex, sim, poly)
+
+
+def test_an_edge_move_that_locates_the_end_it_set_off_past_reports_no_vertex(monkeypatch):
+    """An edge move whose pad set off past the end of the edge behind it locates that end as it comes onto the edge
+    (trapezohedron_12 of the formula corpus at 77 mm, seed 1: 2 mm past one end of a 9 mm edge, the vertex put 0.3 mm
+    from it, 1.7 mm ahead of the start). Reported as the end it ran toward, the edge's interval collapsed onto it and
+    its two ends were one vertex: the matcher pruned the true object (no-match). Here the box's edge is known end to
+    end and the vertex the move locates is put within the bound of the end behind it: the move reports nothing and
+    the edge keeps both ends."""
+    _, _, ex = _at_a_vertex()
+    for sense in (-1, 1):
+        if ex.execute(EdgeMove(sense)).ok:
+            break
+    seg = ex.segmenter
+    rec = seg.edges[ex.state.edge]
+    assert len(rec.vertices) == 2 and ex.state.vertex in rec.vertices
+    behind = rec.vertices[ex.state.vertex]
+    toward = 1 if behind < 0.5 * (rec.interval[0] + rec.interval[1]) else -1  # along the line to the other end
+    bound = seg.vertices[ex.state.vertex].position_bound
+    floor = seg.bounds.length_floor
+    assert bound > floor  # room for a vertex past the move's start yet within the end's bound
+    located = behind + toward * 0.5 * (floor + bound)
+    monkeypatch.setattr(ex, "_vertex_param", lambda *a, **k: (located, 1e-4))
+    ends = dict(rec.vertices)
+    r = ex.execute(EdgeMove(toward))  # an edge move's sense is along the data edge's direction
+    assert not r.ok and "the edge's other end" in r.reason, (r.status, r.reason)
+    assert dict(seg.edges[ex.state.edge].vertices) == ends
