@@ -3,12 +3,14 @@
 
     .venv/bin/python scripts/bench_verify_time.py [--episodes 50] [--seed 0] [--policy planner,random]
                                                   [--verify full] [--moves all] [--models DIR] [--json out.json]
+                                                  [--records records.json]
 
 The episodes are those of ``haptic bench`` with the same options (:func:`~haptic.bench.runner.plan_sweep`), run one
 after another in this process. Each verification move's choice (:meth:`~haptic.planning.verify.Verifier.choose`) is
 timed in wall and CPU time (its own ``decision_times`` are wall time); the script prints the 50th, 90th and 99th
 percentile and the largest, in milliseconds, the number of choices, and the CPU seconds per episode with the
-machine's load average over the last minute when it ends.
+machine's load average over the last minute when it ends. ``--records`` writes the episodes' records (a JSON list),
+to compare two runs with ``scripts/compare_records.py``.
 """
 
 from __future__ import annotations
@@ -36,6 +38,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--moves", default="all")
     ap.add_argument("--models", default=None)
     ap.add_argument("--json", default=None, help="also write the figures to this file")
+    ap.add_argument("--records", default=None, help="also write the episodes' records (a JSON list) to this file")
     args = ap.parse_args(argv)
     wall: list[float] = []
     cpu: list[float] = []
@@ -54,8 +57,7 @@ def main(argv: list[str] | None = None) -> int:
     specs = plan_sweep(names, args.episodes, args.seed, args.policy.split(","), verify=args.verify,
                        moves=args.moves, models=args.models)  # fmt: skip
     c0 = time.process_time()
-    for spec in specs:
-        run_episode(spec)
+    records = [run_episode(spec).to_json() for spec in specs]
     per_episode = (time.process_time() - c0) / len(specs)
     out = {"episodes": len(specs), "choices": len(wall), "cpu_s_per_episode": per_episode,
            "load_1min": os.getloadavg()[0]}  # fmt: skip
@@ -70,6 +72,8 @@ def main(argv: list[str] | None = None) -> int:
             print(f"  {name}: " + ", ".join(f"{k} {v:.1f}" for k, v in out[name].items()))
     if args.json:
         atomic_write(args.json, json.dumps(out, indent=1))
+    if args.records:
+        atomic_write(args.records, json.dumps(records, indent=1))
     return 0
 
 

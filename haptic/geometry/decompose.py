@@ -76,21 +76,31 @@ def _volume(points: np.ndarray) -> float:
 
 
 def _merge(pieces: list[np.ndarray]) -> list[np.ndarray]:
+    """Greedy merging: the first pair (in list order) whose union is convex (its hull's volume is the sum of
+    theirs) becomes one piece, until no pair merges. A pair's hull volume is computed once: a pair of pieces that
+    did not merge is not tried again until one of them changes (each piece carries a token, new when it does)."""
     pieces = list(pieces)
     vols = [_volume(p) for p in pieces]
+    tokens = list(range(len(pieces)))
+    fresh = len(pieces)
+    apart: set[tuple[int, int]] = set()  # pairs of tokens whose union is not convex
     merged = True
     while merged:
         merged = False
         for i in range(len(pieces)):
             for j in range(i + 1, len(pieces)):
+                if (tokens[i], tokens[j]) in apart:
+                    continue
                 union = np.vstack([pieces[i], pieces[j]])
                 hv = _volume(union)
                 if abs(hv - vols[i] - vols[j]) <= 1e-9 * max(hv, 1e-12):
                     pieces[i] = _hull_vertices(union)
                     vols[i] = hv
-                    del pieces[j], vols[j]
+                    tokens[i], fresh = fresh, fresh + 1
+                    del pieces[j], vols[j], tokens[j]
                     merged = True
                     break
+                apart.add((tokens[i], tokens[j]))
             if merged:
                 break
     return pieces
