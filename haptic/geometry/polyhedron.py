@@ -436,9 +436,26 @@ class Polyhedron:
         """Axis-aligned bounding box size in the model frame [m]."""
         return _readonly(self.vertices.max(axis=0) - self.vertices.min(axis=0))
 
+    @cached_property
+    def _box(self) -> tuple[np.ndarray, np.ndarray]:
+        """The axis-aligned bounding box ``(lo, hi)`` of the vertices, model frame [m]."""
+        return _readonly(self.vertices.min(axis=0)), _readonly(self.vertices.max(axis=0))
+
     def contains(self, points: np.ndarray) -> np.ndarray:
-        """Inside test by the generalised winding number (robust for any closed oriented surface)."""
+        """Inside test by the generalised winding number (robust for any closed oriented surface); points outside
+        the bounding box are outside without it (their winding number is 0)."""
         p = np.atleast_2d(np.asarray(points, dtype=float))
+        lo, hi = self._box
+        boxed = ((p >= lo) & (p <= hi)).all(axis=1)
+        if boxed.all():
+            return self._winding_inside(p)
+        out = np.zeros(len(p), dtype=bool)
+        if boxed.any():
+            out[boxed] = self._winding_inside(p[boxed])
+        return out
+
+    def _winding_inside(self, p: np.ndarray) -> np.ndarray:
+        """Whether each point (P, 3) has a generalised winding number over 1/2, (P,) bool."""
         t = self.vertices[self.triangles]  # (T,3,3)
         a = t[None, :, 0, :] - p[:, None, :]
         b = t[None, :, 1, :] - p[:, None, :]

@@ -157,3 +157,49 @@ def test_shipped_files_are_what_the_generator_makes():
     root = Path(__file__).resolve().parents[2]
     r = subprocess.run([sys.executable, str(root / "scripts" / "make_models.py"), "--check"], capture_output=True)
     assert r.returncode == 0, r.stderr.decode()
+
+
+def _merge_every_pair_afresh(pieces):
+    """The greedy merge tried over every pair after each merge (what the decomposition's merge must equal)."""
+    from haptic.geometry.decompose import _hull_vertices, _volume
+
+    pieces = list(pieces)
+    merged = True
+    while merged:
+        merged = False
+        for i in range(len(pieces)):
+            for j in range(i + 1, len(pieces)):
+                union = np.vstack([pieces[i], pieces[j]])
+                hv = _volume(union)
+                if abs(hv - _volume(pieces[i]) - _volume(pieces[j])) <= 1e-9 * max(hv, 1e-12):
+                    pieces[i] = _hull_vertices(union)
+                    del pieces[j]
+                    merged = True
+                    break
+            if merged:
+                break
+    return pieces
+
+
+def test_decomposition_merge_tries_a_pair_once_and_still_merges_alike():
+    """Merging the unit cubes of a 3 x 2 x 1 block with one cube taken out: the merge that skips the pairs it
+    already found apart gives the same pieces, in the same order, as the one that tries every pair again."""
+    from haptic.geometry.decompose import _merge
+
+    cube = np.array([[x, y, z] for x in (0.0, 1.0) for y in (0.0, 1.0) for z in (0.0, 1.0)])
+    cells = [cube + [i, j, 0.0] for i in range(3) for j in range(2) if (i, j) != (1, 1)]
+    fast, slow = _merge(cells), _merge_every_pair_afresh(cells)
+    assert 1 < len(fast) < len(cells)
+    assert len(fast) == len(slow)
+    assert all(np.array_equal(a, b) for a, b in zip(fast, slow, strict=True))
+
+
+@pytest.mark.parametrize("name", ["FRAME01", "LBLOCK01", "TETRA01L"])
+def test_contains_outside_the_box_is_the_winding_numbers_verdict(name):
+    """The inside test skips the winding number outside the bounding box: the same verdict on every point."""
+    m = LIB[name]
+    lo, hi = m.vertices.min(axis=0), m.vertices.max(axis=0)
+    pts = (lo + hi) / 2 + (np.random.default_rng(3).random((4000, 3)) - 0.5) * 1.6 * (hi - lo)
+    inside = m.contains(pts)
+    assert 0 < inside.sum() < len(pts) and not inside[((pts < lo) | (pts > hi)).any(axis=1)].any()
+    assert np.array_equal(inside, m._winding_inside(pts))
