@@ -31,7 +31,7 @@ import numpy as np
 
 from haptic.episode.loop import EpisodeObserver, chain_observers
 from haptic.episode.spec import EpisodeSpec
-from haptic.episode.worlds import run_episode
+from haptic.episode.worlds import preload_physics, run_episode
 from haptic.errors import HapticError
 from haptic.geometry import load_library
 from haptic.geometry.io import atomic_write
@@ -238,6 +238,7 @@ def main(argv: list[str] | None = None) -> int:
              args.fingers) for o in objects for k in range(args.poses)]
     t0 = time.perf_counter()
     if args.jobs > 1:
+        preload_physics()  # the workers fork with it loaded
         with ProcessPoolExecutor(args.jobs) as pool:
             records = list(pool.map(one, *zip(*jobs, strict=True)))
     else:

@@ -192,6 +192,15 @@ class PhysicsWorld:
         )  # fmt: skip
 
 
+def preload_physics() -> None:
+    """Import now what a physics episode loads on first use (MuJoCo, the simulated hand, its executor, the
+    scoring of perception): a process about to fork workers hands it to them loaded, where each would import it
+    again."""
+    from haptic import sim  # noqa: F401
+    from haptic.episode import evaluate  # noqa: F401
+    from haptic.executor import physics, touch_config  # noqa: F401
+
+
 WORLDS = {w.name: w for w in (GeometricWorld, PhysicsWorld)}
 """The worlds by executor name (``EpisodeSpec.executor``)."""
 
