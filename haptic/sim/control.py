@@ -117,6 +117,11 @@ class HybridStatus:
     """Tangential reference point (3,) [m]."""
 
 
+def _finite3(v: np.ndarray) -> bool:
+    """``np.isfinite(v).all()`` of a (3,) vector, without numpy's per-call overhead (asked every tick)."""
+    return math.isfinite(v[0]) and math.isfinite(v[1]) and math.isfinite(v[2])
+
+
 def _rotation_error(r: np.ndarray, r_des: np.ndarray) -> np.ndarray:
     """Small-angle orientation error (3,) [rad] taking r to r_des, world frame: ½ Σ_i r_i × r_des_i."""
     a = r_des @ r.T
@@ -303,7 +308,7 @@ class Controller:
         compliant and the arm cannot orient a link beyond them.
         """
         x = np.asarray(point_in_world, dtype=float)
-        if x.shape != (3,) or not np.all(np.isfinite(x)):
+        if x.shape != (3,) or not _finite3(x):
             raise SceneError(f"fingertip target: expected a finite (3,) point, got {x!r}")
         self._mode = "fingertip"
         self._x_ref = x.copy()
@@ -328,18 +333,22 @@ class Controller:
         normal estimate and reference (use it to change the velocity or force mid-stroke).
         """
         v = np.asarray(velocity_in_world, dtype=float)
-        if v.shape != (3,) or not np.all(np.isfinite(v)) or not np.isfinite(force) or force <= 0:
+        if v.shape != (3,) or not _finite3(v) or not np.isfinite(force) or force <= 0:
             raise SceneError(f"hybrid target: need force > 0 [N] and a finite (3,) velocity, got {force}, {v!r}")
         prev = self._hybrid if (keep_state and self._mode == "hybrid") else None
+        if prev is not None and normal_hint is None:  # a running press, its hint kept (the fast path of a slide)
+            prev.force, prev.velocity = float(force), v.copy()
+            self._threshold = self._contact_threshold(force)
+            return
         hint = np.array([0.0, 0.0, 1.0]) if normal_hint is None else np.asarray(normal_hint, dtype=float)
-        if np.linalg.norm(hint) < ZERO_VECTOR:
+        size = np.linalg.norm(hint)
+        if size < ZERO_VECTOR:
             raise SceneError("hybrid target: normal_hint must be a non-zero vector")
-        hint = hint / np.linalg.norm(hint)
+        hint = hint / size
         if prev is not None:
             prev.force, prev.velocity = float(force), v.copy()
             self._threshold = self._contact_threshold(force)
-            if normal_hint is not None:
-                prev.hint = hint
+            prev.hint = hint
             return
         x, _ = self.fingertip_pose()
         self._mode = "hybrid"
