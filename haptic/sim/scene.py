@@ -12,6 +12,7 @@ from __future__ import annotations
 import os
 import shutil
 import tempfile
+import weakref
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -180,9 +181,18 @@ def scene_object_from_parts(name: str, parts: Sequence[np.ndarray]) -> SceneObje
     return SceneObject(name=name, parts=tuple(checked))
 
 
+_PIECES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+"""The convex pieces of each non-convex model decomposed in this process (a library's model is one object for every
+episode of a process: it is decomposed once)."""
+
+
 def scene_object_from_polyhedron(poly) -> SceneObject:
     """A :class:`SceneObject` from a ``haptic.geometry.Polyhedron`` (convex pieces for non-convex solids)."""
-    parts = [np.asarray(poly.vertices, dtype=float)] if poly.is_convex else convex_decomposition(poly)
+    if poly.is_convex:
+        return scene_object_from_parts(poly.name, [np.asarray(poly.vertices, dtype=float)])
+    parts = _PIECES.get(poly)
+    if parts is None:
+        parts = _PIECES[poly] = tuple(convex_decomposition(poly))
     return scene_object_from_parts(poly.name, parts)
 
 
