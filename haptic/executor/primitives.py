@@ -34,7 +34,7 @@ import numpy as np
 
 from haptic.executor.segment import SegmentBounds
 from haptic.executor.touch_config import TouchConfig
-from haptic.geometry.se3 import angle, perpendicular, unit
+from haptic.geometry.se3 import angle, finite3, perpendicular, unit
 from haptic.matching.batch_poses import exp_so3
 from haptic.matching.trace import PHASES, ContactTrace, empty_trace
 from haptic.sim.robot import RobotInterface
@@ -50,6 +50,7 @@ STOPS = ("table", "hand")
 """Events that end a leg of a stroke without failing the stroke (the table ahead, a finger link on the object)."""
 FAILURES = ("no-contact", "unreachable", "timeout", "unstable")
 """Failure statuses of a primitive (the move statuses of :class:`~haptic.planning.moves.MoveResult`)."""
+
 
 @dataclass(frozen=True, eq=False)
 class PrimitiveResult:
@@ -124,7 +125,7 @@ class Toucher:
         tip, rot = r.fingertip_pose()
         self.tip, self.rotation = tip, rot
         f, n, p = c.normal_force, c.normal_in_world, c.point_in_world
-        valid = n is not None and f > self.threshold and bool(np.all(np.isfinite(n)))
+        valid = n is not None and f > self.threshold and finite3(n)
         if valid:
             self.contact_ticks += 1
             if self.normal is None or self.contact_ticks == 1:
@@ -142,7 +143,7 @@ class Toucher:
         self.contact = (f, n if valid else None, p if valid else None)
         nan3 = (math.nan, math.nan, math.nan)
         self._rows.append((r.time, tip, rot, p if valid else nan3, n if valid else nan3, f, PHASES.index(phase)))
-        if not (np.all(np.isfinite(tip)) and math.isfinite(f)):
+        if not (finite3(tip) and math.isfinite(f)):
             self._unhealthy = True
         elif len(self._rows) % self.config.stability_every == 0 and not r.is_stable():
             self._unhealthy = True

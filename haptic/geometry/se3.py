@@ -152,6 +152,12 @@ def perpendicular(v: np.ndarray) -> np.ndarray:
     return plane_basis(v, assume_unit=True)[0]
 
 
+def finite3(v: np.ndarray) -> bool:
+    """``np.isfinite(v).all()`` of a (3,) vector, without numpy's per-call overhead (a control loop asks it every
+    tick)."""
+    return math.isfinite(v[0]) and math.isfinite(v[1]) and math.isfinite(v[2])
+
+
 def unit(v: np.ndarray) -> np.ndarray:
     """``v`` normalised (``v`` itself when it is zero)."""
     n = math.sqrt(float(v @ v))

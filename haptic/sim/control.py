@@ -29,6 +29,7 @@ import mujoco
 import numpy as np
 
 from haptic.errors import SceneError
+from haptic.geometry.se3 import finite3
 from haptic.sim.physics import N_ARM, ContactSummary, Simulation, finger_index
 from haptic.sim.scene import ARM_HOME, FINGERS, ROTATION_ATOL, ZERO_VECTOR
 
@@ -115,11 +116,6 @@ class HybridStatus:
     """Filtered sensed normal (3,), out of the touched surface; None before the first contact."""
     reference_in_world: np.ndarray
     """Tangential reference point (3,) [m]."""
-
-
-def _finite3(v: np.ndarray) -> bool:
-    """``np.isfinite(v).all()`` of a (3,) vector, without numpy's per-call overhead (asked every tick)."""
-    return math.isfinite(v[0]) and math.isfinite(v[1]) and math.isfinite(v[2])
 
 
 def _rotation_error(r: np.ndarray, r_des: np.ndarray) -> np.ndarray:
@@ -295,6 +291,10 @@ class Controller:
         d = self.sim.data
         return d.site_xpos[self._site].copy(), d.site_xmat[self._site].reshape(3, 3).copy()
 
+    def fingertip_position(self) -> np.ndarray:
+        """Active fingertip site position (3,) [m] in the world (forward kinematics)."""
+        return self.sim.data.site_xpos[self._site].copy()
+
     def hand_rotation(self) -> np.ndarray:
         """Rotation (3, 3) ``world_from_hand`` of the hand frame (the flange site, z along the fingers)."""
         return self.sim.data.site_xmat[self._hand_site].reshape(3, 3).copy()
@@ -308,7 +308,7 @@ class Controller:
         compliant and the arm cannot orient a link beyond them.
         """
         x = np.asarray(point_in_world, dtype=float)
-        if x.shape != (3,) or not _finite3(x):
+        if x.shape != (3,) or not finite3(x):
             raise SceneError(f"fingertip target: expected a finite (3,) point, got {x!r}")
         self._mode = "fingertip"
         self._x_ref = x.copy()
@@ -333,7 +333,7 @@ class Controller:
         normal estimate and reference (use it to change the velocity or force mid-stroke).
         """
         v = np.asarray(velocity_in_world, dtype=float)
-        if v.shape != (3,) or not _finite3(v) or not np.isfinite(force) or force <= 0:
+        if v.shape != (3,) or not finite3(v) or not np.isfinite(force) or force <= 0:
             raise SceneError(f"hybrid target: need force > 0 [N] and a finite (3,) velocity, got {force}, {v!r}")
         prev = self._hybrid if (keep_state and self._mode == "hybrid") else None
         if prev is not None and normal_hint is None:  # a running press, its hint kept (the fast path of a slide)

@@ -313,6 +313,7 @@ class Simulation:
 
         pre = [HAND_PREFIX + FINGER_PREFIX[f] for f in FINGERS]
         self.tip_site = np.array([oid(mujoco.mjtObj.mjOBJ_SITE, p + "_tip") for p in pre])
+        self._tip_site_list: list[int] = self.tip_site.tolist()
         self.pad_geom = np.array([oid(mujoco.mjtObj.mjOBJ_GEOM, p + "_pad") for p in pre])
         touch = [oid(mujoco.mjtObj.mjOBJ_SENSOR, p + "_touch") for p in pre]
         self.touch_adr = np.array([m.sensor_adr[s] for s in touch])
@@ -520,12 +521,15 @@ class Simulation:
         body's frame (the pad sites' frames for the fingertips), (len(LINK_NAMES), 7), world frame (forward
         kinematics of the robot's own bodies)."""
         d = self.data
-        quat = np.empty((len(self.tip_site), 4))
-        for k, s in enumerate(self.tip_site):
-            mujoco.mju_mat2Quat(quat[k], d.site_xmat[s])
-        return np.concatenate(
-            (np.c_[d.xpos[self.link_body], d.xquat[self.link_body]], np.c_[d.site_xpos[self.tip_site], quat])
-        )
+        nb = len(self.link_body)
+        out = np.empty((nb + len(self.tip_site), 7))
+        out[:nb, :3] = d.xpos[self.link_body]
+        out[:nb, 3:] = d.xquat[self.link_body]
+        out[nb:, :3] = d.site_xpos[self.tip_site]
+        xmat = d.site_xmat
+        for k, s in enumerate(self._tip_site_list):
+            mujoco.mju_mat2Quat(out[nb + k, 3:], xmat[s])
+        return out
 
     def link_geoms(self) -> tuple[LinkGeom, ...]:
         """The robot's collision geometry, each geom in its link's frame (links of :data:`LINK_NAMES`, posed by

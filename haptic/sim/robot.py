@@ -119,7 +119,7 @@ class RobotInterface:
 
     def fingertip_pose(self) -> tuple[np.ndarray, np.ndarray]:
         """Active fingertip position (3,) [m] and hand rotation (3, 3), from the joint encoders."""
-        return self._ctl.fingertip_pose()[0], self._ctl.hand_rotation()
+        return self._ctl.fingertip_position(), self._ctl.hand_rotation()
 
     def arm_posture(self) -> np.ndarray:
         """The arm's joint angles (6,) [rad] from its encoders, without reading the other sensors (no noise
