@@ -1,5 +1,5 @@
 """Physics episodes on every object of the seed library at a few random resting poses, headless: outcome,
-moves, path cost, wall and simulated time, pose error and perception errors per episode, then a summary per object.
+moves, path cost, wall, CPU and simulated time, pose error and perception errors per episode, then a summary per object.
 
     .venv/bin/python scripts/physics_episodes.py [--poses 3] [--first-seed 1] [--objects BOX01,WEDGE01]
                                                  [--policy planner] [--moves tracing|all]
@@ -102,6 +102,7 @@ def one(model: str, seed: int, policy: str, moves: str = "tracing", verify: str 
             failed.append(f"{result.status}: {why}")
 
     watch = ProbeCosts(make_policy(policy)) if probe_costs else None
+    cpu0 = time.process_time()
     try:
         spec = EpisodeSpec(model=model, seed=seed, policy=policy, executor="physics", moves=moves, verify=verify,
                            models=models, fingers=fingers)  # fmt: skip
@@ -111,7 +112,7 @@ def one(model: str, seed: int, policy: str, moves: str = "tracing", verify: str 
     except HapticError as exc:
         return {"model": model, "seed": seed, "outcome": "error", "correct": False, "detail": str(exc)}
     rec.update(probes_failed=len(failed), probe_failures=failed, move_results=kinds, failure_reasons=reasons,
-               recoveries=recovered)
+               recoveries=recovered, cpu_time_s=round(time.process_time() - cpu0, 3))
     if watch is not None:
         rec["probe_costs"] = watch.rows
     return rec
@@ -281,8 +282,10 @@ def main(argv: list[str] | None = None) -> int:
           f"{', '.join(f'{k} {v}' for k, v in sorted(outcomes.items()))}; median wall time to recognition "
           f"{_f(float(np.median(walls)) if walls else None)} s; total {time.perf_counter() - t0:.0f} s")  # fmt: skip
     print(f"mean over all episodes: path cost {_f(_mean(records, 'path_cost'), '.2f')}, moves "
-          f"{_f(_mean(records, 'moves'), '.2f')}, wall time {_f(_mean(records, 'wall_time_s'), '.2f')} s; over the "
-          f"correct: path cost {_f(_mean(good, 'path_cost'), '.2f')}, moves {_f(_mean(good, 'moves'), '.2f')}")
+          f"{_f(_mean(records, 'moves'), '.2f')}, wall time {_f(_mean(records, 'wall_time_s'), '.2f')} s, CPU time "
+          f"{_f(_mean(records, 'cpu_time_s'), '.2f')} s (the episode's process's, its start not included), simulated "
+          f"{_f(_mean(records, 'sim_time_s'), '.1f')} s; over the correct: path cost "
+          f"{_f(_mean(good, 'path_cost'), '.2f')}, moves {_f(_mean(good, 'moves'), '.2f')}")
     print_moves(records)
     print_placements(records)
     if args.probe_costs:
