@@ -115,3 +115,17 @@ def test_checked_in_scene_matches_the_composition():
     for attr in ("njnt", "nbody", "ngeom", "nsite", "nsensor", "nu", "nkey"):
         assert getattr(m, attr) == getattr(fresh, attr), attr
     np.testing.assert_allclose(m.body_pos, fresh.body_pos, atol=1e-9)
+
+
+def test_a_non_convex_model_is_decomposed_once_per_process(monkeypatch):
+    """The second scene of the same library model reuses its convex pieces: the same parts, no second
+    decomposition."""
+    from haptic.geometry import load_library
+
+    model = load_library()["LBLOCK01"]
+    first = sc.scene_object_from_polyhedron(model)
+    calls = []
+    monkeypatch.setattr(sc, "convex_decomposition", lambda poly: calls.append(poly) or [])
+    second = sc.scene_object_from_polyhedron(model)
+    assert not calls and len(first.parts) == len(second.parts) > 1
+    assert all(np.array_equal(a, b) for a, b in zip(first.parts, second.parts, strict=True))
