@@ -34,7 +34,7 @@ import numpy as np
 
 from haptic.executor.segment import SegmentBounds
 from haptic.executor.touch_config import TouchConfig
-from haptic.geometry.se3 import angle, finite3, perpendicular, unit
+from haptic.geometry.se3 import angle, cross, finite3, perpendicular, unit
 from haptic.matching.batch_poses import exp_so3
 from haptic.matching.trace import PHASES, ContactTrace, empty_trace
 from haptic.sim.robot import RobotInterface
@@ -262,7 +262,7 @@ class Toucher:
         m = np.asarray(away, dtype=float) - float(np.asarray(away, dtype=float) @ back) * back
         if float(m @ m) < self.config.tilt_min_sin**2:
             return None
-        return exp_so3(angle_ * unit(np.cross(back, m))) @ upright
+        return exp_so3(angle_ * unit(cross(back, m))) @ upright
 
     def reaches(self, normal: np.ndarray, rotation: np.ndarray | None = None) -> bool:
         """Whether the pad can touch a face of ``normal`` with the hand at ``rotation`` (default: as held): the
@@ -583,9 +583,9 @@ class Toucher:
         cfg = self.config
         n_a = unit(np.asarray(n_a, dtype=float))
         d = np.asarray(direction, dtype=float)
-        e = unit(np.cross(n_a, self.normal)) if self.normal is not None else perpendicular(n_a)
+        e = unit(cross(n_a, self.normal)) if self.normal is not None else perpendicular(n_a)
         if e @ e < cfg.roll_axis_sin2:
-            e = unit(np.cross(n_a, d))
+            e = unit(cross(n_a, d))
         sign = -1.0 if kind == "convex" else 1.0
         back = -(self.hand_rotation @ np.array([0.0, 0.0, 1.0]))  # up the finger
         hist: list[tuple[float, np.ndarray]] = []
@@ -596,10 +596,10 @@ class Toucher:
         for _ in range(int(cfg.roll_max / cfg.roll_speed * 2.0 / self.dt)):
             n = self.normal if self.normal is not None else n_a
             if angle(n, n_a) > self.bounds.sample_cone:
-                e_new = np.cross(n_a, n)
+                e_new = cross(n_a, n)
                 if e_new @ e_new > cfg.turned_axis_sin2:
                     e = unit(e_new)
-            t = unit(np.cross(n, e))
+            t = unit(cross(n, e))
             if sign * float(t @ n_a) < 0:
                 t = -t
             if kind == "convex" and float(t @ n_a) > 0:  # never climb back onto face a
@@ -639,10 +639,10 @@ class Toucher:
                 old = [nn for s, nn in hist if s <= travelled - cfg.roll_window]
                 if old and angle(old[-1], self.normal) < cfg.roll_settled:
                     n_b = self.normal.copy()
-                    away = unit(np.cross(n_b, e))
+                    away = unit(cross(n_b, e))
                     if float(away @ t) < 0:
                         away = -away
-                    return self._result("ok", "done", 0.0, normal=n_b, edge_direction=unit(np.cross(n_a, n_b)),
+                    return self._result("ok", "done", 0.0, normal=n_b, edge_direction=unit(cross(n_a, n_b)),
                                         away=away)  # fmt: skip
             if travelled > cfg.roll_max:
                 return self._result("unreachable", "limit", 0.0)
@@ -850,7 +850,7 @@ class Toucher:
         r0 = p0 - vtx
         r0 = unit(r0 - (r0 @ n_f) * n_f)
         t0 = unit(start_direction - (start_direction @ n_f) * n_f)
-        axis = unit(np.cross(r0, t0))  # ± n_f: the sense of the circle
+        axis = unit(cross(r0, t0))  # ± n_f: the sense of the circle
         over = 0
         swept = 0.0
         prev = r0
@@ -867,7 +867,7 @@ class Toucher:
             r = r - (r @ n_f) * n_f
             rad = math.sqrt(float(r @ r))
             rh = r / rad if rad > AT_CENTRE else r0
-            t = unit(np.cross(axis, rh))
+            t = unit(cross(axis, rh))
             v = cfg.face_speed * t + cfg.circle_gain * (radius - rad) * rh
             self._press(v)
             prev_tip = self.tip.copy()
@@ -879,7 +879,7 @@ class Toucher:
             # signed about the circle's axis: the contact point's noise turns ``rh`` back and forth by a degree a
             # tick at the circle's radius, and unsigned turns summed that noise (trapezohedron_12 at 77 mm: a circle
             # that gave up after "sweeping" 342° had gone 137° round its vertex, short of the next edge)
-            swept += math.atan2(float(axis @ np.cross(prev, rh)), float(prev @ rh))
+            swept += math.atan2(float(axis @ cross(prev, rh)), float(prev @ rh))
             prev = rh
             if (swept > max_sweep and max_sweep < full) or self.below_floor(t):
                 return self._result("unreachable", "table", 0.0, arc=swept)

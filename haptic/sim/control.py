@@ -147,7 +147,7 @@ def solve_fingertip_ik(
     g = gains or ControlGains()
     k = finger_index(finger)
     m = sim.model
-    d = mujoco.MjData(m)
+    d = sim.scratch_data()
     d.qpos[:] = sim.data.qpos
     if hand_q is not None:
         d.qpos[sim.hand] = hand_q

@@ -333,6 +333,7 @@ class Simulation:
         self.wrist_site = oid(mujoco.mjtObj.mjOBJ_SITE, HAND_PREFIX + "wrist_ft")
         self.home_key = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_KEY, "home")
         self._force6 = np.zeros(6)
+        self._scratch: mujoco.MjData | None = None
         self.reset()
 
     # -- state ---------------------------------------------------------------------------------------------
@@ -361,6 +362,13 @@ class Simulation:
             if b in link_of and g not in set(self.pad_geom.tolist()) and m.geom_contype[g] | m.geom_conaffinity[g]:
                 out[g] = link_of[b]
         return out
+
+    def scratch_data(self) -> mujoco.MjData:
+        """A second ``MjData`` of the model, for what must not touch the simulation (the fingertip IK's kinematics):
+        made once; each user sets the joint positions it works at (the kinematics depend on nothing else)."""
+        if self._scratch is None:
+            self._scratch = mujoco.MjData(self.model)
+        return self._scratch
 
     def step(self, n: int = 1) -> None:
         """Advance ``n`` physics steps with the current controls (``mj_step`` with ``nstep``)."""
