@@ -154,7 +154,10 @@ class PhysicsSettings:
     on the ridge leaned 5° by noise alone, and the vertex put at their median lay 14 mm short of the edge's end (BOX01
     at 150 mm, seed 1: 2.55 times its bound; LBLOCK01 13 mm, 3.08) [-]."""
     min_block_cos: float = 0.2
-    """A blocking contact locates a vertex only when its normal has at least this component along the edge [-]."""
+    """A blocking contact locates a vertex only when its normal has at least this component along the edge [-] ..."""
+    gap_rows: int = 15
+    """... and when the pad's last contacts on the ridge before it (at most this many) lie at its radius (the pad did
+    not span a gap in the ridge, ``PhysicsExecutor._spans_a_gap``) [-]."""
     roll_lead_rows: int = 8
     """The last rows of a trace on a face before a roll count with the roll (for the edge between) [-]."""
     stroke_headings: int = 4
@@ -895,8 +898,9 @@ class PhysicsExecutor(LandingSearch):
         rows = ContactTrace.concatenate([r.trace, hold.trace])
         s_v, s_sigma = self._vertex_param(rec, rows, u, r.info.get("event_sign", 1))
         if s_v is None:
-            why = ("could not locate the vertex (no contact there, a concave edge's end, which its faces run past, or "
-                   "contacts off the edge's line, on an edge turning little from it)")  # fmt: skip
+            why = ("could not locate the vertex (no contact there, a concave edge's end, which its faces run past, "
+                   "contacts off the edge's line, on an edge turning little from it, or the pad spanning a gap in the "
+                   "ridge before what blocked it)")  # fmt: skip
             return self.failed_result(move, "unreachable", why)
         # the vertex lies ahead of everything behind the move: the explored interval's back end and the start (BOX01N
         # at 60 mm, seed 2: a move along +e set off 23 mm behind the interval, past the edge's other end, and located
@@ -970,6 +974,8 @@ class PhysicsExecutor(LandingSearch):
                 # vertex along an edge turning little from this one (a 12-gon's, 30°): the contacts lie past it
                 return None, 0.0
             return float(np.median(along)), max(float(np.std(along)), b.point_sigma) / math.sqrt(len(along))
+        if rec.convex and self._spans_a_gap(rows, u):
+            return None, 0.0
         contacts = self._finger_contacts()
         if not contacts:
             return None, 0.0
@@ -979,6 +985,23 @@ class PhysicsExecutor(LandingSearch):
             return None, 0.0
         s_v = float((blk.point_in_world - rec.point) @ blk.normal_in_world) / denom
         return s_v, b.point_sigma / abs(denom)
+
+    def _spans_a_gap(self, rows: ContactTrace, u: np.ndarray) -> bool:
+        """Whether the pad, following a convex ridge along ``u`` until something blocked it, spanned a gap in the
+        ridge before the block: its contacts on the ridge (the last :attr:`PhysicsSettings.gap_rows`) lie inside
+        the pad, nearer its centre than its model's radius by more than the bound of a contact point (their median;
+        not the radius refined from the contacts, which such rows pull in). On a ridge the pad touches one patch at
+        its radius; across a gap narrower than the pad it touches the two sides
+        at once, and the sensor reads the patches' mean, on the ridge's line but inside the pad (BOX01N at 30 mm,
+        seed 1: 1.0 mm inside across a 9 mm slot; the far side blocked the pad, the vertex was put there and the
+        edge's interval extended across the slot, 3.2 bounds past the edge's end)."""
+        ridge = np.flatnonzero(self._on_ridge(rows, u))[-self.settings.gap_rows :]
+        if not len(ridge):
+            return False
+        b = self.bounds
+        d = np.linalg.norm(rows.tip_in_world[ridge] - rows.point_in_world[ridge], axis=1)
+        inside = self.toucher.pad_model_radius - float(np.median(d))
+        return inside > b.bound(b.point_sigma / math.sqrt(len(ridge)), b.position_floor)
 
     def _vertex_move(self, move: VertexMove, pieces: list[PrimitiveResult]) -> MoveResult:
         st, t, seg, s = self.state, self.toucher, self.segmenter, self.settings
