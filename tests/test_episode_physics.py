@@ -327,6 +327,20 @@ def test_a_vertex_move_whose_circle_meets_an_edge_near_the_vertex_circled_report
     assert score_components(ep.executor.components, ep.true_model, ep.world_from_model, results).missed == 0
     assert _within_bounds(ep)
 
+
+def test_an_edge_move_blocked_after_spanning_a_slot_reports_no_vertex(tmp_path):
+    # BOX01N at 30 mm, seed 1, --verify none (perception_report.py --sizes 30 --verify none): an edge move ran down
+    # the end face's edge to the 9 mm slot, which the 12 mm pad spans: touching both sides at once, its sensed contact
+    # (the two patches' mean) lay on the edge's line, 1.0 mm inside the pad, until the slot's far side blocked it. The
+    # vertex was put there and the edge's interval extended across the slot (edge extent 3.2 bounds, no-match). A
+    # block after contacts inside the pad locates no vertex.
+    spec = EpisodeSpec(model="BOX01N", seed=1, executor="physics", verify="none",
+                       models=_scaled_library(tmp_path, 0.03))  # fmt: skip
+    ep = build_episode(spec)
+    rec = ep.run(None)
+    assert rec.outcome != "no-match", rec.detail
+    assert _within_bounds(ep)
+
 @pytest.mark.xfail(strict=True, reason=(
     "no face move stays in the corner, but the episode ends incomplete at its move budget, one corner of the slot's "
     "floor not measured: the face moves up the 20 mm wall beside it fail at its rim (the ridge there, between the "
