@@ -341,6 +341,31 @@ def test_an_edge_move_blocked_after_spanning_a_slot_reports_no_vertex(tmp_path):
     assert rec.outcome != "no-match", rec.detail
     assert _within_bounds(ep)
 
+
+class _Enough(Exception):
+    """Ends a replay after the move that showed what it tests."""
+
+
+def test_an_edge_move_that_never_rides_the_ridge_locates_no_vertex(tmp_path):
+    # trapezohedron_09 of the formula corpus at 60 mm, seed 1 (perception_report.py --corpus --sizes 60 --first-seed
+    # 1): during the verification a vertex move's circle crossed an edge 2 mm from its far end, and the edge move
+    # after it set off with the pad already rolling on that vertex: it went 0.1 mm, no contact on the ridge, and the
+    # vertex was put at the contacts where it pressed, 1.28 mm off (1.05 bounds). Without a contact on the ridge
+    # before the surface falls away the move locates no vertex. The replay stops after that move (the 15th).
+    moves = []
+
+    def on_move(n, r, *a):
+        moves.append(r)
+        if len(moves) > 15:
+            raise _Enough
+
+    spec = EpisodeSpec(model="trapezohedron_09", seed=1, executor="physics",
+                       models=_scaled_library(tmp_path, 0.06, corpus=True))  # fmt: skip
+    ep = build_episode(spec)
+    with pytest.raises(_Enough):
+        ep.run(None, EpisodeObserver(on_move=on_move, on_failed_move=lambda n, r: on_move(n, r)))
+    assert _within_bounds(ep)
+
 @pytest.mark.xfail(strict=True, reason=(
     "no face move stays in the corner, but the episode ends incomplete at its move budget, one corner of the slot's "
     "floor not measured: the face moves up the 20 mm wall beside it fail at its rim (the ridge there, between the "
