@@ -154,7 +154,10 @@ class PhysicsSettings:
     on the ridge leaned 5° by noise alone, and the vertex put at their median lay 14 mm short of the edge's end (BOX01
     at 150 mm, seed 1: 2.55 times its bound; LBLOCK01 13 mm, 3.08) [-]."""
     min_block_cos: float = 0.2
-    """A blocking contact locates a vertex only when its normal has at least this component along the edge [-]."""
+    """A blocking contact locates a vertex only when its normal has at least this component along the edge [-] ..."""
+    gap_rows: int = 15
+    """... and when the pad's last contacts on the ridge before it (at most this many) lie at its radius (the pad did
+    not span a gap in the ridge, ``PhysicsExecutor._spans_a_gap``) [-]."""
     roll_lead_rows: int = 8
     """The last rows of a trace on a face before a roll count with the roll (for the edge between) [-]."""
     stroke_headings: int = 4
@@ -829,6 +832,11 @@ class PhysicsExecutor(LandingSearch):
         first = face if face in rec.faces else rec.faces[1]
         # beside the last contact: the pad may be far off in free space (backed out after a tilted move)
         s0 = rec.param(self.contact_point() if self.toucher.contact[2] is not None else self.state.position)
+        # ... within the explored interval, to its ends' bound: beyond, the line is extrapolated and the edge may not
+        # run there (BOX01N at 60 mm, seed 2: a contact 25 mm past an interval 1 mm long, beyond the slot that breaks
+        # the top edge; the move followed the edge on the slot's far side and the interval was extended across it)
+        reach = self.bounds.bound(0.0, self.bounds.length_floor)
+        s0 = float(np.clip(s0, rec.interval[0] - reach, rec.interval[1] + reach))
         status, why = "unreachable", "the edge next to the table is out of the pad's reach"
         for fid in (first, *(f for f in rec.faces if f != first and f in rec.inward)):
             n = seg.faces[fid].component.normal
@@ -890,8 +898,9 @@ class PhysicsExecutor(LandingSearch):
         rows = ContactTrace.concatenate([r.trace, hold.trace])
         s_v, s_sigma = self._vertex_param(rec, rows, u, r.info.get("event_sign", 1))
         if s_v is None:
-            why = ("could not locate the vertex (no contact there, a concave edge's end, which its faces run past, or "
-                   "contacts off the edge's line, on an edge turning little from it)")  # fmt: skip
+            why = ("could not locate the vertex (no contact there, no contact on the ridge before it, a concave edge's "
+                   "end, which its faces run past, contacts off the edge's line, on an edge turning little from it, or "
+                   "the pad spanning a gap in the ridge before what blocked it)")  # fmt: skip
             return self.failed_result(move, "unreachable", why)
         # the vertex lies ahead of everything behind the move: the explored interval's back end and the start (BOX01N
         # at 60 mm, seed 2: a move along +e set off 23 mm behind the interval, past the edge's other end, and located
@@ -949,6 +958,11 @@ class PhysicsExecutor(LandingSearch):
             # at 40 mm: 3.6 mm past): the surface falling away does not locate a concave edge's end
             return None, 0.0
         if event_sign > 0:
+            if not self._on_ridge(rows, u).any():
+                # the pad never rode the ridge: it set off rolling on the vertex (or past it), and its contacts are
+                # where it was put, not where the ridge ends (trapezohedron_09 at 60 mm, seed 1: an edge move that
+                # set off 2 mm from the end of its edge went 0.1 mm and put the vertex 1.28 mm off, 1.05 bounds)
+                return None, 0.0
             lean = max(s.touch.loss_lean_sin, math.sin(s.vertex_lean_sigmas * b.normal_sigma))
             at_v = ok & (c > lean)  # the pad rolls on the vertex
             if at_v.sum() < s.min_vertex_rows:  # contact was lost: the last contacts
@@ -965,6 +979,8 @@ class PhysicsExecutor(LandingSearch):
                 # vertex along an edge turning little from this one (a 12-gon's, 30°): the contacts lie past it
                 return None, 0.0
             return float(np.median(along)), max(float(np.std(along)), b.point_sigma) / math.sqrt(len(along))
+        if rec.convex and self._spans_a_gap(rows, u):
+            return None, 0.0
         contacts = self._finger_contacts()
         if not contacts:
             return None, 0.0
@@ -974,6 +990,23 @@ class PhysicsExecutor(LandingSearch):
             return None, 0.0
         s_v = float((blk.point_in_world - rec.point) @ blk.normal_in_world) / denom
         return s_v, b.point_sigma / abs(denom)
+
+    def _spans_a_gap(self, rows: ContactTrace, u: np.ndarray) -> bool:
+        """Whether the pad, following a convex ridge along ``u`` until something blocked it, spanned a gap in the
+        ridge before the block: its contacts on the ridge (the last :attr:`PhysicsSettings.gap_rows`) lie inside
+        the pad, nearer its centre than its model's radius by more than the bound of a contact point (their median;
+        not the radius refined from the contacts, which such rows pull in). On a ridge the pad touches one patch at
+        its radius; across a gap narrower than the pad it touches the two sides
+        at once, and the sensor reads the patches' mean, on the ridge's line but inside the pad (BOX01N at 30 mm,
+        seed 1: 1.0 mm inside across a 9 mm slot; the far side blocked the pad, the vertex was put there and the
+        edge's interval extended across the slot, 3.2 bounds past the edge's end)."""
+        ridge = np.flatnonzero(self._on_ridge(rows, u))[-self.settings.gap_rows :]
+        if not len(ridge):
+            return False
+        b = self.bounds
+        d = np.linalg.norm(rows.tip_in_world[ridge] - rows.point_in_world[ridge], axis=1)
+        inside = self.toucher.pad_model_radius - float(np.median(d))
+        return inside > b.bound(b.point_sigma / math.sqrt(len(ridge)), b.position_floor)
 
     def _vertex_move(self, move: VertexMove, pieces: list[PrimitiveResult]) -> MoveResult:
         st, t, seg, s = self.state, self.toucher, self.segmenter, self.settings
@@ -1036,8 +1069,12 @@ class PhysicsExecutor(LandingSearch):
         b = self.bounds
         off = float(np.linalg.norm(vtx - line.point - s_vtx * line.direction))
         lever = abs(s_vtx - float(np.clip(s_vtx, *line.s_range)))  # from the explored interval to the vertex
-        allowed = (seg.vertices[st.vertex].position_bound + b.bound(line.position_sigma, b.position_floor)
-                   + lever * b.bound(line.direction_sigma, b.direction_floor))  # fmt: skip
+        # the vertex (located on the earlier edge) and the line (the circle's roll) are independent estimates: their
+        # bounds add in quadrature. Added up, they let through an edge 1.9 mm off the vertex on trapezohedron_10 at
+        # 30 mm (a kite's edge 4.2 mm long inside the 8 mm circle, the edge beyond it met), whose errors were 0.16 and
+        # 0.14 mm against bounds of 1.2 and 0.75 mm; the tree pruned the truth (no-match)
+        allowed = math.hypot(seg.vertices[st.vertex].position_bound, b.bound(line.position_sigma, b.position_floor),
+                             lever * b.bound(line.direction_sigma, b.direction_floor))  # fmt: skip
         if off > allowed:
             # the circle crossed an edge that does not leave the vertex (on a face narrower than the circle)
             return self.failed_result(move, "unreachable", f"the edge met passes {off * MM:.1f} mm from the vertex "

@@ -97,6 +97,7 @@ class Toucher:
         self.weak_ticks = 0  # consecutive samples with force below loss_fraction × force
         self.hybrid = False
         self.pad_radius = PAD_RADIUS  # refined from the sensed contact (|tip − contact point|)
+        self.pad_model_radius = PAD_RADIUS  # the pad's radius in the hand's model (what a contact on one patch reads)
         self._rows: list[tuple] = []
         self._ticks = 0
         self._links: list[tuple[float, np.ndarray]] = []  # (time, link positions) samples

@@ -404,3 +404,42 @@ def test_an_edge_move_that_locates_the_end_it_set_off_past_reports_no_vertex(mon
     r = ex.execute(EdgeMove(toward))  # an edge move's sense is along the data edge's direction
     assert not r.ok and "the edge's other end" in r.reason, (r.status, r.reason)
     assert dict(seg.edges[ex.state.edge].vertices) == ends
+
+
+def _ridge_rows(inside: float, n: int = 40, seed: int = 0):
+    """A ridge trace along +x under the pad: contacts on the line (the x axis) with the sensor's noise at level 1,
+    the pad's centre above each at the model's radius less ``inside`` [m]."""
+    from haptic.matching.trace import PHASES, ContactTrace
+    from haptic.sim.scene import PAD_RADIUS
+
+    rng = np.random.default_rng(seed)
+    x = np.linspace(0.0, 0.02, n)
+    normal = np.tile(np.array([0.0, -np.sqrt(0.5), np.sqrt(0.5)]), (n, 1))  # the bisector of a square ridge
+    points = np.column_stack([x, np.zeros(n), np.zeros(n)]) + 2e-4 * rng.standard_normal((n, 3))
+    tips = np.column_stack([x, np.zeros(n), np.zeros(n)]) + (PAD_RADIUS - inside) * normal
+    return ContactTrace(time=np.arange(n) * 1e-3, tip_in_world=tips, hand_rotation=np.tile(np.eye(3), (n, 1, 1)),
+                        point_in_world=points, normal_in_world=normal, force=np.ones(n),
+                        phase=np.full(n, PHASES.index("ridge")))  # fmt: skip
+
+
+def test_a_pad_spanning_a_gap_in_the_ridge_is_told_from_one_on_the_ridge():
+    """Across a gap in a ridge narrower than the pad (BOX01N's slot at 30 mm) the pad touches both sides, and the
+    sensed contact, the patches' mean, lies on the ridge's line but inside the pad (1.0 mm across a 9 mm slot): a
+    block after that is the gap's far side, no vertex. On the ridge itself the contacts lie at the pad's radius
+    (less its compliance), within a contact point's bound, whatever the radius refined from the contacts says."""
+    import types
+
+    from haptic.executor.segment import SegmentBounds
+    from haptic.sim.scene import PAD_RADIUS
+
+    toucher = types.SimpleNamespace(pad_model_radius=PAD_RADIUS, pad_radius=PAD_RADIUS - 7e-4)  # refined, pulled in
+    ex = types.SimpleNamespace(bounds=SegmentBounds(), settings=physics_module.PhysicsSettings(), toucher=toucher)
+    ex._on_ridge = lambda rows, u: PhysicsExecutor._on_ridge(ex, rows, u)
+    u = np.array([1.0, 0.0, 0.0])
+    for seed in range(5):
+        assert not PhysicsExecutor._spans_a_gap(ex, _ridge_rows(1.5e-4, seed=seed), u)  # pressed in 0.15 mm
+        assert PhysicsExecutor._spans_a_gap(ex, _ridge_rows(1.0e-3, seed=seed), u)
+    # only the rows on the ridge count: rolling on the vertex at its end (the normal leaning along it), they do not
+    rows = _ridge_rows(1.0e-3)
+    leaning = dataclasses.replace(rows, normal_in_world=np.tile(np.array([0.5, -0.6124, 0.6124]), (len(rows), 1)))
+    assert not PhysicsExecutor._spans_a_gap(ex, leaning, u)
