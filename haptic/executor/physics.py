@@ -829,6 +829,8 @@ class PhysicsExecutor(LandingSearch):
         first = face if face in rec.faces else rec.faces[1]
         # beside the last contact: the pad may be far off in free space (backed out after a tilted move)
         s0 = rec.param(self.contact_point() if self.toucher.contact[2] is not None else self.state.position)
+        if not rec.convex and None not in rec.faces:
+            return self._touch_corner(rec, s0, u, first, pieces)
         status, why = "unreachable", "the edge next to the table is out of the pad's reach"
         for fid in (first, *(f for f in rec.faces if f != first and f in rec.inward)):
             n = seg.faces[fid].component.normal
@@ -843,6 +845,40 @@ class PhysicsExecutor(LandingSearch):
             why = f"could not return next to the edge: {self._why}"
         self._why = why
         return status
+
+    def _touch_corner(self, rec, s0: float, u: np.ndarray, face: int, pieces: list[PrimitiveResult]) -> str:
+        """Put the pad in the corner of concave edge ``rec``, touching both its faces, beside parameter ``s0`` (or
+        further along ``u`` where that is within the pad's reach of the table): approached along the bisector of
+        the faces' normals. A touch of either face next to the edge meets the other face first, nearer than the
+        pad's radius (BOX01N's upright slot: 16 of 16 returns next to its concave edges touched the face across and
+        failed). "ok" with the pad on ``face``, or a failure with the reason in ``self._why``."""
+        t, seg = self.toucher, self.segmenter
+        n_a, n_b = (seg.faces[f].component.normal for f in rec.faces)
+        b = n_a + n_b
+        if float(b @ b) < 1e-6:
+            self._why = "could not return into the concave corner: its faces are opposed"
+            return "unreachable"
+        b = unit(b)
+        # the pad's point along -b when it rests touching both faces: its centre lies r / cos(half the angle
+        # between the normals) out along b from the edge's line
+        depth = t.pad_radius / max(float(b @ n_a), 1e-3) - t.pad_radius
+        s = self.settings
+        target = self.workspace.reentry_point(rec, b, b, s0, u, depth, s.reentry)
+        if target is None:
+            self._why = "the concave edge next to the table is out of the pad's reach"
+            return "unreachable"
+        r = t.lift_and_approach(target, b, floor_z=TABLE_TOP_Z + t.pad_radius + s.table_margin)
+        pieces.append(r)
+        if not r.ok:
+            self._why = f"could not return into the concave corner: {r.status}/{r.event}"
+            return r.status
+        n = unit(np.asarray(r.info["normal"], dtype=float))
+        # the sensed normal, a force-weighted mean of the two faces' normals, lies on the arc between them
+        if angle(n, n_a) + angle(n, n_b) > angle(n_a, n_b) + self.bounds.retouch_cone:
+            self._why = f"returning into the concave corner touched a normal {math.degrees(angle(n, b)):.0f}° off it"
+            return "unreachable"
+        self.on_face = face
+        return "ok"
 
     def _edge_move(self, move: EdgeMove, pieces: list[PrimitiveResult]) -> MoveResult:
         st, t, seg, s = self.state, self.toucher, self.segmenter, self.settings
