@@ -131,13 +131,6 @@ class PhysicsSettings:
     pad_clearance: float = 0.002
     """A touch (a repositioning target, a point of a vertex circle) is out of reach when the pad's lowest
     point would come closer than this to the table top; a slide heading down stops there [m]."""
-    level_rise: float = math.radians(5.0)
-    """A face move whose slide down came within the pad's reach of the table goes on across the face at this rise
-    above the level [rad] ..."""
-    level_min_slope: float = math.radians(20.0)
-    """... on a face sloping at least this much (nearer level, no side to go on to) ... [rad]"""
-    level_min_heading: float = math.radians(20.0)
-    """... when the slide headed at least this much from straight down the face [rad]."""
     edge_reentry: float = 0.004
     """An edge move that must first return next to its edge touches the face this far in from the edge [m]."""
     reentry: ReentrySearch = field(default_factory=ReentrySearch)
@@ -666,18 +659,10 @@ class PhysicsExecutor(LandingSearch):
         status = self._ensure_on_face(st.face, pieces)
         if status != "ok":
             return self.failed_result(move, status, f"could not return to the current face: {self._why}")
-        recrossed = tilted = levelled = False
+        recrossed = tilted = False
         while True:
             r = t.trace_face(inplane, n_a, self.settings.max_face_trace)
             pieces.append(r)
-            level = self._level_heading(inplane, n_a) if r.event == "table" and not levelled else None
-            if level is not None:
-                # the slide heading down came within the pad's reach of the table before any edge: it goes on across
-                # the face nearly level, toward the side it was heading, to the edge there
-                levelled, inplane = True, level
-                self.recoveries.append("the finger would meet the table before an edge: the slide went on level")
-                r = t.trace_face(inplane, n_a, self.settings.max_face_trace)
-                pieces.append(r)
             if r.event == "hand":
                 why = f"trace across the face: the finger's {r.info['link']} met the object"
                 if tilted or not self._tilt_away(r, st.face, self._last_on(r.trace, st.face, inplane), pieces):
@@ -735,21 +720,6 @@ class PhysicsExecutor(LandingSearch):
                                  edge_faces=(st.face, face.id))  # fmt: skip
         return MoveResult(move=move, status="ok", components=(edge, face), distance=r.distance,
                           cost=self.costs.face_move(r.distance), state=self.state, info={"kind": kind})  # fmt: skip
-
-    def _level_heading(self, d: np.ndarray, n: np.ndarray) -> np.ndarray | None:
-        """The heading across the face of normal ``n`` that goes on from a slide along ``d`` stopped over the table:
-        level, toward the side ``d`` heads, rising ``PhysicsSettings.level_rise`` (clear of the table's limit it
-        reached); None where the face is nearly level or ``d`` heads nearly straight down it (there is no side)."""
-        s = self.settings
-        side = np.cross(n, np.array([0.0, 0.0, 1.0]))
-        if float(np.linalg.norm(side)) < math.sin(s.level_min_slope):
-            return None
-        side = unit(side)
-        across = float(side @ d)
-        if abs(across) < math.sin(s.level_min_heading):
-            return None
-        up = unit(np.array([0.0, 0.0, 1.0]) - n[2] * n)
-        return unit(math.copysign(math.cos(s.level_rise), across) * side + math.sin(s.level_rise) * up)
 
     def _last_on(self, trace: ContactTrace, fid: int, d: np.ndarray) -> np.ndarray:
         """Where to touch data face ``fid`` again after a slide along ``d`` that a link of the finger stopped:
