@@ -49,6 +49,20 @@ def test_a_face_measured_with_the_hand_tilted_is_touched_again_tilted():
     assert _within_bounds(ep)
 
 
+def test_an_edge_move_whose_ridge_acquisition_meets_the_corner_acquires_it_again_clear_of_it():
+    # FRAME01 seed 1 stands on an end, its hole's axis horizontal. Edge moves along the hole's edges began next to the
+    # corners where the edges end at a third face (the hole's walls): rolling onto the ridge, the pad met that face,
+    # its normals leaning 35-40 degrees along the edge, and never settled on the bisector ("acquiring the ridge:
+    # limit"). The pad now touches the face again a pad's radius from that corner, acquires the ridge and follows it
+    # to the vertex; the components stay within their bounds.
+    said = []
+    obs = EpisodeObserver(on_move=lambda n, r, *a: said.extend(r.info.get("recoveries", ())))
+    ep = build_episode(EpisodeSpec(model="FRAME01", seed=1, executor="physics", verify="full", max_moves=36))
+    ep.run(None, obs)
+    assert any("acquired again a pad's radius from it" in x for x in said), said
+    assert _within_bounds(ep)
+
+
 def test_touches_past_an_unreachable_edge_tell_the_box_family_apart():
     # BOX01P resting tilted: the moves that separate it from BOX01 and BOX01N all end stepping onto a face
     # leaning under the pad; their touches on the way still rule the look-alikes out
