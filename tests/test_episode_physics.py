@@ -49,6 +49,20 @@ def test_a_face_measured_with_the_hand_tilted_is_touched_again_tilted():
     assert _within_bounds(ep)
 
 
+def test_an_edge_move_whose_ridge_acquisition_meets_the_corner_acquires_it_again_clear_of_it():
+    # FRAME01 seed 1 stands on an end, its hole's axis horizontal. Edge moves along the hole's edges began next to the
+    # corners where the edges end at a third face (the hole's walls): rolling onto the ridge, the pad met that face,
+    # its normals leaning 35-40 degrees along the edge, and never settled on the bisector ("acquiring the ridge:
+    # limit"). The pad now touches the face again a pad's radius from that corner, acquires the ridge and follows it
+    # to the vertex; the components stay within their bounds.
+    said = []
+    obs = EpisodeObserver(on_move=lambda n, r, *a: said.extend(r.info.get("recoveries", ())))
+    ep = build_episode(EpisodeSpec(model="FRAME01", seed=1, executor="physics", verify="full", max_moves=36))
+    ep.run(None, obs)
+    assert any("acquired again a pad's radius from it" in x for x in said), said
+    assert _within_bounds(ep)
+
+
 def test_touches_past_an_unreachable_edge_tell_the_box_family_apart():
     # BOX01P resting tilted: the moves that separate it from BOX01 and BOX01N all end stepping onto a face
     # leaning under the pad; their touches on the way still rule the look-alikes out
@@ -305,7 +319,6 @@ def test_a_vertex_move_whose_circle_meets_an_edge_of_another_vertex_reports_no_e
     assert score_components(ep.executor.components, ep.true_model, ep.world_from_model, results).missed == 0
 
 
-
 def test_a_vertex_move_whose_circle_meets_an_edge_near_the_vertex_circled_reports_no_edge(tmp_path):
     # trapezohedron_10 of the formula corpus at 30 mm, seed 2 (perception_report.py --corpus --sizes 30 --first-seed
     # 2): circling a vertex across a kite whose edge from it is 4.2 mm long, inside the 8 mm circle, the pad met the
@@ -366,10 +379,7 @@ def test_an_edge_move_that_never_rides_the_ridge_locates_no_vertex(tmp_path):
         ep.run(None, EpisodeObserver(on_move=on_move, on_failed_move=lambda n, r: on_move(n, r)))
     assert _within_bounds(ep)
 
-@pytest.mark.xfail(strict=True, reason=(
-    "no face move stays in the corner, but the episode ends incomplete at its move budget, one corner of the slot's "
-    "floor not measured: the face moves up the 20 mm wall beside it fail at its rim (the ridge there, between the "
-    "floor and the wall's far end, spans too little to follow: 'no edge along the roll's axis')"))
+
 def test_face_moves_out_of_a_concave_corner_leave_it(tmp_path):
     # BOX01N seed 2 stands on an end with its slot upright, 30 mm wide for the 24 mm pad. Verifying it, face moves
     # started from the slot's concave edges, traced from the corner where the pad rested touching both faces: each
@@ -383,7 +393,10 @@ def test_face_moves_out_of_a_concave_corner_leave_it(tmp_path):
     # back to the ridge of the slot's floor, which the pad cannot follow between the walls, over and over (the
     # tour's cheapest way to the last vertex runs along it) until the stall rule ended it one vertex short; an edge
     # move that failed along a model edge is no longer taken that way again, and the last vertex is reached round
-    # the other arm.
+    # the other arm. An edge move along one of the slot's concave edges first returned next to it by touching one of
+    # its faces 4 mm from the edge, where the pad (12 mm) meets the face across first: 16 of 16 such returns failed
+    # ("could not return next to the edge"), and the episode ended one corner of the floor short at its move budget.
+    # The pad now returns into the corner along the bisector of the two faces' normals, touching both.
     del tmp_path
     start, ended = [None], []
 

@@ -131,6 +131,11 @@ class PhysicsSettings:
     pad_clearance: float = 0.002
     """A touch (a repositioning target, a point of a vertex circle) is out of reach when the pad's lowest
     point would come closer than this to the table top; a slide heading down stops there [m]."""
+    corner_lean: float = math.radians(15.0)
+    """A ridge acquisition that did not settle, its last normals leaning along the edge by more than this, met a
+    third face at the edge's end: the pad tries once more a pad's radius from there [rad] ..."""
+    corner_rows: int = 20
+    """... judged on its last this many rows in contact [-]."""
     edge_reentry: float = 0.004
     """An edge move that must first return next to its edge touches the face this far in from the edge [m]."""
     reentry: ReentrySearch = field(default_factory=ReentrySearch)
@@ -825,18 +830,25 @@ class PhysicsExecutor(LandingSearch):
         toward_a = rec.inward.get(fa, np.zeros(3)) - rec.inward.get(fb, np.zeros(3))
         return rec, n_a, n_b, toward_a
 
-    def _return_next_to_edge(self, rec, u: np.ndarray, face: int, pieces: list[PrimitiveResult]) -> str:
-        """Put the pad on a face of edge ``rec`` next to it, before following it along ``u``: on the current
-        face ``face`` when it is one of the edge's, else on the other; when that touch fails, on the other face."""
+    def _return_next_to_edge(
+        self, rec, u: np.ndarray, face: int, pieces: list[PrimitiveResult], s0: float | None = None
+    ) -> str:
+        """Put the pad on a face of edge ``rec`` next to it (beside parameter ``s0`` when given, else beside the
+        last contact), before following it along ``u``: on the current face ``face`` when it is one of the edge's,
+        else on the other; when that touch fails, on the other face."""
         s, seg = self.settings, self.segmenter
         first = face if face in rec.faces else rec.faces[1]
         # beside the last contact: the pad may be far off in free space (backed out after a tilted move)
-        s0 = rec.param(self.contact_point() if self.toucher.contact[2] is not None else self.state.position)
-        # ... within the explored interval, to its ends' bound: beyond, the line is extrapolated and the edge may not
-        # run there (BOX01N at 60 mm, seed 2: a contact 25 mm past an interval 1 mm long, beyond the slot that breaks
-        # the top edge; the move followed the edge on the slot's far side and the interval was extended across it)
-        reach = self.bounds.bound(0.0, self.bounds.length_floor)
-        s0 = float(np.clip(s0, rec.interval[0] - reach, rec.interval[1] + reach))
+        if s0 is None:
+            s0 = rec.param(self.contact_point() if self.toucher.contact[2] is not None else self.state.position)
+            # ... within the explored interval, to its ends' bound: beyond, the line is extrapolated and the edge may
+            # not run there (BOX01N at 60 mm, seed 2: a contact 25 mm past an interval 1 mm long, beyond the slot that
+            # breaks the top edge; the move followed the edge on the slot's far side and the interval was extended
+            # across it)
+            reach = self.bounds.bound(0.0, self.bounds.length_floor)
+            s0 = float(np.clip(s0, rec.interval[0] - reach, rec.interval[1] + reach))
+        if not rec.convex and None not in rec.faces:
+            return self._touch_corner(rec, s0, u, first, pieces)
         status, why = "unreachable", "the edge next to the table is out of the pad's reach"
         for fid in (first, *(f for f in rec.faces if f != first and f in rec.inward)):
             n = seg.faces[fid].component.normal
@@ -851,6 +863,40 @@ class PhysicsExecutor(LandingSearch):
             why = f"could not return next to the edge: {self._why}"
         self._why = why
         return status
+
+    def _touch_corner(self, rec, s0: float, u: np.ndarray, face: int, pieces: list[PrimitiveResult]) -> str:
+        """Put the pad in the corner of concave edge ``rec``, touching both its faces, beside parameter ``s0`` (or
+        further along ``u`` where that is within the pad's reach of the table): approached along the bisector of
+        the faces' normals. A touch of either face next to the edge meets the other face first, nearer than the
+        pad's radius (BOX01N's upright slot: 16 of 16 returns next to its concave edges touched the face across and
+        failed). "ok" with the pad on ``face``, or a failure with the reason in ``self._why``."""
+        t, seg = self.toucher, self.segmenter
+        n_a, n_b = (seg.faces[f].component.normal for f in rec.faces)
+        b = n_a + n_b
+        if float(b @ b) < 1e-6:
+            self._why = "could not return into the concave corner: its faces are opposed"
+            return "unreachable"
+        b = unit(b)
+        # the pad's point along -b when it rests touching both faces: its centre lies r / cos(half the angle
+        # between the normals) out along b from the edge's line
+        depth = t.pad_radius / max(float(b @ n_a), 1e-3) - t.pad_radius
+        s = self.settings
+        target = self.workspace.reentry_point(rec, b, b, s0, u, depth, s.reentry)
+        if target is None:
+            self._why = "the concave edge next to the table is out of the pad's reach"
+            return "unreachable"
+        r = t.lift_and_approach(target, b, floor_z=TABLE_TOP_Z + t.pad_radius + s.table_margin)
+        pieces.append(r)
+        if not r.ok:
+            self._why = f"could not return into the concave corner: {r.status}/{r.event}"
+            return r.status
+        n = unit(np.asarray(r.info["normal"], dtype=float))
+        # the sensed normal, a force-weighted mean of the two faces' normals, lies on the arc between them
+        if angle(n, n_a) + angle(n, n_b) > angle(n_a, n_b) + self.bounds.retouch_cone:
+            self._why = f"returning into the concave corner touched a normal {math.degrees(angle(n, b)):.0f}° off it"
+            return "unreachable"
+        self.on_face = face
+        return "ok"
 
     def _edge_move(self, move: EdgeMove, pieces: list[PrimitiveResult]) -> MoveResult:
         st, t, seg, s = self.state, self.toucher, self.segmenter, self.settings
@@ -874,6 +920,19 @@ class PhysicsExecutor(LandingSearch):
                 return self.failed_result(move, status, self._why)
         acq = t.follow_edge(u, n_a, n_b, toward_a, 0.0, acquire_only=True)
         pieces.append(acq)
+        shift = self._off_the_corner(acq, rec) if not acq.ok else None
+        if shift is not None:
+            # the pad rolling onto the ridge met a third face, where the edge ends at a corner: it tries once more
+            # from a pad's radius farther from that corner
+            status = self._return_next_to_edge(rec, u, self.on_face if self.on_face in rec.faces else st.face,
+                                               pieces, shift)  # fmt: skip
+            if status != "ok":
+                return self.failed_result(move, status, f"acquiring the ridge: {acq.event}; {self._why}")
+            acq = t.follow_edge(u, n_a, n_b, toward_a, 0.0, acquire_only=True)
+            pieces.append(acq)
+            if acq.ok:
+                self.recoveries.append("acquiring the ridge, the pad met a face at the edge's end: acquired again "
+                                       "a pad's radius from it")  # fmt: skip
         if not acq.ok:
             return self.failed_result(move, acq, f"acquiring the ridge: {acq.event}")
         off = self._line_distance(rec, self.contact_point())
@@ -938,6 +997,22 @@ class PhysicsExecutor(LandingSearch):
         return MoveResult(move=move, status="ok", components=(edge, vertex), distance=r.distance,
                           cost=self.costs.edge_move(r.distance), state=self.state,
                           info={"vertex_event": r.info.get("event_sign", 1)})  # fmt: skip
+
+    def _off_the_corner(self, acq: PrimitiveResult, rec) -> float | None:
+        """After a ridge acquisition along edge ``rec`` that never settled on the bisector: the parameter along the
+        edge a pad's radius from where it ended, away from the face its last normals leaned from (a third face, where
+        the edge ends at a corner); None when they did not lean along the edge by more than
+        ``PhysicsSettings.corner_lean`` (or it lost contact, or went unstable)."""
+        if acq.status == "unstable":
+            return None
+        tr = acq.trace
+        rows = np.flatnonzero(tr.in_contact)[-self.settings.corner_rows:]
+        if not len(rows):
+            return None
+        lean = float(np.median(tr.normal_in_world[rows] @ rec.direction))
+        if abs(lean) < math.sin(self.settings.corner_lean):
+            return None
+        return rec.param(tr.point_in_world[rows[-1]]) + math.copysign(self.toucher.pad_radius, lean)
 
     @staticmethod
     def _line_distance(rec, w: np.ndarray) -> float:
