@@ -154,7 +154,7 @@ def main(argv: list[str] | None = None) -> int:
         else:
             names = args.objects.split(",") if args.objects else sorted(library or load_library())
             pairs = [(m, int(s)) for m in names for s in args.seeds.split(",")]
-        rows, verdicts, by = [], Counter(), Counter()
+        rows, verdicts, by, fingers = [], Counter(), Counter(), Counter()
         placed = 0
         for model, seed in pairs:
             r = study(model, seed, library)
@@ -170,6 +170,7 @@ def main(argv: list[str] | None = None) -> int:
                             else f"{f['distance_mm']:.0f} mm from it: " + (", ".join(f["reached"]) or "no finger"))
                     parts.append(f"f{f['face']} (leans under {f['lean_under_deg']:.0f}°) {what}")
                     by.update({a.split(" ", 1)[1] for a in f["reached"]})
+                    fingers.update({a.split(" ", 1)[0] for a in f["reached"]})
                 planes = "enough planes in some finger's reach" if x["planes"] else "too few planes"
                 print(f"  v{x['vertex']} {x['height_mm']:.0f} mm up: {x['verdict']} ({planes}); " + "; ".join(parts),
                       flush=True)  # fmt: skip
@@ -183,6 +184,7 @@ def main(argv: list[str] | None = None) -> int:
         if by:
             print("approaches that reach a face out of the verification's reach (faces): "
                   + ", ".join(f"{k} {v}" for k, v in by.most_common()))
+            print("fingers that reach one (faces): " + ", ".join(f"{k} {v}" for k, v in fingers.most_common()))
         if args.json:
             with open(args.json, "w") as fh:
                 json.dump(rows, fh, indent=1)
