@@ -83,3 +83,17 @@ def test_another_finger_probes_under_the_step(by_another_finger):
     # the sensor state is where it was: the exploring pad goes back to the face it left
     assert ep.executor.state is state
     assert res.cost > ep.config.costs.c_p
+
+
+def test_the_ideal_sensor_probes_the_same_line_whatever_the_finger():
+    """The geometric executor's probe is the line's (a point sensor): naming a finger changes nothing."""
+    out = []
+    for finger in (None, "thumb"):
+        ep = build_episode(EpisodeSpec(model="BOX01P", seed=1, executor="geometric", verify="none"))
+        assert ep.executor.start().ok
+        line = _line(ep)
+        res = ep.executor.execute(ProbeMove(line.start, line.direction, line.length, finger=finger))
+        assert res.ok and len(res.components) == 1, res.reason
+        out.append(res)
+    assert np.allclose(out[0].components[0].normal, out[1].components[0].normal)
+    assert out[0].cost == out[1].cost
