@@ -439,8 +439,9 @@ class PhysicsExecutor(LandingSearch):
             return self._run(move, lambda pieces: self._edge_move(move, pieces))
         if isinstance(move, VertexMove):
             return self._run(move, lambda pieces: self._vertex_move(move, pieces))
-        if isinstance(move, ProbeMove) and move.finger not in (None, self.toucher.finger):
-            # another fingertip, the wrist turned to point it along the line: haptic.executor.placement
+        if isinstance(move, ProbeMove) and move.finger is not None:
+            # a named fingertip (the exploring one too), the wrist turned to point it along the line, the hand's way
+            # the planner's: haptic.executor.placement
             return self._run(move, lambda pieces: finger_probe_move(self, move, pieces))
         if isinstance(move, ProbeMove):  # the free-space probe: haptic.executor.physics_probe
             return self._run(move, lambda pieces: probe_move(self, move, pieces))
