@@ -391,8 +391,8 @@ must span across, in every heading; an 8 mm one put the pad on the table."""
 
 def finger_probe_move(ex: PhysicsExecutor, move: ProbeMove, pieces: list[PrimitiveResult],
                       settings: PlacementSettings = PROBE_SETTINGS) -> MoveResult:  # fmt: skip
-    """Carry out probe ``move`` with its own finger (``move.finger``, not the exploring one), pointing along its line:
-    the hand's joint-space way of a placement of that one finger (module docstring: the planner's path when the
+    """Carry out probe ``move`` with the finger it names (``move.finger``, the exploring one too), pointing along its
+    line: the hand's joint-space way of a placement of that one finger (module docstring: the planner's path when the
     move has one, else the solver's on the robot and table alone), its closing, press and stroke, and the way back;
     the touched face measured from that fingertip's contacts alone (its pad's sensed points and normals, through the
     same sensing interface as every move). A probe's result and cost (:meth:`~haptic.planning.moves.CostModel.
