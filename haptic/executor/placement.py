@@ -836,10 +836,10 @@ def _assignments(own: tuple[str, ...]):
 
 
 FINGER_PROBE_REACH = ReachSettings(clearance=0.008, pads_touch=False, tip_table_clearance=TIP_TABLE_CLEARANCE,
-                                   hold_clearance=HOLD_CLEARANCE)  # fmt: skip
+                                   hold_clearance=0.004)  # fmt: skip
 """The planner's reach test of a probe by one finger (:func:`finger_probe`): every link 8 mm from the hypothesised
-object and the table (a placement's 20 mm leave no finger a way under a 20 mm overhang: BOX01P, seed 1, the side
-under its step, which the thumb turned along the line touches with 8 mm)."""
+object and the table, the path held to at least 4 mm (a placement's 20 mm leave no finger a way under a 20 mm
+overhang: BOX01P, seed 1, the side under its step, which the thumb turned along the line touches with 8 mm)."""
 
 
 def finger_probe(move: ProbeMove, hypotheses: Sequence, reach: PlacementReach | None = None,
