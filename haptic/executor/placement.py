@@ -842,19 +842,39 @@ object and the table, the path held to at least 4 mm (a placement's 20 mm leave 
 overhang: BOX01P, seed 1, the side under its step, which the thumb turned along the line touches with 8 mm)."""
 
 
+PROBE_TILTS = (math.radians(60.0), math.radians(30.0))
+"""Where no finger reaches a probe's line pointing along it, the finger's axis turned from straight down toward the
+line's level direction by these angles, in turn (:func:`finger_probe`): a face leaning under is pressed level with
+the finger tilted (trapezohedron_05 of the formula corpus, seed 1, a face leaning under 35.5°: the index pointing
+down met it with its medial link, tilted 60° it measured the face within 0.2°)."""
+
+
 def finger_probe(move: ProbeMove, hypotheses: Sequence, reach: PlacementReach | None = None,
-                 fingers: Sequence[str] = FINGERS) -> ProbeMove | None:  # fmt: skip
+                 fingers: Sequence[str] = FINGERS,
+                 tilts: Sequence[float] = PROBE_TILTS) -> ProbeMove | None:  # fmt: skip
     """Probe ``move`` carried out by the first of ``fingers`` whose pad the hand can put at the line's start pointing
     along the line, clear of the most likely of ``hypotheses`` (its model at its pose; the planner's reach test of
-    placements, ``reach``, asked for a placement of that one finger): the move with that finger and the path, or
-    None when no finger reaches. The finger and the wrist's turn are the reach solver's choice, the hand's way with
-    them the path the executor follows (:func:`finger_probe_move`)."""
+    placements, ``reach``, asked for a placement of that one finger); failing that, the first with its axis turned
+    from straight down toward the line by one of ``tilts`` [rad] (a line with a level part). The move with that
+    finger and the path, or None when no finger reaches. The finger and the wrist's turn are the reach solver's
+    choice, the hand's way with them the path the executor follows (:func:`finger_probe_move`)."""
     reach = reach if reach is not None else PlacementReach(FINGER_PROBE_REACH)
     line = (np.asarray(move.start, dtype=float), np.asarray(move.direction, dtype=float), float(move.length))
     for name in fingers:
         got = reach(PlacementMove((FingerApproach(name, *line),)), hypotheses, own_only=True)
         if got is not None:
             return replace(move, finger=got.fingers[0].finger, path=got.path)
+    level = line[1] * np.array([1.0, 1.0, 0.0])
+    if not tilts or float(np.linalg.norm(level)) < 0.1:
+        return None
+    level = unit(level)
+    solver = reach._solver(hypotheses[0])
+    for tilt in tilts:
+        axis = math.cos(tilt) * np.array([0.0, 0.0, -1.0]) + math.sin(tilt) * level
+        for name in fingers:
+            r = solver.solve([FingertipTarget(name, pad_target(FingerApproach(name, *line)), axis)])
+            if r.ok:
+                return replace(move, finger=name, path=r.path)
     return None
 
 
@@ -863,6 +883,6 @@ def reach_oracle(fingers: int) -> Callable | None:
     return PlacementReach() if fingers > 1 else None
 
 
-__all__ = ["FINGER_PROBE_REACH", "HOLD_CLEARANCE", "PROBE_SETTINGS", "REACH_CLEARANCE", "SETTINGS",
+__all__ = ["FINGER_PROBE_REACH", "HOLD_CLEARANCE", "PROBE_SETTINGS", "PROBE_TILTS", "REACH_CLEARANCE", "SETTINGS",
            "TIP_TABLE_CLEARANCE", "PlacementReach", "PlacementSettings", "finger_probe", "finger_probe_move",
            "hand_solver", "pad_target", "placement_move", "reach_oracle"]
