@@ -16,7 +16,8 @@ from haptic.executor.placement import finger_probe
 from haptic.matching.trace import PHASES
 from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import FINGER_NAMES, ProbeMove
-from haptic.sim.scene import FINGERS
+from haptic.sim.scene import FINGERS, PAD_RADIUS
+from tests.test_episode_physics import _sized_corpus
 
 UNDER_STEP = 8
 """BOX01P's face under its step: at seed 1 it stands on an end, this face vertical and 20 mm in under the step."""
@@ -30,8 +31,8 @@ def _line(ep) -> ProbeMove:
     return ProbeMove(middle + 0.04 * n, -n, 0.06)
 
 
-def _episode():
-    ep = build_episode(EpisodeSpec(model="BOX01P", seed=1, executor="physics", verify="none"))
+def _episode(model: str = "BOX01P", models: str | None = None):
+    ep = build_episode(EpisodeSpec(model=model, seed=1, executor="physics", verify="none", models=models))
     first = ep.executor.start()
     assert first.ok, first.reason
     return ep
@@ -97,3 +98,31 @@ def test_the_ideal_sensor_probes_the_same_line_whatever_the_finger():
         out.append(res)
     assert np.allclose(out[0].components[0].normal, out[1].components[0].normal)
     assert out[0].cost == out[1].cost
+
+
+LEANING = 6
+"""trapezohedron_05's face that leans under by 35.5° at seed 1 of the sized formula corpus (the verification's limit
+for fingers pointing down is 31°)."""
+
+
+@pytest.mark.slow
+def test_a_tilted_finger_probes_a_face_leaning_under(tmp_path):
+    ep = _episode("trapezohedron_05", _sized_corpus(tmp_path))
+    poly, pose = ep.true_model, ep.world_from_model
+    n = pose.rotate(poly.face_normals[LEANING])
+    assert np.degrees(np.arcsin(-n[2])) > 35.0
+    # a level line into the face 30 mm above the table, the pad's centre 12 mm out from it
+    up = np.array([0.0, 0.0, 1.0]) - n[2] * n
+    up /= np.linalg.norm(up)
+    middle = pose.apply(poly.vertices[list(poly.faces[LEANING])]).mean(axis=0)
+    point = middle + (ep.config.table_z + 0.03 - middle[2]) / up[2] * up
+    level = -n * np.array([1.0, 1.0, 0.0])
+    level /= np.linalg.norm(level)
+    line = ProbeMove(point + PAD_RADIUS * n + (PAD_RADIUS - 0.03) * level, level, 0.05)
+    h = Hypothesis(model="trapezohedron_05", poly=poly, world_from_model=pose, faces={}, edges={}, vertices={})
+    move = finger_probe(line, [h])
+    assert move is not None and move.path is not None
+    res = ep.executor.execute(move)
+    assert res.ok and len(res.components) == 1, res.reason
+    assert np.degrees(np.arccos(np.clip(res.components[0].normal @ n, -1.0, 1.0))) < 1.0
+    assert res.info["finger"] == move.finger
