@@ -44,7 +44,7 @@ from haptic.executor.primitives import PrimitiveResult
 from haptic.geometry.se3 import perpendicular, unit
 from haptic.matching.trace import PHASES, ContactTrace
 from haptic.planning.handpath import CLEARANCE, LIFT, safe_height
-from haptic.planning.moves import FingerApproach, MoveResult, PlacementMove, SensorState
+from haptic.planning.moves import FingerApproach, MoveResult, PlacementMove, ProbeMove, SensorState
 from haptic.sim.reach import FingertipTarget, ReachSettings, ReachSolver
 from haptic.sim.scene import ARM_HOME, FINGERS, HAND_TRACE, PAD_RADIUS, TABLE_TOP_Z
 
@@ -87,6 +87,12 @@ class PlacementSettings:
     stroke_headings: int = 4
     """A finger whose stroke finds no face strokes again in up to this many headings in all, a quarter turn
     apart (its stroke may have left a narrow face)."""
+    stroke_across: float | None = None
+    """Length of the L's second leg [m]; None: :attr:`stroke`."""
+    level_stroke: bool = False
+    """Whether the L's first leg runs level (along the face, horizontal; the other way at each further heading) and
+    its second rises, in place of a random heading: a pad that came in under an overhang, close above the table,
+    has room along the face but little up or down."""
     path_ticks: int = 4
     """Each configuration of the solver's path to the lines' starts (a joint moves at most 0.05 rad from one to the
     next) is held at least this many ticks [-] ..."""
@@ -327,6 +333,15 @@ def placement_move(ex: PhysicsExecutor, move: PlacementMove, pieces: list[Primit
     """Carry out ``move`` with ``ex``'s hand (module docstring); a failure is a status, never an exception."""
     if (problem := move.problem()) is not None:
         return ex.invalid_result(move, problem)
+    return _placement(ex, move, pieces, settings)
+
+
+def _placement(ex: PhysicsExecutor, move: PlacementMove, pieces: list[PrimitiveResult], settings: PlacementSettings,
+               single: bool = False) -> MoveResult:  # fmt: skip
+    """:func:`placement_move` of a placement already checked; ``single``: one finger's probe
+    (:func:`finger_probe_move`), whose pad backs out along its whole line before the hand rises (it may be under an
+    overhang) and after which the exploring pad does not touch the face measured (the other finger reached it where
+    the exploring one does not)."""
     t, s = ex.toucher, settings
     starts = np.array([pad_target(f) for f in move.fingers])
     if np.any(starts[:, 2] - PAD_RADIUS < TABLE_TOP_Z + ex.settings.pad_clearance):
@@ -346,12 +361,13 @@ def placement_move(ex: PhysicsExecutor, move: PlacementMove, pieces: list[Primit
     if not up.ok or up.event != "done":
         return ex.failed_result(move, "unreachable", f"rising above the object: {up.event}")
     c = _Closing(ex, move, s)
-    result = _place(ex, move, c, starts, z_safe, pieces)
-    _restore(ex, c, move, z_safe, pieces)
+    result = _place(ex, move, c, starts, z_safe, pieces, single)
+    _restore(ex, c, move, z_safe, pieces, to_start=single)
     if result.status != "ok":
         return result
     touched = [i for i in result.info["fingers"] if i["status"] == "touched"]
-    for info in touched:  # the sensor rests on the first face measured that the exploring pad touches again
+    for info in [] if single else touched:  # the sensor rests on the first face measured that the exploring pad
+        # touches again
         fid = info["component"]
         if ex._ensure_on_face(fid, pieces, near=np.asarray(info["point"])) == "ok":
             ex.state = SensorState(position=ex.contact_point(), face=fid)
@@ -363,6 +379,44 @@ def placement_move(ex: PhysicsExecutor, move: PlacementMove, pieces: list[Primit
         info.pop("point", None)
     return replace(result, distance=dist, cost=cost, state=ex.state,
                    info={**result.info, "travel": {k: round(v, 4) for k, v in way.items()}})  # fmt: skip
+
+
+PROBE_SETTINGS = replace(SETTINGS, stroke=0.008, stroke_across=0.003, level_stroke=True)
+"""A probe by another finger (:func:`finger_probe_move`) strokes an L of 8 mm level along the face, then 3 mm up: a
+pad that came in under an overhang close above the table has room along the face, little up or down (BOX01P, seed 1,
+the side under its step, 35 mm high: the pad's centre has 5 mm up to the step and 5 mm down to the table's
+clearance). A placement's 4 mm L at a random heading spanned 5.3 × 1.2 mm there, under the 1.5 mm a face's stroke
+must span across, in every heading; an 8 mm one put the pad on the table."""
+
+
+def finger_probe_move(ex: PhysicsExecutor, move: ProbeMove, pieces: list[PrimitiveResult],
+                      settings: PlacementSettings = PROBE_SETTINGS) -> MoveResult:  # fmt: skip
+    """Carry out probe ``move`` with the finger it names (``move.finger``, the exploring one too), pointing along its
+    line: the hand's joint-space way of a placement of that one finger (module docstring: the planner's path when the
+    move has one, else the solver's on the robot and table alone), its closing, press and stroke, and the way back;
+    the touched face measured from that fingertip's contacts alone (its pad's sensed points and normals, through the
+    same sensing interface as every move). A probe's result and cost (:meth:`~haptic.planning.moves.CostModel.
+    probe_move`, plus a stroke when it touched); the sensor state stays where it was (the exploring pad touches the
+    face it left again at the next move)."""
+    if (problem := move.problem()) is not None:
+        return ex.invalid_result(move, problem)
+    approach = FingerApproach(str(move.finger), np.asarray(move.start, dtype=float),
+                              np.asarray(move.direction, dtype=float), float(move.length))  # fmt: skip
+    place = PlacementMove((approach,), path=move.path)
+    res = _placement(ex, place, pieces, settings, single=True)
+    info = dict(res.info)
+    fingers = info.pop("fingers", [])
+    mine = fingers[0] if fingers else {}
+    info.update(finger=move.finger, finger_status=mine.get("status"))
+    if res.status != "ok":
+        return replace(res, move=move, info=info)
+    touched = bool(res.components)
+    if touched:
+        info.update(contact=mine.get("contact"), hit_point=res.components[0].points.mean(axis=0).tolist())
+    else:
+        info["contact"] = None
+    cost = ex.costs.probe_move(res.distance) + (ex.costs.c_n if touched else 0.0)
+    return replace(res, move=move, cost=cost, state=ex.state, info=info)
 
 
 def _travel(c: _Closing, move: PlacementMove, pieces: list[PrimitiveResult], first: int,
@@ -383,7 +437,7 @@ def _travel(c: _Closing, move: PlacementMove, pieces: list[PrimitiveResult], fir
 
 
 def _place(ex: PhysicsExecutor, move: PlacementMove, c: _Closing, starts: np.ndarray, z_safe: float,
-           pieces: list[PrimitiveResult]) -> MoveResult:  # fmt: skip
+           pieces: list[PrimitiveResult], single: bool = False) -> MoveResult:  # fmt: skip
     s = c.s
     names = [f.finger for f in move.fingers]
     axes = {f.finger: np.asarray(f.direction, dtype=float) for f in move.fingers}
@@ -531,7 +585,8 @@ def _place(ex: PhysicsExecutor, move: PlacementMove, c: _Closing, starts: np.nda
         elif status[name] != "missed":
             info["reason"] = reason[name]
         fingers.append(info)
-    pieces.append(PrimitiveResult("ok", "done", c.trace(ex.toucher.finger), 0.0))  # the exploring pad's way
+    # the exploring pad's way; a probe by another finger: that finger's, whose contacts are the move's
+    pieces.append(PrimitiveResult("ok", "done", c.trace(names[0] if single else ex.toucher.finger), 0.0))
     c.own.add(id(pieces[-1]))
     if not comps and not any(i["status"] == "missed" for i in fingers):
         why = "; ".join(f"{i['finger']}: {i.get('reason', i['status'])}" for i in fingers)
@@ -594,17 +649,25 @@ def _stroke(c: _Closing, fingers: Sequence[FingerApproach], held: dict[str, np.n
         a = perpendicular(n)
         phi = heading[f.finger]
         d1 = math.cos(phi) * a + math.sin(phi) * np.cross(n, a)
-        legs[f.finger] = (d1, np.cross(n, d1))
+        level = np.cross(np.array([0.0, 0.0, 1.0]), n)
+        if s.level_stroke and float(level @ level) > 0.25:  # the face leans under 60° from horizontal, at least
+            d1 = unit(level) * (1.0 if math.cos(phi) >= 0.0 else -1.0)
+            d2 = np.cross(n, d1)
+            legs[f.finger] = (d1, d2 if d2[2] >= 0.0 else -d2)
+        else:
+            legs[f.finger] = (d1, np.cross(n, d1))
     first = {f.finger: len(c.rows[f.finger]) for f in fingers}
-    steps = max(1, int(round(s.stroke / s.stroke_step)))
     depth = {f.finger: s.stroke_press for f in fingers}
-    for leg in range(2):
+    along = s.stroke
+    across = s.stroke if s.stroke_across is None else s.stroke_across
+    for leg, length in enumerate((along, across)):
+        steps = max(1, int(round(length / s.stroke_step)))
         for k in range(1, steps + 1 + s.dwell_steps):
             k = min(k, steps)  # then dwell at the leg's end: the joints' servo trails its targets
             off = {}
             for f in fingers:
                 d1, d2 = legs[f.finger]
-                off[f.finger] = (k * s.stroke_step * d1) if leg == 0 else (s.stroke * d1 + k * s.stroke_step * d2)
+                off[f.finger] = (k * s.stroke_step * d1) if leg == 0 else (along * d1 + k * s.stroke_step * d2)
             _pressing_step(c, fingers, held, normals, contacts, radius, depth, off, "stroke")
     return {f.finger: c.trace(f.finger, first[f.finger]) for f in fingers}
 
@@ -631,14 +694,23 @@ def _pressing_step(c: _Closing, fingers: Sequence[FingerApproach], held: dict[st
 
 
 def _restore(ex: PhysicsExecutor, c: _Closing, move: PlacementMove, z_safe: float,
-             pieces: list[PrimitiveResult]) -> None:  # fmt: skip
-    """The fingers back along their lines, the hand up to ``z_safe`` and back to the tracing posture."""
+             pieces: list[PrimitiveResult], to_start: bool = False) -> None:  # fmt: skip
+    """The fingers back along their lines (by :attr:`PlacementSettings.lift`, or ``to_start``: to their pads'
+    places at the lines' starts, the way they came), the hand up to ``z_safe`` and back to the tracing posture."""
     s, t = c.s, ex.toucher
     c.back_from = {f: len(c.rows[f]) for f in c.rows}
     c.pieces_at_back = len(pieces)
     r = ex.robot.read()
     names = [f.finger for f in move.fingers]
     back = {f.finger: r.fingertip_in_world[c.index[f.finger]] - s.lift * np.asarray(f.direction) for f in move.fingers}
+    if to_start:  # along the line in steps, as it closed, so that the pad keeps to the way it came
+        now = {f.finger: r.fingertip_in_world[c.index[f.finger]].copy() for f in move.fingers}
+        back = {f.finger: pad_target(f) for f in move.fingers}
+        steps = max(1, int(np.ceil(max(np.linalg.norm(back[f] - now[f]) for f in names) / (3.0 * s.step))))
+        for k in range(1, steps):
+            c.hold(c.solve({f: now[f] + (back[f] - now[f]) * k / steps for f in names}))
+            for _ in range(s.step_ticks):
+                c.tick("free")
     c.hold(c.solve(back))
     for _ in range(s.settle_ticks):
         c.tick("free")
@@ -683,10 +755,13 @@ class PlacementReach:
         self.reasons: dict[str, int] = {}
         """Why the others were not, by the solver's reason (the last assignment's)."""
 
-    def __call__(self, move: PlacementMove, hypotheses: Sequence) -> PlacementMove | None:
+    def __call__(self, move: PlacementMove, hypotheses: Sequence, own_only: bool = False) -> PlacementMove | None:
+        """The placement with the fingers that reach and their path, or None (``own_only``: its own fingers
+        alone, no other assignment tried)."""
         h = hypotheses[0]
-        key = (h.model, *np.round(h.world_from_model.as_matrix()[:3].ravel(), 3),
+        key = (h.model, *np.round(h.world_from_model.as_matrix()[:3].ravel(), 3), own_only,
                *(tuple(np.round(np.concatenate([f.start, f.direction]), 4)) for f in move.fingers))
+        key = (*key, *(f.finger for f in move.fingers))
         if key in self._answers:
             return self._answers[key]
         solver = self._solver(h)
@@ -694,7 +769,8 @@ class PlacementReach:
         answer, why = None, ""
         lines = list(move.fingers)
         tried = 0
-        for names in _assignments(tuple(f.finger for f in lines)):
+        own = tuple(f.finger for f in lines)
+        for names in [own] if own_only else _assignments(own):
             if tried >= self.assignments:
                 break
             tried += 1
@@ -759,10 +835,54 @@ def _assignments(own: tuple[str, ...]):
             yield names
 
 
+FINGER_PROBE_REACH = ReachSettings(clearance=0.008, pads_touch=False, tip_table_clearance=TIP_TABLE_CLEARANCE,
+                                   hold_clearance=0.004)  # fmt: skip
+"""The planner's reach test of a probe by one finger (:func:`finger_probe`): every link 8 mm from the hypothesised
+object and the table, the path held to at least 4 mm (a placement's 20 mm leave no finger a way under a 20 mm
+overhang: BOX01P, seed 1, the side under its step, which the thumb turned along the line touches with 8 mm)."""
+
+
+PROBE_TILTS = (math.radians(60.0), math.radians(30.0))
+"""Where no finger reaches a probe's line pointing along it, the finger's axis turned from straight down toward the
+line's level direction by these angles, in turn (:func:`finger_probe`): a face leaning under is pressed level with
+the finger tilted (trapezohedron_05 of the formula corpus, seed 1, a face leaning under 35.5°: the index pointing
+down met it with its medial link, tilted 60° it measured the face within 0.2°)."""
+
+
+def finger_probe(move: ProbeMove, hypotheses: Sequence, reach: PlacementReach | None = None,
+                 fingers: Sequence[str] = FINGERS,
+                 tilts: Sequence[float] = PROBE_TILTS) -> ProbeMove | None:  # fmt: skip
+    """Probe ``move`` carried out by the first of ``fingers`` whose pad the hand can put at the line's start pointing
+    along the line, clear of the most likely of ``hypotheses`` (its model at its pose; the planner's reach test of
+    placements, ``reach``, asked for a placement of that one finger); failing that, the first with its axis turned
+    from straight down toward the line by one of ``tilts`` [rad] (a line with a level part). The move with that
+    finger and the path, or None when no finger reaches. The finger and the wrist's turn are the reach solver's
+    choice, the hand's way with them the path the executor follows (:func:`finger_probe_move`)."""
+    reach = reach if reach is not None else PlacementReach(FINGER_PROBE_REACH)
+    line = (np.asarray(move.start, dtype=float), np.asarray(move.direction, dtype=float), float(move.length))
+    for name in fingers:
+        got = reach(PlacementMove((FingerApproach(name, *line),)), hypotheses, own_only=True)
+        if got is not None:
+            return replace(move, finger=got.fingers[0].finger, path=got.path)
+    level = line[1] * np.array([1.0, 1.0, 0.0])
+    if not tilts or float(np.linalg.norm(level)) < 0.1:
+        return None
+    level = unit(level)
+    solver = reach._solver(hypotheses[0])
+    for tilt in tilts:
+        axis = math.cos(tilt) * np.array([0.0, 0.0, -1.0]) + math.sin(tilt) * level
+        for name in fingers:
+            r = solver.solve([FingertipTarget(name, pad_target(FingerApproach(name, *line)), axis)])
+            if r.ok:
+                return replace(move, finger=name, path=r.path)
+    return None
+
+
 def reach_oracle(fingers: int) -> Callable | None:
     """The planner's placement reach test for an episode of ``fingers`` fingers at once (None for one)."""
     return PlacementReach() if fingers > 1 else None
 
 
-__all__ = ["HOLD_CLEARANCE", "REACH_CLEARANCE", "SETTINGS", "TIP_TABLE_CLEARANCE", "PlacementReach",
-           "PlacementSettings", "hand_solver", "pad_target", "placement_move", "reach_oracle"]
+__all__ = ["FINGER_PROBE_REACH", "HOLD_CLEARANCE", "PROBE_SETTINGS", "PROBE_TILTS", "REACH_CLEARANCE", "SETTINGS",
+           "TIP_TABLE_CLEARANCE", "PlacementReach", "PlacementSettings", "finger_probe", "finger_probe_move",
+           "hand_solver", "pad_target", "placement_move", "reach_oracle"]

@@ -188,6 +188,15 @@ class ProbeMove:
     """Unit direction of the approach in the world frame, shape (3,)."""
     length: float
     """How far along the line the approach goes before it counts as a miss [m]."""
+    finger: str | None = None
+    """Which fingertip carries the probe out (a name of ``haptic.sim.scene.FINGERS``), pointing along the line;
+    None: the exploring one, the hand in its tracing posture (the fingers pointing down). A face that the exploring
+    pad cannot come to that way (under an overhang, the back of a slot) may be touched by another finger with the
+    wrist turned (:func:`haptic.executor.placement.finger_probe`)."""
+    path: np.ndarray | None = None
+    """With ``finger``: the hand's way to the line's start as the planner's reach test found it, clear of the
+    hypothesised object -- joint configurations (K, n) from the tracing posture to that finger's pad at the start,
+    pointing along the line [rad]; None: the executor finds its own."""
 
     kind = "probe"
 
@@ -204,8 +213,13 @@ class ProbeMove:
         length = float(self.length)
         if abs(float(np.linalg.norm(u)) - 1.0) > 1e-6 or not np.isfinite(length) or length <= 0.0:
             return "direction must be a unit vector and length a positive number of metres"
+        if self.finger is not None and self.finger not in FINGER_NAMES:
+            return f"unknown finger {self.finger!r}; valid fingers: {', '.join(FINGER_NAMES)}"
         return None
 
+
+FINGER_NAMES = ("index", "middle", "ring", "thumb")
+"""The hand's fingertips by name (``haptic.sim.scene.FINGERS``, which the pure core does not import)."""
 
 FINGER_COUNTS = (1, 2, 4)
 """The fingers an episode may use at once (``--fingers``): the index finger alone, or placements of up to two or

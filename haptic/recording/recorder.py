@@ -448,7 +448,8 @@ class EpisodeRecorder:
             rec.log("world/probes/misses", rr.LineStrips3D(s.probe_misses, colors=[PROBE_MISS_COLOR],
                                                            radii=PROBE_RADIUS, labels=labels,
                                                            show_labels=False))  # fmt: skip
-        rec.log("log/moves", rr.TextLog(f"probe {n}: {'hit' if face is not None else 'miss'}",
+        by = f" by the {move.finger}" if getattr(move, "finger", None) else ""
+        rec.log("log/moves", rr.TextLog(f"probe {n}{by}: {'hit' if face is not None else 'miss'}",
                                         level=rr.TextLogLevel.INFO))  # fmt: skip
 
     def _begin_move(self, i: int, result: MoveResult) -> Any:

@@ -1,0 +1,198 @@
+"""Whether the vertices the verification counts out of the hand's reach really are: for each episode's object at
+its true resting pose, the vertices that ``--verify full`` takes as hidden (off the table, not at the end of an edge
+between two faces in its reach) or cannot pin on the table, and for each of their faces out of the verification's
+reach, whether any fingertip, with any wrist turn, can put its pad on that face near the vertex.
+
+    .venv/bin/python scripts/reach_hidden.py [--objects BOX01N,BOX01P] [--seeds 1,2,3] [--models DIR]
+                                             [--pairs BOX01N:1,FRAME01:3] [--json out.json]
+
+The verification's reach (:func:`haptic.planning.verify.reachable_features`) is the index finger's, pointing down,
+on faces leaning under by at most ``PlannerConfig.max_undercut``. Here, per face at such a vertex:
+
+- *pad positions*: points of the face within 30 mm of the vertex (a 2 mm grid) where the 12 mm pad touching it
+  touches that face alone (its centre at least the pad's radius from the rest of the object) and stays 2 mm above
+  the table (the executor's limit);
+- *fingers*: for the nearest of those to the vertex, every finger with each of the approaches (the finger's axis
+  toward the pad): straight down, along the face's inward normal, level toward the face, and down tilted 30° and
+  60° toward it; the reach solver (:mod:`haptic.sim.reach`, mink) on the robot with the object at its pose (the
+  truth, as a right hypothesis has it), its default clearances.
+
+A vertex no pad position of any of its faces out of reach can touch is out of reach for a 12 mm pad whatever the
+finger (a slot narrower than the pad, a face against the table); one whose pad positions no finger reaches is out
+of the hand's reach; otherwise the fingers and approaches that reach are listed. A vertex *has enough planes in
+some finger's reach* when three of its faces (two besides the table's, for one on the table) are in the
+verification's reach or reached here: those planes alone would place it (touching one face near it does not).
+Ground truth is read here (this is evaluation), never by the executor. Geometry and inverse kinematics only: no physics.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from collections import Counter
+
+import numpy as np
+
+from haptic.episode.spec import EpisodeSpec
+from haptic.episode.worlds import build_episode
+from haptic.errors import HapticError
+from haptic.geometry import load_library
+from haptic.geometry.distance import surface_distance
+from haptic.planning.verify import TABLE_CONTACT, reachable_features, table_pins
+from haptic.sim import compose_scene
+from haptic.sim.reach import FingertipTarget, ReachSolver
+from haptic.sim.scene import FINGERS, PAD_RADIUS, scene_object_from_polyhedron
+
+FIVE = "BOX01N:1,BOX01N:3,BOX01P:1,BOX01P:2,FRAME01:3"
+"""The seed library's episodes whose default verification ends with vertices out of the hand's reach."""
+NEAR = 0.03
+"""Pad positions within this of the vertex [m] ..."""
+GRID = 0.002
+"""... on a grid of this spacing [m]."""
+TABLE_LIMIT = 0.002
+"""The pad's lowest point at least this above the table (the executor's limit) [m]."""
+ON_FACE = 1e-4
+"""A grid point within this of the surface is on it [m]."""
+
+
+def approaches(n: np.ndarray) -> dict[str, np.ndarray]:
+    """The finger axes tried for a face of outward normal ``n`` (toward the pad, unit)."""
+    down = np.array([0.0, 0.0, -1.0])
+    out = {"down": down, "along -n": -n}
+    level = -n.copy()
+    level[2] = 0.0
+    if np.linalg.norm(level) > 1e-3:
+        level /= np.linalg.norm(level)
+        out["level"] = level
+        for deg in (30, 60):
+            a = np.radians(deg)
+            out[f"tilted {deg}°"] = np.cos(a) * down + np.sin(a) * level
+    return out
+
+
+def pad_positions(poly, pose, v: int, f: int, table_z: float) -> np.ndarray:
+    """Points of face ``f`` near vertex ``v`` (world frame) where the pad touches that face alone, clear of the
+    table, nearest the vertex first."""
+    inv = pose.inverse()
+    n = pose.rotate(poly.face_normals[f])
+    vw = pose.apply(poly.vertices[v])
+    a = np.cross(n, [1.0, 0.0, 0.0]) if abs(n[0]) < 0.9 else np.cross(n, [0.0, 1.0, 0.0])
+    a /= np.linalg.norm(a)
+    b = np.cross(n, a)
+    g = np.arange(-NEAR, NEAR + 1e-9, GRID)
+    pts = np.array([vw + x * a + y * b for x in g for y in g])
+    pts = pts[np.linalg.norm(pts - vw, axis=1) <= NEAR]
+    on = np.abs(surface_distance(poly, inv.apply(pts))) < ON_FACE
+    centres = pts + PAD_RADIUS * n
+    alone = surface_distance(poly, inv.apply(centres)) >= PAD_RADIUS - 3e-4
+    clear = centres[:, 2] - PAD_RADIUS - table_z >= TABLE_LIMIT
+    keep = pts[on & alone & clear]
+    return keep[np.argsort(np.linalg.norm(keep - vw, axis=1))]
+
+
+def study(model: str, seed: int, library) -> dict:
+    """The hidden and unpinnable vertices of one episode's object at its pose, and what reaches their faces."""
+    ep = build_episode(EpisodeSpec(model=model, seed=seed, executor="physics", verify="full"), library)
+    poly, pose, cfg = ep.true_model, ep.world_from_model, ep.config
+    reach = reachable_features(poly, pose, cfg)
+    z = pose.apply(poly.vertices)[:, 2] - cfg.table_z
+    hidden = [v for v in range(poly.n_vertices) if v not in reach[2] and z[v] > TABLE_CONTACT]
+    _, unpinned = table_pins(poly, pose, reach, cfg)
+    out = {"model": model, "seed": seed, "hidden": hidden, "unpinned": [int(v) for v in unpinned], "vertices": []}
+    if not hidden and not unpinned:
+        return out
+    solver = ReachSolver(compose_scene(scene_object_from_polyhedron(poly), pose.as_matrix()))
+    for v in [*hidden, *unpinned]:
+        faces = []
+        for f in (int(f) for f in poly.vertex_faces[v]):
+            if f in reach[0]:
+                continue
+            n = pose.rotate(poly.face_normals[f])
+            lean = float(np.degrees(np.arcsin(np.clip(-n[2], -1.0, 1.0))))
+            pts = pad_positions(poly, pose, v, f, cfg.table_z)
+            row = {"face": f, "lean_under_deg": round(lean, 1) + 0.0, "pad_positions": len(pts), "reached": []}
+            if len(pts):
+                centre = pts[0] + PAD_RADIUS * n
+                row["distance_mm"] = round(float(np.linalg.norm(pts[0] - pose.apply(poly.vertices[v]))) * 1000, 1)
+                for finger in FINGERS:
+                    for name, axis in approaches(n).items():
+                        if solver.solve([FingertipTarget(finger, centre, axis)]).ok:
+                            row["reached"].append(f"{finger} {name}")
+            faces.append(row)
+        # enough planes through the vertex measurable to place it: three (two besides the table's, on the table), of
+        # its faces in the verification's reach or reached here
+        around = [int(f) for f in poly.vertex_faces[v]]
+        on_table = [f for f in around if np.all(z[list(poly.faces[f])] <= TABLE_CONTACT)]
+        measurable = [f for f in around if f in reach[0]] + [r["face"] for r in faces if r["reached"]]
+        planes = len(measurable) >= min(3 - (1 if z[v] <= TABLE_CONTACT else 0), len(around) - len(on_table))
+        if any(r["reached"] for r in faces):
+            verdict = "reached"
+        elif any(r["pad_positions"] for r in faces):
+            verdict = "no finger"
+        else:
+            verdict = "no pad position"
+        out["vertices"].append({"vertex": int(v), "height_mm": round(float(z[v]) * 1000, 1),
+                                "on_table": bool(v in unpinned), "verdict": verdict, "planes": bool(planes),
+                                "faces": faces})  # fmt: skip
+    return out
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--models", default=None, metavar="DIR", help="library directory (default: the shipped one)")
+    ap.add_argument("--objects", default=None, help="comma-separated model names (default: every model)")
+    ap.add_argument("--seeds", default="1", help="comma-separated episode seeds")
+    ap.add_argument("--pairs", default=None, help=f"OBJECT:SEED,... in place of --objects/--seeds (the seed "
+                                                   f"library's five out-of-reach episodes: {FIVE})")
+    ap.add_argument("--json", default=None, help="write the findings here")
+    args = ap.parse_args(argv)
+    try:
+        library = load_library(args.models) if args.models else None
+        if args.pairs:
+            pairs = [(p.split(":")[0], int(p.split(":")[1])) for p in args.pairs.split(",")]
+        else:
+            names = args.objects.split(",") if args.objects else sorted(library or load_library())
+            pairs = [(m, int(s)) for m in names for s in args.seeds.split(",")]
+        rows, verdicts, by, fingers = [], Counter(), Counter(), Counter()
+        placed = 0
+        for model, seed in pairs:
+            r = study(model, seed, library)
+            rows.append(r)
+            if not r["vertices"]:
+                continue
+            print(f"{model} seed {seed}: hidden {r['hidden']}, unpinned on the table {r['unpinned']}", flush=True)
+            for x in r["vertices"]:
+                verdicts[x["verdict"]] += 1
+                parts = []
+                for f in x["faces"]:
+                    what = ("no pad position" if not f["pad_positions"]
+                            else f"{f['distance_mm']:.0f} mm from it: " + (", ".join(f["reached"]) or "no finger"))
+                    parts.append(f"f{f['face']} (leans under {f['lean_under_deg']:.0f}°) {what}")
+                    by.update({a.split(" ", 1)[1] for a in f["reached"]})
+                    fingers.update({a.split(" ", 1)[0] for a in f["reached"]})
+                planes = "enough planes in some finger's reach" if x["planes"] else "too few planes"
+                print(f"  v{x['vertex']} {x['height_mm']:.0f} mm up: {x['verdict']} ({planes}); " + "; ".join(parts),
+                      flush=True)  # fmt: skip
+                placed += x["planes"]
+        n_eps = sum(1 for r in rows if r["vertices"])
+        print(f"\n{n_eps} of {len(rows)} episodes with vertices out of the verification's reach; "
+              f"{sum(verdicts.values())} vertices: " + ", ".join(f"{k} {v}" for k, v in verdicts.most_common())
+              + f"; {placed} with enough planes in some finger's reach to place them")
+        complete = sum(1 for r in rows if r["vertices"] and all(x["planes"] for x in r["vertices"]))
+        print(f"episodes whose every such vertex has enough planes in some finger's reach: {complete} of {n_eps}")
+        if by:
+            print("approaches that reach a face out of the verification's reach (faces): "
+                  + ", ".join(f"{k} {v}" for k, v in by.most_common()))
+            print("fingers that reach one (faces): " + ", ".join(f"{k} {v}" for k, v in fingers.most_common()))
+        if args.json:
+            with open(args.json, "w") as fh:
+                json.dump(rows, fh, indent=1)
+        return 0
+    except HapticError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())
