@@ -513,7 +513,8 @@ def test_a_decision_without_candidates_says_what_it_was():
 
 def test_a_placement_is_drawn_finger_by_finger_with_its_candidate_table(tmp_path):
     """An episode where the planner places fingers (four fingers, tracing moves, no verification): each finger's
-    closings in its own colour under ``world/placements/<finger>``, and a table of the candidate placements."""
+    closings in its own colour under ``world/placements/<finger>``, and a table of the candidate placements in a
+    view of its own beside the candidate moves."""
     from haptic.recording.style import FINGER_COLORS
 
     out = tmp_path / "placed.rrd"
@@ -531,3 +532,10 @@ def test_a_placement_is_drawn_finger_by_finger_with_its_candidate_table(tmp_path
     assert len(set(FINGER_COLORS.values())) == len(FINGER_COLORS), "one colour per finger"
     _, tables = ents["decision/placements"].series("TextDocument:text")
     assert any("(chosen)" in t[0] and "placement of" in t[0] for t in tables)
+    # each table in a view of its own: a text view given two documents shows an error instead of either
+    docs = [e for e, ent in ents.items() if ent.components.get("TextDocument:text")]
+    views = {name: v for name, v in _views(out).items() if v["class"] == "TextDocument"}
+    assert {v["origin"] for v in views.values()} == {"decision/scores", "decision/placements"}
+    for name, v in views.items():
+        shown = [e for e in docs if e == v["origin"] or e.startswith(v["origin"] + "/")]
+        assert len(shown) == 1, (name, shown)

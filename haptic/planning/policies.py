@@ -32,7 +32,7 @@ from haptic.planning.move_scores import (  # noqa: F401 -- Context, Decision, re
 )
 from haptic.planning.moves import Move
 from haptic.planning.predict import candidate_moves
-from haptic.planning.search import lookahead_choice
+from haptic.planning.search import lookahead_best, lookahead_choice
 from haptic.planning.table import table_safe_moves
 
 
@@ -50,6 +50,10 @@ class _ScoringPolicy(Policy):
     further away), toward where look-alike hypotheses disagree (:func:`~haptic.planning.disagree.disagreement_move`),
     else the first move of the most efficient sequence of ``lookahead`` moves, failing that the cheapest move that
     reaches a new edge and face."""
+
+    weighs_sequences = False
+    """Whether a placement that no other candidate move's score rivals must also beat the look-ahead's best
+    sequence of tracing moves (:func:`_placement_or_sequence`): for a policy whose score is an efficiency."""
 
     def __init__(self, lookahead: int = 3) -> None:
         self.lookahead = lookahead
@@ -72,13 +76,17 @@ class _ScoringPolicy(Policy):
         if scores.max() <= 0:
             return Decision(_further(ctx, cands, rng, self.lookahead), cands)
         best = np.flatnonzero(scores >= scores.max() * (1 - 1e-9))
-        return Decision(self.tie_break(cands, best, rng), cands)
+        move = self.tie_break(cands, best, rng)
+        if move.kind == "placement" and self.weighs_sequences:
+            move = _placement_or_sequence(ctx, cands, move, self.lookahead)
+        return Decision(move, cands)
 
 
 class PlannerPolicy(_ScoringPolicy):
     """Highest efficiency (expected pose classes eliminated per expected cost, §4.1); ties at random."""
 
     name = "planner"
+    weighs_sequences = True
 
     def score(self, efficiency: float, eliminated: float) -> float:
         return efficiency
@@ -118,6 +126,24 @@ class RandomPolicy(Policy):
         kind = kinds[int(rng.integers(len(kinds)))]
         of_kind = [m for m in moves if m.kind == kind]
         return Decision(of_kind[int(rng.integers(len(of_kind)))])
+
+
+def _placement_or_sequence(ctx: Context, cands: Sequence[Scored], placement: Move, depth: int) -> Move:
+    """``placement``, the most efficient candidate, or, when no other kind of candidate is expected to eliminate
+    anything, the first move of the look-ahead's best sequence of tracing moves (:func:`~haptic.planning.search.
+    lookahead_best`, two to ``depth`` moves) where that sequence is expected to eliminate at least as many pose
+    classes per unit cost. Without the comparison a placement expected to eliminate anything at all beats every
+    one-move score of zero, however dear: on the hand, where a placement's way there and back is 24-36 units
+    against 3-15 for a tracing move, the seed library's placements were taken only there and each left the
+    episode dearer than the index finger's tracing (BOX01 seed 3: 36 units for no pose class eliminated)."""
+    if ctx.config.moves == "probing" or any(c.score > 0 for c in cands if c.move.kind != "placement"):
+        return placement
+    own = max(c.score for c in cands if c.move is placement)
+    for d in range(2, depth + 1):
+        move, score = lookahead_best(ctx, depth=d)
+        if move is not None and score >= own:
+            return move
+    return placement
 
 
 def _further(ctx: Context, cands: Sequence[Scored], rng: np.random.Generator, depth: int) -> Move:

@@ -116,6 +116,12 @@ def probe_branches(
 def lookahead_choice(ctx: Context, depth: int = 2) -> Move | None:
     """The first move of the best ``depth``-move sequence by expected eliminations per expected cost, for
     when no single move is expected to eliminate anything. None when no sequence eliminates anything."""
+    return lookahead_best(ctx, depth)[0]
+
+
+def lookahead_best(ctx: Context, depth: int = 2) -> tuple[Move | None, float]:
+    """:func:`lookahead_choice` with the sequence's score: its expected pose classes eliminated per expected cost
+    (0 with None: no sequence eliminates anything)."""
     weights = class_weights([h.model for h in ctx.hypotheses])
     best, best_move = 0.0, None
     for move in candidate_moves(ctx.state, ctx.components, ctx.config):
@@ -124,7 +130,7 @@ def lookahead_choice(ctx: Context, depth: int = 2) -> Move | None:
         score = _lookahead_score(ctx, list(ctx.hypotheses), weights, move, ctx.state, ctx.components, depth, 0.0)
         if score > best:
             best, best_move = score, move
-    return best_move
+    return best_move, best
 
 
 def _lookahead_score(ctx, hyps, weights, move, state, components, depth, spent) -> float:

@@ -28,7 +28,8 @@ class Framing:
 
 def default_blueprint(framing: Framing | None = None) -> rrb.Blueprint:
     """The layout a recording opens with: on the left the ``object`` 3-D view (its eye on the object's region)
-    over the ``fingertip`` view (following the active pad close up) and the latest decision's candidate table;
+    over the ``fingertip`` view (following the active pad close up) and the latest decision's candidate table (in a
+    tab beside it, its candidate placements of several fingertips);
     on the right the interpretations and pose classes (log10, with a marker per move coloured by its kind and
     failed moves crossed), the normal force, the path cost and the logs."""
     f = framing or Framing()
@@ -49,7 +50,13 @@ def default_blueprint(framing: Framing | None = None) -> rrb.Blueprint:
                 rrb.Horizontal(
                     rrb.Spatial3DView(origin="world/hand/pad", contents="/world/**", name="fingertip",
                                       eye_controls=tip_eye, background=rrb.BackgroundKind.GradientBright),
-                    rrb.TextDocumentView(origin="decision", name="candidate moves"),
+                    # one text document per view (a view given two shows an error instead): the decision's
+                    # candidate moves, and beside them in a tab the candidate placements of several fingertips
+                    rrb.Tabs(
+                        rrb.TextDocumentView(origin="decision/scores", name="candidate moves"),
+                        rrb.TextDocumentView(origin="decision/placements", name="candidate placements"),
+                        active_tab=0,
+                    ),
                     column_shares=[1, 1],
                 ),
                 row_shares=[3, 2],

@@ -223,3 +223,45 @@ def test_a_placement_the_reach_test_reaches_is_costed_along_its_way():
     bare = replace(near[0].move, travel=None, home=None)
     assert np.array_equal(placement_path_costs(lines, bare, ctx.state.position, ctx.config.costs, hand),
                           placement_costs(lines, ctx.state.position, ctx.config.costs, hand))  # fmt: skip
+
+
+def test_a_placement_no_other_move_rivals_is_taken_only_where_it_beats_the_look_ahead(monkeypatch):
+    """When the placement is the best candidate and no other kind of candidate is expected to eliminate anything,
+    the planner weighs it against the look-ahead's best sequence of tracing moves (eliminations per unit cost
+    both): the sequence's first move where that is as efficient or more, else the placement. A tracing move
+    that scores above zero keeps the comparison one move against one, as before."""
+    from types import SimpleNamespace
+
+    import haptic.planning.policies as policies
+    from haptic.planning.moves import FaceMove
+    from haptic.planning.policies import GreedyPolicy
+
+    ctx = _context(["BOX01", "WEDGE01"], fingers=2)
+    placement = PlacementMove((FingerApproach("index", np.zeros(3), np.array([0.0, 0.0, -1.0]), 0.05),
+                               FingerApproach("thumb", np.ones(3), np.array([0.0, 0.0, -1.0]), 0.05)))  # fmt: skip
+    face, step = FaceMove(direction=np.array([1.0, 0.0, 0.0])), FaceMove(direction=np.array([0.0, 1.0, 0.0]))
+    asked: list[int] = []
+
+    def choose(face_eff: float, sequence: tuple, policy=None) -> object:
+        cands = [(SimpleNamespace(move=placement), 0.1, 2.0, 20.0, 0.0),
+                 (SimpleNamespace(move=face), face_eff, face_eff * 5.0, 5.0, 0.0)]  # fmt: skip
+        monkeypatch.setattr(policies, "score_all", lambda c: cands)
+
+        def best(c, depth=2):
+            asked.append(depth)
+            return sequence
+
+        monkeypatch.setattr(policies, "lookahead_best", best)
+        return (policy or PlannerPolicy()).choose(ctx, np.random.default_rng(0)).move
+
+    assert choose(0.0, (step, 0.2)) is step  # the sequence is more efficient
+    assert asked == [2]
+    assert choose(0.0, (step, 0.1)) is step  # as efficient: the index finger's tracing
+    assert choose(0.0, (step, 0.05)) is placement  # the placement is more efficient than any sequence
+    assert asked[-2:] == [2, 3]  # two and three moves weighed
+    assert choose(0.0, (None, 0.0)) is placement  # no sequence eliminates anything
+    asked.clear()
+    assert choose(0.05, (step, 0.2)) is placement  # a tracing move scores too: one move against one
+    assert asked == []
+    assert choose(0.0, (step, 0.2), GreedyPolicy()) is placement  # a score of eliminations: no comparison
+    assert asked == []
