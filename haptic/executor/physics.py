@@ -961,9 +961,9 @@ class PhysicsExecutor(LandingSearch):
         rows = ContactTrace.concatenate([r.trace, hold.trace])
         s_v, s_sigma = self._vertex_param(rec, rows, u, r.info.get("event_sign", 1))
         if s_v is None:
-            why = ("could not locate the vertex (no contact there, no contact on the ridge before it, a concave edge's "
-                   "end, which its faces run past, contacts off the edge's line, on an edge turning little from it, or "
-                   "the pad spanning a gap in the ridge before what blocked it)")  # fmt: skip
+            why = ("could not locate the vertex (no contact there, a concave edge's end, which its faces run past, "
+                   "contacts off the edge's line, on an edge turning little from it, or the pad spanning a gap in the "
+                   "ridge before what blocked it)")  # fmt: skip
             return self.failed_result(move, "unreachable", why)
         # the vertex lies ahead of everything behind the move: the explored interval's back end and the start (BOX01N
         # at 60 mm, seed 2: a move along +e set off 23 mm behind the interval, past the edge's other end, and located
@@ -1037,11 +1037,6 @@ class PhysicsExecutor(LandingSearch):
             # at 40 mm: 3.6 mm past): the surface falling away does not locate a concave edge's end
             return None, 0.0
         if event_sign > 0:
-            if not self._on_ridge(rows, u).any():
-                # the pad never rode the ridge: it set off rolling on the vertex (or past it), and its contacts are
-                # where it was put, not where the ridge ends (trapezohedron_09 at 60 mm, seed 1: an edge move that
-                # set off 2 mm from the end of its edge went 0.1 mm and put the vertex 1.28 mm off, 1.05 bounds)
-                return None, 0.0
             lean = max(s.touch.loss_lean_sin, math.sin(s.vertex_lean_sigmas * b.normal_sigma))
             at_v = ok & (c > lean)  # the pad rolls on the vertex
             if at_v.sum() < s.min_vertex_rows:  # contact was lost: the last contacts
