@@ -443,3 +443,33 @@ def test_a_pad_spanning_a_gap_in_the_ridge_is_told_from_one_on_the_ridge():
     rows = _ridge_rows(1.0e-3)
     leaning = dataclasses.replace(rows, normal_in_world=np.tile(np.array([0.5, -0.6124, 0.6124]), (len(rows), 1)))
     assert not PhysicsExecutor._spans_a_gap(ex, leaning, u)
+
+
+def test_a_ridge_acquisition_that_met_the_edges_end_tries_again_a_pad_radius_clear_of_it():
+    # an acquisition whose last normals lean along the edge met a third face at the edge's end (FRAME01's hole, 35-40
+    # degrees): the pad tries again a pad's radius from where it ended, away from that face; one that did not lean,
+    # or went unstable, is not tried again
+    from types import SimpleNamespace
+
+    from haptic.executor.physics import PhysicsSettings
+    from haptic.executor.primitives import PrimitiveResult
+    from haptic.executor.segment import EdgeRecord
+    from haptic.matching.trace import ContactTrace
+
+    rec = EdgeRecord(point=np.zeros(3), direction=np.array([1.0, 0.0, 0.0]), direction_sigma=0.01,
+                     position_sigma=1e-4, interval=(0.0, 0.01), faces=(0, 1), convex=True)  # fmt: skip
+    fake = SimpleNamespace(settings=PhysicsSettings(), toucher=SimpleNamespace(pad_radius=0.012))
+
+    def acquisition(lean: float, status: str = "timeout") -> PrimitiveResult:
+        n = 30
+        normal = np.tile([lean, 0.0, np.sqrt(1.0 - lean**2)], (n, 1))
+        point = np.tile([0.02, 0.0, 0.0], (n, 1))
+        trace = ContactTrace(np.arange(n) * 0.005, point, np.tile(np.eye(3), (n, 1, 1)), point, normal,
+                             np.ones(n), np.zeros(n, dtype=int))  # fmt: skip
+        return PrimitiveResult(status, "limit", trace, 0.0)
+
+    off = PhysicsExecutor._off_the_corner
+    assert off(fake, acquisition(-0.6), rec) == pytest.approx(0.02 - 0.012)  # pushed back: the face lies ahead
+    assert off(fake, acquisition(0.6), rec) == pytest.approx(0.02 + 0.012)
+    assert off(fake, acquisition(0.1), rec) is None  # under 15 degrees: no face at the end
+    assert off(fake, acquisition(0.6, "unstable"), rec) is None
