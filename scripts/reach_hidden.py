@@ -4,7 +4,7 @@ between two faces in its reach) or cannot pin on the table, and for each of thei
 reach, whether any fingertip, with any wrist turn, can put its pad on that face near the vertex.
 
     .venv/bin/python scripts/reach_hidden.py [--objects BOX01N,BOX01P] [--seeds 1,2,3] [--models DIR]
-                                             [--pairs BOX01N:1,FRAME01:3] [--json out.json]
+                                             [--pairs BOX01N:1,FRAME01:3] [--json out.json] [--probe]
 
 The verification's reach (:func:`haptic.planning.verify.reachable_features`) is the index finger's, pointing down,
 on faces leaning under by at most ``PlannerConfig.max_undercut``. Here, per face at such a vertex:
@@ -22,7 +22,10 @@ finger (a slot narrower than the pad, a face against the table); one whose pad p
 of the hand's reach; otherwise the fingers and approaches that reach are listed. A vertex *has enough planes in
 some finger's reach* when three of its faces (two besides the table's, for one on the table) are in the
 verification's reach or reached here: those planes alone would place it (touching one face near it does not).
-Ground truth is read here (this is evaluation), never by the executor. Geometry and inverse kinematics only: no physics.
+Geometry and inverse kinematics only, unless ``--probe``: then each face some finger reaches is probed on the
+simulated hand by the finger :func:`haptic.executor.placement.finger_probe` picks (a level line to the nearest pad
+position): measured (and how far its normal is off), or why not. Ground truth is read here (this is evaluation),
+never by the executor.
 """
 
 from __future__ import annotations
@@ -91,8 +94,36 @@ def pad_positions(poly, pose, v: int, f: int, table_z: float) -> np.ndarray:
     return keep[np.argsort(np.linalg.norm(keep - vw, axis=1))]
 
 
-def study(model: str, seed: int, library) -> dict:
-    """The hidden and unpinnable vertices of one episode's object at its pose, and what reaches their faces."""
+def probe_face(ep, f: int, pad_point: np.ndarray) -> dict:
+    """A probe of face ``f`` of the episode's object by whichever finger :func:`~haptic.executor.placement.
+    finger_probe` picks (the truth as the hypothesis), carried out on the hand: a line 30 mm long to the pad touching
+    ``pad_point`` and 20 mm on, level toward the face (along its inward normal when it is level)."""
+    from haptic.executor.placement import finger_probe
+    from haptic.planning.hypothesis import Hypothesis
+    from haptic.planning.moves import ProbeMove
+
+    poly, pose = ep.true_model, ep.world_from_model
+    n = pose.rotate(poly.face_normals[f])
+    u = -n * np.array([1.0, 1.0, 0.0])
+    u = u / np.linalg.norm(u) if np.linalg.norm(u) > 0.1 else -n
+    centre = pad_point + PAD_RADIUS * n
+    line = ProbeMove(centre + (PAD_RADIUS - 0.03) * u, u, 0.05)
+    h = Hypothesis(model=poly.name, poly=poly, world_from_model=pose, faces={}, edges={}, vertices={})
+    move = finger_probe(line, [h])
+    if move is None:
+        return {"status": "no finger reaches the line"}
+    res = ep.executor.execute(move)
+    out = {"finger": move.finger, "status": str(res.status), "reason": res.reason}
+    if res.ok and res.components:
+        out["error_deg"] = round(float(np.degrees(np.arccos(np.clip(res.components[0].normal @ n, -1.0, 1.0)))), 2)
+    elif res.ok:
+        out["status"] = "missed"
+    return out
+
+
+def study(model: str, seed: int, library, probe: bool = False) -> dict:
+    """The hidden and unpinnable vertices of one episode's object at its pose, and what reaches their faces (with
+    ``probe``: each face some finger reaches probed on the hand, :func:`probe_face`)."""
     ep = build_episode(EpisodeSpec(model=model, seed=seed, executor="physics", verify="full"), library)
     poly, pose, cfg = ep.true_model, ep.world_from_model, ep.config
     reach = reachable_features(poly, pose, cfg)
@@ -103,6 +134,7 @@ def study(model: str, seed: int, library) -> dict:
     if not hidden and not unpinned:
         return out
     solver = ReachSolver(compose_scene(scene_object_from_polyhedron(poly), pose.as_matrix()))
+    started, probed = False, set()
     for v in [*hidden, *unpinned]:
         faces = []
         for f in (int(f) for f in poly.vertex_faces[v]):
@@ -119,6 +151,11 @@ def study(model: str, seed: int, library) -> dict:
                     for name, axis in approaches(n).items():
                         if solver.solve([FingertipTarget(finger, centre, axis)]).ok:
                             row["reached"].append(f"{finger} {name}")
+                if probe and row["reached"] and f not in probed:
+                    if not started:
+                        started = bool(ep.executor.start().ok)
+                    probed.add(f)
+                    row["probe"] = probe_face(ep, f, pts[0]) if started else {"status": "the start failed"}
             faces.append(row)
         # enough planes through the vertex measurable to place it: three (two besides the table's, on the table), of
         # its faces in the verification's reach or reached here
@@ -146,6 +183,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--pairs", default=None, help=f"OBJECT:SEED,... in place of --objects/--seeds (the seed "
                                                    f"library's five out-of-reach episodes: {FIVE})")
     ap.add_argument("--json", default=None, help="write the findings here")
+    ap.add_argument("--probe", action="store_true",
+                    help="probe each face some finger reaches on the hand (physics; the finger finger_probe picks)")
     args = ap.parse_args(argv)
     try:
         library = load_library(args.models) if args.models else None
@@ -154,10 +193,10 @@ def main(argv: list[str] | None = None) -> int:
         else:
             names = args.objects.split(",") if args.objects else sorted(library or load_library())
             pairs = [(m, int(s)) for m in names for s in args.seeds.split(",")]
-        rows, verdicts, by, fingers = [], Counter(), Counter(), Counter()
+        rows, verdicts, by, fingers, probes = [], Counter(), Counter(), Counter(), Counter()
         placed = 0
         for model, seed in pairs:
-            r = study(model, seed, library)
+            r = study(model, seed, library, args.probe)
             rows.append(r)
             if not r["vertices"]:
                 continue
@@ -168,6 +207,12 @@ def main(argv: list[str] | None = None) -> int:
                 for f in x["faces"]:
                     what = ("no pad position" if not f["pad_positions"]
                             else f"{f['distance_mm']:.0f} mm from it: " + (", ".join(f["reached"]) or "no finger"))
+                    if "probe" in f:
+                        pr = f["probe"]
+                        what += f" [probe by the {pr.get('finger', '-')}: {pr['status']}" + (
+                            f", {pr['error_deg']}° off" if "error_deg" in pr else
+                            f" ({pr['reason']})" if pr.get("reason") else "") + "]"
+                        probes[pr["status"] if "error_deg" not in pr else "measured"] += 1
                     parts.append(f"f{f['face']} (leans under {f['lean_under_deg']:.0f}°) {what}")
                     by.update({a.split(" ", 1)[1] for a in f["reached"]})
                     fingers.update({a.split(" ", 1)[0] for a in f["reached"]})
@@ -185,6 +230,9 @@ def main(argv: list[str] | None = None) -> int:
             print("approaches that reach a face out of the verification's reach (faces): "
                   + ", ".join(f"{k} {v}" for k, v in by.most_common()))
             print("fingers that reach one (faces): " + ", ".join(f"{k} {v}" for k, v in fingers.most_common()))
+        if probes:
+            print("probes on the hand of the faces some finger reaches: "
+                  + ", ".join(f"{k} {v}" for k, v in probes.most_common()))
         if args.json:
             with open(args.json, "w") as fh:
                 json.dump(rows, fh, indent=1)
