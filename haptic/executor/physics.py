@@ -845,12 +845,6 @@ class PhysicsExecutor(LandingSearch):
         # beside the last contact: the pad may be far off in free space (backed out after a tilted move)
         if s0 is None:
             s0 = rec.param(self.contact_point() if self.toucher.contact[2] is not None else self.state.position)
-            # ... within the explored interval, to its ends' bound: beyond, the line is extrapolated and the edge may
-            # not run there (BOX01N at 60 mm, seed 2: a contact 25 mm past an interval 1 mm long, beyond the slot that
-            # breaks the top edge; the move followed the edge on the slot's far side and the interval was extended
-            # across it)
-            reach = self.bounds.bound(0.0, self.bounds.length_floor)
-            s0 = float(np.clip(s0, rec.interval[0] - reach, rec.interval[1] + reach))
         if not rec.convex and None not in rec.faces:
             return self._touch_corner(rec, s0, u, first, pieces)
         status, why = "unreachable", "the edge next to the table is out of the pad's reach"
