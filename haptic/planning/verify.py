@@ -68,10 +68,14 @@ MOVES_PER_FEATURE = 3
 """Verification moves allowed per feature of the coverage target (:func:`verify_move_budget`): a vertex costs about
 two moves (an aimed face move and a short edge move, or a vertex move and an edge trace), and getting from one to
 the next about one more."""
+BUDGET_CAP = 2
+"""The verification ends at this many times its budget (:func:`verify_move_budget`) of moves whatever they measured:
+the budget counts the moves that measured nothing missing (:meth:`Verifier.verdict`), and this bounds the rest."""
 
 
 def verify_move_budget(n_target: int) -> int:
-    """The verification moves after which the verification ends with what it has measured (status "incomplete"),
+    """The verification moves that measure nothing missing after which the verification ends with what it has
+    measured (status "incomplete"; :data:`BUDGET_CAP` times as many moves in all),
     for a model with ``n_target`` reachable features in its coverage target (the vertices under ``full``, the faces
     and edges under ``fast``): :data:`STALL_MOVES` plus :data:`MOVES_PER_FEATURE` per feature, so that the budget
     follows the model (a fixed one is sized to some library's largest model and cuts a larger one short).
@@ -766,6 +770,8 @@ class Verifier:
         :func:`verify_move_budget` made: ambiguous between the model and an object outside the library),
         "verifying", or "not needed" (no pose class was ever left alone)."""
         self._progress = (-1, 0)  # (features measured, verification moves then)
+        self._measuring = 0
+        """Verification moves after which more of the coverage target was measured than before."""
         self._relocated = 0
         self._failed_crossings: set[tuple[int, int]] = set()
         """On the hand, the (model face, model edge) that face moves failed to cross :data:`CROSSING_FAILURES`
@@ -872,12 +878,16 @@ class Verifier:
             self.status = "verifying"
             got = self.coverage.measured() if self.coverage is not None else 0
             if got > self._progress[0]:
+                self._measuring += self._progress[0] >= 0  # not the first verdict, before any move
                 self._progress = (got, self.moves)
                 self._travelled.clear()
                 self._visited.clear()
             elif self.moves - max(self._progress[1], self._relocated) >= STALL_MOVES:
                 self.status = "incomplete"
-            if self.moves >= self.move_budget():
+            # a verification still measuring goes on: on the hand failed moves and returns come between those that
+            # measure, and a budget of all moves ended trapezohedron_12 of the formula corpus (18 vertices in reach)
+            # two moves after it last measured one
+            if self.moves - self._measuring >= self.move_budget() or self.moves >= BUDGET_CAP * self.move_budget():
                 self.status = "incomplete"
         if self.status in ("confirmed", "incomplete"):  # the final word: the statistical acceptance test
             self.accept = acceptance(cls.model, tree.data, it, self.check.world_from_model, k_sigma=self.k_sigma,
