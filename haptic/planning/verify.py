@@ -31,7 +31,7 @@ from haptic.matching.acceptance import TablePin
 from haptic.matching.components import DataComponent, DataEdge, DataFace, SensorNoise
 from haptic.planning.config import PlannerConfig
 from haptic.planning.hypothesis import Hypothesis
-from haptic.planning.moves import EdgeMove, FaceMove, Move, SensorState
+from haptic.planning.moves import EdgeMove, FaceMove, Move, SensorState, VertexMove
 from haptic.planning.predict import candidate_moves, predict_moves
 from haptic.planning.table import _inward, descent_risk, hidden_concave_end
 from haptic.planning.tour import (
@@ -53,6 +53,11 @@ STALL_MOVES = 8
 """Verification moves in a row that measure no missing feature after which the verification ends with what it
 has measured (status "incomplete": the episode ends as ambiguous, its record says what was not measured); on the
 hand counted from the last relocation too (:data:`RELOCATE_AFTER`), which puts the pad somewhere new."""
+HAND_STALL_MOVES = 16
+"""On the hand, :data:`STALL_MOVES` there: a failed move is not asked again (an edge move along a model edge, a
+vertex move round a model vertex, a face move's crossing), and the way round to another way in -- back over the
+edges and faces measured -- takes moves that measure nothing; eight ended antiprism_05 and trapezohedron_04 of
+the formula corpus (seed 1) with a face and an edge unmeasured, and sixteen confirm them."""
 RELOCATE_PROBES = 6
 """Probe lines a relocation weighs, to the missing features nearest the sensor first (:func:`_verification_probes`):
 on the hand many are refused (the table, the finger's way down), and the tour's two cheapest entries are often
@@ -785,6 +790,9 @@ class Verifier:
         """Where the sensor was when each verification move since the last feature measured was chosen (world)."""
         self._failed_edges: list[tuple[int, np.ndarray]] = []
         """Edge moves that failed during the verification: the model edge and the world direction of travel."""
+        self._failed_rounds: set[tuple[int, int]] = set()
+        """On the hand, vertex moves that failed during the verification: the model vertex and the model face the
+        circle crossed (:meth:`_failed_round`)."""
         self.check = None
         self.accept = None
         self.coverage = None
@@ -882,7 +890,7 @@ class Verifier:
                 self._progress = (got, self.moves)
                 self._travelled.clear()
                 self._visited.clear()
-            elif self.moves - max(self._progress[1], self._relocated) >= STALL_MOVES:
+            elif self.moves - max(self._progress[1], self._relocated) >= self._stall_moves():
                 self.status = "incomplete"
             # a verification still measuring goes on: on the hand failed moves and returns come between those that
             # measure, and a budget of all moves ended trapezohedron_12 of the formula corpus (18 vertices in reach)
@@ -895,6 +903,11 @@ class Verifier:
             if not self.accept.ok:
                 self.status = "rejected"
         return self.status
+
+    def _stall_moves(self) -> int:
+        """Verification moves in a row measuring nothing missing after which it ends (:data:`STALL_MOVES`; on the
+        hand :data:`HAND_STALL_MOVES`)."""
+        return STALL_MOVES if self.config.table_z is None else HAND_STALL_MOVES
 
     def _probes_admitted(self) -> bool:
         return self.config.moves != "tracing" and self.config.table_z is None and MAX_VERIFY_PROBES > 0
@@ -1051,18 +1064,34 @@ class Verifier:
         -- is the edge's, not where the pad was: back on the edge after other moves, the tour's cheapest way on
         was the same edge move, and the verification went back and forth until it stalled). Failures from here
         (``avoid``) are remembered first."""
+        out = self._failed_round(h, state, avoid)
         edge = components.get(state.edge) if state.edge is not None else None
         e_m = h.edges.get(state.edge) if state.edge is not None else None
         if not isinstance(edge, DataEdge) or e_m is None:
-            return []
+            return out
         for m in avoid:
             if isinstance(m, EdgeMove):
                 d = m.sense * np.asarray(edge.direction, float)
                 if not any(e == e_m and float(d @ u) > 0.9 for e, u in self._failed_edges):
                     self._failed_edges.append((e_m, d))
-        return [EdgeMove(s) for s in (1, -1)
-                if any(e == e_m and float(s * np.asarray(edge.direction, float) @ u) > 0.9
-                       for e, u in self._failed_edges)]  # fmt: skip
+        return out + [EdgeMove(s) for s in (1, -1)
+                      if any(e == e_m and float(s * np.asarray(edge.direction, float) @ u) > 0.9
+                             for e, u in self._failed_edges)]  # fmt: skip
+
+    def _failed_round(self, h: Hypothesis, state: SensorState, avoid: Sequence[Move]) -> list[Move]:
+        """On the hand, vertex moves from ``state`` not to take again: round a model vertex across a model face,
+        the way a vertex move failed earlier in the verification. The hand's failure to circle a vertex -- the pad
+        rolling round it onto a third face, a face too small beside it -- is the vertex's: back at it by another
+        edge, the tour's cheapest way on was the same circle, and it failed again (bipyramid_12 of the formula corpus,
+        seed 1). Failures from here (``avoid``) are remembered first."""
+        v_m = h.vertices.get(state.vertex) if state.vertex is not None else None
+        if self.config.table_z is None or v_m is None:
+            return []
+        for m in avoid:
+            if isinstance(m, VertexMove) and h.faces.get(m.across_face) is not None:
+                self._failed_rounds.add((v_m, h.faces[m.across_face]))
+        return [VertexMove(f) for f in state.edge_faces
+                if (v_m, h.faces.get(f)) in self._failed_rounds]  # fmt: skip
 
     def record(self, cost: float) -> dict:
         """What was verified: the mode, the verdict, the verification's moves and cost, the pose check's worst
