@@ -618,3 +618,14 @@ def test_a_verification_that_failed_a_way_in_finds_another(tmp_path, model):
     # faces and edges measured, where the stall rule ended it before it came round to another way in
     rec = run_episode(EpisodeSpec(model=model, seed=1, executor="physics", models=_sized_corpus(tmp_path)))
     assert rec.outcome == "recognized" and rec.correct, rec.detail
+
+
+@pytest.mark.slow
+def test_a_verification_with_no_move_left_ends_saying_so():
+    # FRAME01 seed 2, default options: every move from the vertex the verification reached failed (the way on was
+    # through the frame's hole), the verifier had no admissible move left, and the loop's random fallback moves
+    # from there failed in turn until the stall rule ended it ("incomplete after 20 moves"); with none left the
+    # verification ends there and says why
+    rec = run_episode(EpisodeSpec(model="FRAME01", seed=2, executor="physics"))
+    assert rec.outcome == "ambiguous" and not rec.correct
+    assert "no admissible move left" in rec.detail, rec.detail

@@ -58,6 +58,10 @@ HAND_STALL_MOVES = 16
 vertex move round a model vertex, a face move's crossing), and the way round to another way in -- back over the
 edges and faces measured -- takes moves that measure nothing; eight ended antiprism_05 and trapezohedron_04 of
 the formula corpus (seed 1) with a face and an edge unmeasured, and sixteen confirm them."""
+NO_MOVE_DECISIONS = 2
+"""On the hand, verification decisions in a row with no admissible move (every move from where the pad is failed or
+is left out) after which the verification ends, saying so: the loop's random fallback moves from there, and more
+of them only fail in turn until none is left (FRAME01 seed 2: three after the verification had none, all failed)."""
 RELOCATE_PROBES = 6
 """Probe lines a relocation weighs, to the missing features nearest the sensor first (:func:`_verification_probes`):
 on the hand many are refused (the table, the finger's way down), and the tour's two cheapest entries are often
@@ -776,6 +780,10 @@ class Verifier:
         "verifying", or "not needed" (no pose class was ever left alone)."""
         self._progress = (-1, 0)  # (features measured, verification moves then)
         self._measuring = 0
+        self._no_move = 0
+        """On the hand, verification decisions in a row that had no admissible move (:data:`NO_MOVE_DECISIONS`)."""
+        self.stuck = False
+        """Whether the verification ended with no admissible move left (:data:`NO_MOVE_DECISIONS`)."""
         """Verification moves after which more of the coverage target was measured than before."""
         self._relocated = 0
         self._failed_crossings: set[tuple[int, int]] = set()
@@ -887,11 +895,15 @@ class Verifier:
             got = self.coverage.measured() if self.coverage is not None else 0
             if got > self._progress[0]:
                 self._measuring += self._progress[0] >= 0  # not the first verdict, before any move
+                self._no_move = 0
                 self._progress = (got, self.moves)
                 self._travelled.clear()
                 self._visited.clear()
             elif self.moves - max(self._progress[1], self._relocated) >= self._stall_moves():
                 self.status = "incomplete"
+            elif self._no_move >= NO_MOVE_DECISIONS:
+                self.status = "incomplete"
+                self.stuck = True
             # a verification still measuring goes on: on the hand failed moves and returns come between those that
             # measure, and a budget of all moves ended trapezohedron_12 of the formula corpus (18 vertices in reach)
             # two moves after it last measured one
@@ -970,8 +982,10 @@ class Verifier:
                     "there cannot be measured)")  # fmt: skip
         if self.status == "incomplete" and self.coverage is not None:
             f, e, v = (len(x) for x in self.coverage.missing(self.mode))
+            why = (": no admissible move left toward them (every move from where the hand stopped failed or is left "
+                   "out)") if self.stuck else ""
             return (f"verification incomplete after {self.moves} moves: {f} faces, {e} edges, {v} vertices of "
-                    f"{self._model_name} not measured")  # fmt: skip
+                    f"{self._model_name} not measured{why}")  # fmt: skip
         return ""
 
     def choose(
@@ -1000,6 +1014,8 @@ class Verifier:
                                                        self._visited, relocate, self._failed_crossings)  # fmt: skip
         if relocate and move is not None and move.kind == "probe":
             self._relocated = self.moves
+        if self.config.table_z is not None and h.world_from_model is not None:
+            self._no_move = self._no_move + 1 if move is None else 0
         self._visited.append(np.array(state.position, float))
         self._tour_model = h.poly
         if move is not None and move.kind != "probe" and h.world_from_model is not None:
