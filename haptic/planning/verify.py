@@ -56,8 +56,8 @@ hand counted from the last relocation too (:data:`RELOCATE_AFTER`), which puts t
 HAND_STALL_MOVES = 16
 """On the hand, :data:`STALL_MOVES` there: a failed move is not asked again (an edge move along a model edge, a
 vertex move round a model vertex, a face move's crossing), and the way round to another way in -- back over the
-edges and faces measured -- takes moves that measure nothing; eight ended antiprism_05 and trapezohedron_04 of
-the formula corpus (seed 1) with a face and an edge unmeasured, and sixteen confirm them."""
+edges and faces measured -- takes moves that measure nothing; eight ended antiprism_05 of the formula corpus
+(seed 1) with a face and an edge unmeasured, and with sixteen it is confirmed."""
 NO_MOVE_DECISIONS = 2
 """On the hand, verification decisions in a row with no admissible move (every move from where the pad is failed or
 is left out) after which the verification ends, saying so: the loop's random fallback moves from there, and more
