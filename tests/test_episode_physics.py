@@ -629,3 +629,13 @@ def test_a_verification_with_no_move_left_ends_saying_so():
     rec = run_episode(EpisodeSpec(model="FRAME01", seed=2, executor="physics"))
     assert rec.outcome == "ambiguous" and not rec.correct
     assert "no admissible move left" in rec.detail, rec.detail
+
+
+@pytest.mark.slow
+def test_a_verification_going_round_one_way_takes_another(tmp_path):
+    # trapezohedron_04 of the sized formula corpus (115 mm), seed 1, default options: a face move failed to cross
+    # to the face leaning under that was missing, and the verification went round one vertex over the same three
+    # faces, face move and edge move in turn, until the stall rule ended it ("incomplete after 30 moves")
+    rec = run_episode(EpisodeSpec(model="trapezohedron_04", seed=1, executor="physics",
+                                  models=_sized_corpus(tmp_path)))  # fmt: skip
+    assert rec.outcome == "recognized" and rec.correct, rec.detail

@@ -58,6 +58,11 @@ HAND_STALL_MOVES = 16
 vertex move round a model vertex, a face move's crossing), and the way round to another way in -- back over the
 edges and faces measured -- takes moves that measure nothing; eight ended antiprism_05 of the formula corpus
 (seed 1) with a face and an edge unmeasured, and with sixteen it is confirmed."""
+HAND_WAYS_AGAIN = 2
+"""On the hand, times a verification move predicted to measure nothing may go one way (:func:`outcome_key`) since
+the last feature measured before that way is left out (:func:`plan_verification_move`): after a face move failed
+to cross to what is missing, the tour's estimate from the faces round it kept trapezohedron_04 of the formula
+corpus (seed 1) going round one vertex over the same three faces until the verification stalled."""
 NO_MOVE_DECISIONS = 2
 """On the hand, verification decisions in a row with no admissible move (every move from where the pad is failed or
 is left out) after which the verification ends, saying so: the loop's random fallback moves from there, and more
@@ -547,9 +552,10 @@ def plan_verification_move(
     """:func:`choose_verification_move`, with the tour it planned over ``missing`` (from ``previous``'s order,
     when given) and that tour's cost from the sensor as it is [units] (None and 0 without a pose). A candidate
     predicted to measure nothing missing along a way already travelled (its :func:`outcome_key` in
-    ``travelled``), or to end within :data:`REVISIT` of a place in ``visited`` (world), is left out without a table
-    (on the hand a move ends where the pad stops, and going back can be the way on; there it kept BOX01N's
-    verification from a vertex it then found, seed 2), unless every candidate is: the tour's
+    ``travelled``), or, without a table, to end within :data:`REVISIT` of a place in ``visited`` (world), is left
+    out (on the hand a move ends where the pad stops, and going back can be the way on: the place kept BOX01N's
+    verification from a vertex it then found, seed 2, and the verifier gives as ``travelled`` there only the ways
+    taken :data:`HAND_WAYS_AGAIN` times), unless every candidate is: the tour's
     estimate from where such moves end can keep them the cheapest, and the verification goes back and forth
     until it stalls.
 
@@ -598,7 +604,7 @@ def plan_verification_move(
     ends: list[tuple[Move, np.ndarray | None, float]] = []
     again: list[tuple[Move, np.ndarray | None, float]] = []  # left out as going back: the last resort
     refused: list[tuple[Move, np.ndarray | None, float]] = []  # crossings that failed: after the last resort
-    going_back = config.table_z is None  # the hand's moves end where the pad stops, not where predicted
+    revisits = config.table_z is None  # the hand's moves end where the pad stops, not where predicted
     for m, c, r in [*first, *probes]:
         sim = (simulate_probe(h, m, state, components, noise) if m.kind == "probe"
                else simulate(h, m, state, components, config))  # fmt: skip
@@ -610,7 +616,7 @@ def plan_verification_move(
             refused.append((m, h.world_from_model.inverse().apply(s1.position), c))
             continue
         new = _new_features(h, h1)
-        if going_back and _gain(new, missing) == 0 and (outcome_key(h, m, state, h1, s1) in travelled or any(
+        if _gain(new, missing) == 0 and (outcome_key(h, m, state, h1, s1) in travelled or revisits and any(
                 float(np.linalg.norm(s1.position - p)) < REVISIT for p in visited)):
             again.append((m, h.world_from_model.inverse().apply(s1.position), c))
             continue
@@ -792,8 +798,9 @@ class Verifier:
         self._crossing_failures: dict[tuple[int, int], int] = {}
         self._failures_seen: set[tuple[int, ...]] = set()
         """Verification moves made when the last relocation (:meth:`_relocate`) was chosen."""
-        self._travelled: set[tuple] = set()
-        """:func:`outcome_key` of the moves made since the last feature measured that were to measure nothing."""
+        self._travelled: dict[tuple, int] = {}
+        """:func:`outcome_key` of the moves made since the last feature measured that were to measure nothing, with
+        how many times each was made."""
         self._visited: list[np.ndarray] = []
         """Where the sensor was when each verification move since the last feature measured was chosen (world)."""
         self._failed_edges: list[tuple[int, np.ndarray]] = []
@@ -916,6 +923,13 @@ class Verifier:
                 self.status = "rejected"
         return self.status
 
+    def _ways_done(self) -> set[tuple]:
+        """The ways (:func:`outcome_key`) not to travel again to measure nothing: each one travelled since the last
+        feature measured; on the hand each one travelled :data:`HAND_WAYS_AGAIN` times (a move ends where the pad
+        stops, and going back once can be the way on)."""
+        times = 1 if self.config.table_z is None else HAND_WAYS_AGAIN
+        return {k for k, n in self._travelled.items() if n >= times}
+
     def _stall_moves(self) -> int:
         """Verification moves in a row measuring nothing missing after which it ends (:data:`STALL_MOVES`; on the
         hand :data:`HAND_STALL_MOVES`)."""
@@ -1010,7 +1024,7 @@ class Verifier:
         faces_ok = self._reach[self._model_name][0] if self._model_name in self._reach else None
         previous = self._tour if self._tour is not None and self._tour_model is h.poly else None
         move, self._tour, now = plan_verification_move(h, state, components, missing, self.noise, self.config,
-                                                       avoid, probed, faces_ok, previous, self._travelled,
+                                                       avoid, probed, faces_ok, previous, self._ways_done(),
                                                        self._visited, relocate, self._failed_crossings)  # fmt: skip
         if relocate and move is not None and move.kind == "probe":
             self._relocated = self.moves
@@ -1023,7 +1037,8 @@ class Verifier:
 
             sim = simulate(h, move, state, components, self.config)
             if sim is not None and _gain(_new_features(h, sim[0]), missing) == 0:
-                self._travelled.add(outcome_key(h, move, state, sim[0], sim[1]))
+                key = outcome_key(h, move, state, sim[0], sim[1])
+                self._travelled[key] = self._travelled.get(key, 0) + 1
         if self.tour_planned is None and self._tour is not None:
             legs = _legs(self.config)
             keys = features(h.poly).index(missing)
