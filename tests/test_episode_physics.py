@@ -607,3 +607,35 @@ def test_an_edge_move_that_locates_the_end_it_set_off_past_does_not_turn_the_obj
     rec = run_episode(EpisodeSpec(model="trapezohedron_12", seed=1, executor="physics",
                                   models=_sized_corpus(tmp_path)))  # fmt: skip
     assert rec.outcome != "no-match", rec.detail
+
+
+@pytest.mark.slow
+def test_a_verification_that_failed_a_way_in_finds_another(tmp_path):
+    # antiprism_05 of the sized formula corpus, seed 1, default options: the verification ended "incomplete after
+    # 30 moves" with one face and one edge unmeasured, 8 after it last measured something: face moves failed to
+    # cross to them, and the verification went back over the faces and edges measured, where the stall rule ended
+    # it before it came round to another way in
+    rec = run_episode(EpisodeSpec(model="antiprism_05", seed=1, executor="physics",
+                                  models=_sized_corpus(tmp_path)))  # fmt: skip
+    assert rec.outcome == "recognized" and rec.correct, rec.detail
+
+
+@pytest.mark.slow
+def test_a_verification_with_no_move_left_ends_saying_so():
+    # FRAME01 seed 2, default options: every move from the vertex the verification reached failed (the way on was
+    # through the frame's hole), the verifier had no admissible move left, and the loop's random fallback moves
+    # from there failed in turn until the stall rule ended it ("incomplete after 20 moves"); with none left the
+    # verification ends there and says why
+    rec = run_episode(EpisodeSpec(model="FRAME01", seed=2, executor="physics"))
+    assert rec.outcome == "ambiguous" and not rec.correct
+    assert "no admissible move left" in rec.detail, rec.detail
+
+
+@pytest.mark.slow
+def test_a_verification_going_round_one_way_takes_another(tmp_path):
+    # trapezohedron_04 of the sized formula corpus (115 mm), seed 1, default options: a face move failed to cross
+    # to the face leaning under that was missing, and the verification went round one vertex over the same three
+    # faces, face move and edge move in turn, until the stall rule ended it ("incomplete after 30 moves")
+    rec = run_episode(EpisodeSpec(model="trapezohedron_04", seed=1, executor="physics",
+                                  models=_sized_corpus(tmp_path)))  # fmt: skip
+    assert rec.outcome == "recognized" and rec.correct, rec.detail
