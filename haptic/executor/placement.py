@@ -878,6 +878,17 @@ def finger_probe(move: ProbeMove, hypotheses: Sequence, reach: PlacementReach | 
     return None
 
 
+def finger_reach(fingers: Sequence[str] = FINGERS, tilts: Sequence[float] = PROBE_TILTS) -> Callable:
+    """The planner's reach test of a probe by any finger (``PlannerConfig.finger_reach``): :func:`finger_probe` with
+    one reach test (:data:`FINGER_PROBE_REACH`, its compiled scenes kept) for the episode."""
+    reach = PlacementReach(FINGER_PROBE_REACH)
+
+    def test(move: ProbeMove, hypotheses: Sequence) -> ProbeMove | None:
+        return finger_probe(move, hypotheses, reach, fingers, tilts)
+
+    return test
+
+
 def reach_oracle(fingers: int) -> Callable | None:
     """The planner's placement reach test for an episode of ``fingers`` fingers at once (None for one)."""
     return PlacementReach() if fingers > 1 else None
@@ -885,4 +896,4 @@ def reach_oracle(fingers: int) -> Callable | None:
 
 __all__ = ["FINGER_PROBE_REACH", "HOLD_CLEARANCE", "PROBE_SETTINGS", "PROBE_TILTS", "REACH_CLEARANCE", "SETTINGS",
            "TIP_TABLE_CLEARANCE", "PlacementReach", "PlacementSettings", "finger_probe", "finger_probe_move",
-           "hand_solver", "pad_target", "placement_move", "reach_oracle"]
+           "finger_reach", "hand_solver", "pad_target", "placement_move", "reach_oracle"]
