@@ -39,6 +39,11 @@ RUN_ON = 0.02
 POSITIONS = 3
 """Pad positions tried per face, the nearest the vertex first, each a line (the reach solver's answer differs from
 one to the next where the object is in the hand's way)."""
+MIN_ROOM = 0.0035
+"""Pad positions with less room than this to the face's rim are not weighed [m]: the stroke that measures the face
+must span 3 mm along its principal axis and 1.5 mm across (``SegmentBounds.min_face_extent``, ``min_face_width``);
+an L of 2.9 × 2 mm (:func:`haptic.executor.placement.stroke_within`) spans 3.5 mm along its diagonal and 1.6 mm
+across, and stays on the face with this much room about its start."""
 ROOM = 0.008
 """A pad position whose contact is at least this far from the face's rim is preferred [m]: the probe's stroke runs
 8 mm level along the face (:data:`haptic.executor.placement.PROBE_SETTINGS`), and one that leaves the face over an
@@ -69,7 +74,8 @@ def faces_to_probe(poly: Polyhedron, world_from_model: SE3, vertices: Iterable[i
 
 def pad_positions(poly: Polyhedron, world_from_model: SE3, v: int, f: int, config: PlannerConfig) -> np.ndarray:
     """Points of face ``f`` (world frame) where the pad touching it touches that face alone (its centre a pad's radius
-    from the rest of the object, outside it) and its lowest point stays ``config.table_clearance`` above the table;
+    from the rest of the object, outside it), with :data:`MIN_ROOM` to the face's rim, and its lowest point stays
+    ``config.table_clearance`` above the table;
     those with :data:`ROOM` to the face's rim first, then the nearest vertex ``v`` first. Anywhere on the face: its
     plane is what places the vertex, and a face leaning under is pressed clear of the table only well above it (the
     pad's lowest point lies ``r (1 + sin lean)`` under its contact)."""
@@ -95,7 +101,8 @@ def pad_positions(poly: Polyhedron, world_from_model: SE3, v: int, f: int, confi
     centres = inv.apply(pts + r * n)
     keep = (surface_distance(poly, centres) >= r - PAD_ALONE) & ~poly.contains(centres)
     pts = pts[keep]
-    room = np.minimum(_rim_distance(pts, world_from_model.apply(poly.vertices[list(poly.faces[f])])), ROOM)
+    room = _rim_distance(pts, world_from_model.apply(poly.vertices[list(poly.faces[f])]))
+    pts, room = pts[room >= MIN_ROOM], np.minimum(room[room >= MIN_ROOM], ROOM)
     return pts[np.lexsort((np.linalg.norm(pts - vw, axis=1), -np.round(room, 4)))]
 
 
@@ -111,12 +118,15 @@ def _rim_distance(pts: np.ndarray, loop: np.ndarray) -> np.ndarray:
 
 def face_line(world_from_model: SE3, poly: Polyhedron, f: int, pad_point: np.ndarray, r: float) -> ProbeMove:
     """A probe line to the pad touching face ``f`` at ``pad_point`` (world): level toward the face (along its inward
-    normal when the face is level), starting :data:`RUN_UP` before the touch and ending :data:`RUN_ON` past it."""
+    normal when the face is level), starting :data:`RUN_UP` before the touch and ending :data:`RUN_ON` past it; its
+    ``room`` the point's distance to the face's rim."""
     n = world_from_model.rotate(poly.face_normals[f])
     u = -n * np.array([1.0, 1.0, 0.0])
     u = u / np.linalg.norm(u) if float(np.linalg.norm(u)) > 0.1 else -n
     centre = np.asarray(pad_point, dtype=float) + r * n
-    return ProbeMove(centre + (r - RUN_UP) * u, u, RUN_UP + RUN_ON)
+    room = float(_rim_distance(np.asarray(pad_point, dtype=float)[None],
+                               world_from_model.apply(poly.vertices[list(poly.faces[f])]))[0])  # fmt: skip
+    return ProbeMove(centre + (r - RUN_UP) * u, u, RUN_UP + RUN_ON, room=room)
 
 
 def table_face_lines(poly: Polyhedron, world_from_model: SE3, v: int, f: int, config: PlannerConfig,
@@ -194,7 +204,7 @@ class TableFaceProbes:
         parts = []
         if room:
             parts.append(f"the pad touches face{'s' if len(room) > 1 else ''} {', '.join(map(str, room))} nowhere "
-                         "clear of the table")  # fmt: skip
+                         "clear of the table with room for a stroke")  # fmt: skip
         if none:
             parts.append(f"no finger reaches face{'s' if len(none) > 1 else ''} {', '.join(map(str, none))}")
         if missed:
