@@ -170,15 +170,19 @@ def move_reach(result) -> tuple[str, str, str, str, str]:
     return (m.kind, finger, by, str(result.status), why)
 
 
-REACH_WORDS = ("unreachable", "table", "reach", "joint", "blocked", "met the object", "limit", "touched something")
-"""A failed move's reason that says the hand could not get where the move needed it (rather than that it got there
-and sensed something else than predicted) names one of these."""
+REACH_WORDS = ("unreachable", "table", "limit", "blocked", "joint", "met the object", "out of the pad's reach",
+               "out of reach", "runaway", "touched something", "carry it no further")
+"""A failed move's reason that says the hand could not get or go where the move needed it (the table, a joint limit,
+the object in the way of a link, a blocked stroke), rather than that it got there and sensed other than predicted,
+names one of these ..."""
+NOT_REACH = ("could not locate the vertex",)
+"""... unless it begins with one of these (an edge move that found no vertex: what it sensed, whatever blocked it)."""
 
 
 def reach_failure(reason: str) -> bool:
-    """Whether a failed move failed for the hand's reach: its reason names one of :data:`REACH_WORDS` (the status
-    does not tell: "unreachable" also ends a stroke that found no face)."""
-    return any(w in reason for w in REACH_WORDS)
+    """Whether a failed move failed for the hand's reach (:data:`REACH_WORDS`, :data:`NOT_REACH`; the status does
+    not tell: "unreachable" also ends a stroke that found no face)."""
+    return not reason.startswith(NOT_REACH) and any(w in reason for w in REACH_WORDS)
 
 
 def print_reach(records: list[dict]) -> None:
