@@ -33,6 +33,7 @@ from haptic.geometry.se3 import SE3
 from haptic.matching.acceptance import TablePin
 from haptic.matching.components import DataComponent, DataEdge, DataFace, SensorNoise
 from haptic.planning.config import PlannerConfig
+from haptic.planning.finger_faces import TableFaceProbes
 from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import EdgeMove, FaceMove, Move, ProbeMove, SensorState, VertexMove
 from haptic.planning.predict import candidate_moves, predict_moves
@@ -906,6 +907,11 @@ class Verifier:
         """Path cost when the first face's middle was asked for [units] (None: never)."""
         self.middles_unmeasured: list[int] = []
         """Faces whose middle a probe did not measure (the verification is incomplete)."""
+        self.finger_faces = (TableFaceProbes(config.finger_reach)
+                             if config.finger_reach is not None and config.table_z is not None else None)  # fmt: skip
+        """On the hand, once every vertex in the pad's reach is measured: probes by another finger, or a tilted one,
+        at the faces of table vertices that nothing measured places (:mod:`haptic.planning.finger_faces`); None
+        without a reach test of such probes (``PlannerConfig.finger_reach``)."""
         self.middles_unprobed: set[int] = set()
         """Faces of :attr:`middles` that no admissible probe was predicted to reach at their middle (not asked for:
         a slot across such a face is not caught)."""
@@ -951,6 +957,8 @@ class Verifier:
             if self.config.table_z is not None:
                 self.table_band = table_band(cls.model, self.check.world_from_model, self.config)
             self.status = "incomplete" if self.mode == "full" and (self.hidden or self.unpinnable) else "confirmed"
+            if self.status == "incomplete" and not self.hidden and self._finger_probe_next():
+                self.status = "verifying"
             if self.status == "confirmed" and self.mode == "full" and self._probes_admitted():
                 todo = [f for f in unmeasured_middles(cls.model, self.check.world_from_model, tree.data,
                                                       self._reach[cls.name][0]) if f not in self.middles_unprobed]
@@ -999,6 +1007,16 @@ class Verifier:
         """Verification moves in a row measuring nothing missing after which it ends (:data:`STALL_MOVES`; on the
         hand :data:`HAND_STALL_MOVES`)."""
         return STALL_MOVES if self.config.table_z is None else HAND_STALL_MOVES
+
+    def _finger_probe_next(self) -> bool:
+        """Whether a probe by another finger is to measure a face of the table vertices still unplaced
+        (:attr:`finger_faces`, kept as its pending move)."""
+        ff = self.finger_faces
+        if ff is None or not self.unpinnable or self._hyp is None or self._hyp.world_from_model is None:
+            return False
+        if ff.pending is not None:
+            return True
+        return ff.next(self._hyp, self.unpinnable, self.coverage.faces, self.config) is not None
 
     def _probes_admitted(self) -> bool:
         return self.config.moves != "tracing" and self.config.table_z is None and MAX_VERIFY_PROBES > 0
@@ -1064,6 +1082,11 @@ class Verifier:
             if self.unpinnable:
                 where.append(f"{len(self.unpinnable)} on the table with neither an edge rising from them nor two of "
                              "their faces in reach")  # fmt: skip
+                ff = self.finger_faces
+                why = (ff.unmeasured(self.unpinnable, self._hyp, self.coverage.faces, self.config)
+                       if ff is not None and self._hyp is not None and not self.hidden else "")  # fmt: skip
+                if why:
+                    where[-1] += f" ({why})"
             return (f"verification incomplete: vertices of {self._model_name} {' and '.join(where)} (a difference "
                     "there cannot be measured)")  # fmt: skip
         if self.status == "incomplete" and self.coverage is not None:
@@ -1083,6 +1106,10 @@ class Verifier:
         ``probed``: the probes' lines so far (not probed again)."""
         t0 = time.perf_counter()
         self.moves += 1
+        if self.finger_faces is not None and self.finger_faces.pending is not None:
+            move = self.finger_faces.take()
+            self.decision_times.append(time.perf_counter() - t0)
+            return move
         if self._hyp is not None and self._hyp.world_from_model is not None:
             h = self._hyp
         if self.middles and h.world_from_model is not None:
@@ -1228,6 +1255,8 @@ class Verifier:
             # verified up to what the hand cannot measure: every feature in its reach measured (the status says
             # whether that was all: "incomplete" with vertices hidden is this, never "confirmed")
             out["reach_complete"] = bool(self.coverage.met(self.mode))
+        if self.finger_faces is not None and self.finger_faces.asked:
+            out["finger_faces"] = self.finger_faces.record()
         if self.table_band is not None:
             # the claim: the object is the model above this height; below it, next to the table, nothing measured
             out["table_band_mm"] = round(self.table_band * 1000.0, 2)
