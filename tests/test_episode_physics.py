@@ -607,3 +607,31 @@ def test_an_edge_move_that_locates_the_end_it_set_off_past_does_not_turn_the_obj
     rec = run_episode(EpisodeSpec(model="trapezohedron_12", seed=1, executor="physics",
                                   models=_sized_corpus(tmp_path)))  # fmt: skip
     assert rec.outcome != "no-match", rec.detail
+
+
+def test_a_roll_at_an_edges_end_with_the_next_face_out_of_reach_reports_no_edge(tmp_path):
+    # HEXPRISM01 at 30 mm, seed 2 (perception_report.py --sizes 30 --first-seed 2): a face move rolled over an edge
+    # whose next face leant out of reach with the pad's centre 0.2-0.5 mm past the edge's end; the edge's direction,
+    # the axis the rolling normals turned about, took in their turn round the vertex and lay 2.1° off (2.1 bounds),
+    # and the episode ended no-match. Following the ridge from the roll meets that vertex at once: no edge.
+    failed = []
+    spec = EpisodeSpec(model="HEXPRISM01", seed=2, executor="physics", models=_scaled_library(tmp_path, 0.03))
+    ep = build_episode(spec)
+    rec = ep.run(None, EpisodeObserver(on_failed_move=lambda n, r: failed.append(r)))
+    assert any("the roll crossed the edge" in r.reason for r in failed)
+    assert rec.outcome != "no-match", rec.detail
+    assert _within_bounds(ep)
+
+
+def test_a_stroke_along_a_rim_does_not_tilt_the_face_it_refits(tmp_path):
+    # prism_12 of the formula corpus at 150 mm, seed 3 (perception_report.py --corpus --sizes 150 --first-seed 3):
+    # a face move's stroke slid along the rim of an edge, its normal steady 2.3° off the face, within the face cone;
+    # its 556 rows refitted the face, 2.3° off with a σ of 0.04°, and the edge crossed next lay 2.3° off (2.6
+    # bounds): the episode ended no-match. Rows whose mean normal is off the face's fit beyond their bound do not
+    # refit it.
+    spec = EpisodeSpec(model="prism_12", seed=3, executor="physics",
+                       models=_scaled_library(tmp_path, 0.15, corpus=True))  # fmt: skip
+    ep = build_episode(spec)
+    rec = ep.run(None)
+    assert rec.outcome != "no-match", rec.detail
+    assert _within_bounds(ep)
