@@ -837,7 +837,7 @@ class PhysicsExecutor(LandingSearch):
             pts.append(f.trace.point_in_world[self._on_ridge(f.trace, e)])
             if not f.ok and f.event != "limit":
                 return f"following the edge: {f.event}"
-            if f.event == "vertex" and f.trace.in_contact.any():
+            if end_clearance > 0.0 and f.event == "vertex" and f.trace.in_contact.any():
                 q = f.trace.point_in_world[f.trace.in_contact] @ (sense * e)
                 if q[-1] - q[0] < end_clearance:
                     return (f"the roll crossed the edge {max(q[-1] - q[0], 0.0) * MM:.1f} mm from its end: its normals "
