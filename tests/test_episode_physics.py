@@ -653,11 +653,16 @@ def test_a_roll_that_began_round_a_vertex_with_the_next_face_out_of_reach_report
     assert _within_bounds(ep)
 
 
+@pytest.mark.xfail(strict=True, reason=(
+    "the legs' steady normals of a thumb's stroke on a face differ by 2.0° as well (tests/executor/"
+    "test_placement_physics.py), its face within its bound: comparing the legs cannot tell a rim from the pad's own "
+    "bias along each leg"))
 def test_a_stroke_whose_second_leg_rides_a_rim_measures_no_face(tmp_path):
     # FRAME01 at 30 mm, seed 1 (perception_report.py --sizes 30): touched afresh after stepping onto a rim, the next
     # face's L-shaped stroke held the face's normal on its first leg and one 2.4° off on its second, which rode the rim
     # of an edge; the steady rows were mostly the second leg's, and the face lay 1.7° off (2.1 bounds): no-match. The
-    # legs' steady normals differ by more than the noise allows: no face is measured from that stroke.
+    # legs' steady normals differ by more than the noise allows, but so do a thumb's on a face it measures within its
+    # bound: no face should be measured from such a stroke, and the legs alone do not tell.
     spec = EpisodeSpec(model="FRAME01", seed=1, executor="physics", models=_scaled_library(tmp_path, 0.03))
     ep = build_episode(spec)
     rec = ep.run(None)

@@ -274,37 +274,6 @@ def steady_rows(trace: ContactTrace, mask: np.ndarray, bounds: SegmentBounds) ->
     return out
 
 
-def legs_agree(trace: ContactTrace, mask: np.ndarray, bounds: SegmentBounds) -> bool:
-    """Whether the face rows ``mask`` of a stroke that turned (an L: pad centres spanning more than
-    :attr:`~SegmentBounds.two_d_extent` across) hold one normal on both legs. The corner is the pad centre farthest
-    from the chord between the first and the last; a row belongs to the leg whose direction (start to corner, corner
-    to end) its pad's motion follows more closely; the mean normals of the legs' steady rows (:func:`steady_rows`, each
-    leg about its own) must agree within the bound of their difference (σn over each leg's rows, and each leg's own
-    floor). True for a straight stroke, or a leg of fewer than :attr:`~SegmentBounds.min_refine_rows` rows."""
-    idx = np.flatnonzero(mask)
-    if len(idx) < 2 * bounds.min_refine_rows:
-        return True
-    tips = trace.tip_in_world[idx]
-    if _extent(tips)[1] <= bounds.two_d_extent:
-        return True
-    rel = tips - tips[0]
-    chord = unit(rel[-1])
-    corner = int(np.argmax(np.linalg.norm(rel - np.outer(rel @ chord, chord), axis=1)))
-    u1, u2 = unit(tips[corner] - tips[0]), unit(tips[-1] - tips[corner])
-    step = np.gradient(trace.tip_in_world, axis=0)[idx]
-    second = np.abs(step @ u2) > np.abs(step @ u1)
-    legs = []
-    for rows in (idx[~second], idx[second]):
-        leg = np.zeros_like(mask)
-        leg[rows] = True
-        legs.append(trace.normal_in_world[steady_rows(trace, leg, bounds)])
-    a, b = legs
-    if min(len(a), len(b)) < bounds.min_refine_rows:
-        return True
-    sigma = bounds.normal_sigma * math.sqrt(1.0 / len(a) + 1.0 / len(b))
-    return angle_between(a.sum(axis=0), b.sum(axis=0)) <= bounds.bound(sigma, math.sqrt(2.0) * bounds.normal_floor)
-
-
 def fit_face(points: np.ndarray, normals: np.ndarray, bounds: SegmentBounds) -> FaceFit:
     """Combine the mean sensed normal (σn/√N) with the plane fit of the points (residual / spread) by inverse
     variance; the plane fit counts only when the points span two dimensions (pitfall 6)."""
@@ -509,7 +478,6 @@ class Segmenter:
         spread = float(np.sqrt(np.mean(np.sum((normals - mean) ** 2, axis=1))))  # rms angle [rad]
         if spread > self.bounds.max_spread_sigmas * self.bounds.normal_sigma + self.bounds.spread_slack:
             return None  # the rows do not come from one plane (a roll, a vertex)
-        legs_ok = legs_agree(trace, mask, self.bounds)
         mask = steady_rows(trace, mask, self.bounds)
         if _extent(trace.tip_in_world[mask])[0] < self.bounds.min_face_extent:
             # the rows that hold one normal are the pad pressing in place, the rest turning: the stroke rode a rim
@@ -519,11 +487,6 @@ class Segmenter:
         if two_d and _extent(trace.tip_in_world[mask])[1] < self.bounds.min_face_width:
             # the steady rows are one leg of the L: the other's normal held elsewhere (the pad rode a rim along the
             # first leg, its normal turned 3° round the edge), and no row measures the face across
-            return None
-        if not legs_ok:
-            # the legs of the L held different normals: one rode a rim, its normal turned 2-3° round the edge, and the
-            # steady rows mixed both (FRAME01 at 30 mm, seed 1: the second leg 2.4° off, most of the steady rows its,
-            # the face 2.1 bounds off, no-match)
             return None
         return fit_face(trace.point_in_world[mask], trace.normal_in_world[mask], self.bounds)
 
@@ -790,7 +753,6 @@ __all__ = [
     "edge_direction",
     "face_rows",
     "fit_face",
-    "legs_agree",
     "line_from_points",
     "plane_intersection",
 ]
