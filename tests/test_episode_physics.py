@@ -607,3 +607,33 @@ def test_an_edge_move_that_locates_the_end_it_set_off_past_does_not_turn_the_obj
     rec = run_episode(EpisodeSpec(model="trapezohedron_12", seed=1, executor="physics",
                                   models=_sized_corpus(tmp_path)))  # fmt: skip
     assert rec.outcome != "no-match", rec.detail
+
+
+def test_a_vertex_move_whose_circle_start_touches_the_far_rim_starts_halfway_to_the_edge(tmp_path):
+    # bipyramid_12 of the formula corpus at 70 mm, seed 1: the verification's vertex moves round the equator's
+    # vertices, where the faces' corners are narrow, touched the circle's start (8 mm from the vertex, 25° from the
+    # edge) with a normal 6-7° off the face: the pad met the rim of the face's far edge, and 5 of 47 moves failed
+    # "could not reach the face next to the vertex". The circle now starts halfway to the edge instead. The episode
+    # is stopped once a vertex move has met it.
+    class Seen(Exception):
+        pass
+
+    said, failed = [], []
+
+    def on_move(n, r, *a) -> None:
+        said.extend(x for x in (r.info or {}).get("recoveries", ()) if "the circle started halfway" in x)
+        if said:
+            raise Seen
+
+    def on_failed(n, r) -> None:
+        if r.move.kind == "vertex" and "could not reach the face next to the vertex" in r.reason:
+            failed.append(r.reason)
+            raise Seen
+
+    spec = EpisodeSpec(model="bipyramid_12", seed=1, executor="physics",
+                       models=_scaled_library(tmp_path, 0.07, corpus=True))  # fmt: skip
+    ep = build_episode(spec)
+    with pytest.raises(Seen):
+        ep.run(None, EpisodeObserver(on_move=on_move, on_failed_move=on_failed))
+    assert said and not failed, failed
+    assert _within_bounds(ep)

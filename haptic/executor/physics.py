@@ -1098,6 +1098,19 @@ class PhysicsExecutor(LandingSearch):
             return self.failed_result(move, "unreachable", "the vertex is next to the table: the circle around it "
                                                           "would put the pad on the table")  # fmt: skip
         status = self._ensure_on_face(f, pieces, near=p0)
+        if status == "unreachable" and self._why.startswith("touched a normal"):
+            # the pad at the circle's start touched the rim of the face's far edge (the face's corner at the vertex
+            # narrower than the start angle, or the vertex located a little off): the circle starts halfway to the
+            # current edge instead
+            beta = 0.5 * beta
+            p1 = vtx + rho * (-math.cos(beta) * u + math.sin(beta) * w_f)
+            if self.workspace.pad_clearance(p1, n_f) >= s.pad_clearance:
+                why = self._why
+                status = self._ensure_on_face(f, pieces, near=p1)
+                if status == "ok":
+                    self.recoveries.append(f"could not reach the face next to the vertex: {why}: the circle started "
+                                           "halfway to the edge")  # fmt: skip
+                p0 = p1
         if status != "ok":
             return self.failed_result(move, status, f"could not reach the face next to the vertex: {self._why}")
         tangent = math.sin(beta) * u + math.cos(beta) * w_f
