@@ -698,4 +698,77 @@ def test_a_stroke_whose_second_leg_rides_a_rim_measures_no_face(tmp_path):
     ep = build_episode(spec)
     rec = ep.run(None)
     assert rec.outcome != "no-match", rec.detail
+
+
+def test_a_vertex_move_whose_circle_start_touches_the_far_rim_starts_halfway_to_the_edge(tmp_path):
+    # bipyramid_12 of the formula corpus at 70 mm, seed 1: the verification's vertex moves round the equator's
+    # vertices, where the faces' corners are narrow, touched the circle's start (8 mm from the vertex, 25° from the
+    # edge) with a normal 6-7° off the face: the pad met the rim of the face's far edge, and 5 of 47 moves failed
+    # "could not reach the face next to the vertex". The circle now starts halfway to the edge instead. The episode
+    # is stopped once a vertex move has met it.
+    class Seen(Exception):
+        pass
+
+    said, failed = [], []
+
+    def on_move(n, r, *a) -> None:
+        said.extend(x for x in (r.info or {}).get("recoveries", ()) if "the circle started halfway" in x)
+        if said:
+            raise Seen
+
+    def on_failed(n, r) -> None:
+        if r.move.kind == "vertex" and "could not reach the face next to the vertex" in r.reason:
+            failed.append(r.reason)
+            raise Seen
+
+    spec = EpisodeSpec(model="bipyramid_12", seed=1, executor="physics",
+                       models=_scaled_library(tmp_path, 0.07, corpus=True))  # fmt: skip
+    ep = build_episode(spec)
+    with pytest.raises(Seen):
+        ep.run(None, EpisodeObserver(on_move=on_move, on_failed_move=on_failed))
+    assert said and not failed, failed
+    assert _within_bounds(ep)
+
+
+def _sized_corpus(directory) -> str:
+    """The formula corpus with each solid at a size drawn from 30 to 150 mm (``scripts/make_corpus.py --sizes
+    30:150 --encodings obj6``, seed 0), written to ``directory``: the library directory."""
+    from haptic.geometry import Polyhedron
+    from haptic.geometry.corpus import corpus_solids, write_corpus
+
+    rng = np.random.default_rng(0)
+    solids = []
+    for spec, poly in corpus_solids(seed=0):
+        v = poly.vertices
+        k = rng.uniform(0.03, 0.15) / float(np.linalg.norm(v[:, None] - v[None], axis=2).max())
+        c = poly.centroid
+        solids.append((spec, Polyhedron.from_faces(c + k * (v - c), poly.faces, name=poly.name)))
+    return str(write_corpus(directory, seed=0, solids=solids, encodings=("obj6",))["obj6"])
+
+
+def test_a_vertex_move_whose_roll_went_round_the_edges_end_crosses_again_inside_it(tmp_path):
+    # trapezohedron_06 of the sized formula corpus (33 mm), seed 1: four vertex moves' circles met the next edge and
+    # rolled round its end (the normals leaning 3-7° along it, more than the noise allows), and each failed "no edge
+    # between the faces". The circle's roll is now crossed again as a face move's is: back on the face before where
+    # it met the edge, shifted along the edge back inside it. The episode is stopped once a vertex move has done so.
+    class Seen(Exception):
+        pass
+
+    said, failed = [], []
+
+    def on_move(n, r, *a) -> None:
+        if r.move.kind == "vertex":
+            said.extend(x for x in (r.info or {}).get("recoveries", ()) if "crossed again" in x)
+        if said:
+            raise Seen
+
+    def on_failed(n, r) -> None:
+        if r.move.kind == "vertex" and "a roll round a vertex" in r.reason:
+            failed.append(r.reason)
+
+    spec = EpisodeSpec(model="trapezohedron_06", seed=1, executor="physics", models=_sized_corpus(tmp_path))
+    ep = build_episode(spec)
+    with pytest.raises(Seen):
+        ep.run(None, EpisodeObserver(on_move=on_move, on_failed_move=on_failed))
+    assert said and not failed, failed
     assert _within_bounds(ep)

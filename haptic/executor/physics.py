@@ -190,6 +190,9 @@ class PhysicsSettings:
     much farther inside the edge (plus how far the pad overshot the end) ... [m]"""
     recross_back: float = 0.008
     """... starting this far back on the face from where it met the edge [m]."""
+    circle_recross: float = 0.024
+    """A vertex move whose circle's roll went round the end of the edge it met crosses again so (``recross_shift``,
+    ``recross_back``), sliding at most this far to the edge [m]."""
     reacquire_step_in: float = 0.003
     """... and measuring it by an L whose first leg, away from the edge, is this long: a face must span both legs
     (a stroke along a ridge keeps one normal too) [m]."""
@@ -1120,6 +1123,19 @@ class PhysicsExecutor(LandingSearch):
             return self.failed_result(move, "unreachable", "the vertex is next to the table: the circle around it "
                                                           "would put the pad on the table")  # fmt: skip
         status = self._ensure_on_face(f, pieces, near=p0)
+        if status == "unreachable" and self._why.startswith("touched a normal"):
+            # the pad at the circle's start touched the rim of the face's far edge (the face's corner at the vertex
+            # narrower than the start angle, or the vertex located a little off): the circle starts halfway to the
+            # current edge instead
+            beta = 0.5 * beta
+            p1 = vtx + rho * (-math.cos(beta) * u + math.sin(beta) * w_f)
+            if self.workspace.pad_clearance(p1, n_f) >= s.pad_clearance:
+                why = self._why
+                status = self._ensure_on_face(f, pieces, near=p1)
+                if status == "ok":
+                    self.recoveries.append(f"could not reach the face next to the vertex: {why}: the circle started "
+                                           "halfway to the edge")  # fmt: skip
+                p0 = p1
         if status != "ok":
             return self.failed_result(move, status, f"could not reach the face next to the vertex: {self._why}")
         tangent = math.sin(beta) * u + math.cos(beta) * w_f
@@ -1153,7 +1169,11 @@ class PhysicsExecutor(LandingSearch):
             break
         fit_f, line, why = self._edge_between(f, r.trace, "circle", roll, fit_g, kind, corner)
         if line is None:
-            return self.failed_result(move, "unreachable", why)
+            again = self._circle_crossed_again(f, n_f, r.info["direction"], corner, roll, fit_f, fit_g, vtx, pieces)
+            if again is None:
+                return self.failed_result(move, "unreachable", why)
+            _, kind, roll, stroke, fit_g, fit_f, line, shifted = again
+            self.recoveries.append(f"{why}: crossed again {shifted * MM:.0f} mm along the edge")
         new_face = seg.next_id + 1
         s_vtx = float((vtx - line.point) @ line.direction)
         b = self.bounds
@@ -1178,6 +1198,37 @@ class PhysicsExecutor(LandingSearch):
                                  edge_faces=(f, face.id))  # fmt: skip
         return MoveResult(move=move, status="ok", components=(edge, face), distance=r.distance,
                           cost=self.costs.vertex_move(r.distance), state=self.state, info={"kind": kind})  # fmt: skip
+
+    def _circle_crossed_again(self, f: int, n_f: np.ndarray, direction: np.ndarray, corner: np.ndarray,
+                              roll: ContactTrace, fit_f: FaceFit, fit_g: FaceFit, vtx: np.ndarray,
+                              pieces: list[PrimitiveResult]):  # fmt: skip
+        """After a vertex circle whose roll leaned along the edge between face ``f`` and the next face (the pad
+        rolled round an end of the edge met), as a face move does: touch face ``f`` again ``recross_back`` before
+        where the circle met the edge and shifted along it back inside (:meth:`_away_from_vertex`), slide on along
+        the circle's heading there (``direction``) to the edge, over it and onto the next face. Returns (the slide,
+        kind, roll, stroke, next face's fit, face ``f``'s fit, the line, the shift [m]), or None when it gives no
+        edge."""
+        t, s = self.toucher, self.settings
+        shift = self._away_from_vertex(fit_f.normal, fit_g.normal, roll)
+        d = in_plane(np.asarray(direction, dtype=float), n_f)
+        if shift is None or d is None:
+            return None
+        start = corner - s.recross_back * d + shift
+        if self._touch_face(f, n_f, start, pieces) != "ok":
+            return None
+        r = t.trace_face(d, n_f, s.circle_recross)
+        pieces.append(r)
+        if not r.ok or r.event == "done":
+            return None
+        kind, corner = r.info["kind"], self.contact_point()
+        status, _, roll, stroke, fit_g = self._cross_and_acquire(kind, r.info["face_normal"], r.info["direction"],
+                                                                 pieces, away_from=vtx)  # fmt: skip
+        if status != "ok":
+            return None
+        fit_f, line, _ = self._edge_between(f, r.trace, "face", roll, fit_g, kind, corner)
+        if line is None:
+            return None
+        return r, kind, roll, stroke, fit_g, fit_f, line, float(np.linalg.norm(shift))
 
     # ------------------------------------------------------------------------------------------ helpers
     def admissible_moves(self, rng: np.random.Generator, n_directions: int = 8) -> list[Move]:
