@@ -86,10 +86,12 @@ def one(model: str, seed: int, policy: str, moves: str = "tracing", verify: str 
     kinds: list[tuple[str, bool]] = []
     reasons: list[tuple[str, str]] = []
     recovered: list[tuple[str, str]] = []
+    reach: list[tuple[str, str, str, str, str]] = []
 
     def on_move(n, result, *rest) -> None:
         if n > 0 and result.move is not None:  # the start is no move
             kinds.append((result.move.kind, True))
+            reach.append(move_reach(result))
             recovered.extend((result.move.kind, why) for why in result.info.get("recoveries", ()))
 
     def on_failed(n, result) -> None:
@@ -98,6 +100,7 @@ def one(model: str, seed: int, policy: str, moves: str = "tracing", verify: str 
         why = result.reason or result.info.get("reason", "") or str(result.status)
         kinds.append((result.move.kind, False))
         reasons.append((result.move.kind, why))
+        reach.append(move_reach(result))
         if result.move.kind == "probe":
             failed.append(f"{result.status}: {why}")
 
@@ -112,7 +115,7 @@ def one(model: str, seed: int, policy: str, moves: str = "tracing", verify: str 
     except HapticError as exc:
         return {"model": model, "seed": seed, "outcome": "error", "correct": False, "detail": str(exc)}
     rec.update(probes_failed=len(failed), probe_failures=failed, move_results=kinds, failure_reasons=reasons,
-               recoveries=recovered, cpu_time_s=round(time.process_time() - cpu0, 3))
+               recoveries=recovered, move_reach=reach, cpu_time_s=round(time.process_time() - cpu0, 3))
     if watch is not None:
         rec["probe_costs"] = watch.rows
     return rec
@@ -153,6 +156,58 @@ def _print_probe_costs(records: list[dict]) -> None:
         print(f"probes carried out {len(a)}: actual − predicted (for the outcome) mean {a.mean():+.2f}, "
               f"mean |·| {np.abs(a).mean():.2f}, range {a.min():+.2f} … {a.max():+.2f}; actual − expected mean "
               f"{e.mean():+.2f}, range {e.min():+.2f} … {e.max():+.2f} [units]")  # fmt: skip
+
+
+def move_reach(result) -> tuple[str, str, str, str, str]:
+    """A move made, as the reach it was offered with and what came of it: (kind, finger -- "index" for the exploring
+    one pointing down --, whose prediction it was -- "solver" for a move with the reach solver's path, the
+    planner's otherwise --, status, reason ("" when it succeeded))."""
+    m = result.move
+    finger = getattr(m, "finger", None) or ("+".join(f.finger for f in m.fingers) if m.kind == "placement"
+                                             else "index")  # fmt: skip
+    by = "solver" if getattr(m, "path", None) is not None else "planner"
+    why = "" if result.ok else (result.reason or result.info.get("reason", "") or str(result.status))
+    return (m.kind, finger, by, str(result.status), why)
+
+
+REACH_WORDS = ("unreachable", "table", "limit", "blocked", "joint", "met the object", "out of the pad's reach",
+               "out of reach", "runaway", "touched something", "carry it no further")
+"""A failed move's reason that says the hand could not get or go where the move needed it (the table, a joint limit,
+the object in the way of a link, a blocked stroke), rather than that it got there and sensed other than predicted,
+names one of these ..."""
+NOT_REACH = ("could not locate the vertex",)
+"""... unless it begins with one of these (an edge move that found no vertex: what it sensed, whatever blocked it)."""
+
+
+def reach_failure(reason: str) -> bool:
+    """Whether a failed move failed for the hand's reach (:data:`REACH_WORDS`, :data:`NOT_REACH`; the status does
+    not tell: "unreachable" also ends a stroke that found no face)."""
+    return not reason.startswith(NOT_REACH) and any(w in reason for w in REACH_WORDS)
+
+
+def print_reach(records: list[dict]) -> None:
+    """Moves predicted reachable (every move offered: the planner's table and undercut checks for the index pointing
+    down, the reach solver's path for a named finger) against their outcome: the share that failed, the share that
+    failed for the hand's reach (:func:`reach_failure`), those by reason; and the moves by another finger or a
+    turned wrist."""
+    rows = [tuple(x) for r in records for x in r.get("move_reach", [])]
+    if not rows:
+        return
+    failed = [x for x in rows if x[3] != "ok"]
+    reach = [x for x in failed if reach_failure(x[4])]
+    n = len(rows)
+    print()
+    print(f"moves predicted reachable {n}: failed {len(failed)} ({100 * len(failed) / n:.1f} %), of them for the "
+          f"hand's reach {len(reach)} ({100 * len(reach) / n:.1f} % of the moves)")  # fmt: skip
+    why = Counter((k, reason_class(w)) for k, _, _, _, w in reach)
+    for (k, w), c in why.most_common():
+        print(f"  {c:>4}  {k:<6} {w}")
+    solver = [x for x in rows if x[2] == "solver"]
+    if solver:
+        bad = [x for x in solver if x[3] != "ok"]
+        fingers = Counter(x[1] for x in solver)
+        print(f"moves on the reach solver's path {len(solver)} ({', '.join(f'{k} {v}' for k, v in fingers.items())})"
+              f": failed {len(bad)}" + "".join(f"; {x[1]} {x[0]}: {reason_class(x[4])}" for x in bad))  # fmt: skip
 
 
 def reason_class(reason: str) -> str:
@@ -287,6 +342,7 @@ def main(argv: list[str] | None = None) -> int:
           f"{_f(_mean(records, 'sim_time_s'), '.1f')} s; over the correct: path cost "
           f"{_f(_mean(good, 'path_cost'), '.2f')}, moves {_f(_mean(good, 'moves'), '.2f')}")
     print_moves(records)
+    print_reach(records)
     print_placements(records)
     if args.probe_costs:
         _print_probe_costs(records)

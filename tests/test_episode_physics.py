@@ -607,3 +607,168 @@ def test_an_edge_move_that_locates_the_end_it_set_off_past_does_not_turn_the_obj
     rec = run_episode(EpisodeSpec(model="trapezohedron_12", seed=1, executor="physics",
                                   models=_sized_corpus(tmp_path)))  # fmt: skip
     assert rec.outcome != "no-match", rec.detail
+
+
+@pytest.mark.slow
+def test_a_verification_that_failed_a_way_in_finds_another(tmp_path):
+    # antiprism_05 of the sized formula corpus, seed 1, default options: the verification ended "incomplete after
+    # 30 moves" with one face and one edge unmeasured, 8 after it last measured something: face moves failed to
+    # cross to them, and the verification went back over the faces and edges measured, where the stall rule ended
+    # it before it came round to another way in
+    rec = run_episode(EpisodeSpec(model="antiprism_05", seed=1, executor="physics",
+                                  models=_sized_corpus(tmp_path)))  # fmt: skip
+    assert rec.outcome == "recognized" and rec.correct, rec.detail
+
+
+@pytest.mark.slow
+def test_a_verification_with_no_move_left_ends_saying_so():
+    # FRAME01 seed 2, default options: every move from the vertex the verification reached failed (the way on was
+    # through the frame's hole), the verifier had no admissible move left, and the loop's random fallback moves
+    # from there failed in turn until the stall rule ended it ("incomplete after 20 moves"); with none left the
+    # verification ends there and says why
+    rec = run_episode(EpisodeSpec(model="FRAME01", seed=2, executor="physics"))
+    assert rec.outcome == "ambiguous" and not rec.correct
+    assert "no admissible move left" in rec.detail, rec.detail
+
+
+@pytest.mark.slow
+def test_a_verification_going_round_one_way_takes_another(tmp_path):
+    # trapezohedron_04 of the sized formula corpus (115 mm), seed 1, default options: a face move failed to cross
+    # to the face leaning under that was missing, and the verification went round one vertex over the same three
+    # faces, face move and edge move in turn, until the stall rule ended it ("incomplete after 30 moves")
+    rec = run_episode(EpisodeSpec(model="trapezohedron_04", seed=1, executor="physics",
+                                  models=_sized_corpus(tmp_path)))  # fmt: skip
+    assert rec.outcome == "recognized" and rec.correct, rec.detail
+
+def test_a_roll_at_an_edges_end_with_the_next_face_out_of_reach_reports_no_edge(tmp_path):
+    # HEXPRISM01 at 30 mm, seed 2 (perception_report.py --sizes 30 --first-seed 2): a face move rolled over an edge
+    # whose next face leant out of reach with the pad's centre 0.2-0.5 mm past the edge's end; the edge's direction,
+    # the axis the rolling normals turned about, took in their turn round the vertex and lay 2.1° off (2.1 bounds),
+    # and the episode ended no-match. Following the ridge from the roll meets that vertex at once: no edge.
+    failed = []
+    spec = EpisodeSpec(model="HEXPRISM01", seed=2, executor="physics", models=_scaled_library(tmp_path, 0.03))
+    ep = build_episode(spec)
+    rec = ep.run(None, EpisodeObserver(on_failed_move=lambda n, r: failed.append(r)))
+    assert any("the roll crossed the edge" in r.reason for r in failed)
+    assert rec.outcome != "no-match", rec.detail
+    assert _within_bounds(ep)
+
+
+def test_a_stroke_along_a_rim_does_not_tilt_the_face_it_refits(tmp_path):
+    # prism_12 of the formula corpus at 150 mm, seed 3 (perception_report.py --corpus --sizes 150 --first-seed 3):
+    # a face move's stroke slid along the rim of an edge, its normal steady 2.3° off the face, within the face cone;
+    # its 556 rows refitted the face, 2.3° off with a σ of 0.04°, and the edge crossed next lay 2.3° off (2.6
+    # bounds): the episode ended no-match. Rows whose mean normal is off the face's fit beyond their bound do not
+    # refit it.
+    spec = EpisodeSpec(model="prism_12", seed=3, executor="physics",
+                       models=_scaled_library(tmp_path, 0.15, corpus=True))  # fmt: skip
+    ep = build_episode(spec)
+    rec = ep.run(None)
+    assert rec.outcome != "no-match", rec.detail
+    assert _within_bounds(ep)
+
+
+def test_a_roll_that_began_round_a_vertex_with_the_next_face_out_of_reach_reports_no_edge(tmp_path):
+    # bipyramid_09 of the formula corpus at 30 mm, seed 1 (perception_report.py --corpus --sizes 30): a face move
+    # rolled round the apex and on over an edge whose next face leant out of reach; the axis the rolling normals turned
+    # about lay 18° off the edge (7.9° once refined by the ridge: 5 bounds), and the episode ended no-match. Over a
+    # true edge the normals lie off the plane perpendicular to its axis by the noise alone (rms 0.0175 at σn 1°);
+    # these by 0.056 (3.2°): the roll gives no edge.
+    failed = []
+    spec = EpisodeSpec(model="bipyramid_09", seed=1, executor="physics",
+                       models=_scaled_library(tmp_path, 0.03, corpus=True))  # fmt: skip
+    ep = build_episode(spec)
+    rec = ep.run(None, EpisodeObserver(on_failed_move=lambda n, r: failed.append(r)))
+    assert any("off the plane of any one axis" in r.reason for r in failed)
+    assert rec.outcome != "no-match", rec.detail
+    assert _within_bounds(ep)
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "the legs' steady normals of a thumb's stroke on a face differ by 2.0° as well (tests/executor/"
+    "test_placement_physics.py), its face within its bound: comparing the legs cannot tell a rim from the pad's own "
+    "bias along each leg"))
+def test_a_stroke_whose_second_leg_rides_a_rim_measures_no_face(tmp_path):
+    # FRAME01 at 30 mm, seed 1 (perception_report.py --sizes 30): touched afresh after stepping onto a rim, the next
+    # face's L-shaped stroke held the face's normal on its first leg and one 2.4° off on its second, which rode the rim
+    # of an edge; the steady rows were mostly the second leg's, and the face lay 1.7° off (2.1 bounds): no-match. The
+    # legs' steady normals differ by more than the noise allows, but so do a thumb's on a face it measures within its
+    # bound: no face should be measured from such a stroke, and the legs alone do not tell.
+    spec = EpisodeSpec(model="FRAME01", seed=1, executor="physics", models=_scaled_library(tmp_path, 0.03))
+    ep = build_episode(spec)
+    rec = ep.run(None)
+    assert rec.outcome != "no-match", rec.detail
+
+
+def test_a_vertex_move_whose_circle_start_touches_the_far_rim_starts_halfway_to_the_edge(tmp_path):
+    # bipyramid_12 of the formula corpus at 70 mm, seed 1: the verification's vertex moves round the equator's
+    # vertices, where the faces' corners are narrow, touched the circle's start (8 mm from the vertex, 25° from the
+    # edge) with a normal 6-7° off the face: the pad met the rim of the face's far edge, and 5 of 47 moves failed
+    # "could not reach the face next to the vertex". The circle now starts halfway to the edge instead. The episode
+    # is stopped once a vertex move has met it.
+    class Seen(Exception):
+        pass
+
+    said, failed = [], []
+
+    def on_move(n, r, *a) -> None:
+        said.extend(x for x in (r.info or {}).get("recoveries", ()) if "the circle started halfway" in x)
+        if said:
+            raise Seen
+
+    def on_failed(n, r) -> None:
+        if r.move.kind == "vertex" and "could not reach the face next to the vertex" in r.reason:
+            failed.append(r.reason)
+            raise Seen
+
+    spec = EpisodeSpec(model="bipyramid_12", seed=1, executor="physics",
+                       models=_scaled_library(tmp_path, 0.07, corpus=True))  # fmt: skip
+    ep = build_episode(spec)
+    with pytest.raises(Seen):
+        ep.run(None, EpisodeObserver(on_move=on_move, on_failed_move=on_failed))
+    assert said and not failed, failed
+    assert _within_bounds(ep)
+
+
+def _sized_corpus(directory) -> str:
+    """The formula corpus with each solid at a size drawn from 30 to 150 mm (``scripts/make_corpus.py --sizes
+    30:150 --encodings obj6``, seed 0), written to ``directory``: the library directory."""
+    from haptic.geometry import Polyhedron
+    from haptic.geometry.corpus import corpus_solids, write_corpus
+
+    rng = np.random.default_rng(0)
+    solids = []
+    for spec, poly in corpus_solids(seed=0):
+        v = poly.vertices
+        k = rng.uniform(0.03, 0.15) / float(np.linalg.norm(v[:, None] - v[None], axis=2).max())
+        c = poly.centroid
+        solids.append((spec, Polyhedron.from_faces(c + k * (v - c), poly.faces, name=poly.name)))
+    return str(write_corpus(directory, seed=0, solids=solids, encodings=("obj6",))["obj6"])
+
+
+def test_a_vertex_move_whose_roll_went_round_the_edges_end_crosses_again_inside_it(tmp_path):
+    # trapezohedron_06 of the sized formula corpus (33 mm), seed 1: four vertex moves' circles met the next edge and
+    # rolled round its end (the normals leaning 3-7° along it, more than the noise allows), and each failed "no edge
+    # between the faces". The circle's roll is now crossed again as a face move's is: back on the face before where
+    # it met the edge, shifted along the edge back inside it. The episode is stopped once a vertex move has done so.
+    class Seen(Exception):
+        pass
+
+    said, failed = [], []
+
+    def on_move(n, r, *a) -> None:
+        if r.move.kind == "vertex":
+            said.extend(x for x in (r.info or {}).get("recoveries", ()) if "crossed again" in x)
+        if said:
+            raise Seen
+
+    def on_failed(n, r) -> None:
+        if r.move.kind == "vertex" and "a roll round a vertex" in r.reason:
+            failed.append(r.reason)
+
+    spec = EpisodeSpec(model="trapezohedron_06", seed=1, executor="physics", models=_sized_corpus(tmp_path))
+    ep = build_episode(spec)
+    with pytest.raises(Seen):
+        ep.run(None, EpisodeObserver(on_move=on_move, on_failed_move=on_failed))
+    assert said and not failed, failed
+    assert _within_bounds(ep)

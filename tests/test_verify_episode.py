@@ -84,6 +84,21 @@ def test_an_incomplete_verification_is_not_a_recognition(monkeypatch):
     assert outcome_class(r) != "wrong model"
 
 
+def test_a_verification_still_measuring_goes_on_past_its_budget(monkeypatch):
+    """The budget counts the verification moves that measured nothing missing: BOX01 seed 3, verified in 14 moves
+    of which more than half measure a vertex, is confirmed under a budget of 8 (a budget of all moves ended it
+    as ambiguous at 8), and no verification runs past twice its budget."""
+    import haptic.planning.verify as verify
+
+    monkeypatch.setattr(verify, "verify_move_budget", lambda n_target: 8)
+    r = run_episode(EpisodeSpec(model="BOX01", seed=3, verify="full", moves="tracing"), library=LIB).to_json()
+    assert r["outcome"] == "recognized" and r["correct"], r["detail"]
+    assert 8 < r["verified"]["moves"] <= verify.BUDGET_CAP * 8
+    monkeypatch.setattr(verify, "verify_move_budget", lambda n_target: 5)
+    r = run_episode(EpisodeSpec(model="BOX01", seed=3, verify="full", moves="tracing"), library=LIB).to_json()
+    assert r["outcome"] == "ambiguous" and r["verified"]["moves"] <= verify.BUDGET_CAP * 5, r["detail"]
+
+
 def test_verification_moves_do_not_use_the_move_budget_of_recognition():
     """BOX01N (16 vertices) with a move budget of 12: recognised within it, then verified beyond it."""
     spec = EpisodeSpec(model="BOX01N", seed=411492782, verify="full", max_moves=12, moves="tracing")

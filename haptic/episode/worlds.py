@@ -141,6 +141,7 @@ class PhysicsWorld:
         # MuJoCo and the physics executor load only for physics episodes (geometric sweeps never import them)
         from haptic.episode.evaluate import score_components
         from haptic.executor.physics import PhysicsExecutor, PhysicsSettings
+        from haptic.executor.placement import finger_reach
         from haptic.executor.touch_config import TouchConfig
         from haptic.sim import RobotInterface, Simulation, compose_scene, random_object_pose
         from haptic.sim.scene import scene_object_from_polyhedron
@@ -160,6 +161,8 @@ class PhysicsWorld:
             from haptic.executor.placement import PlacementReach
 
             config = replace(config, placement_reach=PlacementReach())
+        if config.finger_reach is None:  # probes by another finger: the reach solver with the hypothesis at its pose
+            config = replace(config, finger_reach=finger_reach())
         sim_noise, bounds, noise = noise_models(NoiseModel(check_noise_level(spec.noise)))
         sim = Simulation(scene, noise=sim_noise, seed=int(sim_seq.integers(2**31 - 1)))
         settings = PhysicsSettings()

@@ -389,6 +389,24 @@ clearance). A placement's 4 mm L at a random heading spanned 5.3 × 1.2 mm there
 must span across, in every heading; an 8 mm one put the pad on the table."""
 
 
+STROKE_ACROSS_MIN = 0.002
+"""The least second leg of a probe's L stroke kept within a face's room (:func:`stroke_within`) [m]: 1.5 mm across
+the face is what a face's stroke must span (``SegmentBounds.min_face_width``), and the servo trails its targets."""
+
+
+def stroke_within(settings: PlacementSettings, room: float) -> PlacementSettings:
+    """``settings`` with the L stroke's legs shortened to stay within ``room`` of where the pad touched (the planner's
+    ``ProbeMove.room`` of the hypothesised face): the second leg its own or at least :data:`STROKE_ACROSS_MIN`, the
+    first what is left of the room; unchanged where the room holds the whole L."""
+    along = settings.stroke
+    across = settings.stroke if settings.stroke_across is None else settings.stroke_across
+    if math.hypot(along, across) <= room:
+        return settings
+    across = min(across, max(STROKE_ACROSS_MIN, room / 3.0))
+    along = math.sqrt(max(room * room - across * across, 0.0))
+    return replace(settings, stroke=max(along, across), stroke_across=across)
+
+
 def finger_probe_move(ex: PhysicsExecutor, move: ProbeMove, pieces: list[PrimitiveResult],
                       settings: PlacementSettings = PROBE_SETTINGS) -> MoveResult:  # fmt: skip
     """Carry out probe ``move`` with the finger it names (``move.finger``, the exploring one too), pointing along its
@@ -403,6 +421,8 @@ def finger_probe_move(ex: PhysicsExecutor, move: ProbeMove, pieces: list[Primiti
     approach = FingerApproach(str(move.finger), np.asarray(move.start, dtype=float),
                               np.asarray(move.direction, dtype=float), float(move.length))  # fmt: skip
     place = PlacementMove((approach,), path=move.path)
+    if move.room is not None:
+        settings = stroke_within(settings, float(move.room))
     res = _placement(ex, place, pieces, settings, single=True)
     info = dict(res.info)
     fingers = info.pop("fingers", [])
@@ -878,6 +898,17 @@ def finger_probe(move: ProbeMove, hypotheses: Sequence, reach: PlacementReach | 
     return None
 
 
+def finger_reach(fingers: Sequence[str] = FINGERS, tilts: Sequence[float] = PROBE_TILTS) -> Callable:
+    """The planner's reach test of a probe by any finger (``PlannerConfig.finger_reach``): :func:`finger_probe` with
+    one reach test (:data:`FINGER_PROBE_REACH`, its compiled scenes kept) for the episode."""
+    reach = PlacementReach(FINGER_PROBE_REACH)
+
+    def test(move: ProbeMove, hypotheses: Sequence) -> ProbeMove | None:
+        return finger_probe(move, hypotheses, reach, fingers, tilts)
+
+    return test
+
+
 def reach_oracle(fingers: int) -> Callable | None:
     """The planner's placement reach test for an episode of ``fingers`` fingers at once (None for one)."""
     return PlacementReach() if fingers > 1 else None
@@ -885,4 +916,4 @@ def reach_oracle(fingers: int) -> Callable | None:
 
 __all__ = ["FINGER_PROBE_REACH", "HOLD_CLEARANCE", "PROBE_SETTINGS", "PROBE_TILTS", "REACH_CLEARANCE", "SETTINGS",
            "TIP_TABLE_CLEARANCE", "PlacementReach", "PlacementSettings", "finger_probe", "finger_probe_move",
-           "hand_solver", "pad_target", "placement_move", "reach_oracle"]
+           "finger_reach", "hand_solver", "pad_target", "placement_move", "reach_oracle"]

@@ -88,6 +88,12 @@ class PlannerConfig:
     reaches is the one placement offered. None: every candidate is offered (the ideal sensor)."""
     placement_checks: int = 3
     """Most placements of one decision asked about (``placement_reach``)."""
+    finger_reach: Callable | None = None
+    """Which finger, if any, can carry out a free-space probe line, as the episode's world knows it: called with a
+    :class:`~haptic.planning.moves.ProbeMove` and the hypotheses (the most likely first), it returns the probe with
+    the finger (``ProbeMove.finger``) and the hand's way to it, or None when no finger reaches the line. The
+    verification asks it for the faces the exploring finger pointing down cannot press
+    (:mod:`haptic.planning.finger_faces`). None: no such probe is offered (a point sensor)."""
     moves: str = "tracing"
     """Admissible kinds of move (``MOVE_SETS``): "tracing" (face, edge and vertex moves), "probing" (free-space
     probes) or "all" (both, ranked together by one efficiency, seed §1.1)."""

@@ -197,6 +197,10 @@ class ProbeMove:
     """With ``finger``: the hand's way to the line's start as the planner's reach test found it, clear of the
     hypothesised object -- joint configurations (K, n) from the tracing posture to that finger's pad at the start,
     pointing along the line [rad]; None: the executor finds its own."""
+    room: float | None = None
+    """With ``finger``: how far the hypothesised face the line is aimed at extends around where the pad is to touch
+    it (its contact's distance to the face's rim) [m]: the finger's stroke on it is kept within (a face leaning under
+    is pressed clear of the table only near its top, often a narrow corner); None: the executor's own stroke."""
 
     kind = "probe"
 

@@ -33,8 +33,9 @@ from haptic.geometry.se3 import SE3
 from haptic.matching.acceptance import TablePin
 from haptic.matching.components import DataComponent, DataEdge, DataFace, SensorNoise
 from haptic.planning.config import PlannerConfig
+from haptic.planning.finger_faces import TableFaceProbes
 from haptic.planning.hypothesis import Hypothesis
-from haptic.planning.moves import EdgeMove, FaceMove, Move, ProbeMove, SensorState
+from haptic.planning.moves import EdgeMove, FaceMove, Move, ProbeMove, SensorState, VertexMove
 from haptic.planning.predict import candidate_moves, predict_moves
 from haptic.planning.table import _inward, descent_risk, hidden_concave_end
 from haptic.planning.tour import (
@@ -56,6 +57,20 @@ STALL_MOVES = 8
 """Verification moves in a row that measure no missing feature after which the verification ends with what it
 has measured (status "incomplete": the episode ends as ambiguous, its record says what was not measured); on the
 hand counted from the last relocation too (:data:`RELOCATE_AFTER`), which puts the pad somewhere new."""
+HAND_STALL_MOVES = 16
+"""On the hand, :data:`STALL_MOVES` there: a failed move is not asked again (an edge move along a model edge, a
+vertex move round a model vertex, a face move's crossing), and the way round to another way in -- back over the
+edges and faces measured -- takes moves that measure nothing; eight ended antiprism_05 of the formula corpus
+(seed 1) with a face and an edge unmeasured, and with sixteen it is confirmed."""
+HAND_WAYS_AGAIN = 2
+"""On the hand, times a verification move predicted to measure nothing may go one way (:func:`outcome_key`) since
+the last feature measured before that way is left out (:func:`plan_verification_move`): after a face move failed
+to cross to what is missing, the tour's estimate from the faces round it kept trapezohedron_04 of the formula
+corpus (seed 1) going round one vertex over the same three faces until the verification stalled."""
+NO_MOVE_DECISIONS = 2
+"""On the hand, verification decisions in a row with no admissible move (every move from where the pad is failed or
+is left out) after which the verification ends, saying so: the loop's random fallback moves from there, and more
+of them only fail in turn until none is left (FRAME01 seed 2: three after the verification had none, all failed)."""
 RELOCATE_PROBES = 6
 """Probe lines a relocation weighs, to the missing features nearest the sensor first (:func:`_verification_probes`):
 on the hand many are refused (the table, the finger's way down), and the tour's two cheapest entries are often
@@ -71,10 +86,14 @@ MOVES_PER_FEATURE = 3
 """Verification moves allowed per feature of the coverage target (:func:`verify_move_budget`): a vertex costs about
 two moves (an aimed face move and a short edge move, or a vertex move and an edge trace), and getting from one to
 the next about one more."""
+BUDGET_CAP = 2
+"""The verification ends at this many times its budget (:func:`verify_move_budget`) of moves whatever they measured:
+the budget counts the moves that measured nothing missing (:meth:`Verifier.verdict`), and this bounds the rest."""
 
 
 def verify_move_budget(n_target: int) -> int:
-    """The verification moves after which the verification ends with what it has measured (status "incomplete"),
+    """The verification moves that measure nothing missing after which the verification ends with what it has
+    measured (status "incomplete"; :data:`BUDGET_CAP` times as many moves in all),
     for a model with ``n_target`` reachable features in its coverage target (the vertices under ``full``, the faces
     and edges under ``fast``): :data:`STALL_MOVES` plus :data:`MOVES_PER_FEATURE` per feature, so that the budget
     follows the model (a fixed one is sized to some library's largest model and cuts a larger one short).
@@ -587,9 +606,10 @@ def plan_verification_move(
     """:func:`choose_verification_move`, with the tour it planned over ``missing`` (from ``previous``'s order,
     when given) and that tour's cost from the sensor as it is [units] (None and 0 without a pose). A candidate
     predicted to measure nothing missing along a way already travelled (its :func:`outcome_key` in
-    ``travelled``), or to end within :data:`REVISIT` of a place in ``visited`` (world), is left out without a table
-    (on the hand a move ends where the pad stops, and going back can be the way on; there it kept BOX01N's
-    verification from a vertex it then found, seed 2), unless every candidate is: the tour's
+    ``travelled``), or, without a table, to end within :data:`REVISIT` of a place in ``visited`` (world), is left
+    out (on the hand a move ends where the pad stops, and going back can be the way on: the place kept BOX01N's
+    verification from a vertex it then found, seed 2, and the verifier gives as ``travelled`` there only the ways
+    taken :data:`HAND_WAYS_AGAIN` times), unless every candidate is: the tour's
     estimate from where such moves end can keep them the cheapest, and the verification goes back and forth
     until it stalls.
 
@@ -639,7 +659,7 @@ def plan_verification_move(
     ends: list[tuple[Move, np.ndarray | None, float]] = []
     again: list[tuple[Move, np.ndarray | None, float]] = []  # left out as going back: the last resort
     refused: list[tuple[Move, np.ndarray | None, float]] = []  # crossings that failed: after the last resort
-    going_back = config.table_z is None  # the hand's moves end where the pad stops, not where predicted
+    revisits = config.table_z is None  # the hand's moves end where the pad stops, not where predicted
     for m, c, r in [*first, *probes]:
         sim = (simulate_probe(h, m, state, components, noise) if m.kind == "probe"
                else simulate(h, m, state, components, config))  # fmt: skip
@@ -651,7 +671,7 @@ def plan_verification_move(
             refused.append((m, h.world_from_model.inverse().apply(s1.position), c))
             continue
         new = _new_features(h, h1)
-        if going_back and _gain(new, missing) == 0 and (outcome_key(h, m, state, h1, s1) in travelled or any(
+        if _gain(new, missing) == 0 and (outcome_key(h, m, state, h1, s1) in travelled or revisits and any(
                 float(np.linalg.norm(s1.position - p)) < REVISIT for p in visited)):
             again.append((m, h.world_from_model.inverse().apply(s1.position), c))
             continue
@@ -829,6 +849,12 @@ class Verifier:
         :func:`verify_move_budget` made: ambiguous between the model and an object outside the library),
         "verifying", or "not needed" (no pose class was ever left alone)."""
         self._progress = (-1, 0)  # (features measured, verification moves then)
+        self._measuring = 0
+        self._no_move = 0
+        """On the hand, verification decisions in a row that had no admissible move (:data:`NO_MOVE_DECISIONS`)."""
+        self.stuck = False
+        """Whether the verification ended with no admissible move left (:data:`NO_MOVE_DECISIONS`)."""
+        """Verification moves after which more of the coverage target was measured than before."""
         self._relocated = 0
         self._failed_crossings: set[tuple[int, int]] = set()
         """On the hand, the (model face, model edge) that face moves failed to cross :data:`CROSSING_FAILURES`
@@ -836,12 +862,16 @@ class Verifier:
         self._crossing_failures: dict[tuple[int, int], int] = {}
         self._failures_seen: set[tuple[int, ...]] = set()
         """Verification moves made when the last relocation (:meth:`_relocate`) was chosen."""
-        self._travelled: set[tuple] = set()
-        """:func:`outcome_key` of the moves made since the last feature measured that were to measure nothing."""
+        self._travelled: dict[tuple, int] = {}
+        """:func:`outcome_key` of the moves made since the last feature measured that were to measure nothing, with
+        how many times each was made."""
         self._visited: list[np.ndarray] = []
         """Where the sensor was when each verification move since the last feature measured was chosen (world)."""
         self._failed_edges: list[tuple[int, np.ndarray]] = []
         """Edge moves that failed during the verification: the model edge and the world direction of travel."""
+        self._failed_rounds: set[tuple[int, int]] = set()
+        """On the hand, vertex moves that failed during the verification: the model vertex and the model face the
+        circle crossed (:meth:`_failed_round`)."""
         self.check = None
         self._data = None
         self.accept = None
@@ -877,6 +907,11 @@ class Verifier:
         """Path cost when the first face's middle was asked for [units] (None: never)."""
         self.middles_unmeasured: list[int] = []
         """Faces whose middle a probe did not measure (the verification is incomplete)."""
+        self.finger_faces = (TableFaceProbes(config.finger_reach)
+                             if config.finger_reach is not None and config.table_z is not None else None)  # fmt: skip
+        """On the hand, once every vertex in the pad's reach is measured: probes by another finger, or a tilted one,
+        at the faces of table vertices that nothing measured places (:mod:`haptic.planning.finger_faces`); None
+        without a reach test of such probes (``PlannerConfig.finger_reach``)."""
         self.middles_unprobed: set[int] = set()
         """Faces of :attr:`middles` that no admissible probe was predicted to reach at their middle (not asked for:
         a slot across such a face is not caught)."""
@@ -922,6 +957,8 @@ class Verifier:
             if self.config.table_z is not None:
                 self.table_band = table_band(cls.model, self.check.world_from_model, self.config)
             self.status = "incomplete" if self.mode == "full" and (self.hidden or self.unpinnable) else "confirmed"
+            if self.status == "incomplete" and not self.hidden and self._finger_probe_next():
+                self.status = "verifying"
             if self.status == "confirmed" and self.mode == "full" and self._probes_admitted():
                 todo = [f for f in unmeasured_middles(cls.model, self.check.world_from_model, tree.data,
                                                       self._reach[cls.name][0]) if f not in self.middles_unprobed]
@@ -937,12 +974,20 @@ class Verifier:
             self.status = "verifying"
             got = self.coverage.measured() if self.coverage is not None else 0
             if got > self._progress[0]:
+                self._measuring += self._progress[0] >= 0  # not the first verdict, before any move
+                self._no_move = 0
                 self._progress = (got, self.moves)
                 self._travelled.clear()
                 self._visited.clear()
-            elif self.moves - max(self._progress[1], self._relocated) >= STALL_MOVES:
+            elif self.moves - max(self._progress[1], self._relocated) >= self._stall_moves():
                 self.status = "incomplete"
-            if self.moves >= self.move_budget():
+            elif self._no_move >= NO_MOVE_DECISIONS:
+                self.status = "incomplete"
+                self.stuck = True
+            # a verification still measuring goes on: on the hand failed moves and returns come between those that
+            # measure, and a budget of all moves ended trapezohedron_12 of the formula corpus (18 vertices in reach)
+            # two moves after it last measured one
+            if self.moves - self._measuring >= self.move_budget() or self.moves >= BUDGET_CAP * self.move_budget():
                 self.status = "incomplete"
         if self.status in ("confirmed", "incomplete"):  # the final word: the statistical acceptance test
             self.accept = acceptance(cls.model, tree.data, it, self.check.world_from_model, k_sigma=self.k_sigma,
@@ -950,6 +995,28 @@ class Verifier:
             if not self.accept.ok:
                 self.status = "rejected"
         return self.status
+
+    def _ways_done(self) -> set[tuple]:
+        """The ways (:func:`outcome_key`) not to travel again to measure nothing: each one travelled since the last
+        feature measured; on the hand each one travelled :data:`HAND_WAYS_AGAIN` times (a move ends where the pad
+        stops, and going back once can be the way on)."""
+        times = 1 if self.config.table_z is None else HAND_WAYS_AGAIN
+        return {k for k, n in self._travelled.items() if n >= times}
+
+    def _stall_moves(self) -> int:
+        """Verification moves in a row measuring nothing missing after which it ends (:data:`STALL_MOVES`; on the
+        hand :data:`HAND_STALL_MOVES`)."""
+        return STALL_MOVES if self.config.table_z is None else HAND_STALL_MOVES
+
+    def _finger_probe_next(self) -> bool:
+        """Whether a probe by another finger is to measure a face of the table vertices still unplaced
+        (:attr:`finger_faces`, kept as its pending move)."""
+        ff = self.finger_faces
+        if ff is None or not self.unpinnable or self._hyp is None or self._hyp.world_from_model is None:
+            return False
+        if ff.pending is not None:
+            return True
+        return ff.next(self._hyp, self.unpinnable, self.coverage.faces, self.config) is not None
 
     def _probes_admitted(self) -> bool:
         return self.config.moves != "tracing" and self.config.table_z is None and MAX_VERIFY_PROBES > 0
@@ -1015,12 +1082,19 @@ class Verifier:
             if self.unpinnable:
                 where.append(f"{len(self.unpinnable)} on the table with neither an edge rising from them nor two of "
                              "their faces in reach")  # fmt: skip
+                ff = self.finger_faces
+                why = (ff.unmeasured(self.unpinnable, self._hyp, self.coverage.faces, self.config)
+                       if ff is not None and self._hyp is not None and not self.hidden else "")  # fmt: skip
+                if why:
+                    where[-1] += f" ({why})"
             return (f"verification incomplete: vertices of {self._model_name} {' and '.join(where)} (a difference "
                     "there cannot be measured)")  # fmt: skip
         if self.status == "incomplete" and self.coverage is not None:
             f, e, v = (len(x) for x in self.coverage.missing(self.mode))
+            why = (": no admissible move left toward them (every move from where the hand stopped failed or is left "
+                   "out)") if self.stuck else ""
             return (f"verification incomplete after {self.moves} moves: {f} faces, {e} edges, {v} vertices of "
-                    f"{self._model_name} not measured")  # fmt: skip
+                    f"{self._model_name} not measured{why}")  # fmt: skip
         return ""
 
     def choose(
@@ -1032,6 +1106,10 @@ class Verifier:
         ``probed``: the probes' lines so far (not probed again)."""
         t0 = time.perf_counter()
         self.moves += 1
+        if self.finger_faces is not None and self.finger_faces.pending is not None:
+            move = self.finger_faces.take()
+            self.decision_times.append(time.perf_counter() - t0)
+            return move
         if self._hyp is not None and self._hyp.world_from_model is not None:
             h = self._hyp
         if self.middles and h.world_from_model is not None:
@@ -1049,11 +1127,13 @@ class Verifier:
                 and self._data is not None):
             due = frozenset(unmeasured_middles(h.poly, h.world_from_model, self._data, faces_ok))
         move, self._tour, now = plan_verification_move(h, state, components, missing, self.noise, self.config,
-                                                       avoid, probed, faces_ok, previous, self._travelled,
+                                                       avoid, probed, faces_ok, previous, self._ways_done(),
                                                        self._visited, relocate, self._failed_crossings,
                                                        due)  # fmt: skip
         if relocate and move is not None and move.kind == "probe":
             self._relocated = self.moves
+        if self.config.table_z is not None and h.world_from_model is not None:
+            self._no_move = self._no_move + 1 if move is None else 0
         self._visited.append(np.array(state.position, float))
         self._tour_model = h.poly
         if move is not None and move.kind != "probe" and h.world_from_model is not None:
@@ -1061,7 +1141,8 @@ class Verifier:
 
             sim = simulate(h, move, state, components, self.config)
             if sim is not None and _gain(_new_features(h, sim[0]), missing) == 0:
-                self._travelled.add(outcome_key(h, move, state, sim[0], sim[1]))
+                key = outcome_key(h, move, state, sim[0], sim[1])
+                self._travelled[key] = self._travelled.get(key, 0) + 1
         if self.tour_planned is None and self._tour is not None:
             legs = _legs(self.config)
             keys = features(h.poly).index(missing)
@@ -1118,18 +1199,34 @@ class Verifier:
         -- is the edge's, not where the pad was: back on the edge after other moves, the tour's cheapest way on
         was the same edge move, and the verification went back and forth until it stalled). Failures from here
         (``avoid``) are remembered first."""
+        out = self._failed_round(h, state, avoid)
         edge = components.get(state.edge) if state.edge is not None else None
         e_m = h.edges.get(state.edge) if state.edge is not None else None
         if not isinstance(edge, DataEdge) or e_m is None:
-            return []
+            return out
         for m in avoid:
             if isinstance(m, EdgeMove):
                 d = m.sense * np.asarray(edge.direction, float)
                 if not any(e == e_m and float(d @ u) > 0.9 for e, u in self._failed_edges):
                     self._failed_edges.append((e_m, d))
-        return [EdgeMove(s) for s in (1, -1)
-                if any(e == e_m and float(s * np.asarray(edge.direction, float) @ u) > 0.9
-                       for e, u in self._failed_edges)]  # fmt: skip
+        return out + [EdgeMove(s) for s in (1, -1)
+                      if any(e == e_m and float(s * np.asarray(edge.direction, float) @ u) > 0.9
+                             for e, u in self._failed_edges)]  # fmt: skip
+
+    def _failed_round(self, h: Hypothesis, state: SensorState, avoid: Sequence[Move]) -> list[Move]:
+        """On the hand, vertex moves from ``state`` not to take again: round a model vertex across a model face,
+        the way a vertex move failed earlier in the verification. The hand's failure to circle a vertex -- the pad
+        rolling round it onto a third face, a face too small beside it -- is the vertex's: back at it by another
+        edge, the tour's cheapest way on was the same circle, and it failed again (bipyramid_12 of the formula corpus,
+        seed 1). Failures from here (``avoid``) are remembered first."""
+        v_m = h.vertices.get(state.vertex) if state.vertex is not None else None
+        if self.config.table_z is None or v_m is None:
+            return []
+        for m in avoid:
+            if isinstance(m, VertexMove) and h.faces.get(m.across_face) is not None:
+                self._failed_rounds.add((v_m, h.faces[m.across_face]))
+        return [VertexMove(f) for f in state.edge_faces
+                if (v_m, h.faces.get(f)) in self._failed_rounds]  # fmt: skip
 
     def record(self, cost: float) -> dict:
         """What was verified: the mode, the verdict, the verification's moves and cost, the pose check's worst
@@ -1158,6 +1255,8 @@ class Verifier:
             # verified up to what the hand cannot measure: every feature in its reach measured (the status says
             # whether that was all: "incomplete" with vertices hidden is this, never "confirmed")
             out["reach_complete"] = bool(self.coverage.met(self.mode))
+        if self.finger_faces is not None and self.finger_faces.asked:
+            out["finger_faces"] = self.finger_faces.record()
         if self.table_band is not None:
             # the claim: the object is the model above this height; below it, next to the table, nothing measured
             out["table_band_mm"] = round(self.table_band * 1000.0, 2)

@@ -327,3 +327,39 @@ def test_a_vertex_whose_edges_the_pad_cannot_follow_to_it_clear_of_the_table_is_
     # measured all the same, a vertex is not hidden
     measured = Coverage(frozenset(), frozenset(), frozenset(low.tolist()), f, e, v)
     assert not set(low.tolist()) & set(hidden_vertices(poly, pose, measured, table))
+
+
+def test_a_vertex_move_that_failed_round_a_model_vertex_is_not_taken_again_there():
+    """On the hand, a vertex move that failed round a model vertex across a model face (the pad rolling round the
+    vertex onto a third face) is the vertex's failure: back at that vertex later -- by another data edge, its faces
+    measured afresh -- the verifier does not offer the circle across that face again, and still offers the other.
+    Without a table (a point sensor) nothing is remembered."""
+    import dataclasses
+
+    from haptic.planning.moves import FaceMove, VertexMove
+    from haptic.planning.verify import Verifier
+
+    h, state, comps, ex = _on_a_face("BOX01", 0)
+    n = comps[state.face].normal
+    d = np.cross(n, [0.0, 0.0, 1.0] if abs(n[2]) < 0.9 else [1.0, 0.0, 0.0])
+    r = ex.execute(FaceMove(d / np.linalg.norm(d)))
+    got = [r]
+    r = ex.execute(EdgeMove(1))
+    got.append(r)
+    assert r.ok and r.state.vertex is not None and len(r.state.edge_faces) == 2
+    for res in got:
+        comps = {**comps, **{c.id: c for c in res.components}}
+    kinds = {c.id: ex.truth[c.id] for res in got for c in res.components}
+    h = dataclasses.replace(h, faces={**h.faces, **{i: m for i, (k, m) in kinds.items() if k == "face"}},
+                            edges={i: m for i, (k, m) in kinds.items() if k == "edge"},
+                            vertices={i: m for i, (k, m) in kinds.items() if k == "vertex"})  # fmt: skip
+    f1, f2 = r.state.edge_faces
+    v = Verifier("full", SensorNoise(), PlannerConfig(table_z=0.0))
+    assert v._failed_along(h, r.state, comps, ()) == []
+    assert v._failed_along(h, r.state, comps, (VertexMove(f1),)) == [VertexMove(f1)]
+    # back at the vertex by another edge, its faces measured afresh as data faces 98 and 99
+    there = dataclasses.replace(r.state, edge=None, edge_faces=(98, 99))
+    h2 = dataclasses.replace(h, faces={**h.faces, 98: h.faces[f1], 99: h.faces[f2]})
+    assert v._failed_along(h2, there, {**comps, 98: comps[f1], 99: comps[f2]}, ()) == [VertexMove(98)]
+    point = Verifier("full", SensorNoise(), PlannerConfig())
+    assert point._failed_along(h, r.state, comps, (VertexMove(f1),)) == []

@@ -1,0 +1,222 @@
+"""Probes by another finger, or a tilted one, at the faces a verification needs and the index pointing down cannot
+press: the faces of a vertex resting on the table whose place on it nothing in the pad's reach gives
+(:func:`~haptic.planning.verify.table_pins`).
+
+The verification's reach (:func:`~haptic.planning.verify.reachable_features`) is the index finger's, pointing down:
+a face leaning under at a table vertex (an octahedron on a face, a bipyramid on its side) is out of it, and so is
+the vertex's place on the table, which two of its faces' planes would give. Another finger, the thumb turned level,
+or the index tilted toward the face can press such a face (measured within 0.2° on trapezohedron_05 of the formula
+corpus). Here, for each such face, lines that a probe may follow to it (:func:`table_face_lines`): level, toward the
+face, ending past a pad position near the vertex where the pad touches that face alone, clear of the table. Which
+finger, if any, carries a line out, and the hand's way there, is the reach solver's answer
+(``PlannerConfig.finger_reach``: the hand's, with the hypothesised model at its pose); the verification asks it
+line by line (:meth:`~haptic.planning.verify.Verifier.choose`) and ends naming the faces no finger reaches.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from haptic.geometry.distance import surface_distance
+from haptic.geometry.polyhedron import Polyhedron
+from haptic.geometry.se3 import SE3
+from haptic.planning.config import PlannerConfig
+from haptic.planning.moves import ProbeMove
+
+GRID = 0.002
+"""Pad positions are weighed on a grid of this spacing over the face [m]."""
+ON_FACE = 1e-4
+"""A grid point within this of the surface is on it [m]."""
+PAD_ALONE = 3e-4
+"""Slack of the pad's clearance of the rest of the object at a pad position [m]."""
+RUN_UP = 0.03
+"""A line starts this far before the pad touches its face ..."""
+RUN_ON = 0.02
+"""... and goes on this far past it (a miss measures the face absent there) [m]."""
+POSITIONS = 3
+"""Pad positions tried per face, the nearest the vertex first, each a line (the reach solver's answer differs from
+one to the next where the object is in the hand's way)."""
+MIN_ROOM = 0.0035
+"""Pad positions with less room than this to the face's rim are not weighed [m]: the stroke that measures the face
+must span 3 mm along its principal axis and 1.5 mm across (``SegmentBounds.min_face_extent``, ``min_face_width``);
+an L of 2.9 × 2 mm (:func:`haptic.executor.placement.stroke_within`) spans 3.5 mm along its diagonal and 1.6 mm
+across, and stays on the face with this much room about its start."""
+ROOM = 0.008
+"""A pad position whose contact is at least this far from the face's rim is preferred [m]: the probe's stroke runs
+8 mm level along the face (:data:`haptic.executor.placement.PROBE_SETTINGS`), and one that leaves the face over an
+edge measures none (the first pad positions taken, nearest the vertex, were 2-4 mm from an edge, and the stroke found
+no face in 8 of 18 probes of the formula corpus's table vertices)."""
+SPREAD = 0.004
+"""Pad positions of one face at least this far apart [m]."""
+
+
+def faces_to_probe(poly: Polyhedron, world_from_model: SE3, vertices: Iterable[int], measured: frozenset[int],
+                   config: PlannerConfig) -> list[tuple[int, int]]:  # fmt: skip
+    """The faces at ``vertices`` (resting on the table) that are off the table and not ``measured``, each with its
+    vertex: (vertex, face), in the order of ``vertices``, each face once."""
+    if config.table_z is None:
+        return []
+    z = world_from_model.apply(poly.vertices)[:, 2] - config.table_z
+    out: list[tuple[int, int]] = []
+    seen: set[int] = set()
+    for v in vertices:
+        for f in (int(f) for f in poly.vertex_faces[int(v)]):
+            loop = list(poly.faces[f])
+            if f in measured or f in seen or np.all(z[loop] <= config.table_clearance):
+                continue
+            seen.add(f)
+            out.append((int(v), f))
+    return out
+
+
+def pad_positions(poly: Polyhedron, world_from_model: SE3, v: int, f: int, config: PlannerConfig) -> np.ndarray:
+    """Points of face ``f`` (world frame) where the pad touching it touches that face alone (its centre a pad's radius
+    from the rest of the object, outside it), with :data:`MIN_ROOM` to the face's rim, and its lowest point stays
+    ``config.table_clearance`` above the table;
+    those with :data:`ROOM` to the face's rim first, then the nearest vertex ``v`` first. Anywhere on the face: its
+    plane is what places the vertex, and a face leaning under is pressed clear of the table only well above it (the
+    pad's lowest point lies ``r (1 + sin lean)`` under its contact)."""
+    r = config.pad_radius
+    inv = world_from_model.inverse()
+    n = world_from_model.rotate(poly.face_normals[f])
+    vw = world_from_model.apply(poly.vertices[v])
+    a = np.cross(n, [1.0, 0.0, 0.0]) if abs(n[0]) < 0.9 else np.cross(n, [0.0, 1.0, 0.0])
+    a /= np.linalg.norm(a)
+    b = np.cross(n, a)
+    corners = world_from_model.apply(poly.vertices[list(poly.faces[f])]) - vw
+    ga = np.arange(float((corners @ a).min()), float((corners @ a).max()) + 1e-9, GRID)
+    gb = np.arange(float((corners @ b).min()), float((corners @ b).max()) + 1e-9, GRID)
+    x, y = np.meshgrid(ga, gb, indexing="ij")
+    pts = vw + x.reshape(-1, 1) * a + y.reshape(-1, 1) * b
+    if config.table_z is not None:
+        pts = pts[pts[:, 2] + r * n[2] - r - config.table_z >= config.table_clearance]
+    if not len(pts):
+        return pts
+    pts = pts[surface_distance(poly, inv.apply(pts)) < ON_FACE]
+    if not len(pts):
+        return pts
+    centres = inv.apply(pts + r * n)
+    keep = (surface_distance(poly, centres) >= r - PAD_ALONE) & ~poly.contains(centres)
+    pts = pts[keep]
+    room = _rim_distance(pts, world_from_model.apply(poly.vertices[list(poly.faces[f])]))
+    pts, room = pts[room >= MIN_ROOM], np.minimum(room[room >= MIN_ROOM], ROOM)
+    return pts[np.lexsort((np.linalg.norm(pts - vw, axis=1), -np.round(room, 4)))]
+
+
+def _rim_distance(pts: np.ndarray, loop: np.ndarray) -> np.ndarray:
+    """Distance of each of ``pts`` from the closed polygon ``loop``'s sides [m], shape (P,)."""
+    best = np.full(len(pts), np.inf)
+    for a, b in zip(loop, np.roll(loop, -1, axis=0), strict=True):
+        d = b - a
+        t = np.clip((pts - a) @ d / max(float(d @ d), 1e-18), 0.0, 1.0)
+        best = np.minimum(best, np.linalg.norm(pts - a - t[:, None] * d, axis=1))
+    return best
+
+
+def face_line(world_from_model: SE3, poly: Polyhedron, f: int, pad_point: np.ndarray, r: float) -> ProbeMove:
+    """A probe line to the pad touching face ``f`` at ``pad_point`` (world): level toward the face (along its inward
+    normal when the face is level), starting :data:`RUN_UP` before the touch and ending :data:`RUN_ON` past it; its
+    ``room`` the point's distance to the face's rim."""
+    n = world_from_model.rotate(poly.face_normals[f])
+    u = -n * np.array([1.0, 1.0, 0.0])
+    u = u / np.linalg.norm(u) if float(np.linalg.norm(u)) > 0.1 else -n
+    centre = np.asarray(pad_point, dtype=float) + r * n
+    room = float(_rim_distance(np.asarray(pad_point, dtype=float)[None],
+                               world_from_model.apply(poly.vertices[list(poly.faces[f])]))[0])  # fmt: skip
+    return ProbeMove(centre + (r - RUN_UP) * u, u, RUN_UP + RUN_ON, room=room)
+
+
+def table_face_lines(poly: Polyhedron, world_from_model: SE3, v: int, f: int, config: PlannerConfig,
+                     most: int = POSITIONS) -> list[ProbeMove]:  # fmt: skip
+    """Up to ``most`` probe lines (:func:`face_line`) to face ``f`` near vertex ``v``, at pad positions
+    (:func:`pad_positions`) at least :data:`SPREAD` apart, the nearest the vertex first; none where the pad cannot
+    touch the face alone clear of the table."""
+    picked: list[np.ndarray] = []
+    for p in pad_positions(poly, world_from_model, v, f, config):
+        if all(float(np.linalg.norm(p - q)) >= SPREAD for q in picked):
+            picked.append(p)
+            if len(picked) >= most:
+                break
+    return [face_line(world_from_model, poly, f, p, config.pad_radius) for p in picked]
+
+
+@dataclass
+class TableFaceProbes:
+    """The verification's probes of the faces at table vertices that nothing in the pad's reach places, by whichever
+    finger the hand's reach test (``reach``, ``PlannerConfig.finger_reach``) finds for each line: each face's lines
+    (:func:`table_face_lines`) asked in turn until one is reached, that probe made; a face measured leaves the list,
+    one not measured has its next line asked; a face none of whose lines any finger reaches is named as such."""
+
+    reach: Callable
+    """The reach test: (probe line, hypotheses) -> the probe with its finger and path, or None."""
+    lines: dict[int, list[ProbeMove]] = field(default_factory=dict)
+    """Each face's lines not asked yet (filled the first time the face is weighed)."""
+    no_finger: list[int] = field(default_factory=list)
+    """Faces none of whose lines any finger reaches, in the order found."""
+    no_position: list[int] = field(default_factory=list)
+    """Faces the pad cannot touch alone clear of the table anywhere (no line), in the order found."""
+    probed: dict[int, int] = field(default_factory=dict)
+    """Probes made per face."""
+    fingers: dict[str, int] = field(default_factory=dict)
+    """Probes made per finger."""
+    asked: int = 0
+    """Lines the reach test was asked about."""
+    pending: ProbeMove | None = None
+    """The probe chosen for the next verification move (None: none)."""
+
+    def next(self, h, vertices: Sequence[int], measured: frozenset[int], config: PlannerConfig) -> ProbeMove | None:
+        """The next probe for hypothesis ``h`` (a pose) at the faces of table ``vertices`` not ``measured``, kept as
+        :attr:`pending`; None when every such face's lines are used up."""
+        self.pending = None
+        for v, f in faces_to_probe(h.poly, h.world_from_model, vertices, measured, config):
+            if f not in self.lines:
+                self.lines[f] = table_face_lines(h.poly, h.world_from_model, v, f, config)
+                if not self.lines[f]:
+                    self.no_position.append(f)
+                    continue
+            while self.lines[f]:
+                line = self.lines[f].pop(0)
+                self.asked += 1
+                got = self.reach(line, [h])
+                if got is not None:
+                    self.pending = got
+                    self.probed[f] = self.probed.get(f, 0) + 1
+                    self.fingers[str(got.finger)] = self.fingers.get(str(got.finger), 0) + 1
+                    return got
+            if f not in self.probed and f not in self.no_finger and f not in self.no_position:
+                self.no_finger.append(f)
+        return None
+
+    def take(self) -> ProbeMove | None:
+        """The pending probe, once."""
+        move, self.pending = self.pending, None
+        return move
+
+    def unmeasured(self, vertices: Sequence[int], h, measured: frozenset[int], config: PlannerConfig) -> str:
+        """Why the faces at ``vertices`` are still not measured, in words ("" when no probe was weighed)."""
+        left = {f for _, f in faces_to_probe(h.poly, h.world_from_model, vertices, measured, config)}
+        none = sorted(f for f in self.no_finger if f in left)
+        room = sorted(f for f in self.no_position if f in left)
+        missed = sorted(f for f in self.probed if f in left)
+        parts = []
+        if room:
+            parts.append(f"the pad touches face{'s' if len(room) > 1 else ''} {', '.join(map(str, room))} nowhere "
+                         "clear of the table with room for a stroke")  # fmt: skip
+        if none:
+            parts.append(f"no finger reaches face{'s' if len(none) > 1 else ''} {', '.join(map(str, none))}")
+        if missed:
+            parts.append(f"face{'s' if len(missed) > 1 else ''} {', '.join(map(str, missed))} probed and not "
+                         "measured")  # fmt: skip
+        return "; ".join(parts)
+
+    def record(self) -> dict:
+        """What the probes did: lines asked, probes per finger, faces probed and faces no finger reaches."""
+        return {"asked": self.asked, "fingers": dict(self.fingers), "faces_probed": len(self.probed),
+                "no_finger": list(self.no_finger), "no_position": list(self.no_position)}  # fmt: skip
+
+
+__all__ = ["GRID", "POSITIONS", "TableFaceProbes", "faces_to_probe", "face_line", "pad_positions",
+           "table_face_lines"]

@@ -1,0 +1,159 @@
+"""Probes by another finger, or a tilted one, at the faces of table vertices the index pointing down cannot press
+(:mod:`haptic.planning.finger_faces`): the lines the verification weighs, the stroke kept within a face's room, and
+an episode of the formula corpus whose verification completes only with such probes."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from haptic.geometry import SE3, Polyhedron
+from haptic.planning.config import PlannerConfig
+from haptic.planning.finger_faces import MIN_ROOM, TableFaceProbes, faces_to_probe, pad_positions, table_face_lines
+from haptic.planning.hypothesis import Hypothesis
+from haptic.planning.moves import ProbeMove
+
+
+def _octahedron(size: float) -> tuple[Polyhedron, SE3]:
+    """A regular octahedron resting on a face (table at z = 0), ``size`` from vertex to opposite vertex [m]."""
+    a = size / 2.0
+    v = np.array([[a, 0, 0], [-a, 0, 0], [0, a, 0], [0, -a, 0], [0, 0, a], [0, 0, -a]], dtype=float)
+    faces = []
+    for sx in (0, 1):
+        for sy in (2, 3):
+            for sz in (4, 5):
+                tri = [sx, sy, sz]
+                n = np.cross(v[tri[1]] - v[tri[0]], v[tri[2]] - v[tri[0]])
+                faces.append(tri if n @ v[tri].mean(axis=0) > 0 else tri[::-1])
+    poly = Polyhedron.from_faces(v, faces, name="octahedron")
+    # onto the face (0, 2, 4)'s opposite, (1, 3, 5): its normal turned straight down, resting on z = 0
+    n = -np.ones(3) / math.sqrt(3.0)
+    axis = np.cross(n, [0.0, 0.0, -1.0])
+    angle = math.asin(float(np.linalg.norm(axis)))
+    axis /= np.linalg.norm(axis)
+    k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+    rot = np.eye(3) + math.sin(angle) * k + (1.0 - math.cos(angle)) * k @ k
+    m = np.eye(4)
+    m[:3, :3] = rot
+    m[2, 3] = -float((poly.vertices @ rot.T)[:, 2].min())
+    return poly, SE3.from_matrix(m)
+
+
+def _config() -> PlannerConfig:
+    return PlannerConfig(table_z=0.0, pad_radius=0.012, max_undercut=math.radians(10.0))
+
+
+def _table_vertices(poly, pose) -> list[int]:
+    z = pose.apply(poly.vertices)[:, 2]
+    return [int(v) for v in np.flatnonzero(z < 1e-6)]
+
+
+def test_the_faces_leaning_under_at_the_table_vertices_are_the_ones_weighed():
+    poly, pose = _octahedron(0.1)
+    config = _config()
+    got = faces_to_probe(poly, pose, _table_vertices(poly, pose), frozenset(), config)
+    z = pose.apply(poly.vertices)[:, 2]
+    assert len(got) == 6  # the bottom face rests on the table; the six around it rise from the table
+    for _, f in got:
+        assert not np.all(z[list(poly.faces[f])] < 1e-6)
+    measured = frozenset(f for _, f in got[:2])
+    assert {f for _, f in faces_to_probe(poly, pose, _table_vertices(poly, pose), measured, config)} == {
+        f for _, f in got[2:]}  # fmt: skip
+
+
+def test_a_line_meets_its_face_level_with_room_for_a_stroke():
+    poly, pose = _octahedron(0.1)
+    config = _config()
+    for v, f in faces_to_probe(poly, pose, _table_vertices(poly, pose), frozenset(), config):
+        n = pose.rotate(poly.face_normals[f])
+        lines = table_face_lines(poly, pose, v, f, config)
+        if n[2] >= 0.0:
+            continue
+        assert lines, f"face {f} leans under {np.degrees(np.arcsin(-n[2])):.0f}° and has room high on it"
+        for line in lines:
+            assert abs(float(line.direction[2])) < 1e-9  # level
+            assert line.room is not None and line.room >= MIN_ROOM - 1e-9
+            # the pad's centre along the line comes to a pad's radius off the face's plane, above the table
+            p0 = pose.apply(poly.vertices[poly.faces[f][0]])
+            t = np.linspace(0.0, line.length, 2001)
+            centres = line.start + t[:, None] * line.direction
+            d = (centres - p0) @ n
+            k = int(np.argmin(np.abs(d - config.pad_radius)))
+            assert abs(d[k] - config.pad_radius) < 1e-3
+            assert centres[k, 2] - config.pad_radius >= config.table_clearance - 1e-9
+
+
+def test_a_small_octahedron_leaves_no_room_clear_of_the_table():
+    # 30 mm from vertex to vertex: its faces leaning under rise 20 mm, and a pad pressing one (its lowest point
+    # r (1 + sin 19.5°) = 16 mm under its contact) would have to touch it above 20 mm
+    poly, pose = _octahedron(0.03)
+    config = _config()
+    for v, f in faces_to_probe(poly, pose, _table_vertices(poly, pose), frozenset(), config):
+        n = pose.rotate(poly.face_normals[f])
+        if n[2] < 0.0:
+            assert not len(pad_positions(poly, pose, v, f, config))
+
+
+def test_the_probes_ask_each_line_once_and_name_what_no_finger_reaches():
+    poly, pose = _octahedron(0.1)
+    config = _config()
+    h = Hypothesis(model="octahedron", poly=poly, world_from_model=pose, faces={}, edges={}, vertices={})
+    asked: list[ProbeMove] = []
+
+    def nobody(line, hypotheses):
+        asked.append(line)
+        return None
+
+    probes = TableFaceProbes(nobody)
+    vertices = _table_vertices(poly, pose)
+    assert probes.next(h, vertices, frozenset(), config) is None
+    assert probes.next(h, vertices, frozenset(), config) is None
+    n_lines = sum(len(table_face_lines(poly, pose, v, f, config))
+                  for v, f in faces_to_probe(poly, pose, vertices, frozenset(), config))  # fmt: skip
+    assert len(asked) == n_lines == probes.asked
+    assert "no finger reaches" in probes.unmeasured(vertices, h, frozenset(), config)
+
+    def thumb(line, hypotheses):
+        return ProbeMove(line.start, line.direction, line.length, finger="thumb", room=line.room)
+
+    probes = TableFaceProbes(thumb)
+    got = probes.next(h, vertices, frozenset(), config)
+    assert got is not None and got.finger == "thumb" and probes.take() is got and probes.take() is None
+    assert probes.fingers == {"thumb": 1}
+
+
+def test_the_stroke_is_kept_within_the_faces_room():
+    from haptic.executor.placement import PROBE_SETTINGS, stroke_within
+
+    assert stroke_within(PROBE_SETTINGS, 0.02) == PROBE_SETTINGS
+    s = stroke_within(PROBE_SETTINGS, MIN_ROOM)
+    assert math.hypot(s.stroke, s.stroke_across) <= MIN_ROOM + 1e-9
+    # the L still spans what a face's stroke must: 3 mm along its diagonal, 1.5 mm across
+    assert math.hypot(s.stroke, s.stroke_across) >= 0.003
+    assert s.stroke * s.stroke_across / math.hypot(s.stroke, s.stroke_across) >= 0.0015
+
+
+@pytest.mark.slow
+def test_a_verification_completes_with_probes_by_a_turned_finger(tmp_path):
+    # trapezohedron_05 of the sized formula corpus (seed 1) rests with two vertices on the table whose faces lean
+    # under 35°: the index pointing down cannot press them, and the verification ended incomplete ("2 on the table
+    # with neither an edge rising from them nor two of their faces in reach"). The reach solver finds a finger and
+    # a wrist turn for a level line onto each face; the probes measure them, and the model is confirmed.
+    from haptic.episode.loop import EpisodeObserver
+    from haptic.episode.spec import EpisodeSpec
+    from haptic.episode.worlds import run_episode
+    from tests.test_episode_physics import _sized_corpus
+
+    moves = []
+    obs = EpisodeObserver(on_move=lambda i, res, *a: moves.append(res), on_failed_move=lambda i, res: moves.append(res))
+    rec = run_episode(EpisodeSpec(model="trapezohedron_05", seed=1, executor="physics", verify="full",
+                                  models=_sized_corpus(tmp_path)), observer=obs)  # fmt: skip
+    assert rec.outcome == "recognized" and rec.correct, rec.detail
+    by_finger = [r for r in moves if r.move.kind == "probe" and r.move.finger is not None]
+    assert by_finger, "no probe by a named finger"
+    assert all(r.move.path is not None for r in by_finger)  # the planner's path, from the reach solver
+    measured = [r for r in by_finger if r.ok and r.components]
+    assert len(measured) >= 2
+    assert rec.verified["finger_faces"]["faces_probed"] >= 2
