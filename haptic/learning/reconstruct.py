@@ -215,9 +215,6 @@ def fit_plane(points: np.ndarray, normals: np.ndarray, position_bound: float, no
     return n / np.linalg.norm(n), float(centre @ n)
 
 
-SIDE_MISFIT = 1.0
-"""A face the side of a fold's edge sends to the other half's group stays where its misfit there (:func:`_misfit`)
-is this much more than in its own group [-]."""
 FOLD_NEAR = 2.0
 """A data face whose every touched point lies within this many times its and a shallow data edge's position bounds
 of that edge (:func:`at_shallow_folds`) is grouped after the others [-]."""
@@ -270,15 +267,12 @@ def _fold_sides(groups: list[list[DataFace]], components: Mapping[int, DataCompo
     Two groups divided by data edges whose planes meet at less than :data:`FOLD_FACTOR` times their normals'
     bounds are the halves of a face folded by under a degree or so (a vertex moved almost in its faces' planes):
     there a touched point lies on both planes within its bound, so agreement grouped the faces by the order they
-    came in, each half's group holding faces of both. The data edges between them measure the fold's line; each
-    group keeps the side most of its faces lie on, and every face of either group whose points all lie on one side,
-    clear of the line by
-    :data:`FOLD_NEAR` times the bounds and within the fold's measured extent, goes to that side's group where it
-    agrees with that group's plane and fits it not clearly worse than its own (:data:`SIDE_MISFIT`), unless a data
-    edge divides it from a face there; a face on the line, to the side opposite the faces its data edges divide it
-    from, or the side of its point beside the fold's edge (a point touched on it beside the edge). A fold the sides
-    would leave with two faces in one group that a data edge divides is left as it is. Groups left empty are
-    dropped."""
+    came in, each half's group holding faces of both. The data edges between them measure the fold's line, and
+    their side points (a point touched on each face beside the edge) say which side of it each group's half
+    lies on; every face of either group whose points all lie on one side, clear of the line by
+    :data:`FOLD_NEAR` times the bounds and within the fold's measured extent, goes to that side's group
+    unless a data edge divides it from a face there. A fold whose side points disagree is left as it is. Groups
+    left empty are dropped."""
     groups = [list(g) for g in groups]
     plane_of = {f.id: k for k, g in enumerate(groups) for f in g}
     between: dict[tuple[int, int], list[DataEdge]] = {}
@@ -316,28 +310,8 @@ def _fold_sides(groups: list[list[DataFace]], components: Mapping[int, DataCompo
                     s = float((np.asarray(q) - centre) @ w)
                     if abs(s) > FOLD_NEAR * (components[f].position_bound + bound):
                         side[f] = float(np.sign(s))
-        both = [*groups[a], *groups[b]]
-        # the side each group keeps: the one most of its faces are on (the fewest faces move; either on a tie)
-        votes = sum(side.get(f.id, 0.0) for f in groups[a]) - sum(side.get(f.id, 0.0) for f in groups[b])
-        to = {(1.0 if votes >= 0 else -1.0): a, (-1.0 if votes >= 0 else 1.0): b}
-        # a face goes to the other group only where it agrees with that group's plane, and fits it not clearly worse
-        # than its own (by :data:`SIDE_MISFIT`): a face that is not convex (an L's side) can reach across the fold's
-        # line beyond the fold, where the planes are far apart
-        agree = {}
-        for k in (a, b):
-            pts = np.concatenate([x.points for x in groups[k]])
-            pb_k = max(x.position_bound for x in groups[k])
-            agree[k] = (fits[k][0], fits[k][1], pts, fits[k][2], pb_k)
-        for f in both:
-            here = plane_of[f.id]
-            if f.id not in side or to[side[f.id]] == here:
-                continue
-            n_k, d_k, pts, nb_k, pb_k = agree[to[side[f.id]]]
-            n_h, d_h, _, nb_h, pb_h = agree[here]
-            if not _same_plane(f, n_k, d_k, pts, nb_k, pb_k) or (
-                    _misfit(f, n_k, d_k, nb_k, pb_k) > _misfit(f, n_h, d_h, nb_h, pb_h) + SIDE_MISFIT):
-                del side[f.id]
         # a face near the line whose data edge divides it from a face on one side is on the other
+        both = [*groups[a], *groups[b]]
         grown = True
         while grown:
             grown = False
@@ -348,6 +322,9 @@ def _fold_sides(groups: list[list[DataFace]], components: Mapping[int, DataCompo
                 if len(across) == 1:
                     side[f.id] = -next(iter(across))
                     grown = True
+        # the side each group keeps: the one most of its faces are on (the fewest faces move; either on a tie)
+        votes = sum(side.get(f.id, 0.0) for f in groups[a]) - sum(side.get(f.id, 0.0) for f in groups[b])
+        to = {(1.0 if votes >= 0 else -1.0): a, (-1.0 if votes >= 0 else 1.0): b}
         new_a = [f for f in both if to.get(side.get(f.id), plane_of[f.id]) == a]
         new_b = [f for f in both if to.get(side.get(f.id), plane_of[f.id]) == b]
         ids_a, ids_b = {f.id for f in new_a}, {f.id for f in new_b}

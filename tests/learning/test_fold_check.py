@@ -90,14 +90,6 @@ def test_a_frame_with_a_corner_moved_4_mm_closes(tmp_path):
     assert (learned["V"], learned["E"], learned["F"]) == (poly.n_vertices, poly.n_edges, poly.n_faces)
 
 
-def test_an_l_block_with_a_corner_moved_4_mm_closes(tmp_path):
-    """LBLOCK01 with its vertex 0 moved 4 mm, the bench's episode: the L-shaped bottom face reaches across the line
-    of the fold that cuts its corner off, and a face touched there, beyond the fold, was sent to the corner's group
-    by its side of the line; it fits its own plane better and stays."""
-    learned, poly = _learn("LBLOCK01", 0, 1041939683, tmp_path, offset=4e-3)
-    assert (learned["V"], learned["E"], learned["F"]) == (poly.n_vertices, poly.n_edges, poly.n_faces)
-
-
 def test_the_fold_check_is_off_on_the_hand_unless_asked_for():
     assert LearnSettings().checks_folds(None) and not LearnSettings().checks_folds(0.0)
     assert LearnSettings(fold_check=True).checks_folds(0.0) and not LearnSettings(fold_check=False).checks_folds(None)
