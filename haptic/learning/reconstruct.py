@@ -339,13 +339,11 @@ def _fold_sides(groups: list[list[DataFace]], components: Mapping[int, DataCompo
 
 
 def face_planes(components: Mapping[int, DataComponent], fold_vertices: bool = False) -> list[Plane]:
-    """The object's planes: the data faces grouped by agreement (in order of acquisition, those touched only at a
-    shallow fold last (:func:`at_shallow_folds`), each joining the plane it agrees with best, by normal, but never
-    one that holds a face a data edge divides it from: two faces that meet at an edge are two planes, however small
-    the angle between them; a shallow fold's two groups then regrouped by the side of its edge each face lies on,
-    :func:`_fold_sides`), each group fitted to its points, edge ends and vertices (:func:`fit_plane`). A fold's two
-    planes are fitted through the line of the edge between them, and with ``fold_vertices`` through the vertices
-    measured at that edge's ends too (:func:`_fold_vertices`)."""
+    """The object's planes: the data faces grouped by agreement (in order of acquisition, each joining the plane
+    it agrees with best, by normal, but never one that holds a face a data edge divides it from: two faces that
+    meet at an edge are two planes, however small the angle between them), each group fitted to its points,
+    edge ends and vertices (:func:`fit_plane`). A fold's two planes are fitted through the line of the edge between
+    them, and with ``fold_vertices`` through the vertices measured at that edge's ends too (:func:`_fold_vertices`)."""
     faces = [c for c in components.values() if isinstance(c, DataFace)]
     faces.sort(key=lambda c: c.id)
     ef = edge_faces(components)
