@@ -30,7 +30,14 @@ from haptic.learning.folds import crosses
 from haptic.matching.components import DataComponent, DataEdge, DataFace
 from haptic.planning.config import PlannerConfig
 from haptic.planning.move_scores import same_move
-from haptic.planning.moves import EdgeMove, FaceMove, Move, SensorState, VertexMove
+from haptic.planning.moves import EdgeMove, FaceMove, Move, ProbeMove, SensorState, VertexMove
+
+FOLD_PROBE_AFTER = 2
+"""Fold moves off the faces with diagonals left to cross that crossed none, after which the fold check probes
+(:meth:`BoundaryWalk.fold_move`)."""
+FOLD_PROBE_STANDOFF = 1.0
+"""A fold check's probe starts this many times the data's size outside the face it is aimed at (outside every
+measured point) [-]."""
 
 
 @dataclass(eq=False)
@@ -273,11 +280,15 @@ class BoundaryWalk:
     # ------------------------------------------------------------------------------------------ fold check
 
     def fold_move(self, state: SensorState, avoid: tuple[Move, ...], targets: list[tuple[int, np.ndarray, np.ndarray]],
-                  turn: int = 0) -> Move | None:
+                  turn: int = 0, stalled: int = 0) -> Move | None:
         """A face move for the fold check (:mod:`haptic.learning.folds`), ``targets`` the diagonals left to cross
         ``(plane, one end, the other)``: on a face with some, the move across it that crosses the most of them
         before it meets the face's boundary (aimed at each one's middle); elsewhere, toward the nearest one's
-        middle (onto the next face that way); None when no such move is left."""
+        middle (onto the next face that way); None when no such move is left. Elsewhere after
+        :data:`FOLD_PROBE_AFTER` moves that crossed no diagonal (``stalled``), where the move set admits probes, a
+        probe onto the nearest one's middle (:meth:`fold_probe`): the way toward a middle can lead onto a face whose
+        own way toward it leads back (BOX01N with a vertex moved 2 mm went back and forth between two faces of its
+        notch until the check gave up, and the learned model had a face and an edge too few)."""
         face = self.components.get(state.face)
         if not isinstance(face, DataFace) or not targets:
             return None
@@ -299,6 +310,9 @@ class BoundaryWalk:
                 scored.append((-got, float(np.linalg.norm(end - state.position)), len(scored), u))
             dirs = [u for *_, u in sorted(scored, key=lambda x: x[:3])]
         else:
+            probe = self.fold_probe(state, avoid, targets) if stalled >= FOLD_PROBE_AFTER else None
+            if probe is not None:
+                return probe
             mids = np.array([0.5 * (a + b) for _, a, b in targets]) - state.position
             mids = mids - np.outer(mids @ n, n)
             norms = np.linalg.norm(mids, axis=1)
@@ -308,6 +322,20 @@ class BoundaryWalk:
             if not any(same_move(move, bad) for bad in avoid):
                 return move
         return self._face_move(state, avoid, turn)
+
+    def fold_probe(self, state: SensorState, avoid: tuple[Move, ...],
+                   targets: list[tuple[int, np.ndarray, np.ndarray]]) -> Move | None:
+        """A probe onto the middle of the nearest of ``targets``' diagonals along its plane's normal, from
+        :data:`FOLD_PROBE_STANDOFF` times the data's size outside it, when the move set admits probes and the
+        sensor is a point (no table); None otherwise or when one was tried from here (``avoid``)."""
+        if self.config.moves == "tracing" or self.config.table_z is not None:
+            return None
+        mids = [(float(np.linalg.norm(0.5 * (a + b) - state.position)), k, 0.5 * (a + b)) for k, a, b in targets]
+        _, k, mid = min(mids, key=lambda x: x[0])
+        n = self.est.planes[k].normal
+        far = FOLD_PROBE_STANDOFF * max(self.est.bounds.size, 1e-3)
+        move = ProbeMove(mid + far * n, -n, far + far)
+        return None if any(same_move(move, bad) for bad in avoid) else move
 
     def _exit(self, start: np.ndarray, u: np.ndarray, p: int | None) -> np.ndarray:
         """Where the path from ``start`` along ``u`` first meets an edge of plane ``p``'s faces (the traced loops)

@@ -251,8 +251,9 @@ class ClosureMoves(MoveSource):
                 return None
             walk = BoundaryWalk(self.boundary, self.components, view.config)
             if self._folds_only:
+                stalled = self.moves - self._fold_best[1] if self._fold_best is not None else 0
                 return walk.fold_move(view.sensor, tuple(view.failed_here), self.fold_targets(),
-                                      turn=self.moves + len(view.failed_here))  # fmt: skip
+                                      turn=self.moves + len(view.failed_here), stalled=stalled)  # fmt: skip
             move = walk.best_move(view.sensor, tuple(view.failed_here), turn=self.moves + len(view.failed_here))
             return move
         if self.estimate is None:

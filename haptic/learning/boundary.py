@@ -281,13 +281,24 @@ def _half_edges(est: BoundaryEstimate) -> dict[int, list[tuple[int, int, int]]]:
         d = est.positions[b] - est.positions[a]
         for p in be.planes:
             w = np.cross(est.planes[p].normal, d)
-            side = [float((q - est.positions[a]) @ w) for q in be.sides.get(p, [])]
-            if not side:
+            side = np.array([float((q - est.positions[a]) @ w) for q in be.sides.get(p, [])])
+            if not len(side):
                 est.problems.append(f"edge {k} has no measured point on the face of plane {p}")
                 continue
-            left = float(np.sum(np.sign(side))) > 0
+            left = _left(side / float(np.linalg.norm(w)), est.bounds.position)
             out.setdefault(p, []).append((a, b, k) if left else (b, a, k))
     return out
+
+
+def _left(side: np.ndarray, bound: float) -> bool:
+    """Whether the points beside an edge at signed distances ``side`` from it [m] put its face on the left: by the
+    points farther from it than the data's position ``bound``, most of them; by the farthest when none is. A
+    point touched on the edge itself (an edge traced again, a move along it) is on either side within its
+    bound, and such points outvoted the one touched on the face beside it."""
+    clear = side[np.abs(side) > bound]
+    if not len(clear) or float(np.sum(np.sign(clear))) == 0.0:
+        return float(side[int(np.argmax(np.abs(side)))]) > 0
+    return float(np.sum(np.sign(clear))) > 0
 
 
 def _trace_faces(est: BoundaryEstimate) -> None:

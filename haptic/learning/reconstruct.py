@@ -215,12 +215,160 @@ def fit_plane(points: np.ndarray, normals: np.ndarray, position_bound: float, no
     return n / np.linalg.norm(n), float(centre @ n)
 
 
+SIDE_MISFIT = 1.0
+"""A face the side of a fold's edge sends to the other half's group stays where its misfit there (:func:`_misfit`)
+is this much more than in its own group [-]."""
+FOLD_NEAR = 2.0
+"""A data face whose every touched point lies within this many times its and a shallow data edge's position bounds
+of that edge (:func:`at_shallow_folds`) is grouped after the others [-]."""
+
+
+def _segment_distance(points: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Distance of each of ``points`` from the segment ``a``-``b`` [m]."""
+    ab = b - a
+    t = np.clip((points - a) @ ab / max(float(ab @ ab), BOUND_FLOOR**2), 0.0, 1.0)
+    return np.linalg.norm(points - a - t[:, None] * ab[None], axis=1)
+
+
+def at_shallow_folds(components: Mapping[int, DataComponent], faces: Iterable[DataFace],
+                     ef: Mapping[int, set[int]]) -> set[int]:
+    """Ids of the data ``faces`` touched only at a shallow fold: every point within :data:`FOLD_NEAR` times the
+    bounds of a data edge between two data faces whose normals agree within their bounds (``ef``:
+    :func:`edge_faces`). A vertex moved a few millimetres folds its faces by under a degree: near the fold a
+    point lies on both halves' planes within its bound, and the normal there agrees with both, so nothing but
+    the edges that divide the face from others says which half it is on (at the moved corner, no point
+    can)."""
+    shallow = []
+    for eid, fs in ef.items():
+        side = [components[f] for f in fs if isinstance(components.get(f), DataFace)]
+        if any(float(np.arccos(np.clip(a.normal @ b.normal, -1.0, 1.0))) <= a.normal_bound + b.normal_bound
+               for i, a in enumerate(side) for b in side[i + 1:]):  # fmt: skip
+            shallow.append(components[eid])
+    out = set()
+    for f in faces:
+        pts = np.asarray(f.points, float).reshape(-1, 3)
+        for e in shallow:
+            tol = FOLD_NEAR * (f.position_bound + e.position_bound)
+            if len(pts) and (_segment_distance(pts, e.point, e.end_point) <= tol).all():
+                out.add(f.id)
+                break
+    return out
+
+
+def _group_fit(g: list[DataFace]) -> tuple[np.ndarray, float, float]:
+    """The plane ``(n, d)`` of a group of data faces (:func:`fit_plane`) and its normals' bound [rad]."""
+    nb = max(x.normal_bound for x in g)
+    n, d = fit_plane(np.concatenate([x.points for x in g]), np.array([x.normal for x in g]),
+                     max(x.position_bound for x in g), nb)  # fmt: skip
+    return n, d, nb
+
+
+def _fold_sides(groups: list[list[DataFace]], components: Mapping[int, DataComponent],
+                ef: Mapping[int, set[int]], apart: Mapping[int, set[int]]) -> list[list[DataFace]]:
+    """``groups`` with the faces of each shallow fold's two groups regrouped by the side of the fold they lie on.
+
+    Two groups divided by data edges whose planes meet at less than :data:`FOLD_FACTOR` times their normals'
+    bounds are the halves of a face folded by under a degree or so (a vertex moved almost in its faces' planes):
+    there a touched point lies on both planes within its bound, so agreement grouped the faces by the order they
+    came in, each half's group holding faces of both. The data edges between them measure the fold's line; each
+    group keeps the side most of its faces lie on, and every face of either group whose points all lie on one side,
+    clear of the line by
+    :data:`FOLD_NEAR` times the bounds and within the fold's measured extent, goes to that side's group where it
+    agrees with that group's plane and fits it not clearly worse than its own (:data:`SIDE_MISFIT`), unless a data
+    edge divides it from a face there; a face on the line, to the side opposite the faces its data edges divide it
+    from, or the side of its point beside the fold's edge (a point touched on it beside the edge). A fold the sides
+    would leave with two faces in one group that a data edge divides is left as it is. Groups left empty are
+    dropped."""
+    groups = [list(g) for g in groups]
+    plane_of = {f.id: k for k, g in enumerate(groups) for f in g}
+    between: dict[tuple[int, int], list[DataEdge]] = {}
+    for eid, fs in ef.items():
+        ks = sorted({plane_of[f] for f in fs if f in plane_of})
+        if len(ks) == 2:
+            between.setdefault((ks[0], ks[1]), []).append(components[eid])
+    fits = {k: _group_fit(g) for k, g in enumerate(groups)}
+    order = sorted(between.items(), key=lambda kv: -sum(e.length for e in kv[1]))
+    for (a, b), edges in order:
+        (na, _, ba), (nb_, _, bb) = fits[a], fits[b]
+        if float(np.arccos(np.clip(na @ nb_, -1.0, 1.0))) >= FOLD_FACTOR * (ba + bb):
+            continue
+        ends = np.array([p for e in edges for p in (e.point, e.end_point)])
+        centre = ends.mean(axis=0)
+        _, sv, vt = np.linalg.svd(ends - centre)
+        if sv[0] < BOUND_FLOOR:
+            continue
+        u = vt[0]
+        n = na + nb_
+        w = np.cross(n / np.linalg.norm(n), u)
+        span = (ends - centre) @ u
+        lo, hi = float(span.min()), float(span.max())
+        bound = max(e.position_bound for e in edges)
+        side: dict[int, float] = {}  # face id -> the side of the line its points lie on (+1, -1)
+        for f in [*groups[a], *groups[b]]:
+            q = np.asarray(f.points, float).reshape(-1, 3) - centre
+            s, t = q @ w, q @ u
+            tol = FOLD_NEAR * (f.position_bound + bound)
+            if len(q) and (t >= lo).all() and (t <= hi).all() and ((s > tol).all() or (s < -tol).all()):
+                side[f.id] = float(np.sign(s[0]))
+        for e in edges:  # a face touched on the line itself: the side its point beside the edge is on
+            for f, q in e.side_points:
+                if plane_of.get(f) in (a, b) and f not in side:
+                    s = float((np.asarray(q) - centre) @ w)
+                    if abs(s) > FOLD_NEAR * (components[f].position_bound + bound):
+                        side[f] = float(np.sign(s))
+        both = [*groups[a], *groups[b]]
+        # the side each group keeps: the one most of its faces are on (the fewest faces move; either on a tie)
+        votes = sum(side.get(f.id, 0.0) for f in groups[a]) - sum(side.get(f.id, 0.0) for f in groups[b])
+        to = {(1.0 if votes >= 0 else -1.0): a, (-1.0 if votes >= 0 else 1.0): b}
+        # a face goes to the other group only where it agrees with that group's plane, and fits it not clearly worse
+        # than its own (by :data:`SIDE_MISFIT`): a face that is not convex (an L's side) can reach across the fold's
+        # line beyond the fold, where the planes are far apart
+        agree = {}
+        for k in (a, b):
+            pts = np.concatenate([x.points for x in groups[k]])
+            pb_k = max(x.position_bound for x in groups[k])
+            agree[k] = (fits[k][0], fits[k][1], pts, fits[k][2], pb_k)
+        for f in both:
+            here = plane_of[f.id]
+            if f.id not in side or to[side[f.id]] == here:
+                continue
+            n_k, d_k, pts, nb_k, pb_k = agree[to[side[f.id]]]
+            n_h, d_h, _, nb_h, pb_h = agree[here]
+            if not _same_plane(f, n_k, d_k, pts, nb_k, pb_k) or (
+                    _misfit(f, n_k, d_k, nb_k, pb_k) > _misfit(f, n_h, d_h, nb_h, pb_h) + SIDE_MISFIT):
+                del side[f.id]
+        # a face near the line whose data edge divides it from a face on one side is on the other
+        grown = True
+        while grown:
+            grown = False
+            for f in both:
+                if f.id in side:
+                    continue
+                across = {side[x] for x in apart.get(f.id, ()) if x in side}
+                if len(across) == 1:
+                    side[f.id] = -next(iter(across))
+                    grown = True
+        new_a = [f for f in both if to.get(side.get(f.id), plane_of[f.id]) == a]
+        new_b = [f for f in both if to.get(side.get(f.id), plane_of[f.id]) == b]
+        ids_a, ids_b = {f.id for f in new_a}, {f.id for f in new_b}
+        if not new_a or not new_b or any(apart.get(f, set()) & ids for ids in (ids_a, ids_b) for f in ids):
+            continue  # a face the sides leave with one a data edge divides it from: the fold is left as it was
+        groups[a], groups[b] = new_a, new_b
+        plane_of.update({f: a for f in ids_a} | {f: b for f in ids_b})
+        for k in (a, b):
+            if groups[k]:
+                fits[k] = _group_fit(groups[k])
+    return [g for g in groups if g]
+
+
 def face_planes(components: Mapping[int, DataComponent], fold_vertices: bool = False) -> list[Plane]:
-    """The object's planes: the data faces grouped by agreement (in order of acquisition, each joining the plane
-    it agrees with best, by normal, but never one that holds a face a data edge divides it from: two faces that
-    meet at an edge are two planes, however small the angle between them), each group fitted to its points,
-    edge ends and vertices (:func:`fit_plane`). A fold's two planes are fitted through the line of the edge between
-    them, and with ``fold_vertices`` through the vertices measured at that edge's ends too (:func:`_fold_vertices`)."""
+    """The object's planes: the data faces grouped by agreement (in order of acquisition, those touched only at a
+    shallow fold last (:func:`at_shallow_folds`), each joining the plane it agrees with best, by normal, but never
+    one that holds a face a data edge divides it from: two faces that meet at an edge are two planes, however small
+    the angle between them; a shallow fold's two groups then regrouped by the side of its edge each face lies on,
+    :func:`_fold_sides`), each group fitted to its points, edge ends and vertices (:func:`fit_plane`). A fold's two
+    planes are fitted through the line of the edge between them, and with ``fold_vertices`` through the vertices
+    measured at that edge's ends too (:func:`_fold_vertices`)."""
     faces = [c for c in components.values() if isinstance(c, DataFace)]
     faces.sort(key=lambda c: c.id)
     ef = edge_faces(components)
@@ -230,7 +378,10 @@ def face_planes(components: Mapping[int, DataComponent], fold_vertices: bool = F
             apart.setdefault(a, set()).update(b for b in fs if b != a)
     groups: list[list[DataFace]] = []
     fitted: list[tuple[np.ndarray, float, np.ndarray, float, float]] = []
-    for f in faces:
+    # a face touched only at a shallow fold agrees with both halves' planes: grouped after every other face, where
+    # the data edges that divide it from faces of one half leave it the other
+    late = at_shallow_folds(components, faces, ef)
+    for f in [x for x in faces if x.id not in late] + [x for x in faces if x.id in late]:
         agree = [
             (_misfit(f, n, d, nb, pb), k)
             for k, (n, d, pts, nb, pb) in enumerate(fitted)
@@ -276,6 +427,7 @@ def face_planes(components: Mapping[int, DataComponent], fold_vertices: bool = F
             moved = True
         if not moved:
             break
+    groups = _fold_sides(groups, components, ef, apart)
     # the edges and vertices on each plane join its fit
     plane_of = {f.id: k for k, g in enumerate(groups) for f in g}
     extra: list[list[np.ndarray]] = [[] for _ in groups]

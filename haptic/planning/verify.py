@@ -13,7 +13,9 @@ not taken again (:func:`outcome_key`): either kept the verification going back a
 
 Where the move set admits probes (``--moves probing|all``) and the sensor is a point (no table: the geometric
 executor), a free-space probe may carry the sensor to a face beside where the tour is cheapest to enter
-(:func:`verification_probes`). The verification's move budget follows the model (:func:`verify_move_budget`).
+(:func:`verification_probes`); under ``full``, where a face at the vertex still has its middle to be probed
+(:func:`unmeasured_middles`), the probe may land at that middle instead, which then needs no probe of its own
+(:data:`MIDDLE_CREDIT`). The verification's move budget follows the model (:func:`verify_move_budget`).
 """
 
 from __future__ import annotations
@@ -26,13 +28,14 @@ from dataclasses import replace
 import numpy as np
 
 from haptic.geometry.polyhedron import Polyhedron
+from haptic.geometry.raycast import line_hits
 from haptic.geometry.se3 import SE3
 from haptic.matching.acceptance import TablePin
 from haptic.matching.components import DataComponent, DataEdge, DataFace, SensorNoise
 from haptic.planning.config import PlannerConfig
 from haptic.planning.finger_faces import TableFaceProbes
 from haptic.planning.hypothesis import Hypothesis
-from haptic.planning.moves import EdgeMove, FaceMove, Move, SensorState, VertexMove
+from haptic.planning.moves import EdgeMove, FaceMove, Move, ProbeMove, SensorState, VertexMove
 from haptic.planning.predict import candidate_moves, predict_moves
 from haptic.planning.table import _inward, descent_risk, hidden_concave_end
 from haptic.planning.tour import (
@@ -458,6 +461,7 @@ def verification_probes(
     h: Hypothesis, state: SensorState, components: Mapping[int, DataComponent],
     missing: tuple[frozenset[int], frozenset[int], frozenset[int]], noise: SensorNoise, config: PlannerConfig,
     avoid: Sequence[Move] = (), probed: Sequence[Move] = (), faces_ok: frozenset[int] | None = None,
+    middles: frozenset[int] = frozenset(),
 ) -> list[tuple[Move, float, float]]:
     """Free-space probes that carry the sensor to what of hypothesis ``h``'s model is still missing, with their
     predicted cost and risk, when the configuration admits probes (``config.moves``): a probe measures no edge
@@ -465,9 +469,46 @@ def verification_probes(
     there costs ``c_f`` per metre of face and ``c_e`` per metre of edge. Lines (:func:`~haptic.planning.probe_lines.
     aimed_probes`) at the targets of :func:`_probe_targets` at least :data:`MIN_PROBE_TRANSFER` from the sensor,
     the :data:`MAX_VERIFY_PROBES` nearest, predicted to hit their face in ``h``'s world and not to fail there (the
-    hand's checks); none after a probe failed from here (``avoid``), nor along a line probed before (``probed``)."""
+    hand's checks); none after a probe failed from here (``avoid``), nor along a line probed before (``probed``).
+    With ``middles`` (faces whose middle is still to be probed, :func:`unmeasured_middles`), also lines at the middles
+    of those of them at a missing vertex (up to :data:`MAX_VERIFY_PROBES` more): landing there measures the middle
+    on the way to the vertex (:data:`MIDDLE_CREDIT`)."""
     return [(m, c, r) for m, c, r, _ in _verification_probes(h, state, components, missing, noise, config, avoid,
-                                                             probed, faces_ok)]  # fmt: skip
+                                                             probed, faces_ok, middles=middles)]  # fmt: skip
+
+
+VERIFY_STANDOFF = 0.01
+"""A verification probe's line starts this far before where it meets the recognised model at its fitted pose [m]
+(:func:`close_start`), not before the sphere round the model as the recognition's lines do (several hypotheses,
+any of which may be the object): with one pose left, free space farther out tells nothing, and a probe at a face's
+middle (a box's top, 30 mm in from a sphere of 71 mm radius) travelled 4-5 cm more to start there and back. An
+object that is not the model and reaches this far beyond it along the line starts the line inside it: the
+executor reports it unreachable, and the verification goes on without probes from there."""
+
+
+def close_start(h: Hypothesis, move: ProbeMove, standoff: float = VERIFY_STANDOFF) -> ProbeMove:
+    """``move`` started ``standoff`` before its first contact with hypothesis ``h``'s posed model (its end kept);
+    ``move`` itself when the line meets the model nearer its start than that, or not at all."""
+    u = np.asarray(move.direction, float)
+    start = np.asarray(move.start, float)
+    hit = line_hits(h.poly, h.model_from_world.apply(start)[None], h.model_from_world.rotate(u)[None])
+    t = float(hit.first[0])
+    if not np.isfinite(t) or t <= standoff:
+        return move
+    cut = t - standoff
+    return ProbeMove(start + cut * u, u, float(move.length) - cut)
+
+
+def same_line(a: Move, b: Move) -> bool:
+    """Whether probes ``a`` and ``b`` run along nearly one line (directions within ~8°, the lines within a probe
+    target's spacing of each other), wherever they start; False for other moves."""
+    from haptic.planning.probe_lines import ProbeConfig
+
+    if a.kind != "probe" or b.kind != "probe" or float(np.dot(a.direction, b.direction)) <= 0.99:
+        return False
+    d = np.asarray(b.start, float) - np.asarray(a.start, float)
+    u = np.asarray(a.direction, float)
+    return float(np.linalg.norm(d - (d @ u) * u)) < ProbeConfig.target_spacing
 
 
 LANDS_NEAR = 2 * PROBE_INSET
@@ -479,7 +520,7 @@ def _verification_probes(
     h: Hypothesis, state: SensorState, components: Mapping[int, DataComponent],
     missing: tuple[frozenset[int], frozenset[int], frozenset[int]], noise: SensorNoise, config: PlannerConfig,
     avoid: Sequence[Move] = (), probed: Sequence[Move] = (), faces_ok: frozenset[int] | None = None,
-    relocate: bool = False, most: int = MAX_VERIFY_PROBES,
+    relocate: bool = False, most: int = MAX_VERIFY_PROBES, middles: frozenset[int] = frozenset(),
 ) -> list[tuple[Move, float, float, bool]]:
     """:func:`verification_probes`, each with whether it lands near what is missing (:data:`LANDS_NEAR`): the
     target on a face beside a vertex lies far from it where the face's corner there is narrow, and a line aimed at
@@ -494,8 +535,18 @@ def _verification_probes(
     targets = [(p, f) for p, f in _probe_targets(h.poly, missing, faces_ok)
                if float(np.linalg.norm(p - here)) >= MIN_PROBE_TRANSFER]  # fmt: skip
     targets.sort(key=lambda pf: float(np.linalg.norm(pf[0] - here)))
-    lines = [(mv, targets[k]) for mv, k in aimed_probes(h, targets, probe_config(config))
-             if not any(same_move(mv, done) for done in probed)][:most]  # fmt: skip
+    if config.table_z is not None:  # the hand's relocation: lines from outside the sphere, as the recognition's
+        lines = [(mv, targets[k]) for mv, k in aimed_probes(h, targets, probe_config(config))
+                 if not any(same_move(mv, done) for done in probed)][:most]  # fmt: skip
+    else:
+        lines = [(close_start(h, mv), targets[k]) for mv, k in aimed_probes(h, targets, probe_config(config))
+                 if not any(same_line(mv, done) for done in probed)][:most]  # fmt: skip
+    beside = sorted({int(f) for v in missing[2] for f in h.poly.vertex_faces[v]} & set(middles))
+    if beside:  # a face at a vertex to measure whose middle is still to be probed: landing there measures both
+        mids = [(face_middle(h.poly, f), f) for f in beside]
+        mids = [t for t in mids if float(np.linalg.norm(t[0] - here)) >= MIN_PROBE_TRANSFER]
+        lines += [(close_start(h, mv), mids[k]) for mv, k in aimed_probes(h, mids, probe_config(config))
+                  if not any(same_line(mv, done) for done in probed)][:most]  # fmt: skip
     preds = predict_probe_moves(Context((h,), state, components, noise, config), [mv for mv, _ in lines])
     poly = h.poly
     mf, me, mv = missing
@@ -506,7 +557,8 @@ def _verification_probes(
         move = pred.move
         start, u = np.asarray(move.start, float), np.asarray(move.direction, float)
         c = h.model_from_world.apply(start + float(pred.distance[0]) * u)  # the contact, model frame
-        near = face in mf or any(float(np.linalg.norm(c - poly.vertices[v])) <= LANDS_NEAR for v in mv)
+        near = face in mf or any(float(np.linalg.norm(c - poly.vertices[v])) <= LANDS_NEAR for v in mv) or (
+            face in middles and float(np.linalg.norm(c - face_middle(poly, face))) <= MIDDLE_REACH)
         for e in me:
             s_ = float(np.clip((c - poly.edge_points[e]) @ poly.edge_directions[e], 0.0, poly.edge_lengths[e]))
             near = near or float(np.linalg.norm(c - poly.edge_points[e] - s_ * poly.edge_directions[e])) <= LANDS_NEAR
@@ -549,6 +601,7 @@ def plan_verification_move(
     visited: Sequence[np.ndarray] = (),
     relocate: bool = False,
     failed_crossings: frozenset[tuple[int, int]] | set[tuple[int, int]] = frozenset(),
+    middles: frozenset[int] = frozenset(),
 ) -> tuple[Move | None, Tour | None, float]:
     """:func:`choose_verification_move`, with the tour it planned over ``missing`` (from ``previous``'s order,
     when given) and that tour's cost from the sensor as it is [units] (None and 0 without a pose). A candidate
@@ -564,7 +617,8 @@ def plan_verification_move(
     offered whatever the move set, and when one is predicted to land near where the tour is entered only such
     probes are: the next move carries the pad over the object to there. A face move predicted to cross a model
     edge from a model face where face moves failed to cross before (``failed_crossings``, :func:`_crossing`) is
-    left out, after those going back."""
+    left out, after those going back. ``middles``: faces whose middle is still to be probed (under ``full`` with
+    probes admitted); a probe predicted to land at one of them scores :data:`MIDDLE_CREDIT` less."""
     from haptic.planning.search import simulate
     from haptic.planning.simulate import simulate_probe
 
@@ -585,7 +639,7 @@ def plan_verification_move(
                                        RELOCATE_PROBES)  # fmt: skip
     else:
         landing = _verification_probes(h, state, components, _entries(poly, tour, here, keys), noise, config, avoid,
-                                       probed, faces_ok)  # fmt: skip
+                                       probed, faces_ok, middles=middles)  # fmt: skip
     probes = [(m, c, r) for m, c, r, _ in landing]
     if relocate:  # a relocation, where a probe lands near what is missing; else the traced moves as ever
         near = [(m, c, r) for m, c, r, near in landing if near]
@@ -624,6 +678,11 @@ def plan_verification_move(
         measured = frozenset(int(k) for k in features(poly).index(tuple(  # type: ignore[arg-type]
             frozenset(n & x) for n, x in zip(new, missing, strict=True))))  # fmt: skip
         score = c / max(1.0 - r, 1e-9) + tour.cost_from(_start_costs(h1, s1, table), measured)
+        if m.kind == "probe" and middles and h1.world_from_model is not None:
+            landed = h.model_from_world.apply(s1.position)
+            f1 = h1.faces.get(s1.face)
+            if f1 in middles and float(np.linalg.norm(landed - face_middle(poly, f1))) <= MIDDLE_REACH:
+                score -= MIDDLE_CREDIT
         if score < best_score:
             best, best_score = m, score
         ends.append((m, h.world_from_model.inverse().apply(s1.position), c))
@@ -650,6 +709,10 @@ def _crossing(h: Hypothesis, state: SensorState, after: Hypothesis, end: SensorS
     return None if f is None or e is None else (int(f), int(e))
 
 
+MIDDLE_CREDIT = 2.4
+"""What a verification probe that lands at the middle of a face whose middle is still to be probed saves [units]:
+the probe at that middle the verification would make after the vertices, at least ``c_p`` and its standoff both
+ways at ``c_s`` (2 + 0.4)."""
 REVISIT = 3e-3
 """A verification move predicted to measure nothing that ends this near a place the sensor was at since the
 verification last measured something goes back there (:func:`plan_verification_move`) [m]."""
@@ -810,6 +873,7 @@ class Verifier:
         """On the hand, vertex moves that failed during the verification: the model vertex and the model face the
         circle crossed (:meth:`_failed_round`)."""
         self.check = None
+        self._data = None
         self.accept = None
         self.coverage = None
         self._hyp: Hypothesis | None = None
@@ -882,6 +946,7 @@ class Verifier:
                 self._pins[cls.name] = table_pins(cls.model, self.check.world_from_model, reach, self.config)
             self.coverage = coverage(cls.model, it, self._reach[cls.name], self._pins[cls.name][0])
         self._model_name, self._model = cls.name, cls.model
+        self._data = tree.data
         if not self.check.ok:
             self.status = "mismatch"
         elif self.coverage is not None and self.coverage.met(self.mode):
@@ -959,7 +1024,7 @@ class Verifier:
     def _middle_probe(self, h: Hypothesis, state: SensorState, components: Mapping[int, DataComponent],
                       avoid: Sequence[Move], probed: Sequence[Move]) -> Move | None:
         """A probe at the middle of the next face of :attr:`middles` predicted to land on it (None: none left)."""
-        from haptic.planning.move_scores import Context, predict_probe_moves, probe_config, same_move
+        from haptic.planning.move_scores import Context, predict_probe_moves, probe_config
         from haptic.planning.probe_lines import aimed_probes
 
         if any(m.kind == "probe" for m in avoid):  # no probe from here: the faces left are not probed
@@ -967,16 +1032,23 @@ class Verifier:
             self._middles_tried.update(self.middles)
             self.middles = []
             return None
-        while self.middles:
-            f = self.middles.pop(0)
-            self._middles_tried.add(f)
-            lines = [mv for mv, _ in aimed_probes(h, [(face_middle(h.poly, f), f)], probe_config(self.config))
-                     if not any(same_move(mv, done) for done in probed)]  # fmt: skip
-            for pred in predict_probe_moves(Context((h,), state, components, self.noise, self.config), lines):
-                if bool(pred.hit[0]) and int(pred.face[0]) == f and pred.risk() == 0.0:
-                    return pred.move
-            self.middles_unprobed.add(f)
-        return None
+        # the cheapest of the middles left next (a tour of them by nearest neighbour): in the faces' order the
+        # probes crossed the object back and forth
+        targets = [(face_middle(h.poly, f), f) for f in self.middles]
+        lines = [(close_start(h, mv), targets[k][1]) for mv, k in aimed_probes(h, targets, probe_config(self.config))
+                 if not any(same_line(mv, done) for done in probed)]  # fmt: skip
+        preds = predict_probe_moves(Context((h,), state, components, self.noise, self.config), [m for m, _ in lines])
+        good = sorted(((float(p.costs[0]), k) for k, p in enumerate(preds)
+                       if bool(p.hit[0]) and int(p.face[0]) == lines[k][1] and p.risk() == 0.0))  # fmt: skip
+        if not good:
+            self.middles_unprobed.update(self.middles)
+            self._middles_tried.update(self.middles)
+            self.middles = []
+            return None
+        f = lines[good[0][1]][1]
+        self._middles_tried.add(f)
+        self.middles.remove(f)
+        return preds[good[0][1]].move
 
     def move_budget(self) -> int:
         """The verification moves this verification may make (:func:`verify_move_budget` of the recognised
@@ -1050,9 +1122,14 @@ class Verifier:
         self._fail_crossings(h, state, components, avoid)
         faces_ok = self._reach[self._model_name][0] if self._model_name in self._reach else None
         previous = self._tour if self._tour is not None and self._tour_model is h.poly else None
+        due: frozenset[int] = frozenset()
+        if (self.mode == "full" and self._probes_admitted() and faces_ok is not None and h.world_from_model is not None
+                and self._data is not None):
+            due = frozenset(unmeasured_middles(h.poly, h.world_from_model, self._data, faces_ok))
         move, self._tour, now = plan_verification_move(h, state, components, missing, self.noise, self.config,
                                                        avoid, probed, faces_ok, previous, self._ways_done(),
-                                                       self._visited, relocate, self._failed_crossings)  # fmt: skip
+                                                       self._visited, relocate, self._failed_crossings,
+                                                       due)  # fmt: skip
         if relocate and move is not None and move.kind == "probe":
             self._relocated = self.moves
         if self.config.table_z is not None and h.world_from_model is not None:

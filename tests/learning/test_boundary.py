@@ -126,3 +126,25 @@ def test_the_matcher_widens_the_data_bounds_by_a_learned_models():
     assert tree.data[0] is face  # the data as reported
     assert tree._data.items[0].normal_bound == pytest.approx(np.hypot(0.01, 0.01))
     assert tree._data.items[0].position_bound == pytest.approx(0.001)
+
+
+def test_points_touched_on_an_edge_do_not_outvote_the_one_beside_it():
+    """An edge traced twice more, each time with its points beside it touched on the edge itself and off it the
+    wrong way by less than the data's bound: the face is on the side of the one point touched clear of the
+    edge, and the boundary closes (by the points' signs alone it had the face on the wrong side of the edge,
+    and the fans of the edge's vertices open)."""
+    model = load_library()["LBLOCK01"]
+    comps = exact_boundary(model, SE3.identity())
+    nf, ne = model.n_faces, model.n_edges
+    e = comps[nf + 2]
+    nid = nf + ne + model.n_vertices
+    for k in range(2):
+        wrong = []
+        for f, q in e.side_points:
+            mid = e.point + 0.5 * e.length * e.direction
+            off = q - mid - ((q - mid) @ e.direction) * e.direction
+            wrong.append((f, mid - 0.5e-6 * off / np.linalg.norm(off)))
+        comps[nid + k] = DataEdge(nid + k, e.direction, e.point, e.length, 0.0, 0.0, 0.0, start_vertex=e.start_vertex,
+                                  end_vertex=e.end_vertex, adjacent=e.adjacent, side_points=tuple(wrong))  # fmt: skip
+    est = boundary_estimate(comps)
+    assert est.closed, (est.counts(), est.problems, est.unbalanced)

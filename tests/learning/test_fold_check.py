@@ -59,10 +59,10 @@ def test_unchecked_diagonals_follow_the_strokes_on_each_plane():
     assert unchecked_diagonals(SQUARE, loops, normals, {7: 0, 8: 1}, [elsewhere]) == {0: [(0, 2), (1, 3)]}
 
 
-def _learn(base: str, vertex: int, seed: int, tmp_path) -> dict:
-    """Learn library model ``base`` with ``vertex`` moved 2 mm (as ``scripts/bench_unknown.py`` moves it) in the
-    episode of ``seed``: the record's ``learned``."""
-    poly = move_vertex(load_library()[base], vertex, 2e-3, name=f"{base}_MOVED")
+def _learn(base: str, vertex: int, seed: int, tmp_path, offset: float = 2e-3) -> dict:
+    """Learn library model ``base`` with ``vertex`` moved ``offset`` (as ``scripts/bench_unknown.py`` moves it) in
+    the episode of ``seed``: the record's ``learned``."""
+    poly = move_vertex(load_library()[base], vertex, offset, name=f"{base}_MOVED")
     path = tmp_path / f"{base}_MOVED.json"
     save_model(poly, path)
     rec = run_episode(EpisodeSpec(model=str(path), seed=seed, noise=1.0, learn=str(tmp_path / "lib"),
@@ -71,14 +71,34 @@ def _learn(base: str, vertex: int, seed: int, tmp_path) -> dict:
     return rec.learned, poly
 
 
-@pytest.mark.parametrize(("base", "vertex", "seed"), [("BOX01", 1, 74845286), ("BOX01P", 0, 1858836761)])
+@pytest.mark.parametrize(("base", "vertex", "seed"), [
+    ("BOX01", 1, 74845286), ("BOX01P", 0, 1858836761), ("BOX01N", 15, 586626705), ("FRAME01", 2, 1016164991),
+])  # fmt: skip
 def test_a_face_folded_along_its_diagonal_is_found(base, vertex, seed, tmp_path):
     """A corner moved 2 mm inward folds a face by about a degree along a diagonal. The bench's episodes learned
     these without the fold (a face and an edge too few: no move crossed it, and one plane held every point
-    touched on both halves); crossing every diagonal finds the fold's edge."""
+    touched on both halves); crossing every diagonal finds the fold's edge. BOX01N's and FRAME01's fold checks went
+    from face to face toward the folds without reaching them, and gave up with the fold not crossed: a probe
+    onto a diagonal's middle reaches it."""
     learned, poly = _learn(base, vertex, seed, tmp_path)
     assert learned["fold_check"] and learned["fold_moves"] > 0
     assert learned["folds_unchecked"] == 0
+    assert (learned["V"], learned["E"], learned["F"]) == (poly.n_vertices, poly.n_edges, poly.n_faces)
+
+
+def test_a_frame_with_a_corner_moved_4_mm_closes(tmp_path):
+    """FRAME01 with its vertex 2 moved 4 mm, the bench's episode: a traced edge measured again and again by moves
+    along it, with points beside it touched on the edge itself, had its face on the wrong side, and a vertex's
+    fan stayed open to the learning's budget."""
+    learned, poly = _learn("FRAME01", 2, 1099128568, tmp_path, offset=4e-3)
+    assert (learned["V"], learned["E"], learned["F"]) == (poly.n_vertices, poly.n_edges, poly.n_faces)
+
+
+def test_an_l_block_with_a_corner_moved_4_mm_closes(tmp_path):
+    """LBLOCK01 with its vertex 0 moved 4 mm, the bench's episode: the L-shaped bottom face reaches across the line
+    of the fold that cuts its corner off, and a face touched there, beyond the fold, was sent to the corner's group
+    by its side of the line; it fits its own plane better and stays."""
+    learned, poly = _learn("LBLOCK01", 0, 1041939683, tmp_path, offset=4e-3)
     assert (learned["V"], learned["E"], learned["F"]) == (poly.n_vertices, poly.n_edges, poly.n_faces)
 
 

@@ -1,6 +1,7 @@
 """Verification with free-space probes (haptic.planning.verify): where probes are admitted, a probe carries the
 sensor to a face beside a vertex still to be measured; and the verification's move budget follows the model."""
 
+import copy
 from dataclasses import replace
 
 import numpy as np
@@ -144,3 +145,72 @@ def test_probes_in_an_all_verification_and_none_under_tracing():
     # the probed verification then probes the faces' middles, which tracing does not ask for
     assert probed["verified"]["middles_probed"] >= 1 and "middles_probed" not in traced["verified"]
     assert probed["verified"]["cost"] - probed["verified"]["middles_cost"] < traced["verified"]["cost"]
+
+
+def test_a_verification_probe_starts_its_standoff_before_the_model_and_costs_less_for_it():
+    from haptic.planning.move_scores import probe_config
+    from haptic.planning.probe_lines import aimed_probes
+    from haptic.planning.verify import VERIFY_STANDOFF, close_start, same_line
+
+    for name, seed in [("BOX01", 0), ("HEXPRISM01", 1), ("WEDGE01", 3)]:
+        h, state, comps, ex = _on_a_face(name, seed)
+        missing = (frozenset(), frozenset(), _far_vertices(h, state))
+        probes = verification_probes(h, state, comps, missing, ex.noise, ALL)
+        assert probes, name
+        for move, _, _ in probes:
+            _, s1, _ = simulate_probe(h, move, state, comps, ex.noise)
+            assert np.linalg.norm(s1.position - move.start) == pytest.approx(VERIFY_STANDOFF, abs=1e-9)
+            assert not h.poly.contains(h.model_from_world.apply(move.start)[None])[0]
+        # the same line from the sphere round the model: carried out, it lands on the same face for more
+        from haptic.planning.verify import face_middle
+
+        targets = [(face_middle(h.poly, f), f) for f in range(h.poly.n_faces)]
+        shorter = 0
+        for line, _ in aimed_probes(h, targets, probe_config(ALL)):
+            near = close_start(h, line)
+            assert same_line(line, near) and np.allclose(near.end, line.end)
+            far = copy.deepcopy(ex).execute(line)
+            close = copy.deepcopy(ex).execute(near)
+            assert close.status == far.status == "ok"
+            assert close.cost <= far.cost + 1e-9
+            assert np.allclose(close.state.position, far.state.position)
+            shorter += close.cost < far.cost - 0.1
+        assert shorter, name
+
+
+def test_same_line_is_the_line_not_where_it_starts():
+    from haptic.planning.verify import same_line
+
+    u = np.array([0.0, 0.0, -1.0])
+    a = ProbeMove(np.array([0.0, 0.0, 0.2]), u, 0.3)
+    assert same_line(a, ProbeMove(np.array([0.0, 0.0, 0.1]), u, 0.1))
+    assert same_line(a, ProbeMove(np.array([0.005, 0.0, 0.05]), u, 0.1))
+    assert not same_line(a, ProbeMove(np.array([0.02, 0.0, 0.2]), u, 0.3))  # parallel, 2 cm across
+    assert not same_line(a, ProbeMove(np.array([0.0, 0.0, 0.2]), np.array([1.0, 0.0, 0.0]), 0.3))
+
+
+def test_a_probe_may_land_at_the_middle_still_to_be_probed_of_a_face_beside_a_missing_vertex():
+    from haptic.planning.verify import MIDDLE_REACH, face_middle
+
+    for name, seed in [("BOX01", 0), ("WEDGE01", 3)]:
+        h, state, comps, ex = _on_a_face(name, seed)
+        missing = (frozenset(), frozenset(), _far_vertices(h, state))
+        beside = frozenset(int(f) for v in missing[2] for f in h.poly.vertex_faces[v])
+
+        def at_middles(probes, h=h, state=state, comps=comps, ex=ex) -> set[int]:
+            out = set()
+            for move, _, _ in probes:
+                h1, s1, _ = simulate_probe(h, move, state, comps, ex.noise)
+                f = h1.faces[s1.face]
+                if np.linalg.norm(h.model_from_world.apply(s1.position) - face_middle(h.poly, f)) <= MIDDLE_REACH:
+                    out.add(int(f))
+            return out
+
+        plain = verification_probes(h, state, comps, missing, ex.noise, ALL)
+        assert not at_middles(plain), name  # aimed beside the vertices, far from any middle
+        with_middles = verification_probes(h, state, comps, missing, ex.noise, ALL, middles=beside)
+        landed = at_middles(with_middles)
+        assert landed and landed <= beside, name
+        # a face whose middle is measured already is not a target
+        assert not at_middles(verification_probes(h, state, comps, missing, ex.noise, ALL,
+                                                  middles=frozenset(landed) ^ beside)) & landed  # fmt: skip
