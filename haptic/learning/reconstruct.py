@@ -361,6 +361,42 @@ def _fold_sides(groups: list[list[DataFace]], components: Mapping[int, DataCompo
     return [g for g in groups if g]
 
 
+def _merge_agreeing(groups: list[list[DataFace]], apart: Mapping[int, set[int]]) -> list[list[DataFace]]:
+    """``groups`` with every two that are one plane merged: no data edge divides a face of one from a face of the
+    other, and every face of both agrees with the plane fitted to them all (:func:`_same_plane`), the closest pair
+    first. Regrouping moves faces one at a time: where agreement grouped a shallow fold's faces by the order they
+    came in (each half's group holding faces of both), moving each to the plane it fits best can leave one half's
+    faces in two groups, the one a data edge divides from a face of the other half and the one none does (FRAME01
+    with a corner moved 2 mm: a face move that crossed the fold's line split its far half's plane in two, and the
+    boundary could not close)."""
+    groups = [list(g) for g in groups]
+    while True:
+        best: tuple[float, int, int] | None = None
+        fits = [_group_fit(g) for g in groups]
+        for i, gi in enumerate(groups):
+            ids_i = {f.id for f in gi}
+            for j in range(i + 1, len(groups)):
+                gj = groups[j]
+                (ni, _, bi), (nj, _, bj) = fits[i], fits[j]
+                if float(np.arccos(np.clip(ni @ nj, -1.0, 1.0))) > bi + bj + BOUND_FLOOR:
+                    continue
+                if any(apart.get(f.id, set()) & ids_i for f in gj):
+                    continue
+                union = gi + gj
+                n, d, nb = _group_fit(union)
+                pts = np.concatenate([x.points for x in union])
+                pb = max(x.position_bound for x in union)
+                if not all(_same_plane(f, n, d, pts, nb, pb) for f in union):
+                    continue
+                worst = max(_misfit(f, n, d, nb, pb) for f in union)
+                if best is None or worst < best[0]:
+                    best = (worst, i, j)
+        if best is None:
+            return groups
+        _, i, j = best
+        groups[i] = groups[i] + groups.pop(j)
+
+
 def face_planes(components: Mapping[int, DataComponent], fold_vertices: bool = False) -> list[Plane]:
     """The object's planes: the data faces grouped by agreement (in order of acquisition, those touched only at a
     shallow fold last (:func:`at_shallow_folds`), each joining the plane it agrees with best, by normal, but never
@@ -427,7 +463,7 @@ def face_planes(components: Mapping[int, DataComponent], fold_vertices: bool = F
             moved = True
         if not moved:
             break
-    groups = _fold_sides(groups, components, ef, apart)
+    groups = _fold_sides(_merge_agreeing(groups, apart), components, ef, apart)
     # the edges and vertices on each plane join its fit
     plane_of = {f.id: k for k, g in enumerate(groups) for f in g}
     extra: list[list[np.ndarray]] = [[] for _ in groups]

@@ -6,7 +6,7 @@ itself by the data edges that divide it from faces of one half -- not by the ord
 import numpy as np
 import pytest
 
-from haptic.learning.reconstruct import at_shallow_folds, edge_faces, face_planes
+from haptic.learning.reconstruct import _merge_agreeing, at_shallow_folds, edge_faces, face_planes
 from haptic.matching.components import DataEdge, DataFace
 from tests.learning.test_fold import FOLDED
 
@@ -103,3 +103,28 @@ def test_a_face_touched_at_the_fold_is_grouped_by_the_edges_that_divide_it(seed)
     planes = face_planes(comps)
     assert len(planes) == 2
     assert sorted(map(sorted, halves_of(planes, truth))) == [[0], [1]]
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_one_halfs_faces_left_in_two_groups_are_merged(seed):
+    """Moving faces one at a time to the plane each fits best can leave one half of a fold in two groups: the one a
+    data edge divides from a face of the other half and the one none does. Two groups no data edge divides whose
+    faces all agree with one plane are one plane; the other half, divided from both by data edges, stays apart."""
+    rng = np.random.default_rng(seed)
+    comps: dict = {}
+    truth: dict[int, int] = {}
+    for fid, half in enumerate([1, 1, 0, 0, 0, 1, 1]):
+        comps[fid] = touched(fid, half, [off_fold(rng, half), off_fold(rng, half)])
+        truth[fid] = half
+    comps[20] = fold_data_edge(20, 0.3, ((2, 0), (1, 1)))
+    comps[21] = fold_data_edge(21, 0.6, ((4, 0), (6, 1)))
+    ef = edge_faces(comps)
+    apart = {f: {g for fs in ef.values() if f in fs for g in fs if g != f} for f in truth}
+    groups = [[comps[0], comps[1]], [comps[2], comps[3], comps[4]], [comps[5], comps[6]]]
+    merged = _merge_agreeing(groups, apart)
+    assert sorted(sorted(truth[f.id] for f in g) for g in merged) == [[0, 0, 0], [1, 1, 1, 1]]
+    # divided by a data edge, the two groups of half 1 stay two
+    comps[22] = fold_data_edge(22, 0.5, ((0, 1), (5, 1)))
+    ef = edge_faces(comps)
+    apart = {f: {g for fs in ef.values() if f in fs for g in fs if g != f} for f in truth}
+    assert len(_merge_agreeing(groups, apart)) == 3
