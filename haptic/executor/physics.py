@@ -834,16 +834,21 @@ class PhysicsExecutor(LandingSearch):
         if not acq.ok:
             return f"acquiring the ridge: {acq.event}"
         pts = []
+        # where the roll ended: the last contact of the acquisition (else the first of the ridge's); the way back
+        # starts from where the way out stopped, so a vertex's distance from the roll is measured from here
+        origin = acq.trace.point_in_world[acq.trace.in_contact][-1] if acq.trace.in_contact.any() else None
         for sense, reach in ((1.0, RIDGE_PROBE), (-1.0, 2.0 * RIDGE_PROBE)):
             f = t.follow_edge(sense * e, n_a, n_b, toward_a, reach)
             pieces.append(f)
             pts.append(f.trace.point_in_world[self._on_ridge(f.trace, e)])
+            if origin is None and f.trace.in_contact.any():
+                origin = f.trace.point_in_world[f.trace.in_contact][0]
             if not f.ok and f.event != "limit":
                 return f"following the edge: {f.event}"
-            if end_clearance > 0.0 and f.event == "vertex" and f.trace.in_contact.any():
-                q = f.trace.point_in_world[f.trace.in_contact] @ (sense * e)
-                if q[-1] - q[0] < end_clearance:
-                    return (f"the roll crossed the edge {max(q[-1] - q[0], 0.0) * MM:.1f} mm from its end: its normals "
+            if end_clearance > 0.0 and f.event == "vertex" and origin is not None and f.trace.in_contact.any():
+                gap = float((f.trace.point_in_world[f.trace.in_contact][-1] - origin) @ (sense * e))
+                if gap < end_clearance:
+                    return (f"the roll crossed the edge {max(gap, 0.0) * MM:.1f} mm from its end: its normals "
                             "turned round the vertex too")  # fmt: skip
         pts = np.concatenate(pts)
         span = float(np.ptp(pts @ e)) if len(pts) else 0.0
