@@ -366,6 +366,7 @@ def summarize(records: list[dict], worst: int = 10, plot: str | None = None, lib
     for r in records:
         if r["outcome"] == "no-match":
             print(f"  no-match: {r['library']} {r['model']} seed {r['seed']}: {r['detail']}")
+    _hand_summary(records)
     print(f"worst {worst}:")
     for ratio, what, cid, r in sorted(rows, key=lambda x: -x[0])[:worst]:
         print(f"  {ratio:6.2f} {what:14} component {cid:2d}  {r['library']} {r['model']} seed {r['seed']}: "
@@ -373,6 +374,26 @@ def summarize(records: list[dict], worst: int = 10, plot: str | None = None, lib
     if plot:
         _plot(rows, plot)
     return len(outside)
+
+
+def _hand_summary(records: list[dict]) -> None:
+    """The contacts of links other than the exploring pad (``perception.hand``): in how many episodes and moves, on
+    which links, their points' distance from the true surface in units of the link's bound, and the components
+    reported by the moves that had them, in units of their own bounds."""
+    hands = [(r, (r.get("perception") or {}).get("hand") or {}) for r in records]
+    hands = [(r, h) for r, h in hands if h.get("moves")]
+    if not hands:
+        print("contacts of links other than the pad: none")
+        return
+    links = Counter(link for _, h in hands for link in h["links"])
+    comp = [h["component_ratio_max"] for _, h in hands if h.get("component_ratio_max") is not None]
+    worst = max(hands, key=lambda rh: rh[1]["point_ratio_max"])
+    print(f"contacts of links other than the pad: {len(hands)} episodes, {sum(h['moves'] for _, h in hands)} moves, "
+          f"{sum(h['points'] for _, h in hands)} points ({', '.join(f'{k} {v}' for k, v in links.most_common())}); "
+          f"largest point off the surface {max(h['point_mm_max'] for _, h in hands):.2f} mm, "
+          f"{worst[1]['point_ratio_max']:.3f} of its link's bound ({worst[0]['model']} seed {worst[0]['seed']}); "
+          f"{sum(h['components'] for _, h in hands)} components from those moves, the largest "
+          f"{max(comp) if comp else 0.0:.2f} of its bound")  # fmt: skip
 
 
 def _plot(rows: list, path: str) -> None:

@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from haptic.geometry import tracing
-from haptic.geometry.distance import point_triangle_distance
+from haptic.geometry.distance import point_triangle_distance, surface_distance
 from haptic.geometry.polyhedron import Polyhedron
 from haptic.geometry.se3 import SE3, plane_basis
 from haptic.matching.acceptance import residual_ratios
@@ -85,6 +85,8 @@ class PerceptionScore:
     """Per-move checks."""
     ratios: tuple[BoundRatio, ...] = ()
     """Every measured quantity of every component in units of its bound (:func:`bound_ratios`)."""
+    hand: dict = field(default_factory=dict)
+    """Contacts of links other than the pad (:func:`score_hand`)."""
 
     @property
     def outside_bounds(self) -> tuple[int, ...]:
@@ -119,6 +121,7 @@ class PerceptionScore:
             },
             "outside_bounds": len(self.outside_bounds),
             "ratios": [[r.id, r.what, round(r.ratio, 4), r.true_id] for r in self.ratios],
+            "hand": self.hand,
         }
 
 
@@ -261,8 +264,37 @@ def score_components(
     if results:
         missed, details = _missed(results, model, rot, trans, by_id, tol)
     ratios = tuple(bound_ratios(components, model, world_from_model))
+    hand = score_hand(results or (), ratios, model, world_from_model)
     return PerceptionScore(tuple(scores), sum(1 for s in scores if s.true_id is None), missed, concave, details,
-                           ratios)  # fmt: skip
+                           ratios, hand)  # fmt: skip
+
+
+def score_hand(results, ratios, model: Polyhedron, world_from_model: SE3) -> dict:
+    """The contacts of links other than the exploring pad (``MoveResult.hand``) against the truth: how many moves
+    had them and on which links; each point's distance from the true surface, also in units of its link's bound
+    (``point_ratio_max``: above 1, the bound does not hold); and the components those moves reported
+    (``component_ratio_max``: their largest quantity in units of its bound, from ``ratios``), which tells whether a
+    link's contact spoils what the pad measures at the same time. Empty without such contacts."""
+    moves, links, dist, rat, ids = 0, set(), [], [], set()
+    inv = world_from_model.inverse()
+    for r in results:
+        groups = [g for g in getattr(r, "hand", ()) if len(g)]
+        if not groups:
+            continue
+        moves += 1
+        ids.update(c.id for c in r.components)
+        for g in groups:
+            links.add(g.link)
+            d = surface_distance(model, inv.apply(g.point_in_world))
+            dist.extend(d.tolist())
+            rat.extend((d / g.bound).tolist() if g.bound > 0 else [math.inf] * len(d))
+    if not moves:
+        return {}
+    comp = [x.ratio for x in ratios if x.id in ids]
+    return {"moves": moves, "links": sorted(links), "points": len(dist),
+            "point_mm_max": round(1e3 * max(dist), 3), "point_ratio_max": round(max(rat), 4),
+            "components": len(ids), "component_ratio_max": round(max(comp), 4) if comp else None,
+            "component_ids": sorted(ids)}
 
 
 MIN_TILT = math.radians(10.0)

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from haptic.geometry.distance import surface_distance
 from haptic.matching.recognition import AMBIGUOUS, EXPLORING, RECOGNIZED, PoseTolerance, Recognition, same_solid
 from haptic.matching.tree import InterpretationTree
 from haptic.planning.config import PlannerConfig
@@ -48,18 +49,42 @@ def fits_touches(c, touched: tuple[np.ndarray, np.ndarray], config: PlannerConfi
     return int((d > config.touch_tol).sum()) < config.touch_outliers
 
 
+def hand_points(result: MoveResult) -> tuple[np.ndarray, np.ndarray]:
+    """The points on the object that links of the hand other than the exploring pad touched during a move
+    (``result.hand``) and each one's bound (its link's), shapes (P, 3), (P,)."""
+    groups = [g for g in result.hand if len(g)]
+    if not groups:
+        return np.zeros((0, 3)), np.zeros(0)
+    return (np.concatenate([g.point_in_world for g in groups]),
+            np.concatenate([np.full(len(g), g.bound) for g in groups]))  # fmt: skip
+
+
+def fits_hand(c, hand: tuple[np.ndarray, np.ndarray], tol: PoseTolerance) -> bool:
+    """Whether pose class ``c`` has every point a link of the hand touched within that point's bound of its
+    surface, beyond the class's pose error there (``tol``: a displacement and a rotation about the model's
+    centroid, as free space is judged)."""
+    pts, bound = hand
+    inv = c.world_from_model.inverse()
+    d = surface_distance(c.model, inv.apply(pts))
+    r = np.linalg.norm(inv.apply(pts) - c.model.centroid, axis=1)
+    return bool((d <= bound + tol.distance + tol.angle * r).all())
+
+
 def on_the_table(
     rec: Recognition,
     tree: InterpretationTree,
     components,
     config: PlannerConfig,
     touched: tuple[np.ndarray, np.ndarray] | None = None,
+    hand: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> Recognition:
     """The matcher's verdict with the workspace prior that the object rests on the table (``config.table_z``):
     once the data fix the poses, pose classes that would put the model through the table or float it above
     it are set aside, and the verdict is taken again over the rest (left as it is when that would leave no
     class: the prior is then doubted, not the data). With ``touched`` points (every contact sensed so far),
-    classes that leave some of them off their faces are set aside too. A few classes left that differ only
+    classes that leave some of them off their faces are set aside too; with ``hand`` points (where links other
+    than the pad touched the object, :func:`hand_points`), classes that leave one off their surface by more
+    than its link's bound (:func:`fits_hand`). A few classes left that differ only
     where the fingertip
     cannot reach (:func:`~haptic.planning.reach.indistinguishable`: their difference faces the table) are
     ambiguous."""
@@ -68,6 +93,9 @@ def on_the_table(
     keep = tuple(c for c in rec.classes if rests_on_table(c.model, c.world_from_model, config)) or rec.classes
     if touched is not None and len(touched[0]) and len(keep) <= MAX_TOUCH_CHECK:
         keep = tuple(c for c in keep if fits_touches(c, touched, config)) or keep
+    if hand is not None and len(hand[0]) and len(keep) <= MAX_TOUCH_CHECK:
+        tol = PoseTolerance.from_data(tree.data)
+        keep = tuple(c for c in keep if fits_hand(c, hand, tol)) or keep
     if len(keep) == len(rec.classes) and rec.status != EXPLORING:
         return rec
     models = tuple(sorted({c.name for c in keep}))

@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from haptic.episode.perception import on_the_table, touched_points
+from haptic.episode.perception import hand_points, on_the_table, touched_points
 from haptic.geometry import Polyhedron
 from haptic.matching.acceptance import own_bounds_keep
 from haptic.matching.components import DataComponent, SensorNoise
@@ -81,6 +81,8 @@ class EpisodeState:
     """Moves that failed from the current sensor state (cleared when a move succeeds)."""
     touched: list[tuple[np.ndarray, np.ndarray]] = field(default_factory=list)
     """Touched points and sensed normals of each move (``config.touch_evidence``)."""
+    hand: list[tuple[np.ndarray, np.ndarray]] = field(default_factory=list)
+    """Points on the object links other than the pad touched, and their bounds, of each move."""
     free: list[FreeSegment] = field(default_factory=list)
     """Free space the probes travelled (a miss's line, a hit's approach)."""
     probe_faces: list[int] = field(default_factory=list)
@@ -145,10 +147,13 @@ class EpisodeState:
         r = recognize(self.tree, max_interpretations=MAX_GROUPED_INTERPRETATIONS)
         if self.config.table_z is None:
             return r
+        hand = None
+        if any(len(b) for _, b in self.hand):
+            hand = (np.concatenate([p for p, _ in self.hand]), np.concatenate([b for _, b in self.hand]))
         if not self.touched:
-            return on_the_table(r, self.tree, self.components, self.config)
+            return on_the_table(r, self.tree, self.components, self.config, hand=hand)
         both = (np.concatenate([p for p, _ in self.touched]), np.concatenate([n for _, n in self.touched]))
-        return on_the_table(r, self.tree, self.components, self.config, both)
+        return on_the_table(r, self.tree, self.components, self.config, both, hand)
 
     def took(self, result: MoveResult) -> None:
         """Book a move that succeeded (or the start): its components into the tree, its free space and touches,
@@ -172,6 +177,7 @@ class EpisodeState:
                 self.tree.retain(keep)
         if self.config.touch_evidence:
             self.touched.append(touched_points(result, self.config))
+        self.hand.append(hand_points(result))
         self._placed(result)
         self.cost += result.cost
         self.rec = self.assess()
@@ -204,6 +210,7 @@ class EpisodeState:
             self.sensor = result.state
         if self.config.touch_evidence and self.rec is not None:
             self.touched.append(touched_points(result, self.config))
+            self.hand.append(hand_points(result))
             before = len(self.rec.classes)
             self.rec = self.assess()
             if len(self.rec.classes) < before:  # the failed move's touches told something

@@ -51,6 +51,7 @@ from haptic.planning.moves import (
     EdgeMove,
     FaceMove,
     HandLinks,
+    HandTouch,
     Move,
     MoveResult,
     MoveStatus,
@@ -77,6 +78,24 @@ RIDGE_MIN_SPAN = 0.003
 TOUCH_PHASES = ("face", "circle")
 """Trace phases whose contacts count as touches: the pad sliding on one face (rolling over an edge, or resting
 on an edge or a vertex, it may touch two faces at once, and the sensed point is their mean)."""
+
+
+HAND_SPACING = 0.001
+"""A link's contacts with the object are kept one per this much of their way (the readout is watched every few
+ticks; a link resting on the object gives one point) [m]."""
+
+
+def hand_touches(contacts, radii: dict[str, float]) -> tuple[HandTouch, ...]:
+    """The links' contacts with the object watched through a move (:class:`~haptic.executor.primitives.HandContact`,
+    in order), one group per link, thinned to one per :data:`HAND_SPACING`, each link's bound its radius
+    (``radii``)."""
+    kept: dict[str, list] = {}
+    for c in contacts:
+        rows = kept.setdefault(c.link, [])
+        if not rows or float(np.linalg.norm(c.point_in_world - rows[-1].point_in_world)) >= HAND_SPACING:
+            rows.append(c)
+    return tuple(HandTouch(link, np.array([c.point_in_world for c in rows]), radii.get(link, 0.0),
+                           np.array([c.time for c in rows])) for link, rows in kept.items())  # fmt: skip
 
 
 def touches_of(trace: ContactTrace) -> tuple[Touches, ...]:
@@ -274,6 +293,7 @@ class PhysicsExecutor(LandingSearch):
         self._stroke_blocked = False  # the last stroke on a next face met an edge along both of its legs
         self._met: PrimitiveResult | None = None  # the last crossing a link of the finger stopped
         self._links_until: float | None = None  # sim time of the last hand-link sample reported
+        self._radii: dict[str, float] | None = None  # per link, the bound of a point its readout reports
 
     @property
     def components(self) -> list[DataComponent]:
@@ -286,6 +306,7 @@ class PhysicsExecutor(LandingSearch):
         pieces: list[PrimitiveResult] = []
         self.recoveries = []
         self.toucher.take_links()  # drop samples taken outside a move
+        self.toucher.take_hand()
         if self.robot.time != self._links_until:  # the pose at the start, unless the last move reported it
             self.toucher.sample_links()
         try:
@@ -302,9 +323,10 @@ class PhysicsExecutor(LandingSearch):
         trace = ContactTrace.concatenate([p.trace for p in pieces])
         self.traces.append(trace)
         links = self._hand_links()
+        hand = hand_touches(self.toucher.take_hand(), self._link_radii())
         return MoveResult(move=res.move, status=res.status, components=res.components, distance=res.distance,
                           cost=res.cost, state=res.state, touches=touches_of(trace), trace=trace, reason=res.reason,
-                          links=links, sim_time=self.robot.time - t0, wall_time=time.perf_counter() - w0,
+                          links=links, hand=hand, sim_time=self.robot.time - t0, wall_time=time.perf_counter() - w0,
                           free_space=res.free_space,
                           info={**res.info, "recoveries": list(self.recoveries)} if self.recoveries else res.info)
 
@@ -361,6 +383,11 @@ class PhysicsExecutor(LandingSearch):
                     break
         t.hand_rotation = np.array(t.config.hand_rotation, dtype=float)
         return False
+
+    def _link_radii(self) -> dict[str, float]:
+        if self._radii is None:
+            self._radii = self.robot.link_radii()
+        return self._radii
 
     def _hand_links(self) -> HandLinks:
         """The hand's link poses sampled during the move (the robot's own forward kinematics), for
@@ -834,16 +861,21 @@ class PhysicsExecutor(LandingSearch):
         if not acq.ok:
             return f"acquiring the ridge: {acq.event}"
         pts = []
+        # where the roll ended: the last contact of the acquisition (else the first of the ridge's); the way back
+        # starts from where the way out stopped, so a vertex's distance from the roll is measured from here
+        origin = acq.trace.point_in_world[acq.trace.in_contact][-1] if acq.trace.in_contact.any() else None
         for sense, reach in ((1.0, RIDGE_PROBE), (-1.0, 2.0 * RIDGE_PROBE)):
             f = t.follow_edge(sense * e, n_a, n_b, toward_a, reach)
             pieces.append(f)
             pts.append(f.trace.point_in_world[self._on_ridge(f.trace, e)])
+            if origin is None and f.trace.in_contact.any():
+                origin = f.trace.point_in_world[f.trace.in_contact][0]
             if not f.ok and f.event != "limit":
                 return f"following the edge: {f.event}"
-            if end_clearance > 0.0 and f.event == "vertex" and f.trace.in_contact.any():
-                q = f.trace.point_in_world[f.trace.in_contact] @ (sense * e)
-                if q[-1] - q[0] < end_clearance:
-                    return (f"the roll crossed the edge {max(q[-1] - q[0], 0.0) * MM:.1f} mm from its end: its normals "
+            if end_clearance > 0.0 and f.event == "vertex" and origin is not None and f.trace.in_contact.any():
+                gap = float((f.trace.point_in_world[f.trace.in_contact][-1] - origin) @ (sense * e))
+                if gap < end_clearance:
+                    return (f"the roll crossed the edge {max(gap, 0.0) * MM:.1f} mm from its end: its normals "
                             "turned round the vertex too")  # fmt: skip
         pts = np.concatenate(pts)
         span = float(np.ptp(pts @ e)) if len(pts) else 0.0

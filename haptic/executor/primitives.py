@@ -73,6 +73,23 @@ class PrimitiveResult:
         return self.status == "ok"
 
 
+@dataclass(frozen=True)
+class HandContact:
+    """A contact of a link of the hand other than the exploring pad (another finger, a phalanx, the palm) with the
+    object, as the link's contact readout senses it (world frame)."""
+
+    time: float
+    """Simulation time [s]."""
+    link: str
+    """The link's name."""
+    point_in_world: np.ndarray
+    """Contact point (3,) [m]."""
+    normal_in_world: np.ndarray
+    """Unit normal (3,) out of the touched surface, towards the link."""
+    normal_force: float
+    """Force along the normal [N]."""
+
+
 class Toucher:
     """Runs the primitives with one finger of the robot and records everything it senses.
 
@@ -101,6 +118,7 @@ class Toucher:
         self._rows: list[tuple] = []
         self._ticks = 0
         self._links: list[tuple[float, np.ndarray]] = []  # (time, link positions) samples
+        self._hand: list[HandContact] = []  # the links' contacts with the object watched since the last take
         tip, rot = robot.fingertip_pose()
         self.tip = tip
         self.rotation = rot
@@ -152,6 +170,27 @@ class Toucher:
         every = self.config.link_every
         if every > 0 and self._ticks % every == 0:
             self._links.append((r.time, r.link_poses()))
+        watch = self.config.watch_every
+        if watch > 0 and self._ticks % watch == 0:
+            self._watch_links()
+
+    def _watch_links(self) -> None:
+        """Book the links' contacts with anything but the table (:meth:`on_table`) above the contact threshold."""
+        for c in self.robot.watch_links():
+            if c.normal_force > self.threshold and not self.on_table(c):
+                self._hand.append(HandContact(self.robot.time, c.link, c.point_in_world, c.normal_in_world,
+                                              c.normal_force))  # fmt: skip
+
+    def take_hand(self) -> list[HandContact]:
+        """The links' contacts with the object watched since the last call, in order."""
+        out, self._hand = self._hand, []
+        return out
+
+    def on_table(self, c) -> bool:
+        """Whether a link's contact ``c`` is with the table top: below :attr:`floor_z` with an upward normal."""
+        return float(c.normal_in_world[2]) > self.config.table_link_cos and (
+            self.floor_z is None or float(c.point_in_world[2]) < self.floor_z
+        )
 
     def sample_links(self) -> None:
         """Sample the hand's link poses now (once per simulation time)."""
@@ -235,10 +274,7 @@ class Toucher:
         contact readout; None when there is none."""
         best = None
         for c in self.robot.link_contacts():
-            on_table = float(c.normal_in_world[2]) > self.config.table_link_cos and (
-                self.floor_z is None or float(c.point_in_world[2]) < self.floor_z
-            )
-            if on_table or c.normal_force <= self.threshold:
+            if self.on_table(c) or c.normal_force <= self.threshold:
                 continue
             if best is None or c.normal_force > best.normal_force:
                 best = c

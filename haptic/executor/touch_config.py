@@ -189,6 +189,10 @@ class TouchConfig:
     """The hand's link positions (forward kinematics, for recordings) are sampled every this many ticks
     (0: never) [ticks]."""
 
+    watch_every: int = 5
+    """The links' contact readout is watched every this many ticks through a move (0: never): a link other than
+    the pad touching the object is reported with the move (:class:`HandContact`) [ticks]."""
+
     @property
     def reach_undercut(self) -> float:
         """The undercut the planner's reach model takes the hand to reach: ``max_undercut`` less

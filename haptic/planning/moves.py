@@ -319,6 +319,26 @@ class Touches:
 
 
 @dataclass(frozen=True, eq=False)
+class HandTouch:
+    """Points on the object that one link of the hand other than the exploring pad (another finger, a phalanx, the
+    palm) touched during a move, from the link's contact readout (world frame): evidence with the link's own
+    bound, never a data component."""
+
+    link: str
+    """The link's name."""
+    point_in_world: np.ndarray
+    """Sensed contact points (P, 3) [m], one per ``spacing`` of the link's way."""
+    bound: float
+    """How far from the object's surface a sensed point may lie [m]: the link's radius (its readout localises a
+    touch within its own thickness, not as the pad's)."""
+    time: np.ndarray
+    """Time of each point (P,) [s]."""
+
+    def __len__(self) -> int:
+        return len(self.point_in_world)
+
+
+@dataclass(frozen=True, eq=False)
 class HandLinks:
     """The hand's link poses sampled during a move (the robot's own forward kinematics, never the object), as
     a recording draws them."""
@@ -361,6 +381,9 @@ class MoveResult:
     """Why the move failed, in words ("" when it did not, or the executor does not say)."""
     links: HandLinks | None = None
     """The hand's link poses during the move, for recordings (None: the executor has no hand)."""
+    hand: tuple[HandTouch, ...] = ()
+    """Where links of the hand other than the exploring pad touched the object during the move, one group per
+    link (none from an executor without a hand)."""
     sim_time: float | None = None
     """Simulated time the move took [s] (None: the executor does not simulate)."""
     wall_time: float | None = None

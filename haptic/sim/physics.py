@@ -347,6 +347,8 @@ class Simulation:
         self._rng = np.random.default_rng(self._seed)
         # the added senses draw their noise apart, so that the fingertip's readings are those of the same seed
         self._senses_rng = np.random.default_rng([self._seed, 1])
+        # the links' readout watched through a move draws apart again: watching leaves every other reading as it was
+        self._watch_rng = np.random.default_rng([self._seed, 2])
         mujoco.mj_forward(m, d)
 
     def _robot_geom_links(self) -> np.ndarray:
@@ -481,10 +483,12 @@ class Simulation:
             torque = torque + nz.torque_std * self._senses_rng.standard_normal(3)
         return force, torque
 
-    def link_contacts(self) -> tuple[LinkContact, ...]:
+    def link_contacts(self, watch: bool = False) -> tuple[LinkContact, ...]:
         """Contacts of the robot's links other than the fingertip pads with anything not of the robot (the
-        object, the table), noise applied as to a pad's contacts: each link's contact readout."""
+        object, the table), noise applied as to a pad's contacts: each link's contact readout. ``watch``: the
+        readout taken all through a move, its noise drawn apart from the other senses'."""
         d, nz = self.data, self.noise
+        rng = self._watch_rng if watch else self._senses_rng
         if d.ncon == 0:
             return ()
         owner = self._geom_link_list
@@ -503,9 +507,24 @@ class Simulation:
                 normal = -normal  # out of the touched surface, towards the link
             point = c.pos.copy()
             if nz.point_std > 0:
-                point = point + nz.point_std * self._senses_rng.standard_normal(3)
+                point = point + nz.point_std * rng.standard_normal(3)
             out.append(LinkContact(LINK_NAMES[link], point, normal, float(self._force6[0])))
         return tuple(out)
+
+    def link_radii(self) -> dict[str, float]:
+        """Per link of :data:`LINK_NAMES` with collision geometry (the pads apart), the radius of its thickest
+        geom [m] (a sphere's, capsule's or cylinder's radius, a box's least half-size): how far from where its
+        readout puts a contact the touched point may lie (a link's skin is not the pad's)."""
+        m = self.model
+        out: dict[str, float] = {}
+        for g, k in enumerate(self._geom_link_list):
+            if k < 0:
+                continue
+            size = m.geom_size[g]
+            kind = GEOM_KINDS.get(int(m.geom_type[g]))
+            r = float(min(size)) if kind in ("box", "ellipsoid", "mesh") else float(size[0])
+            out[LINK_NAMES[k]] = max(out.get(LINK_NAMES[k], 0.0), r)
+        return out
 
     def touch(self) -> np.ndarray:
         """Touch force per fingertip (4,) [N], noise applied (clipped at 0)."""

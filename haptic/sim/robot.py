@@ -58,6 +58,16 @@ class RobotInterface:
         alone, noise applied, without reading the other sensors (no noise drawn when there are none)."""
         return self._sim.link_contacts()
 
+    def watch_links(self) -> tuple[LinkContact, ...]:
+        """:meth:`link_contacts` as watched all through a move (its noise drawn apart, so that watching changes no
+        other reading)."""
+        return self._sim.link_contacts(watch=True)
+
+    def link_radii(self) -> dict[str, float]:
+        """Per link, the radius of its thickest collision geom [m]: the bound of a point its readout reports
+        (the robot's own geometry)."""
+        return self._sim.link_radii()
+
     @property
     def time(self) -> float:
         """Simulation time [s]."""
