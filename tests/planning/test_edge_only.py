@@ -59,3 +59,16 @@ def test_moves_toward_an_edge_that_failed_are_tried_last():
     # 10 mm under the top edge, every move heading up (at 45°, 90°, 135°) crosses it: left out while the
     # five heading sideways or down remain
     assert len(fresh) == 5 and all(float(m.direction[2]) < 1e-9 for m in fresh)
+
+
+def test_the_outlook_names_what_stops_a_move():
+    from haptic.planning.table import EDGE_ONLY, MADE, TABLE, UNDERCUT, move_outlook, table_prediction
+
+    hyps, state, comps = _setup(0.25)
+    assert [move_outlook(h, DOWN, state, comps, CFG)[0] for h in hyps] == [EDGE_ONLY, TABLE]
+    up = FaceMove(np.array([0.0, 0.0, 1.0]))  # onto the top face: the pad rolls over
+    assert [move_outlook(h, up, state, comps, CFG)[0] for h in hyps] == [MADE, MADE]
+    hyps, state, comps = _setup(0.238)  # near the slot's side: no room to roll over its edge alone
+    assert move_outlook(hyps[0], DOWN, state, comps, CFG)[0] == UNDERCUT
+    # table_conflict is 1 for exactly the outlooks that stop
+    assert [table_prediction(h, DOWN, state, comps, CFG)[0] for h in hyps] == [1.0, 1.0]
