@@ -18,7 +18,7 @@ from haptic.geometry.se3 import SE3
 from haptic.geometry.tracing import circle_vertex
 from haptic.matching.components import DataComponent, DataEdge, DataFace
 from haptic.planning.config import PlannerConfig
-from haptic.planning.hypothesis import Hypothesis, trace_in
+from haptic.planning.hypothesis import FaceTrace, Hypothesis, trace_in
 from haptic.planning.moves import EdgeMove, FaceMove, Move, SensorState, VertexMove
 
 EDGE_ROLL = np.deg2rad(12.0)
@@ -169,7 +169,10 @@ def move_outlook(
             if near_end or float(n_w[2]) < -np.sin(config.max_undercut - EDGE_ROLL):
                 return UNDERCUT, float(hit.distance), 0.0  # no room to roll over the edge alone: the move fails there
             return EDGE_ONLY, float(hit.distance), 1.0
-        return onto(hit.edge, hit.next_face, hit.point), float(hit.distance), 0.0
+        what = onto(hit.edge, hit.next_face, hit.point)
+        if what == TABLE and rolls_to_edge(h, tr, config):
+            return EDGE_ONLY, float(hit.distance), 1.0  # the roll gives the edge, the table hides the next face
+        return what, float(hit.distance), 0.0
     if isinstance(move, EdgeMove):
         # refused toward an end where the pad on the ridge would meet the table first (a motion the table stops
         # locates no vertex), or toward a concave edge's end the hand cannot tell (config.concave_end_block)
@@ -200,6 +203,23 @@ def move_outlook(
         at = poly.vertices[v_m] + config.vertex_radius * away
         return onto(hit.edge, hit.next_face, at), np.nan, np.nan
     raise TypeError(f"unknown move {move!r}")
+
+
+def rolls_to_edge(h: Hypothesis, tr: FaceTrace, config: PlannerConfig) -> bool:
+    """Whether face move trace ``tr`` of ``h``, meeting a convex edge onto a face the table hides, ends at the edge
+    with the edge alone, as the hand does there: clear of the edge's ends (:data:`EDGE_ONLY_CLEARANCE`), its pad can
+    roll over the edge by :data:`EDGE_ROLL` -- enough for the edge from the roll -- before coming within
+    ``config.table_clearance`` of the table."""
+    poly, t, hit = h.poly, h.world_from_model, tr.hit
+    if poly.edge_convexity[hit.edge] <= 0 or tr.clearance(poly) < EDGE_ONLY_CLEARANCE:
+        return False
+    n_a, n_b = t.rotate(poly.face_normals[tr.face]), t.rotate(poly.face_normals[hit.next_face])
+    toward = n_b - float(n_b @ n_a) * n_a
+    norm = float(np.linalg.norm(toward))
+    if norm < 1e-9:
+        return False
+    rolled = np.cos(EDGE_ROLL) * n_a + np.sin(EDGE_ROLL) * toward / norm
+    return pad_clearance(t.apply(hit.point), rolled, config) >= config.table_clearance
 
 
 def _edge_end(
