@@ -66,36 +66,16 @@ class FaceTrace:
         return min(s_hit, float(poly.edge_lengths[e]) - s_hit)
 
 
-ON_EDGE_INSIDE = 1e-5
-"""A face move from a data edge of the face is traced from at least this far inside the face from the edge's model
-line [m]: the sensor on the edge it has just crossed lies as often a noise's width outside it, where the trace would
-meet that edge at once, entering the face, in place of the edge it leaves the face by."""
-
-
-def face_start(h: Hypothesis, f_m: int, state: SensorState) -> np.ndarray:
-    """Where a face move from ``state`` starts on model face ``f_m`` of posed hypothesis ``h`` (model frame): the
-    sensor's position projected onto the face's plane and, when the sensor is on a data edge that ``h`` pairs with a
-    side of the face, moved inside that side by at least :data:`ON_EDGE_INSIDE`."""
-    poly, p_m = h.poly, h.model_from_world.apply(state.position)
-    n = poly.face_normals[f_m]
-    p_m = p_m - (p_m @ n - poly.face_offsets[f_m]) * n
-    e_m = h.edges.get(state.edge) if state.edge is not None else None
-    if e_m is None or f_m not in (poly.edge_left_face[e_m], poly.edge_right_face[e_m]):
-        return p_m
-    w = np.cross(n, poly.edge_directions[e_m])
-    w = w if poly.edge_left_face[e_m] == f_m else -w  # into the face
-    inside = float((p_m - poly.edge_points[e_m]) @ w)
-    return p_m + (ON_EDGE_INSIDE - inside) * w if inside < ON_EDGE_INSIDE else p_m
-
-
 def trace_in(h: Hypothesis, move: FaceMove, state: SensorState) -> FaceTrace | None:
-    """Face move ``move`` from ``state`` traced in hypothesis ``h``'s world (from :func:`face_start`); None when
-    ``h`` cannot say (no pose, the current face not matched, no single edge met)."""
+    """Face move ``move`` from ``state`` traced in hypothesis ``h``'s world; None when ``h`` cannot say (no
+    pose, the current face not matched, no single edge met)."""
     f_m = h.faces.get(state.face)
     if h.world_from_model is None or f_m is None:
         return None
     model_from_world = h.model_from_world
-    poly, p_m = h.poly, face_start(h, f_m, state)
+    poly, p_m = h.poly, model_from_world.apply(state.position)
+    n = poly.face_normals[f_m]
+    p_m = p_m - (p_m @ n - poly.face_offsets[f_m]) * n
     d_m = model_from_world.rotate(move.direction)
     hit = trace_face(poly, f_m, p_m, d_m)
     return None if hit is None else FaceTrace(f_m, p_m, d_m, hit)

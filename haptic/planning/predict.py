@@ -21,7 +21,7 @@ from haptic.geometry.tracing import FaceHit, circle_vertex, trace_edge
 from haptic.matching.components import DataComponent, DataEdge, DataFace, SensorNoise
 from haptic.planning import kernels
 from haptic.planning.config import PlannerConfig
-from haptic.planning.hypothesis import FaceTrace, Hypothesis, face_start, trace_in
+from haptic.planning.hypothesis import FaceTrace, Hypothesis, trace_in
 from haptic.planning.moves import EdgeMove, FaceMove, Move, SensorState, VertexMove
 from haptic.planning.table import data_table_conflict, table_prediction
 
@@ -206,9 +206,11 @@ def trace_moves(
         f_m = h.faces.get(state.face)
         if h.world_from_model is None or f_m is None:
             continue
-        poly, n = h.poly, h.poly.face_normals[f_m]
+        model_from_world = h.model_from_world
+        poly, p_m = h.poly, model_from_world.apply(state.position)
+        n = poly.face_normals[f_m]
         rows.append(i)
-        starts.append(face_start(h, f_m, state))
+        starts.append(p_m - (p_m @ n - poly.face_offsets[f_m]) * n)
         rots.append(h.world_from_model.rotation)  # SE3.rotate of model_from_world multiplies by it
         normals.append(n)
         loops.append(_face_loop(poly, f_m))
@@ -464,9 +466,10 @@ def face_outcomes(
         f_m = h.faces.get(state.face)
         if h.world_from_model is None or f_m is None:
             continue
-        poly, n = h.poly, h.poly.face_normals[f_m]
+        poly, p_m = h.poly, h.model_from_world.apply(state.position)
+        n = poly.face_normals[f_m]
         rows.append(i)
-        starts.append(face_start(h, f_m, state))
+        starts.append(p_m - (p_m @ n - poly.face_offsets[f_m]) * n)
         rots.append(h.world_from_model.rotation)
         normals.append(n)
         loops.append(_face_loop(poly, f_m))

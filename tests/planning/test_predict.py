@@ -203,32 +203,3 @@ def test_edge_outcomes_equal_the_predictions_one_hypothesis_at_a_time():
             assert np.isclose(cost[i], c1, rtol=0, atol=1e-13, equal_nan=True)
             said += not np.isnan(one[0])
     assert said == 2 * 80
-
-
-def test_a_face_move_from_just_outside_its_edge_is_traced_to_the_edge_it_leaves_by():
-    """The sensor on the edge it has just crossed, a noise's width outside it (0.03 mm): the move into the face is
-    traced across the face to the far edge, not to the edge it starts on at once (BOX01 s1's 7th move: predicted
-    to cross back onto the face it came from after 0.06 mm, it slid down the side to the table)."""
-    from haptic.matching.components import DataEdge, DataFace
-    from haptic.planning.moves import FaceMove, SensorState
-    from haptic.planning.predict import face_outcomes, trace_all
-
-    model = LIB["BOX01"]
-    f = 0
-    e = int(model.face_edges[f][0])
-    n = model.face_normals[f]
-    w = np.cross(n, model.edge_directions[e])
-    w = w if model.edge_left_face[e] == f else -w
-    mid = model.edge_points[e] + 0.5 * model.edge_lengths[e] * model.edge_directions[e]
-    p = mid - 3e-5 * w
-    comps = {0: DataFace(0, n, np.array([p, p + 0.01 * w]), 0.01, 1e-3),
-             1: DataEdge(1, model.edge_directions[e], mid, 0.01, 0.01, 1e-3, 1e-3)}  # fmt: skip
-    h = Hypothesis("BOX01", model, SE3.identity(), {0: f}, {1: e}, {})
-    state = SensorState(position=p, face=0, edge=1)
-    move = FaceMove(np.cos(0.6) * w + np.sin(0.6) * model.edge_directions[e])
-    tr = trace_all([h], move, state)[0]
-    assert tr is not None and tr.hit.edge != e and tr.hit.distance > 0.01
-    (out, _, _), = face_outcomes([h], [move], state, PlannerConfig())
-    assert np.isclose(out[0, 0], tr.hit.distance)
-    out_one, _ = predict_one(h, move, state, comps, PlannerConfig())
-    assert np.isclose(out_one[0], tr.hit.distance)
