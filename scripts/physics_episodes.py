@@ -13,6 +13,10 @@ counted per episode).
 ``--probe-costs`` lists every probe the planner chose with its predicted cost -- the expected one it was ranked
 by, and the mean over the hypotheses that predicted the outcome it had (hit or miss) -- beside the cost the hand
 reported, and sums up their differences.
+After the failed moves by reason, every face, edge and vertex move is set against what the planner predicts of it
+under the true interpretation of the data so far (:class:`TruthOutlook`, evaluation only): predicted made and then
+failed, by reason; predicted to stop (the table, an undercut, a concave end) and stopped or went through; then every
+move offered against its outcome, as before.
 Copy and adapt: one episode is ``run_episode(EpisodeSpec(model=..., seed=..., executor="physics"))``.
 """
 
