@@ -13,6 +13,10 @@ counted per episode).
 ``--probe-costs`` lists every probe the planner chose with its predicted cost -- the expected one it was ranked
 by, and the mean over the hypotheses that predicted the outcome it had (hit or miss) -- beside the cost the hand
 reported, and sums up their differences.
+After the failed moves by reason, every face, edge and vertex move is set against what the planner predicts of it
+under the true interpretation of the data so far (:class:`TruthOutlook`, evaluation only): predicted made and then
+failed, by reason; predicted to stop (the table, an undercut, a concave end) and stopped or went through; then every
+move offered against its outcome, as before.
 Copy and adapt: one episode is ``run_episode(EpisodeSpec(model=..., seed=..., executor="physics"))``.
 """
 
@@ -31,13 +35,14 @@ import numpy as np
 
 from haptic.episode.loop import EpisodeObserver, chain_observers
 from haptic.episode.spec import EpisodeSpec
-from haptic.episode.worlds import preload_physics, run_episode
+from haptic.episode.worlds import Episode, build_episode, preload_physics
 from haptic.errors import HapticError
 from haptic.geometry import load_library
 from haptic.geometry.io import atomic_write
 from haptic.planning.efficiency import class_weights
 from haptic.planning.move_scores import bounded, predict_probe_moves
 from haptic.planning.registry import make_policy
+from haptic.planning.table import MADE, STOPS, data_table_conflict, move_outlook
 
 SEED_OBJECTS = ("BOX01", "WEDGE01", "BOX01N", "BOX01P", "PYR01", "TETRA01L", "TETRA01R", "HEXPRISM01", "LBLOCK01",
                 "FRAME01")
@@ -77,6 +82,52 @@ class ProbeCosts:
         return EpisodeObserver(on_move=self._result, on_failed_move=self._result)
 
 
+class TruthOutlook:
+    """The episode's executor, but before each move it keeps what the planner predicts of the move under the true
+    interpretation (:func:`truth_outlook`; evaluation: the truth is read here, never by the executor or the
+    planner) in :attr:`outlook`, and the risk the deciding policy gave it (:meth:`decided`) in :attr:`risk`."""
+
+    def __init__(self, episode: Episode) -> None:
+        self.inner, self.episode = episode.executor, episode
+        self.outlook: str | None = None
+        self.risk: float | None = None
+        self._decision = None
+
+    def start(self):
+        return self.inner.start()
+
+    def execute(self, move):
+        self.outlook = truth_outlook(self.episode, move)
+        d = self._decision
+        self.risk = next((float(c.risk) for c in d.candidates if c.move is move), None) if d is not None else None
+        self._decision = None
+        return self.inner.execute(move)
+
+    def decided(self, n, decision) -> None:
+        self._decision = decision
+
+    def __getattr__(self, name):
+        return getattr(self.inner, name)
+
+
+def truth_outlook(episode: Episode, move) -> str | None:
+    """What the planner's prediction (:func:`~haptic.planning.table.move_outlook`, and what the data alone say:
+    :func:`~haptic.planning.table.data_table_conflict`) says of a face, edge or vertex ``move`` from the executor's
+    state under the true interpretation of the data so far (:func:`~haptic.episode.evaluate.true_hypothesis`):
+    "made", "edge only", "table", "undercut", "concave"; None for other moves, or where the truth cannot say (a data
+    component the true model does not explain)."""
+    from haptic.episode.evaluate import true_hypothesis
+
+    ex = episode.executor
+    if move.kind not in ("face", "edge", "vertex") or ex.state is None:
+        return None
+    comps = {c.id: c for c in ex.components}
+    if data_table_conflict(move, ex.state, comps, episode.config):
+        return "table"
+    h = true_hypothesis(ex.components, episode.true_model, episode.world_from_model)
+    return move_outlook(h, move, ex.state, comps, episode.config)[0]
+
+
 def one(model: str, seed: int, policy: str, moves: str = "tracing", verify: str = "none",
         probe_costs: bool = False, models: str | None = None, fingers: int = 1) -> dict:  # fmt: skip
     """One physics episode's record as JSON (an ``error`` entry when it could not run), with the probes that
@@ -86,12 +137,13 @@ def one(model: str, seed: int, policy: str, moves: str = "tracing", verify: str 
     kinds: list[tuple[str, bool]] = []
     reasons: list[tuple[str, str]] = []
     recovered: list[tuple[str, str]] = []
-    reach: list[tuple[str, str, str, str, str]] = []
+    reach: list[tuple[str, str, str, str, str, str | None, float | None]] = []
+    watch_truth: TruthOutlook | None = None
 
     def on_move(n, result, *rest) -> None:
         if n > 0 and result.move is not None:  # the start is no move
             kinds.append((result.move.kind, True))
-            reach.append(move_reach(result))
+            reach.append(move_reach(result, watch_truth))
             recovered.extend((result.move.kind, why) for why in result.info.get("recoveries", ()))
 
     def on_failed(n, result) -> None:
@@ -100,7 +152,7 @@ def one(model: str, seed: int, policy: str, moves: str = "tracing", verify: str 
         why = result.reason or result.info.get("reason", "") or str(result.status)
         kinds.append((result.move.kind, False))
         reasons.append((result.move.kind, why))
-        reach.append(move_reach(result))
+        reach.append(move_reach(result, watch_truth))
         if result.move.kind == "probe":
             failed.append(f"{result.status}: {why}")
 
@@ -109,9 +161,12 @@ def one(model: str, seed: int, policy: str, moves: str = "tracing", verify: str 
     try:
         spec = EpisodeSpec(model=model, seed=seed, policy=policy, executor="physics", moves=moves, verify=verify,
                            models=models, fingers=fingers)  # fmt: skip
-        mine = EpisodeObserver(on_move=on_move, on_failed_move=on_failed)
+        episode = build_episode(spec)
+        watch_truth = TruthOutlook(episode)
+        episode.executor = watch_truth
+        mine = EpisodeObserver(on_move=on_move, on_failed_move=on_failed, on_decision=watch_truth.decided)
         obs = chain_observers(mine, watch.observer() if watch else None)
-        rec = run_episode(spec, observer=obs, policy=watch).to_json()
+        rec = episode.run(watch, obs).to_json()
     except HapticError as exc:
         return {"model": model, "seed": seed, "outcome": "error", "correct": False, "detail": str(exc)}
     rec.update(probes_failed=len(failed), probe_failures=failed, move_results=kinds, failure_reasons=reasons,
@@ -158,16 +213,19 @@ def _print_probe_costs(records: list[dict]) -> None:
               f"{e.mean():+.2f}, range {e.min():+.2f} … {e.max():+.2f} [units]")  # fmt: skip
 
 
-def move_reach(result) -> tuple[str, str, str, str, str]:
+def move_reach(result, truth: TruthOutlook | None = None) -> tuple[str, str, str, str, str, str | None, float | None]:
     """A move made, as the reach it was offered with and what came of it: (kind, finger -- "index" for the exploring
     one pointing down --, whose prediction it was -- "solver" for a move with the reach solver's path, the
-    planner's otherwise --, status, reason ("" when it succeeded))."""
+    planner's otherwise --, status, reason ("" when it succeeded), the planner's prediction under the true
+    interpretation (:class:`TruthOutlook`; None: none), the risk the deciding policy gave it (None: no policy's
+    decision))."""
     m = result.move
     finger = getattr(m, "finger", None) or ("+".join(f.finger for f in m.fingers) if m.kind == "placement"
                                              else "index")  # fmt: skip
     by = "solver" if getattr(m, "path", None) is not None else "planner"
     why = "" if result.ok else (result.reason or result.info.get("reason", "") or str(result.status))
-    return (m.kind, finger, by, str(result.status), why)
+    outlook, risk = (truth.outlook, truth.risk) if truth is not None else (None, None)
+    return (m.kind, finger, by, str(result.status), why, outlook, risk)
 
 
 REACH_WORDS = ("unreachable", "table", "limit", "blocked", "joint", "met the object", "out of the pad's reach",
@@ -186,20 +244,20 @@ def reach_failure(reason: str) -> bool:
 
 
 def print_reach(records: list[dict]) -> None:
-    """Moves predicted reachable (every move offered: the planner's table and undercut checks for the index pointing
-    down, the reach solver's path for a named finger) against their outcome: the share that failed, the share that
-    failed for the hand's reach (:func:`reach_failure`), those by reason; and the moves by another finger or a
-    turned wrist."""
+    """The planner's prediction under the true interpretation against the outcome (:func:`print_outlook`); then
+    every move offered against its outcome: the share that failed, the share that failed for the hand's reach
+    (:func:`reach_failure`), those by reason; and the moves by another finger or a turned wrist."""
     rows = [tuple(x) for r in records for x in r.get("move_reach", [])]
     if not rows:
         return
+    print_outlook(rows)
     failed = [x for x in rows if x[3] != "ok"]
     reach = [x for x in failed if reach_failure(x[4])]
     n = len(rows)
-    print()
-    print(f"moves predicted reachable {n}: failed {len(failed)} ({100 * len(failed) / n:.1f} %), of them for the "
-          f"hand's reach {len(reach)} ({100 * len(reach) / n:.1f} % of the moves)")  # fmt: skip
-    why = Counter((k, reason_class(w)) for k, _, _, _, w in reach)
+    print(f"moves offered {n} (the planner's risk under its hypotheses aside): failed {len(failed)} "
+          f"({100 * len(failed) / n:.1f} %), of them for the hand's reach {len(reach)} "
+          f"({100 * len(reach) / n:.1f} % of the moves)")  # fmt: skip
+    why = Counter((k, reason_class(w)) for k, _, _, _, w, *_ in reach)
     for (k, w), c in why.most_common():
         print(f"  {c:>4}  {k:<6} {w}")
     solver = [x for x in rows if x[2] == "solver"]
@@ -208,6 +266,35 @@ def print_reach(records: list[dict]) -> None:
         fingers = Counter(x[1] for x in solver)
         print(f"moves on the reach solver's path {len(solver)} ({', '.join(f'{k} {v}' for k, v in fingers.items())})"
               f": failed {len(bad)}" + "".join(f"; {x[1]} {x[0]}: {reason_class(x[4])}" for x in bad))  # fmt: skip
+
+
+def print_outlook(rows: list[tuple]) -> None:
+    """Face, edge and vertex moves by what the planner predicts of them under the true interpretation
+    (:class:`TruthOutlook`) against what the hand then did: predicted made (or ending at its edge) and failed, by
+    reason, and of them for the hand's reach; predicted to stop (the table, an undercut, a concave end) and stopped
+    or went through; the truth could not say."""
+    traced = [x for x in rows if len(x) > 5 and x[0] in ("face", "edge", "vertex")]
+    if not traced:
+        return
+    made = [x for x in traced if x[5] is not None and x[5] not in STOPS]
+    stops = [x for x in traced if x[5] in STOPS]
+    unsaid = [x for x in traced if x[5] is None]
+    bad = [x for x in made if x[3] != "ok"]
+    reach = [x for x in bad if reach_failure(x[4])]
+    n = max(1, len(made))
+    print()
+    print(f"moves predicted made under the true interpretation {len(made)} (of {len(traced)} face, edge, vertex moves;"
+          f" {sum(x[5] != MADE for x in made)} ending at their edge): failed {len(bad)} ({100 * len(bad) / n:.1f} %), "
+          f"for the hand's reach {len(reach)} ({100 * len(reach) / n:.1f} %)")  # fmt: skip
+    for (k, w), c in Counter((x[0], reason_class(x[4])) for x in bad).most_common():
+        print(f"  {c:>4}  {k:<6} {'reach ' if reach_failure(w) else '      '}{w}")
+    went = [x for x in stops if x[3] == "ok"]
+    kinds = Counter(x[5] for x in stops)
+    print(f"moves predicted to stop {len(stops)} ({', '.join(f'{k} {v}' for k, v in kinds.most_common())}): stopped "
+          f"{len(stops) - len(went)}, went through {len(went)}")  # fmt: skip
+    for (k, o, w), c in Counter((x[0], x[5], reason_class(x[4]) or "ok") for x in stops).most_common():
+        print(f"  {c:>4}  {k:<6} {o:<8} {w}")
+    print(f"moves the truth could not predict {len(unsaid)}: failed {sum(x[3] != 'ok' for x in unsaid)}")
 
 
 def reason_class(reason: str) -> str:

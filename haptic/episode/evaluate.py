@@ -36,6 +36,7 @@ from haptic.matching.acceptance import residual_ratios
 from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex
 from haptic.matching.trace import PHASES
 from haptic.matching.tree import Interpretation
+from haptic.planning.hypothesis import Hypothesis
 from haptic.sim.scene import PAD_RADIUS
 
 
@@ -455,3 +456,22 @@ __all__ = [
     "bound_ratios",
     "score_components",
 ]
+
+
+def true_hypothesis(
+    components, model: Polyhedron, world_from_model: SE3, tolerances: EvaluationTolerances | None = None
+) -> Hypothesis:
+    """The true interpretation of ``components`` (every report; the latest of each id counts) as the planner's
+    :class:`~haptic.planning.hypothesis.Hypothesis`: ``model`` at its true pose, each data component paired with
+    the true feature of its kind that scores it (:func:`score_components`; a spurious one left out). Through it the
+    planner's predictions are made as the truth would make them (:func:`haptic.planning.table.move_outlook`)."""
+    tol = tolerances or EvaluationTolerances()
+    rot, trans = world_from_model.rotation, world_from_model.translation
+    pairs: dict[str, dict[int, int]] = {"face": {}, "edge": {}, "vertex": {}}
+    for c in _latest(components):
+        score = score_face if isinstance(c, DataFace) else score_edge if isinstance(c, DataEdge) else score_vertex
+        s = score(c, model, rot, trans, tol)
+        if s.true_id is not None:
+            pairs[s.kind][c.id] = int(s.true_id)
+    return Hypothesis(model=model.name, poly=model, world_from_model=world_from_model, faces=pairs["face"],
+                      edges=pairs["edge"], vertices=pairs["vertex"])  # fmt: skip

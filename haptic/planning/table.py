@@ -18,7 +18,7 @@ from haptic.geometry.se3 import SE3
 from haptic.geometry.tracing import circle_vertex
 from haptic.matching.components import DataComponent, DataEdge, DataFace
 from haptic.planning.config import PlannerConfig
-from haptic.planning.hypothesis import Hypothesis, trace_in
+from haptic.planning.hypothesis import FaceTrace, Hypothesis, trace_in
 from haptic.planning.moves import EdgeMove, FaceMove, Move, SensorState, VertexMove
 
 EDGE_ROLL = np.deg2rad(12.0)
@@ -105,6 +105,15 @@ def table_conflict(
     return table_prediction(h, move, state, components, config)[0]
 
 
+MADE, EDGE_ONLY, TABLE, UNDERCUT, CONCAVE = "made", "edge only", "table", "undercut", "concave"
+"""What a hypothesis predicts of a move on the hand (:func:`move_outlook`): carried out; a face move ending at its
+edge, the next face leaning under out of the pad's reach (a success that reports the edge alone); stopped by the
+table (the pad would come onto it, or the next face is too close to it); stopped at a convex edge onto a face
+leaning under further than the pad reaches; stopped at a concave edge's end or vertex the hand cannot tell."""
+STOPS = (TABLE, UNDERCUT, CONCAVE)
+"""The outlooks of a move the hand is predicted not to carry out."""
+
+
 def table_prediction(
     h: Hypothesis, move: Move, state: SensorState, components: Mapping[int, DataComponent], config: PlannerConfig
 ) -> tuple[float, float, float]:
@@ -113,9 +122,22 @@ def table_prediction(
     reach (:attr:`~haptic.planning.predict.Prediction.edge_only`); NaN, NaN for other moves."""
     if config.table_z is None:
         return 0.0, np.nan, np.nan
+    why, reach, edge_only = move_outlook(h, move, state, components, config)
+    return (np.nan if why is None else float(why in STOPS)), reach, edge_only
+
+
+def move_outlook(
+    h: Hypothesis, move: Move, state: SensorState, components: Mapping[int, DataComponent], config: PlannerConfig
+) -> tuple[str | None, float, float]:
+    """What hypothesis ``h`` predicts of ``move`` on the hand, through its own pose: one of :data:`MADE`,
+    :data:`EDGE_ONLY`, :data:`TABLE`, :data:`UNDERCUT`, :data:`CONCAVE` (None: it cannot say); for a face move, how
+    far its trace touches the face and whether it ends at its edge (1.0, else 0.0; NaN, NaN for other moves). Without
+    a table (``config.table_z`` None) every move it can say of is made."""
+    if config.table_z is None:
+        return MADE, np.nan, np.nan
     t = h.world_from_model
     if t is None:
-        return np.nan, np.nan, np.nan
+        return None, np.nan, np.nan
     poly, lim = h.poly, config.table_clearance
 
     def leans_under(e_m: int, g_m: int) -> bool:
@@ -124,55 +146,80 @@ def table_prediction(
             return False
         return float(t.rotate(poly.face_normals[g_m])[2]) < -np.sin(config.max_undercut)
 
-    def onto_hidden(e_m: int, g_m: int, at_m: np.ndarray) -> bool:
+    def onto(e_m: int, g_m: int, at_m: np.ndarray) -> str:
+        """Stepping over edge ``e_m`` onto face ``g_m`` at ``at_m``: made, or stopped by an undercut or the table."""
+        if leans_under(e_m, g_m):
+            return UNDERCUT
         q = t.apply(at_m + TABLE_STEP_ONTO * _inward(poly, e_m, g_m))
-        return leans_under(e_m, g_m) or pad_clearance(q, t.rotate(poly.face_normals[g_m]), config) < lim
+        return TABLE if pad_clearance(q, t.rotate(poly.face_normals[g_m]), config) < lim else MADE
 
     if isinstance(move, FaceMove):
         tr = trace_in(h, move, state)
         if tr is None:
-            return np.nan, np.nan, np.nan
+            return None, np.nan, np.nan
         hit = tr.hit
         n_w = t.rotate(poly.face_normals[tr.face])
         d_z = float(np.asarray(move.direction)[2])
         if d_z < 0.0 and pad_clearance(t.apply(hit.point), n_w, config) < lim:
             # the slide stops where the pad comes too close to the table
             start = pad_clearance(t.apply(tr.start), n_w, config)
-            return 1.0, float(np.clip((start - lim) / -d_z, 0.0, hit.distance)), 0.0
+            return TABLE, float(np.clip((start - lim) / -d_z, 0.0, hit.distance)), 0.0
         if leans_under(hit.edge, hit.next_face):
             near_end = tr.clearance(poly) < EDGE_ONLY_CLEARANCE
             if near_end or float(n_w[2]) < -np.sin(config.max_undercut - EDGE_ROLL):
-                return 1.0, float(hit.distance), 0.0  # no room to roll over the edge alone: the move fails there
-            return 0.0, float(hit.distance), 1.0
-        return float(onto_hidden(hit.edge, hit.next_face, hit.point)), float(hit.distance), 0.0
+                return UNDERCUT, float(hit.distance), 0.0  # no room to roll over the edge alone: the move fails there
+            return EDGE_ONLY, float(hit.distance), 1.0
+        what = onto(hit.edge, hit.next_face, hit.point)
+        if what == TABLE and rolls_to_edge(h, tr, config):
+            return EDGE_ONLY, float(hit.distance), 1.0  # the roll gives the edge, the table hides the next face
+        return what, float(hit.distance), 0.0
     if isinstance(move, EdgeMove):
         # refused toward an end where the pad on the ridge would meet the table first (a motion the table stops
         # locates no vertex), or toward a concave edge's end the hand cannot tell (config.concave_end_block)
-        refused = edge_end_on_table(h, move, state, components, config) or hidden_concave_end(
-            h, move, state, components, config) or at_concave_vertex(h, state, config)
-        return float(refused), np.nan, np.nan
+        if edge_end_on_table(h, move, state, components, config):
+            return TABLE, np.nan, np.nan
+        if hidden_concave_end(h, move, state, components, config) or at_concave_vertex(h, state, config):
+            return CONCAVE, np.nan, np.nan
+        return MADE, np.nan, np.nan
     if isinstance(move, VertexMove):
         e_m = h.edges.get(state.edge) if state.edge is not None else None
         v_m = h.vertices.get(state.vertex) if state.vertex is not None else None
         a_m = h.faces.get(move.across_face)
         if e_m is None or v_m is None or a_m is None:
-            return np.nan, np.nan, np.nan
+            return None, np.nan, np.nan
         if at_concave_vertex(h, state, config):
-            return 1.0, np.nan, np.nan
+            return CONCAVE, np.nan, np.nan
         try:
             hit = circle_vertex(poly, v_m, e_m, a_m, config.vertex_radius)
         except ValueError:
-            return np.nan, np.nan, np.nan
+            return None, np.nan, np.nan
         u = poly.edge_directions[e_m] * (1.0 if poly.edges[e_m, 1] == v_m else -1.0)
         pts = circle_points(poly.vertices[v_m], u, _inward(poly, e_m, a_m), config.vertex_radius,
                             VERTEX_START_ANGLE, hit.angle, CIRCLE_CHECK_STEP)  # fmt: skip
         n_w = t.rotate(poly.face_normals[a_m])
         if min(pad_clearance(q, n_w, config) for q in t.apply(pts)) < lim:
-            return 1.0, np.nan, np.nan
+            return TABLE, np.nan, np.nan
         away = poly.edge_directions[hit.edge] * (1.0 if poly.edges[hit.edge, 0] == v_m else -1.0)
         at = poly.vertices[v_m] + config.vertex_radius * away
-        return float(onto_hidden(hit.edge, hit.next_face, at)), np.nan, np.nan
+        return onto(hit.edge, hit.next_face, at), np.nan, np.nan
     raise TypeError(f"unknown move {move!r}")
+
+
+def rolls_to_edge(h: Hypothesis, tr: FaceTrace, config: PlannerConfig) -> bool:
+    """Whether face move trace ``tr`` of ``h``, meeting a convex edge onto a face the table hides, ends at the edge
+    with the edge alone, as the hand does there: clear of the edge's ends (:data:`EDGE_ONLY_CLEARANCE`), its pad can
+    roll over the edge by :data:`EDGE_ROLL` -- enough for the edge from the roll -- before coming within
+    ``config.table_clearance`` of the table."""
+    poly, t, hit = h.poly, h.world_from_model, tr.hit
+    if poly.edge_convexity[hit.edge] <= 0 or tr.clearance(poly) < EDGE_ONLY_CLEARANCE:
+        return False
+    n_a, n_b = t.rotate(poly.face_normals[tr.face]), t.rotate(poly.face_normals[hit.next_face])
+    toward = n_b - float(n_b @ n_a) * n_a
+    norm = float(np.linalg.norm(toward))
+    if norm < 1e-9:
+        return False
+    rolled = np.cos(EDGE_ROLL) * n_a + np.sin(EDGE_ROLL) * toward / norm
+    return pad_clearance(t.apply(hit.point), rolled, config) >= config.table_clearance
 
 
 def _edge_end(
