@@ -776,3 +776,19 @@ def test_a_vertex_move_whose_roll_went_round_the_edges_end_crosses_again_inside_
         ep.run(None, EpisodeObserver(on_move=on_move, on_failed_move=on_failed))
     assert said and not failed, failed
     assert _within_bounds(ep)
+
+
+def test_a_face_move_whose_crossing_rolled_round_a_vertex_crosses_again_beside_it():
+    # PYR01 seed 1 (physics_episodes.py --verify full): the fourth move traced a side face down at a slant into the
+    # foot of a slanted edge, at the base vertex; the pad rolled round the vertex onto the ridge along the base, and
+    # every touch of the next face afresh past the edge landed on the rims round it: the move failed ("too few
+    # contacts on the next face"). It now crosses again shifted square to its travel, away from the vertex the roll
+    # went round, and reports the edge and the next face within their bounds.
+    results = []
+    obs = EpisodeObserver(on_move=lambda n, r, *a: results.append(r), on_failed_move=lambda n, r: results.append(r))
+    ep = build_episode(EpisodeSpec(model="PYR01", seed=1, executor="physics", max_moves=5))
+    ep.run(None, obs)
+    face = [r for r in results if r.move is not None and r.move.kind == "face"]
+    assert all(r.ok for r in face), [r.reason for r in face if not r.ok]
+    assert any("crossed again" in why for r in face for why in r.info.get("recoveries", ()))
+    assert _within_bounds(ep)

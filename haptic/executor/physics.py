@@ -27,7 +27,7 @@ from haptic.errors import HapticError
 from haptic.executor.landing import LandingSearch
 from haptic.executor.physics_probe import probe_move
 from haptic.executor.placement import finger_probe_move, placement_move
-from haptic.executor.primitives import PrimitiveResult, Toucher
+from haptic.executor.primitives import OPPOSED, PrimitiveResult, Toucher
 from haptic.executor.segment import (
     AT_END,
     MM,
@@ -73,6 +73,11 @@ RIDGE_PROBE = 0.004
 """An edge measured from a roll alone is followed this far each way from where the roll ended [m] ..."""
 RIDGE_MIN_SPAN = 0.003
 """... and its ridge contacts must span at least this along it [m]."""
+NEXT_FACE_LOST = ("too few contacts on the next face", "stepping onto the next face, the pad reached the rim")
+"""How a crossing that rolled over the edge but measured too little of a face past it ends
+(:meth:`PhysicsExecutor._cross_and_acquire`). A stroke on the next face that was blocked is not among them: that is
+the finger held back in a slot (BOX01N seed 1), no vertex's doing; crossed again farther along the slot's wall, the
+episode went on to fail four moves in a row at the slot (with ``--verify none``, recognised without it)."""
 
 
 TOUCH_PHASES = ("face", "circle")
@@ -209,6 +214,10 @@ class PhysicsSettings:
     much farther inside the edge (plus how far the pad overshot the end) ... [m]"""
     recross_back: float = 0.008
     """... starting this far back on the face from where it met the edge [m]."""
+    recross_side_cos: float = 0.3
+    """A face move whose crossing found no next face crosses again shifted square to its travel, to the side away
+    from the vertex the roll went round, when the edge's way from that vertex has at least this component there
+    [-]."""
     circle_recross: float = 0.024
     """A vertex move whose circle's roll went round the end of the edge it met crosses again so (``recross_shift``,
     ``recross_back``), sliding at most this far to the edge [m]."""
@@ -292,6 +301,8 @@ class PhysicsExecutor(LandingSearch):
         self._why = ""  # detail of the last repositioning failure
         self._stroke_blocked = False  # the last stroke on a next face met an edge along both of its legs
         self._met: PrimitiveResult | None = None  # the last crossing a link of the finger stopped
+        self._roll: ContactTrace | None = None  # the last crossing's roll (or climb) over the edge
+        self._past: list[np.ndarray] = []  # normals the last crossing's touches afresh met past the edge
         self._links_until: float | None = None  # sim time of the last hand-link sample reported
         self._radii: dict[str, float] | None = None  # per link, the bound of a point its readout reports
 
@@ -565,11 +576,13 @@ class PhysicsExecutor(LandingSearch):
         """Roll over / climb out of the edge just met, then stroke on the next face. Returns (status, reason,
         roll trace, stroke trace, next face fit)."""
         t = self.toucher
+        self._roll, self._past = None, []
         if kind == "concave" and self.workspace.touching_table(self._finger_contacts()):
             return "unreachable", "the finger met the table", None, None, None
         corner = self.contact_point()
         r = t.cross_edge(kind, n_a, direction)
         pieces.append(r)
+        self._roll = r.trace
         if not r.ok:
             if r.event == "hand":
                 self._met = r
@@ -688,6 +701,7 @@ class PhysicsExecutor(LandingSearch):
             return "miss"
         if self.workspace.is_table(n, t.contact[2]):
             return "table"
+        self._past.append(n)
         e_n = unit(np.cross(n_a, n))
         away = unit(np.cross(n, e_n))
         if float(away @ (t.tip - corner)) < 0:
@@ -738,6 +752,22 @@ class PhysicsExecutor(LandingSearch):
                 tilted = True
                 if self._tilt_away(self._met, st.face, corner - self.settings.recross_back * inplane, pieces):
                     continue
+            if status != "ok" and not recrossed and reason.startswith(NEXT_FACE_LOST) and self._past_spread():
+                # the pad rolled over the edge and touched no one face past it: met near the edge's end, it rolled
+                # round the vertex onto the rims of the faces there. Cross again beside the first crossing, on the
+                # side away from that vertex, as after a roll that gave no edge
+                recrossed = True
+                shift = self._shift_from_roll(r.info["face_normal"], inplane, self._roll)
+                if shift is not None:  # as far back as aside: inside the face however the edge slants; nearer
+                    # the edge when that would put the pad by the table
+                    back = self.settings.recross_back + float(np.linalg.norm(shift))
+                    start = corner - back * inplane + shift
+                    if self.workspace.pad_clearance(start, n_a) < self.settings.pad_clearance:
+                        start = corner - self.settings.recross_back * inplane + shift
+                if shift is not None and self._touch_face(st.face, n_a, start, pieces) == "ok":
+                    self.recoveries.append(f"{reason}: crossed again {np.linalg.norm(shift) * 1000:.0f} mm aside, "
+                                           "away from the vertex")  # fmt: skip
+                    continue
             if status != "ok":
                 return self.failed_result(move, status, reason)
             fit_a, line, why = self._edge_between(st.face, r.trace, "face", roll, fit_b, kind, corner)
@@ -781,6 +811,47 @@ class PhysicsExecutor(LandingSearch):
         ok = np.flatnonzero(nn @ n > math.cos(self.bounds.face_cone))
         last = trace.point_in_world[ok[-1]] if len(ok) else self._faces[fid].anchor
         return last - self.settings.recross_back * d
+
+    def _past_spread(self) -> bool:
+        """Whether the last crossing's touches afresh past the edge met no one face: none touched, or normals more
+        than :attr:`PhysicsSettings.reacquire_cone` apart -- the rims of the faces round a vertex (PYR01 seed 1:
+        seven touches up to 88° apart). Touches that all met one face found it there, too small for the stroke or out of
+        its reach, and a crossing farther along the edge meets the same (trapezohedron_04 of the sized corpus,
+        seed 1: four touches within 8° of each other, each stroke cut short)."""
+        if not self._past:
+            return True
+        n = np.array(self._past)
+        return float((n @ n.T).min()) < math.cos(self.settings.reacquire_cone)
+
+    def _shift_from_roll(self, n_a: np.ndarray, d: np.ndarray, roll: ContactTrace | None) -> np.ndarray | None:
+        """After a slide along ``d`` on face ``n_a`` whose crossing found no next face: the sideways shift, square to
+        ``d`` in the face, of a slide that crosses the same boundary clear of the vertex the roll went round; None
+        when the roll has no contacts, did not turn, or its edge runs too near along ``d`` to tell a side.
+
+        The way is that of :meth:`_away_from_vertex` about the axis the roll first turned about (its normals where
+        they first turned twice the edge angle from face a's stand for the next face's): rolling on round the
+        vertex, onto the ridge of two other faces, its last normals turn about another axis (PYR01 seed 1: a
+        slanted edge met at its foot, the roll ending on the ridge along the base). The shift is
+        ``recross_shift`` plus the pad's radius: the crossing may have been at the vertex, and a pad past a concave
+        corner there touches its other wall until a radius away (LBLOCK01 seed 1: met 4 mm from the corner, crossed
+        again 6 mm farther, the pad wedged between the walls). Square to the travel (and as far back), the new start
+        stays on the face where a shift along a misjudged edge left it (PYR01 seed 1: on the ridge of the edge met)."""
+        side = np.cross(n_a, d)
+        if roll is None or not roll.in_contact.any() or float(side @ side) < OPPOSED:
+            return None
+        side = unit(side)
+        n = roll.normal_in_world[roll.in_contact]
+        k = self.bounds.steady_window
+        turned = np.flatnonzero(n @ n_a < math.cos(2.0 * self.toucher.config.edge_angle))
+        i = int(turned[0]) if len(turned) else len(n) - k
+        n_b = unit(n[max(0, i):i + k].sum(axis=0))
+        e = np.cross(n_a, n_b)
+        if float(e @ e) < math.sin(self.bounds.min_edge_angle) ** 2:
+            return None
+        away = self._away_from_vertex(n_a, n_b, roll)
+        if away is None or abs(float(unit(away) @ side)) < self.settings.recross_side_cos:
+            return None
+        return math.copysign(self.settings.recross_shift + self.toucher.pad_radius, float(away @ side)) * side
 
     def _away_from_vertex(self, n_a: np.ndarray, n_b: np.ndarray, roll: ContactTrace) -> np.ndarray | None:
         """After a roll whose normals leaned along the edge between faces ``n_a`` and ``n_b`` (the pad rolled
