@@ -58,6 +58,25 @@ def test_self_intersecting_surface_names_two_faces_that_cross(tmp_path, capsys):
     assert "intersects itself" in err and "faces 0" in err and "cross" in err
 
 
+def _l_block_with_a_crossed_face() -> str:
+    """An L block (the library's LBLOCK01, in metres) with corner 0 moved 4 mm outward and cut off its three faces
+    as triangles: the bottom's triangle (1, 0, 5) spans the L's notch, so the rest of the bottom, (5, 4, 3, 2, 1),
+    crosses itself (its edge 1-5 runs through edge 4-3; 2-6 and 5-4 in the file's numbering), while every two
+    faces meet only along edges."""
+    xy = [(0, 0), (100, 0), (100, 35), (35, 35), (35, 80), (0, 80)]
+    v = [(x / 1e3, y / 1e3, 0.0) for x, y in xy] + [(x / 1e3, y / 1e3, 0.05) for x, y in xy]
+    v[0] = (-0.004 / 3**0.5,) * 3
+    faces = [(1, 0, 5), (5, 4, 3, 2, 1), (6, 0, 1), (1, 7, 6), (5, 0, 6), (5, 6, 11), (6, 7, 8, 9, 10, 11),
+             (1, 2, 8, 7), (2, 3, 9, 8), (3, 4, 10, 9), (4, 5, 11, 10)]
+    return "".join(f"v {x:.6f} {y:.6f} {z:.6f}\n" for x, y, z in v) + "".join(
+        "f " + " ".join(str(i + 1) for i in f) + "\n" for f in faces)
+
+
+def test_a_face_whose_loop_crosses_itself_is_named(tmp_path, capsys):
+    err = _check(tmp_path, capsys, "crossed.obj", _l_block_with_a_crossed_face())
+    assert "face 1" in err and "crosses itself" in err and "2-6" in err and "5-4" in err, err  # the file's numbers
+
+
 def test_obj_vertex_with_two_coordinates_names_the_line(tmp_path, capsys):
     err = _check(tmp_path, capsys, "short.obj", TETRA + "v 0 0\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n")
     assert "line 5" in err and "needs x y z" in err

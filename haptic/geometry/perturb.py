@@ -62,11 +62,23 @@ def move_vertex(poly: Polyhedron, vertex: int, offset: float, name: str | None =
         n = poly.face_normals[fi]
         convex_corner = float(np.cross(v[vertex] - v[prev], v[nxt] - v[vertex]) @ n) > 0
         if convex_corner:
+            inside = [i for i in loop if i not in (prev, vertex, nxt) and _in_triangle(v, (prev, vertex, nxt), i, n)]
+            if inside:
+                raise ModelError(
+                    f"{poly.name}: moving vertex {vertex} would cut the corner triangle {(prev, vertex, nxt)} off "
+                    f"face {fi}, which holds vertex {inside[0]} of that face (another vertex can be moved)"
+                )
             faces.append((prev, vertex, nxt))
             faces.append(tuple(i for i in loop if i != vertex))
         else:
             faces.extend(triangulate_polygon(v, loop, n))
     return Polyhedron.from_faces(moved, faces, name=name or f"{poly.name}_v{vertex}_{offset * 1e3:g}mm")
+
+
+def _in_triangle(v: np.ndarray, tri: tuple[int, int, int], i: int, normal: np.ndarray) -> bool:
+    """Whether vertex ``i`` lies in triangle ``tri`` of a face with ``normal`` (on its rim included)."""
+    a, b, c = (v[k] for k in tri)
+    return all(float(np.cross(q - p, v[i] - p) @ normal) >= 0 for p, q in ((a, b), (b, c), (c, a)))
 
 
 def chamfer_edge(poly: Polyhedron, edge: int, size: float, name: str | None = None) -> Polyhedron:

@@ -256,6 +256,16 @@ class Polyhedron:
         set_(self, "edge_right_face", _readonly(np.array(right, dtype=int)))
         set_(self, "face_edges", face_edges)
 
+        # each face's loop a simple polygon: a loop that crosses itself overlaps its own face
+        for fi, loop in enumerate(self.faces):
+            crossed = loop_crossing(v, loop, normals[fi], t.planar)
+            if crossed is not None:
+                (a, b), (c, d) = crossed
+                raise ModelError(
+                    f"{where}: face {fi} (vertices {[lab(i) for i in loop]}) crosses itself: its edges "
+                    f"{lab(a)}-{lab(b)} and {lab(c)}-{lab(d)} intersect; a face's loop must be a simple polygon"
+                )
+
         # coplanar neighbours would be an edge no finger can feel
         for e, (fl, fr) in enumerate(zip(left, right, strict=True)):
             if _coplanar(v, self.faces[fl], normals[fl], offsets[fl], self.faces[fr], normals[fr], offsets[fr], t):
@@ -543,6 +553,51 @@ def triangulate_polygon(
             raise ModelError(f"face loop {list(loop)} is self-intersecting or not simple: cannot triangulate")
     out.append((idx[0], idx[1], idx[2]))
     return out
+
+
+def loop_crossing(
+    vertices: np.ndarray, loop: tuple[int, ...], normal: np.ndarray, eps: float
+) -> tuple[tuple[int, int], tuple[int, int]] | None:
+    """Two edges of face loop ``loop`` (not neighbours in it) that meet, seen along ``normal``, or ``None`` for
+    a simple polygon. Edges that come within ``eps`` [m] of each other's line count as meeting only where
+    each passes more than ``eps`` beyond the other's ends' sides, so rounding in a source does not."""
+    m = len(loop)
+    if m < 4:
+        return None
+    u, w = plane_basis(normal)
+    q = np.asarray(vertices)[list(loop)]
+    pts = np.stack([q @ u, q @ w], axis=1)
+    a, b = pts, np.roll(pts, -1, axis=0)
+    i, j = np.triu_indices(m, k=2)
+    keep = ~((i == 0) & (j == m - 1))  # the loop's last edge neighbours its first
+    i, j = i[keep], j[keep]
+    if len(i) == 0:
+        return None
+
+    def side(p0, p1, x):
+        d = p1 - p0
+        length = np.maximum(np.linalg.norm(d, axis=1), 1e-300)
+        return (d[:, 0] * (x[:, 1] - p0[:, 1]) - d[:, 1] * (x[:, 0] - p0[:, 0])) / length
+
+    s1, s2 = side(a[i], b[i], a[j]), side(a[i], b[i], b[j])
+    s3, s4 = side(a[j], b[j], a[i]), side(a[j], b[j], b[i])
+    hit = (((s1 > eps) & (s2 < -eps)) | ((s1 < -eps) & (s2 > eps))) & (
+        ((s3 > eps) & (s4 < -eps)) | ((s3 < -eps) & (s4 > eps))
+    )
+    # a vertex of one edge lying on the other (within eps, between its ends) meets it too
+    for (p0, p1), (x0, x1) in (((a[i], b[i]), (a[j], b[j])), ((a[j], b[j]), (a[i], b[i]))):
+        d = p1 - p0
+        length2 = np.maximum(np.einsum("ij,ij->i", d, d), 1e-300)
+        for x in (x0, x1):
+            t_ = np.einsum("ij,ij->i", x - p0, d) / length2
+            off = np.abs(side(p0, p1, x))
+            reach = eps / np.sqrt(length2)
+            hit |= (off <= eps) & (t_ > reach) & (t_ < 1 - reach)
+    if not hit.any():
+        return None
+    k = int(np.flatnonzero(hit)[0])
+    e1, e2 = int(i[k]), int(j[k])
+    return (loop[e1], loop[(e1 + 1) % m]), (loop[e2], loop[(e2 + 1) % m])
 
 
 def _coplanar(v: np.ndarray, loop_a, n_a, d_a, loop_b, n_b, d_b, t: Tolerances) -> bool:

@@ -55,3 +55,14 @@ def test_chamfer_too_large_is_refused():
     b = box(0.1, 0.08, 0.006)
     with pytest.raises(ModelError, match="chamfer"):
         chamfer_edge(b, int(np.argmax(b.edge_lengths)), 0.01)
+
+
+def test_a_corner_whose_triangle_holds_another_vertex_is_refused():
+    """LBLOCK01's corner 0 lies on the L-shaped bottom: its corner triangle (1, 0, 5) spans the L's notch and holds
+    vertex 3, so cutting it off would leave the rest of the bottom crossing itself. The move is refused (the
+    benchmarks take another vertex); a corner whose triangle stays inside its faces moves."""
+    lblock = LIB["LBLOCK01"]
+    with pytest.raises(ModelError, match=r"corner triangle \(1, 0, 5\) off face 0, which holds vertex 3"):
+        move_vertex(lblock, 0, 0.004)
+    q = move_vertex(lblock, 2, 0.004)
+    assert q.n_faces == lblock.n_faces + 3 and q.volume > lblock.volume
