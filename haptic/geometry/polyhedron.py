@@ -256,8 +256,18 @@ class Polyhedron:
         set_(self, "edge_right_face", _readonly(np.array(right, dtype=int)))
         set_(self, "face_edges", face_edges)
 
-        # each face's loop a simple polygon: a loop that crosses itself overlaps its own face
-        for fi, loop in enumerate(self.faces):
+        # each face's loop a simple polygon: a loop that crosses itself overlaps its own face. A loop turning left
+        # at every corner and once round in all is convex, hence simple; the others are tested edge by edge
+        prv = np.concatenate([np.roll(np.asarray(loop), 1) for loop in self.faces])
+        into, out = v[flat] - v[prv], v[nxt] - v[flat]
+        turn = np.arctan2(np.einsum("ij,ij->i", np.cross(into, out), normals[owner]), np.einsum("ij,ij->i", into, out))
+        total = np.zeros(len(self.faces))
+        np.add.at(total, owner, turn)
+        turns_left = np.ones(len(self.faces), dtype=bool)
+        np.logical_and.at(turns_left, owner, turn > -1e-9)
+        convex = turns_left & (np.abs(total - 2 * np.pi) < 1e-6)
+        for fi in map(int, np.flatnonzero(~convex)):
+            loop = self.faces[fi]
             crossed = loop_crossing(v, loop, normals[fi], t.planar)
             if crossed is not None:
                 (a, b), (c, d) = crossed
