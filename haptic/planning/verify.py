@@ -636,9 +636,8 @@ def plan_verification_move(
     offered whatever the move set, and when one is predicted to land near where the tour is entered only such
     probes are: the next move carries the pad over the object to there. A face move predicted to cross a model
     edge from a model face where face moves failed to cross before (``failed_crossings``, :func:`_crossing`) is
-    left out, after those going back; so is, on the hand, one predicted to meet its edge at a glancing angle
-    (under :data:`GRAZING`). ``middles``: faces whose middle is still to be probed (under ``full`` with probes
-    admitted); a probe predicted to land at one of them scores :data:`MIDDLE_CREDIT` less."""
+    left out, after those going back. ``middles``: faces whose middle is still to be probed (under ``full`` with
+    probes admitted); a probe predicted to land at one of them scores :data:`MIDDLE_CREDIT` less."""
     from haptic.planning.search import simulate
     from haptic.planning.simulate import simulate_probe
 
@@ -687,8 +686,7 @@ def plan_verification_move(
             ends.append((m, None, c))
             continue
         h1, s1, _ = sim
-        if m.kind == "face" and (_crossing(h, state, h1, s1) in failed_crossings
-                                 or config.table_z is not None and _grazing(h, m, h1, s1)):
+        if m.kind == "face" and _crossing(h, state, h1, s1) in failed_crossings:
             refused.append((m, h.world_from_model.inverse().apply(s1.position), c))
             continue
         new = _new_features(h, h1)
@@ -720,25 +718,6 @@ def plan_verification_move(
         for k, (m, p, c) in enumerate(ends)
     ]
     return ends[min(scored)[2]][0], tour, now
-
-
-GRAZING = np.deg2rad(10.0)
-"""On the hand, a face move whose direction makes less than this angle with the model edge it is predicted to meet
-(from a vertex, toward a point near the far end of an edge at that vertex) does not cross that edge: the pad runs
-along its rim, and the roll and the stroke read the rim or the face beyond the vertex. Of the face moves of three
-stalled verifications of the formula corpus (hull_05, antiprism_08 and trapezohedron_11, seed 1; the angle in the
-hypothesis's world), 4 of 16 under 10° succeeded, 45 of 59 over 20°; between, 1 of 3 there and one of BOX01N's
-(seed 2, 11°, on the way to its confirmation), too few to leave out."""
-
-
-def _grazing(h: Hypothesis, move: Move, after: Hypothesis, end: SensorState) -> bool:
-    """Whether face ``move`` meets the model edge it is predicted to end on (in hypothesis ``h``'s world) at a
-    glancing angle (:data:`GRAZING`); False when that edge is unknown."""
-    e = after.edges.get(end.edge) if end.edge is not None else None
-    if e is None:
-        return False
-    d = h.model_from_world.rotate(np.asarray(move.direction, float))
-    return abs(float(d @ h.poly.edge_directions[e])) > np.cos(GRAZING) * float(np.linalg.norm(d))
 
 
 def _crossing(h: Hypothesis, state: SensorState, after: Hypothesis, end: SensorState) -> tuple[int, int] | None:
