@@ -62,7 +62,7 @@ from haptic.planning.moves import (
     VertexMove,
     in_plane,
 )
-from haptic.planning.table import VERTEX_START_ANGLE
+from haptic.planning.table import VERTEX_START_ANGLE, level_heading
 from haptic.sim.robot import RobotInterface
 from haptic.sim.scene import TABLE_TOP_Z
 
@@ -725,10 +725,19 @@ class PhysicsExecutor(LandingSearch):
         status = self._ensure_on_face(st.face, pieces)
         if status != "ok":
             return self.failed_result(move, status, f"could not return to the current face: {self._why}")
-        recrossed = tilted = False
+        recrossed = tilted = levelled = False
+        lead = 0.0
         while True:
             r = t.trace_face(inplane, n_a, self.settings.max_face_trace)
             pieces.append(r)
+            level = level_heading(inplane, n_a) if r.event == "table" and not levelled else None
+            if level is not None:
+                # the slide heading down came within the pad's reach of the table before any edge: it goes on across
+                # the face nearly level, toward the side it was heading, to the edge there (the planner predicts so)
+                levelled, inplane, lead = True, level, r.distance
+                self.recoveries.append("the finger would meet the table before an edge: the slide went on level")
+                r = t.trace_face(inplane, n_a, self.settings.max_face_trace)
+                pieces.append(r)
             if r.event == "hand":
                 why = f"trace across the face: the finger's {r.info['link']} met the object"
                 if tilted or not self._tilt_away(r, st.face, self._last_on(r.trace, st.face, inplane), pieces):
@@ -800,8 +809,9 @@ class PhysicsExecutor(LandingSearch):
         self.on_face = face.id
         self.state = SensorState(position=self.contact_point(), face=face.id, edge=edge.id,
                                  edge_faces=(st.face, face.id))  # fmt: skip
-        return MoveResult(move=move, status="ok", components=(edge, face), distance=r.distance,
-                          cost=self.costs.face_move(r.distance), state=self.state, info={"kind": kind})  # fmt: skip
+        run = lead + r.distance
+        return MoveResult(move=move, status="ok", components=(edge, face), distance=run,
+                          cost=self.costs.face_move(run), state=self.state, info={"kind": kind})  # fmt: skip
 
     def _last_on(self, trace: ContactTrace, fid: int, d: np.ndarray) -> np.ndarray:
         """Where to touch data face ``fid`` again after a slide along ``d`` that a link of the finger stopped:

@@ -11,7 +11,15 @@ from haptic.matching.components import SensorNoise
 from haptic.planning.config import PlannerConfig
 from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import CostModel, FaceMove
-from haptic.planning.table import rests_on_table, table_conflict, table_safe_moves
+from haptic.planning.table import (
+    MADE,
+    TABLE,
+    hand_trace,
+    move_outlook,
+    rests_on_table,
+    table_conflict,
+    table_safe_moves,
+)
 
 LIB = load_library()
 TABLE_Z = 0.35
@@ -54,3 +62,23 @@ def test_a_pose_through_or_above_the_table_does_not_rest_on_it():
     assert not rests_on_table(box, SE3(np.eye(3), on.translation - [0, 0, 0.02]), config)
     assert not rests_on_table(box, SE3(np.eye(3), on.translation + [0, 0, 0.02]), config)
     assert rests_on_table(box, SE3(np.eye(3), on.translation - [0, 0, 0.02]), replace(config, table_z=None))
+
+
+def test_a_face_move_heading_down_beside_the_table_is_predicted_to_go_on_level_to_the_side_edge():
+    # The hand's slide heading down a side face stops within the pad's reach of the table and goes on nearly level
+    # toward the side it headed (level_heading); the planner predicts that edge, not a stop at the table.
+    h, state, comps = _on_a_side_face()
+    config = PlannerConfig(table_z=TABLE_Z)
+    n = comps[state.face].normal
+    side = np.cross(n, [0.0, 0.0, 1.0])
+    side /= np.linalg.norm(side)
+    steep = FaceMove(np.cos(np.deg2rad(60.0)) * side - np.sin(np.deg2rad(60.0)) * np.array([0.0, 0.0, 1.0]))
+    why, reach, _ = move_outlook(h, steep, state, comps, config)
+    assert why == MADE, why
+    tr = hand_trace(h, steep, state, config)
+    edge = h.world_from_model.rotate(h.poly.edge_directions[tr.hit.edge])
+    assert abs(edge[2]) > 0.99  # the upright edge at the side, not the one along the table
+    assert reach == tr.hit.distance > np.linalg.norm(tr.hit.point - h.model_from_world.apply(state.position)) - 1e-9
+    assert table_conflict(h, steep, state, comps, config) == 0.0
+    # straight down the face there is no side to go to: still a stop at the table
+    assert move_outlook(h, FaceMove(np.array([0.0, 0.0, -1.0])), state, comps, config)[0] == TABLE
