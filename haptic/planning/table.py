@@ -14,6 +14,7 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 
 from haptic.geometry.polyhedron import Polyhedron
+from haptic.geometry.raycast import line_hits
 from haptic.geometry.se3 import SE3
 from haptic.geometry.tracing import FaceHit, circle_vertex, trace_face
 from haptic.matching.components import DataComponent, DataEdge, DataFace
@@ -39,6 +40,10 @@ LEVEL_MIN_SLOPE = np.deg2rad(20.0)
 LEVEL_MIN_HEADING = np.deg2rad(20.0)
 """... when the slide headed at least this much from straight down the face [rad]."""
 _UP = np.array([0.0, 0.0, 1.0])
+FINGER_ABOVE = 0.065
+"""How far above the pad's centre the finger pointing down runs (its distal link, 26.7 mm from the pad's centre to
+the DIP joint, and its medial link, 38.4 mm: ``assets/mjcf/hand/README.md``): a face of the object over the pad
+within this blocks it [m]."""
 
 
 def pad_height(point: np.ndarray, normal: np.ndarray, pad_radius: float, table_z: float) -> float:
@@ -176,11 +181,13 @@ def table_conflict(
 
 
 MADE, EDGE_ONLY, TABLE, UNDERCUT, CONCAVE = "made", "edge only", "table", "undercut", "concave"
+OVERHANG = "overhang"
 """What a hypothesis predicts of a move on the hand (:func:`move_outlook`): carried out; a face move ending at its
 edge, the next face leaning under out of the pad's reach (a success that reports the edge alone); stopped by the
 table (the pad would come onto it, or the next face is too close to it); stopped at a convex edge onto a face
-leaning under further than the pad reaches; stopped at a concave edge's end or vertex the hand cannot tell."""
-STOPS = (TABLE, UNDERCUT, CONCAVE)
+leaning under further than the pad reaches; stopped at a concave edge's end or vertex the hand cannot tell; stopped
+stepping onto a face the object overhangs, where the finger's links meet it (:func:`overhung`)."""
+STOPS = (TABLE, UNDERCUT, CONCAVE, OVERHANG)
 """The outlooks of a move the hand is predicted not to carry out."""
 
 
@@ -220,8 +227,10 @@ def move_outlook(
         """Stepping over edge ``e_m`` onto face ``g_m`` at ``at_m``: made, or stopped by an undercut or the table."""
         if leans_under(e_m, g_m):
             return UNDERCUT
-        q = t.apply(at_m + TABLE_STEP_ONTO * _inward(poly, e_m, g_m))
-        return TABLE if pad_clearance(q, t.rotate(poly.face_normals[g_m]), config) < lim else MADE
+        q_m = at_m + TABLE_STEP_ONTO * _inward(poly, e_m, g_m)
+        if pad_clearance(t.apply(q_m), t.rotate(poly.face_normals[g_m]), config) < lim:
+            return TABLE
+        return OVERHANG if overhung(h, q_m, g_m, config) else MADE
 
     if isinstance(move, FaceMove):
         tr = trace_in(h, move, state)
@@ -277,6 +286,20 @@ def move_outlook(
         at = poly.vertices[v_m] + config.vertex_radius * away
         return onto(hit.edge, hit.next_face, at), np.nan, np.nan
     raise TypeError(f"unknown move {move!r}")
+
+
+def overhung(h: Hypothesis, at_m: np.ndarray, face: int, config: PlannerConfig) -> bool:
+    """Whether the pad of the fingers pointing down, touching face ``face`` of ``h`` at ``at_m`` (model frame), has
+    another face of the object above its centre within :data:`FINGER_ABOVE`: the finger's links meet the object
+    over it (BOX01N stood on an end: the pad on the floor of its slot, 30 mm under the slot's upper wall, cannot
+    stroke the floor; its medial link meets the wall). Not checked on a convex model: the pad near an edge has none
+    of the object above it but the face it touches where that leans under, which ``config.max_undercut`` judges."""
+    poly = h.poly
+    if poly.is_convex:
+        return False
+    centre = at_m + config.pad_radius * poly.face_normals[face]
+    hits = line_hits(poly, centre[None], h.model_from_world.rotate(_UP)[None])
+    return bool(hits.first[0] < FINGER_ABOVE and int(hits.face[0]) != face)
 
 
 def rolls_to_edge(h: Hypothesis, tr: FaceTrace, config: PlannerConfig) -> bool:
