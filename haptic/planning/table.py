@@ -40,10 +40,12 @@ LEVEL_MIN_SLOPE = np.deg2rad(20.0)
 LEVEL_MIN_HEADING = np.deg2rad(20.0)
 """... when the slide headed at least this much from straight down the face [rad]."""
 _UP = np.array([0.0, 0.0, 1.0])
-FINGER_ABOVE = 0.065
-"""How far above the pad's centre the finger pointing down runs (its distal link, 26.7 mm from the pad's centre to
-the DIP joint, and its medial link, 38.4 mm: ``assets/mjcf/hand/README.md``): a face of the object over the pad
-within this blocks it [m]."""
+FINGER_ABOVE = 0.03
+"""How far above the pad's centre a face of the object over it blocks the finger pointing down: its distal link
+runs 26.7 mm from the pad's centre to the DIP joint, the medial link 38.4 mm on (``assets/mjcf/hand/README.md``).
+On the seed library's verification, the floor of BOX01N's slot stood on an end, 18 mm under its upper wall, blocked
+4 of 5 moves onto it (the medial link met the wall); the lower wall of FRAME01's hole stood on an end, 48 mm under
+the upper one, 4 of 12 (a link meeting the rim tilts the hand away) [m]."""
 
 
 def pad_height(point: np.ndarray, normal: np.ndarray, pad_radius: float, table_z: float) -> float:
