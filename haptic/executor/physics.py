@@ -906,6 +906,10 @@ class PhysicsExecutor(LandingSearch):
                                   end_clearance=b.bound(b.point_sigma, b.vertex_floor))  # fmt: skip
         if isinstance(ridge, str):
             return self.failed_result(move, "unreachable", f"{reason}; {ridge}")
+        ridge = self._on_roll_line(ridge, line)
+        if ridge is None:
+            return self.failed_result(move, "unreachable", f"{reason}; the ridge followed left the roll's line (the "
+                                                           "pad met the table or a face round the edge's end)")
         line = line_from_points(ridge, line.direction, line.direction_sigma, seg.bounds)
         edge = seg.add_edge(line, (st.face, None), True, (fit_a.normal, n_last), adjacent=(st.face,))
         self.on_face = None
@@ -913,6 +917,20 @@ class PhysicsExecutor(LandingSearch):
         return MoveResult(move=move, status="ok", components=(edge,), distance=r.distance,
                           cost=self.costs.face_move(r.distance), state=self.state,
                           info={"kind": "convex", "next_face": "out of reach"})  # fmt: skip
+
+    def _on_roll_line(self, ridge: np.ndarray, line) -> np.ndarray | None:
+        """The contacts of ``ridge`` on the line of the roll that gave an edge alone (within a point's bound of it);
+        None when too few of them remain, or they span too little, for a line. Followed from a roll next to the table,
+        or near the edge's end, the pad touches the table or the faces round the end too (BOX01N seed 3, its slot
+        against the table: ridge contacts down to the table 20 mm below the edge, the line fitted to them 6.6 mm low,
+        2.4 bounds off)."""
+        b = self.segmenter.bounds
+        off = ridge - line.point
+        off = off - np.outer(off @ line.direction, line.direction)
+        near = ridge[np.linalg.norm(off, axis=1) <= b.bound(b.point_sigma, b.vertex_floor)]
+        if len(near) < self.bounds.min_line_points or float(np.ptp(near @ line.direction)) < RIDGE_MIN_SPAN:
+            return None
+        return near
 
     def _on_ridge(self, rows: ContactTrace, u: np.ndarray) -> np.ndarray:
         """Rows of a ridge-following trace in contact on the ridge itself: the sensed normal within
