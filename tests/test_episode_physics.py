@@ -50,6 +50,23 @@ def test_a_face_measured_with_the_hand_tilted_is_touched_again_tilted():
     assert _within_bounds(ep)
 
 
+def test_a_face_move_sliding_down_to_the_table_goes_on_level_to_an_edge():
+    # BOX01 seed 3 stands 60 mm tall on a side. The planner's face moves from a top corner diagonally down a side face
+    # (heading 34 degrees below level) came within the pad's reach of the table some 7 mm short of the far upright
+    # edge: 4 of 28 moves failed, "the finger would meet the table before an edge". The slide now goes on across the
+    # face nearly level, toward the side it was heading, to the edge there, and measures it; the planner predicts
+    # that edge (planning.table.level_leg).
+    said, failed = [], []
+    obs = EpisodeObserver(on_move=lambda n, r, *a: said.extend(r.info.get("recoveries", ())),
+                          on_failed_move=lambda n, r: failed.append(r.reason))  # fmt: skip
+    ep = build_episode(EpisodeSpec(model="BOX01", seed=3, executor="physics", verify="full"))
+    rec = ep.run(None, obs)
+    assert any("the slide went on level" in x for x in said), said
+    assert not [x for x in failed if "table before an edge" in x], failed
+    assert rec.outcome == "recognized" and rec.correct, rec.detail
+    assert _within_bounds(ep)
+
+
 def test_touches_past_an_unreachable_edge_tell_the_box_family_apart():
     # BOX01P resting tilted: the moves that separate it from BOX01 and BOX01N all end stepping onto a face
     # leaning under the pad; their touches on the way still rule the look-alikes out

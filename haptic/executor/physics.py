@@ -62,7 +62,7 @@ from haptic.planning.moves import (
     VertexMove,
     in_plane,
 )
-from haptic.planning.table import VERTEX_START_ANGLE
+from haptic.planning.table import VERTEX_START_ANGLE, level_heading
 from haptic.sim.robot import RobotInterface
 from haptic.sim.scene import TABLE_TOP_Z
 
@@ -725,10 +725,19 @@ class PhysicsExecutor(LandingSearch):
         status = self._ensure_on_face(st.face, pieces)
         if status != "ok":
             return self.failed_result(move, status, f"could not return to the current face: {self._why}")
-        recrossed = tilted = False
+        recrossed = tilted = levelled = False
+        lead = 0.0
         while True:
             r = t.trace_face(inplane, n_a, self.settings.max_face_trace)
             pieces.append(r)
+            level = level_heading(inplane, n_a) if r.event == "table" and not levelled else None
+            if level is not None:
+                # the slide heading down came within the pad's reach of the table before any edge: it goes on across
+                # the face nearly level, toward the side it was heading, to the edge there (the planner predicts so)
+                levelled, inplane, lead = True, level, r.distance
+                self.recoveries.append("the finger would meet the table before an edge: the slide went on level")
+                r = t.trace_face(inplane, n_a, self.settings.max_face_trace)
+                pieces.append(r)
             if r.event == "hand":
                 why = f"trace across the face: the finger's {r.info['link']} met the object"
                 if tilted or not self._tilt_away(r, st.face, self._last_on(r.trace, st.face, inplane), pieces):
@@ -800,8 +809,9 @@ class PhysicsExecutor(LandingSearch):
         self.on_face = face.id
         self.state = SensorState(position=self.contact_point(), face=face.id, edge=edge.id,
                                  edge_faces=(st.face, face.id))  # fmt: skip
-        return MoveResult(move=move, status="ok", components=(edge, face), distance=r.distance,
-                          cost=self.costs.face_move(r.distance), state=self.state, info={"kind": kind})  # fmt: skip
+        run = lead + r.distance
+        return MoveResult(move=move, status="ok", components=(edge, face), distance=run,
+                          cost=self.costs.face_move(run), state=self.state, info={"kind": kind})  # fmt: skip
 
     def _last_on(self, trace: ContactTrace, fid: int, d: np.ndarray) -> np.ndarray:
         """Where to touch data face ``fid`` again after a slide along ``d`` that a link of the finger stopped:
@@ -896,6 +906,10 @@ class PhysicsExecutor(LandingSearch):
                                   end_clearance=b.bound(b.point_sigma, b.vertex_floor))  # fmt: skip
         if isinstance(ridge, str):
             return self.failed_result(move, "unreachable", f"{reason}; {ridge}")
+        ridge = self._on_roll_line(ridge, line)
+        if ridge is None:
+            return self.failed_result(move, "unreachable", f"{reason}; the ridge followed left the roll's line (the "
+                                                           "pad met the table or a face round the edge's end)")
         line = line_from_points(ridge, line.direction, line.direction_sigma, seg.bounds)
         edge = seg.add_edge(line, (st.face, None), True, (fit_a.normal, n_last), adjacent=(st.face,))
         self.on_face = None
@@ -903,6 +917,20 @@ class PhysicsExecutor(LandingSearch):
         return MoveResult(move=move, status="ok", components=(edge,), distance=r.distance,
                           cost=self.costs.face_move(r.distance), state=self.state,
                           info={"kind": "convex", "next_face": "out of reach"})  # fmt: skip
+
+    def _on_roll_line(self, ridge: np.ndarray, line) -> np.ndarray | None:
+        """The contacts of ``ridge`` on the line of the roll that gave an edge alone (within a point's bound of it);
+        None when too few of them remain, or they span too little, for a line. Followed from a roll next to the table,
+        or near the edge's end, the pad touches the table or the faces round the end too (BOX01N seed 3, its slot
+        against the table: ridge contacts down to the table 20 mm below the edge, the line fitted to them 6.6 mm low,
+        2.4 bounds off)."""
+        b = self.segmenter.bounds
+        off = ridge - line.point
+        off = off - np.outer(off @ line.direction, line.direction)
+        near = ridge[np.linalg.norm(off, axis=1) <= b.bound(b.point_sigma, b.vertex_floor)]
+        if len(near) < self.bounds.min_line_points or float(np.ptp(near @ line.direction)) < RIDGE_MIN_SPAN:
+            return None
+        return near
 
     def _on_ridge(self, rows: ContactTrace, u: np.ndarray) -> np.ndarray:
         """Rows of a ridge-following trace in contact on the ridge itself: the sensed normal within

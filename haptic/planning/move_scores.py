@@ -19,7 +19,7 @@ from haptic.planning.bound import reduce_hypotheses
 from haptic.planning.config import PlannerConfig
 from haptic.planning.efficiency import class_weights, distinguishable, efficiency_of, expected_eliminated
 from haptic.planning.handpath import HandStart
-from haptic.planning.hypothesis import Hypothesis, trace_in
+from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import EdgeMove, FaceMove, Move, PlacementMove, ProbeMove, SensorState
 from haptic.planning.placements import (
     HAND_MAX_TILT,
@@ -33,7 +33,7 @@ from haptic.planning.predict import Prediction, candidate_moves, crossed_edge, p
 from haptic.planning.probe_lines import ProbeConfig, candidate_probes
 from haptic.planning.probe_prediction import ProbePrediction, predict_probes
 from haptic.planning.simulate import circled_vertex
-from haptic.planning.table import descent_risk
+from haptic.planning.table import descent_risk, hand_trace
 
 PROBE_RISK = 0.25
 """Probes the hand's pad is predicted to fail in this share of the hypotheses' weight or more are not offered
@@ -162,7 +162,7 @@ def remeasures(ctx: Context, move: Move) -> bool:
             if hit.vertex not in set(h.vertices.values()):
                 return False
         else:
-            tr = trace_in(h, move, state)
+            tr = hand_trace(h, move, state, ctx.config)
             if tr is None or tr.hit.edge not in set(h.edges.values()) or tr.hit.next_face not in set(h.faces.values()):
                 return False
     return True
@@ -372,7 +372,7 @@ def _same_crossing(a: FaceMove, b: FaceMove, ctx: Context) -> bool:
     weights = class_weights([h.model for h in ctx.hypotheses])
     same = differ = 0.0
     for h, w in zip(ctx.hypotheses, weights, strict=True):
-        ea, eb = crossed_edge(h, a, ctx.state), crossed_edge(h, b, ctx.state)
+        ea, eb = crossed_edge(h, a, ctx.state, ctx.config), crossed_edge(h, b, ctx.state, ctx.config)
         if ea is None or eb is None:
             continue
         if ea == eb:

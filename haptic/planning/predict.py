@@ -23,7 +23,7 @@ from haptic.planning import kernels
 from haptic.planning.config import PlannerConfig
 from haptic.planning.hypothesis import FaceTrace, Hypothesis, trace_in
 from haptic.planning.moves import EdgeMove, FaceMove, Move, SensorState, VertexMove
-from haptic.planning.table import data_table_conflict, table_prediction
+from haptic.planning.table import data_table_conflict, hand_trace, table_prediction
 
 
 @dataclass(frozen=True, eq=False)
@@ -298,7 +298,7 @@ def _predict_one(
         return _NAN[move.kind], np.nan, np.nan
     poly = h.poly
     if isinstance(move, FaceMove):
-        tr = trace_in(h, move, state) if trace is False else trace
+        tr = hand_trace(h, move, state, config, trace_in(h, move, state) if trace is False else trace)
         if tr is None:
             return nan_face, np.nan, np.nan
         hit = tr.hit
@@ -334,9 +334,10 @@ def _predict_one(
     raise TypeError(f"unknown move {move!r}")
 
 
-def crossed_edge(h: Hypothesis, move: FaceMove, state: SensorState) -> int | None:
-    """The model edge hypothesis ``h`` predicts face move ``move`` to meet (None when it cannot say)."""
-    tr = trace_in(h, move, state)
+def crossed_edge(h: Hypothesis, move: FaceMove, state: SensorState, config: PlannerConfig | None = None) -> int | None:
+    """The model edge hypothesis ``h`` predicts face move ``move`` to meet (None when it cannot say); with
+    ``config``, as the hand follows it (:func:`~haptic.planning.table.hand_trace`)."""
+    tr = trace_in(h, move, state) if config is None else hand_trace(h, move, state, config)
     return None if tr is None else int(tr.hit.edge)
 
 

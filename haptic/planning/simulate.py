@@ -21,8 +21,9 @@ from haptic.geometry.se3 import cross
 from haptic.geometry.tracing import VertexHit, circle_vertex, trace_edge
 from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex, SensorNoise
 from haptic.planning.config import PlannerConfig
-from haptic.planning.hypothesis import Hypothesis, trace_in
+from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import EdgeMove, FaceMove, Move, ProbeMove, SensorState, VertexMove
+from haptic.planning.table import hand_trace
 
 STEP_ONTO = 0.003
 """How far onto the next face a simulated face or vertex move steps for its normal [m]."""
@@ -82,7 +83,7 @@ def simulate(
 
     if isinstance(move, FaceMove | VertexMove):
         if isinstance(move, FaceMove):
-            tr = trace_in(h, move, state)
+            tr = hand_trace(h, move, state, config)
             if tr is None:
                 return None
             e_m, g_m, at_m, from_face = tr.hit.edge, tr.hit.next_face, tr.hit.point, state.face

@@ -14,8 +14,9 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 
 from haptic.geometry.polyhedron import Polyhedron
+from haptic.geometry.raycast import line_hits
 from haptic.geometry.se3 import SE3
-from haptic.geometry.tracing import circle_vertex
+from haptic.geometry.tracing import FaceHit, circle_vertex, trace_face
 from haptic.matching.components import DataComponent, DataEdge, DataFace
 from haptic.planning.config import PlannerConfig
 from haptic.planning.hypothesis import FaceTrace, Hypothesis, trace_in
@@ -31,6 +32,20 @@ the edge at least this far from both its ends: the pad rolls some 40° over it, 
 edge's line as ``pad_radius · sin 40°``, and nearer an end it touches the faces round the vertex [m]."""
 TABLE_STEP_ONTO = 0.003
 """How far onto the next face a face or vertex move strokes for its normal (for the table check) [m]."""
+LEVEL_RISE = np.deg2rad(5.0)
+"""A face move whose slide heading down comes within the pad's reach of the table goes on across the face at
+this rise above the level, toward the side it was heading (clear of the table's limit it reached) [rad] ..."""
+LEVEL_MIN_SLOPE = np.deg2rad(20.0)
+"""... on a face sloping at least this much (nearer level it has no side to go on to) ... [rad]"""
+LEVEL_MIN_HEADING = np.deg2rad(20.0)
+"""... when the slide headed at least this much from straight down the face [rad]."""
+_UP = np.array([0.0, 0.0, 1.0])
+FINGER_ABOVE = 0.03
+"""How far above the pad's centre a face of the object over it blocks the finger pointing down: its distal link
+runs 26.7 mm from the pad's centre to the DIP joint, the medial link 38.4 mm on (``assets/mjcf/hand/README.md``).
+On the seed library's verification, the floor of BOX01N's slot stood on an end, 18 mm under its upper wall, blocked
+4 of 5 moves onto it (the medial link met the wall); the lower wall of FRAME01's hole stood on an end, 48 mm under
+the upper one, 4 of 12 (a link meeting the rim tilts the hand away) [m]."""
 
 
 def pad_height(point: np.ndarray, normal: np.ndarray, pad_radius: float, table_z: float) -> float:
@@ -44,6 +59,68 @@ def pad_clearance(point: np.ndarray, normal: np.ndarray, config: PlannerConfig) 
     if config.table_z is None:
         return float("inf")
     return pad_height(point, normal, config.pad_radius, config.table_z)
+
+
+def level_heading(d: np.ndarray, n: np.ndarray) -> np.ndarray | None:
+    """The heading a slide along ``d`` across a face of outward ``n`` (world frame) goes on along once the table
+    stops it heading down: level, toward the side ``d`` heads, rising :data:`LEVEL_RISE`; None where the face is
+    nearly level or ``d`` heads nearly straight down it (there is no side). The hand's rule, which the planner
+    predicts with the same function."""
+    side = np.cross(n, _UP)
+    norm = float(np.linalg.norm(side))
+    if norm < np.sin(LEVEL_MIN_SLOPE):
+        return None
+    side = side / norm
+    across = float(side @ d) / max(float(np.linalg.norm(d)), 1e-12)
+    if abs(across) < np.sin(LEVEL_MIN_HEADING):
+        return None
+    up = _UP - float(n[2]) * n
+    up = up / float(np.linalg.norm(up))
+    return np.copysign(np.cos(LEVEL_RISE), across) * side + np.sin(LEVEL_RISE) * up
+
+
+def level_leg(h: Hypothesis, tr: FaceTrace, config: PlannerConfig) -> tuple[bool, FaceTrace | None]:
+    """Whether face move trace ``tr`` of ``h`` goes on level (:func:`level_heading`): its slide heads down and
+    comes within ``config.table_clearance`` of the table before its edge, on a face with a side to go to; and
+    then the trace the hand follows, from where the slide stopped along the level heading to the edge it meets
+    (its distance the two legs' together; None when it meets a vertex). False, None without a table."""
+    t = h.world_from_model
+    if config.table_z is None or t is None:
+        return False, None
+    poly, hit, lim = h.poly, tr.hit, config.table_clearance
+    n_m = poly.face_normals[tr.face]
+    u_m = tr.direction - float(tr.direction @ n_m) * n_m
+    norm = float(np.linalg.norm(u_m))
+    if norm < 1e-9:
+        return False, None
+    u_m = u_m / norm
+    n_w, u_w = t.rotate(n_m), t.rotate(u_m)
+    if float(u_w[2]) >= 0.0 or pad_clearance(t.apply(hit.point), n_w, config) >= lim:
+        return False, None
+    level = level_heading(u_w, n_w)
+    if level is None:
+        return False, None
+    start = pad_clearance(t.apply(tr.start), n_w, config)
+    s = float(np.clip((start - lim) / -float(u_w[2]), 0.0, hit.distance))
+    at = tr.start + s * u_m
+    lev_m = h.model_from_world.rotate(level)
+    got = trace_face(poly, tr.face, at, lev_m)
+    if got is None:
+        return True, None
+    return True, FaceTrace(tr.face, at, lev_m, FaceHit(got.edge, s + got.distance, got.point, got.next_face))
+
+
+def hand_trace(
+    h: Hypothesis, move: FaceMove, state: SensorState, config: PlannerConfig, tr: FaceTrace | None | bool = False
+) -> FaceTrace | None:
+    """Face move ``move`` traced in ``h``'s world as the hand follows it (``tr``: its :func:`trace_in`, when already
+    computed): the straight trace, or where the table stops it heading down, its level leg (:func:`level_leg`);
+    None when ``h`` cannot say. The straight trace without a table."""
+    tr = trace_in(h, move, state) if tr is False else tr
+    if tr is None or config.table_z is None:
+        return tr
+    levelled, leg = level_leg(h, tr, config)
+    return leg if levelled else tr
 
 
 def _inward(poly: Polyhedron, edge: int, face: int) -> np.ndarray:
@@ -106,11 +183,13 @@ def table_conflict(
 
 
 MADE, EDGE_ONLY, TABLE, UNDERCUT, CONCAVE = "made", "edge only", "table", "undercut", "concave"
+OVERHANG = "overhang"
 """What a hypothesis predicts of a move on the hand (:func:`move_outlook`): carried out; a face move ending at its
 edge, the next face leaning under out of the pad's reach (a success that reports the edge alone); stopped by the
 table (the pad would come onto it, or the next face is too close to it); stopped at a convex edge onto a face
-leaning under further than the pad reaches; stopped at a concave edge's end or vertex the hand cannot tell."""
-STOPS = (TABLE, UNDERCUT, CONCAVE)
+leaning under further than the pad reaches; stopped at a concave edge's end or vertex the hand cannot tell; stopped
+stepping onto a face the object overhangs, where the finger's links meet it (:func:`overhung`)."""
+STOPS = (TABLE, UNDERCUT, CONCAVE, OVERHANG)
 """The outlooks of a move the hand is predicted not to carry out."""
 
 
@@ -150,17 +229,23 @@ def move_outlook(
         """Stepping over edge ``e_m`` onto face ``g_m`` at ``at_m``: made, or stopped by an undercut or the table."""
         if leans_under(e_m, g_m):
             return UNDERCUT
-        q = t.apply(at_m + TABLE_STEP_ONTO * _inward(poly, e_m, g_m))
-        return TABLE if pad_clearance(q, t.rotate(poly.face_normals[g_m]), config) < lim else MADE
+        q_m = at_m + TABLE_STEP_ONTO * _inward(poly, e_m, g_m)
+        if pad_clearance(t.apply(q_m), t.rotate(poly.face_normals[g_m]), config) < lim:
+            return TABLE
+        return OVERHANG if overhung(h, q_m, g_m, config) else MADE
 
     if isinstance(move, FaceMove):
         tr = trace_in(h, move, state)
         if tr is None:
             return None, np.nan, np.nan
+        levelled, leg = level_leg(h, tr, config)
+        if levelled and leg is None:
+            return None, np.nan, np.nan
+        tr = leg if levelled else tr  # the table stops the slide heading down: it goes on level to another edge
         hit = tr.hit
         n_w = t.rotate(poly.face_normals[tr.face])
         d_z = float(np.asarray(move.direction)[2])
-        if d_z < 0.0 and pad_clearance(t.apply(hit.point), n_w, config) < lim:
+        if not levelled and d_z < 0.0 and pad_clearance(t.apply(hit.point), n_w, config) < lim:
             # the slide stops where the pad comes too close to the table
             start = pad_clearance(t.apply(tr.start), n_w, config)
             return TABLE, float(np.clip((start - lim) / -d_z, 0.0, hit.distance)), 0.0
@@ -203,6 +288,20 @@ def move_outlook(
         at = poly.vertices[v_m] + config.vertex_radius * away
         return onto(hit.edge, hit.next_face, at), np.nan, np.nan
     raise TypeError(f"unknown move {move!r}")
+
+
+def overhung(h: Hypothesis, at_m: np.ndarray, face: int, config: PlannerConfig) -> bool:
+    """Whether the pad of the fingers pointing down, touching face ``face`` of ``h`` at ``at_m`` (model frame), has
+    another face of the object above its centre within :data:`FINGER_ABOVE`: the finger's links meet the object
+    over it (BOX01N stood on an end: the pad on the floor of its slot, 30 mm under the slot's upper wall, cannot
+    stroke the floor; its medial link meets the wall). Not checked on a convex model: the pad near an edge has none
+    of the object above it but the face it touches where that leans under, which ``config.max_undercut`` judges."""
+    poly = h.poly
+    if poly.is_convex:
+        return False
+    centre = at_m + config.pad_radius * poly.face_normals[face]
+    hits = line_hits(poly, centre[None], h.model_from_world.rotate(_UP)[None])
+    return bool(hits.first[0] < FINGER_ABOVE and int(hits.face[0]) != face)
 
 
 def rolls_to_edge(h: Hypothesis, tr: FaceTrace, config: PlannerConfig) -> bool:
@@ -322,12 +421,14 @@ def data_table_conflict(
     move: Move, state: SensorState, components: Mapping[int, DataComponent], config: PlannerConfig
 ) -> bool:
     """What the data alone say about the table, whatever the model: a face move heading down from a point
-    already within the pad's reach of the table, or a vertex move whose circle cannot even start off it."""
+    already within the pad's reach of the table with no side to go on to level (:func:`level_heading`), or a
+    vertex move whose circle cannot even start off it."""
     if config.table_z is None:
         return False
     if isinstance(move, FaceMove):
         face = components.get(state.face)
-        if not isinstance(face, DataFace) or float(np.asarray(move.direction)[2]) >= 0.0:
+        d = np.asarray(move.direction, dtype=float)
+        if not isinstance(face, DataFace) or float(d[2]) >= 0.0 or level_heading(d, face.normal) is not None:
             return False
         return pad_clearance(state.position, face.normal, config) < config.table_clearance
     if isinstance(move, VertexMove):

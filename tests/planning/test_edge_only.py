@@ -81,7 +81,8 @@ def test_onto_a_face_the_table_hides_the_roll_gives_the_edge_alone():
     under, its far edge on the table): the pad rolls over the edge and reaches the table's clearance before that
     face, and the hand reports the edge alone (HEXPRISM01 s1 and s3 under verification: predicted to run into the
     table, all went through)."""
-    from haptic.planning.table import EDGE_ONLY, TABLE, move_outlook, table_prediction
+    from haptic.planning.hypothesis import trace_in
+    from haptic.planning.table import EDGE_ONLY, hand_trace, move_outlook, rolls_to_edge, table_prediction
 
     poly = LIB["HEXPRISM01"]
     rx = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])  # model y up, model z toward world -y
@@ -102,6 +103,12 @@ def test_onto_a_face_the_table_hides_the_roll_gives_the_edge_alone():
     assert move_outlook(h, move, state, comps, cfg)[0] == EDGE_ONLY
     table, reach, edge_only = table_prediction(h, move, state, comps, cfg)
     assert (table, edge_only) == (0.0, 1.0) and np.isclose(reach, 0.02)
-    # with no room to roll before the table's clearance, the table stops it
+    # with no room to roll before the table's clearance, the table stops the roll where the straight slide meets the
+    # edge; the slide, heading 30 degrees off straight down, stops short of the edge there and goes on level to it,
+    # meeting it higher up (level_leg), with room to roll
     higher = replace(cfg, table_clearance=0.012)
-    assert move_outlook(h, move, state, comps, higher)[0] == TABLE
+    straight = trace_in(h, move, state)
+    assert not rolls_to_edge(h, straight, higher)
+    levelled = hand_trace(h, move, state, higher)
+    assert levelled.hit.edge == e and pose.apply(levelled.hit.point)[2] > pose.apply(straight.hit.point)[2] + 0.005
+    assert move_outlook(h, move, state, comps, higher)[0] == EDGE_ONLY
