@@ -318,6 +318,7 @@ class PhysicsExecutor(LandingSearch):
         self.recoveries = []
         self.toucher.take_links()  # drop samples taken outside a move
         self.toucher.take_hand()
+        self.toucher.take_wrist()
         if self.robot.time != self._links_until:  # the pose at the start, unless the last move reported it
             self.toucher.sample_links()
         try:
@@ -335,11 +336,15 @@ class PhysicsExecutor(LandingSearch):
         self.traces.append(trace)
         links = self._hand_links()
         hand = hand_touches(self.toucher.take_hand(), self._link_radii())
+        info = {**res.info, "recoveries": list(self.recoveries)} if self.recoveries else dict(res.info)
+        wrist = self.toucher.take_wrist()
+        if wrist["watched"]:
+            info["wrist"] = wrist
         return MoveResult(move=res.move, status=res.status, components=res.components, distance=res.distance,
                           cost=res.cost, state=res.state, touches=touches_of(trace), trace=trace, reason=res.reason,
                           links=links, hand=hand, sim_time=self.robot.time - t0, wall_time=time.perf_counter() - w0,
                           free_space=res.free_space,
-                          info={**res.info, "recoveries": list(self.recoveries)} if self.recoveries else res.info)
+                          info=info)
 
     def _upright(self, pieces: list[PrimitiveResult]) -> None:
         """After a move made with the hand tilted: lift the pad off along the sensed normal and turn the hand back

@@ -192,6 +192,12 @@ class TouchConfig:
     watch_every: int = 5
     """The links' contact readout is watched every this many ticks through a move (0: never): a link other than
     the pad touching the object is reported with the move (:class:`HandContact`) [ticks]."""
+    wrist_force: float = 2.5
+    """With the pad and every link free, the wrist's force sensor reads the hand's weight and its motion: within
+    1.6 N of the weight while the hand moves under force control (FRAME01 seed 2, 665 watched ticks of guarded
+    approach), up to 17 N while it is carried between moves. Watched with the links' readout outside those
+    carries, a force farther than this from the hand's weight is a contact of the hand, and one that neither the pad
+    nor a link reports is counted with the move (``MoveResult.info["wrist"]``) [N]."""
 
     @property
     def reach_undercut(self) -> float:
