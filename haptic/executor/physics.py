@@ -1111,6 +1111,9 @@ class PhysicsExecutor(LandingSearch):
             if sign * (s_known - middle) < 0 and abs(s_v - s_known) <= seg.vertices[vid].position_bound:
                 return self.failed_result(move, "unreachable", "the vertex located is the edge's other end, which the "
                                                                "move set off past")  # fmt: skip
+        if self._acquired_past(rec, acq.trace, u, s_v):
+            return self.failed_result(move, "unreachable", "the vertex located lies behind where the pad acquired "
+                                                           "the ridge (the pad set off past it)")  # fmt: skip
         # refine the line with the ridge contacts (convex edges), then extend it to the vertex
         ridge = self._on_ridge(rows, u)
         w_v, w_from = rec.at(s_v), rec.at(s_from)
@@ -1191,6 +1194,22 @@ class PhysicsExecutor(LandingSearch):
             return None, 0.0
         s_v = float((blk.point_in_world - rec.point) @ blk.normal_in_world) / denom
         return s_v, b.point_sigma / abs(denom)
+
+    def _acquired_past(self, rec, acq: ContactTrace, u: np.ndarray, s_v: float) -> bool:
+        """Whether the pad acquired the ridge past the vertex it then located at ``s_v``: acquiring the ridge short
+        of the vertex, its first contacts on the ridge (:attr:`~PhysicsSettings.min_vertex_rows`, their median) lie
+        behind it along ``u``; lying ahead of it by more than the bound of a vertex, they came from a pad already
+        past the edge's end, whose contacts then slid back toward it (trapezohedron_09 of the formula corpus at
+        60 mm, seed 1: the pad acquired the "ridge" 4.4 mm past the end of its edge, on the faces beyond, its tip
+        went 0.4 mm along the edge while the contacts slid to 1.3 mm past the vertex, and the vertex was put there,
+        1.05 bounds off)."""
+        first = np.flatnonzero(acq.in_contact & (acq.phase == PHASES.index("ridge")))[: self.settings.min_vertex_rows]
+        if len(first) < self.settings.min_vertex_rows:
+            return False
+        sign = 1.0 if float(u @ rec.direction) > 0 else -1.0
+        ahead = sign * (float(np.median((acq.point_in_world[first] - rec.point) @ rec.direction)) - s_v)
+        b = self.bounds
+        return ahead > b.bound(b.point_sigma, b.vertex_floor)
 
     def _spans_a_gap(self, rows: ContactTrace, u: np.ndarray) -> bool:
         """Whether the pad, following a convex ridge along ``u`` until something blocked it, spanned a gap in the
