@@ -126,7 +126,6 @@ class Toucher:
         self._links: list[tuple[float, np.ndarray]] = []  # (time, link positions) samples
         self._hand: list[HandContact] = []  # the links' contacts with the object watched since the last take
         self._wrist = _wrist_watch()  # the wrist's force watched since the last take
-        self._weight = robot.hand_weight()  # what the wrist reads of the hand touching nothing
         tip, rot = robot.fingertip_pose()
         self.tip = tip
         self.rotation = rot
@@ -198,14 +197,15 @@ class Toucher:
 
     def _watch_wrist(self, link_touching: bool) -> None:
         """With the pad free and the hand under force control (not carried between moves), the wrist's force off
-        the hand's weight by more than :attr:`~TouchConfig.wrist_force` is a contact of the hand: counted as one a
-        link reports (``links_felt`` of ``links``) or as one nothing else reports (``unexplained``). The largest
-        force off the weight with nothing touching is kept (``free_max``), which tells how far the threshold
-        stands from the hand's own motion."""
+        what the hand's weight and motion read (:meth:`~haptic.sim.robot.RobotInterface.hand_inertia_force`) by more
+        than :attr:`~TouchConfig.wrist_force` is a contact of the hand: counted as one a link reports
+        (``links_felt`` of ``links``) or as one nothing else reports (``unexplained``). The largest force off that
+        reading with nothing touching is kept (``free_max``), which tells how far the threshold stands from the
+        hand's own motion."""
         if self.contact[1] is not None or not self._rows or self._rows[-1][-1] == _FREE:
             return
         force, _ = self.robot.watch_wrist()
-        off = float(np.linalg.norm(force - self._weight))
+        off = float(np.linalg.norm(force - self.robot.hand_inertia_force()))
         felt = off > self.config.wrist_force
         w = self._wrist
         w["watched"] += 1
@@ -219,8 +219,8 @@ class Toucher:
     def take_wrist(self) -> dict:
         """The wrist's watch since the last call (:meth:`_watch_wrist`): ticks ``watched`` with the pad free, of them
         those with a link's contact (``links``) and those the wrist felt (``links_felt``), ticks with a force
-        nothing else reports (``unexplained``) and the largest force off the hand's weight with nothing touching
-        (``free_max``) [N]."""
+        nothing else reports (``unexplained``) and the largest force off the hand's weight and motion with nothing
+        touching (``free_max``) [N]."""
         out, self._wrist = self._wrist, _wrist_watch()
         return out
 

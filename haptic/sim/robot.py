@@ -68,6 +68,11 @@ class RobotInterface:
         drawn apart, so that watching changes no other reading)."""
         return self._sim.wrist_wrench(watch=True)
 
+    def hand_inertia_force(self) -> np.ndarray:
+        """The wrist force sensor's reading of the hand touching nothing, moving as it moves now (the robot's own
+        masses and the motion of its joints) [N]."""
+        return self._sim.hand_inertia_force()
+
     def hand_weight(self) -> np.ndarray:
         """The wrist force sensor's reading of the hand touching nothing, at rest (the robot's own masses) [N]."""
         return self._sim.hand_weight()
