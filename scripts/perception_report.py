@@ -367,6 +367,7 @@ def summarize(records: list[dict], worst: int = 10, plot: str | None = None, lib
         if r["outcome"] == "no-match":
             print(f"  no-match: {r['library']} {r['model']} seed {r['seed']}: {r['detail']}")
     _hand_summary(records)
+    _wrist_summary(records)
     print(f"worst {worst}:")
     for ratio, what, cid, r in sorted(rows, key=lambda x: -x[0])[:worst]:
         print(f"  {ratio:6.2f} {what:14} component {cid:2d}  {r['library']} {r['model']} seed {r['seed']}: "
@@ -394,6 +395,21 @@ def _hand_summary(records: list[dict]) -> None:
           f"{worst[1]['point_ratio_max']:.3f} of its link's bound ({worst[0]['model']} seed {worst[0]['seed']}); "
           f"{sum(h['components'] for _, h in hands)} components from those moves, the largest "
           f"{max(comp) if comp else 0.0:.2f} of its bound")  # fmt: skip
+
+
+def _wrist_summary(records: list[dict]) -> None:
+    """The wrist force sensor's watch (``perception.wrist``): ticks watched with the pad free, how many of those
+    with a link's contact the wrist felt, the ticks and moves with a force neither the pad nor a link reports, and
+    the largest force off the hand's weight with nothing touching."""
+    ws = [w for w in ((r.get("perception") or {}).get("wrist") or {} for r in records) if w.get("watched")]
+    if not ws:
+        print("wrist force sensor: not watched")
+        return
+    total = {k: sum(w[k] for w in ws) for k in ("watched", "links", "links_felt", "unexplained", "unexplained_moves")}
+    print(f"wrist force sensor, pad free: {total['watched']} ticks watched in {len(ws)} episodes; with a link's "
+          f"contact {total['links']}, the wrist felt {total['links_felt']}; a force no link nor the pad reports: "
+          f"{total['unexplained']} ticks in {total['unexplained_moves']} moves; nothing touching, the force off the "
+          f"hand's weight at most {max(w['free_max'] for w in ws):.2f} N")  # fmt: skip
 
 
 def _plot(rows: list, path: str) -> None:

@@ -76,3 +76,69 @@ def test_the_hands_contacts_lie_within_their_links_bound_and_spoil_no_component(
     assert hand["moves"] >= 3 and "index_medial" in hand["links"], hand
     assert hand["point_ratio_max"] < 1.0, hand
     assert hand["components"] and hand["component_ratio_max"] < 1.0, hand
+
+
+def test_the_wrist_reads_the_hands_weight_touching_nothing():
+    # the baseline the wrist's watch compares with: the masses of the hand below the sensor, from the robot's own
+    # model; held still in free space, the sensor reads that weight (the hand's motion and contacts aside)
+    from haptic.sim import Simulation, compose_scene
+    from haptic.sim.robot import RobotInterface
+
+    robot = RobotInterface(Simulation(compose_scene(), seed=1))
+    robot.hold_posture()
+    robot.step(1500)
+    force, _ = robot.watch_wrist()
+    weight = robot.hand_weight()
+    assert 5.0 < weight[2] < 15.0 and np.allclose(weight[:2], 0.0)
+    assert np.linalg.norm(force - weight) < 0.05, (force, weight)
+    assert np.linalg.norm(robot.hand_inertia_force() - weight) < 0.05
+
+
+def test_the_wrist_reads_the_hands_motion_touching_nothing():
+    # the arm swinging the hand through free space: the wrist's force is far off the hand's weight, and within a
+    # fraction of a newton of the masses of the hand's bodies times their acceleration
+    from haptic.sim import Simulation, compose_scene
+    from haptic.sim.robot import RobotInterface
+
+    robot = RobotInterface(Simulation(compose_scene(), seed=1))
+    robot.hold_posture()
+    robot.step(1000)
+    tip, _ = robot.fingertip_pose()
+    robot.move_fingertip(tip + np.array([0.15, 0.1, 0.1]))
+    far, off = 0.0, 0.0
+    for _ in range(300):
+        robot.step(1)
+        force, _ = robot.watch_wrist()
+        far = max(far, float(np.linalg.norm(force - robot.hand_weight())))
+        off = max(off, float(np.linalg.norm(force - robot.hand_inertia_force())))
+    assert far > 1.0 and off < 0.1 * far, (far, off)
+
+
+def test_watching_the_wrist_changes_no_other_reading():
+    from haptic.sim import SimulatedSensorNoise, Simulation, compose_scene
+
+    def readings(watch: bool):
+        sim = Simulation(compose_scene(), noise=SimulatedSensorNoise.from_notes(), seed=3)
+        sim.step(5)
+        if watch:
+            sim.wrist_wrench(watch=True)
+        return sim.wrist_wrench(), sim.link_contacts(watch=True), sim.contact_summary(0)
+
+    a, b = readings(False), readings(True)
+    assert np.array_equal(a[0][0], b[0][0]) and np.array_equal(a[0][1], b[0][1])
+    assert len(a[1]) == len(b[1]) and a[2].normal_force == b[2].normal_force
+
+
+@pytest.mark.slow
+def test_the_wrist_feels_the_links_contacts_and_nothing_else_touches():
+    # FRAME01 seed 2 (above): with the pad free, the wrist's force sensor feels the links pressing the hole's rim
+    # (off the hand's weight and motion by more than 1.5 N), and it feels no contact that neither the pad nor a link
+    # reports: with a readout on every link the wrist tells nothing more
+    from haptic.episode.spec import EpisodeSpec
+    from haptic.episode.worlds import run_episode
+
+    rec = run_episode(EpisodeSpec(model="FRAME01", seed=2, executor="physics"))
+    w = rec.perception["wrist"]
+    assert w["watched"] > 100 and w["links"] >= 10, w
+    assert w["links_felt"] >= 0.75 * w["links"], w
+    assert w["unexplained"] == 0 and w["free_max"] < 1.5, w

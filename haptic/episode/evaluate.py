@@ -88,6 +88,8 @@ class PerceptionScore:
     """Every measured quantity of every component in units of its bound (:func:`bound_ratios`)."""
     hand: dict = field(default_factory=dict)
     """Contacts of links other than the pad (:func:`score_hand`)."""
+    wrist: dict = field(default_factory=dict)
+    """The wrist force sensor's watch over the moves (:func:`wrist_watch`)."""
 
     @property
     def outside_bounds(self) -> tuple[int, ...]:
@@ -123,6 +125,7 @@ class PerceptionScore:
             "outside_bounds": len(self.outside_bounds),
             "ratios": [[r.id, r.what, round(r.ratio, 4), r.true_id] for r in self.ratios],
             "hand": self.hand,
+            "wrist": self.wrist,
         }
 
 
@@ -267,7 +270,26 @@ def score_components(
     ratios = tuple(bound_ratios(components, model, world_from_model))
     hand = score_hand(results or (), ratios, model, world_from_model)
     return PerceptionScore(tuple(scores), sum(1 for s in scores if s.true_id is None), missed, concave, details,
-                           ratios, hand)  # fmt: skip
+                           ratios, hand, wrist_watch(results or ()))  # fmt: skip
+
+
+def wrist_watch(results) -> dict:
+    """The wrist force sensor's watch summed over the moves (``MoveResult.info["wrist"]``, the physics executor's
+    :meth:`~haptic.executor.primitives.Toucher.take_wrist`): ticks watched with the pad free, those with a link's
+    contact and those of them the wrist felt, those with a force nothing else reports (``unexplained``, and the
+    moves with one), and the largest force off the hand's weight with nothing touching. Empty without a watch."""
+    out = {"watched": 0, "links": 0, "links_felt": 0, "unexplained": 0, "unexplained_moves": 0, "free_max": 0.0}
+    seen = False
+    for r in results:
+        w = (getattr(r, "info", None) or {}).get("wrist")
+        if not w:
+            continue
+        seen = True
+        for k in ("watched", "links", "links_felt", "unexplained"):
+            out[k] += int(w[k])
+        out["unexplained_moves"] += int(w["unexplained"] > 0)
+        out["free_max"] = max(out["free_max"], float(w["free_max"]))
+    return out if seen else {}
 
 
 def score_hand(results, ratios, model: Polyhedron, world_from_model: SE3) -> dict:
@@ -455,6 +477,7 @@ __all__ = [
     "PerceptionScore",
     "bound_ratios",
     "score_components",
+    "wrist_watch",
 ]
 
 

@@ -329,6 +329,7 @@ class PhysicsExecutor(LandingSearch):
         self.recoveries = []
         self.toucher.take_links()  # drop samples taken outside a move
         self.toucher.take_hand()
+        self.toucher.take_wrist()
         if self.robot.time != self._links_until:  # the pose at the start, unless the last move reported it
             self.toucher.sample_links()
         try:
@@ -346,11 +347,15 @@ class PhysicsExecutor(LandingSearch):
         self.traces.append(trace)
         links = self._hand_links()
         hand = hand_touches(self.toucher.take_hand(), self._link_radii())
+        info = {**res.info, "recoveries": list(self.recoveries)} if self.recoveries else dict(res.info)
+        wrist = self.toucher.take_wrist()
+        if wrist["watched"]:
+            info["wrist"] = wrist
         return MoveResult(move=res.move, status=res.status, components=res.components, distance=res.distance,
                           cost=res.cost, state=res.state, touches=touches_of(trace), trace=trace, reason=res.reason,
                           links=links, hand=hand, sim_time=self.robot.time - t0, wall_time=time.perf_counter() - w0,
                           free_space=res.free_space,
-                          info={**res.info, "recoveries": list(self.recoveries)} if self.recoveries else res.info)
+                          info=info)
 
     def _upright(self, pieces: list[PrimitiveResult]) -> None:
         """After a move made with the hand tilted: lift the pad off along the sensed normal and turn the hand back
@@ -1207,6 +1212,9 @@ class PhysicsExecutor(LandingSearch):
             if sign * (s_known - middle) < 0 and abs(s_v - s_known) <= seg.vertices[vid].position_bound:
                 return self.failed_result(move, "unreachable", "the vertex located is the edge's other end, which the "
                                                                "move set off past")  # fmt: skip
+        if self._acquired_past(rec, acq.trace, u, s_v):
+            return self.failed_result(move, "unreachable", "the vertex located lies behind where the pad acquired "
+                                                           "the ridge (the pad set off past it)")  # fmt: skip
         # refine the line with the ridge contacts (convex edges), then extend it to the vertex
         ridge = self._on_ridge(rows, u)
         w_v, w_from = rec.at(s_v), rec.at(s_from)
@@ -1287,6 +1295,22 @@ class PhysicsExecutor(LandingSearch):
             return None, 0.0
         s_v = float((blk.point_in_world - rec.point) @ blk.normal_in_world) / denom
         return s_v, b.point_sigma / abs(denom)
+
+    def _acquired_past(self, rec, acq: ContactTrace, u: np.ndarray, s_v: float) -> bool:
+        """Whether the pad acquired the ridge past the vertex it then located at ``s_v``: acquiring the ridge short
+        of the vertex, its first contacts on the ridge (:attr:`~PhysicsSettings.min_vertex_rows`, their median) lie
+        behind it along ``u``; lying ahead of it by more than the bound of a vertex, they came from a pad already
+        past the edge's end, whose contacts then slid back toward it (trapezohedron_09 of the formula corpus at
+        60 mm, seed 1: the pad acquired the "ridge" 4.4 mm past the end of its edge, on the faces beyond, its tip
+        went 0.4 mm along the edge while the contacts slid to 1.3 mm past the vertex, and the vertex was put there,
+        1.05 bounds off)."""
+        first = np.flatnonzero(acq.in_contact & (acq.phase == PHASES.index("ridge")))[: self.settings.min_vertex_rows]
+        if len(first) < self.settings.min_vertex_rows:
+            return False
+        sign = 1.0 if float(u @ rec.direction) > 0 else -1.0
+        ahead = sign * (float(np.median((acq.point_in_world[first] - rec.point) @ rec.direction)) - s_v)
+        b = self.bounds
+        return ahead > b.bound(b.point_sigma, b.vertex_floor)
 
     def _spans_a_gap(self, rows: ContactTrace, u: np.ndarray) -> bool:
         """Whether the pad, following a convex ridge along ``u`` until something blocked it, spanned a gap in the

@@ -50,6 +50,12 @@ STOPS = ("table", "hand")
 """Events that end a leg of a stroke without failing the stroke (the table ahead, a finger link on the object)."""
 FAILURES = ("no-contact", "unreachable", "timeout", "unstable")
 """Failure statuses of a primitive (the move statuses of :class:`~haptic.planning.moves.MoveResult`)."""
+_FREE = PHASES.index("free")
+
+
+def _wrist_watch() -> dict:
+    """The counts of :meth:`Toucher.take_wrist` before any watch."""
+    return {"watched": 0, "links": 0, "links_felt": 0, "unexplained": 0, "free_max": 0.0}
 
 
 @dataclass(frozen=True, eq=False)
@@ -119,6 +125,7 @@ class Toucher:
         self._ticks = 0
         self._links: list[tuple[float, np.ndarray]] = []  # (time, link positions) samples
         self._hand: list[HandContact] = []  # the links' contacts with the object watched since the last take
+        self._wrist = _wrist_watch()  # the wrist's force watched since the last take
         tip, rot = robot.fingertip_pose()
         self.tip = tip
         self.rotation = rot
@@ -175,11 +182,47 @@ class Toucher:
             self._watch_links()
 
     def _watch_links(self) -> None:
-        """Book the links' contacts with anything but the table (:meth:`on_table`) above the contact threshold."""
+        """Book the links' contacts with anything but the table (:meth:`on_table`) above the contact threshold, and
+        compare the wrist's force with what the pad and the links report (:meth:`_watch_wrist`)."""
+        touching = False
         for c in self.robot.watch_links():
-            if c.normal_force > self.threshold and not self.on_table(c):
+            if c.normal_force <= self.threshold:
+                continue
+            touching = True
+            if not self.on_table(c):
                 self._hand.append(HandContact(self.robot.time, c.link, c.point_in_world, c.normal_in_world,
                                               c.normal_force))  # fmt: skip
+        if self.config.wrist_force > 0:
+            self._watch_wrist(touching)
+
+    def _watch_wrist(self, link_touching: bool) -> None:
+        """With the pad free and the hand under force control (not carried between moves), the wrist's force off
+        what the hand's weight and motion read (:meth:`~haptic.sim.robot.RobotInterface.hand_inertia_force`) by more
+        than :attr:`~TouchConfig.wrist_force` is a contact of the hand: counted as one a link reports
+        (``links_felt`` of ``links``) or as one nothing else reports (``unexplained``). The largest force off that
+        reading with nothing touching is kept (``free_max``), which tells how far the threshold stands from the
+        hand's own motion."""
+        if self.contact[1] is not None or not self._rows or self._rows[-1][-1] == _FREE:
+            return
+        force, _ = self.robot.watch_wrist()
+        off = float(np.linalg.norm(force - self.robot.hand_inertia_force()))
+        felt = off > self.config.wrist_force
+        w = self._wrist
+        w["watched"] += 1
+        if link_touching:
+            w["links"] += 1
+            w["links_felt"] += int(felt)
+        else:
+            w["unexplained"] += int(felt)
+            w["free_max"] = max(w["free_max"], round(off, 3))
+
+    def take_wrist(self) -> dict:
+        """The wrist's watch since the last call (:meth:`_watch_wrist`): ticks ``watched`` with the pad free, of them
+        those with a link's contact (``links``) and those the wrist felt (``links_felt``), ticks with a force
+        nothing else reports (``unexplained``) and the largest force off the hand's weight and motion with nothing
+        touching (``free_max``) [N]."""
+        out, self._wrist = self._wrist, _wrist_watch()
+        return out
 
     def take_hand(self) -> list[HandContact]:
         """The links' contacts with the object watched since the last call, in order."""

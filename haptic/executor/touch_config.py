@@ -192,6 +192,14 @@ class TouchConfig:
     watch_every: int = 5
     """The links' contact readout is watched every this many ticks through a move (0: never): a link other than
     the pad touching the object is reported with the move (:class:`HandContact`) [ticks]."""
+    wrist_force: float = 1.5
+    """With the pad and every link free, the wrist's force sensor reads the hand's weight and motion (the masses of
+    its bodies times their acceleration, :meth:`~haptic.sim.robot.RobotInterface.hand_inertia_force`): off it by
+    0.07 N (99th percentile) and 1.03 N at most while the hand moves under force control (PYR01 at 60 and 100 mm,
+    FRAME01 at 100 mm, seed 1: 3368 watched ticks), where the weight alone is 18 N off during fast approaches.
+    Watched with the links' readout outside the carries between moves, a force farther than this from that reading
+    is a contact of the hand, and one that neither the pad nor a link reports is counted with the move
+    (``MoveResult.info["wrist"]``) [N]."""
 
     @property
     def reach_undercut(self) -> float:

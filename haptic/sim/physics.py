@@ -331,10 +331,23 @@ class Simulation:
         ft = [oid(mujoco.mjtObj.mjOBJ_SENSOR, HAND_PREFIX + n) for n in ("wrist_force", "wrist_torque")]
         self.wrist_adr = np.concatenate([m.sensor_adr[s] + np.arange(3) for s in ft])
         self.wrist_site = oid(mujoco.mjtObj.mjOBJ_SITE, HAND_PREFIX + "wrist_ft")
+        root = int(m.site_bodyid[self.wrist_site])
+        below = [b for b in range(m.nbody) if b == root or self._descends(b, root)]
+        self._hand_bodies = tuple(below)  # the bodies whose weight and motion the wrist's sensor carries
+        self._acc6 = np.zeros(6)
         self.home_key = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_KEY, "home")
         self._force6 = np.zeros(6)
         self._scratch: mujoco.MjData | None = None
         self.reset()
+
+    def _descends(self, body: int, root: int) -> bool:
+        """Whether ``body`` hangs below ``root`` in the kinematic tree."""
+        parent = self.model.body_parentid
+        while body != 0:
+            body = int(parent[body])
+            if body == root:
+                return True
+        return False
 
     # -- state ---------------------------------------------------------------------------------------------
     def reset(self, arm_q: np.ndarray | None = None, hand_q: np.ndarray | None = None) -> None:
@@ -349,6 +362,8 @@ class Simulation:
         self._senses_rng = np.random.default_rng([self._seed, 1])
         # the links' readout watched through a move draws apart again: watching leaves every other reading as it was
         self._watch_rng = np.random.default_rng([self._seed, 2])
+        # and the wrist's watched through a move apart from those
+        self._wrist_rng = np.random.default_rng([self._seed, 3])
         mujoco.mj_forward(m, d)
 
     def _robot_geom_links(self) -> np.ndarray:
@@ -470,18 +485,39 @@ class Simulation:
                 normal /= math.sqrt(float(normal @ normal))
         return total, normal, point, len(raw)
 
-    def wrist_wrench(self) -> tuple[np.ndarray, np.ndarray]:
+    def wrist_wrench(self, watch: bool = False) -> tuple[np.ndarray, np.ndarray]:
         """The wrist force/torque sensor (MuJoCo ``force`` and ``torque`` sensors at the hand's ``wrist_ft``
-        site): force (3,) [N] and torque (3,) [N m] in the world frame, noise applied."""
+        site): force (3,) [N] and torque (3,) [N m] in the world frame, noise applied. ``watch``: the sensor
+        watched all through a move, its noise drawn apart from the other senses'."""
         raw = self.data.sensordata[self.wrist_adr]
         rot = self.data.site_xmat[self.wrist_site].reshape(3, 3)
         force, torque = rot @ raw[:3], rot @ raw[3:]
         nz = self.noise
+        rng = self._wrist_rng if watch else self._senses_rng
         if nz.force_std > 0:
-            force = force + nz.force_std * self._senses_rng.standard_normal(3)
+            force = force + nz.force_std * rng.standard_normal(3)
         if nz.torque_std > 0:
-            torque = torque + nz.torque_std * self._senses_rng.standard_normal(3)
+            torque = torque + nz.torque_std * rng.standard_normal(3)
         return force, torque
+
+    def hand_inertia_force(self) -> np.ndarray:
+        """What the wrist's force sensor reads of the hand touching nothing, moving as it moves now (3,) [N], world
+        frame: the mass of each of the hand's bodies below the sensor times its acceleration with gravity's offset
+        (the robot's own model and the motion of its joints; at rest :meth:`hand_weight`). Carried between moves the
+        arm swings the hand by up to 17 N off its weight."""
+        m, d = self.model, self.data
+        out = np.zeros(3)
+        for b in self._hand_bodies:
+            mujoco.mj_objectAcceleration(m, d, mujoco.mjtObj.mjOBJ_BODY, b, self._acc6, 0)
+            out += m.body_mass[b] * self._acc6[3:]
+        return out
+
+    def hand_weight(self) -> np.ndarray:
+        """What the wrist's force sensor reads of the hand at rest touching nothing (3,) [N], world frame: the
+        weight of the hand below the sensor, from the robot's own model (the masses of its bodies)."""
+        m = self.model
+        body = int(m.site_bodyid[self.wrist_site])
+        return -float(m.body_subtreemass[body]) * np.asarray(m.opt.gravity, dtype=float)
 
     def link_contacts(self, watch: bool = False) -> tuple[LinkContact, ...]:
         """Contacts of the robot's links other than the fingertip pads with anything not of the robot (the

@@ -63,6 +63,20 @@ class RobotInterface:
         other reading)."""
         return self._sim.link_contacts(watch=True)
 
+    def watch_wrist(self) -> tuple[np.ndarray, np.ndarray]:
+        """The wrist force/torque sensor's force and torque (world frame) as watched all through a move (its noise
+        drawn apart, so that watching changes no other reading)."""
+        return self._sim.wrist_wrench(watch=True)
+
+    def hand_inertia_force(self) -> np.ndarray:
+        """The wrist force sensor's reading of the hand touching nothing, moving as it moves now (the robot's own
+        masses and the motion of its joints) [N]."""
+        return self._sim.hand_inertia_force()
+
+    def hand_weight(self) -> np.ndarray:
+        """The wrist force sensor's reading of the hand touching nothing, at rest (the robot's own masses) [N]."""
+        return self._sim.hand_weight()
+
     def link_radii(self) -> dict[str, float]:
         """Per link, the radius of its thickest collision geom [m]: the bound of a point its readout reports
         (the robot's own geometry)."""
