@@ -63,15 +63,15 @@ def test_watching_the_links_changes_no_other_reading():
 
 @pytest.mark.slow
 def test_the_hands_contacts_lie_within_their_links_bound_and_spoil_no_component():
-    # FRAME01 seed 2 stands on an end, its hole's axis horizontal: reaching the hole's walls, the index finger's
-    # phalanges (and the middle finger's) touch the rim while the pad measures (13 moves, 263 points). Every point
-    # lies within 0.7 mm of the true surface (bound 8.5 mm: the links' radius), and the components those moves
-    # report are within their own bounds (0.22 at most): what the matcher gets from such a contact is its point
-    # with the link's bound; the pad's components stand.
+    # FRAME01 seed 1: its verification reaches toward the hole, and the index finger's phalanges touch the rim while
+    # the pad measures (5 moves, 28 points). Every point lies within a small part of its bound (8.5 mm: the links'
+    # radius; 0.06 at most), and the components those moves report are within their own bounds (0.41 at most): what
+    # the matcher gets from such a contact is its point with the link's bound; the pad's components stand. (Seed 2
+    # went into the hole until the verification named the hole's corners out of reach up front.)
     from haptic.episode.spec import EpisodeSpec
     from haptic.episode.worlds import run_episode
 
-    rec = run_episode(EpisodeSpec(model="FRAME01", seed=2, executor="physics"))
+    rec = run_episode(EpisodeSpec(model="FRAME01", seed=1, executor="physics"))
     hand = rec.perception["hand"]
     assert hand["moves"] >= 3 and "index_medial" in hand["links"], hand
     assert hand["point_ratio_max"] < 1.0, hand
@@ -131,13 +131,13 @@ def test_watching_the_wrist_changes_no_other_reading():
 
 @pytest.mark.slow
 def test_the_wrist_feels_the_links_contacts_and_nothing_else_touches():
-    # FRAME01 seed 2 (above): with the pad free, the wrist's force sensor feels the links pressing the hole's rim
+    # FRAME01 seed 1 (above): with the pad free, the wrist's force sensor feels the links pressing the hole's rim
     # (off the hand's weight and motion by more than 1.5 N), and it feels no contact that neither the pad nor a link
     # reports: with a readout on every link the wrist tells nothing more
     from haptic.episode.spec import EpisodeSpec
     from haptic.episode.worlds import run_episode
 
-    rec = run_episode(EpisodeSpec(model="FRAME01", seed=2, executor="physics"))
+    rec = run_episode(EpisodeSpec(model="FRAME01", seed=1, executor="physics"))
     w = rec.perception["wrist"]
     assert w["watched"] > 100 and w["links"] >= 10, w
     assert w["links_felt"] >= 0.75 * w["links"], w
