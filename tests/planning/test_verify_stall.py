@@ -17,6 +17,7 @@ from haptic.planning.verify import (
     hidden_vertices,
     reachable_features,
 )
+from tests.planning.test_verify_moves import _resting_on as resting_on
 
 LIB = load_library()
 HAND = dataclasses.replace(PlannerConfig(), table_z=0.35, pad_radius=0.012, concave_end_block=0.2)
@@ -26,17 +27,7 @@ concave edge's end (``PhysicsSettings.min_block_cos``)."""
 
 def _resting_on(poly, face: int) -> SE3:
     """A pose of ``poly`` with ``face`` on a table at z = 0.35 m."""
-    n = poly.face_normals[face]
-    axis = np.cross(n, [0.0, 0.0, -1.0])
-    s, c = np.linalg.norm(axis), float(n @ [0.0, 0.0, -1.0])
-    if s < 1e-9:
-        rot = np.eye(3) if c > 0 else np.diag([1.0, -1.0, -1.0])
-    else:
-        k = axis / s
-        kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
-        rot = np.eye(3) + s * kx + (1 - c) * kx @ kx
-    low = (poly.vertices @ rot.T)[:, 2].min()
-    return SE3(rot, np.array([0.55, 0.0, 0.35 - low]))
+    return resting_on(poly, face)[0]
 
 
 def test_the_corners_of_a_hole_that_only_valleys_lead_to_are_named_out_of_reach_up_front():
