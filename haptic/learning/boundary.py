@@ -64,6 +64,10 @@ class BoundaryEdge:
     """The vertices (groups) its data edges reach."""
     sides: dict[int, list[np.ndarray]] = field(default_factory=dict)
     """Plane → points measured on that plane's face beside the edge [m]."""
+    beside: dict[int, tuple[np.ndarray, ...]] = field(default_factory=dict)
+    """Plane → the points touched on that plane's faces: those of its data edges' faces, then of every face on the
+    plane, shape (P, 3) each [m]. Which side of the edge the face lies on is taken from them where no point of
+    :attr:`sides` lies clear of the edge (:func:`_side_from_faces`)."""
 
     @property
     def flat(self) -> bool:
@@ -241,6 +245,10 @@ def boundary_estimate(components: Mapping[int, DataComponent], bounds: LearnBoun
                         off = pts - p0 - np.outer((pts - p0) @ u, u)
                         be.sides[k] = [pts[int(np.argmin(np.linalg.norm(off, axis=1)))]]
                 edge_of[e.id] = len(edges)
+            for k in set(pair):
+                own = sorted({f for e in es for f in ef.get(e.id, ()) if plane_of.get(f) == k})
+                be.beside[k] = tuple(np.concatenate([np.atleast_2d(components[f].points) for f in fs]).reshape(-1, 3)
+                                     for fs in (own, sorted(planes[k].faces)))  # fmt: skip
             if len(be.vertices) > 2:
                 problems.append(f"an edge between planes {pair} reaches {len(be.vertices)} vertices")
             edges.append(be)
@@ -281,13 +289,41 @@ def _half_edges(est: BoundaryEstimate) -> dict[int, list[tuple[int, int, int]]]:
         d = est.positions[b] - est.positions[a]
         for p in be.planes:
             w = np.cross(est.planes[p].normal, d)
-            side = np.array([float((q - est.positions[a]) @ w) for q in be.sides.get(p, [])])
+            side = np.array([float((q - est.positions[a]) @ w) for q in be.sides.get(p, [])]) / float(np.linalg.norm(w))
             if not len(side):
                 est.problems.append(f"edge {k} has no measured point on the face of plane {p}")
                 continue
-            left = _left(side / float(np.linalg.norm(w)), est.bounds.position)
+            if not np.any(np.abs(side) > est.bounds.position):
+                side = np.append(
+                    side, _side_from_faces(be.beside.get(p, ()), est.positions[a], d, w, est.bounds.position)
+                )
+            left = _left(side, est.bounds.position)
             out.setdefault(p, []).append((a, b, k) if left else (b, a, k))
     return out
+
+
+def _side_from_faces(beside: tuple[np.ndarray, ...], a: np.ndarray, d: np.ndarray, w: np.ndarray, bound: float
+                     ) -> list[float]:  # fmt: skip
+    """The signed distance (along ``w``, the plane's normal crossed with the edge's ``d``) from the edge ``a`` to
+    ``a + d`` of the touched point nearest to it among those farther than ``bound`` from its line and beside it
+    (between its ends): of the first of ``beside``'s point sets that has one (the plane's faces at the edge, then
+    all of them); none when none has. A vertex move's only point beside the edge it meets is where its circle met
+    it, on the line within the bound: on a sliver face (LBLOCK01 with a corner moved 4 mm folds a wall into two
+    triangles, one of them 4 mm across at its end) the face was taken on the wrong side of its edge, the fans at
+    the edge's ends never balanced, and the walk went back and forth across another edge until the learning's
+    budget ran out."""
+    length = float(np.linalg.norm(d))
+    u, w = d / length, w / float(np.linalg.norm(w))
+    for pts in beside:
+        if not len(pts):
+            continue
+        t = (pts - a) @ u
+        off = np.linalg.norm(pts - a - np.outer(t, u), axis=1)
+        ok = (off > bound) & (t >= 0.0) & (t <= length)
+        if ok.any():
+            i = int(np.flatnonzero(ok)[np.argmin(off[ok])])
+            return [float((pts[i] - a) @ w)]
+    return []
 
 
 def _left(side: np.ndarray, bound: float) -> bool:

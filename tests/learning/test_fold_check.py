@@ -103,6 +103,18 @@ def test_an_l_block_with_a_corner_moved_4_mm_closes(vertex, seed, tmp_path):
     assert (learned["V"], learned["E"], learned["F"]) == (poly.n_vertices, poly.n_edges, poly.n_faces)
 
 
+@pytest.mark.parametrize(("vertex", "seed"), [(2, 1099128568), (10, 115815300)])
+def test_a_sliver_faces_side_of_its_edge_is_taken_from_its_plane(vertex, seed, tmp_path):
+    """LBLOCK01 with a corner moved 4 mm at these seeds: a wall folds into two triangles, one of them 4 mm across
+    at its end. The edge a vertex move met on it had one point beside it on the sliver, where the circle met the
+    edge (0.05 and 0.01 mm off its line, the bound 0.6 mm), and the face was taken on the edge's wrong side: the fans
+    at its ends never balanced and the walk went back and forth across another edge to the learning's budget (150
+    moves). The side comes from the plane's touched points clear of the line."""
+    learned, poly = _learn("LBLOCK01", vertex, seed, tmp_path, offset=4e-3)
+    assert (learned["V"], learned["E"], learned["F"]) == (poly.n_vertices, poly.n_edges, poly.n_faces)
+    assert learned["moves"] < 100
+
+
 def test_the_fold_check_is_off_on_the_hand_unless_asked_for():
     assert LearnSettings().checks_folds(None) and not LearnSettings().checks_folds(0.0)
     assert LearnSettings(fold_check=True).checks_folds(0.0) and not LearnSettings(fold_check=False).checks_folds(None)
