@@ -962,6 +962,8 @@ class Verifier:
         """On the hand, the (model face, model edge) that face moves failed to cross :data:`CROSSING_FAILURES`
         times (:meth:`_fail_crossings`)."""
         self._crossing_failures: dict[tuple[int, int], int] = {}
+        self._asked: tuple[Move, tuple[int, int]] | None = None
+        """On the hand, the last face move chosen and the crossing it was predicted to make (:meth:`_missed`)."""
         self._failed_at_vertex: dict[tuple[int, int], list[np.ndarray]] = {}
         """On the hand, per (model vertex, model face): the model-frame directions of face moves that failed
         starting there (:meth:`_failed_from_vertex`)."""
@@ -1211,6 +1213,7 @@ class Verifier:
         ``probed``: the probes' lines so far (not probed again)."""
         t0 = time.perf_counter()
         self.moves += 1
+        asked, self._asked = self._asked, None  # the last face move asked: set again below when this is one
         if self.finger_faces is not None and self.finger_faces.pending is not None:
             move = self.finger_faces.take()
             self.decision_times.append(time.perf_counter() - t0)
@@ -1225,6 +1228,7 @@ class Verifier:
         failed = tuple(avoid)
         avoid = (*avoid, *self._failed_along(h, state, components, avoid), *self._failed_from_vertex(h, state, avoid))
         relocate = self._relocate()
+        self._missed(h, state, failed, asked)
         self._fail_crossings(h, state, components, failed)
         faces_ok = self._reach[self._model_name][0] if self._model_name in self._reach else None
         previous = self._tour if self._tour is not None and self._tour_model is h.poly else None
@@ -1246,6 +1250,9 @@ class Verifier:
             from haptic.planning.search import simulate
 
             sim = simulate(h, move, state, components, self.config)
+            if move.kind == "face" and sim is not None and self.config.table_z is not None:
+                crossing = _crossing(h, state, sim[0], sim[1])
+                self._asked = (move, crossing) if crossing is not None else None
             key = None
             if sim is not None and _gain(_new_features(h, sim[0]), missing) == 0:
                 key = outcome_key(h, move, state, sim[0], sim[1])
@@ -1289,6 +1296,25 @@ class Verifier:
                 self._crossing_failures[key] = self._crossing_failures.get(key, 0) + 1
                 if self._crossing_failures[key] >= CROSSING_FAILURES:
                     self._failed_crossings.add(key)
+
+    def _missed(self, h: Hypothesis, state: SensorState, failed: Sequence[Move],
+                asked: tuple[Move, tuple[int, int]] | None) -> None:
+        """On the hand, count as a failure to cross (:meth:`_fail_crossings`) the last face move chosen (``asked``,
+        with its predicted crossing) when it did not fail (not among ``failed``, the moves that failed from here)
+        and yet ended off the model edge it was predicted to cross: the pad stopped on the face it started on, or
+        slid to another edge. The verification
+        asked the same crossing again and again, each ending elsewhere: antiprism_08 of the formula corpus (seed 1)
+        from its octagon over one edge three times, trapezohedron_10 over one edge three times."""
+        from haptic.planning.move_scores import same_move
+
+        if asked is None or h.world_from_model is None or any(same_move(asked[0], m) for m in failed):
+            return
+        key = asked[1]
+        if (h.edges.get(state.edge) if state.edge is not None else None) == key[1]:
+            return
+        self._crossing_failures[key] = self._crossing_failures.get(key, 0) + 1
+        if self._crossing_failures[key] >= CROSSING_FAILURES:
+            self._failed_crossings.add(key)
 
     def _relocate(self) -> bool:
         """Whether the next move is to relocate on the hand (:func:`plan_verification_move`): the last

@@ -211,3 +211,24 @@ def test_a_move_the_model_cannot_follow_is_not_taken_again_and_again_on_the_hand
     ways.add(unpredicted_key(h, back, state))
     chosen = plan_verification_move(h, state, comps, missing, noise, config, travelled=ways)[0]
     assert chosen is not None and not (isinstance(chosen, VertexMove) and chosen.across_face == back.across_face)
+
+
+def test_a_face_move_that_ended_off_the_edge_it_was_to_cross_counts_as_a_failed_crossing_on_the_hand():
+    """On the hand a face move can succeed and end elsewhere than predicted: the pad stops on the face it started
+    on, or slides to another edge. The verification asked such a crossing again and again (antiprism_08 of the
+    formula corpus, seed 1: three times from its octagon over one edge). Ending off the edge predicted counts as a
+    failure to cross it, and after :data:`CROSSING_FAILURES` the crossing is not asked again; a move that ended on
+    its edge counts nothing, nor one that failed (counted as such by the failures from here)."""
+    from haptic.planning.verify import CROSSING_FAILURES
+
+    h, state, comps = _at_a_vertex("BOX01", 0)
+    here = h.edges[state.edge]
+    other = next(int(e) for e in h.poly.face_edges[h.faces[state.face]] if int(e) != here)
+    move = FaceMove(comps[state.face].normal)  # which move does not matter here, only what it was to cross
+    v = Verifier("full", SensorNoise(), HAND)
+    v._missed(h, state, (), (move, (h.faces[state.face], here)))  # it ended on the edge it was to cross
+    v._missed(h, state, (move,), (move, (h.faces[state.face], other)))  # it failed
+    assert not v._crossing_failures and not v._failed_crossings
+    for _ in range(CROSSING_FAILURES):
+        v._missed(h, state, (), (move, (h.faces[state.face], other)))
+    assert (h.faces[state.face], other) in v._failed_crossings
