@@ -637,12 +637,12 @@ def plan_verification_move(
     probes are: the next move carries the pad over the object to there. A face move predicted to cross a model
     edge from a model face where face moves failed to cross before (``failed_crossings``, :func:`_crossing`) is
     left out, after those going back; so is, on the hand, one predicted to meet its edge at a glancing angle
-    (under :data:`GRAZING`), and a vertex move whose circle leaves the face it crosses through an edge that does not
-    leave the vertex (:func:`_circle_leaves_corner`). A move the hypothesis cannot follow (a vertex move that circles
-    back to what is explored) made :data:`HAND_WAYS_AGAIN` times from one place since the last feature measured
-    (:func:`unpredicted_key` in ``travelled``) is left out as going back. ``middles``: faces whose middle is still
-    to be probed (under ``full`` with probes admitted); a probe predicted to land at one of them scores
-    :data:`MIDDLE_CREDIT` less."""
+    (under :data:`GRAZING`). A vertex move whose circle leaves the face it crosses through an edge that does not
+    leave the vertex (:func:`_circle_leaves_corner`) is not made on the hand at all. A move the hypothesis cannot
+    follow (a vertex move that circles back to what is explored) made :data:`HAND_WAYS_AGAIN` times from one place
+    since the last feature measured (:func:`unpredicted_key` in ``travelled``) is left out as going back.
+    ``middles``: faces whose middle is still to be probed (under ``full`` with probes admitted); a probe predicted
+    to land at one of them scores :data:`MIDDLE_CREDIT` less."""
     from haptic.planning.search import simulate
     from haptic.planning.simulate import simulate_probe
 
@@ -687,14 +687,14 @@ def plan_verification_move(
     for m, c, r in [*first, *probes]:
         sim = (simulate_probe(h, m, state, components, noise) if m.kind == "probe"
                else simulate(h, m, state, components, config))  # fmt: skip
+        if config.table_z is not None and isinstance(m, VertexMove) and _circle_leaves_corner(h, m, state, config):
+            continue  # the hand cannot make it: not even a last resort
         if sim is None:
             (again if unpredicted_key(h, m, state) in travelled else ends).append((m, None, c))
             continue
         h1, s1, _ = sim
-        if (m.kind == "face" and (_crossing(h, state, h1, s1) in failed_crossings
-                                  or config.table_z is not None and _grazing(h, m, h1, s1))
-                or config.table_z is not None and isinstance(m, VertexMove) and _circle_leaves_corner(h, m, state,
-                                                                                                        config)):
+        if m.kind == "face" and (_crossing(h, state, h1, s1) in failed_crossings
+                                 or config.table_z is not None and _grazing(h, m, h1, s1)):
             refused.append((m, h.world_from_model.inverse().apply(s1.position), c))
             continue
         new = _new_features(h, h1)
@@ -813,15 +813,16 @@ def unpredicted_key(h: Hypothesis, move: Move, state: SensorState) -> tuple:
     """The way of a move that hypothesis ``h`` cannot follow (:func:`~haptic.planning.search.simulate` None: a vertex
     move that only circles back to an edge and face already explored, a face move that meets a vertex), from
     ``state``: its kind, the model face, edge and vertex it starts at, and where it heads in the model's frame (the
-    model face a vertex move crosses, a face move's direction to a tenth, an edge move's sense). On the hand such a
+    model face a vertex move crosses, a face move's direction to a tenth, an edge move's sense); a vertex move's,
+    the model vertex it circles and the model face it crosses, from either edge of that face there. On the hand such a
     move measures nothing the tour counts on, and when every move predicted to measure something has been left out,
     the verification took it as the way nearest what is missing again and again: round one vertex between two of
     its edges, an edge move back to it and the circle again (platonic_dodecahedron and trapezohedron_09 of the
     formula corpus, seed 1: 6 and 4 times, until the budget ended them)."""
     start = (move.kind, h.faces.get(state.face), h.edges.get(state.edge) if state.edge is not None else None,
              h.vertices.get(state.vertex) if state.vertex is not None else None)  # fmt: skip
-    if isinstance(move, VertexMove):
-        return (*start, h.faces.get(move.across_face))
+    if isinstance(move, VertexMove):  # round one vertex across one face, from either edge of it there
+        return (move.kind, start[3], h.faces.get(move.across_face))
     if isinstance(move, FaceMove) and h.world_from_model is not None:
         d = h.model_from_world.rotate(np.asarray(move.direction, float))
         return (*start, *np.round(d * 10.0).astype(int))
