@@ -346,15 +346,19 @@ def test_a_vertex_move_whose_circle_meets_an_edge_of_another_vertex_reports_no_e
     assert score_components(ep.executor.components, ep.true_model, ep.world_from_model, results).missed == 0
 
 
-def test_a_vertex_move_whose_circle_meets_an_edge_near_the_vertex_circled_reports_no_edge(tmp_path):
+def test_a_vertex_move_whose_circle_meets_an_edge_near_the_vertex_circled_reports_no_edge(tmp_path, monkeypatch):
     # trapezohedron_10 of the formula corpus at 30 mm, seed 2 (perception_report.py --corpus --sizes 30 --first-seed
     # 2): circling a vertex across a kite whose edge from it is 4.2 mm long, inside the 8 mm circle, the pad met the
     # kite's next edge, which leaves another vertex and passes 1.9 mm from the one circled. The vertex's and the
     # line's bounds added up (1.2 + 0.75 mm) let it through although each was 0.15 mm off: the edge was reported
     # adjacent to the vertex and the tree pruned the truth (no-match after 7 moves). Independent estimates, their
-    # bounds add in quadrature (1.4 mm): the move reports nothing.
+    # bounds add in quadrature (1.4 mm): the move reports nothing. The verification on the hand no longer asks a
+    # circle that leaves its face through such an edge (verify._circle_leaves_corner): the replay asks it as
+    # recorded, the rule switched off, to see what the hand does with it.
+    import haptic.planning.verify as verify
     from haptic.episode.evaluate import score_components
 
+    monkeypatch.setattr(verify, "_circle_leaves_corner", lambda *args: False)
     failed, results = [], []
     obs = EpisodeObserver(on_move=lambda n, r, *a: results.append(r),
                           on_failed_move=lambda n, r: (failed.append(r), results.append(r)))  # fmt: skip
@@ -689,13 +693,19 @@ def test_a_verification_going_round_one_way_takes_another(tmp_path):
                                   models=_sized_corpus(tmp_path)))  # fmt: skip
     assert rec.outcome == "recognized" and rec.correct, rec.detail
 
-def test_a_roll_at_an_edges_end_with_the_next_face_out_of_reach_reports_no_edge(tmp_path):
+def test_a_roll_at_an_edges_end_with_the_next_face_out_of_reach_reports_no_edge(tmp_path, monkeypatch):
     # HEXPRISM01 at 30 mm, seed 2 (perception_report.py --sizes 30 --first-seed 2): a face move rolled over an edge
     # whose next face leant out of reach with the pad's centre 0.2-0.5 mm past the edge's end; the edge's direction,
     # the axis the rolling normals turned about, took in their turn round the vertex and lay 2.1° off (2.1 bounds),
     # and the episode ended no-match. Following the ridge from the roll meets that vertex at once: no edge. A later
     # roll ended 0.2 mm from a vertex too (its axis 5.8° off, 5.4 bounds), but the ridge was followed 4 mm away from
     # the vertex first and the vertex's distance taken from there (3.8 mm): it is measured from where the roll ended.
+    # The roll that fails so came from a verification face move predicted to meet its edge at 0.9°, which the
+    # verification on the hand now leaves out unless nothing else is left (verify.GRAZING; the episode then ends as
+    # before, one vertex unmeasured, with a failed move less): the replay asks it as recorded, the rule switched off.
+    import haptic.planning.verify as verify
+
+    monkeypatch.setattr(verify, "_grazing", lambda *args: False)
     failed = []
     spec = EpisodeSpec(model="HEXPRISM01", seed=2, executor="physics", models=_scaled_library(tmp_path, 0.03))
     ep = build_episode(spec)
