@@ -751,37 +751,49 @@ def _grazing(h: Hypothesis, move: Move, after: Hypothesis, end: SensorState) -> 
 def _circle_leaves_corner(h: Hypothesis, move: VertexMove, state: SensorState, config: PlannerConfig) -> bool:
     """Whether vertex ``move``'s circle (:attr:`~haptic.planning.config.PlannerConfig.vertex_radius` round the model
     vertex the sensor is at, in hypothesis ``h``) leaves the model face it crosses before it meets that face's other
-    edge at the vertex: an edge of the face that does not leave the vertex comes nearer the vertex than the circle
-    (a face convex there lies within its corner, so the circle stays on it otherwise). The hand's circle then meets
-    that edge -- "the edge met passes 2.7 mm from the vertex circled" on the kites of trapezohedron_12 at 60 mm
-    (seed 2), asked round vertex after vertex -- or rolls past the end of a short edge round the vertex there (all
-    five such circles of trapezohedron_09 of the formula corpus, seed 1, their kites' edges 7.3 mm). False when the
-    vertex or the face is not matched."""
+    edge at the vertex (:func:`arc_leaves_face`): the hand's circle then meets an edge that does not leave the
+    vertex -- "the edge met passes 2.7 mm from the vertex circled" on the kites of trapezohedron_12 at 60 mm (seed
+    2), asked round vertex after vertex -- or rolls past the end of a short edge round the vertex there (all five
+    such circles of trapezohedron_09 of the formula corpus, seed 1, their kites' edges 7.3 mm). False when the
+    vertex or the face is not matched, or the face has no corner at the vertex."""
     v_m = h.vertices.get(state.vertex) if state.vertex is not None else None
     a_m = h.faces.get(move.across_face)
-    if v_m is None or a_m is None:
+    if v_m is None or a_m is None or int(v_m) not in h.poly.faces[a_m]:
         return False
-    return corner_reach(h.poly, int(v_m), int(a_m)) < config.vertex_radius
+    return arc_leaves_face(h.poly, int(v_m), int(a_m), config.vertex_radius)
 
 
-_REACH: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+_ARCS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+ARC_SAMPLES = 24
+"""Points along a vertex circle's arc checked to lie on its face (:func:`arc_leaves_face`)."""
 
 
-def corner_reach(poly: Polyhedron, v: int, f: int) -> float:
-    """How far face ``f`` of ``poly`` reaches from its vertex ``v``: the least distance from ``v`` to an edge of the
-    face that does not leave ``v`` [m] (computed once per model, face and vertex)."""
-    cache = _REACH.setdefault(poly, {})
-    if (v, f) not in cache:
+def arc_leaves_face(poly: Polyhedron, v: int, f: int, radius: float) -> bool:
+    """Whether the arc of ``radius`` round vertex ``v`` of ``poly`` across face ``f``, from one of the face's edges
+    at ``v`` to the other through the face's corner there, leaves the face: a point of it (of
+    :data:`ARC_SAMPLES`) lies outside the face's polygon, past an edge that does not leave ``v``, or an edge of the
+    face at ``v`` is shorter than ``radius`` (the arc ends past its far end). Computed once per model, vertex, face
+    and radius."""
+    from haptic.geometry.se3 import plane_basis
+    from haptic.geometry.tracing import corner_angle, inside_polygon
+
+    cache = _ARCS.setdefault(poly, {})
+    key = (v, f, float(radius))
+    if key not in cache:
         loop = [int(x) for x in poly.faces[f]]
-        p, out = poly.vertices[v], np.inf
-        for a, b in zip(loop, loop[1:] + loop[:1], strict=True):
-            if v in (a, b):
-                continue
-            pa, ab = poly.vertices[a], poly.vertices[b] - poly.vertices[a]
-            t = float(np.clip((p - pa) @ ab / max(float(ab @ ab), 1e-18), 0.0, 1.0))
-            out = min(out, float(np.linalg.norm(pa + t * ab - p)))
-        cache[(v, f)] = out
-    return cache[(v, f)]
+        k = loop.index(v)
+        n, p = poly.face_normals[f], poly.vertices[v]
+        u = poly.vertices[loop[(k + 1) % len(loop)]] - p
+        u = u / max(float(np.linalg.norm(u)), 1e-18)
+        # the loop runs counter-clockwise about the normal: the corner turns from the next vertex to the previous
+        theta = corner_angle(poly, f, v) * (np.arange(1, ARC_SAMPLES + 1) / (ARC_SAMPLES + 1))
+        pts = p + radius * (np.cos(theta)[:, None] * u + np.sin(theta)[:, None] * np.cross(n, u))
+        a, b = plane_basis(n)
+        poly2 = np.column_stack([poly.vertices[loop] @ a, poly.vertices[loop] @ b])
+        ends = (poly.vertices[loop[k - 1]], poly.vertices[loop[(k + 1) % len(loop)]])
+        short = any(float(np.linalg.norm(q - p)) < radius for q in ends)  # the arc ends past that edge's far end
+        cache[key] = short or not all(inside_polygon(np.array([q @ a, q @ b]), poly2) for q in pts)
+    return cache[key]
 
 
 def _crossing(h: Hypothesis, state: SensorState, after: Hypothesis, end: SensorState) -> tuple[int, int] | None:

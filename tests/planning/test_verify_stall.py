@@ -7,7 +7,7 @@ import dataclasses
 import numpy as np
 
 from haptic.executor.geometric import GeometricExecutor
-from haptic.geometry import SE3, load_library
+from haptic.geometry import SE3, Polyhedron, load_library
 from haptic.matching.acceptance import Coverage
 from haptic.matching.components import SensorNoise
 from haptic.planning.config import PlannerConfig
@@ -168,10 +168,21 @@ def test_a_vertex_circle_that_leaves_its_face_through_another_edge_is_not_asked_
     v = h.vertices[state.vertex]
     config = dataclasses.replace(HAND, table_z=-1.0)  # a table far below: the hand's rules, nothing in the way
     kites = [h.faces[f] for f in state.edge_faces]
-    assert all(verify.corner_reach(poly, v, f) < config.vertex_radius for f in kites)
+    assert all(verify.arc_leaves_face(poly, v, f, config.vertex_radius) for f in kites)
     assert all(verify._circle_leaves_corner(h, VertexMove(f), state, config) for f in state.edge_faces)
     wide = scaled_to(solid, 0.15, "trapezohedron_12")
-    assert all(verify.corner_reach(wide, v, f) > config.vertex_radius for f in kites)
+    assert not any(verify.arc_leaves_face(wide, v, f, config.vertex_radius) for f in kites)
+    # an L-shaped face, its legs 10 mm wide and 30 mm long: the circle stays on it round its outer corner and round
+    # its reflex corner (through 270 degrees), and leaves it round the end of a leg whose end edge is 10 mm long
+    # at a radius of 12 mm
+    ell = Polyhedron.from_faces(0.01 * np.array([[0, 0, 0], [3, 0, 0], [3, 1, 0], [1, 1, 0], [1, 3, 0],
+                                                 [0, 3, 0], [0, 0, -1], [3, 0, -1], [3, 1, -1], [1, 1, -1],
+                                                 [1, 3, -1], [0, 3, -1]]),
+                                [[0, 1, 2, 3, 4, 5], [11, 10, 9, 8, 7, 6], [0, 6, 7, 1], [1, 7, 8, 2], [2, 8, 9, 3],
+                                 [3, 9, 10, 4], [4, 10, 11, 5], [5, 11, 6, 0]])  # fmt: skip
+    top = int(np.argmax(ell.face_normals[:, 2]))
+    assert not verify.arc_leaves_face(ell, 0, top, 0.008) and not verify.arc_leaves_face(ell, 3, top, 0.008)
+    assert verify.arc_leaves_face(ell, 1, top, 0.012)
     missing = (frozenset(), frozenset(), frozenset(range(poly.n_vertices)) - set(h.vertices.values()))
     noise = SensorNoise().scaled(0.0)
     chosen = plan_verification_move(h, state, comps, missing, noise, config)[0]
