@@ -204,21 +204,26 @@ def test_a_concave_edge_whose_end_the_pad_rolls_past_reports_no_vertex(tmp_path,
     assert _within_bounds(ep)
 
 
-def test_a_face_move_that_rolls_round_a_vertex_reports_no_edge(tmp_path):
+def test_a_face_move_that_rolls_round_a_vertex_reports_no_edge(tmp_path, monkeypatch):
     # bipyramid_06 of the formula corpus at 60 mm across, seed 1 when found (perception_report.py --corpus
     # --sizes 60; the seed has changed with the trajectories since: steady rows, the undercut limits, the
     # verification's aim at a vertex): a face
     # move rolled round the apex onto a face sharing no edge with the first; the "edge" reported between them
     # (n_a × n_b through the apex) lay 36 mm off every true edge (48 bounds) and the episode ended no-match.
     # The rolling normals leaned along that line more than the noise allows: no edge is reported (the move
-    # then crosses again inside the edge, or fails).
+    # then crosses again inside the edge, or fails). The verification on the hand now leaves such a move out
+    # unless nothing else is left (it meets its edge at a glancing angle, verify.GRAZING): the replay asks it as
+    # recorded, the rule switched off, to see what the hand does with it.
+    import haptic.planning.verify as verify
+
+    monkeypatch.setattr(verify, "_grazing", lambda *args: False)
     ep, failed, results = _replay(tmp_path, "bipyramid_06", 0.06, 11, corpus=True, seed=1)
     said = [r.reason for r in failed] + [x for r in results for x in (r.info or {}).get("recoveries", ())]
     assert any("more than the noise allows" in x for x in said), said
     assert _within_bounds(ep)
 
 
-def test_a_verification_face_move_round_a_vertex_along_the_arc_reports_no_edge(tmp_path):
+def test_a_verification_face_move_round_a_vertex_along_the_arc_reports_no_edge(tmp_path, monkeypatch):
     # antiprism_04 of the formula corpus at 150 mm, seed 1 (perception_report.py --corpus --sizes 150): a
     # verification face move rolled round a vertex onto a face sharing only that vertex with the first, its normals
     # following the arc between the faces' closely (their median lean 0.84°, under the noise's 1.74°); the "edge"
@@ -226,6 +231,11 @@ def test_a_verification_face_move_round_a_vertex_along_the_arc_reports_no_edge(t
     # 0.55° to one side on average (true edges: at most 0.34° over 30 rolls): no edge between the faces. (Since the
     # segmentation picks a face's rows about its own normal and a square crossing follows the ridge first, this
     # episode's rolls round the vertex lean more than the noise allows at once, not only on average: either is told.)
+    # The verification on the hand now leaves such a move out unless nothing else is left (it meets its edge at a
+    # glancing angle, verify.GRAZING): the replay asks it as recorded, the rule switched off.
+    import haptic.planning.verify as verify
+
+    monkeypatch.setattr(verify, "_grazing", lambda *args: False)
     ep, failed, _ = _replay(tmp_path, "antiprism_04", 0.15, 6, corpus=True, seed=1)
     assert any("(a roll round a vertex)" in r.reason for r in failed), [r.reason for r in failed]
     assert _within_bounds(ep)
@@ -336,15 +346,19 @@ def test_a_vertex_move_whose_circle_meets_an_edge_of_another_vertex_reports_no_e
     assert score_components(ep.executor.components, ep.true_model, ep.world_from_model, results).missed == 0
 
 
-def test_a_vertex_move_whose_circle_meets_an_edge_near_the_vertex_circled_reports_no_edge(tmp_path):
+def test_a_vertex_move_whose_circle_meets_an_edge_near_the_vertex_circled_reports_no_edge(tmp_path, monkeypatch):
     # trapezohedron_10 of the formula corpus at 30 mm, seed 2 (perception_report.py --corpus --sizes 30 --first-seed
     # 2): circling a vertex across a kite whose edge from it is 4.2 mm long, inside the 8 mm circle, the pad met the
     # kite's next edge, which leaves another vertex and passes 1.9 mm from the one circled. The vertex's and the
     # line's bounds added up (1.2 + 0.75 mm) let it through although each was 0.15 mm off: the edge was reported
     # adjacent to the vertex and the tree pruned the truth (no-match after 7 moves). Independent estimates, their
-    # bounds add in quadrature (1.4 mm): the move reports nothing.
+    # bounds add in quadrature (1.4 mm): the move reports nothing. The verification on the hand no longer asks a
+    # circle that leaves its face through such an edge (verify._circle_leaves_corner): the replay asks it as
+    # recorded, the rule switched off, to see what the hand does with it.
+    import haptic.planning.verify as verify
     from haptic.episode.evaluate import score_components
 
+    monkeypatch.setattr(verify, "_circle_leaves_corner", lambda *args: False)
     failed, results = [], []
     obs = EpisodeObserver(on_move=lambda n, r, *a: results.append(r),
                           on_failed_move=lambda n, r: (failed.append(r), results.append(r)))  # fmt: skip
@@ -550,11 +564,17 @@ def test_a_stroke_leg_that_a_finger_link_stopped_does_not_measure_the_face(tmp_p
     assert max(r.ratio for r in ratios if r.what == "face normal") <= 1.0
 
 
-def test_a_next_face_met_near_its_end_is_touched_again_along_the_edge():
+def test_a_next_face_met_near_its_end_is_touched_again_along_the_edge(monkeypatch):
     # BOX01 seed 2: after an edge move to a top vertex, a face move across a side 4 mm under its top edge crossed
     # the vertical edge next to the vertex; the stroke on the next face rode the top rim, and so did every touch of
     # it afresh, their normals leaning 8° up along the edge: "too few contacts on the next face", the move failed.
     # The face touched past the edge but measured too little is touched again 7 mm down the edge, clear of its end.
+    # That move was predicted to meet its edge at 4.6°, and the verification on the hand now leaves such a move out
+    # unless nothing else is left (verify.GRAZING; the episode is then recognized with no failed move either way):
+    # the replay asks it as recorded, the rule switched off, to see what the hand does with it.
+    import haptic.planning.verify as verify
+
+    monkeypatch.setattr(verify, "_grazing", lambda *args: False)
     results = []
     obs = EpisodeObserver(on_move=lambda n, r, *a: results.append(r), on_failed_move=lambda n, r: results.append(r))
     ep = build_episode(EpisodeSpec(model="BOX01", seed=2, executor="physics", verify="full"))
@@ -673,13 +693,19 @@ def test_a_verification_going_round_one_way_takes_another(tmp_path):
                                   models=_sized_corpus(tmp_path)))  # fmt: skip
     assert rec.outcome == "recognized" and rec.correct, rec.detail
 
-def test_a_roll_at_an_edges_end_with_the_next_face_out_of_reach_reports_no_edge(tmp_path):
+def test_a_roll_at_an_edges_end_with_the_next_face_out_of_reach_reports_no_edge(tmp_path, monkeypatch):
     # HEXPRISM01 at 30 mm, seed 2 (perception_report.py --sizes 30 --first-seed 2): a face move rolled over an edge
     # whose next face leant out of reach with the pad's centre 0.2-0.5 mm past the edge's end; the edge's direction,
     # the axis the rolling normals turned about, took in their turn round the vertex and lay 2.1° off (2.1 bounds),
     # and the episode ended no-match. Following the ridge from the roll meets that vertex at once: no edge. A later
     # roll ended 0.2 mm from a vertex too (its axis 5.8° off, 5.4 bounds), but the ridge was followed 4 mm away from
     # the vertex first and the vertex's distance taken from there (3.8 mm): it is measured from where the roll ended.
+    # The roll that fails so came from a verification face move predicted to meet its edge at 0.9°, which the
+    # verification on the hand now leaves out unless nothing else is left (verify.GRAZING; the episode then ends as
+    # before, one vertex unmeasured, with a failed move less): the replay asks it as recorded, the rule switched off.
+    import haptic.planning.verify as verify
+
+    monkeypatch.setattr(verify, "_grazing", lambda *args: False)
     failed = []
     spec = EpisodeSpec(model="HEXPRISM01", seed=2, executor="physics", models=_scaled_library(tmp_path, 0.03))
     ep = build_episode(spec)
