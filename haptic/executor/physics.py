@@ -80,6 +80,10 @@ the finger held back in a slot (BOX01N seed 1), no vertex's doing; crossed again
 episode went on to fail four moves in a row at the slot (with ``--verify none``, recognised without it)."""
 
 
+FROM_TOUCHED = ", from where the face was touched"
+"""Said of a crossing made again from a point the face was touched at, its start beside the first lying off the face."""
+
+
 TOUCH_PHASES = ("face", "circle")
 """Trace phases whose contacts count as touches: the pad sliding on one face (rolling over an edge, or resting
 on an edge or a vertex, it may touch two faces at once, and the sensed point is their mean)."""
@@ -218,6 +222,13 @@ class PhysicsSettings:
     """A face move whose crossing found no next face crosses again shifted square to its travel, to the side away
     from the vertex the roll went round, when the edge's way from that vertex has at least this component there
     [-]."""
+    recrosses: int = 2
+    """A face move crosses again at most this many times (a crossing made again may roll round the vertex too, less
+    far from it) [-]."""
+    recross_slant: float = math.radians(60.0)
+    """A crossing made again from a point the face was touched at (the start beside the first crossing off the face,
+    on a face narrowing to a vertex) heads at least this far from along the edge: at 30° such a slanted crossing
+    measured the next face 1.03 bounds off (bipyramid_06 of the formula corpus at 60 mm, seed 1) [rad]."""
     circle_recross: float = 0.024
     """A vertex move whose circle's roll went round the end of the edge it met crosses again so (``recross_shift``,
     ``recross_back``), sliding at most this far to the edge [m]."""
@@ -730,22 +741,23 @@ class PhysicsExecutor(LandingSearch):
         status = self._ensure_on_face(st.face, pieces)
         if status != "ok":
             return self.failed_result(move, status, f"could not return to the current face: {self._why}")
-        recrossed = tilted = levelled = False
+        recrosses, tilted, levelled = 0, False, False
         lead = 0.0
+        heading = inplane  # crossed again from a point the face was touched at, the slide heads from there
         while True:
-            r = t.trace_face(inplane, n_a, self.settings.max_face_trace)
+            r = t.trace_face(heading, n_a, self.settings.max_face_trace)
             pieces.append(r)
-            level = level_heading(inplane, n_a) if r.event == "table" and not levelled else None
+            level = level_heading(heading, n_a) if r.event == "table" and not levelled else None
             if level is not None:
                 # the slide heading down came within the pad's reach of the table before any edge: it goes on across
                 # the face nearly level, toward the side it was heading, to the edge there (the planner predicts so)
-                levelled, inplane, lead = True, level, r.distance
+                levelled, heading, lead = True, level, r.distance
                 self.recoveries.append("the finger would meet the table before an edge: the slide went on level")
-                r = t.trace_face(inplane, n_a, self.settings.max_face_trace)
+                r = t.trace_face(heading, n_a, self.settings.max_face_trace)
                 pieces.append(r)
             if r.event == "hand":
                 why = f"trace across the face: the finger's {r.info['link']} met the object"
-                if tilted or not self._tilt_away(r, st.face, self._last_on(r.trace, st.face, inplane), pieces):
+                if tilted or not self._tilt_away(r, st.face, self._last_on(r.trace, st.face, heading), pieces):
                     return self.failed_result(move, r, why)
                 tilted = True
                 continue
@@ -764,24 +776,26 @@ class PhysicsExecutor(LandingSearch):
                 return self._edge_only(move, r, roll, reason, pieces)
             if status == "hand" and not tilted:
                 tilted = True
-                if self._tilt_away(self._met, st.face, corner - self.settings.recross_back * inplane, pieces):
+                if self._tilt_away(self._met, st.face, corner - self.settings.recross_back * heading, pieces):
                     continue
-            if status != "ok" and not recrossed and reason.startswith(NEXT_FACE_LOST) and self._past_spread():
+            if status != "ok" and not recrosses and reason.startswith(NEXT_FACE_LOST) and self._past_spread():
                 # the pad rolled over the edge and touched no one face past it: met near the edge's end, it rolled
                 # round the vertex onto the rims of the faces there. Cross again beside the first crossing, on the
                 # side away from that vertex, as after a roll that gave no edge
-                recrossed = True
-                shift = self._shift_from_roll(r.info["face_normal"], inplane, self._roll)
+                recrosses += 1
+                shift = self._shift_from_roll(r.info["face_normal"], heading, self._roll)
                 if shift is not None:  # as far back as aside: inside the face however the edge slants; nearer
                     # the edge when that would put the pad by the table
                     back = self.settings.recross_back + float(np.linalg.norm(shift))
-                    start = corner - back * inplane + shift
-                    if self.workspace.pad_clearance(start, n_a) < self.settings.pad_clearance:
-                        start = corner - self.settings.recross_back * inplane + shift
-                if shift is not None and self._touch_face(st.face, n_a, start, pieces) == "ok":
-                    self.recoveries.append(f"{reason}: crossed again {np.linalg.norm(shift) * 1000:.0f} mm aside, "
-                                           "away from the vertex")  # fmt: skip
-                    continue
+                    if self.workspace.pad_clearance(corner - back * heading + shift, n_a) < self.settings.pad_clearance:
+                        back = self.settings.recross_back
+                    way = self._recross_start(st.face, n_a, corner, heading, shift, back, r.trace, pieces)
+                    if way is not None:
+                        where = "" if way is heading else FROM_TOUCHED
+                        self.recoveries.append(f"{reason}: crossed again {np.linalg.norm(shift) * 1000:.0f} mm aside, "
+                                               f"away from the vertex{where}")  # fmt: skip
+                        heading = way
+                        continue
             if status != "ok":
                 return self.failed_result(move, status, reason)
             fit_a, line, why = self._edge_between(st.face, r.trace, "face", roll, fit_b, kind, corner)
@@ -797,15 +811,19 @@ class PhysicsExecutor(LandingSearch):
                     line, why = None, f"no edge between the faces: {ridge}"
             if line is not None:
                 break
-            shift = self._away_from_vertex(fit_a.normal, fit_b.normal, roll) if not recrossed else None
-            recrossed = True
+            shift = self._away_from_vertex(fit_a.normal, fit_b.normal, roll) if recrosses < self.settings.recrosses \
+                else None
+            recrosses += 1
             if shift is None:
                 return self.failed_result(move, "unreachable", why)
             # the roll went round the edge's end: cross again farther along the edge, inside it
-            start = corner - self.settings.recross_back * inplane + shift
-            if self._touch_face(st.face, n_a, start, pieces) != "ok":
+            way = self._recross_start(st.face, n_a, corner, heading, shift, self.settings.recross_back, r.trace,
+                                      pieces)  # fmt: skip
+            if way is None:
                 return self.failed_result(move, "unreachable", why)
-            self.recoveries.append(f"{why}: crossed again {np.linalg.norm(shift) * 1000:.0f} mm along the edge")
+            self.recoveries.append(f"{why}: crossed again {np.linalg.norm(shift) * 1000:.0f} mm along the edge"
+                                   f"{'' if way is heading else FROM_TOUCHED}")  # fmt: skip
+            heading = way
         new_face = seg.next_id + 1
         edge = seg.add_edge(line, (st.face, new_face), kind == "convex", (fit_a.normal, fit_b.normal),
                             adjacent=(st.face,))  # fmt: skip
@@ -826,6 +844,57 @@ class PhysicsExecutor(LandingSearch):
         ok = np.flatnonzero(nn @ n > math.cos(self.bounds.face_cone))
         last = trace.point_in_world[ok[-1]] if len(ok) else self._faces[fid].anchor
         return last - self.settings.recross_back * d
+
+    def _recross_start(self, fid: int, n: np.ndarray, corner: np.ndarray, heading: np.ndarray, shift: np.ndarray,
+                       back: float, trace: ContactTrace, pieces: list[PrimitiveResult]) -> np.ndarray | None:
+        """Put the pad on data face ``fid`` (normal ``n``) to cross its edge again at ``corner + shift`` (``shift``
+        along the edge, away from the vertex the first crossing rolled round): ``back`` before that point against
+        ``heading``; else, that start lying off the face (a face narrowing to the vertex: the pad touched a normal
+        turned off it), at the point the face was touched at (``trace``'s rows on it, then its stored contacts; that
+        point and the crossing beyond the pad's radius from a concave edge of the face) nearest that start from which
+        the way to the new crossing runs at least ``recross_back`` over the face and
+        :attr:`PhysicsSettings.recross_slant` from along the edge. Returns the heading of the slide to cross again
+        (``heading``, or the way from that point), or None when the pad rests on neither (the reason in
+        ``self._why``)."""
+        s = self.settings
+        target = corner + shift
+        # summed as the plain crossing again sums it: a start a few ulps apart may end a slide millimetres apart, and
+        # the episode's later moves with it
+        start = corner - back * heading + shift
+        status = self._touch_face(fid, n, start, pieces)
+        if status == "ok":
+            return heading
+        if status == "unstable" or self._why.startswith("the touch would put the pad on the table"):
+            return None
+        e = unit(shift)
+        across = heading - float(heading @ e) * e
+        if float(across @ across) < OPPOSED:
+            return None
+        across = unit(across)
+        ok = trace.in_contact & (np.where(trace.in_contact[:, None], trace.normal_in_world, 0.0) @ n
+                                 > math.cos(self.bounds.row_cone))  # fmt: skip
+        known = np.vstack([trace.point_in_world[ok], self._faces[fid].points]) if fid in self._faces \
+            else trace.point_in_world[ok]
+        # neither from nor toward a concave corner of the face: a slide there meets the face across first
+        for rec in self.segmenter.edges.values():
+            if not rec.convex and fid in rec.faces and len(known):
+                rel = np.vstack([known, target]) - rec.point
+                off = np.linalg.norm(rel - np.outer(rel @ rec.direction, rec.direction), axis=1)
+                if off[-1] < self.toucher.pad_radius:
+                    return None
+                known = known[off[:-1] >= self.toucher.pad_radius]
+        if not len(known):
+            return None
+        way = target - known
+        way -= np.outer(way @ n, n)
+        dist = np.linalg.norm(way, axis=1)
+        fit = (dist >= s.recross_back) & (way @ across >= math.sin(s.recross_slant) * dist)
+        if not fit.any():
+            return None
+        i = int(np.flatnonzero(fit)[np.argmin(np.linalg.norm(known[fit] - start, axis=1))])
+        if self._touch_face(fid, n, known[i], pieces) != "ok":
+            return None
+        return way[i] / dist[i]
 
     def _past_spread(self) -> bool:
         """Whether the last crossing's touches afresh past the edge met no one face: none touched, or normals more
@@ -855,11 +924,7 @@ class PhysicsExecutor(LandingSearch):
         if roll is None or not roll.in_contact.any() or float(side @ side) < OPPOSED:
             return None
         side = unit(side)
-        n = roll.normal_in_world[roll.in_contact]
-        k = self.bounds.steady_window
-        turned = np.flatnonzero(n @ n_a < math.cos(2.0 * self.toucher.config.edge_angle))
-        i = int(turned[0]) if len(turned) else len(n) - k
-        n_b = unit(n[max(0, i):i + k].sum(axis=0))
+        n_b = self._first_turn(n_a, roll)
         e = np.cross(n_a, n_b)
         if float(e @ e) < math.sin(self.bounds.min_edge_angle) ** 2:
             return None
@@ -867,6 +932,16 @@ class PhysicsExecutor(LandingSearch):
         if away is None or abs(float(unit(away) @ side)) < self.settings.recross_side_cos:
             return None
         return math.copysign(self.settings.recross_shift + self.toucher.pad_radius, float(away @ side)) * side
+
+    def _first_turn(self, n_a: np.ndarray, roll: ContactTrace) -> np.ndarray:
+        """The normal a roll (in contact somewhere) off face ``n_a`` first turned to: the mean of its normals where they
+        first turned twice the edge angle from ``n_a`` (else of its last), which stands for the next face's over the
+        edge the pad met, whatever it rolled on to round a vertex."""
+        n = roll.normal_in_world[roll.in_contact]
+        k = self.bounds.steady_window
+        turned = np.flatnonzero(n @ n_a < math.cos(2.0 * self.toucher.config.edge_angle))
+        i = int(turned[0]) if len(turned) else len(n) - k
+        return unit(n[max(0, i):i + k].sum(axis=0))
 
     def _away_from_vertex(self, n_a: np.ndarray, n_b: np.ndarray, roll: ContactTrace) -> np.ndarray | None:
         """After a roll whose normals leaned along the edge between faces ``n_a`` and ``n_b`` (the pad rolled
@@ -1319,16 +1394,31 @@ class PhysicsExecutor(LandingSearch):
                 tilted = True
                 if self._tilt_away(self._met, f, p0, pieces):
                     continue
+            if status != "ok" and reason.startswith(NEXT_FACE_LOST):
+                # the circle met the edge where the face past it is too narrow for the pad (an acute corner at the
+                # vertex): crossed again farther out along the edge, away from the vertex
+                shift = self._outward(n_f, self._roll, corner, vtx)
+                again = None if shift is None else self._circle_crossed_again(
+                    f, n_f, r.info["direction"], corner, shift, vtx, r.trace, pieces)
+                if again is None:
+                    return self.failed_result(move, status, reason)
+                _, kind, roll, stroke, fit_g, fit_f, line, shifted, touched = again
+                self.recoveries.append(f"{reason}: crossed again {shifted * MM:.0f} mm out along the edge"
+                                       f"{FROM_TOUCHED if touched else ''}")  # fmt: skip
+                break
             if status != "ok":
                 return self.failed_result(move, status, reason)
+            fit_f, line, why = self._edge_between(f, r.trace, "circle", roll, fit_g, kind, corner)
             break
-        fit_f, line, why = self._edge_between(f, r.trace, "circle", roll, fit_g, kind, corner)
         if line is None:
-            again = self._circle_crossed_again(f, n_f, r.info["direction"], corner, roll, fit_f, fit_g, vtx, pieces)
+            shift = self._away_from_vertex(fit_f.normal, fit_g.normal, roll)
+            again = None if shift is None else self._circle_crossed_again(
+                f, n_f, r.info["direction"], corner, shift, vtx, r.trace, pieces)
             if again is None:
                 return self.failed_result(move, "unreachable", why)
-            _, kind, roll, stroke, fit_g, fit_f, line, shifted = again
-            self.recoveries.append(f"{why}: crossed again {shifted * MM:.0f} mm along the edge")
+            _, kind, roll, stroke, fit_g, fit_f, line, shifted, touched = again
+            self.recoveries.append(f"{why}: crossed again {shifted * MM:.0f} mm along the edge"
+                                   f"{FROM_TOUCHED if touched else ''}")  # fmt: skip
         new_face = seg.next_id + 1
         s_vtx = float((vtx - line.point) @ line.direction)
         b = self.bounds
@@ -1354,24 +1444,43 @@ class PhysicsExecutor(LandingSearch):
         return MoveResult(move=move, status="ok", components=(edge, face), distance=r.distance,
                           cost=self.costs.vertex_move(r.distance), state=self.state, info={"kind": kind})  # fmt: skip
 
+    def _outward(self, n_f: np.ndarray, roll: ContactTrace | None, corner: np.ndarray, vtx: np.ndarray
+                 ) -> np.ndarray | None:  # fmt: skip
+        """After a vertex circle on face ``n_f`` round ``vtx`` that rolled over an edge at ``corner`` and found too
+        little of the face past it: the shift along that edge (its direction from the roll's first turn,
+        :meth:`_first_turn`) away from the vertex, ``recross_shift`` plus half the pad's radius; None when the roll
+        tells no edge."""
+        if roll is None or not roll.in_contact.any():
+            return None
+        e = np.cross(n_f, self._first_turn(n_f, roll))
+        if float(e @ e) < math.sin(self.bounds.min_edge_angle) ** 2:
+            return None
+        e = unit(e)
+        out = float((corner - vtx) @ e)
+        return math.copysign(self.settings.recross_shift + 0.5 * self.toucher.pad_radius, out) * e
+
     def _circle_crossed_again(self, f: int, n_f: np.ndarray, direction: np.ndarray, corner: np.ndarray,
-                              roll: ContactTrace, fit_f: FaceFit, fit_g: FaceFit, vtx: np.ndarray,
+                              shift: np.ndarray, vtx: np.ndarray, circle: ContactTrace,
                               pieces: list[PrimitiveResult]):  # fmt: skip
         """After a vertex circle whose roll leaned along the edge between face ``f`` and the next face (the pad
-        rolled round an end of the edge met), as a face move does: touch face ``f`` again ``recross_back`` before
-        where the circle met the edge and shifted along it back inside (:meth:`_away_from_vertex`), slide on along
-        the circle's heading there (``direction``) to the edge, over it and onto the next face. Returns (the slide,
-        kind, roll, stroke, next face's fit, face ``f``'s fit, the line, the shift [m]), or None when it gives no
-        edge."""
+        rolled round an end of the edge met), or found too little of the face past it, as a face move does: touch
+        face ``f`` again ``recross_back`` before where the circle met the edge and ``shift`` along it (back inside,
+        :meth:`_away_from_vertex`, or out from the vertex, :meth:`_outward`), slide on along the circle's heading
+        there (``direction``) to the edge, over it and onto the next face; that start off the face, from a point the
+        circle (``circle``) or earlier moves touched it at (:meth:`_recross_start`). Returns (the slide, kind, roll,
+        stroke, next face's fit, face ``f``'s fit, the line, the shift [m], whether it set off from such a point), or
+        None when it gives no edge."""
         t, s = self.toucher, self.settings
-        shift = self._away_from_vertex(fit_f.normal, fit_g.normal, roll)
         d = in_plane(np.asarray(direction, dtype=float), n_f)
-        if shift is None or d is None:
+        if d is None:
             return None
-        start = corner - s.recross_back * d + shift
-        if self._touch_face(f, n_f, start, pieces) != "ok":
+        way = self._recross_start(f, n_f, corner, d, shift, s.recross_back, circle, pieces)
+        if way is None:
             return None
-        r = t.trace_face(d, n_f, s.circle_recross)
+        # from a point the face was touched at, the slide runs as far as it is from the new crossing
+        reach = s.circle_recross if way is d else s.circle_recross + float(np.linalg.norm(self.contact_point()
+                                                                                            - corner - shift))
+        r = t.trace_face(way, n_f, reach)
         pieces.append(r)
         if not r.ok or r.event == "done":
             return None
@@ -1383,7 +1492,7 @@ class PhysicsExecutor(LandingSearch):
         fit_f, line, _ = self._edge_between(f, r.trace, "face", roll, fit_g, kind, corner)
         if line is None:
             return None
-        return r, kind, roll, stroke, fit_g, fit_f, line, float(np.linalg.norm(shift))
+        return r, kind, roll, stroke, fit_g, fit_f, line, float(np.linalg.norm(shift)), way is not d
 
     # ------------------------------------------------------------------------------------------ helpers
     def admissible_moves(self, rng: np.random.Generator, n_directions: int = 8) -> list[Move]:
