@@ -177,6 +177,16 @@ class PhysicsSettings:
     plateau's top and the lower top 12 mm apart at 60 mm) [m]."""
     vertex_hold: float = 0.05
     """At the end of an edge the pad presses in place this long before the vertex is located [s]."""
+    rim_hold: float = 0.1
+    """At the end of a concave edge, where the surface fell away, the pad then presses in place this long more,
+    reading its contacts on the faces' rims apart (``PhysicsExecutor._concave_end``) [s] ..."""
+    rim_plane: float = 0.001
+    """... a contact within this of a face's plane is on it (or on its rim) [m] ..."""
+    min_rim_samples: int = 10
+    """... at least this many such contacts per face ..."""
+    rim_tilt: float = math.radians(10.0)
+    """... whose mean normal has turned off the face by more than this (the pad rests on the rim), and the rim
+    crosses the edge's line at more than this [rad]."""
     min_vertex_rows: int = 3
     """The vertex is located from the rows whose normal leans along the edge (at least this many) ..."""
     lost_vertex_rows: int = 5
@@ -1133,12 +1143,12 @@ class PhysicsExecutor(LandingSearch):
         return "ok"
 
     def _edge_move(self, move: EdgeMove, pieces: list[PrimitiveResult]) -> MoveResult:
-        st, t, seg, s = self.state, self.toucher, self.segmenter, self.settings
+        st, t = self.state, self.toucher
         if st.edge is None:
             return self.invalid_result(move, "no current edge: an edge move starts on or near an edge")
         if move.sense not in (1, -1):
             return self.invalid_result(move, f"sense must be +1 or -1, got {move.sense!r}")
-        rec, n_a, n_b, toward_a = self._edge_frame(st.edge)
+        rec = self.segmenter.edges[st.edge]
         if st.vertex is not None and st.vertex in rec.vertices:
             s_v = rec.vertices[st.vertex]
             lo, hi = rec.interval
@@ -1146,13 +1156,42 @@ class PhysicsExecutor(LandingSearch):
                 return self.invalid_result(move, "the sensor is already at the vertex in that sense")
         u = move.sense * rec.direction
         on_clean = t.normal is not None and any(
-            angle(t.normal, seg.faces[f].component.normal) < self.bounds.face_cone for f in rec.faces
+            angle(t.normal, self.segmenter.faces[f].component.normal) < self.bounds.face_cone for f in rec.faces
         )
-        if self.on_face not in rec.faces or self._line_distance(rec, t.tip) > s.edge_reach or not on_clean:
+        if self.on_face not in rec.faces or self._line_distance(rec, t.tip) > self.settings.edge_reach or not on_clean:
             status = self._return_next_to_edge(rec, u, st.face, pieces)
             if status != "ok":
                 return self.failed_result(move, status, self._why)
-        acq = t.follow_edge(u, n_a, n_b, toward_a, 0.0, acquire_only=True)
+        res = self._trace_edge(move, rec, u, pieces)
+        if isinstance(res, MoveResult):
+            return res
+        # the pad set off where the edge is not (past one of its ends, or beside another edge): it returns next to
+        # the edge in the middle of its explored interval, where the edge was sensed, and sets off again from there
+        # (antiprism_12 of the formula corpus: nine moves along one edge each acquired a ridge 2.2-3.0 mm off its line
+        # and failed; trapezohedron_10: six moves set off past the end they ran toward)
+        status, why = res
+        mid = 0.5 * (rec.interval[0] + rec.interval[1])
+        back = self._return_next_to_edge(rec, u, self.on_face if self.on_face in rec.faces else st.face, pieces,
+                                         mid)  # fmt: skip
+        if back != "ok":
+            return self.failed_result(move, status, f"{why}; {self._why}")
+        res = self._trace_edge(move, rec, u, pieces)
+        if isinstance(res, MoveResult):
+            if res.ok:
+                self.recoveries.append(f"{why}: set off again from the middle of the edge's explored interval")
+            return res
+        return self.failed_result(move, res[0], f"{why}; set off again from the middle of the edge's explored "
+                                                f"interval: {res[1]}")  # fmt: skip
+
+    def _trace_edge(self, move: EdgeMove, rec, u: np.ndarray, pieces: list[PrimitiveResult]) -> MoveResult | tuple:
+        """From a pad resting next to edge ``rec``: acquire its ridge, follow it along ``u`` and locate the vertex
+        at its end. The move's result (done, or failed where setting off elsewhere would not help), or (status,
+        reason) when the pad set off where the edge is not: the ridge it acquired lies off the edge's line, or the
+        vertex it located lies behind where it set off."""
+        st, t, seg, s = self.state, self.toucher, self.segmenter, self.settings
+        _, n_a, n_b, toward_a = self._edge_frame(st.edge)
+        ridge = {"concave": not rec.convex, "strict": True}
+        acq = t.follow_edge(u, n_a, n_b, toward_a, 0.0, acquire_only=True, **ridge)
         pieces.append(acq)
         shift = self._off_the_corner(acq, rec) if not acq.ok else None
         if shift is not None:
@@ -1162,7 +1201,7 @@ class PhysicsExecutor(LandingSearch):
                                                pieces, shift)  # fmt: skip
             if status != "ok":
                 return self.failed_result(move, status, f"acquiring the ridge: {acq.event}; {self._why}")
-            acq = t.follow_edge(u, n_a, n_b, toward_a, 0.0, acquire_only=True)
+            acq = t.follow_edge(u, n_a, n_b, toward_a, 0.0, acquire_only=True, **ridge)
             pieces.append(acq)
             if acq.ok:
                 self.recoveries.append("acquiring the ridge, the pad met a face at the edge's end: acquired again "
@@ -1174,10 +1213,9 @@ class PhysicsExecutor(LandingSearch):
         past = max(rec.interval[0] - s_acq, s_acq - rec.interval[1], 0.0)  # the line extrapolated this far
         slack = past * math.sin(self.bounds.bound(rec.direction_sigma, self.bounds.direction_floor))
         if rec.convex and off > s.ridge_offset + slack:
-            return self.failed_result(move, "unreachable", f"the ridge acquired lies {off * MM:.1f} mm off the "
-                                                           "edge's line: another edge")  # fmt: skip
+            return "unreachable", f"the ridge acquired lies {off * MM:.1f} mm off the edge's line: another edge"
         s_from = rec.param(self.contact_point())
-        r = t.follow_edge(u, n_a, n_b, toward_a, s.max_edge_trace)
+        r = t.follow_edge(u, n_a, n_b, toward_a, s.max_edge_trace, **ridge)
         pieces.append(r)
         if not r.ok:
             return self.failed_result(move, r, f"following the edge: {r.event}")
@@ -1189,7 +1227,10 @@ class PhysicsExecutor(LandingSearch):
         hold = t.hold(s.vertex_hold)
         pieces.append(hold)
         rows = ContactTrace.concatenate([r.trace, hold.trace])
-        s_v, s_sigma = self._vertex_param(rec, rows, u, r.info.get("event_sign", 1))
+        if not rec.convex and r.info.get("event_sign", 1) > 0:
+            s_v, s_sigma = self._concave_end(rec, u, pieces)
+        else:
+            s_v, s_sigma = self._vertex_param(rec, rows, u, r.info.get("event_sign", 1))
         if s_v is None:
             why = ("could not locate the vertex (no contact there, a concave edge's end, which its faces run past, "
                    "contacts off the edge's line, on an edge turning little from it, or the pad spanning a gap in the "
@@ -1202,8 +1243,8 @@ class PhysicsExecutor(LandingSearch):
         sign = 1.0 if float(u @ rec.direction) > 0 else -1.0
         back = min(rec.interval[0], s_from) if sign > 0 else max(rec.interval[1], s_from)
         if sign * (s_v - back) < seg.bounds.length_floor:
-            return self.failed_result(move, "unreachable", "the vertex located lies behind the move's start, at the "
-                                                           "edge's other end (the pad set off past it)")  # fmt: skip
+            return "unreachable", "the vertex located lies behind the move's start, at the edge's other end (the pad " \
+                                  "set off past it)"
         # ... nor is it, within its bound, the vertex known at the edge's end behind the move: the pad set off past
         # that end and located it as it came onto the edge (trapezohedron_12 of the formula corpus at 77 mm, seed 1: a
         # move set off 2 mm past one end of a 9 mm edge toward the other and put a vertex 0.3 mm from the end it
@@ -1212,11 +1253,10 @@ class PhysicsExecutor(LandingSearch):
         middle = 0.5 * (rec.interval[0] + rec.interval[1])
         for vid, s_known in rec.vertices.items():
             if sign * (s_known - middle) < 0 and abs(s_v - s_known) <= seg.vertices[vid].position_bound:
-                return self.failed_result(move, "unreachable", "the vertex located is the edge's other end, which the "
-                                                               "move set off past")  # fmt: skip
+                return "unreachable", "the vertex located is the edge's other end, which the move set off past"
         if self._acquired_past(rec, acq.trace, u, s_v):
-            return self.failed_result(move, "unreachable", "the vertex located lies behind where the pad acquired "
-                                                           "the ridge (the pad set off past it)")  # fmt: skip
+            return "unreachable", "the vertex located lies behind where the pad acquired the ridge (the pad set off " \
+                                  "past it)"
         # refine the line with the ridge contacts (convex edges), then extend it to the vertex
         ridge = self._on_ridge(rows, u)
         w_v, w_from = rec.at(s_v), rec.at(s_from)
@@ -1250,6 +1290,59 @@ class PhysicsExecutor(LandingSearch):
         if abs(lean) < math.sin(self.settings.corner_lean):
             return None
         return rec.param(tr.point_in_world[rows[-1]]) + math.copysign(self.toucher.pad_radius, lean)
+
+    def _concave_end(self, rec, u: np.ndarray, pieces: list[PrimitiveResult]) -> tuple[float | None, float]:
+        """Parameter of the end of concave edge ``rec``, and its σ, where the surface fell away as the pad ran along
+        ``u`` in its corner: the pad rests on the rims where the edge's faces end, and the merged contact it senses
+        lies on neither, nor does it stay at the end where the faces' corners there are obtuse (they run on past
+        it, and so do the contacts: FRAME01's hole at 40 mm, 3.6 mm past). Each contact is read apart: one on a
+        face's plane whose normal has turned along ``u`` off the face's lies on the rim, which runs square to that
+        normal within the plane; the rim meets the edge's line at the end. Both faces' rims must be touched and
+        meet the line within the bound of a vertex of one another (a rim elsewhere on a face does not); (None, 0)
+        otherwise."""
+        t, b, s = self.toucher, self.bounds, self.settings
+        got = t.hold_reading(s.rim_hold)
+        pieces.append(got)
+        if not got.ok:
+            return None, 0.0
+        fits = [self._face_fit(f) for f in rec.faces]
+        ends, sigmas = [], []
+        for k, fit in enumerate(fits):
+            other = fits[1 - k]
+            pts, nrm = [], []
+            for tick in got.info["contacts"]:
+                for c in tick:
+                    p, n = c.point_in_world, c.normal_in_world
+                    # on this face's plane and not the other's, its normal turned from this face's the least: a
+                    # shallow corner's faces lie within the tolerance of one another a few millimetres from it
+                    here = abs(float(p @ fit.normal) - fit.offset)
+                    there = abs(float(p @ other.normal) - other.offset)
+                    if here <= s.rim_plane < there and angle(n, fit.normal) < angle(n, other.normal):
+                        pts.append(p)
+                        nrm.append(n)
+            if len(pts) < s.min_rim_samples:
+                return None, 0.0
+            p, n = np.mean(pts, axis=0), unit(np.sum(nrm, axis=0))
+            if angle(n, fit.normal) < s.rim_tilt or float(n @ u) <= 0.0:
+                return None, 0.0  # the pad still rests on the face: it runs on past the end
+            d = unit(np.cross(fit.normal, n))  # the rim, in the face's plane square to the rim contact's normal
+            e = rec.direction
+            cos_ed = float(e @ d)
+            if abs(cos_ed) > math.cos(s.rim_tilt):
+                return None, 0.0
+            w0 = rec.point - p
+            s_e = (cos_ed * float(d @ w0) - float(e @ w0)) / (1.0 - cos_ed * cos_ed)
+            gap = rec.at(s_e) - (p + float((rec.at(s_e) - p) @ d) * d)
+            lever = float(np.linalg.norm(rec.at(s_e) - p))
+            sigma = math.hypot(b.point_sigma, lever * b.normal_sigma / angle(n, fit.normal)) / math.sqrt(len(pts))
+            if float(np.linalg.norm(gap)) > b.bound(rec.position_sigma, b.position_floor) + s.rim_plane:
+                return None, 0.0
+            ends.append(s_e)
+            sigmas.append(sigma)
+        sigma = math.hypot(*sigmas) / 2.0
+        if abs(ends[0] - ends[1]) > b.bound(math.hypot(*sigmas), b.vertex_floor):
+            return None, 0.0
+        return 0.5 * (ends[0] + ends[1]), max(sigma, 0.5 * abs(ends[0] - ends[1]))
 
     @staticmethod
     def _line_distance(rec, w: np.ndarray) -> float:

@@ -811,6 +811,8 @@ class Toucher:
         toward_a: np.ndarray,
         max_distance: float,
         acquire_only: bool = False,
+        concave: bool = False,
+        strict: bool = False,
     ) -> PrimitiveResult:
         """Ridge following: press along the sensed normal, servo sideways to keep it on the bisector of
         ``n_a`` and ``n_b``, move along ``along`` until a vertex (the normal gains a component along the edge
@@ -818,6 +820,17 @@ class Toucher:
         direction that turns the normal towards ``n_a``. With ``acquire_only`` it stops once the normal is on
         the bisector. Contact lost before the normal leaned along the edge (:attr:`TouchConfig.loss_lean_sin`)
         is no vertex: ``no-contact``, event ``lost``.
+
+        ``concave``: the edge is a valley, where the pad rests in the corner against both faces and no sideways
+        motion turns the sensed normal (the force-weighted mean of the two contacts') onto the bisector: pressed
+        sideways toward a face, the pad leaves the other and the normal jumps to the first's, back and forth,
+        never on the bisector long enough to gather speed along the edge (BOX01N seed 2, BOX01P seed 3: upright
+        valleys, the pad rocking in place until the move stalled). In a valley the pad is drawn into the corner
+        instead (sideways along the tangent plane toward the bisector's inside) and rides it whenever it touches.
+        ``strict``: the pad is on the ridge only when the normal lies within half the way from the bisector to
+        either face's normal (:attr:`TouchConfig.ridge_min_cone` at least), not within ``ridge_cone``: beside an
+        edge turning less than twice that cone, a pad resting on either face is within it (hull_07 of the formula
+        corpus: a pad 3 mm in from a shallow edge "acquired" its ridge at once).
 
         ``info``: ``event_sign`` (+1 the surface fell away at the vertex, −1 the finger was blocked)."""
         cfg = self.config
@@ -828,7 +841,9 @@ class Toucher:
         nb_p = unit(n_b - (n_b @ u) * u)
         theta = math.atan2(float(n_a @ m), float(n_a @ nb_p))
         target = 0.5 * theta
+        cone = min(cfg.ridge_cone, max(cfg.ridge_min_cone, 0.5 * abs(target))) if strict else cfg.ridge_cone
         side = unit(toward_a - (toward_a @ u) * u)
+        into = -unit(n_a + n_b) if concave else u  # into a valley's corner
         start = self.tip.copy()
         speed = 0.0 if acquire_only else cfg.edge_speed
         over = 0
@@ -857,7 +872,10 @@ class Toucher:
             lim = cfg.ridge_side_speed
             v_side = max(-lim, min(lim, v_side))
             s_dir = unit(side - float(side @ n) * n)
-            ridge_ok = abs(err) < cfg.ridge_cone
+            ridge_ok = abs(err) < cone
+            if concave:
+                ridge_ok = self.contact[1] is not None
+                v_side, s_dir = cfg.ridge_side_speed, into - float(into @ n) * n
             v = v_side * s_dir + (self.ramp(on_ridge) * speed * u if (ridge_ok or on_ridge > 0) else 0.0 * u)
             self._press(v)
             self.tick("ridge")
@@ -909,6 +927,23 @@ class Toucher:
             if self._ran_away(start):
                 return self._result("unreachable", "runaway", 0.0)
         return self._result("ok", "done", 0.0)
+
+    def hold_reading(self, seconds: float, phase: str = "vertex") -> PrimitiveResult:
+        """:meth:`hold`, reading the pad's contacts every tick each on its own, not merged into one point and normal
+        (a pad resting on two rims at once senses the mean of the two, on neither): ``info["contacts"]``, per tick
+        the tuple of the fingertip's sensed contacts."""
+        self._press(np.zeros(3))
+        start = self.tip.copy()
+        k = self.robot.fingers.index(self.finger)
+        seen = []
+        for _ in range(max(1, int(seconds / self.dt))):
+            self.tick(phase)
+            if self._unhealthy:
+                return self._result("unstable", "nan", 0.0)
+            if self._ran_away(start):
+                return self._result("unreachable", "runaway", 0.0)
+            seen.append(tuple(self.robot.read().contacts[k]))
+        return self._result("ok", "done", 0.0, contacts=seen)
 
     # -- around a vertex ---------------------------------------------------------------------------------------
     def circle_vertex(

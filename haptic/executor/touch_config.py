@@ -105,6 +105,9 @@ class TouchConfig:
     """... plus this [s]."""
     ridge_cone: float = math.radians(8.0)
     """The pad is on the ridge when the normal is within this of the bisector; only then does it move along [rad]."""
+    ridge_min_cone: float = math.radians(2.0)
+    """An edge move's ridge cone is at most half the angle from the bisector to either face's normal, and at least
+    this (a few times the filtered normal's noise) [rad]."""
     ridge_acquired_ticks: int = 10
     """Ticks on the ridge after which acquiring it is done [ticks]."""
     ridge_timeout_slack: float = 3.0
