@@ -1329,6 +1329,10 @@ class PhysicsExecutor(LandingSearch):
                 return self.failed_result(move, "unreachable", why)
             _, kind, roll, stroke, fit_g, fit_f, line, shifted = again
             self.recoveries.append(f"{why}: crossed again {shifted * MM:.0f} mm along the edge")
+        if seg.beside_parallel_face(st.edge, f, fit_g):
+            return self.failed_result(move, "unreachable", "the edge met lies along the current edge's line, the "
+                                                           "next face parallel to its other face: it leaves another "
+                                                           "vertex")  # fmt: skip
         new_face = seg.next_id + 1
         s_vtx = float((vtx - line.point) @ line.direction)
         b = self.bounds

@@ -649,6 +649,22 @@ class Segmenter:
         self.edges[eid] = rec
         return self._emit_edge(eid)
 
+    def beside_parallel_face(self, eid: int, face: int, fit_next: FaceFit) -> bool:
+        """Whether the next face of an edge met from ``face`` (one of edge ``eid``'s faces), fitted as
+        ``fit_next``, is parallel to the edge's other face within their normal bounds. Its edge with ``face`` then
+        lies on edge ``eid``'s line or on one parallel to it: a vertex circle on ``face`` round an end of edge
+        ``eid`` that met it met that edge again past the vertex, or an edge collinear with it across a gap (BOX01N's
+        end face, circled round a corner of its slot's mouth: the top edge beyond the slot), never an edge leaving
+        the vertex circled (two faces of one plane along one line meet at no vertex there)."""
+        rec = self.edges[eid]
+        other = next((g for g in rec.faces if g is not None and g != face), None)
+        if other is None or other not in self.faces:
+            return False
+        b = self.bounds
+        h = self.faces[other].component
+        allowed = math.hypot(h.normal_bound, b.bound(fit_next.normal_sigma, b.normal_floor))
+        return angle_between(h.normal, fit_next.normal) <= allowed
+
     def _emit_edge(self, eid: int) -> DataEdge:
         rec = self.edges[eid]
         b = self.bounds

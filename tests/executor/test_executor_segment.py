@@ -333,3 +333,26 @@ def test_a_faces_position_bound_covers_one_sample_of_the_sensor():
         assert face.position_bound >= b.k * max(b.point_sigma, b.position_floor)
         assert abs(face.position_bound - b.bound(5e-5, max(b.position_floor, b.point_sigma))) < 1e-12
     assert SegmentBounds().point_sigma < SegmentBounds().position_floor
+
+
+def test_a_vertex_circle_meeting_an_edge_to_a_face_parallel_to_the_current_edges_other_face_met_no_edge_of_it():
+    """BOX01N at 30 mm, seed 2 (perception_report.py --sizes 30 --first-seed 2): after an edge move along the end
+    face's top edge to a corner of the slot's mouth, the vertex circle on the end face went round into the slot's
+    gap and met the top edge beyond it, collinear with the edge it had left; that edge was reported adjacent to the
+    vertex circled (every component within its bounds, but a wrong adjacency) and the tree pruned the truth:
+    no-match. Its next face is parallel to the current edge's other face (the top on either side of the slot):
+    such an edge lies on the current edge's line or one parallel to it, never leaves the vertex circled."""
+    seg = Segmenter(SegmentBounds())
+    end, top, wall = np.array([0.0, 1.0, 0.0]), np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0])
+    corner = np.array([0.0105, 0.024, 0.018])
+    f_end = seg.add_face(_plane(end, corner))
+    f_top = seg.add_face(_plane(top, corner))
+    line = LineFit(corner, np.array([-1.0, 0.0, 0.0]), 1e-3, 1e-4, (0.0, 0.0105))
+    edge = seg.add_edge(line, (f_end.id, f_top.id), True, (end, top), adjacent=(f_end.id,))
+    beyond = corner + np.array([0.009, 0.0, 0.0])  # the top past the 9 mm slot
+    assert seg.beside_parallel_face(edge.id, f_end.id, _plane(top, beyond))
+    assert seg.beside_parallel_face(edge.id, f_end.id, _plane(top, corner - np.array([0.0, 0.0, 0.006])))  # floor
+    # the edges that do leave the corner on the end face: down the slot's wall, or a face turning off the top
+    assert not seg.beside_parallel_face(edge.id, f_end.id, _plane(wall, corner))
+    tilted = unit(top + math.tan(math.radians(3.0)) * wall)
+    assert not seg.beside_parallel_face(edge.id, f_end.id, _plane(tilted, beyond))
