@@ -37,6 +37,7 @@ from haptic.executor.segment import (
     Segmenter,
     face_rows,
     fit_face,
+    lean_widened,
     line_from_points,
     steady_rows,
 )
@@ -470,7 +471,7 @@ class PhysicsExecutor(LandingSearch):
         claiming 0.04°, and the edge crossed next 2.3° off, 2.6 bounds)."""
         fd = self._faces[fid]
         b = self.bounds
-        base = fit_face(fd.points, fd.normals, b)
+        base = lean_widened(fit_face(fd.points, fd.normals, b), fd.normals, b)
         if extra is None or not len(extra):
             return base
         n0 = self.segmenter.faces[fid].component.normal
@@ -484,7 +485,8 @@ class PhysicsExecutor(LandingSearch):
         s_extra = b.normal_sigma / math.sqrt(len(nrm))
         if angle(unit(nrm.sum(axis=0)), base.normal) > b.bound(math.hypot(base.normal_sigma, s_extra), b.normal_floor):
             return base
-        return fit_face(np.vstack([fd.points, extra.point_in_world[keep]]), np.vstack([fd.normals, nrm]), b)
+        normals = np.vstack([fd.normals, nrm])
+        return lean_widened(fit_face(np.vstack([fd.points, extra.point_in_world[keep]]), normals, b), normals, b)
 
     def store_face(self, fid: int, trace: ContactTrace, fit: FaceFit) -> None:
         """Keep the rows of ``trace`` on data face ``fid`` (those within the face cone of its fit ``fit`` whose
@@ -1512,6 +1514,10 @@ class PhysicsExecutor(LandingSearch):
             _, kind, roll, stroke, fit_g, fit_f, line, shifted, touched = again
             self.recoveries.append(f"{why}: crossed again {shifted * MM:.0f} mm along the edge"
                                    f"{FROM_TOUCHED if touched else ''}")  # fmt: skip
+        if seg.beside_parallel_face(st.edge, f, fit_g):
+            return self.failed_result(move, "unreachable", "the edge met lies along the current edge's line, the "
+                                                           "next face parallel to its other face: it leaves another "
+                                                           "vertex")  # fmt: skip
         new_face = seg.next_id + 1
         s_vtx = float((vtx - line.point) @ line.direction)
         b = self.bounds

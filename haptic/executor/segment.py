@@ -159,6 +159,9 @@ class SegmentBounds:
     """A face's rows hold a steady normal: averaged over this many consecutive rows, the sensor's noise drops by
     its square root, while a pad that starts to roll over an edge (the last rows of a trace across the face,
     within :attr:`face_cone` of it for the first few degrees) turns its normal steadily to one side [-] ..."""
+    lean_sigmas: float = 3.0
+    """A face's rows split in two whose mean normals differ by more than this many σ of that difference: one part
+    leaned, and the face's bound covers it (:func:`lean_widened`) [-]."""
     steady_sigmas: float = 3.0
     """... and a row whose averaged normal lies more than this many of that average's σ (with
     :attr:`normal_floor`) from the face's is dropped from the face's fit [-]."""
@@ -300,6 +303,37 @@ def fit_face(points: np.ndarray, normals: np.ndarray, bounds: SegmentBounds) -> 
     s_off = max(resid, bounds.point_sigma) / math.sqrt(len(d))
     projected = points - (d - offset)[:, None] * normal
     return FaceFit(normal, offset, projected, s_n, s_off, nn)
+
+
+def lean_widened(fit: FaceFit, normals: np.ndarray, bounds: SegmentBounds) -> FaceFit:
+    """``fit`` with its normal's σ widened so that its bound covers a systematic lean of part of its rows.
+
+    The face's rows (``normals``, time order) split in two where their mean normals differ most, in units of the
+    noise of that difference (σn √(1/a + 1/b), each part at least :attr:`~SegmentBounds.steady_window` rows): by
+    more than :attr:`~SegmentBounds.lean_sigmas` of it and more than the floor's bound, one part leaned (a leg of the
+    stroke riding a rim) and the face's normal may lie as far off the fit as either part's mean: the bound grows by
+    that. Only where the noise blinds the rim tests, whose cut (:attr:`~SegmentBounds.rim_sigmas` σ of the
+    difference of two nine-row means) then exceeds their fixed cone :attr:`~SegmentBounds.sample_cone` (noise
+    level 2 and above). At noise level 4 (σn 4°) they let through a leg leaning 3-5° (BOX01N at 60 mm, seed 1:
+    a step in whose normal turned from 1.8 to 5.2° off the top face, 3.5° on average, the other leg 1.1°, and the
+    face 2.3° off against a bound of 1.3°: no-match), which the legs' means tell apart."""
+    n = len(normals)
+    m = bounds.steady_window
+    if n < 2 * m or bounds.rim_sigmas * bounds.normal_sigma * math.sqrt(2.0 / m) <= bounds.sample_cone:
+        return fit
+    c = np.cumsum(normals, axis=0)
+    j = np.arange(m, n - m + 1)
+    a, b = c[j - 1], c[-1] - c[j - 1]
+    cos = np.einsum("ij,ij->i", a, b) / (np.linalg.norm(a, axis=1) * np.linalg.norm(b, axis=1))
+    split = np.arccos(np.clip(cos, -1.0, 1.0))
+    score = split / (bounds.normal_sigma * np.sqrt(1.0 / j + 1.0 / (n - j)))
+    i = int(np.argmax(score))
+    if score[i] <= bounds.lean_sigmas or split[i] <= bounds.k * bounds.normal_floor:
+        return fit
+    lean = max(angle_between(a[i], fit.normal), angle_between(b[i], fit.normal))
+    wide = bounds.bound(fit.normal_sigma, bounds.normal_floor) + lean
+    sigma = math.sqrt(max((wide / bounds.k) ** 2 - bounds.normal_floor**2, fit.normal_sigma**2))
+    return replace(fit, normal_sigma=sigma)
 
 
 def normal_turn_rate(coords: np.ndarray, normals: np.ndarray) -> float:
@@ -478,6 +512,7 @@ class Segmenter:
         spread = float(np.sqrt(np.mean(np.sum((normals - mean) ** 2, axis=1))))  # rms angle [rad]
         if spread > self.bounds.max_spread_sigmas * self.bounds.normal_sigma + self.bounds.spread_slack:
             return None  # the rows do not come from one plane (a roll, a vertex)
+        cone = normals  # every row in the face's cone, in time order: a part leaning widens the bound
         mask = steady_rows(trace, mask, self.bounds)
         if _extent(trace.tip_in_world[mask])[0] < self.bounds.min_face_extent:
             # the rows that hold one normal are the pad pressing in place, the rest turning: the stroke rode a rim
@@ -488,7 +523,8 @@ class Segmenter:
             # the steady rows are one leg of the L: the other's normal held elsewhere (the pad rode a rim along the
             # first leg, its normal turned 3° round the edge), and no row measures the face across
             return None
-        return fit_face(trace.point_in_world[mask], trace.normal_in_world[mask], self.bounds)
+        return lean_widened(fit_face(trace.point_in_world[mask], trace.normal_in_world[mask], self.bounds), cone,
+                            self.bounds)  # fmt: skip
 
     def add_face(self, fit: FaceFit, adjacent: tuple[int, ...] = ()) -> DataFace:
         b = self.bounds
@@ -648,6 +684,22 @@ class Segmenter:
             rec.side_points.append((fid, mid + self.bounds.side_reach * rec.inward[fid]))
         self.edges[eid] = rec
         return self._emit_edge(eid)
+
+    def beside_parallel_face(self, eid: int, face: int, fit_next: FaceFit) -> bool:
+        """Whether the next face of an edge met from ``face`` (one of edge ``eid``'s faces), fitted as
+        ``fit_next``, is parallel to the edge's other face within their normal bounds. Its edge with ``face`` then
+        lies on edge ``eid``'s line or on one parallel to it: a vertex circle on ``face`` round an end of edge
+        ``eid`` that met it met that edge again past the vertex, or an edge collinear with it across a gap (BOX01N's
+        end face, circled round a corner of its slot's mouth: the top edge beyond the slot), never an edge leaving
+        the vertex circled (two faces of one plane along one line meet at no vertex there)."""
+        rec = self.edges[eid]
+        other = next((g for g in rec.faces if g is not None and g != face), None)
+        if other is None or other not in self.faces:
+            return False
+        b = self.bounds
+        h = self.faces[other].component
+        allowed = math.hypot(h.normal_bound, b.bound(fit_next.normal_sigma, b.normal_floor))
+        return angle_between(h.normal, fit_next.normal) <= allowed
 
     def _emit_edge(self, eid: int) -> DataEdge:
         rec = self.edges[eid]
