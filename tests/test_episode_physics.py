@@ -875,17 +875,21 @@ def _moves(model: str, seed: int, library: str, max_moves: int) -> tuple:
 
 
 def test_a_face_move_whose_start_beside_the_crossing_lies_off_the_face_crosses_again_from_a_touched_point(tmp_path):
-    # bipyramid_07 of the sized formula corpus (96 mm tall), seed 1: the seventh move traced a face into a rim edge
-    # 0.3 mm from its end (the faces' corners 74° there); the pad rolled round the vertex (the normals leaning 13.7°
-    # along the edge), and the start for crossing again, 8 mm back and shifted 9 mm along the edge away from the
-    # vertex, lay beyond the face's other edge: the pad touched a normal 24° off the face and the move failed. It now
-    # sets off from the point of the face it touched nearest that start, toward the shifted crossing, and reports the
-    # edge and the next face within their bounds.
-    ep, results = _moves("bipyramid_07", 1, _sized_corpus(tmp_path), 8)
+    # antiprism_04 of the sized formula corpus, seed 1: the fifth move traced a face into an edge near its end; the
+    # pad rolled round the vertex (the normals leaning 19.1° along the edge), and the start for crossing again, 8 mm
+    # back and shifted along the edge away from the vertex, lay off the face (a triangle narrowing to that vertex):
+    # the pad touched a normal off the face and the move failed. It now sets off from the point of the face it
+    # touched nearest that start, toward the shifted crossing, and reports the edge and the next face within their
+    # bounds. (bipyramid_07's seventh move showed the same until the verification's moves changed: its episode now
+    # makes no such crossing.)
+    from haptic.executor.physics import NEXT_FACE_LOST
+
+    ep, results = _moves("antiprism_04", 1, _sized_corpus(tmp_path), 8)
     face = [r for r in results if r.move is not None and r.move.kind == "face"]
     again = [r for r in face if any("from where the face was touched" in x for x in r.info.get("recoveries", ()))]
     assert again and all(r.ok for r in again), [r.reason for r in again]
-    assert all(r.ok for r in face), [r.reason for r in face if not r.ok]
+    crossing = ("no edge between the faces", "stroke on the next face", *NEXT_FACE_LOST)
+    assert not any(r.reason.startswith(crossing) for r in face if not r.ok), [r.reason for r in face if not r.ok]
     assert _within_bounds(ep)
 
 
