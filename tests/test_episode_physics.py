@@ -808,22 +808,6 @@ def test_a_vertex_move_whose_circle_start_touches_the_far_rim_starts_halfway_to_
     assert _within_bounds(ep)
 
 
-def _sized_corpus(directory) -> str:
-    """The formula corpus with each solid at a size drawn from 30 to 150 mm (``scripts/make_corpus.py --sizes
-    30:150 --encodings obj6``, seed 0), written to ``directory``: the library directory."""
-    from haptic.geometry import Polyhedron
-    from haptic.geometry.corpus import corpus_solids, write_corpus
-
-    rng = np.random.default_rng(0)
-    solids = []
-    for spec, poly in corpus_solids(seed=0):
-        v = poly.vertices
-        k = rng.uniform(0.03, 0.15) / float(np.linalg.norm(v[:, None] - v[None], axis=2).max())
-        c = poly.centroid
-        solids.append((spec, Polyhedron.from_faces(c + k * (v - c), poly.faces, name=poly.name)))
-    return str(write_corpus(directory, seed=0, solids=solids, encodings=("obj6",))["obj6"])
-
-
 def test_a_vertex_move_whose_roll_went_round_the_edges_end_crosses_again_inside_it(tmp_path):
     # trapezohedron_06 of the sized formula corpus (33 mm), seed 1: four vertex moves' circles met the next edge and
     # rolled round its end (the normals leaning 3-7° along it, more than the noise allows), and each failed "no edge
@@ -990,4 +974,17 @@ def test_an_edge_move_that_set_off_past_its_end_sets_off_again_inside_the_edge(t
     assert edge and any("set off again" in why for why in edge[-1].info.get("recoveries", ())), [
         r.reason for r in edge if not r.ok]
     assert not [r.reason for r in edge if not r.ok and "set off past it" in r.reason]
+    assert _within_bounds(ep)
+
+
+def test_an_edge_move_that_sets_off_past_a_gap_in_its_line_sets_off_again_inside_the_edge(tmp_path):
+    # cad_slotted of the sized formula corpus, seed 1: the 27th move, along a top edge whose explored interval ended
+    # 10 mm short of the slot, returned next to the edge 40 mm past that interval, beyond the 30 mm slot, on the
+    # collinear edge across it; it followed that edge to its far end, and the interval, extended there, spanned the
+    # slot, 21 bounds past the edge's end (the verification refused it: no-match). A ridge acquired more than the
+    # pad's radius past the explored interval now sends the pad back to the interval's middle to set off again.
+    ep, results = _moves("cad_slotted", 1, _sized_corpus(tmp_path), 27)
+    edge = [r for r in results if r.move is not None and r.move.kind == "edge"]
+    again = [r for r in edge if any("past the edge's explored interval" in w for w in r.info.get("recoveries", ()))]
+    assert again and all(r.ok for r in again), [r.reason for r in again]
     assert _within_bounds(ep)

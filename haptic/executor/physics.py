@@ -1216,6 +1216,12 @@ class PhysicsExecutor(LandingSearch):
         slack = past * math.sin(self.bounds.bound(rec.direction_sigma, self.bounds.direction_floor))
         if rec.convex and off > s.ridge_offset + slack:
             return "unreachable", f"the ridge acquired lies {off * MM:.1f} mm off the edge's line: another edge"
+        if past > t.pad_radius:
+            # the pad set off beyond what of the edge was sensed by more than its radius: the ridge there may be
+            # another edge on the same line, past a gap (cad_slotted of the formula corpus: an edge move returned next
+            # to the edge 40 mm past its explored interval, beyond a 30 mm slot, on the collinear edge across it, and
+            # the edge's interval, extended to the vertex there, spanned the slot, 21 bounds past its end)
+            return "unreachable", f"the ridge acquired lies {past * MM:.0f} mm past the edge's explored interval"
         s_from = rec.param(self.contact_point())
         r = t.follow_edge(u, n_a, n_b, toward_a, s.max_edge_trace, **ridge)
         pieces.append(r)
