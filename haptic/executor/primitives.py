@@ -918,23 +918,18 @@ class Toucher:
 
     def hold(self, seconds: float, phase: str = "vertex") -> PrimitiveResult:
         """Press in place (zero tangential velocity) for ``seconds``."""
-        self._press(np.zeros(3))
-        start = self.tip.copy()
-        for _ in range(max(1, int(seconds / self.dt))):
-            self.tick(phase)
-            if self._unhealthy:
-                return self._result("unstable", "nan", 0.0)
-            if self._ran_away(start):
-                return self._result("unreachable", "runaway", 0.0)
-        return self._result("ok", "done", 0.0)
+        return self._hold(seconds, phase, reading=False)
 
     def hold_reading(self, seconds: float, phase: str = "vertex") -> PrimitiveResult:
         """:meth:`hold`, reading the pad's contacts every tick each on its own, not merged into one point and normal
         (a pad resting on two rims at once senses the mean of the two, on neither): ``info["contacts"]``, per tick
         the tuple of the fingertip's sensed contacts."""
+        return self._hold(seconds, phase, reading=True)
+
+    def _hold(self, seconds: float, phase: str, reading: bool) -> PrimitiveResult:
         self._press(np.zeros(3))
         start = self.tip.copy()
-        k = self.robot.fingers.index(self.finger)
+        k = self.robot.fingers.index(self.finger) if reading else None
         seen = []
         for _ in range(max(1, int(seconds / self.dt))):
             self.tick(phase)
@@ -942,8 +937,9 @@ class Toucher:
                 return self._result("unstable", "nan", 0.0)
             if self._ran_away(start):
                 return self._result("unreachable", "runaway", 0.0)
-            seen.append(tuple(self.robot.read().contacts[k]))
-        return self._result("ok", "done", 0.0, contacts=seen)
+            if k is not None:
+                seen.append(tuple(self.robot.read().contacts[k]))
+        return self._result("ok", "done", 0.0, contacts=seen) if reading else self._result("ok", "done", 0.0)
 
     # -- around a vertex ---------------------------------------------------------------------------------------
     def circle_vertex(
