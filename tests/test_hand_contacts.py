@@ -48,17 +48,22 @@ def test_a_hand_point_within_its_links_bound_keeps_the_class_and_one_beyond_sets
 def test_watching_the_links_changes_no_other_reading():
     # the readout watched through a move draws its noise apart: the wrist's and the links' readings asked for
     # otherwise are those of the same seed, watched or not
+    a, b = _readings(), _readings(links=True)
+    assert np.array_equal(a[0][0], b[0][0]) and np.array_equal(a[0][1], b[0][1])
+
+
+def _readings(links: bool = False, wrist: bool = False) -> tuple:
+    """The wrist's wrench, the links' contacts and the pad's contact summary after 5 steps of a noisy simulation at
+    seed 3, with the links' or the wrist's readout watched before them or not."""
     from haptic.sim import SimulatedSensorNoise, Simulation, compose_scene
 
-    def readings(watch: bool):
-        sim = Simulation(compose_scene(), noise=SimulatedSensorNoise.from_notes(), seed=3)
-        sim.step(5)
-        if watch:
-            sim.link_contacts(watch=True)
-        return sim.wrist_wrench()
-
-    a, b = readings(False), readings(True)
-    assert np.array_equal(a[0], b[0]) and np.array_equal(a[1], b[1])
+    sim = Simulation(compose_scene(), noise=SimulatedSensorNoise.from_notes(), seed=3)
+    sim.step(5)
+    if links:
+        sim.link_contacts(watch=True)
+    if wrist:
+        sim.wrist_wrench(watch=True)
+    return sim.wrist_wrench(), sim.link_contacts(watch=True), sim.contact_summary(0)
 
 
 @pytest.mark.slow
@@ -115,16 +120,7 @@ def test_the_wrist_reads_the_hands_motion_touching_nothing():
 
 
 def test_watching_the_wrist_changes_no_other_reading():
-    from haptic.sim import SimulatedSensorNoise, Simulation, compose_scene
-
-    def readings(watch: bool):
-        sim = Simulation(compose_scene(), noise=SimulatedSensorNoise.from_notes(), seed=3)
-        sim.step(5)
-        if watch:
-            sim.wrist_wrench(watch=True)
-        return sim.wrist_wrench(), sim.link_contacts(watch=True), sim.contact_summary(0)
-
-    a, b = readings(False), readings(True)
+    a, b = _readings(), _readings(wrist=True)
     assert np.array_equal(a[0][0], b[0][0]) and np.array_equal(a[0][1], b[0][1])
     assert len(a[1]) == len(b[1]) and a[2].normal_force == b[2].normal_force
 
