@@ -29,12 +29,14 @@ import numpy as np
 
 from haptic.geometry.polyhedron import Polyhedron
 from haptic.geometry.raycast import line_hits
-from haptic.geometry.se3 import SE3
+from haptic.geometry.se3 import SE3, plane_basis
+from haptic.geometry.tracing import corner_angle, inside_polygon
 from haptic.matching.acceptance import TablePin
 from haptic.matching.components import DataComponent, DataEdge, DataFace, SensorNoise
 from haptic.planning.config import PlannerConfig
 from haptic.planning.finger_faces import TableFaceProbes
 from haptic.planning.hypothesis import Hypothesis
+from haptic.planning.move_scores import same_move
 from haptic.planning.moves import EdgeMove, FaceMove, Move, ProbeMove, SensorState, VertexMove
 from haptic.planning.predict import candidate_moves, predict_moves
 from haptic.planning.table import _inward, descent_risk, hidden_concave_end
@@ -774,8 +776,6 @@ def arc_leaves_face(poly: Polyhedron, v: int, f: int, radius: float) -> bool:
     :data:`ARC_SAMPLES`) lies outside the face's polygon, past an edge that does not leave ``v``, or an edge of the
     face at ``v`` is shorter than ``radius`` (the arc ends past its far end). Computed once per model, vertex, face
     and radius."""
-    from haptic.geometry.se3 import plane_basis
-    from haptic.geometry.tracing import corner_angle, inside_polygon
 
     cache = _ARCS.setdefault(poly, {})
     key = (v, f, float(radius))
@@ -1318,7 +1318,6 @@ class Verifier:
         slid to another edge. The verification
         asked the same crossing again and again, each ending elsewhere: antiprism_08 of the formula corpus (seed 1)
         from its octagon over one edge three times, trapezohedron_10 over one edge three times."""
-        from haptic.planning.move_scores import same_move
 
         if asked is None or h.world_from_model is None or any(same_move(asked[0], m) for m in failed):
             return
