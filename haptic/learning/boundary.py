@@ -252,6 +252,7 @@ def boundary_estimate(components: Mapping[int, DataComponent], bounds: LearnBoun
             if len(be.vertices) > 2:
                 problems.append(f"an edge between planes {pair} reaches {len(be.vertices)} vertices")
             edges.append(be)
+    edges, edge_of = _drop_shadowed(edges, edge_of)
     # vertices: the planes of their edges, placed where those meet
     vplanes: list[set[int]] = [set() for _ in range(n_v)]
     for be in edges:
@@ -274,6 +275,36 @@ def boundary_estimate(components: Mapping[int, DataComponent], bounds: LearnBoun
                            problems=problems)  # fmt: skip
     _trace_faces(est)
     return est
+
+
+def _drop_shadowed(edges: list[BoundaryEdge], edge_of: dict[int, int]) -> tuple[list[BoundaryEdge], dict[int, int]]:
+    """``edges`` and ``edge_of`` without the edges another shadows: two edges between the same two vertices on one
+    plane are one segment of that plane's boundary, so where their other planes differ one of them took its other
+    face from a neighbour within the pad's reach of the edge (a fold's sliver that fans in at the edge's end: LBLOCK01
+    with a corner moved 2 mm, a wall folded 2° into two triangles, one edge move along the wall's vertical edge read
+    the fold's other half). The edge with fewer data edges gives way; its data edges count as the other's."""
+    by_ends: dict[frozenset[int], list[int]] = {}
+    for k, be in enumerate(edges):
+        if be.closed and not be.flat:
+            by_ends.setdefault(frozenset(be.vertices), []).append(k)
+    into: dict[int, int] = {}
+    for ks in by_ends.values():
+        for i in ks:
+            for j in ks:
+                a, b = edges[i], edges[j]
+                if len(set(a.planes) & set(b.planes)) == 1 and len(a.data) < len(b.data):
+                    into[i] = j
+    if not into:
+        return edges, edge_of
+    kept = [k for k in range(len(edges)) if k not in into]
+    new = {k: n for n, k in enumerate(kept)}
+
+    def target(k: int) -> int:
+        while k in into:
+            k = into[k]
+        return new[k]
+
+    return [edges[k] for k in kept], {e: target(k) for e, k in edge_of.items()}
 
 
 def _half_edges(est: BoundaryEstimate) -> dict[int, list[tuple[int, int, int]]]:

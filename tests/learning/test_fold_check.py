@@ -9,6 +9,7 @@ from haptic.episode.spec import EpisodeSpec
 from haptic.episode.worlds import run_episode
 from haptic.geometry import load_library, save_model
 from haptic.geometry.perturb import move_vertex
+from haptic.learning.boundary import BoundaryEdge, _drop_shadowed
 from haptic.learning.folds import Stroke, crosses, diagonals, inner_diagonals, unchecked_diagonals
 
 SQUARE = np.array([[0.0, 0.0, 0.0], [0.1, 0.0, 0.0], [0.1, 0.1, 0.0], [0.0, 0.1, 0.0]])
@@ -118,3 +119,28 @@ def test_a_sliver_faces_side_of_its_edge_is_taken_from_its_plane(vertex, seed, t
 def test_the_fold_check_is_off_on_the_hand_unless_asked_for():
     assert LearnSettings().checks_folds(None) and not LearnSettings().checks_folds(0.0)
     assert LearnSettings(fold_check=True).checks_folds(0.0) and not LearnSettings(fold_check=False).checks_folds(None)
+
+
+def test_an_edge_another_shadows_on_its_plane_gives_way():
+    """Two edges between the same two vertices on one plane are one segment of its boundary: where their other
+    planes differ, the one with fewer data edges took its other face from a neighbour and gives way, its data edges
+    counted as the other's; edges that share both vertices on no common plane, or as many data, both stand."""
+    a = BoundaryEdge((4, 10), [1, 2, 3], {1, 4})
+    b = BoundaryEdge((4, 5), [7], {1, 4})
+    c = BoundaryEdge((5, 10), [8], {2, 4})
+    edges, edge_of = _drop_shadowed([a, b, c], {1: 0, 2: 0, 3: 0, 7: 1, 8: 2})
+    assert edges == [a, c] and edge_of == {1: 0, 2: 0, 3: 0, 7: 0, 8: 1}
+    d = BoundaryEdge((4, 5), [7, 9, 11], {1, 4})  # as many data: both stand
+    assert _drop_shadowed([a, d], {1: 0, 7: 1})[0] == [a, d]
+    e = BoundaryEdge((6, 7), [7], {1, 4})  # no plane in common
+    assert _drop_shadowed([a, e], {1: 0, 7: 1})[0] == [a, e]
+
+
+def test_an_l_block_with_a_corner_moved_2_mm_whose_edge_read_the_folds_other_half_closes(tmp_path):
+    """LBLOCK01 with vertex 2 moved 2 mm at this seed: the wall beside the moved corner folds 2° into two triangles
+    meeting at the vertical edge's foot; one of 24 edge moves along that edge took its other face from the fold's
+    other half, which put a second edge between the same two vertices on the first wall's plane. The walk went round
+    the vertex to the learning's budget (150 moves) to trace that edge's missing side."""
+    learned, poly = _learn("LBLOCK01", 2, 287335974, tmp_path)
+    assert (learned["V"], learned["E"], learned["F"]) == (poly.n_vertices, poly.n_edges, poly.n_faces)
+    assert learned["moves"] < 100
