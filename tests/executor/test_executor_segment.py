@@ -158,6 +158,24 @@ def test_a_roll_too_short_or_round_a_vertex_gives_no_edge():
     assert "axis" in seg.edge_from_roll(_face_fit(n_a), both)
 
 
+def test_normals_standing_turned_at_one_point_give_no_edge_from_the_roll():
+    # LBLOCK01 at 30 mm, seed 2: a level slide beside the table ended with ten rows turned 8-11° off the face, at one
+    # point 2.4 mm from a vertex: they fit an axis as well as a roll does (σ 1.8°), 31° off the true edge. Rolling
+    # over an edge the normal turns on as the pad goes (35° over 60 rows below): one standing turned fixes no axis
+    rng = np.random.default_rng(6)
+    n_a, axis = np.array([0.0, 0.0, 1.0]), np.array([0.0, 1.0, 0.0])
+    turned = np.array([math.sin(math.radians(10.0)), 0.0, math.cos(math.radians(10.0))])
+    normals = np.array([unit(turned + rng.normal(0.0, math.radians(1.0), 3)) for _ in range(10)])
+    points = np.array([0.02, 0.0, 0.0]) + rng.normal(0.0, 2e-4, (10, 3))
+    standing = _trace(points + R_PAD * normals, normals, points)
+    unchecked = Segmenter(SegmentBounds(sweep_sigmas=-math.inf)).edge_from_roll(_face_fit(n_a), standing)
+    assert not isinstance(unchecked, str), unchecked  # every other test of a roll passes
+    why = Segmenter().edge_from_roll(_face_fit(n_a), standing)
+    assert isinstance(why, str) and "stood turned" in why
+    rolling = _noisy_roll(axis, n_a, 12.0, np.array([0.02, 0.0, 0.0]), rng, 20)
+    assert not isinstance(Segmenter().edge_from_roll(_face_fit(n_a), rolling), str)
+
+
 def test_a_roll_round_a_vertex_leans_along_the_edge_more_than_the_noise_allows():
     # a roll onto a face that shares only a vertex with the first turns the normals about an axis a few degrees
     # off n_a × n_b (bipyramid_06 at 60 mm: median |n · e| 0.051); a roll over the edge between them leans along
