@@ -157,6 +157,15 @@ class SegmentBounds:
     this many times ``√(σn² / n + floor²)`` is no roll over the edge between the faces [-]."""
     min_skew_rows: int = 9
     """... tested with at least this many rolling contacts [-]."""
+    start_lean_sigmas: float = 4.0
+    """The first :attr:`min_skew_rows` rolling contacts (the last rows on the face among them) turn about the edge
+    too: over a true edge their mean ``n · e`` is the noise's (``σn / √9``, with the floor; at most 2.5 times it
+    over 144 crossings of true edges in 10 episodes at 30-150 mm), while a pad that rolled over another edge of the
+    face and on round the vertex at its end (the roll then turning about the line to the face it landed on, which
+    shares only the vertex) first turned about that edge (bipyramid_10 at 150 mm, seed 2: ten rows turned 8-12°
+    about an axis 20-40° off the line between the faces, 6 times the noise's lean, every row after them on the arc
+    between the faces; the "edge" 28° off the true one, 29 bounds). A mean beyond this many times the noise's is
+    no roll over the edge between the faces [-]."""
     rim_sigmas: float = 3.5
     """A stroke's step onto the next face turns its normal (the mean of its first :attr:`steady_window` rows against
     that of its last) by more than :attr:`sample_cone`, and by more than this many σ of the noise's difference
@@ -661,6 +670,13 @@ class Segmenter:
         ):
             return (f"the rolling normals lean {math.degrees(lean):.1f}° along the edge between the faces on average, "
                     "more than the noise allows (a roll round a vertex)")  # fmt: skip
+        start = n[between][: b.min_skew_rows]
+        lean = abs(float(np.mean(start @ e)))
+        if between.sum() >= b.min_skew_rows and lean > b.start_lean_sigmas * math.hypot(
+            b.normal_sigma / math.sqrt(len(start)), b.normal_floor
+        ):
+            return (f"the first rolling normals lean {math.degrees(lean):.1f}° along the edge between the faces, more "
+                    "than the noise allows (the pad rolled over another edge, then round a vertex)")  # fmt: skip
         if convex:
             q = pts[between]
             off = max(float(np.median(np.abs(q @ fit_a.normal - fit_a.offset))),
