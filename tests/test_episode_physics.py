@@ -988,3 +988,12 @@ def test_an_edge_move_that_sets_off_past_a_gap_in_its_line_sets_off_again_inside
     again = [r for r in edge if any("past the edge's explored interval" in w for w in r.info.get("recoveries", ()))]
     assert again and all(r.ok for r in again), [r.reason for r in again]
     assert _within_bounds(ep)
+
+
+def test_a_verification_whose_every_candidate_the_hand_cannot_make_ends_without_a_move(tmp_path):
+    # FRAME01 at 30 mm, seed 1 (perception_report.py --sizes 30): every verification candidate but vertex moves whose
+    # circles leave their corner was left out, and those the hand cannot make at all; the planner, left with no move
+    # to head for the nearest missing feature with, raised instead of saying so
+    spec = EpisodeSpec(model="FRAME01", seed=1, executor="physics", models=_scaled_library(tmp_path, 0.03))
+    rec = run_episode(spec)
+    assert not (rec.recognized and not rec.correct), rec.detail

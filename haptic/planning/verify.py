@@ -720,6 +720,8 @@ def plan_verification_move(
     # no candidate can be followed in the hypothesis's world (or every one goes back): head for the nearest
     # missing feature
     ends = ends or again or refused
+    if not ends:  # every candidate is one the hand cannot make
+        return None, tour, now
     targets = _target_points(h.poly, missing)
     if not len(targets):
         return ends[0][0], tour, now

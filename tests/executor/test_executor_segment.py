@@ -158,6 +158,24 @@ def test_a_roll_too_short_or_round_a_vertex_gives_no_edge():
     assert "axis" in seg.edge_from_roll(_face_fit(n_a), both)
 
 
+def test_normals_standing_turned_at_one_point_give_no_edge_from_the_roll():
+    # LBLOCK01 at 30 mm, seed 2: a level slide beside the table ended with ten rows turned 8-11° off the face, at one
+    # point 2.4 mm from a vertex: they fit an axis as well as a roll does (σ 1.8°), 31° off the true edge. Rolling
+    # over an edge the normal turns on as the pad goes (35° over 60 rows below): one standing turned fixes no axis
+    rng = np.random.default_rng(6)
+    n_a, axis = np.array([0.0, 0.0, 1.0]), np.array([0.0, 1.0, 0.0])
+    turned = np.array([math.sin(math.radians(10.0)), 0.0, math.cos(math.radians(10.0))])
+    normals = np.array([unit(turned + rng.normal(0.0, math.radians(1.0), 3)) for _ in range(10)])
+    points = np.array([0.02, 0.0, 0.0]) + rng.normal(0.0, 2e-4, (10, 3))
+    standing = _trace(points + R_PAD * normals, normals, points)
+    unchecked = Segmenter(SegmentBounds(sweep_sigmas=-math.inf)).edge_from_roll(_face_fit(n_a), standing)
+    assert not isinstance(unchecked, str), unchecked  # every other test of a roll passes
+    why = Segmenter().edge_from_roll(_face_fit(n_a), standing)
+    assert isinstance(why, str) and "stood turned" in why
+    rolling = _noisy_roll(axis, n_a, 12.0, np.array([0.02, 0.0, 0.0]), rng, 20)
+    assert not isinstance(Segmenter().edge_from_roll(_face_fit(n_a), rolling), str)
+
+
 def test_a_roll_round_a_vertex_leans_along_the_edge_more_than_the_noise_allows():
     # a roll onto a face that shares only a vertex with the first turns the normals about an axis a few degrees
     # off n_a × n_b (bipyramid_06 at 60 mm: median |n · e| 0.051); a roll over the edge between them leans along
@@ -206,6 +224,37 @@ def test_a_roll_round_a_vertex_close_to_the_arc_between_the_faces_still_leans_on
                               roll.phase)  # fmt: skip
         why = seg.edge_inconsistency(fa, fb, True, traced)
         assert (why is None) == is_edge, why
+
+
+def test_a_roll_that_first_turned_over_another_edge_of_the_face_is_no_edge_between_the_faces():
+    # bipyramid_10 at 150 mm, seed 2: the pad slid onto an edge of the top face and rolled over it by 8-12°, then
+    # on round the vertex at its end, about the line to a face sharing only that vertex -- every normal after the
+    # first few on the arc between the faces, whose mean and median leans pass; the "edge" lay 28° off the true one
+    top, side = np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0])
+    vertex = np.array([0.0, 0.01, 0.0])
+    fa, fb = _plane(top, np.array([-0.01, 0.0, 0.0])), _plane(side, np.array([0.0, 0.0, -0.01]))
+    seg = Segmenter()
+    other = np.array([math.sin(math.radians(25.0)), math.cos(math.radians(25.0)), 0.0])  # the face's edge met first
+    first = _roll(other, top, unit(top + math.tan(math.radians(10.0)) * np.cross(other, top)), vertex, 10)
+    for seed in range(10):
+        rng = np.random.default_rng(seed)
+        rows = [first.select(np.arange(len(first)) > 0), _roll(np.array([0.0, 1.0, 0.0]), top, side, vertex, 200)]
+        roll = ContactTrace.concatenate(rows)
+        n = roll.normal_in_world + math.radians(1.0) * rng.normal(size=roll.normal_in_world.shape)
+        n /= np.linalg.norm(n, axis=1, keepdims=True)
+        noisy = ContactTrace(roll.time, roll.tip_in_world, roll.hand_rotation, roll.point_in_world, n, roll.force,
+                             roll.phase)  # fmt: skip
+        unchecked = Segmenter(SegmentBounds(start_lean_sigmas=math.inf)).edge_inconsistency(fa, fb, True, noisy)
+        assert unchecked is None, unchecked  # the roll passes every other test
+        why = seg.edge_inconsistency(fa, fb, True, noisy)
+        assert why is not None and "first rolling normals" in why
+        # over the edge itself from the start, the roll is one
+        over = _roll(np.array([0.0, 1.0, 0.0]), top, side, vertex, 210)
+        n = over.normal_in_world + math.radians(1.0) * rng.normal(size=over.normal_in_world.shape)
+        n /= np.linalg.norm(n, axis=1, keepdims=True)
+        noisy = ContactTrace(over.time, over.tip_in_world, over.hand_rotation, over.point_in_world, n, over.force,
+                             over.phase)  # fmt: skip
+        assert seg.edge_inconsistency(fa, fb, True, noisy) is None
 
 
 def test_rows_where_the_pad_begins_to_roll_over_the_edge_do_not_tilt_the_face():
