@@ -157,3 +157,72 @@ def test_a_verification_completes_with_probes_by_a_turned_finger(tmp_path):
     measured = [r for r in by_finger if r.ok and r.components]
     assert len(measured) >= 2
     assert rec.verified["finger_faces"]["faces_probed"] >= 2
+
+
+def _top_vertex(poly, pose) -> int:
+    return int(np.argmax(pose.apply(poly.vertices)[:, 2]))
+
+
+def test_a_line_to_a_corner_touches_the_face_within_the_corner_with_room_for_a_stroke():
+    from haptic.matching.acceptance import corner_triangle, in_corner
+    from haptic.planning.finger_faces import RUN_UP, corner_lines
+
+    poly, pose = _octahedron(0.1)
+    config = _config()
+    v = _top_vertex(poly, pose)
+    inv = pose.inverse()
+    for f in (int(f) for f in poly.vertex_faces[v]):
+        lines = corner_lines(poly, pose, v, f, config)
+        assert lines, f"face {f} has room within its corner at the top vertex"
+        tri = corner_triangle(poly, v, f)
+        n = pose.rotate(poly.face_normals[f])
+        for line in lines:
+            # the pad's touch: a pad's radius back from its centre where the line meets the face
+            centre = line.start + (RUN_UP - config.pad_radius) * line.direction
+            touch = inv.apply((centre - config.pad_radius * n)[None])
+            assert in_corner(touch, tri, poly.face_normals[f], slack=-MIN_ROOM + 1e-6)[0]
+            assert MIN_ROOM - 1e-9 <= line.room
+            # its room is the corner's, less than the face's where the corner's far side crosses the face
+            assert in_corner(touch, tri, poly.face_normals[f], slack=-line.room + 1e-6)[0]
+
+
+def test_the_corner_probes_ask_nothing_while_some_vertex_cannot_be_placed():
+    from haptic.planning.finger_faces import CornerProbes
+
+    poly, pose = _octahedron(0.1)
+    config = _config()
+    h = Hypothesis(model="octahedron", poly=poly, world_from_model=pose, faces={}, edges={}, vertices={})
+    asked: list[ProbeMove] = []
+
+    def nobody(line, hypotheses):
+        asked.append(line)
+        return None
+
+    v = _top_vertex(poly, pose)
+    table = _table_vertices(poly, pose)[0]
+    faces = frozenset(int(f) for f in poly.vertex_faces[v])
+    # a vertex on the table has faces whose corner the pad cannot touch clear of the table: nothing is asked
+    below = frozenset(int(f) for f in poly.vertex_faces[table])
+    everything = frozenset(range(poly.n_edges))
+    probes = CornerProbes(nobody)
+    assert probes.next(h, {v: faces, table: below}, everything, frozenset(), config) is None
+    assert not asked and probes.no_position
+    # the top vertex alone: its first face's lines are asked in turn and named used up when no finger reaches
+    probes = CornerProbes(nobody)
+    assert probes.next(h, {v: faces}, everything, frozenset(), config) is None
+    first = min(faces)
+    assert probes.used_up == [(v, first)] and probes.asked == len(asked) >= 1
+    assert f"no finger reaches face {first} at {v}" in probes.unmeasured([v])
+    # an edge at the vertex with neither itself nor its other end measured: nothing is asked, and that is named
+    probes = CornerProbes(nobody)
+    asked.clear()
+    assert probes.next(h, {v: faces}, frozenset(), frozenset(), config) is None
+    assert not asked and probes.open_edges == [v] and "neither itself nor its other end" in probes.unmeasured([v])
+
+    def thumb(line, hypotheses):
+        return ProbeMove(line.start, line.direction, line.length, finger="thumb", room=line.room)
+
+    probes = CornerProbes(thumb)
+    got = probes.next(h, {v: faces}, everything, frozenset(), config)
+    assert got is not None and got.finger == "thumb" and probes.take() is got and probes.take() is None
+    assert probes.probed == {(v, first): 1} and probes.fingers == {"thumb": 1}
