@@ -11,6 +11,10 @@ face, ending past a pad position near the vertex where the pad touches that face
 finger, if any, carries a line out, and the hand's way there, is the reach solver's answer
 (``PlannerConfig.finger_reach``: the hand's, with the hypothesised model at its pose); the verification asks it
 line by line (:meth:`~haptic.planning.verify.Verifier.choose`) and ends naming the faces no finger reaches.
+
+The same probes measure the faces of a vertex off the table that no move touches (:class:`CornerProbes`), each within
+its corner at the vertex (:func:`corner_lines`): every one of its faces measured there places it
+(:func:`~haptic.matching.acceptance.placed_near`).
 """
 
 from __future__ import annotations
@@ -345,12 +349,13 @@ class CornerProbes:
         parts = []
         few = [v for v in self.too_few if v in left]
         if few:
-            parts.append(f"fewer than three faces spanning space at vertex{'es' if len(few) > 1 else ''} "
+            parts.append(f"fewer than three faces spanning space at {'vertices' if len(few) > 1 else 'vertex'} "
                          f"{', '.join(map(str, few))}")  # fmt: skip
         open_ = [v for v in self.open_edges if v in left]
         if open_:
-            parts.append(f"an edge at vertex{'es' if len(open_) > 1 else ''} {', '.join(map(str, open_))} with "
-                         "neither itself nor its other end measured")  # fmt: skip
+            at = "each of vertices" if len(open_) > 1 else "vertex"
+            parts.append(f"an edge at {at} {', '.join(map(str, open_))} with neither itself nor its other end "
+                         "measured")  # fmt: skip
         room = [f"{f} at {v}" for v, f in self.no_position if v in left]
         if room:
             parts.append(f"the pad touches face{'s' if len(room) > 1 else ''} {', '.join(room)} nowhere within the "
