@@ -226,3 +226,43 @@ def test_the_corner_probes_ask_nothing_while_some_vertex_cannot_be_placed():
     got = probes.next(h, {v: faces}, everything, frozenset(), config)
     assert got is not None and got.finger == "thumb" and probes.take() is got and probes.take() is None
     assert probes.probed == {(v, first): 1} and probes.fingers == {"thumb": 1}
+
+
+@pytest.mark.slow
+def test_a_probe_by_another_finger_measures_a_face_within_its_corner_at_a_vertex_out_of_reach():
+    # BOX01N at seed 1 lies with its slot on a side: the slot's four inner corners are out of the index's reach. The
+    # slot's back wall, level, is reached by the thumb turned level (scripts/reach_hidden.py); a line within the
+    # wall's corner at one of them, carried out on the hand, measures the wall there and nowhere else: every touched
+    # point in the corner triangle, the normal the model's.
+    from haptic.episode.spec import EpisodeSpec
+    from haptic.episode.worlds import build_episode
+    from haptic.matching.acceptance import corner_triangle, in_corner
+    from haptic.planning.finger_faces import corner_lines
+    from haptic.planning.verify import TABLE_CONTACT, reachable_features
+
+    ep = build_episode(EpisodeSpec(model="BOX01N", seed=1, executor="physics", verify="full"))
+    poly, pose, config = ep.true_model, ep.world_from_model, ep.config
+    reach = reachable_features(poly, pose, config)
+    z = pose.apply(poly.vertices)[:, 2] - config.table_z
+    hidden = [v for v in range(poly.n_vertices) if v not in reach[2] and z[v] > TABLE_CONTACT]
+    assert len(hidden) == 4
+    h = Hypothesis(model=poly.name, poly=poly, world_from_model=pose, faces={}, edges={}, vertices={})
+    probe = None
+    for v in hidden:
+        for f in (int(f) for f in poly.vertex_faces[v]):
+            if f in reach[0]:
+                continue
+            probe = next((g for g in (config.finger_reach(line, [h])
+                                      for line in corner_lines(poly, pose, v, f, config)) if g is not None), None)
+            if probe is not None:
+                break
+        if probe is not None:
+            break
+    assert probe is not None and probe.finger != "index"
+    assert ep.executor.start().ok
+    res = ep.executor.execute(probe)
+    assert res.ok and res.components, res.reason
+    face = res.components[0]
+    tri = corner_triangle(poly, v, f)
+    assert np.all(in_corner(pose.inverse().apply(face.points), tri, poly.face_normals[f], face.position_bound))
+    assert float(face.normal @ pose.rotate(poly.face_normals[f])) > math.cos(math.radians(1.0))
