@@ -228,6 +228,49 @@ def test_the_corner_probes_ask_nothing_while_some_vertex_cannot_be_placed():
     assert probes.probed == {(v, first): 1} and probes.fingers == {"thumb": 1}
 
 
+def test_the_verification_probes_the_corners_of_a_vertex_out_of_reach_and_then_counts_it_placed():
+    # the octahedron's top vertex taken as out of reach (every other vertex measured): once every vertex in reach is
+    # measured the verification asks the reach test for a line within a corner of its faces and makes that probe;
+    # with every face measured within its corner the vertex is placed
+    from dataclasses import replace
+
+    from haptic.matching.acceptance import Coverage, corner_triangle, placed_near
+    from haptic.matching.components import DataFace, SensorNoise
+    from haptic.matching.tree import Interpretation
+    from haptic.planning.verify import Verifier
+
+    poly, pose = _octahedron(0.1)
+    asked: list[ProbeMove] = []
+
+    def thumb(line, hypotheses):
+        asked.append(line)
+        return replace(line, finger="thumb")
+
+    config = replace(_config(), finger_reach=thumb)
+    v = _top_vertex(poly, pose)
+    others = frozenset(range(poly.n_vertices)) - {v}
+    every = frozenset(range(poly.n_faces))
+    ver = Verifier("full", SensorNoise(), config)
+    ver._hyp = Hypothesis(model="octahedron", poly=poly, world_from_model=pose, faces={}, edges={}, vertices={})
+    ver.hidden = [v]
+    ver.coverage = Coverage(frozenset(), frozenset(), others, every, frozenset(), others)
+    it = Interpretation(poly, 0, {}, {}, {}, {}, pose, 0)
+    assert ver._corner_probe_next([], it)
+    move = ver.choose(ver._hyp, None, {}, ())
+    assert move is not None and move.finger == "thumb" and len(asked) == 1 and ver.corner_probes.pending is None
+    # each face touched round the middle of its corner at the vertex: placed
+    faces = [int(f) for f in poly.vertex_faces[v]]
+    data = []
+    for i, f in enumerate(faces):
+        tri = corner_triangle(poly, v, f)
+        touched = pose.apply(0.8 * tri.mean(axis=0) + 0.2 * tri)  # three points round the corner's middle
+        data.append(DataFace(i, pose.rotate(poly.face_normals[f]), touched, math.radians(1.0), 8e-4))
+    measured = Interpretation(poly, 0, {i: f for i, f in enumerate(faces)}, {}, {}, {}, pose, 0)
+    assert not placed_near(poly, data[:-1], Interpretation(poly, 0, {i: f for i, f in enumerate(faces[:-1])},
+                                                           {}, {}, {}, pose, 0), pose, v, frozenset(), others)
+    assert placed_near(poly, data, measured, pose, v, frozenset(), others)
+
+
 @pytest.mark.slow
 def test_a_probe_by_another_finger_measures_a_face_within_its_corner_at_a_vertex_out_of_reach():
     # BOX01N at seed 1 lies with its slot on a side: the slot's four inner corners are out of the index's reach. The
