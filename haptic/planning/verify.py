@@ -255,8 +255,10 @@ def hidden_vertices(poly: Polyhedron, world_from_model: SE3, cov, config: Planne
     take from the table (farther than :data:`TABLE_CONTACT` above it): a vertex under an overhang, or on a face
     turned to the table that rests on other vertices. An object that differs from the model there (a corner
     moved 4 mm) is not told apart by anything the hand can touch, so a verification with one is incomplete, not
-    confirmed. A vertex measured all the same (the hand reached what the prediction counted out of reach) is not
-    hidden. Without a table every vertex is reachable and none is hidden."""
+    confirmed, unless the planes of its faces measured within their corners at it place it (the verifier's
+    :attr:`Verifier.placed`, :func:`~haptic.matching.acceptance.placed_near`). A vertex measured all the same (the
+    hand reached what the prediction counted out of reach) is not hidden. Without a table every vertex is reachable
+    and none is hidden."""
     if config.table_z is None:
         return []
     z = world_from_model.apply(poly.vertices)[:, 2] - config.table_z
