@@ -19,8 +19,9 @@ on faces leaning under by at most ``PlannerConfig.max_undercut``. Here, per face
 
 A vertex no pad position of any of its faces out of reach can touch is out of reach for a 12 mm pad whatever the
 finger (a slot narrower than the pad, a face against the table); one whose pad positions no finger reaches is out
-of the hand's reach; otherwise the fingers and approaches that reach are listed. A vertex *has enough planes in
-some finger's reach* when three of its faces (two besides the table's, for one on the table) are in the
+of the hand's reach; otherwise the fingers and approaches that reach are listed. For each vertex off the table, the
+verification's probes at its faces' corners (:func:`corner_verdict`): whether they could place it. A vertex *has
+enough planes in some finger's reach* when three of its faces (two besides the table's, for one on the table) are in the
 verification's reach or reached here: those planes alone would place it (touching one face near it does not).
 Geometry and inverse kinematics only, unless ``--probe``: then each face some finger reaches is probed on the
 simulated hand by the finger :func:`haptic.executor.placement.finger_probe` picks (a level line to the nearest pad
@@ -121,9 +122,40 @@ def probe_face(ep, f: int, pad_point: np.ndarray) -> dict:
     return out
 
 
+def corner_verdict(poly, pose, cfg, reach, v: int, test) -> dict:
+    """What the verification's probes at the corners would do for hidden vertex ``v``
+    (:class:`~haptic.planning.finger_faces.CornerProbes`, :func:`~haptic.matching.acceptance.placed_near`), with
+    every vertex and edge in the pad's reach taken as measured: whether its faces span space, whether each of its
+    edges or the edge's other end is in reach, and per face the lines within its corner at ``v``
+    (:func:`~haptic.planning.finger_faces.corner_lines`) and the finger the reach test (``test``,
+    ``PlannerConfig.finger_reach``) finds for the first it reaches: "reflex corner", "no pad position", "no finger"
+    or the finger's name. Placeable when every face has a finger and the other two hold."""
+    from haptic.matching.acceptance import corner_spans, corner_triangle
+    from haptic.planning.finger_faces import corner_lines
+    from haptic.planning.hypothesis import Hypothesis
+
+    h = Hypothesis(model=poly.name, poly=poly, world_from_model=pose, faces={}, edges={}, vertices={})
+    edges = all(int(e) in reach[1] or int(sum(poly.edges[int(e)])) - v in reach[2] for e in poly.vertex_edges[v])
+    faces = {}
+    for f in (int(f) for f in poly.vertex_faces[v]):
+        if corner_triangle(poly, v, f) is None:
+            faces[f] = "reflex corner"
+            continue
+        lines = corner_lines(poly, pose, v, f, cfg)
+        got = next((g for g in (test(line, [h]) for line in lines) if g is not None), None)
+        faces[f] = "no pad position" if not lines else "no finger" if got is None else str(got.finger)
+    spans = corner_spans(poly, v)
+    placeable = spans and edges and all(w not in ("reflex corner", "no pad position", "no finger")
+                                        for w in faces.values())  # fmt: skip
+    return {"spans": spans, "edges": edges, "faces": faces, "placeable": placeable}
+
+
 def study(model: str, seed: int, library, probe: bool = False) -> dict:
     """The hidden and unpinnable vertices of one episode's object at its pose, and what reaches their faces (with
-    ``probe``: each face some finger reaches probed on the hand, :func:`probe_face`)."""
+    ``probe``: each face some finger reaches probed on the hand, :func:`probe_face`); for each hidden vertex, what
+    the probes at its faces' corners would do (:func:`corner_verdict`)."""
+    from haptic.executor.placement import finger_reach
+
     ep = build_episode(EpisodeSpec(model=model, seed=seed, executor="physics", verify="full"), library)
     poly, pose, cfg = ep.true_model, ep.world_from_model, ep.config
     reach = reachable_features(poly, pose, cfg)
@@ -135,6 +167,7 @@ def study(model: str, seed: int, library, probe: bool = False) -> dict:
         return out
     solver = ReachSolver(compose_scene(scene_object_from_polyhedron(poly), pose.as_matrix()))
     started, probed = False, set()
+    test = finger_reach()
     for v in [*hidden, *unpinned]:
         faces = []
         for f in (int(f) for f in poly.vertex_faces[v]):
@@ -171,7 +204,8 @@ def study(model: str, seed: int, library, probe: bool = False) -> dict:
             verdict = "no pad position"
         out["vertices"].append({"vertex": int(v), "height_mm": round(float(z[v]) * 1000, 1),
                                 "on_table": bool(v in unpinned), "verdict": verdict, "planes": bool(planes),
-                                "faces": faces})  # fmt: skip
+                                "faces": faces,
+                                "corner": corner_verdict(poly, pose, cfg, reach, v, test) if v in hidden else None})
     return out
 
 
@@ -195,6 +229,7 @@ def main(argv: list[str] | None = None) -> int:
             pairs = [(m, int(s)) for m in names for s in args.seeds.split(",")]
         rows, verdicts, by, fingers, probes = [], Counter(), Counter(), Counter(), Counter()
         placed = 0
+        corners = Counter()
         for model, seed in pairs:
             r = study(model, seed, library, args.probe)
             rows.append(r)
@@ -220,10 +255,19 @@ def main(argv: list[str] | None = None) -> int:
                 print(f"  v{x['vertex']} {x['height_mm']:.0f} mm up: {x['verdict']} ({planes}); " + "; ".join(parts),
                       flush=True)  # fmt: skip
                 placed += x["planes"]
+                if x["corner"] is not None:
+                    c = x["corner"]
+                    corners[c["placeable"]] += 1
+                    print(f"    corners: faces {'span' if c['spans'] else 'do not span'} space, edges' other ends "
+                          f"{'in reach' if c['edges'] else 'not all in reach'}; "
+                          + ", ".join(f"f{f} {w}" for f, w in c["faces"].items())
+                          + (" -> placeable" if c["placeable"] else " -> not placeable"), flush=True)
         n_eps = sum(1 for r in rows if r["vertices"])
         print(f"\n{n_eps} of {len(rows)} episodes with vertices out of the verification's reach; "
               f"{sum(verdicts.values())} vertices: " + ", ".join(f"{k} {v}" for k, v in verdicts.most_common())
               + f"; {placed} with enough planes in some finger's reach to place them")
+        print(f"hidden vertices the probes at their faces' corners would place: {corners[True]} of "
+              f"{corners[True] + corners[False]}")
         complete = sum(1 for r in rows if r["vertices"] and all(x["planes"] for x in r["vertices"]))
         print(f"episodes whose every such vertex has enough planes in some finger's reach: {complete} of {n_eps}")
         if by:

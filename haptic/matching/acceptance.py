@@ -636,6 +636,85 @@ class TablePin:
         return sum(self.plane_known(i, faces, vertices) for i in range(len(self.faces))) >= 2
 
 
+CORNER_SPAN = 0.3
+"""The unit normals of a vertex's faces span space when the least singular value of their matrix is at least this
+(a box's corner: 1; a regular tetrahedron's: 0.58; two faces turned 25° apart and a third across both: 0.31): a
+corner moved 3 mm then moves at least 3 × 0.3 / √k mm along the normal of one of its k faces, which tilts that
+face's corner."""
+
+
+def corner_triangle(model: Polyhedron, v: int, f: int) -> np.ndarray | None:
+    """The corner of face ``f`` at vertex ``v`` of ``model``: the triangle of ``v`` and its two neighbours in the
+    face's loop (model frame, shape (3, 3), ``v`` first), or None where the face's corner at ``v`` is reflex (the
+    triangle lies off the face). A corner of the object moved off the model's place tilts this triangle of each of
+    its faces and keeps the rest of the face's plane (:func:`haptic.geometry.perturb.move_vertex`'s variants: the
+    corner triangle becomes a face of its own): a face measured there sees the move, one measured elsewhere on the
+    face need not."""
+    loop = list(model.faces[f])
+    k = loop.index(v)
+    tri = model.vertices[[v, loop[(k + 1) % len(loop)], loop[k - 1]]]
+    if float(np.cross(tri[1] - tri[0], tri[2] - tri[0]) @ model.face_normals[f]) <= 0.0:
+        return None
+    return tri
+
+
+def in_corner(points: np.ndarray, tri: np.ndarray, normal: np.ndarray, slack: float = 0.0) -> np.ndarray:
+    """Whether each of ``points`` (model frame, (P, 3)) lies, seen along the face's ``normal``, within the corner
+    triangle ``tri`` (:func:`corner_triangle`) or within ``slack`` of it, shape (P,)."""
+    inside = np.ones(len(points), dtype=bool)
+    for a, b in ((tri[0], tri[1]), (tri[1], tri[2]), (tri[2], tri[0])):
+        inward = np.cross(normal, b - a)
+        inward /= max(float(np.linalg.norm(inward)), 1e-12)
+        inside &= (points - a) @ inward >= -slack
+    return inside
+
+
+def faces_measured_near(model: Polyhedron, data: Sequence[DataComponent], it: Interpretation,
+                        world_from_model: SE3, v: int) -> frozenset[int]:  # fmt: skip
+    """The faces of ``model`` at vertex ``v`` that ``it`` pairs with a data face touched within the face's corner at
+    ``v`` alone (:func:`corner_triangle`; every touched point, within its position bound): the faces whose plane is
+    measured near ``v``. A face touched across the rest of the face too is not: its fit would mix the corner's tilt
+    with the plane beyond."""
+    inv = world_from_model.inverse()
+    at_v = {int(f) for f in model.vertex_faces[v]}
+    out = set()
+    for i, f in it.faces.items():
+        f = int(f)
+        if f not in at_v or f in out:
+            continue
+        tri = corner_triangle(model, v, f)
+        c = data[i]
+        if tri is None or not isinstance(c, DataFace):
+            continue
+        pts = inv.apply(np.atleast_2d(c.points))
+        if bool(np.all(in_corner(pts, tri, model.face_normals[f], c.position_bound))):
+            out.add(f)
+    return frozenset(out)
+
+
+def corner_spans(model: Polyhedron, v: int) -> bool:
+    """Whether the faces at vertex ``v`` are at least three with normals spanning space (:data:`CORNER_SPAN`)."""
+    n = model.face_normals[[int(f) for f in model.vertex_faces[v]]]
+    return len(n) >= 3 and float(np.linalg.svd(n, compute_uv=False)[-1]) >= CORNER_SPAN
+
+
+def placed_near(model: Polyhedron, data: Sequence[DataComponent], it: Interpretation, world_from_model: SE3,
+                v: int, edges: frozenset[int], vertices: frozenset[int]) -> bool:  # fmt: skip
+    """Whether vertex ``v`` of ``model``, which no move touches (off the table, out of the hand's reach), is placed by
+    the planes of its faces measured near it: it has at least three faces whose normals span space
+    (:func:`corner_spans`), *every* one of them is measured within its corner at ``v``
+    (:func:`faces_measured_near`: a corner moved 3 mm tilts at least one of them, and a vertex of more faces could
+    move along the line where three of them meet while tilting only the rest), and every edge at ``v`` is measured
+    (in ``edges``) or has its other end measured (in ``vertices``): a chamfer of an edge at ``v`` leaves the planes
+    near ``v`` in place away from the edge and moves both of its ends by its legs, which a measured end sees. The
+    pose check and the acceptance test then test the corner as they test every measured face."""
+    if not corner_spans(model, v):
+        return False
+    if faces_measured_near(model, data, it, world_from_model, v) != {int(f) for f in model.vertex_faces[v]}:
+        return False
+    return all(int(e) in edges or int(sum(model.edges[int(e)])) - v in vertices for e in model.vertex_edges[v])
+
+
 @dataclass(frozen=True)
 class Coverage:
     """Which of a model's faces, edges and vertices the data have measured (under one interpretation)."""
@@ -742,6 +821,7 @@ def coverage(
 
 __all__ = [
     "ACCEPT_ALPHA",
+    "CORNER_SPAN",
     "DEFAULT_VERIFY",
     "K_SIGMA",
     "K_SIGMA_PHYSICS",
@@ -755,6 +835,11 @@ __all__ = [
     "Coverage",
     "PoseCheck",
     "check_verify_mode",
+    "corner_spans",
+    "corner_triangle",
+    "faces_measured_near",
+    "in_corner",
+    "placed_near",
     "coverage",
     "own_bounds_keep",
     "pose_check",

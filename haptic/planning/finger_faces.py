@@ -11,11 +11,15 @@ face, ending past a pad position near the vertex where the pad touches that face
 finger, if any, carries a line out, and the hand's way there, is the reach solver's answer
 (``PlannerConfig.finger_reach``: the hand's, with the hypothesised model at its pose); the verification asks it
 line by line (:meth:`~haptic.planning.verify.Verifier.choose`) and ends naming the faces no finger reaches.
+
+The same probes measure the faces of a vertex off the table that no move touches (:class:`CornerProbes`), each within
+its corner at the vertex (:func:`corner_lines`): every one of its faces measured there places it
+(:func:`~haptic.matching.acceptance.placed_near`).
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -23,6 +27,7 @@ import numpy as np
 from haptic.geometry.distance import surface_distance
 from haptic.geometry.polyhedron import Polyhedron
 from haptic.geometry.se3 import SE3
+from haptic.matching.acceptance import corner_spans, corner_triangle, in_corner
 from haptic.planning.config import PlannerConfig
 from haptic.planning.moves import ProbeMove
 
@@ -116,16 +121,19 @@ def _rim_distance(pts: np.ndarray, loop: np.ndarray) -> np.ndarray:
     return best
 
 
-def face_line(world_from_model: SE3, poly: Polyhedron, f: int, pad_point: np.ndarray, r: float) -> ProbeMove:
+def face_line(world_from_model: SE3, poly: Polyhedron, f: int, pad_point: np.ndarray, r: float,
+              rim: np.ndarray | None = None) -> ProbeMove:  # fmt: skip
     """A probe line to the pad touching face ``f`` at ``pad_point`` (world): level toward the face (along its inward
     normal when the face is level), starting :data:`RUN_UP` before the touch and ending :data:`RUN_ON` past it; its
-    ``room`` the point's distance to the face's rim."""
+    ``room`` the point's distance to the face's rim (to the polygon ``rim``, world frame, where given: the stroke
+    kept within it)."""
     n = world_from_model.rotate(poly.face_normals[f])
     u = -n * np.array([1.0, 1.0, 0.0])
     u = u / np.linalg.norm(u) if float(np.linalg.norm(u)) > 0.1 else -n
     centre = np.asarray(pad_point, dtype=float) + r * n
-    room = float(_rim_distance(np.asarray(pad_point, dtype=float)[None],
-                               world_from_model.apply(poly.vertices[list(poly.faces[f])]))[0])  # fmt: skip
+    if rim is None:
+        rim = world_from_model.apply(poly.vertices[list(poly.faces[f])])
+    room = float(_rim_distance(np.asarray(pad_point, dtype=float)[None], rim)[0])
     return ProbeMove(centre + (r - RUN_UP) * u, u, RUN_UP + RUN_ON, room=room)
 
 
@@ -218,5 +226,156 @@ class TableFaceProbes:
                 "no_finger": list(self.no_finger), "no_position": list(self.no_position)}  # fmt: skip
 
 
-__all__ = ["GRID", "POSITIONS", "TableFaceProbes", "faces_to_probe", "face_line", "pad_positions",
-           "table_face_lines"]
+def corner_positions(poly: Polyhedron, world_from_model: SE3, v: int, f: int, config: PlannerConfig) -> np.ndarray:
+    """Pad positions of face ``f`` (:func:`pad_positions`, world frame) within its corner at vertex ``v``
+    (:func:`~haptic.matching.acceptance.corner_triangle`) with :data:`MIN_ROOM` to the corner's sides, so that the
+    stroke measures the corner alone; those with :data:`ROOM` first, then the nearest ``v``. None where the face's
+    corner at ``v`` is reflex."""
+    tri = corner_triangle(poly, v, f)
+    pts = pad_positions(poly, world_from_model, v, f, config)
+    if tri is None or not len(pts):
+        return np.zeros((0, 3))
+    room = _rim_distance(pts, world_from_model.apply(tri))
+    inside = in_corner(world_from_model.inverse().apply(pts), tri, poly.face_normals[f])
+    keep = inside & (room >= MIN_ROOM)
+    pts, room = pts[keep], np.minimum(room[keep], ROOM)
+    vw = world_from_model.apply(poly.vertices[v])
+    return pts[np.lexsort((np.linalg.norm(pts - vw, axis=1), -np.round(room, 4)))]
+
+
+def corner_lines(poly: Polyhedron, world_from_model: SE3, v: int, f: int, config: PlannerConfig,
+                 most: int = POSITIONS) -> list[ProbeMove]:  # fmt: skip
+    """Up to ``most`` probe lines (:func:`face_line`) to face ``f`` within its corner at vertex ``v``
+    (:func:`corner_positions`), at least :data:`SPREAD` apart, each line's room that to the corner's sides; none
+    where the pad cannot touch the face alone there clear of the table with room for a stroke."""
+    picked: list[np.ndarray] = []
+    for p in corner_positions(poly, world_from_model, v, f, config):
+        if all(float(np.linalg.norm(p - q)) >= SPREAD for q in picked):
+            picked.append(p)
+            if len(picked) >= most:
+                break
+    tri = corner_triangle(poly, v, f)
+    rim = world_from_model.apply(tri) if tri is not None else None
+    return [face_line(world_from_model, poly, f, p, config.pad_radius, rim) for p in picked]
+
+
+@dataclass
+class CornerProbes:
+    """The verification's probes at the corners of the vertices out of the hand's reach off the table
+    (:func:`~haptic.planning.verify.hidden_vertices`): such a vertex is placed when every one of its faces is measured
+    within its corner at the vertex (:func:`~haptic.matching.acceptance.placed_near`). Each face left is probed along
+    lines within its corner (:func:`corner_lines`) by whichever finger the hand's reach test (``reach``,
+    ``PlannerConfig.finger_reach``) finds for each line, asked in turn until one is reached. Nothing is probed unless
+    every such vertex could be placed (its faces span space, each of its edges or the edge's other end is measured,
+    and each face left has a line): a vertex that cannot be leaves the verification incomplete whatever the others
+    measure. The probes stop at the first (vertex, face) whose lines are used up unmeasured."""
+
+    reach: Callable
+    """The reach test: (probe line, hypotheses) -> the probe with its finger and path, or None."""
+    lines: dict[tuple[int, int], list[ProbeMove]] = field(default_factory=dict)
+    """Each (vertex, face)'s lines not asked yet (filled the first time it is weighed)."""
+    no_position: list[tuple[int, int]] = field(default_factory=list)
+    """(vertex, face) where the pad cannot touch the face within its corner, in the order found."""
+    used_up: list[tuple[int, int]] = field(default_factory=list)
+    """(vertex, face) whose lines were all asked and the face is still not measured there, in the order found."""
+    too_few: list[int] = field(default_factory=list)
+    """Vertices whose faces are fewer than three or do not span space (:func:`corner_spans`)."""
+    open_edges: list[int] = field(default_factory=list)
+    """Vertices with an edge of which neither the edge nor its other end is measured (a chamfer of it would not be
+    seen: :func:`~haptic.matching.acceptance.placed_near`)."""
+    probed: dict[tuple[int, int], int] = field(default_factory=dict)
+    """Probes made per (vertex, face)."""
+    fingers: dict[str, int] = field(default_factory=dict)
+    """Probes made per finger."""
+    asked: int = 0
+    """Lines the reach test was asked about."""
+    pending: ProbeMove | None = None
+    """The probe chosen for the next verification move (None: none)."""
+
+    def next(self, h, todo: Mapping[int, frozenset[int]], edges: frozenset[int], vertices: frozenset[int],
+             config: PlannerConfig) -> ProbeMove | None:  # fmt: skip
+        """The next probe for hypothesis ``h`` (a pose): ``todo`` maps each vertex out of reach to its faces not yet
+        measured within their corner at it; ``edges`` and ``vertices``: the model edges and vertices measured. Kept
+        as :attr:`pending`; None when some vertex cannot be placed (too few faces, an edge at it with neither
+        itself nor its other end measured, a face with no line within its corner: each named) or the lines of a
+        face left are used up."""
+        self.pending = None
+        blocked = False
+        for v, faces in todo.items():
+            if not corner_spans(h.poly, v):
+                blocked = True
+                if v not in self.too_few:
+                    self.too_few.append(v)
+                continue
+            if not all(int(e) in edges or int(sum(h.poly.edges[int(e)])) - v in vertices
+                       for e in h.poly.vertex_edges[v]):  # fmt: skip
+                blocked = True
+                if v not in self.open_edges:
+                    self.open_edges.append(v)
+            for f in sorted(faces):
+                if (v, f) not in self.lines:
+                    self.lines[(v, f)] = corner_lines(h.poly, h.world_from_model, v, f, config)
+                    if not self.lines[(v, f)]:
+                        self.no_position.append((v, f))
+                blocked |= (v, f) in self.no_position
+        if blocked:
+            return None
+        for v, faces in todo.items():
+            for f in sorted(faces):
+                key = (v, f)
+                while self.lines[key]:
+                    line = self.lines[key].pop(0)
+                    self.asked += 1
+                    got = self.reach(line, [h])
+                    if got is not None:
+                        self.pending = got
+                        self.probed[key] = self.probed.get(key, 0) + 1
+                        self.fingers[str(got.finger)] = self.fingers.get(str(got.finger), 0) + 1
+                        return got
+                if key not in self.used_up:
+                    self.used_up.append(key)
+                return None
+        return None
+
+    def take(self) -> ProbeMove | None:
+        """The pending probe, once."""
+        move, self.pending = self.pending, None
+        return move
+
+    def unmeasured(self, vertices: Sequence[int]) -> str:
+        """Why ``vertices`` (out of reach, not placed) are not placed by their faces' corners, in words ("" when no
+        probe was weighed for them)."""
+        left = set(int(v) for v in vertices)
+        parts = []
+        few = [v for v in self.too_few if v in left]
+        if few:
+            parts.append(f"fewer than three faces spanning space at {'vertices' if len(few) > 1 else 'vertex'} "
+                         f"{', '.join(map(str, few))}")  # fmt: skip
+        open_ = [v for v in self.open_edges if v in left]
+        if open_:
+            at = "each of vertices" if len(open_) > 1 else "vertex"
+            parts.append(f"an edge at {at} {', '.join(map(str, open_))} with neither itself nor its other end "
+                         "measured")  # fmt: skip
+        room = [f"{f} at {v}" for v, f in self.no_position if v in left]
+        if room:
+            parts.append(f"the pad touches face{'s' if len(room) > 1 else ''} {', '.join(room)} nowhere within the "
+                         "corner clear of the table with room for a stroke")  # fmt: skip
+        none = [f"{f} at {v}" for v, f in self.used_up if v in left and (v, f) not in self.probed]
+        if none:
+            parts.append(f"no finger reaches face{'s' if len(none) > 1 else ''} {', '.join(none)} within the corner")
+        missed = [f"{f} at {v}" for v, f in self.used_up if v in left and (v, f) in self.probed]
+        if missed:
+            parts.append(f"face{'s' if len(missed) > 1 else ''} {', '.join(missed)} probed and not measured within "
+                         "the corner")  # fmt: skip
+        return "; ".join(parts)
+
+    def record(self) -> dict:
+        """What the probes did: lines asked, probes per finger, corners probed, and the (vertex, face) pairs with no
+        pad position or whose lines were used up."""
+        return {"asked": self.asked, "fingers": dict(self.fingers), "corners_probed": len(self.probed),
+                "no_position": [list(k) for k in self.no_position], "used_up": [list(k) for k in self.used_up],
+                "too_few": list(self.too_few), "open_edges": list(self.open_edges)}  # fmt: skip
+
+
+__all__ = ["GRID", "POSITIONS", "CornerProbes", "TableFaceProbes", "corner_lines", "corner_positions",
+           "faces_to_probe", "face_line", "pad_positions", "table_face_lines"]

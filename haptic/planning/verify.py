@@ -31,10 +31,10 @@ from haptic.geometry.polyhedron import Polyhedron
 from haptic.geometry.raycast import line_hits
 from haptic.geometry.se3 import SE3, plane_basis
 from haptic.geometry.tracing import corner_angle, inside_polygon
-from haptic.matching.acceptance import TablePin
+from haptic.matching.acceptance import TablePin, faces_measured_near, placed_near
 from haptic.matching.components import DataComponent, DataEdge, DataFace, SensorNoise
 from haptic.planning.config import PlannerConfig
-from haptic.planning.finger_faces import TableFaceProbes
+from haptic.planning.finger_faces import CornerProbes, TableFaceProbes
 from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.move_scores import same_move
 from haptic.planning.moves import EdgeMove, FaceMove, Move, ProbeMove, SensorState, VertexMove
@@ -255,8 +255,10 @@ def hidden_vertices(poly: Polyhedron, world_from_model: SE3, cov, config: Planne
     take from the table (farther than :data:`TABLE_CONTACT` above it): a vertex under an overhang, or on a face
     turned to the table that rests on other vertices. An object that differs from the model there (a corner
     moved 4 mm) is not told apart by anything the hand can touch, so a verification with one is incomplete, not
-    confirmed. A vertex measured all the same (the hand reached what the prediction counted out of reach) is not
-    hidden. Without a table every vertex is reachable and none is hidden."""
+    confirmed, unless the planes of its faces measured within their corners at it place it (the verifier's
+    :attr:`Verifier.placed`, :func:`~haptic.matching.acceptance.placed_near`). A vertex measured all the same (the
+    hand reached what the prediction counted out of reach) is not hidden. Without a table every vertex is reachable
+    and none is hidden."""
     if config.table_z is None:
         return []
     z = world_from_model.apply(poly.vertices)[:, 2] - config.table_z
@@ -1000,7 +1002,11 @@ class Verifier:
         self.coverage = None
         self._hyp: Hypothesis | None = None
         self.hidden: list[int] = []
-        """Model vertices out of the hand's reach and off the table (:func:`hidden_vertices`)."""
+        """Model vertices out of the hand's reach and off the table (:func:`hidden_vertices`) that the planes of
+        their faces measured near them do not place (:attr:`placed`)."""
+        self.placed: list[int] = []
+        """Model vertices out of the hand's reach off the table that every one of their faces measured within its
+        corner at them places (:func:`~haptic.matching.acceptance.placed_near`): counted measured."""
         self.table_band: float | None = None
         """On the table, once the model's coverage is met: how high above the table the verification measures
         nothing (:func:`table_band`): a confirmation says the object is the model above it [m] (None: no table, or
@@ -1034,6 +1040,11 @@ class Verifier:
         """On the hand, once every vertex in the pad's reach is measured: probes by another finger, or a tilted one,
         at the faces of table vertices that nothing measured places (:mod:`haptic.planning.finger_faces`); None
         without a reach test of such probes (``PlannerConfig.finger_reach``)."""
+        self.corner_probes = (CornerProbes(config.finger_reach)
+                              if config.finger_reach is not None and config.table_z is not None else None)  # fmt: skip
+        """On the hand, once every vertex in the pad's reach is measured: probes by any finger at the faces of the
+        vertices out of reach off the table, within each face's corner at the vertex
+        (:class:`~haptic.planning.finger_faces.CornerProbes`); None without a reach test of such probes."""
         self.middles_unprobed: set[int] = set()
         """Faces of :attr:`middles` that no admissible probe was predicted to reach at their middle (not asked for:
         a slot across such a face is not caught)."""
@@ -1072,14 +1083,19 @@ class Verifier:
         if not self.check.ok:
             self.status = "mismatch"
         elif self.coverage is not None and self.coverage.met(self.mode):
-            self.hidden = hidden_vertices(cls.model, self.check.world_from_model, self.coverage, self.config)
+            hidden = hidden_vertices(cls.model, self.check.world_from_model, self.coverage, self.config)
+            self.placed = [v for v in hidden if placed_near(cls.model, tree.data, it, self.check.world_from_model, v,
+                                                            self.coverage.edges, self.coverage.vertices)]
+            self.hidden = [v for v in hidden if v not in self.placed]
             unpinned = [v for v in self._pins[cls.name][1] if v not in self.hidden]
             placed = placed_by_data(cls.model, self.check.world_from_model, unpinned, self.coverage, self.config)
             self.unpinnable = [v for v in unpinned if v not in placed]
             if self.config.table_z is not None:
                 self.table_band = table_band(cls.model, self.check.world_from_model, self.config)
             self.status = "incomplete" if self.mode == "full" and (self.hidden or self.unpinnable) else "confirmed"
-            if self.status == "incomplete" and not self.hidden and self._finger_probe_next():
+            if self.status == "incomplete" and self.hidden and self._corner_probe_next(tree.data, it):
+                self.status = "verifying"
+            elif self.status == "incomplete" and not self.hidden and self._finger_probe_next():
                 self.status = "verifying"
             if self.status == "confirmed" and self.mode == "full" and self._probes_admitted():
                 todo = [f for f in unmeasured_middles(cls.model, self.check.world_from_model, tree.data,
@@ -1139,6 +1155,19 @@ class Verifier:
         if ff.pending is not None:
             return True
         return ff.next(self._hyp, self.unpinnable, self.coverage.faces, self.config) is not None
+
+    def _corner_probe_next(self, data: Sequence[DataComponent], it) -> bool:
+        """Whether a probe by any finger is to measure a face of the vertices out of reach off the table within its
+        corner at one of them (:attr:`corner_probes`, kept as its pending move)."""
+        cp = self.corner_probes
+        h = self._hyp
+        if cp is None or h is None or h.world_from_model is None or self.coverage is None:
+            return False
+        if cp.pending is not None:
+            return True
+        todo = {v: frozenset(int(f) for f in h.poly.vertex_faces[v])
+                   - faces_measured_near(h.poly, data, it, h.world_from_model, v) for v in self.hidden}  # fmt: skip
+        return cp.next(h, todo, self.coverage.edges, self.coverage.vertices, self.config) is not None
 
     def _probes_admitted(self) -> bool:
         return self.config.moves != "tracing" and self.config.table_z is None and MAX_VERIFY_PROBES > 0
@@ -1201,6 +1230,10 @@ class Verifier:
                     f"{self._model_name} not measured (a slot across a face leaves its vertices in place)")
         if self.status == "incomplete" and (self.hidden or self.unpinnable):
             where = [f"{len(self.hidden)} out of the hand's reach off the table"] if self.hidden else []
+            cp = self.corner_probes
+            why = cp.unmeasured(self.hidden) if cp is not None and self.hidden else ""
+            if why:
+                where[-1] += f" ({why})"
             if self.unpinnable:
                 where.append(f"{len(self.unpinnable)} on the table with neither an edge rising from them nor two of "
                              "their faces in reach")  # fmt: skip
@@ -1229,10 +1262,11 @@ class Verifier:
         t0 = time.perf_counter()
         self.moves += 1
         asked, self._asked = self._asked, None  # the last face move asked: set again below when this is one
-        if self.finger_faces is not None and self.finger_faces.pending is not None:
-            move = self.finger_faces.take()
-            self.decision_times.append(time.perf_counter() - t0)
-            return move
+        for probes in (self.corner_probes, self.finger_faces):
+            if probes is not None and probes.pending is not None:
+                move = probes.take()
+                self.decision_times.append(time.perf_counter() - t0)
+                return move
         if self._hyp is not None and self._hyp.world_from_model is not None:
             h = self._hyp
         if self.middles and h.world_from_model is not None:
@@ -1422,11 +1456,15 @@ class Verifier:
             out["move_budget"] = self.move_budget()
             out.update(self.coverage.record(self._model))
             out["vertices_hidden"] = len(self.hidden) + len(self.unpinnable)
+            if self.placed:
+                out["vertices_placed"] = len(self.placed)
             # verified up to what the hand cannot measure: every feature in its reach measured (the status says
             # whether that was all: "incomplete" with vertices hidden is this, never "confirmed")
             out["reach_complete"] = bool(self.coverage.met(self.mode))
         if self.finger_faces is not None and self.finger_faces.asked:
             out["finger_faces"] = self.finger_faces.record()
+        if self.corner_probes is not None and self.corner_probes.asked:
+            out["corner_probes"] = self.corner_probes.record()
         if self.table_band is not None:
             # the claim: the object is the model above this height; below it, next to the table, nothing measured
             out["table_band_mm"] = round(self.table_band * 1000.0, 2)

@@ -157,3 +157,155 @@ def test_a_verification_completes_with_probes_by_a_turned_finger(tmp_path):
     measured = [r for r in by_finger if r.ok and r.components]
     assert len(measured) >= 2
     assert rec.verified["finger_faces"]["faces_probed"] >= 2
+
+
+def _top_vertex(poly, pose) -> int:
+    return int(np.argmax(pose.apply(poly.vertices)[:, 2]))
+
+
+def test_a_line_to_a_corner_touches_the_face_within_the_corner_with_room_for_a_stroke():
+    from haptic.matching.acceptance import corner_triangle, in_corner
+    from haptic.planning.finger_faces import RUN_UP, corner_lines
+
+    poly, pose = _octahedron(0.1)
+    config = _config()
+    v = _top_vertex(poly, pose)
+    inv = pose.inverse()
+    for f in (int(f) for f in poly.vertex_faces[v]):
+        lines = corner_lines(poly, pose, v, f, config)
+        assert lines, f"face {f} has room within its corner at the top vertex"
+        tri = corner_triangle(poly, v, f)
+        n = pose.rotate(poly.face_normals[f])
+        for line in lines:
+            # the pad's touch: a pad's radius back from its centre where the line meets the face
+            centre = line.start + (RUN_UP - config.pad_radius) * line.direction
+            touch = inv.apply((centre - config.pad_radius * n)[None])
+            assert in_corner(touch, tri, poly.face_normals[f], slack=-MIN_ROOM + 1e-6)[0]
+            assert MIN_ROOM - 1e-9 <= line.room
+            # its room is the corner's, less than the face's where the corner's far side crosses the face
+            assert in_corner(touch, tri, poly.face_normals[f], slack=-line.room + 1e-6)[0]
+
+
+def test_the_corner_probes_ask_nothing_while_some_vertex_cannot_be_placed():
+    from haptic.planning.finger_faces import CornerProbes
+
+    poly, pose = _octahedron(0.1)
+    config = _config()
+    h = Hypothesis(model="octahedron", poly=poly, world_from_model=pose, faces={}, edges={}, vertices={})
+    asked: list[ProbeMove] = []
+
+    def nobody(line, hypotheses):
+        asked.append(line)
+        return None
+
+    v = _top_vertex(poly, pose)
+    table = _table_vertices(poly, pose)[0]
+    faces = frozenset(int(f) for f in poly.vertex_faces[v])
+    # a vertex on the table has faces whose corner the pad cannot touch clear of the table: nothing is asked
+    below = frozenset(int(f) for f in poly.vertex_faces[table])
+    everything = frozenset(range(poly.n_edges))
+    probes = CornerProbes(nobody)
+    assert probes.next(h, {v: faces, table: below}, everything, frozenset(), config) is None
+    assert not asked and probes.no_position
+    # the top vertex alone: its first face's lines are asked in turn and named used up when no finger reaches
+    probes = CornerProbes(nobody)
+    assert probes.next(h, {v: faces}, everything, frozenset(), config) is None
+    first = min(faces)
+    assert probes.used_up == [(v, first)] and probes.asked == len(asked) >= 1
+    assert f"no finger reaches face {first} at {v}" in probes.unmeasured([v])
+    # an edge at the vertex with neither itself nor its other end measured: nothing is asked, and that is named
+    probes = CornerProbes(nobody)
+    asked.clear()
+    assert probes.next(h, {v: faces}, frozenset(), frozenset(), config) is None
+    assert not asked and probes.open_edges == [v] and "neither itself nor its other end" in probes.unmeasured([v])
+
+    def thumb(line, hypotheses):
+        return ProbeMove(line.start, line.direction, line.length, finger="thumb", room=line.room)
+
+    probes = CornerProbes(thumb)
+    got = probes.next(h, {v: faces}, everything, frozenset(), config)
+    assert got is not None and got.finger == "thumb" and probes.take() is got and probes.take() is None
+    assert probes.probed == {(v, first): 1} and probes.fingers == {"thumb": 1}
+
+
+def test_the_verification_probes_the_corners_of_a_vertex_out_of_reach_and_then_counts_it_placed():
+    # the octahedron's top vertex taken as out of reach (every other vertex measured): once every vertex in reach is
+    # measured the verification asks the reach test for a line within a corner of its faces and makes that probe;
+    # with every face measured within its corner the vertex is placed
+    from dataclasses import replace
+
+    from haptic.matching.acceptance import Coverage, corner_triangle, placed_near
+    from haptic.matching.components import DataFace, SensorNoise
+    from haptic.matching.tree import Interpretation
+    from haptic.planning.verify import Verifier
+
+    poly, pose = _octahedron(0.1)
+    asked: list[ProbeMove] = []
+
+    def thumb(line, hypotheses):
+        asked.append(line)
+        return replace(line, finger="thumb")
+
+    config = replace(_config(), finger_reach=thumb)
+    v = _top_vertex(poly, pose)
+    others = frozenset(range(poly.n_vertices)) - {v}
+    every = frozenset(range(poly.n_faces))
+    ver = Verifier("full", SensorNoise(), config)
+    ver._hyp = Hypothesis(model="octahedron", poly=poly, world_from_model=pose, faces={}, edges={}, vertices={})
+    ver.hidden = [v]
+    ver.coverage = Coverage(frozenset(), frozenset(), others, every, frozenset(), others)
+    it = Interpretation(poly, 0, {}, {}, {}, {}, pose, 0)
+    assert ver._corner_probe_next([], it)
+    move = ver.choose(ver._hyp, None, {}, ())
+    assert move is not None and move.finger == "thumb" and len(asked) == 1 and ver.corner_probes.pending is None
+    # each face touched round the middle of its corner at the vertex: placed
+    faces = [int(f) for f in poly.vertex_faces[v]]
+    data = []
+    for i, f in enumerate(faces):
+        tri = corner_triangle(poly, v, f)
+        touched = pose.apply(0.8 * tri.mean(axis=0) + 0.2 * tri)  # three points round the corner's middle
+        data.append(DataFace(i, pose.rotate(poly.face_normals[f]), touched, math.radians(1.0), 8e-4))
+    measured = Interpretation(poly, 0, {i: f for i, f in enumerate(faces)}, {}, {}, {}, pose, 0)
+    assert not placed_near(poly, data[:-1], Interpretation(poly, 0, {i: f for i, f in enumerate(faces[:-1])},
+                                                           {}, {}, {}, pose, 0), pose, v, frozenset(), others)
+    assert placed_near(poly, data, measured, pose, v, frozenset(), others)
+
+
+@pytest.mark.slow
+def test_a_probe_by_another_finger_measures_a_face_within_its_corner_at_a_vertex_out_of_reach():
+    # BOX01N at seed 1 lies with its slot on a side: the slot's four inner corners are out of the index's reach. The
+    # slot's back wall, level, is reached by the thumb turned level (scripts/reach_hidden.py); a line within the
+    # wall's corner at one of them, carried out on the hand, measures the wall there and nowhere else: every touched
+    # point in the corner triangle, the normal the model's.
+    from haptic.episode.spec import EpisodeSpec
+    from haptic.episode.worlds import build_episode
+    from haptic.matching.acceptance import corner_triangle, in_corner
+    from haptic.planning.finger_faces import corner_lines
+    from haptic.planning.verify import TABLE_CONTACT, reachable_features
+
+    ep = build_episode(EpisodeSpec(model="BOX01N", seed=1, executor="physics", verify="full"))
+    poly, pose, config = ep.true_model, ep.world_from_model, ep.config
+    reach = reachable_features(poly, pose, config)
+    z = pose.apply(poly.vertices)[:, 2] - config.table_z
+    hidden = [v for v in range(poly.n_vertices) if v not in reach[2] and z[v] > TABLE_CONTACT]
+    assert len(hidden) == 4
+    h = Hypothesis(model=poly.name, poly=poly, world_from_model=pose, faces={}, edges={}, vertices={})
+    probe = None
+    for v in hidden:
+        for f in (int(f) for f in poly.vertex_faces[v]):
+            if f in reach[0]:
+                continue
+            probe = next((g for g in (config.finger_reach(line, [h])
+                                      for line in corner_lines(poly, pose, v, f, config)) if g is not None), None)
+            if probe is not None:
+                break
+        if probe is not None:
+            break
+    assert probe is not None and probe.finger != "index"
+    assert ep.executor.start().ok
+    res = ep.executor.execute(probe)
+    assert res.ok and res.components, res.reason
+    face = res.components[0]
+    tri = corner_triangle(poly, v, f)
+    assert np.all(in_corner(pose.inverse().apply(face.points), tri, poly.face_normals[f], face.position_bound))
+    assert float(face.normal @ pose.rotate(poly.face_normals[f])) > math.cos(math.radians(1.0))

@@ -363,3 +363,40 @@ def test_a_vertex_move_that_failed_round_a_model_vertex_is_not_taken_again_there
     assert v._failed_along(h2, there, {**comps, 98: comps[f1], 99: comps[f2]}, ()) == [VertexMove(98)]
     point = Verifier("full", SensorNoise(), PlannerConfig())
     assert point._failed_along(h, r.state, comps, (VertexMove(f1),)) == []
+
+
+def test_the_inner_corner_of_an_l_block_out_of_reach_is_not_probed_and_the_verification_says_why():
+    """LBLOCK01 on its long side (as above): the inner corner's vertices 3 and 9, 37 mm up under the overhang, are out
+    of reach. The edge between them (the valley of the inner corner) is measured at neither end -- a chamfer of it
+    would leave the planes near both in place -- and their corners on the L's end faces are reflex (a corner moved
+    need not tilt any triangle of them that a probe could aim at): nothing is probed, and the reasons are named."""
+    from dataclasses import replace
+
+    from haptic.geometry.se3 import quat_to_matrix
+    from haptic.matching.acceptance import Coverage
+    from haptic.matching.components import SensorNoise as Noise
+    from haptic.matching.tree import Interpretation
+    from haptic.planning.moves import ProbeMove
+    from haptic.planning.verify import Verifier, reachable_features
+
+    poly = LIB["LBLOCK01"]
+    asked: list[ProbeMove] = []
+
+    def thumb(line, hypotheses):
+        asked.append(line)
+        return replace(line, finger="thumb")
+
+    config = replace(PlannerConfig(), table_z=0.35, pad_radius=0.012, finger_reach=thumb)
+    side = SE3(quat_to_matrix(np.array([0.043131444, -0.43720511, -0.555744269, 0.705790109])),
+               np.array([0.513729767, 0.103105708, 0.435697725]))  # fmt: skip
+    f, e, v = reachable_features(poly, side, config)
+    ver = Verifier("full", Noise(), config)
+    ver._hyp = Hypothesis("LBLOCK01", poly, side, {}, {}, {})
+    ver.hidden = [3, 9]
+    it = Interpretation(poly, 0, {}, {}, {}, {}, side, 0)
+    ver.coverage = Coverage(frozenset(), frozenset(), frozenset(v), f, e, v)
+    assert not ver._corner_probe_next([], it)
+    why = ver.corner_probes.unmeasured(ver.hidden)
+    assert not asked and ver.corner_probes.open_edges == [3, 9]
+    assert "an edge at each of vertices 3, 9 with neither itself nor its other end measured" in why
+    assert "faces 0 at 3, 1 at 9 nowhere within the corner" in why
