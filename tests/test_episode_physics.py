@@ -516,6 +516,23 @@ def test_an_edge_move_after_a_tilted_move_returns_beside_the_last_contact():
     assert rec.outcome == "recognized" and rec.correct, rec.detail
 
 
+def test_a_face_move_onto_a_face_under_an_overhang_reports_the_edge_alone():
+    # BOX01N seed 1 stands on an end, its slot sideways: the slot's floor lies 30 mm under its ceiling. Face moves
+    # rolled over the floor's edge (and the back wall's), and the stroke's step in stalled within a millimetre, the
+    # finger's medial link on the ceiling; touched afresh there, five touches a move, each ran away or timed out:
+    # five face moves failed, "stroke on the next face failed: blocked" (19 moves in all). A step held back with a
+    # link touching the object ends the crossing: the roll gives the edge alone, as onto a face leaning under.
+    done, failed = [], []
+    obs = EpisodeObserver(on_move=lambda n, r, *a: done.append(r), on_failed_move=lambda n, r: failed.append(r.reason))
+    ep = build_episode(EpisodeSpec(model="BOX01N", seed=1, executor="physics", verify="none"))
+    rec = ep.run(None, obs)
+    assert any(r.move is not None and r.move.kind == "face" and r.info.get("next_face") == "out of reach"
+               for r in done)  # fmt: skip
+    assert not [w for w in failed if "stroke on the next face failed" in w], failed
+    assert rec.outcome == "recognized" and rec.correct, rec.detail
+    assert _within_bounds(ep)
+
+
 def test_a_stroke_that_steps_onto_the_rim_of_another_edge_measures_no_face(tmp_path):
     # BOX01N 30 mm across, seed 1 (perception_report.py --sizes 30): a face move down over the top edge onto a
     # side 10 mm tall, above an overhang, rolled on to that side's lower edge as it stepped in; the stroke's legs

@@ -28,7 +28,7 @@ face normals.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -732,7 +732,9 @@ class Toucher:
                ) -> PrimitiveResult:  # fmt: skip
         """A short L on a face for its normal: ``step_in`` along ``away``, then ``stroke`` along ``along`` (the
         other way if an edge comes first). ``info["normal"]``: mean sensed normal on the face; ``info["at_table"]``:
-        the step in (``step_in`` not given) was stopped by the table, and the pad did not leave the edge.
+        the step in (``step_in`` not given) was stopped by the table, and the pad did not leave the edge. A step in
+        held back fails the stroke; ``info["held"]`` then names the link of the finger touching the object, if one
+        does (:meth:`_held_by_link`).
 
         A leg heading down that would bring the pad onto the table (event ``"table"``: a face leaning under,
         next to the table), or one whose pad a link of the finger lifted off (``"hand"``), ends there without
@@ -753,7 +755,7 @@ class Toucher:
             # 150 mm, seed 1: the step held back after 1.1 mm, the legs measured a "face" 15 bounds off, no-match);
             # elsewhere the legs from a step so held measured the face within its bound (BOX01N seed 1, in a slot),
             # and their rows alone do not tell the two apart
-            return pieces[-1]
+            return self._held_by_link(pieces[-1])
         pieces.append(self.trace_face(along, n_f, cfg.stroke, phase="stroke"))
         if (pieces[-1].ok and pieces[-1].event != "done") or pieces[-1].event in STOPS:
             back = self.trace_face(-along, n_f, cfg.stroke * 2.0, phase="stroke", from_edge=True)
@@ -782,6 +784,17 @@ class Toucher:
         blocked = len(pieces) == 3 and all(p.ok and p.event not in ("done", *STOPS) for p in pieces[1:])
         return PrimitiveResult(status, event, trace, sum(p.distance for p in pieces),
                                {"normal": n_mean, "rim": rim, "blocked": blocked, "at_table": at_table})  # fmt: skip
+
+    def _held_by_link(self, step: PrimitiveResult) -> PrimitiveResult:
+        """A stroke's step in that stalled (``"blocked"``), with ``info["held"]``: the link of the finger that touches
+        the object now (None when none does). The pad stepped in under an overhang, its links meeting the object above
+        it (BOX01N seed 1 on an end, its slot sideways: the pad rolled onto the slot's floor, 30 mm under its ceiling,
+        and the medial link met the ceiling's edge a millimetre in), or onto a face leaning under, the links meeting
+        the face it left."""
+        if step.event != "blocked":
+            return step
+        link = self.link_touch()
+        return replace(step, info={**step.info, "held": None if link is None else link.link})
 
     def _stepped_onto_rim(self, step: PrimitiveResult) -> bool:
         """Whether a stroke's first leg, off the edge just rolled over, met another edge or turned its sensed
