@@ -622,6 +622,8 @@ class PhysicsExecutor(LandingSearch):
                 why = ("the next face leans under, out of the pad's reach" if r.event == "undercut"
                        else "the pad reached the table's clearance before the next face")  # fmt: skip
                 return "undercut", f"crossing the {kind} edge: {why}", r.trace, None, None
+            if r.event == "face":
+                return "face", f"crossing the {kind} edge: the pad stayed on the face", None, None, None
             if r.event != "lost":  # the roll went on turning (limit), or the state is bad: nothing to touch afresh
                 return r.status, f"crossing the {kind} edge: {r.event}", None, None, None
             return self._reacquire(kind, n_a, direction, corner, r.trace, None, pieces, away_from,
@@ -770,7 +772,7 @@ class PhysicsExecutor(LandingSearch):
         status = self._ensure_on_face(st.face, pieces)
         if status != "ok":
             return self.failed_result(move, status, f"could not return to the current face: {self._why}")
-        recrosses, tilted, levelled = 0, False, False
+        recrosses, tilted, levelled, resumed = 0, False, False, False
         lead = 0.0
         heading = inplane  # crossed again from a point the face was touched at, the slide heads from there
         while True:
@@ -804,6 +806,12 @@ class PhysicsExecutor(LandingSearch):
                                                                           overhang=True)  # fmt: skip
             if status in ("undercut", "overhang"):
                 return self._edge_only(move, r, roll, reason, pieces)
+            if status == "face" and not resumed:
+                # the slide's contact weakened where no edge was: the roll came back onto the face, and the slide
+                # goes on from there, once
+                resumed = True
+                self.recoveries.append(f"{reason}: the slide went on")
+                continue
             if status == "hand" and not tilted:
                 tilted = True
                 if self._tilt_away(self._met, st.face, corner - self.settings.recross_back * heading, pieces):

@@ -51,6 +51,11 @@ STOPS = ("table", "hand")
 FAILURES = ("no-contact", "unreachable", "timeout", "unstable")
 """Failure statuses of a primitive (the move statuses of :class:`~haptic.planning.moves.MoveResult`)."""
 _FREE = PHASES.index("free")
+ROLL_ON_FACE = 0.004
+"""A roll over a convex edge whose sensed normal has not yet turned past the edge angle from the face it left after
+this much travel [m] slides on that face (event ``"face"``): the slide's contact weakened with no edge there, or was
+lost at an edge's end before the normal turned, and the roll, heading back against the travel, came onto the face
+again."""
 
 
 def _wrist_watch() -> dict:
@@ -659,7 +664,11 @@ class Toucher:
     def cross_edge(self, kind: str, n_a: np.ndarray, direction: np.ndarray) -> PrimitiveResult:
         """Roll over a convex edge, or climb out of a concave one, from face ``n_a`` onto the next face, until
         the sensed normal settles. ``info``: ``normal`` (the next face's normal, coarse), ``edge_direction``
-        (n_a × n_b), ``away`` (the in-plane direction on the new face pointing away from the edge)."""
+        (n_a × n_b), ``away`` (the in-plane direction on the new face pointing away from the edge). A roll that
+        does not settle within ``roll_max`` of travel (or the time for it) while a link of the finger touches the
+        object ends with event ``"hand"`` (the link held it back: BOX01N seed 1, rolling the tilted hand onto the
+        floor of its slot, the link on the slot's ceiling), else ``"limit"``; a roll over a convex edge whose normal
+        has not turned from ``n_a`` after :data:`ROLL_ON_FACE` of travel, with event ``"face"``."""
         cfg = self.config
         n_a = unit(np.asarray(n_a, dtype=float))
         d = np.asarray(direction, dtype=float)
@@ -673,6 +682,7 @@ class Toucher:
         last = self.tip.copy()
         lost = 0
         met = None  # a link of the finger on the object when the contact was lost
+        turned = False  # the sensed normal turned past the edge angle from n_a
         for _ in range(int(cfg.roll_max / cfg.roll_speed * 2.0 / self.dt)):
             n = self.normal if self.normal is not None else n_a
             if angle(n, n_a) > self.bounds.sample_cone:
@@ -699,6 +709,11 @@ class Toucher:
                 continue
             lost = 0
             hist.append((travelled, self.normal.copy()))
+            turned = turned or angle(self.normal, n_a) > cfg.edge_angle
+            if kind == "convex" and not turned and travelled > ROLL_ON_FACE:
+                # on the face it left, the roll would slide on across it to roll_max (FRAME01 seed 2: the slide's
+                # contact weakened in the middle of the top face, and the roll slid 24 mm over it)
+                return self._lost("unreachable", "face", met)
             if kind == "convex" and self.below_floor():
                 # rolling down round the edge the pad reached the table's clearance: it cannot go on round to the
                 # next face (leaning under next to the table), and the normal it settles at is the edge's, the pad
@@ -725,8 +740,9 @@ class Toucher:
                     return self._result("ok", "done", 0.0, normal=n_b, edge_direction=unit(cross(n_a, n_b)),
                                         away=away)  # fmt: skip
             if travelled > cfg.roll_max:
-                return self._result("unreachable", "limit", 0.0)
-        return self._result("timeout", "limit", 0.0)
+                return self._lost("unreachable", "limit")
+        # a roll that never settled: held back by a link of the finger on the object (event "hand"), or turning on
+        return self._lost("timeout", "limit")
 
     def stroke(self, normal: np.ndarray, away: np.ndarray, along: np.ndarray, step_in: float | None = None
                ) -> PrimitiveResult:  # fmt: skip
