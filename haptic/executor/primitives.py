@@ -28,7 +28,7 @@ face normals.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -51,6 +51,11 @@ STOPS = ("table", "hand")
 FAILURES = ("no-contact", "unreachable", "timeout", "unstable")
 """Failure statuses of a primitive (the move statuses of :class:`~haptic.planning.moves.MoveResult`)."""
 _FREE = PHASES.index("free")
+ROLL_ON_FACE = 0.004
+"""A roll over a convex edge whose sensed normal has not yet turned past the edge angle from the face it left after
+this much travel [m] slides on that face (event ``"face"``): the slide's contact weakened with no edge there, or was
+lost at an edge's end before the normal turned, and the roll, heading back against the travel, came onto the face
+again."""
 
 
 def _wrist_watch() -> dict:
@@ -659,7 +664,11 @@ class Toucher:
     def cross_edge(self, kind: str, n_a: np.ndarray, direction: np.ndarray) -> PrimitiveResult:
         """Roll over a convex edge, or climb out of a concave one, from face ``n_a`` onto the next face, until
         the sensed normal settles. ``info``: ``normal`` (the next face's normal, coarse), ``edge_direction``
-        (n_a × n_b), ``away`` (the in-plane direction on the new face pointing away from the edge)."""
+        (n_a × n_b), ``away`` (the in-plane direction on the new face pointing away from the edge). A roll that
+        does not settle within ``roll_max`` of travel (or the time for it) while a link of the finger touches the
+        object ends with event ``"hand"`` (the link held it back: BOX01N seed 1, rolling the tilted hand onto the
+        floor of its slot, the link on the slot's ceiling), else ``"limit"``; a roll over a convex edge whose normal
+        has not turned from ``n_a`` after :data:`ROLL_ON_FACE` of travel, with event ``"face"``."""
         cfg = self.config
         n_a = unit(np.asarray(n_a, dtype=float))
         d = np.asarray(direction, dtype=float)
@@ -673,6 +682,7 @@ class Toucher:
         last = self.tip.copy()
         lost = 0
         met = None  # a link of the finger on the object when the contact was lost
+        turned = False  # the sensed normal turned past the edge angle from n_a
         for _ in range(int(cfg.roll_max / cfg.roll_speed * 2.0 / self.dt)):
             n = self.normal if self.normal is not None else n_a
             if angle(n, n_a) > self.bounds.sample_cone:
@@ -699,6 +709,11 @@ class Toucher:
                 continue
             lost = 0
             hist.append((travelled, self.normal.copy()))
+            turned = turned or angle(self.normal, n_a) > cfg.edge_angle
+            if kind == "convex" and not turned and travelled > ROLL_ON_FACE:
+                # on the face it left, the roll would slide on across it to roll_max (FRAME01 seed 2: the slide's
+                # contact weakened in the middle of the top face, and the roll slid 24 mm over it)
+                return self._lost("unreachable", "face", met)
             if kind == "convex" and self.below_floor():
                 # rolling down round the edge the pad reached the table's clearance: it cannot go on round to the
                 # next face (leaning under next to the table), and the normal it settles at is the edge's, the pad
@@ -725,14 +740,17 @@ class Toucher:
                     return self._result("ok", "done", 0.0, normal=n_b, edge_direction=unit(cross(n_a, n_b)),
                                         away=away)  # fmt: skip
             if travelled > cfg.roll_max:
-                return self._result("unreachable", "limit", 0.0)
-        return self._result("timeout", "limit", 0.0)
+                return self._lost("unreachable", "limit")
+        # a roll that never settled: held back by a link of the finger on the object (event "hand"), or turning on
+        return self._lost("timeout", "limit")
 
     def stroke(self, normal: np.ndarray, away: np.ndarray, along: np.ndarray, step_in: float | None = None
                ) -> PrimitiveResult:  # fmt: skip
         """A short L on a face for its normal: ``step_in`` along ``away``, then ``stroke`` along ``along`` (the
         other way if an edge comes first). ``info["normal"]``: mean sensed normal on the face; ``info["at_table"]``:
-        the step in (``step_in`` not given) was stopped by the table, and the pad did not leave the edge.
+        the step in (``step_in`` not given) was stopped by the table, and the pad did not leave the edge. A step in
+        held back fails the stroke; ``info["held"]`` then names the link of the finger touching the object, if one
+        does (:meth:`_held_by_link`).
 
         A leg heading down that would bring the pad onto the table (event ``"table"``: a face leaning under,
         next to the table), or one whose pad a link of the finger lifted off (``"hand"``), ends there without
@@ -753,7 +771,7 @@ class Toucher:
             # 150 mm, seed 1: the step held back after 1.1 mm, the legs measured a "face" 15 bounds off, no-match);
             # elsewhere the legs from a step so held measured the face within its bound (BOX01N seed 1, in a slot),
             # and their rows alone do not tell the two apart
-            return pieces[-1]
+            return self._held_by_link(pieces[-1])
         pieces.append(self.trace_face(along, n_f, cfg.stroke, phase="stroke"))
         if (pieces[-1].ok and pieces[-1].event != "done") or pieces[-1].event in STOPS:
             back = self.trace_face(-along, n_f, cfg.stroke * 2.0, phase="stroke", from_edge=True)
@@ -782,6 +800,17 @@ class Toucher:
         blocked = len(pieces) == 3 and all(p.ok and p.event not in ("done", *STOPS) for p in pieces[1:])
         return PrimitiveResult(status, event, trace, sum(p.distance for p in pieces),
                                {"normal": n_mean, "rim": rim, "blocked": blocked, "at_table": at_table})  # fmt: skip
+
+    def _held_by_link(self, step: PrimitiveResult) -> PrimitiveResult:
+        """A stroke's step in that stalled (``"blocked"``), with ``info["held"]``: the link of the finger that touches
+        the object now (None when none does). The pad stepped in under an overhang, its links meeting the object above
+        it (BOX01N seed 1 on an end, its slot sideways: the pad rolled onto the slot's floor, 30 mm under its ceiling,
+        and the medial link met the ceiling's edge a millimetre in), or onto a face leaning under, the links meeting
+        the face it left."""
+        if step.event != "blocked":
+            return step
+        link = self.link_touch()
+        return replace(step, info={**step.info, "held": None if link is None else link.link})
 
     def _stepped_onto_rim(self, step: PrimitiveResult) -> bool:
         """Whether a stroke's first leg, off the edge just rolled over, met another edge or turned its sensed
