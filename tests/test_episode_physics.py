@@ -988,3 +988,18 @@ def test_an_edge_move_that_sets_off_past_a_gap_in_its_line_sets_off_again_inside
     again = [r for r in edge if any("past the edge's explored interval" in w for w in r.info.get("recoveries", ()))]
     assert again and all(r.ok for r in again), [r.reason for r in again]
     assert _within_bounds(ep)
+
+
+def test_a_vertex_move_round_a_valleys_end_circles_clear_of_the_valleys_other_face():
+    # LBLOCK01 seed 2 (physics_episodes.py --verify none): once the edge moves located the ends of the L's valley,
+    # a vertex move set off to circle one of them across the L's floor; the circle (8 mm) lies nearer the valley than
+    # the pad (12 mm) can touch the floor without meeting the wall, and the touch timed out ("could not reach the
+    # face next to the vertex: timeout/limit"). The circle now starts where the pad clears the wall.
+    results = []
+    obs = EpisodeObserver(on_move=lambda n, r, *a: results.append(r), on_failed_move=lambda n, r: results.append(r))
+    ep = build_episode(EpisodeSpec(model="LBLOCK01", seed=2, executor="physics", max_moves=4))
+    ep.run(None, obs)
+    circles = [r for r in results if r.move is not None and r.move.kind == "vertex"
+               and any("valley's end" in w for w in r.info.get("recoveries", ()))]  # fmt: skip
+    assert circles and all(r.ok for r in circles), [r.reason for r in circles]
+    assert _within_bounds(ep)

@@ -181,6 +181,13 @@ class PhysicsSettings:
     rim_hold: float = 0.1
     """At the end of a concave edge, where the surface fell away, the pad then presses in place this long more,
     reading its contacts on the faces' rims apart (``PhysicsExecutor._concave_end``) [s] ..."""
+    valley_margin: float = 0.002
+    """A vertex move's circle about the end of a valley starts where the pad, resting on the face it circles, clears
+    the valley's other face by this (``PhysicsExecutor._valley_circle``) [m] ..."""
+    valley_start_angle: float = math.radians(60.0)
+    """... at this angle from the valley, at least [rad] ..."""
+    valley_max_radius: float = 0.02
+    """... and at most this far from the vertex; farther, the move fails [m]."""
     rim_plane: float = 0.001
     """... a contact within this of a face's plane is on it (or on its rim) [m] ..."""
     min_rim_samples: int = 10
@@ -887,14 +894,18 @@ class PhysicsExecutor(LandingSearch):
                                  > math.cos(self.bounds.row_cone))  # fmt: skip
         known = np.vstack([trace.point_in_world[ok], self._faces[fid].points]) if fid in self._faces \
             else trace.point_in_world[ok]
-        # neither from nor toward a concave corner of the face: a slide there meets the face across first
+        # neither from nor toward a concave corner of the face: a slide there meets the face across first. The
+        # model's radius at least: a touch that met both faces of the corner (the start above, timed out) reads its
+        # contact between the two patches, inside the pad, and the refined radius dips (BOX01N seed 2: 8.7 mm for
+        # 12, and the slide set off 10 mm from a slot's floor met the floor)
+        clear = max(self.toucher.pad_radius, self.toucher.pad_model_radius)
         for rec in self.segmenter.edges.values():
             if not rec.convex and fid in rec.faces and len(known):
                 rel = np.vstack([known, target]) - rec.point
                 off = np.linalg.norm(rel - np.outer(rel @ rec.direction, rec.direction), axis=1)
-                if off[-1] < self.toucher.pad_radius:
+                if off[-1] < clear:
                     return None
-                known = known[off[:-1] >= self.toucher.pad_radius]
+                known = known[off[:-1] >= clear]
         if not len(known):
             return None
         way = target - known
@@ -1447,14 +1458,21 @@ class PhysicsExecutor(LandingSearch):
         u = toward_vertex(rec, rec.vertices[st.vertex])
         w_f = rec.inward[f]
         n_f = seg.faces[f].component.normal
-        rho, beta = s.vertex_radius, s.vertex_start_angle
+        circle = self._valley_circle(rec, f, s.vertex_radius, s.vertex_start_angle)
+        if circle is None:
+            return self.failed_result(move, "unreachable", "the circle around the vertex lies within the pad's reach "
+                                                           "of the valley's other face")  # fmt: skip
+        rho, beta = circle
+        if rho != s.vertex_radius:
+            self.recoveries.append(f"the circle around a valley's end: {rho * MM:.0f} mm from the vertex, clear of "
+                                   "the valley's other face")  # fmt: skip
         p0 = vtx + rho * (-math.cos(beta) * u + math.sin(beta) * w_f)
         sweep = self.workspace.circle_sweep_off_table(vtx, n_f, u, w_f)
         if sweep <= 0.0:
             return self.failed_result(move, "unreachable", "the vertex is next to the table: the circle around it "
                                                           "would put the pad on the table")  # fmt: skip
         status = self._ensure_on_face(f, pieces, near=p0)
-        if status == "unreachable" and self._why.startswith("touched a normal"):
+        if status == "unreachable" and self._why.startswith("touched a normal") and rho == s.vertex_radius:
             # the pad at the circle's start touched the rim of the face's far edge (the face's corner at the vertex
             # narrower than the start angle, or the vertex located a little off): the circle starts halfway to the
             # current edge instead
@@ -1563,6 +1581,31 @@ class PhysicsExecutor(LandingSearch):
         e = unit(e)
         out = float((corner - vtx) @ e)
         return math.copysign(self.settings.recross_shift + 0.5 * self.toucher.pad_radius, out) * e
+
+    def _valley_circle(self, rec, f: int, rho: float, beta: float) -> tuple[float, float] | None:
+        """The radius and start angle of a vertex move's circle on face ``f`` around a vertex at the end of edge
+        ``rec``: ``rho`` and ``beta`` as planned, unless ``rec`` is a valley whose other face (normal ``n_g``) the
+        pad would meet at the circle's start: resting on ``f`` at a distance ``x`` from the valley, the pad's centre
+        clears that face's plane by its radius only where ``x (w_f · n_g) + r (n_f · n_g) >= r``, ``w_f`` pointing
+        into ``f`` from the valley (LBLOCK01 and BOX01N, seed 2: circles of 8 mm about a valley's end timed out
+        touching the face, the pad 12 mm across). Then the circle starts at :attr:`PhysicsSettings.valley_start_angle`
+        at the radius that puts the pad clear of it by :attr:`PhysicsSettings.valley_margin`; None when that radius
+        is over :attr:`PhysicsSettings.valley_max_radius`."""
+        if rec.convex or None in rec.faces or f not in rec.inward:
+            return rho, beta
+        g = rec.faces[1] if rec.faces[0] == f else rec.faces[0]
+        n_f = self.segmenter.faces[f].component.normal
+        n_g = self.segmenter.faces[g].component.normal
+        lean = float(rec.inward[f] @ n_g)
+        if lean <= 1e-3:
+            return rho, beta
+        s, r = self.settings, self.toucher.pad_radius
+        need = (r * (1.0 - float(n_f @ n_g)) + s.valley_margin) / lean
+        if rho * math.sin(beta) >= need:
+            return rho, beta
+        beta = max(beta, s.valley_start_angle)
+        rho = need / math.sin(beta)
+        return (rho, beta) if rho <= s.valley_max_radius else None
 
     def _circle_crossed_again(self, f: int, n_f: np.ndarray, direction: np.ndarray, corner: np.ndarray,
                               shift: np.ndarray, vtx: np.ndarray, circle: ContactTrace,
