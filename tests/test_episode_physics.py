@@ -248,15 +248,17 @@ def test_a_face_move_round_a_vertex_onto_a_narrow_face_follows_the_ridge_first(t
     # bounds off every true edge (no-match). The stroke on the next face met an edge along both of its legs (the
     # face is a wedge at the apex): the move follows the ridge each way before it reports the edge, and there is none.
     # (Since a face move crossing square to the edge follows the ridge too, this episode's moves differ: its rolls
-    # round a vertex are told by their normals or by the ridge.)
-    failed = []
-    obs = EpisodeObserver(on_failed_move=lambda n, r: failed.append(r.reason))
+    # round a vertex are told by their normals or by the ridge. A vertex move whose circle rolls round the apex now
+    # crosses again clear of it: the roll told shows among its recoveries.)
+    failed, recovered = [], []
+    obs = EpisodeObserver(on_move=lambda n, r, *a: recovered.extend(r.info.get("recoveries", ())),
+                          on_failed_move=lambda n, r: failed.append(r.reason))  # fmt: skip
     spec = EpisodeSpec(model="bipyramid_07", seed=1, executor="physics",
                        models=_scaled_library(tmp_path, 0.06, corpus=True))  # fmt: skip
     ep = build_episode(spec)
     rec = ep.run(None, obs)
     told = ("no edge along the roll's axis", "acquiring the ridge", "more than the noise allows")
-    assert any(x in w for w in failed for x in told), failed
+    assert any(x in w for w in failed + recovered for x in told), (failed, recovered)
     assert rec.outcome != "no-match", rec.detail
     assert _within_bounds(ep)
 
@@ -1047,3 +1049,31 @@ def test_a_verification_whose_every_candidate_the_hand_cannot_make_ends_without_
     spec = EpisodeSpec(model="FRAME01", seed=1, executor="physics", models=_scaled_library(tmp_path, 0.03))
     rec = run_episode(spec)
     assert not (rec.recognized and not rec.correct), rec.detail
+
+
+def test_a_vertex_move_round_a_valleys_end_circles_clear_of_the_valleys_other_face():
+    # LBLOCK01 seed 2 (physics_episodes.py --verify none): once the edge moves located the ends of the L's valley,
+    # a vertex move set off to circle one of them across the L's floor; the circle (8 mm) lies nearer the valley than
+    # the pad (12 mm) can touch the floor without meeting the wall, and the touch timed out ("could not reach the
+    # face next to the vertex: timeout/limit"). The circle now starts where the pad clears the wall.
+    results = []
+    obs = EpisodeObserver(on_move=lambda n, r, *a: results.append(r), on_failed_move=lambda n, r: results.append(r))
+    ep = build_episode(EpisodeSpec(model="LBLOCK01", seed=2, executor="physics", max_moves=4))
+    ep.run(None, obs)
+    circles = [r for r in results if r.move is not None and r.move.kind == "vertex"
+               and any("valley's end" in w for w in r.info.get("recoveries", ()))]  # fmt: skip
+    assert circles and all(r.ok for r in circles), [r.reason for r in circles]
+    assert _within_bounds(ep)
+
+
+def test_a_vertex_circle_that_rolled_round_the_vertex_crosses_again_out_along_the_edge_clear_of_it(tmp_path):
+    # bipyramid_08 of the sized formula corpus (130 mm), seed 1: the fifth move circled the apex at 8 mm and met
+    # the next edge 8.7 mm from it; the pad (12 mm) rolled round the apex, and the next face touched afresh was
+    # another round it. The shift told by the roll's lean ran back toward the apex, the start lay off the face, and
+    # the move failed ("no edge between the faces: ... (a roll round a vertex)"). It now crosses again out along the
+    # edge, from the vertex circled through where the circle met it, the pad's radius and more clear of the vertex.
+    ep, results = _moves("bipyramid_08", 1, _sized_corpus(tmp_path), 5)
+    vertex = [r for r in results if r.move is not None and r.move.kind == "vertex"]
+    again = [r for r in vertex if any("clear of the vertex" in w for w in r.info.get("recoveries", ()))]
+    assert again and all(r.ok for r in again), [r.reason for r in vertex]
+    assert _within_bounds(ep)

@@ -181,6 +181,13 @@ class PhysicsSettings:
     rim_hold: float = 0.1
     """At the end of a concave edge, where the surface fell away, the pad then presses in place this long more,
     reading its contacts on the faces' rims apart (``PhysicsExecutor._concave_end``) [s] ..."""
+    valley_margin: float = 0.002
+    """A vertex move's circle about the end of a valley starts where the pad, resting on the face it circles, clears
+    the valley's other face by this (``PhysicsExecutor._valley_circle``) [m] ..."""
+    valley_start_angle: float = math.radians(60.0)
+    """... at this angle from the valley, at least [rad] ..."""
+    valley_max_radius: float = 0.02
+    """... and at most this far from the vertex; farther, the move fails [m]."""
     rim_plane: float = 0.001
     """... a contact within this of a face's plane is on it (or on its rim) [m] ..."""
     min_rim_samples: int = 10
@@ -913,14 +920,18 @@ class PhysicsExecutor(LandingSearch):
                                  > math.cos(self.bounds.row_cone))  # fmt: skip
         known = np.vstack([trace.point_in_world[ok], self._faces[fid].points]) if fid in self._faces \
             else trace.point_in_world[ok]
-        # neither from nor toward a concave corner of the face: a slide there meets the face across first
+        # neither from nor toward a concave corner of the face: a slide there meets the face across first. The
+        # model's radius at least: a touch that met both faces of the corner (the start above, timed out) reads its
+        # contact between the two patches, inside the pad, and the refined radius dips (BOX01N seed 2: 8.7 mm for
+        # 12, and the slide set off 10 mm from a slot's floor met the floor)
+        clear = max(self.toucher.pad_radius, self.toucher.pad_model_radius)
         for rec in self.segmenter.edges.values():
             if not rec.convex and fid in rec.faces and len(known):
                 rel = np.vstack([known, target]) - rec.point
                 off = np.linalg.norm(rel - np.outer(rel @ rec.direction, rec.direction), axis=1)
-                if off[-1] < self.toucher.pad_radius:
+                if off[-1] < clear:
                     return None
-                known = known[off[:-1] >= self.toucher.pad_radius]
+                known = known[off[:-1] >= clear]
         if not len(known):
             return None
         way = target - known
@@ -1473,14 +1484,21 @@ class PhysicsExecutor(LandingSearch):
         u = toward_vertex(rec, rec.vertices[st.vertex])
         w_f = rec.inward[f]
         n_f = seg.faces[f].component.normal
-        rho, beta = s.vertex_radius, s.vertex_start_angle
+        circle = self._valley_circle(rec, f, s.vertex_radius, s.vertex_start_angle)
+        if circle is None:
+            return self.failed_result(move, "unreachable", "the circle around the vertex lies within the pad's reach "
+                                                           "of the valley's other face")  # fmt: skip
+        rho, beta = circle
+        if rho != s.vertex_radius:
+            self.recoveries.append(f"the circle around a valley's end: {rho * MM:.0f} mm from the vertex, clear of "
+                                   "the valley's other face")  # fmt: skip
         p0 = vtx + rho * (-math.cos(beta) * u + math.sin(beta) * w_f)
         sweep = self.workspace.circle_sweep_off_table(vtx, n_f, u, w_f)
         if sweep <= 0.0:
             return self.failed_result(move, "unreachable", "the vertex is next to the table: the circle around it "
                                                           "would put the pad on the table")  # fmt: skip
         status = self._ensure_on_face(f, pieces, near=p0)
-        if status == "unreachable" and self._why.startswith("touched a normal"):
+        if status == "unreachable" and self._why.startswith("touched a normal") and rho == s.vertex_radius:
             # the pad at the circle's start touched the rim of the face's far edge (the face's corner at the vertex
             # narrower than the start angle, or the vertex located a little off): the circle starts halfway to the
             # current edge instead
@@ -1541,10 +1559,18 @@ class PhysicsExecutor(LandingSearch):
             shift = self._away_from_vertex(fit_f.normal, fit_g.normal, roll)
             again = None if shift is None else self._circle_crossed_again(
                 f, n_f, r.info["direction"], corner, shift, vtx, r.trace, pieces)
+            where = "along the edge"
+            if again is None:
+                # the roll's lean told no way, or a wrong one (the next face touched afresh round the vertex, its
+                # normal another face's): the edge met leaves the vertex circled, so out along it, clear of it
+                shift = self._clear_of_vertex(n_f, corner, vtx)
+                again = None if shift is None else self._circle_crossed_again(
+                    f, n_f, r.info["direction"], corner, shift, vtx, r.trace, pieces)
+                where = "out along the edge, clear of the vertex"
             if again is None:
                 return self.failed_result(move, "unreachable", why)
             _, kind, roll, stroke, fit_g, fit_f, line, shifted, touched = again
-            self.recoveries.append(f"{why}: crossed again {shifted * MM:.0f} mm along the edge"
+            self.recoveries.append(f"{why}: crossed again {shifted * MM:.0f} mm {where}"
                                    f"{FROM_TOUCHED if touched else ''}")  # fmt: skip
         if seg.beside_parallel_face(st.edge, f, fit_g):
             return self.failed_result(move, "unreachable", "the edge met lies along the current edge's line, the "
@@ -1590,6 +1616,45 @@ class PhysicsExecutor(LandingSearch):
         out = float((corner - vtx) @ e)
         return math.copysign(self.settings.recross_shift + 0.5 * self.toucher.pad_radius, out) * e
 
+    def _clear_of_vertex(self, n_f: np.ndarray, corner: np.ndarray, vtx: np.ndarray) -> np.ndarray | None:
+        """After a vertex circle on face ``n_f`` round ``vtx`` that met an edge at ``corner`` and rolled round the
+        vertex: the shift along that edge (from the vertex through ``corner``, in the face) that puts the crossing
+        the pad's radius plus ``recross_shift`` from the vertex, ``recross_shift`` at least (bipyramid_08 of the
+        sized corpus at 130 mm, seed 1: met 8.7 mm from the apex, the pad rolled round it, and the shift told by the
+        roll's lean, the next face touched afresh round the apex, ran back toward it); None when the crossing lies
+        at the vertex."""
+        out = in_plane(np.asarray(corner - vtx, dtype=float), n_f)
+        if out is None or float(np.linalg.norm(out)) < self.bounds.position_floor:
+            return None
+        s = self.settings
+        dist = float(np.linalg.norm(out))
+        return max(s.recross_shift, self.toucher.pad_radius + s.recross_shift - dist) * (out / dist)
+
+    def _valley_circle(self, rec, f: int, rho: float, beta: float) -> tuple[float, float] | None:
+        """The radius and start angle of a vertex move's circle on face ``f`` around a vertex at the end of edge
+        ``rec``: ``rho`` and ``beta`` as planned, unless ``rec`` is a valley whose other face (normal ``n_g``) the
+        pad would meet at the circle's start: resting on ``f`` at a distance ``x`` from the valley, the pad's centre
+        clears that face's plane by its radius only where ``x (w_f · n_g) + r (n_f · n_g) >= r``, ``w_f`` pointing
+        into ``f`` from the valley (LBLOCK01 and BOX01N, seed 2: circles of 8 mm about a valley's end timed out
+        touching the face, the pad 12 mm across). Then the circle starts at :attr:`PhysicsSettings.valley_start_angle`
+        at the radius that puts the pad clear of it by :attr:`PhysicsSettings.valley_margin`; None when that radius
+        is over :attr:`PhysicsSettings.valley_max_radius`."""
+        if rec.convex or None in rec.faces or f not in rec.inward:
+            return rho, beta
+        g = rec.faces[1] if rec.faces[0] == f else rec.faces[0]
+        n_f = self.segmenter.faces[f].component.normal
+        n_g = self.segmenter.faces[g].component.normal
+        lean = float(rec.inward[f] @ n_g)
+        if lean <= 1e-3:
+            return rho, beta
+        s, r = self.settings, self.toucher.pad_radius
+        need = (r * (1.0 - float(n_f @ n_g)) + s.valley_margin) / lean
+        if rho * math.sin(beta) >= need:
+            return rho, beta
+        beta = max(beta, s.valley_start_angle)
+        rho = need / math.sin(beta)
+        return (rho, beta) if rho <= s.valley_max_radius else None
+
     def _circle_crossed_again(self, f: int, n_f: np.ndarray, direction: np.ndarray, corner: np.ndarray,
                               shift: np.ndarray, vtx: np.ndarray, circle: ContactTrace,
                               pieces: list[PrimitiveResult]):  # fmt: skip
@@ -1611,13 +1676,25 @@ class PhysicsExecutor(LandingSearch):
         # from a point the face was touched at, the slide runs as far as it is from the new crossing
         reach = s.circle_recross if way is d else s.circle_recross + float(np.linalg.norm(self.contact_point()
                                                                                             - corner - shift))
-        r = t.trace_face(way, n_f, reach)
-        pieces.append(r)
-        if not r.ok or r.event == "done":
-            return None
-        kind, corner = r.info["kind"], self.contact_point()
-        status, _, roll, stroke, fit_g = self._cross_and_acquire(kind, r.info["face_normal"], r.info["direction"],
-                                                                 pieces, away_from=vtx)  # fmt: skip
+        # a link of the finger that meets the object sliding or crossing tilts the hand away once, back at the start
+        start, tilted = self.contact_point(), False
+        while True:
+            r = t.trace_face(way, n_f, reach)
+            pieces.append(r)
+            if r.event == "hand" and not tilted:
+                tilted = True
+                if self._tilt_away(r, f, start, pieces):
+                    continue
+            if not r.ok or r.event == "done":
+                return None
+            kind, corner = r.info["kind"], self.contact_point()
+            status, _, roll, stroke, fit_g = self._cross_and_acquire(kind, r.info["face_normal"], r.info["direction"],
+                                                                     pieces, away_from=vtx)  # fmt: skip
+            if status == "hand" and not tilted:
+                tilted = True
+                if self._tilt_away(self._met, f, start, pieces):
+                    continue
+            break
         if status != "ok":
             return None
         fit_f, line, _ = self._edge_between(f, r.trace, "face", roll, fit_g, kind, corner)
