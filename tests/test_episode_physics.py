@@ -298,10 +298,6 @@ def test_a_stroke_riding_the_rims_of_a_small_face_measures_no_face(tmp_path):
     assert _within_bounds(ep)
 
 
-@pytest.mark.xfail(strict=False, reason=(
-    "the pad returns next to the edge beside its last contact, 23 mm past the explored interval and past the slot; "
-    "holding the return to the interval fixed this episode but sent BOX01N seed 3 (slot against the table) to its "
-    "move budget and FRAME01 seed 2 to 'no admissible move', so it is not done"))
 def test_an_edge_move_that_sets_off_past_the_edges_other_end_reports_no_vertex(tmp_path):
     # BOX01N at 60 mm, seed 2, --verify none (perception_report.py --sizes 60 --first-seed 2): an edge move along +e
     # returned next to the edge 23 mm behind its explored interval, past the edge's other end, and located that end's
@@ -334,10 +330,6 @@ def test_an_edge_move_that_goes_on_round_a_shallow_vertex_reports_no_vertex(tmp_
     assert _within_bounds(ep)
 
 
-@pytest.mark.xfail(strict=False, reason=(
-    "with the level slide beside the table the episode's first moves differ: the vertex move now comes after "
-    "move 6, and by move 8 another move has reported a feature other than the first it met on its way (a missed "
-    "component, not yet explained)"))
 def test_a_vertex_move_whose_circle_meets_an_edge_of_another_vertex_reports_no_edge(tmp_path):
     # trapezohedron_12 of the formula corpus at 60 mm, seed 1 when found (2 since the verification aims a pad's
     # radius from a vertex: the trajectories differ): circling a vertex across a kite narrower than the
@@ -810,10 +802,6 @@ def test_a_roll_that_began_round_a_vertex_with_the_next_face_out_of_reach_report
     assert _within_bounds(ep)
 
 
-@pytest.mark.xfail(strict=False, reason=(
-    "the legs' steady normals of a thumb's stroke on a face differ by 2.0° as well (tests/executor/"
-    "test_placement_physics.py), its face within its bound: comparing the legs cannot tell a rim from the pad's own "
-    "bias along each leg; with the face, stall and reach work merged the episode no longer takes that stroke"))
 def test_a_stroke_whose_second_leg_rides_a_rim_measures_no_face(tmp_path):
     # FRAME01 at 30 mm, seed 1 (perception_report.py --sizes 30): touched afresh after stepping onto a rim, the next
     # face's L-shaped stroke held the face's normal on its first leg and one 2.4° off on its second, which rode the rim
