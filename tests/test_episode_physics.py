@@ -11,6 +11,15 @@ from haptic.episode.spec import EpisodeSpec
 from haptic.episode.worlds import build_episode, run_episode
 
 
+def _watched(spec: EpisodeSpec):
+    """Run the episode of ``spec``: the episode, its record, every move's recoveries and the failed moves' reasons."""
+    said, failed = [], []
+    obs = EpisodeObserver(on_move=lambda n, r, *a: said.extend(r.info.get("recoveries", ())),
+                          on_failed_move=lambda n, r: failed.append(r.reason))  # fmt: skip
+    ep = build_episode(spec)
+    return ep, ep.run(None, obs), said, failed
+
+
 def test_a_physics_episode_recognises_the_pyramid():
     rec = run_episode(EpisodeSpec(model="PYR01", seed=1, executor="physics", verify="none"))
     assert rec.outcome == "recognized", rec.detail
@@ -56,11 +65,7 @@ def test_a_face_move_sliding_down_to_the_table_goes_on_level_to_an_edge():
     # edge: 4 of 28 moves failed, "the finger would meet the table before an edge". The slide now goes on across the
     # face nearly level, toward the side it was heading, to the edge there, and measures it; the planner predicts
     # that edge (planning.table.level_leg).
-    said, failed = [], []
-    obs = EpisodeObserver(on_move=lambda n, r, *a: said.extend(r.info.get("recoveries", ())),
-                          on_failed_move=lambda n, r: failed.append(r.reason))  # fmt: skip
-    ep = build_episode(EpisodeSpec(model="BOX01", seed=3, executor="physics", verify="full"))
-    rec = ep.run(None, obs)
+    ep, rec, said, failed = _watched(EpisodeSpec(model="BOX01", seed=3, executor="physics", verify="full"))
     assert any("the slide went on level" in x for x in said), said
     assert not [x for x in failed if "table before an edge" in x], failed
     assert rec.outcome == "recognized" and rec.correct, rec.detail
@@ -532,11 +537,7 @@ def test_a_roll_that_finds_the_pad_still_on_the_face_lets_the_slide_go_on():
     # the roll, its normal still the face's, headed back over the face until its travel ran out ("crossing the convex
     # edge: limit"). A roll whose normal has not turned after a few millimetres is on the face it left: the slide
     # goes on from there, once.
-    said, failed = [], []
-    obs = EpisodeObserver(on_move=lambda n, r, *a: said.extend(r.info.get("recoveries", ())),
-                          on_failed_move=lambda n, r: failed.append(r.reason))  # fmt: skip
-    ep = build_episode(EpisodeSpec(model="LBLOCK01", seed=3, executor="physics", verify="full"))
-    rec = ep.run(None, obs)
+    ep, rec, said, failed = _watched(EpisodeSpec(model="LBLOCK01", seed=3, executor="physics", verify="full"))
     assert any("the pad stayed on the face: the slide went on" in x for x in said), said
     assert not [w for w in failed if "edge: limit" in w], failed
     assert rec.outcome == "recognized" and rec.correct, rec.detail

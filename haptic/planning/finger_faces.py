@@ -151,6 +151,21 @@ def table_face_lines(poly: Polyhedron, world_from_model: SE3, v: int, f: int, co
     return [face_line(world_from_model, poly, f, p, config.pad_radius) for p in picked]
 
 
+def _first_reached(probes, lines: list[ProbeMove], key, h) -> ProbeMove | None:
+    """The first of ``lines`` (taken off the list as asked) that ``probes``' reach test reaches in hypothesis ``h``'s
+    world, booked as ``probes``' pending probe of ``key`` with its finger; None when none is reached."""
+    while lines:
+        line = lines.pop(0)
+        probes.asked += 1
+        got = probes.reach(line, [h])
+        if got is not None:
+            probes.pending = got
+            probes.probed[key] = probes.probed.get(key, 0) + 1
+            probes.fingers[str(got.finger)] = probes.fingers.get(str(got.finger), 0) + 1
+            return got
+    return None
+
+
 @dataclass
 class TableFaceProbes:
     """The verification's probes of the faces at table vertices that nothing in the pad's reach places, by whichever
@@ -185,15 +200,9 @@ class TableFaceProbes:
                 if not self.lines[f]:
                     self.no_position.append(f)
                     continue
-            while self.lines[f]:
-                line = self.lines[f].pop(0)
-                self.asked += 1
-                got = self.reach(line, [h])
-                if got is not None:
-                    self.pending = got
-                    self.probed[f] = self.probed.get(f, 0) + 1
-                    self.fingers[str(got.finger)] = self.fingers.get(str(got.finger), 0) + 1
-                    return got
+            got = _first_reached(self, self.lines[f], f, h)
+            if got is not None:
+                return got
             if f not in self.probed and f not in self.no_finger and f not in self.no_position:
                 self.no_finger.append(f)
         return None
@@ -323,15 +332,9 @@ class CornerProbes:
         for v, faces in todo.items():
             for f in sorted(faces):
                 key = (v, f)
-                while self.lines[key]:
-                    line = self.lines[key].pop(0)
-                    self.asked += 1
-                    got = self.reach(line, [h])
-                    if got is not None:
-                        self.pending = got
-                        self.probed[key] = self.probed.get(key, 0) + 1
-                        self.fingers[str(got.finger)] = self.fingers.get(str(got.finger), 0) + 1
-                        return got
+                got = _first_reached(self, self.lines[key], key, h)
+                if got is not None:
+                    return got
                 if key not in self.used_up:
                     self.used_up.append(key)
                 return None

@@ -5,15 +5,29 @@ an episode of the formula corpus whose verification completes only with such pro
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
 from haptic.geometry import SE3, Polyhedron
+from haptic.matching.acceptance import Coverage, corner_triangle, in_corner, placed_near
+from haptic.matching.components import DataFace, SensorNoise
+from haptic.matching.tree import Interpretation
 from haptic.planning.config import PlannerConfig
-from haptic.planning.finger_faces import MIN_ROOM, TableFaceProbes, faces_to_probe, pad_positions, table_face_lines
+from haptic.planning.finger_faces import (
+    MIN_ROOM,
+    RUN_UP,
+    CornerProbes,
+    TableFaceProbes,
+    corner_lines,
+    faces_to_probe,
+    pad_positions,
+    table_face_lines,
+)
 from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import ProbeMove
+from haptic.planning.verify import Verifier
 
 
 def _octahedron(size: float) -> tuple[Polyhedron, SE3]:
@@ -96,17 +110,31 @@ def test_a_small_octahedron_leaves_no_room_clear_of_the_table():
             assert not len(pad_positions(poly, pose, v, f, config))
 
 
-def test_the_probes_ask_each_line_once_and_name_what_no_finger_reaches():
+def _setup():
+    """The octahedron at its pose, the planner's configuration and its hypothesis there."""
     poly, pose = _octahedron(0.1)
-    config = _config()
     h = Hypothesis(model="octahedron", poly=poly, world_from_model=pose, faces={}, edges={}, vertices={})
-    asked: list[ProbeMove] = []
+    return poly, pose, _config(), h
 
-    def nobody(line, hypotheses):
+
+def _nobody(asked: list[ProbeMove]):
+    """A reach test no finger passes, booking each line it is asked about in ``asked``."""
+
+    def reach(line, hypotheses):
         asked.append(line)
-        return None
 
-    probes = TableFaceProbes(nobody)
+    return reach
+
+
+def _thumb(line, hypotheses):
+    """A reach test the thumb passes for every line."""
+    return ProbeMove(line.start, line.direction, line.length, finger="thumb", room=line.room)
+
+
+def test_the_probes_ask_each_line_once_and_name_what_no_finger_reaches():
+    poly, pose, config, h = _setup()
+    asked: list[ProbeMove] = []
+    probes = TableFaceProbes(_nobody(asked))
     vertices = _table_vertices(poly, pose)
     assert probes.next(h, vertices, frozenset(), config) is None
     assert probes.next(h, vertices, frozenset(), config) is None
@@ -114,11 +142,7 @@ def test_the_probes_ask_each_line_once_and_name_what_no_finger_reaches():
                   for v, f in faces_to_probe(poly, pose, vertices, frozenset(), config))  # fmt: skip
     assert len(asked) == n_lines == probes.asked
     assert "no finger reaches" in probes.unmeasured(vertices, h, frozenset(), config)
-
-    def thumb(line, hypotheses):
-        return ProbeMove(line.start, line.direction, line.length, finger="thumb", room=line.room)
-
-    probes = TableFaceProbes(thumb)
+    probes = TableFaceProbes(_thumb)
     got = probes.next(h, vertices, frozenset(), config)
     assert got is not None and got.finger == "thumb" and probes.take() is got and probes.take() is None
     assert probes.fingers == {"thumb": 1}
@@ -164,9 +188,6 @@ def _top_vertex(poly, pose) -> int:
 
 
 def test_a_line_to_a_corner_touches_the_face_within_the_corner_with_room_for_a_stroke():
-    from haptic.matching.acceptance import corner_triangle, in_corner
-    from haptic.planning.finger_faces import RUN_UP, corner_lines
-
     poly, pose = _octahedron(0.1)
     config = _config()
     v = _top_vertex(poly, pose)
@@ -187,17 +208,9 @@ def test_a_line_to_a_corner_touches_the_face_within_the_corner_with_room_for_a_s
 
 
 def test_the_corner_probes_ask_nothing_while_some_vertex_cannot_be_placed():
-    from haptic.planning.finger_faces import CornerProbes
-
-    poly, pose = _octahedron(0.1)
-    config = _config()
-    h = Hypothesis(model="octahedron", poly=poly, world_from_model=pose, faces={}, edges={}, vertices={})
+    poly, pose, config, h = _setup()
     asked: list[ProbeMove] = []
-
-    def nobody(line, hypotheses):
-        asked.append(line)
-        return None
-
+    nobody = _nobody(asked)
     v = _top_vertex(poly, pose)
     table = _table_vertices(poly, pose)[0]
     faces = frozenset(int(f) for f in poly.vertex_faces[v])
@@ -218,11 +231,7 @@ def test_the_corner_probes_ask_nothing_while_some_vertex_cannot_be_placed():
     asked.clear()
     assert probes.next(h, {v: faces}, frozenset(), frozenset(), config) is None
     assert not asked and probes.open_edges == [v] and "neither itself nor its other end" in probes.unmeasured([v])
-
-    def thumb(line, hypotheses):
-        return ProbeMove(line.start, line.direction, line.length, finger="thumb", room=line.room)
-
-    probes = CornerProbes(thumb)
+    probes = CornerProbes(_thumb)
     got = probes.next(h, {v: faces}, everything, frozenset(), config)
     assert got is not None and got.finger == "thumb" and probes.take() is got and probes.take() is None
     assert probes.probed == {(v, first): 1} and probes.fingers == {"thumb": 1}
@@ -232,13 +241,6 @@ def test_the_verification_probes_the_corners_of_a_vertex_out_of_reach_and_then_c
     # the octahedron's top vertex taken as out of reach (every other vertex measured): once every vertex in reach is
     # measured the verification asks the reach test for a line within a corner of its faces and makes that probe;
     # with every face measured within its corner the vertex is placed
-    from dataclasses import replace
-
-    from haptic.matching.acceptance import Coverage, corner_triangle, placed_near
-    from haptic.matching.components import DataFace, SensorNoise
-    from haptic.matching.tree import Interpretation
-    from haptic.planning.verify import Verifier
-
     poly, pose = _octahedron(0.1)
     asked: list[ProbeMove] = []
 
