@@ -488,6 +488,23 @@ def test_a_verification_up_to_hidden_vertices_says_so_and_is_not_confirmed():
     assert v["reach_complete"] and v["vertices_hidden"] >= 8 and v["moves"] <= 30, rec.detail
 
 
+
+def test_vertices_whose_moves_change_only_the_tables_shadow_are_taken_on_trust(tmp_path):
+    # cad_stepped3 of the sized formula corpus (37 mm high), seed 1, default options: every feature in the pad's reach
+    # measured, the verification ended incomplete with 6 vertices out of reach off the table (under its steps) and 6
+    # on the table that nothing in reach places. The 6 on the table have every face's corner, every edge and
+    # themselves under the pad's reach for their contact normals: a move of any of them changes only surface no pad
+    # clear of the table touches, and they are taken on trust, the claim's height the band's (26.3 mm, the faces
+    # leaning under that rise from the table). The 6 under the steps are not: the corners of their faces reach above
+    # the shadow unmeasured, and the episode stays ambiguous, saying so.
+    rec = run_episode(EpisodeSpec(model="cad_stepped3", seed=1, executor="physics",
+                                  models=_sized_corpus(tmp_path)))  # fmt: skip
+    v = rec.verified
+    assert rec.outcome == "ambiguous" and v["reach_complete"], rec.detail
+    assert v["vertices_shadowed"] == 6 and v["vertices_hidden"] == 6, v
+    assert v["table_shadow_mm"] == v["table_band_mm"] and 25.0 < v["table_shadow_mm"] < 28.0, v
+    assert "6 out of the hand's reach off the table" in rec.detail and "on the table" not in rec.detail, rec.detail
+
 def test_a_stalled_verification_relocates_over_the_object_and_measures_what_is_in_reach():
     # BOX01P seed 1 stands upright, its tab 30 mm high on a side. The traced verification measured the top and the
     # tab's upper corners; the tour, pricing the way to the tab's lower corners as a straight line, then kept the pad
