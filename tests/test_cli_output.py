@@ -78,6 +78,15 @@ def test_verification_counts_what_it_says():
     assert "(of all the model's: 7/8, 9/12, 6/6)" in line and "6 verification moves" in line
 
 
+
+def test_the_verified_line_says_how_far_the_model_is_taken_on_trust_beside_the_table():
+    v = {"mode": "full", "status": "confirmed", "moves": 6, "cost": 30.0, "table_band_mm": 16.0}
+    assert "nothing measured within 16.0 mm of the table (the model taken on trust there)" in verified_line(
+        _record(verified=v))
+    line = verified_line(_record(verified={**v, "table_shadow_mm": 26.3, "vertices_shadowed": 6, "shadowed": [1]}))
+    assert "nothing measured within 26.3 mm of the table" in line and "6 vertices in the table's shadow" in line
+    assert "16.0 mm" not in line
+
 def test_a_failed_episode_does_not_pretend_to_verify():
     v = {"mode": "full", "status": "verifying", "moves": 4, "cost": 0.0}
     line = verified_line(_record(outcome="failed", recognized=None, correct=False, verified=v))
