@@ -1587,4 +1587,7 @@ class Verifier:
             out["table_shadow_mm"] = round(self.table_shadow * 1000.0, 2)
             out["vertices_shadowed"] = len(self.shadowed)
             out["shadowed"] = list(self.shadowed)
+            if self.check is not None and self.check.world_from_model is not None:  # where, at the fitted pose
+                at = self.check.world_from_model.apply(self._model.vertices[self.shadowed]) * 1000.0
+                out["shadowed_at_mm"] = np.round(at, 1).tolist()
         return out
