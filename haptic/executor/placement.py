@@ -39,7 +39,7 @@ import mink
 import mujoco
 import numpy as np
 
-from haptic.executor.physics_probe import _highest_contact, _leading_segment
+from haptic.executor.physics_probe import _highest_contact, _leading_segment, rise
 from haptic.executor.primitives import PrimitiveResult
 from haptic.geometry.se3 import perpendicular, unit
 from haptic.matching.trace import PHASES, ContactTrace
@@ -356,8 +356,7 @@ def _placement(ex: PhysicsExecutor, move: PlacementMove, pieces: list[PrimitiveR
     ex.on_face = None
     z_safe = float(np.max(safe_height(_highest_contact(ex), t.pad_radius, starts, t.tip, s.clearance)))
     z_safe = min(z_safe, TABLE_TOP_Z + ex.settings.max_approach_height)  # the hand's reach over the region
-    up = t.move_guarded(np.array([t.tip[0], t.tip[1], z_safe]), 0.15, max_lag=0.012)
-    pieces.append(up)
+    up = rise(t, z_safe, 0.15, 0.012, pieces)  # round what holds the pad back (a joint's limit, an overhang)
     if not up.ok or up.event != "done":
         return ex.failed_result(move, "unreachable", f"rising above the object: {up.event}")
     c = _Closing(ex, move, s)
