@@ -668,19 +668,23 @@ class PhysicsExecutor(LandingSearch):
 
     def _stroke_tilted(self, st: PrimitiveResult, away: np.ndarray, along: np.ndarray,
                        pieces: list[PrimitiveResult]) -> tuple[FaceFit, PrimitiveResult] | None:  # fmt: skip
-        """For :meth:`_cross_and_acquire`: a stroke on the next face (``st``, the hand upright) whose legs a link of
-        the finger stopped, lifting the pad off, and which measured too little of the face. On a face leaning under,
+        """For :meth:`_cross_and_acquire`: a stroke on the next face (``st``) whose legs a link of the finger
+        stopped, lifting the pad off, and which measured too little of the face. On a face leaning under,
         the finger's links meet the edge above it as the pad slides (antiprism_03 of the formula corpus at 78 mm,
         seed 1: the face 24° under, every leg stopped within a millimetre, five touches afresh past the edge the
         same, four moves failed "too few contacts on the next face"). The hand tilts away from the link's contact
         by the first of :attr:`TouchConfig.tilt_angles` at which the pad still reaches the face, touches it again
         :attr:`PhysicsSettings.reacquire_inset` in from where the stroke began (``away`` from the edge) and strokes
-        there (``along`` the edge). The fit and the stroke, the hand left tilted (the move turns it upright when it
-        ends); None, the hand upright, when no tilt measures the face."""
+        there (``along`` the edge). A hand already tilted (away from a link's contact earlier in the move) tilts
+        anew from the upright posture, away from this link's (antiprism_05, seed 1: tilted away from the distal
+        link's contact on the face traced, the medial link met the edge as the pad stepped onto the next face). The
+        fit and the stroke, the hand left tilted (the move turns it upright when it ends); None, the hand as it
+        was, when no tilt measures the face."""
         t, s = self.toucher, self.settings
         rows = np.flatnonzero(st.trace.in_contact)
-        if not len(rows) or not np.array_equal(t.hand_rotation, t.config.hand_rotation):
+        if not len(rows):
             return None
+        held = t.hand_rotation.copy()
         n = unit(st.info["normal"])
         target = st.trace.point_in_world[rows[0]] + s.reacquire_inset * unit(away - float(away @ n) * n)
         if self.workspace.pad_clearance(target, n) < s.pad_clearance:
@@ -691,7 +695,8 @@ class PhysicsExecutor(LandingSearch):
             rot = t.tilted(st.info["link_normal"], a)
             if rot is None:
                 break
-            if not t.reaches(n, rot) or not self.robot.reachable(t.finger, above, rot).reachable:
+            if np.allclose(rot, held, atol=1e-6) or not t.reaches(n, rot) \
+                    or not self.robot.reachable(t.finger, above, rot).reachable:  # fmt: skip
                 continue
             t.hand_rotation = rot
             r = t.lift_and_approach(target, n, floor_z=floor)
@@ -709,7 +714,7 @@ class PhysicsExecutor(LandingSearch):
                 self.recoveries.append(f"stepping onto the next face, the finger's {st.info['link']} met the object: "
                                        f"the hand tilted {math.degrees(a):.0f}° away")  # fmt: skip
                 return fit, again
-        t.hand_rotation = np.array(t.config.hand_rotation, dtype=float)
+        t.hand_rotation = held
         return None
 
     def _overhung(self, kind: str, link: str, roll: ContactTrace):
