@@ -1083,3 +1083,30 @@ def test_a_vertex_circle_that_rolled_round_the_vertex_crosses_again_out_along_th
     again = [r for r in vertex if any("clear of the vertex" in w for w in r.info.get("recoveries", ()))]
     assert again and all(r.ok for r in again), [r.reason for r in vertex]
     assert _within_bounds(ep)
+
+
+def test_a_stroke_on_a_face_leaning_under_that_a_finger_link_stops_tilts_the_hand(tmp_path):
+    # antiprism_03 of the sized formula corpus (78 mm), seed 1, default options: a vertex move and three face moves
+    # rolled over an edge onto a face leaning 24° under; every leg of the stroke there ended within a millimetre, the
+    # finger's distal link meeting the edge above and lifting the pad off, and so did every touch of it afresh past
+    # the edge: four moves failed "too few contacts on the next face". The hand now tilts away from the link's
+    # contact and strokes the face again, which measures it.
+    ep, rec, said, failed = _watched(EpisodeSpec(model="antiprism_03", seed=1, executor="physics",
+                                                 models=_sized_corpus(tmp_path)))  # fmt: skip
+    assert any("met the object: the hand tilted" in x and "next face" in x for x in said), said
+    assert not [x for x in failed if "too few contacts" in x], failed
+    assert rec.outcome == "recognized" and rec.correct, rec.detail
+    assert _within_bounds(ep)
+
+
+def test_a_stroke_on_the_next_face_stopped_by_another_link_tilts_the_tilted_hand_anew(tmp_path):
+    # antiprism_05 of the sized formula corpus, seed 1, default options: a face move whose trace the distal link
+    # stopped went on with the hand tilted away from it; past the edge the medial link met the face it left as the
+    # pad stepped onto the next face, every leg ended within a millimetre and the move failed "too few contacts on
+    # the next face". The hand tilts anew, away from the medial link's contact, and the stroke measures the face.
+    ep, rec, said, failed = _watched(EpisodeSpec(model="antiprism_05", seed=1, executor="physics",
+                                                 models=_sized_corpus(tmp_path)))  # fmt: skip
+    assert any("next face, the finger's index_medial met the object: the hand tilted" in x for x in said), said
+    assert not [x for x in failed if "too few contacts" in x], failed
+    assert rec.outcome == "recognized" and rec.correct, rec.detail
+    assert _within_bounds(ep)
