@@ -170,7 +170,10 @@ def verified_line(rec: dict) -> str:
         line += f"; measured of the reachable: {', '.join(parts)} (of all the model's: {', '.join(totals)})"
     if "pose_residual" in v:
         line += f"; largest residual {v['pose_residual']:.2f} x its bound ({v['pose_what']})"
-    if v.get("table_band_mm"):
+    if v.get("table_shadow_mm"):
+        line += (f"; nothing measured within {v['table_shadow_mm']:.1f} mm of the table (the model taken on trust "
+                 f"there, {v['vertices_shadowed']} vertices in the table's shadow)")  # fmt: skip
+    elif v.get("table_band_mm"):
         line += f"; nothing measured within {v['table_band_mm']:.1f} mm of the table (the model taken on trust there)"
     return line + f"; {v['moves']} verification moves, cost {v['cost']:.1f}"
 

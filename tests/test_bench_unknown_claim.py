@@ -47,3 +47,24 @@ def test_a_chamfer_on_the_table_lies_within_the_band_and_a_moved_vertex_above_it
     assert not bench.within_claim(dict(rec), moved, base, TABLE)
     assert not bench.within_claim({**rec, "verified": {"table_band_mm": 2.0}}, chamfered, base, TABLE)
     assert not bench.within_claim({**rec, "recognized": "TETRA01L"}, chamfered, base, TABLE)
+
+
+def test_a_moved_vertex_counts_within_the_shadow_only_where_the_verification_took_it_on_trust():
+    """A box 8 mm high, a bottom corner moved 4 mm: it differs from the box up to 8 mm over the table. A recognition
+    whose verification took that corner on trust in the table's shadow, 16 mm high, claims nothing there; one that
+    took another vertex on trust, or a lower shadow, or none, is a false recognition (above a band of 5 mm)."""
+    from haptic.geometry.shapes import box
+
+    bench = _bench()
+    base = box(0.06, 0.04, 0.008, name="LOWBOX")
+    v = int(np.flatnonzero(np.all(np.isclose(base.vertices, 0.0), axis=1))[0])
+    moved = move_vertex(base, v, 0.004)
+    pose = {"quat_wxyz": [1.0, 0.0, 0.0, 0.0], "translation_m": [0.55, 0.0, TABLE]}
+    assert bench.moved_vertices(moved, base) == {v}
+    verified = {"table_band_mm": 5.0, "table_shadow_mm": 16.0, "shadowed": [v]}
+    rec = {"outcome": "recognized", "recognized": "LOWBOX", "pose": pose, "verified": verified}
+    assert bench.within_claim(rec, moved, base, TABLE) and rec["shadow_claim"]
+    assert 5.0 < rec["difference_top_mm"] <= 8.0 + 1e-6
+    assert not bench.within_claim({**rec, "verified": {**verified, "shadowed": [v + 1]}}, moved, base, TABLE)
+    assert not bench.within_claim({**rec, "verified": {**verified, "table_shadow_mm": 6.0}}, moved, base, TABLE)
+    assert not bench.within_claim({**rec, "verified": {"table_band_mm": 5.0}}, moved, base, TABLE)

@@ -488,6 +488,23 @@ def test_a_verification_up_to_hidden_vertices_says_so_and_is_not_confirmed():
     assert v["reach_complete"] and v["vertices_hidden"] >= 8 and v["moves"] <= 30, rec.detail
 
 
+
+def test_vertices_whose_moves_change_only_the_tables_shadow_are_taken_on_trust(tmp_path):
+    # cad_stepped3 of the sized formula corpus (37 mm high), seed 1, default options: every feature in the pad's reach
+    # measured, the verification ended incomplete with 6 vertices out of reach off the table (under its steps) and 6
+    # on the table that nothing in reach places. The 6 on the table have every face's corner, every edge and
+    # themselves under the pad's reach for their contact normals: a move of any of them changes only surface no pad
+    # clear of the table touches, and they are taken on trust, the claim's height the band's (26.3 mm, the faces
+    # leaning under that rise from the table). The 6 under the steps are not: the corners of their faces reach above
+    # the shadow unmeasured, and the episode stays ambiguous, saying so.
+    rec = run_episode(EpisodeSpec(model="cad_stepped3", seed=1, executor="physics",
+                                  models=_sized_corpus(tmp_path)))  # fmt: skip
+    v = rec.verified
+    assert rec.outcome == "ambiguous" and v["reach_complete"], rec.detail
+    assert v["vertices_shadowed"] == 6 and v["vertices_hidden"] == 6, v
+    assert v["table_shadow_mm"] == v["table_band_mm"] and 25.0 < v["table_shadow_mm"] < 28.0, v
+    assert "6 out of the hand's reach off the table" in rec.detail and "on the table" not in rec.detail, rec.detail
+
 def test_a_stalled_verification_relocates_over_the_object_and_measures_what_is_in_reach():
     # BOX01P seed 1 stands upright, its tab 30 mm high on a side. The traced verification measured the top and the
     # tab's upper corners; the tour, pricing the way to the tab's lower corners as a straight line, then kept the pad
@@ -1065,4 +1082,31 @@ def test_a_vertex_circle_that_rolled_round_the_vertex_crosses_again_out_along_th
     vertex = [r for r in results if r.move is not None and r.move.kind == "vertex"]
     again = [r for r in vertex if any("clear of the vertex" in w for w in r.info.get("recoveries", ()))]
     assert again and all(r.ok for r in again), [r.reason for r in vertex]
+    assert _within_bounds(ep)
+
+
+def test_a_stroke_on_a_face_leaning_under_that_a_finger_link_stops_tilts_the_hand(tmp_path):
+    # antiprism_03 of the sized formula corpus (78 mm), seed 1, default options: a vertex move and three face moves
+    # rolled over an edge onto a face leaning 24° under; every leg of the stroke there ended within a millimetre, the
+    # finger's distal link meeting the edge above and lifting the pad off, and so did every touch of it afresh past
+    # the edge: four moves failed "too few contacts on the next face". The hand now tilts away from the link's
+    # contact and strokes the face again, which measures it.
+    ep, rec, said, failed = _watched(EpisodeSpec(model="antiprism_03", seed=1, executor="physics",
+                                                 models=_sized_corpus(tmp_path)))  # fmt: skip
+    assert any("met the object: the hand tilted" in x and "next face" in x for x in said), said
+    assert not [x for x in failed if "too few contacts" in x], failed
+    assert rec.outcome == "recognized" and rec.correct, rec.detail
+    assert _within_bounds(ep)
+
+
+def test_a_stroke_on_the_next_face_stopped_by_another_link_tilts_the_tilted_hand_anew(tmp_path):
+    # antiprism_05 of the sized formula corpus, seed 1, default options: a face move whose trace the distal link
+    # stopped went on with the hand tilted away from it; past the edge the medial link met the face it left as the
+    # pad stepped onto the next face, every leg ended within a millimetre and the move failed "too few contacts on
+    # the next face". The hand tilts anew, away from the medial link's contact, and the stroke measures the face.
+    ep, rec, said, failed = _watched(EpisodeSpec(model="antiprism_05", seed=1, executor="physics",
+                                                 models=_sized_corpus(tmp_path)))  # fmt: skip
+    assert any("next face, the finger's index_medial met the object: the hand tilted" in x for x in said), said
+    assert not [x for x in failed if "too few contacts" in x], failed
+    assert rec.outcome == "recognized" and rec.correct, rec.detail
     assert _within_bounds(ep)

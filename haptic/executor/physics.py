@@ -653,6 +653,10 @@ class PhysicsExecutor(LandingSearch):
             return self._overhung(kind, st.info["held"], r.trace)
         rim = st.ok and st.info["rim"]
         fit = self.segmenter.fit_face_trace(st.trace, st.info["normal"]) if st.ok and not rim else None
+        if fit is None and st.ok and not rim and st.info["link_normal"] is not None:
+            tilted = self._stroke_tilted(st, r.info["away"], along, pieces)
+            if tilted is not None:
+                fit, st = tilted
         if fit is None:
             why = (f"stroke on the next face failed: {st.event}" if not st.ok
                    else "stepping onto the next face, the pad reached the rim of another edge" if rim
@@ -661,6 +665,57 @@ class PhysicsExecutor(LandingSearch):
                 return st.status, why, None, None, None
             return self._reacquire(kind, n_a, direction, corner, r.trace, n_b, pieces, away_from, why)
         return "ok", "", r.trace, st.trace, fit
+
+    def _stroke_tilted(self, st: PrimitiveResult, away: np.ndarray, along: np.ndarray,
+                       pieces: list[PrimitiveResult]) -> tuple[FaceFit, PrimitiveResult] | None:  # fmt: skip
+        """For :meth:`_cross_and_acquire`: a stroke on the next face (``st``) whose legs a link of the finger
+        stopped, lifting the pad off, and which measured too little of the face. On a face leaning under,
+        the finger's links meet the edge above it as the pad slides (antiprism_03 of the formula corpus at 78 mm,
+        seed 1: the face 24° under, every leg stopped within a millimetre, five touches afresh past the edge the
+        same, four moves failed "too few contacts on the next face"). The hand tilts away from the link's contact
+        by the first of :attr:`TouchConfig.tilt_angles` at which the pad still reaches the face, touches it again
+        :attr:`PhysicsSettings.reacquire_inset` in from where the stroke began (``away`` from the edge) and strokes
+        there (``along`` the edge). A hand already tilted (away from a link's contact earlier in the move) tilts
+        anew from the upright posture, away from this link's (antiprism_05, seed 1: tilted away from the distal
+        link's contact on the face traced, the medial link met the edge as the pad stepped onto the next face). The
+        fit and the stroke, the hand left tilted (the move turns it upright when it ends); None, the hand as it
+        was, when no tilt measures the face."""
+        t, s = self.toucher, self.settings
+        rows = np.flatnonzero(st.trace.in_contact)
+        if not len(rows):
+            return None
+        held = t.hand_rotation.copy()
+        n = unit(st.info["normal"])
+        target = st.trace.point_in_world[rows[0]] + s.reacquire_inset * unit(away - float(away @ n) * n)
+        if self.workspace.pad_clearance(target, n) < s.pad_clearance:
+            return None
+        above = target + (t.config.lift + t.pad_radius) * n
+        floor = TABLE_TOP_Z + t.pad_radius + s.table_margin
+        for a in t.config.tilt_angles:
+            rot = t.tilted(st.info["link_normal"], a)
+            if rot is None:
+                break
+            if np.allclose(rot, held, atol=1e-6) or not t.reaches(n, rot) \
+                    or not self.robot.reachable(t.finger, above, rot).reachable:  # fmt: skip
+                continue
+            t.hand_rotation = rot
+            r = t.lift_and_approach(target, n, floor_z=floor)
+            pieces.append(r)
+            if r.status == "unstable":
+                break
+            if not r.ok or angle(r.info["normal"], n) > self.bounds.retouch_cone:
+                continue
+            again = t.stroke(r.info["normal"], away, along)
+            pieces.append(again)
+            if not again.ok or again.info["rim"]:
+                continue
+            fit = self.segmenter.fit_face_trace(again.trace, again.info["normal"])
+            if fit is not None:
+                self.recoveries.append(f"stepping onto the next face, the finger's {st.info['link']} met the object: "
+                                       f"the hand tilted {math.degrees(a):.0f}° away")  # fmt: skip
+                return fit, again
+        t.hand_rotation = held
+        return None
 
     def _overhung(self, kind: str, link: str, roll: ContactTrace):
         """For :meth:`_cross_and_acquire`: the stroke on the next face held back as it stepped in, a link of the

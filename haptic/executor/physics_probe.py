@@ -102,6 +102,49 @@ def _leading_segment(tips: np.ndarray, u: np.ndarray, radius: float, cut: float,
     return FreeSegment(p0 + radius * u, u, length, bound + dev)
 
 
+RISE_TRIES = 4
+"""A rise above the object (:func:`rise`) is tried again at most this many times after it was held back [-] ..."""
+STEP_OUT = 0.008
+"""... each time a touch held it back stepping this far level away from the touch first [m]."""
+LEVEL_NORMAL = 0.3
+"""A touch whose sensed normal's level part is shorter than this (a face above, nearly level) gives no way out to the
+side: the rise fails [-]."""
+
+
+def rise(t, z: float, speed: float, lag: float, pieces: list[PrimitiveResult],
+         tries: int = RISE_TRIES) -> PrimitiveResult:  # fmt: skip
+    """The pad guarded straight up to height ``z`` (toucher ``t``'s :meth:`move_guarded`), recovering where it is held
+    back: with nothing sensed touching (the arm's posture: a joint at its limit pulls the pad off its line) the arm
+    goes in joint space to the posture of its home family above (:meth:`back_to_home_posture`) and rises again; at a
+    touch of a fingertip or a link (a face leaning over the finger, an overhang) it steps :data:`STEP_OUT` level along
+    the sensed normal, away from the object, and rises again from there; at most ``tries`` times. Every piece is
+    appended to ``pieces``; the last one returned (``"done"`` when the pad got up)."""
+    res = t.move_guarded(np.array([t.tip[0], t.tip[1], z]), speed, max_lag=lag)
+    pieces.append(res)
+    for _ in range(tries):
+        if res.ok and res.event == "done":
+            break
+        link = t.link_touch() if res.event == "blocked" else None
+        if res.event == "blocked" and link is None:
+            if not t.back_to_home_posture(np.array([t.tip[0], t.tip[1], z])):
+                break
+        elif (res.ok and res.event == "contact") or link is not None:
+            sensed = res.info["normal"] if link is None else link.normal_in_world
+            n = np.asarray(sensed, dtype=float) * np.array([1.0, 1.0, 0.0])
+            if float(np.linalg.norm(n)) < LEVEL_NORMAL:
+                break
+            out = t.move_free(t.tip + STEP_OUT * unit(n), timeout=t.config.lift_timeout, tol=t.config.lift_tol,
+                              retry=False)  # fmt: skip
+            pieces.append(out)
+            if not out.ok:
+                break
+        else:
+            break
+        res = t.move_guarded(np.array([t.tip[0], t.tip[1], z]), speed, max_lag=lag)
+        pieces.append(res)
+    return res
+
+
 def probe_move(ex: PhysicsExecutor, move: ProbeMove, pieces: list[PrimitiveResult],
                settings: ProbeSettings = SETTINGS) -> MoveResult:  # fmt: skip
     """Carry out ``move`` with ``ex``'s hand (module docstring); a failure is a status, never an exception."""
@@ -153,12 +196,17 @@ def probe_move(ex: PhysicsExecutor, move: ProbeMove, pieces: list[PrimitiveResul
         else:
             _return(ex, lifted, z_safe, n_left, was_on, settings, pieces, [])
         return out
-    # 2. up, across, down to the line's start
+    # 2. up (round what holds the pad back: :func:`rise`), across, down to the line's start
     for name, w in zip(("rising", "moving across", "descending to the line"), over_the_top(lifted, z_safe, centre0),
                        strict=True):  # fmt: skip
         if float(np.linalg.norm(w - t.tip)) < t.config.target_tol:
             continue
-        res = leg(w, settings.transfer_speed, settings.transfer_lag)
+        if name == "rising":
+            n0 = len(pieces)
+            res = rise(t, z_safe, settings.transfer_speed, settings.transfer_lag, pieces)
+            free.extend(pieces[n0:])
+        else:
+            res = leg(w, settings.transfer_speed, settings.transfer_lag)
         if not res.ok or res.event != "done":
             why = f"touched the object {name} (finger {res.info['finger']})" if res.event == "contact" else res.event
             return fail("unreachable" if res.ok else res, f"transfer to the probe's line: {why}")
@@ -299,4 +347,4 @@ def _return(ex: PhysicsExecutor, lifted: np.ndarray, z_safe: float, n_left: np.n
     return True
 
 
-__all__ = ["SETTINGS", "ProbeSettings", "probe_move"]
+__all__ = ["LEVEL_NORMAL", "RISE_TRIES", "SETTINGS", "STEP_OUT", "ProbeSettings", "probe_move", "rise"]

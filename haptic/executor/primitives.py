@@ -748,7 +748,9 @@ class Toucher:
                ) -> PrimitiveResult:  # fmt: skip
         """A short L on a face for its normal: ``step_in`` along ``away``, then ``stroke`` along ``along`` (the
         other way if an edge comes first). ``info["normal"]``: mean sensed normal on the face; ``info["at_table"]``:
-        the step in (``step_in`` not given) was stopped by the table, and the pad did not leave the edge. A step in
+        the step in (``step_in`` not given) was stopped by the table, and the pad did not leave the edge;
+        ``info["link"]``, ``info["link_normal"]``: the link of the finger that lifted the pad off in the last leg it
+        did, and its contact's normal (None when none did). A step in
         held back fails the stroke; ``info["held"]`` then names the link of the finger touching the object, if one
         does (:meth:`_held_by_link`).
 
@@ -798,8 +800,12 @@ class Toucher:
         event = failed[-1].event if failed else "done"
         # both legs along the edge met another edge: the next face is narrow along it there
         blocked = len(pieces) == 3 and all(p.ok and p.event not in ("done", *STOPS) for p in pieces[1:])
+        # the last leg whose pad a link of the finger lifted off: which link, and its contact's normal (the way the
+        # hand would tilt to clear it)
+        held = next((p.info for p in reversed(pieces) if p.event == "hand"), {})
         return PrimitiveResult(status, event, trace, sum(p.distance for p in pieces),
-                               {"normal": n_mean, "rim": rim, "blocked": blocked, "at_table": at_table})  # fmt: skip
+                               {"normal": n_mean, "rim": rim, "blocked": blocked, "at_table": at_table,
+                                "link": held.get("link"), "link_normal": held.get("link_normal")})  # fmt: skip
 
     def _held_by_link(self, step: PrimitiveResult) -> PrimitiveResult:
         """A stroke's step in that stalled (``"blocked"``), with ``info["held"]``: the link of the finger that touches

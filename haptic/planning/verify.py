@@ -31,7 +31,7 @@ from haptic.geometry.polyhedron import Polyhedron
 from haptic.geometry.raycast import line_hits
 from haptic.geometry.se3 import SE3, plane_basis
 from haptic.geometry.tracing import corner_angle, inside_polygon
-from haptic.matching.acceptance import TablePin, faces_measured_near, placed_near
+from haptic.matching.acceptance import TablePin, corner_triangle, faces_measured_near, placed_near
 from haptic.matching.components import DataComponent, DataEdge, DataFace, SensorNoise
 from haptic.planning.config import PlannerConfig
 from haptic.planning.finger_faces import CornerProbes, TableFaceProbes
@@ -235,6 +235,96 @@ def table_band(poly: Polyhedron, world_from_model: SE3, config: PlannerConfig) -
                 continue  # the face on the table
             band = max(band, config.pad_radius * (1.0 - float(nz[f])) + config.table_clearance)
     return band
+
+
+def cone_top(normals: np.ndarray) -> float:
+    """The largest vertical component of a unit vector in the convex cone spanned by the unit ``normals`` (world,
+    rows): the steepest upward direction a pad can press a vertex or an edge from, its contact normal being any
+    direction between its faces' normals. 1 when the cone holds the vertical (an apex); else the largest over each
+    normal and each great-circle arc between two of them (the cone's rim is among those arcs, and none leaves it)."""
+    from scipy.optimize import nnls
+
+    n = np.atleast_2d(np.asarray(normals, float))
+    up = np.array([0.0, 0.0, 1.0])
+    if float(nnls(n.T, up)[1]) < 1e-9:
+        return 1.0
+    best = float(n[:, 2].max())
+    for i in range(len(n)):
+        for j in range(i + 1, len(n)):
+            k = np.cross(n[i], n[j])
+            if float(np.linalg.norm(k)) < 1e-9:
+                continue
+            k /= np.linalg.norm(k)
+            u = up - k[2] * k  # the vertical projected onto the arc's plane: its highest point, if within the arc
+            if float(np.linalg.norm(u)) < 1e-12:
+                continue
+            w = np.linalg.lstsq(np.column_stack([n[i], n[j]]), u, rcond=None)[0]
+            if np.all(w >= -1e-12):
+                best = max(best, float(np.linalg.norm(u)))
+    return min(best, 1.0)
+
+
+def shadow_of(nz: float, config: PlannerConfig) -> float:
+    """How high above the table the pad touches nothing of a surface whose contact normals rise at most ``nz``
+    (vertical component) [m]: pressing along a contact normal m its centre is the pad's radius r out along m, so
+    its lowest point lies r (1 - m_z) under the contact, and it is kept the pad's clearance of the table above it:
+    r (1 - nz) + clearance (:func:`table_band`'s formula)."""
+    return config.pad_radius * (1.0 - nz) + config.table_clearance
+
+
+def table_shadow(poly: Polyhedron, world_from_model: SE3, v: int, config: PlannerConfig,
+                 near: frozenset[int] = frozenset(), edges: frozenset[int] = frozenset()) -> float | None:  # fmt: skip
+    """Whether what the hand cannot measure of vertex ``v`` of ``poly`` at ``world_from_model`` lies in the table's
+    shadow: the height above the table below which the model is then taken on trust [m], else None (no table,
+    or some of it is touchable unmeasured).
+
+    A move of ``v`` (:func:`~haptic.geometry.perturb.move_vertex`'s variants) tilts the corner triangle of each face
+    at it (:func:`~haptic.matching.acceptance.corner_triangle`; the whole face where that is reflex) and moves its
+    edges, each all the way to its other end; nothing else of the surface. No pad can tell such a move apart where
+    it changes only points of the shadow, those no contact clear of the table reaches: a point of a face of outward
+    normal n lower than r (1 - n_z) + clearance (:func:`shadow_of`); of an edge or a vertex, lower than that for
+    the steepest upward direction between its faces' normals (:func:`cone_top`: an apex is touched from above). A
+    triangle's highest point is a corner, so every point of the changed surface is in the shadow when:
+
+    - ``v`` itself is (the cone of all its faces' normals);
+    - each edge at ``v`` lies wholly in it (both ends under the edge's height), or is measured (in ``edges``: its
+      line, through its measured part, rotates when ``v`` moves);
+    - each face at ``v`` has its corner wholly in it (its three corners under the face's height), rests on the
+      table (the table is a datum of the acceptance test), or is measured within its corner at ``v`` (in ``near``,
+      :func:`~haptic.matching.acceptance.faces_measured_near`: the corner's tilt is seen in its normal). A corner
+      whose top rises out of the shadow is touchable there, and taken on trust only so measured.
+
+    The height returned is the largest of the shadows relied on (of ``v``, the edges and the faces not measured):
+    the object is the model above it, as measured, whatever ``v``'s move within the shadow. A move that carries
+    part of the surface out of the shadow unmeasured is not caught, as a chamfer of an edge on the table larger than
+    :func:`table_band` is not."""
+    if config.table_z is None:
+        return None
+    z = world_from_model.apply(poly.vertices)[:, 2] - config.table_z
+    n = world_from_model.rotate(poly.face_normals)
+    faces = [int(f) for f in poly.vertex_faces[v]]
+    height = shadow_of(cone_top(n[faces]), config)
+    if z[v] >= height:
+        return None
+    for e in poly.vertex_edges[v]:
+        e = int(e)
+        h = shadow_of(cone_top(n[[int(poly.edge_left_face[e]), int(poly.edge_right_face[e])]]), config)
+        if max(z[v], z[int(sum(poly.edges[e])) - v]) < h:
+            height = max(height, h)
+        elif e not in edges:
+            return None
+    for f in faces:
+        loop = [int(u) for u in poly.faces[f]]
+        if np.all(z[loop] <= TABLE_CONTACT):
+            continue  # the face on the table
+        tri = corner_triangle(poly, v, f)
+        top = float(z[loop].max()) if tri is None else float((world_from_model.apply(tri)[:, 2] - config.table_z).max())
+        h = shadow_of(float(n[f, 2]), config)
+        if top < h:
+            height = max(height, h)
+        elif f not in near:
+            return None
+    return height
 
 
 def placed_by_data(poly: Polyhedron, world_from_model: SE3, vertices: Sequence[int], cov, config: PlannerConfig
@@ -886,8 +976,9 @@ def _target_points(poly: Polyhedron, missing: tuple[frozenset[int], frozenset[in
     return np.array(pts).reshape(-1, 3)
 
 
-__all__ = ["aimed_face_moves", "choose_verification_move", "hidden_vertices", "plan_verification_move",
-           "face_middle", "reachable_features", "unmeasured_middles", "verification_probes", "verify_move_budget"]
+__all__ = ["aimed_face_moves", "choose_verification_move", "cone_top", "hidden_vertices", "plan_verification_move",
+           "face_middle", "reachable_features", "shadow_of", "table_shadow", "unmeasured_middles",
+           "verification_probes", "verify_move_budget"]
 
 
 MIDDLE_REACH = 5e-3
@@ -1013,6 +1104,12 @@ class Verifier:
         not reached)."""
         self.unpinnable: list[int] = []
         """Model vertices on the table whose place on it nothing in the hand's reach gives (:func:`table_pins`)."""
+        self.shadowed: list[int] = []
+        """Model vertices out of the hand's reach (off the table or on it) whose moves change only the table's shadow
+        or what is measured (:func:`table_shadow`): taken on trust there, neither hidden nor unpinnable."""
+        self.table_shadow: float | None = None
+        """With :attr:`shadowed` vertices: how high above the table the model is taken on trust, at least
+        :attr:`table_band` [m]; a confirmation says the object is the model above it (None: none shadowed)."""
         self._model_name: str | None = None
         self._model: Polyhedron | None = None
         self._reach: dict[str, tuple[frozenset[int], frozenset[int], frozenset[int]]] = {}
@@ -1092,6 +1189,7 @@ class Verifier:
             self.unpinnable = [v for v in unpinned if v not in placed]
             if self.config.table_z is not None:
                 self.table_band = table_band(cls.model, self.check.world_from_model, self.config)
+                self._take_shadowed(cls.model, tree.data, it)
             self.status = "incomplete" if self.mode == "full" and (self.hidden or self.unpinnable) else "confirmed"
             if self.status == "incomplete" and self.hidden and self._corner_probe_next(tree.data, it):
                 self.status = "verifying"
@@ -1133,6 +1231,22 @@ class Verifier:
             if not self.accept.ok:
                 self.status = "rejected"
         return self.status
+
+    def _take_shadowed(self, model: Polyhedron, data: Sequence[DataComponent], it) -> None:
+        """Of the vertices out of reach (:attr:`hidden`, :attr:`unpinnable`), take on trust those whose moves change
+        nothing touchable unmeasured (:func:`table_shadow`): into :attr:`shadowed`, and :attr:`table_shadow` the
+        height above the table below which the model is then taken on trust (at least :attr:`table_band`)."""
+        pose = self.check.world_from_model
+        heights = {}
+        for v in (*self.hidden, *self.unpinnable):
+            near = faces_measured_near(model, data, it, pose, v)
+            h = table_shadow(model, pose, v, self.config, near, self.coverage.edges)
+            if h is not None:
+                heights[int(v)] = h
+        self.shadowed = sorted(heights)
+        self.hidden = [v for v in self.hidden if v not in heights]
+        self.unpinnable = [v for v in self.unpinnable if v not in heights]
+        self.table_shadow = max([self.table_band or 0.0, *heights.values()]) if heights else None
 
     def _ways_done(self) -> set[tuple]:
         """The ways (:func:`outcome_key`) not to travel again to measure nothing: each one travelled since the last
@@ -1468,4 +1582,9 @@ class Verifier:
         if self.table_band is not None:
             # the claim: the object is the model above this height; below it, next to the table, nothing measured
             out["table_band_mm"] = round(self.table_band * 1000.0, 2)
+        if self.table_shadow is not None:
+            # the claim with vertices taken on trust in the table's shadow: the object is the model above this height
+            out["table_shadow_mm"] = round(self.table_shadow * 1000.0, 2)
+            out["vertices_shadowed"] = len(self.shadowed)
+            out["shadowed"] = list(self.shadowed)
         return out

@@ -17,7 +17,7 @@ from haptic.matching.trace import PHASES
 from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import FINGER_NAMES, ProbeMove
 from haptic.sim.scene import FINGERS, PAD_RADIUS
-from tests.test_episode_physics import _sized_corpus
+from tests.test_episode_physics import _sized_corpus, _watched
 
 UNDER_STEP = 8
 """BOX01P's face under its step: at seed 1 it stands on an end, this face vertical and 20 mm in under the step."""
@@ -126,3 +126,14 @@ def test_a_tilted_finger_probes_a_face_leaning_under(tmp_path):
     assert res.ok and len(res.components) == 1, res.reason
     assert np.degrees(np.arccos(np.clip(res.components[0].normal @ n, -1.0, 1.0))) < 1.0
     assert res.info["finger"] == move.finger
+
+
+def test_the_hand_keeps_to_the_planned_way_under_a_face_leaning_over_it(tmp_path):
+    # hull_02 of the sized formula corpus, seed 1: the verification probes faces leaning under 37° at a table vertex
+    # with the index finger tilted toward them. The solver's path keeps the pad 4 mm clear of the face above the
+    # line's start; held a configuration of it at a time (up to 0.05 rad apart), the servo swung the pad off the
+    # path and it touched that face on the way down in two probes of three
+    ep, rec, _, failed = _watched(EpisodeSpec(model="hull_02", seed=1, executor="physics", verify="full",
+                                              models=_sized_corpus(tmp_path)))  # fmt: skip
+    assert not [x for x in failed if "on the planned way" in x], failed
+    assert rec.probes >= 2 and rec.outcome == "recognized" and rec.correct, rec.detail

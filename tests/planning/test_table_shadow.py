@@ -1,0 +1,110 @@
+"""The table's shadow: what no pad kept clear of the table can touch, and the vertices whose moves change only that
+(or what is measured), which the full verification takes on trust there
+(:func:`haptic.planning.verify.table_shadow`)."""
+
+from dataclasses import replace
+
+import numpy as np
+
+from haptic.geometry import SE3
+from haptic.geometry.distance import surface_distance
+from haptic.geometry.perturb import move_vertex
+from haptic.geometry.shapes import box, prism
+from haptic.planning.config import PlannerConfig
+from haptic.planning.verify import cone_top, table_shadow
+
+TABLE = 0.35
+CONFIG = replace(PlannerConfig(), table_z=TABLE)  # the pad's radius 12 mm, kept 4 mm clear of the table
+WALL = CONFIG.pad_radius + CONFIG.table_clearance  # the shadow beside a vertical face: 16 mm
+
+
+def _on_table(poly, rotation: np.ndarray | None = None) -> SE3:
+    rotation = np.eye(3) if rotation is None else rotation
+    low = (poly.vertices @ rotation.T)[:, 2].min()
+    return SE3(rotation, np.array([0.55, 0.0, TABLE - low]))
+
+
+def _changed_top(variant, base, pose: SE3) -> float:
+    """The highest point above the table where ``variant`` and ``base`` differ by more than 0.1 mm, at ``pose``."""
+    tops = []
+    for a, b in ((variant, base), (base, variant)):
+        pts = [a.vertices]
+        for i, j, k in a.triangles:
+            u, v = np.meshgrid(np.linspace(0, 1, 41), np.linspace(0, 1, 41), indexing="ij")
+            keep = u + v <= 1
+            p, q, r = a.vertices[i], a.vertices[j], a.vertices[k]
+            pts.append(p + u[keep][:, None] * (q - p) + v[keep][:, None] * (r - p))
+        pts = np.concatenate(pts)
+        off = pts[surface_distance(b, pts) > 1e-4]
+        if len(off):
+            tops.append(float(pose.apply(off)[:, 2].max()) - TABLE)
+    return max(tops)
+
+
+def _corner(poly, z: float) -> int:
+    return int(np.flatnonzero(np.all(np.isclose(poly.vertices, [0.0, 0.0, z]), axis=1))[0])
+
+
+def test_the_steepest_contact_normal_at_an_edge_or_a_vertex():
+    """An apex is pressed from straight above; an edge between two walls leaning out from the vertical at most
+    level; the ridge between two faces rising 30° is pressed from above too."""
+    walls = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, -1.0]])
+    assert abs(cone_top(walls)) < 1e-12
+    s, c = np.sin(np.radians(30)), np.cos(np.radians(30))
+    assert abs(cone_top(np.array([[c, 0.0, s], [-c, 0.0, s]])) - 1.0) < 1e-12
+    ridge = np.array([c, c, 2 * s]) / np.linalg.norm([c, c, 2 * s])  # between faces rising 30° toward x and y
+    assert abs(cone_top(np.array([[c, 0.0, s], [0.0, c, s]])) - ridge[2]) < 1e-9
+    assert abs(cone_top(np.array([[c, 0.0, -s], [-c, 0.0, -s]])) + s) < 1e-9  # both lean under: the arc tops there
+
+
+def test_a_low_box_corner_on_the_table_lies_in_the_shadow():
+    """A box 8 mm high on the table: its walls' corners at a bottom vertex reach 8 mm, under the 16 mm the pad
+    pressing a vertical wall clear of the table cannot go below; its edges and the vertex are pressed at best level.
+    The vertex is taken on trust up to 16 mm, and every move of it (2, 4, 8 mm) changes the box only below that.
+    Its top corners are pressed from above."""
+    poly = box(0.06, 0.04, 0.008)
+    pose = _on_table(poly)
+    v = _corner(poly, 0.0)
+    assert abs(table_shadow(poly, pose, v, CONFIG) - WALL) < 1e-9
+    for mm in (2, 4, 8):
+        assert _changed_top(move_vertex(poly, v, mm * 1e-3), poly, pose) < WALL
+    assert table_shadow(poly, pose, _corner(poly, 0.008), CONFIG) is None
+    assert table_shadow(poly, pose, v, PlannerConfig()) is None  # no table, no shadow
+
+
+def test_a_corner_that_reaches_out_of_the_shadow_is_taken_on_trust_only_measured_there():
+    """A box 30 mm high: its walls' corners at a bottom vertex reach 30 mm, touchable above 16 mm, and a move of
+    the vertex changes them there: not in the shadow, unless both walls are measured within their corners at the
+    vertex and the vertical edge is measured (then what changes out of the shadow is measured, and the rest lies
+    below 16 mm)."""
+    poly = box(0.06, 0.04, 0.03)
+    pose = _on_table(poly)
+    v = _corner(poly, 0.0)
+    assert _changed_top(move_vertex(poly, v, 0.004), poly, pose) > WALL
+    assert table_shadow(poly, pose, v, CONFIG) is None
+    z = pose.apply(poly.vertices)[:, 2] - TABLE
+    walls = frozenset(int(f) for f in poly.vertex_faces[v] if abs(pose.rotate(poly.face_normals[int(f)])[2]) < 0.5)
+    rising = frozenset(int(e) for e in poly.vertex_edges[v] if max(z[int(u)] for u in poly.edges[int(e)]) > 0.02)
+    assert len(walls) == 2 and len(rising) == 1
+    assert abs(table_shadow(poly, pose, v, CONFIG, walls, rising) - WALL) < 1e-9
+    assert table_shadow(poly, pose, v, CONFIG, walls, frozenset()) is None
+    assert table_shadow(poly, pose, v, CONFIG, frozenset(sorted(walls)[:1]), rising) is None
+
+
+def test_a_vertex_under_an_overhang_lies_in_the_shadow_of_the_faces_turned_down():
+    """An L block lying with its step's underside 6 mm over the table: the outer vertex under the overhang has the
+    underside (turned down: the pad reaches none of it under 28 mm), the end face and the outer wall (16 mm, their
+    corners there reaching 14 mm); pressed at best level (16 mm). The block's top vertices are pressed from
+    above."""
+    poly = prism([(0, 0), (0.02, 0), (0.02, 0.006), (0.04, 0.006), (0.04, 0.014), (0, 0.014)], 0.03)
+    turn = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])  # the profile's y up, the extrusion level
+    pose = _on_table(poly, turn)
+    z = pose.apply(poly.vertices)[:, 2] - TABLE
+    x = pose.apply(poly.vertices)[:, 0] - 0.55
+    under = [int(v) for v in np.flatnonzero(np.isclose(z, 0.006) & np.isclose(x, 0.04))]
+    assert len(under) == 2
+    for v in under:
+        assert abs(table_shadow(poly, pose, v, CONFIG) - (2 * CONFIG.pad_radius + CONFIG.table_clearance)) < 1e-9
+        assert _changed_top(move_vertex(poly, v, 0.002), poly, pose) < WALL
+    top = int(np.flatnonzero(np.isclose(z, 0.014))[0])
+    assert table_shadow(poly, pose, top, CONFIG) is None
