@@ -172,13 +172,16 @@ def table(rows: list[dict]) -> str:
         def pct(k: int, d: int) -> str:  # rounded down: 443 of 445 is not 100 %
             return f"{k}/{d} ({int(100 * k // d)} %)" if d else "-"
 
+        def mean(key: str, fmt: str, rs: list = rs) -> str:  # a family with no object (no convex one drawn): "-"
+            return format(float(np.mean([r[key] for r in rs])), fmt) if rs else "-"
+
         lines.append(
             f"| {fam} | {n} | {pct(len(ok), n)} | {pct(vef, n)} | "
             + (f"{np.mean(h):.3f} / {np.max(h):.3f} | {pct(sum(x <= HAUSDORFF_GOAL_MM for x in h), n)} | "
                f"{np.mean(v):.2f} / {np.max(v):.2f} | {pct(sum(x <= VOLUME_GOAL * 100 for x in v), n)} | "
                if ok else "- | - | - | - | ")
-            + f"{np.mean([r['learn_moves'] for r in rs]):.1f} | {np.mean([r['learn_cost'] for r in rs]):.1f} | "
-            f"{np.mean([r['learn_wall_s'] for r in rs]):.2f} | {pct(reid, reid_n)} | {false}/{false_n} |"
+            + f"{mean('learn_moves', '.1f')} | {mean('learn_cost', '.1f')} | {mean('learn_wall_s', '.2f')} | "
+            f"{pct(reid, reid_n)} | {false}/{false_n} |"
         )  # fmt: skip
     return "\n".join(lines) + "\n"
 
