@@ -660,7 +660,7 @@ class PhysicsExecutor(LandingSearch):
         if fit is None:
             why = (f"stroke on the next face failed: {st.event}" if not st.ok
                    else "stepping onto the next face, the pad reached the rim of another edge" if rim
-                   else "too few contacts on the next face")  # fmt: skip
+                   else f"too few contacts on the next face ({self.segmenter.face_refusal})")  # fmt: skip
             if st.status == "unstable":
                 return st.status, why, None, None, None
             return self._reacquire(kind, n_a, direction, corner, r.trace, n_b, pieces, away_from, why)

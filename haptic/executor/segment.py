@@ -514,6 +514,8 @@ class Segmenter:
         self.vertices: dict[int, DataVertex] = {}
         self.components: list[DataComponent] = []
         self._next = 0
+        self.face_refusal = ""
+        """Why the last :meth:`fit_face_trace` gave no face ("" when it gave one)."""
 
     def _id(self) -> int:
         i = self._next
@@ -533,34 +535,39 @@ class Segmenter:
         b = self.bounds
         mask = face_rows(trace, unit(np.asarray(normal_guess, float)), b.row_cone, b.min_refine_rows)
         if mask.sum() < self.bounds.min_face_rows:
-            return None
+            return self._refuse(f"{int(mask.sum())} rows in the face's cone")
         tips = trace.tip_in_world[mask]
         q = tips - tips.mean(axis=0)
         ext, vt = _extent(tips, axes=True)
         if ext[0] < self.bounds.min_face_extent or (two_d and ext[1] < self.bounds.min_face_width):
-            return None
+            return self._refuse(f"the rows span {ext[0] * 1e3:.1f} mm" + (f" × {ext[1] * 1e3:.1f}" if two_d else ""))
         if normal_turn_rate(q @ vt[: 2 if ext[1] > self.bounds.two_d_extent else 1].T, trace.normal_in_world[mask]) > (
             self.bounds.max_face_curvature
         ):
-            return None
+            return self._refuse("the normals turn along the stroke")
         normals = trace.normal_in_world[mask]
         mean = unit(normals.sum(axis=0))
         spread = float(np.sqrt(np.mean(np.sum((normals - mean) ** 2, axis=1))))  # rms angle [rad]
         if spread > self.bounds.max_spread_sigmas * self.bounds.normal_sigma + self.bounds.spread_slack:
-            return None  # the rows do not come from one plane (a roll, a vertex)
+            return self._refuse("the normals spread")  # the rows do not come from one plane (a roll, a vertex)
         cone = normals  # every row in the face's cone, in time order: a part leaning widens the bound
         mask = steady_rows(trace, mask, self.bounds)
         if _extent(trace.tip_in_world[mask])[0] < self.bounds.min_face_extent:
             # the rows that hold one normal are the pad pressing in place, the rest turning: the stroke rode a rim
             # (bipyramid_10 at 30 mm, seed 3: every contact within 1.5 mm of the face's edges, the steady rows those
             # of the step in, 4° off the face, spanning 1 mm, and the face 2.8 bounds off)
-            return None
+            return self._refuse("the steady rows press in place")
         if two_d and _extent(trace.tip_in_world[mask])[1] < self.bounds.min_face_width:
             # the steady rows are one leg of the L: the other's normal held elsewhere (the pad rode a rim along the
             # first leg, its normal turned 3° round the edge), and no row measures the face across
-            return None
+            return self._refuse("the steady rows are one leg")
+        self.face_refusal = ""
         return lean_widened(fit_face(trace.point_in_world[mask], trace.normal_in_world[mask], self.bounds), cone,
                             self.bounds)  # fmt: skip
+
+    def _refuse(self, why: str) -> None:
+        """No face from a trace, and why (:attr:`face_refusal`, which a move's failure names)."""
+        self.face_refusal = why
 
     def add_face(self, fit: FaceFit, adjacent: tuple[int, ...] = ()) -> DataFace:
         b = self.bounds

@@ -58,6 +58,25 @@ def test_rolling_on_a_vertex_or_a_ridge_is_not_a_face():
     assert normal_turn_rate(tips[:, :2], normals) > 0.5 / R_PAD  # turns with 1/r
 
 
+def test_a_trace_that_gives_no_face_says_why():
+    # a failed move names why its stroke gave no face: on a vertex the rows whose normals lie near the face's span
+    # too little, as does a short stroke; a good stroke leaves no reason behind
+    rng = np.random.default_rng(1)
+    seg = Segmenter()
+    tips = _l_stroke() + np.array([0.0, 0.0, R_PAD])
+    normals = tips / np.linalg.norm(tips, axis=1)[:, None]
+    noisy = 2e-4 * rng.normal(size=tips.shape)
+    assert seg.fit_face_trace(_trace(tips, normals, noisy), np.array([0.0, 0.0, 1.0])) is None
+    assert seg.face_refusal.startswith("the rows span"), seg.face_refusal  # the rows in the face's cone, near the top
+    up = np.tile([0.0, 0.0, 1.0], (len(tips), 1))
+    short = np.column_stack([np.linspace(0, 5e-4, len(tips)), np.zeros(len(tips)), np.full(len(tips), R_PAD)])
+    assert seg.fit_face_trace(_trace(short, up, short - [0.0, 0.0, R_PAD]), up[0]) is None
+    assert seg.face_refusal.startswith("the rows span 0.5 mm"), seg.face_refusal
+    flat = _l_stroke() * 6 + np.array([0.0, 0.0, R_PAD])
+    assert seg.fit_face_trace(_trace(flat, up, flat - [0.0, 0.0, R_PAD]), up[0]) is not None
+    assert seg.face_refusal == ""
+
+
 def test_edge_sides_follow_from_normals_and_convexity():
     seg = Segmenter(SegmentBounds())
     line = LineFit(np.zeros(3), np.array([0.0, 1.0, 0.0]), 1e-3, 1e-4, (0.0, 0.01))
