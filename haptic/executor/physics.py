@@ -405,29 +405,42 @@ class PhysicsExecutor(LandingSearch):
         away from that contact, by the first of :attr:`TouchConfig.tilt_angles` at which the pad still reaches data
         face ``fid`` and touches it at ``target``. True when the pad rests on the face, tilted; else the hand is
         upright again."""
-        t = self.toucher
         n = self.segmenter.faces[fid].component.normal
+        for a, _ in self._tilted_touches(met.info["link_normal"], target, n, pieces):
+            self.on_face = fid
+            self.recoveries.append(f"the finger's {met.info['link']} met the object: the hand tilted "
+                                   f"{math.degrees(a):.0f}° away")  # fmt: skip
+            return True
+        self.toucher.hand_rotation = np.array(self.toucher.config.hand_rotation, dtype=float)
+        return False
+
+    def _tilted_touches(self, link_normal: np.ndarray, target: np.ndarray, n: np.ndarray,
+                        pieces: list[PrimitiveResult], held: np.ndarray | None = None):  # fmt: skip
+        """The hand tilted away from a link's contact (its normal ``link_normal``) by each of
+        :attr:`TouchConfig.tilt_angles` in turn at which the pad reaches a face of normal ``n`` (but the rotation
+        ``held``, if given: the hand's already), the pad touching the face again at ``target``: yields each angle
+        and touch that landed on the face (within the retouch cone of ``n``), the hand left tilted; stops where the
+        pad has no clearance at ``target``, no tilt is left, or the state went unstable. The caller puts the hand's
+        rotation back when it takes none."""
+        t = self.toucher
+        if self.workspace.pad_clearance(target, n) < self.settings.pad_clearance:
+            return
         above = target + (t.config.lift + t.pad_radius) * n
         floor = TABLE_TOP_Z + t.pad_radius + self.settings.table_margin
-        if self.workspace.pad_clearance(target, n) >= self.settings.pad_clearance:
-            for a in t.config.tilt_angles:
-                rot = t.tilted(met.info["link_normal"], a)
-                if rot is None:
-                    break
-                if not t.reaches(n, rot) or not self.robot.reachable(t.finger, above, rot).reachable:
-                    continue
-                t.hand_rotation = rot
-                r = t.lift_and_approach(target, n, floor_z=floor)
-                pieces.append(r)
-                if r.ok and angle(r.info["normal"], n) <= self.bounds.retouch_cone:
-                    self.on_face = fid
-                    self.recoveries.append(f"the finger's {met.info['link']} met the object: the hand tilted "
-                                           f"{math.degrees(a):.0f}° away")  # fmt: skip
-                    return True
-                if r.status == "unstable":
-                    break
-        t.hand_rotation = np.array(t.config.hand_rotation, dtype=float)
-        return False
+        for a in t.config.tilt_angles:
+            rot = t.tilted(link_normal, a)
+            if rot is None:
+                return
+            if (held is not None and np.allclose(rot, held, atol=1e-6)) or not t.reaches(n, rot) \
+                    or not self.robot.reachable(t.finger, above, rot).reachable:  # fmt: skip
+                continue
+            t.hand_rotation = rot
+            r = t.lift_and_approach(target, n, floor_z=floor)
+            pieces.append(r)
+            if r.ok and angle(r.info["normal"], n) <= self.bounds.retouch_cone:
+                yield a, r
+            elif r.status == "unstable":
+                return
 
     def _link_radii(self) -> dict[str, float]:
         if self._radii is None:
@@ -687,24 +700,7 @@ class PhysicsExecutor(LandingSearch):
         held = t.hand_rotation.copy()
         n = unit(st.info["normal"])
         target = st.trace.point_in_world[rows[0]] + s.reacquire_inset * unit(away - float(away @ n) * n)
-        if self.workspace.pad_clearance(target, n) < s.pad_clearance:
-            return None
-        above = target + (t.config.lift + t.pad_radius) * n
-        floor = TABLE_TOP_Z + t.pad_radius + s.table_margin
-        for a in t.config.tilt_angles:
-            rot = t.tilted(st.info["link_normal"], a)
-            if rot is None:
-                break
-            if np.allclose(rot, held, atol=1e-6) or not t.reaches(n, rot) \
-                    or not self.robot.reachable(t.finger, above, rot).reachable:  # fmt: skip
-                continue
-            t.hand_rotation = rot
-            r = t.lift_and_approach(target, n, floor_z=floor)
-            pieces.append(r)
-            if r.status == "unstable":
-                break
-            if not r.ok or angle(r.info["normal"], n) > self.bounds.retouch_cone:
-                continue
+        for a, r in self._tilted_touches(st.info["link_normal"], target, n, pieces, held):
             again = t.stroke(r.info["normal"], away, along)
             pieces.append(again)
             if not again.ok or again.info["rim"]:
