@@ -733,6 +733,20 @@ def test_an_edge_move_that_locates_the_end_it_set_off_past_does_not_turn_the_obj
     assert rec.outcome != "no-match", rec.detail
 
 
+def test_an_edge_move_whose_return_beside_the_last_contact_fails_returns_beside_the_edges_middle(tmp_path):
+    # trapezohedron_06 of the sized formula corpus, seed 1, default options: a vertex move left the pad 5 mm past the
+    # far end of an 8 mm edge, and the edge move along it toward that end, returning next to the edge beside the last
+    # contact, touched the faces round that end (normals 7° and 24° off the edge's faces) and failed; the vertex
+    # there was measured by nothing else, and the verification went round the object for 20 more moves until its
+    # budget ended it "incomplete after 31 moves: ... 1 vertices ... not measured". Returned beside the middle of
+    # the edge behind its end, the move locates the vertex, and the verification ends with every vertex in the
+    # hand's reach measured
+    rec = run_episode(EpisodeSpec(model="trapezohedron_06", seed=1, executor="physics",
+                                  models=_sized_corpus(tmp_path)))  # fmt: skip
+    assert rec.verified["reach_complete"], rec.detail
+    assert rec.perception["outside_bounds"] == 0
+
+
 @pytest.mark.slow
 def test_a_verification_that_failed_a_way_in_finds_another(tmp_path):
     # antiprism_05 of the sized formula corpus, seed 1, default options: the verification ended "incomplete after
