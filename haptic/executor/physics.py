@@ -225,6 +225,10 @@ class PhysicsSettings:
     """... at a point this far from the edge on the guessed face [m] ..."""
     reacquire_cone: float = math.radians(12.0)
     """... skipping a guess within this of one tried [rad]."""
+    rim_reading_cone: float = math.radians(30.0)
+    """A face touched afresh along the edge after a first touch past it that read the rims at the edge's end is
+    the same face when its normal lies within this of that reading, turned as far from the face crossed from
+    (``PhysicsExecutor._same_next_face``) [rad]."""
     square_crossing: float = math.radians(25.0)
     """A face move whose travel crossed the convex edge it reports within this of square to it follows the ridge
     first: crossing square, a roll round a vertex onto a face sharing only it turns the normals about the same axis
@@ -783,7 +787,7 @@ class PhysicsExecutor(LandingSearch):
                     again = self._touch_next(kind, n_a, d, corner, moved, n, pieces, away_from)
                     if again == "table":
                         return "unreachable", "the edge lies on the table", None, None, None
-                    if not isinstance(again, str) and again[1] is not None and angle(again[0], n) <= s.reacquire_cone:
+                    if not isinstance(again, str) and again[1] is not None and self._same_next_face(n_a, n, again[0]):
                         self.recoveries.append(f"{why}: the next face touched afresh {step * 1000:.0f} mm along the "
                                                "edge, clear of its end")  # fmt: skip
                         return "ok", "", roll, again[2].trace, again[1]
@@ -791,6 +795,21 @@ class PhysicsExecutor(LandingSearch):
                 self.recoveries.append(f"{why}: the next face touched afresh")
                 return "ok", "", roll, st.trace, fit
         return "unreachable", why, None, None, None
+
+    def _same_next_face(self, n_a: np.ndarray, n: np.ndarray, again: np.ndarray) -> bool:
+        """For :meth:`_reacquire`: whether normal ``again``, touched farther along the edge where an L measured the
+        face, is that of the face touched first past the edge (normal ``n``; ``n_a`` the face crossed from): within
+        :attr:`PhysicsSettings.reacquire_cone` of it; or, the first touch having read the rims at the edge's end
+        (its L measured no face), turned from ``n_a`` as far as ``n`` within that cone and no farther from ``n``
+        than :attr:`PhysicsSettings.rim_reading_cone`. On the rims of the faces round the vertex the pad reads a
+        normal partway between them, turned about the edge about as far as the next face (platonic_dodecahedron of
+        the formula corpus, seed 1: the first touches read 58° and 59° turns 24° and 21° off the next face, which
+        the touches along the edge measured at the solid's 63.4°, and the crossings failed "too few contacts on the
+        next face")."""
+        s = self.settings
+        if angle(again, n) <= s.reacquire_cone:
+            return True
+        return angle(again, n) <= s.rim_reading_cone and abs(angle(again, n_a) - angle(n, n_a)) <= s.reacquire_cone
 
     def _touch_next(self, kind: str, n_a: np.ndarray, d: np.ndarray, corner: np.ndarray, target: np.ndarray,
                     n_guess: np.ndarray, pieces: list[PrimitiveResult], away_from):  # fmt: skip
