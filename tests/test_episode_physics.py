@@ -1110,3 +1110,14 @@ def test_a_stroke_on_the_next_face_stopped_by_another_link_tilts_the_tilted_hand
     assert not [x for x in failed if "too few contacts" in x], failed
     assert rec.outcome == "recognized" and rec.correct, rec.detail
     assert _within_bounds(ep)
+
+
+def test_a_stroke_riding_the_far_rim_of_a_narrow_next_face_keeps_the_face_within_its_bound(tmp_path):
+    # bipyramid_12 of the formula corpus at 30 mm, seed 2 (perception_report.py --corpus --sizes 30 --first-seed 2):
+    # a vertex move at the apex crossed onto a triangle 6.2 mm wide and stroked it along the edge crossed, the first
+    # half of the stroke 0.1-0.5 mm from the triangle's other long edge, its sensed normal leaning 1.75° toward it:
+    # the face 0.88° off, 1.06 bounds (the only component outside its bounds in the 300 episodes on aec5f4b). The
+    # steady rows split by 6.7 σ; the face's bound covers both halves (SegmentBounds.steady_lean_sigmas).
+    ep, _, _ = _replay(tmp_path, "bipyramid_12", 0.03, 6, corpus=True, seed=2)
+    assert len(ep.executor.components) > 11
+    assert _within_bounds(ep)

@@ -226,7 +226,7 @@ def loop_steps(
     obs = observer or EpisodeObserver()
     if obs.on_start:
         obs.on_start(true_model, world_from_model)
-    view = EpisodeState.begin(library, noise, config, _verifier(spec, noise, config))
+    view = EpisodeState.begin(library, noise, config, _verifier(spec, noise, config, executor))
     sources = episode_sources(library, config, rng) if sources is None else sources
     end = _start(view, executor, obs)
     while end is None:
@@ -294,11 +294,15 @@ def _next_move(
     raise PlanningError(f"no move source proposed a move (asked: {', '.join(s.name for s in sources)})")
 
 
-def _verifier(spec: EpisodeSpec, noise: SensorNoise, config: PlannerConfig) -> Verifier | None:
-    """The episode's verification stage (None with ``spec.verify`` "none"), its bounds by executor."""
+def _verifier(spec: EpisodeSpec, noise: SensorNoise, config: PlannerConfig, executor: Executor | None = None
+              ) -> Verifier | None:  # fmt: skip
+    """The episode's verification stage (None with ``spec.verify`` "none"), its bounds by executor: an executor
+    whose bounds hold systematic floors says how (``bound_floors``,
+    :class:`~haptic.matching.acceptance.BoundFloors`)."""
     if spec.verify == "none":
         return None
-    return Verifier(spec.verify, noise, config, K_SIGMA_PHYSICS if spec.executor == "physics" else K_SIGMA)
+    return Verifier(spec.verify, noise, config, K_SIGMA_PHYSICS if spec.executor == "physics" else K_SIGMA,
+                    getattr(executor, "bound_floors", None))  # fmt: skip
 
 
 @dataclass(frozen=True)

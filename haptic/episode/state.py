@@ -172,7 +172,7 @@ class EpisodeState:
         if self.free:  # after every add: poses tighten, and leaves unposed or too many before become testable
             apply_probes(self.tree, self.free, self.probe_faces)
         if self.verifier is not None:  # with learned models in the library: each model held to its own bounds
-            keep = own_bounds_keep(self.tree, self.verifier.k_sigma)
+            keep = own_bounds_keep(self.tree, self.verifier.k_sigma, self.verifier.floors)
             if keep is not None and not keep.all():
                 self.tree.retain(keep)
         if self.config.touch_evidence:

@@ -44,6 +44,7 @@ from haptic.executor.segment import (
 from haptic.executor.touch_config import TouchConfig
 from haptic.executor.workspace import ReentrySearch, Workspace, admissible_moves, toward_vertex
 from haptic.geometry.se3 import angle, unit
+from haptic.matching.acceptance import BoundFloors
 from haptic.matching.components import DataComponent
 from haptic.matching.trace import PHASES, ContactTrace
 from haptic.planning.moves import (
@@ -339,6 +340,11 @@ class PhysicsExecutor(LandingSearch):
     def components(self) -> list[DataComponent]:
         """Every component reported so far, in order (re-reported edges appear again)."""
         return self.segmenter.components
+
+    @property
+    def bound_floors(self) -> BoundFloors:
+        """How the components' bounds are made (the segmenter's floors), for the acceptance test."""
+        return self.bounds.floors()
 
     # ------------------------------------------------------------------------------------------ plumbing
     def _run(self, move: Move, body) -> MoveResult:
