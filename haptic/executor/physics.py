@@ -911,8 +911,7 @@ class PhysicsExecutor(LandingSearch):
             if recrosses < self.settings.recrosses:
                 shift = self._past_the_vertex(fit_a.normal, fit_b, roll, corner)
                 if shift is not None:  # the next face met lies round the vertex: crossed again square to the edge
-                    across = in_plane(heading - float(heading @ unit(shift)) * unit(shift), n_a)
-                    across = heading if across is None else across
+                    across = self._square_to(heading, shift, n_a)
                 else:
                     shift = self._away_from_vertex(fit_a.normal, fit_b.normal, roll)
             recrosses += 1
@@ -1050,6 +1049,14 @@ class PhysicsExecutor(LandingSearch):
         i = int(turned[0]) if len(turned) else len(n) - k
         return unit(n[max(0, i):i + k].sum(axis=0))
 
+    @staticmethod
+    def _square_to(heading: np.ndarray, edge: np.ndarray, n: np.ndarray) -> np.ndarray:
+        """``heading`` turned in the plane of normal ``n`` square to ``edge``, still toward it, a unit vector
+        (``heading`` itself when it runs along the edge)."""
+        e = unit(edge)
+        across = in_plane(heading - float(heading @ e) * e, n)
+        return heading if across is None else unit(across)
+
     def _past_the_vertex(self, n_a: np.ndarray, fit_b: FaceFit, roll: ContactTrace | None, corner: np.ndarray
                          ) -> np.ndarray | None:  # fmt: skip
         """After a crossing from face ``n_a`` at ``corner`` whose next face (``fit_b``, stroked or touched afresh)
@@ -1066,13 +1073,18 @@ class PhysicsExecutor(LandingSearch):
         apex). None when the roll turned about no axis, ``fit_b`` is the face it settled on, leans too little along
         the edge (within :attr:`SegmentBounds.sample_cone`) to tell a side, or its plane cuts the edge behind the
         crossing or beyond the pad's radius plus ``recross_shift``, or the shift would be longer than that (not a
-        face round a vertex the pad reached: the start's slide along an edge into the apex, the roll over it)."""
+        face round a vertex the pad reached: the start's slide along an edge into the apex, the roll over it); None
+        too when the roll did not settle on the face it first turned to (a roll round the vertex itself, its first
+        turn about no edge: prism_09 of the sized corpus, seed 1, met an edge 0.2 mm from its end)."""
         if roll is None or not roll.in_contact.any():
             return None
         s, n_b = self.settings, fit_b.normal
         n_t = self._first_turn(n_a, roll)
+        n = roll.normal_in_world[roll.in_contact]
+        settled = unit(n[-self.bounds.steady_window:].sum(axis=0))
         e = np.cross(n_a, n_t)
-        if float(e @ e) < math.sin(self.bounds.min_edge_angle) ** 2 or angle(n_b, n_t) <= s.reacquire_cone:
+        if float(e @ e) < math.sin(self.bounds.min_edge_angle) ** 2 or angle(n_b, n_t) <= s.reacquire_cone \
+                or angle(settled, n_t) > s.reacquire_cone:  # fmt: skip
             return None
         e = unit(e)
         lean = float(n_b @ e)
@@ -1653,10 +1665,15 @@ class PhysicsExecutor(LandingSearch):
             fit_f, line, why = self._edge_between(f, r.trace, "circle", roll, fit_g, kind, corner)
             break
         if line is None:
-            shift = self._away_from_vertex(fit_f.normal, fit_g.normal, roll)
+            heading, where = r.info["direction"], "along the edge"
+            shift = self._past_the_vertex(fit_f.normal, fit_g, roll, corner)
+            if shift is not None:  # the next face met lies round a vertex past a narrow face: square to the edge
+                heading = self._square_to(heading, shift, n_f)
+                where = "along the edge square to it"
+            else:
+                shift = self._away_from_vertex(fit_f.normal, fit_g.normal, roll)
             again = None if shift is None else self._circle_crossed_again(
-                f, n_f, r.info["direction"], corner, shift, vtx, r.trace, pieces)
-            where = "along the edge"
+                f, n_f, heading, corner, shift, vtx, r.trace, pieces)
             if again is None:
                 # the roll's lean told no way, or a wrong one (the next face touched afresh round the vertex, its
                 # normal another face's): the edge met leaves the vertex circled, so out along it, clear of it
