@@ -1121,3 +1121,61 @@ def test_a_stroke_riding_the_far_rim_of_a_narrow_next_face_keeps_the_face_within
     ep, _, _ = _replay(tmp_path, "bipyramid_12", 0.03, 6, corpus=True, seed=2)
     assert len(ep.executor.components) > 11
     assert _within_bounds(ep)
+
+
+def test_a_face_move_onto_a_kite_near_its_apex_crosses_again_square_where_it_is_wider(tmp_path):
+    # trapezohedron_12 of the sized formula corpus (77 mm), seed 1, default options: the verification asked five
+    # face moves across long edges of its kites (20° at the apex) 3.2-7.4 mm from the apex, where the next kite is
+    # 1.2-2.7 mm wide. The roll settled on it, the stroke stepped onto the rim of its other edge, and the face
+    # touched afresh was one round the apex: "no edge between the faces: ... (a roll round a vertex)". The shift
+    # told by the lean of the roll's normals (noise alone) ran on past the apex, the start lay off the face, and the
+    # episode stalled with 7 vertices not measured. The face touched afresh cuts the edge at the apex and leans
+    # toward it: the move crosses again square to the edge, out where the kite is wide enough. The episode is
+    # stopped once a face move has done so.
+    class Seen(Exception):
+        pass
+
+    said, failed = [], []
+
+    def on_move(n, r, *a) -> None:
+        if r.move.kind == "face":
+            said.extend(x for x in (r.info or {}).get("recoveries", ()) if "square to it" in x)
+        if said:
+            raise Seen
+
+    def on_failed(n, r) -> None:
+        if r.move.kind == "face" and "a roll round a vertex" in r.reason:
+            failed.append(r.reason)
+
+    spec = EpisodeSpec(model="trapezohedron_12", seed=1, executor="physics", models=_sized_corpus(tmp_path))
+    ep = build_episode(spec)
+    with pytest.raises(Seen):
+        ep.run(None, EpisodeObserver(on_move=on_move, on_failed_move=on_failed))
+    assert said and not failed, failed
+    assert _within_bounds(ep)
+
+
+def test_a_vertex_move_onto_a_narrow_triangle_near_its_apex_crosses_again_square_where_it_is_wider(tmp_path):
+    # bipyramid_11 of the sized formula corpus (55 mm), seed 1, default options: late in the verification a vertex
+    # circle met a long edge 7.5 mm from the apex, where the next triangle (20° there) is 2.8 mm wide. The roll
+    # settled on it, the stroke found too little of it, the face touched afresh was one round the apex, and the
+    # shift told by the roll's own lean ran back toward the apex: "no edge between the faces: ... (a roll round a
+    # vertex)". The circle now crosses again square to the edge, out where the triangle is wide enough, as a face
+    # move does. The episode is stopped once a vertex move has done so.
+    class Seen(Exception):
+        pass
+
+    said = []
+
+    def on_move(n, r, *a) -> None:
+        if r.move.kind == "vertex":
+            said.extend(x for x in (r.info or {}).get("recoveries", ()) if "square to it" in x)
+        if said:
+            raise Seen
+
+    spec = EpisodeSpec(model="bipyramid_11", seed=1, executor="physics", models=_sized_corpus(tmp_path))
+    ep = build_episode(spec)
+    with pytest.raises(Seen):
+        ep.run(None, EpisodeObserver(on_move=on_move))
+    assert said
+    assert _within_bounds(ep)
