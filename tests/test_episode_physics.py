@@ -733,6 +733,55 @@ def test_an_edge_move_that_locates_the_end_it_set_off_past_does_not_turn_the_obj
     assert rec.outcome != "no-match", rec.detail
 
 
+def test_an_edge_move_whose_return_beside_the_last_contact_fails_returns_beside_the_edges_middle(tmp_path):
+    # trapezohedron_06 of the sized formula corpus, seed 1, default options: a vertex move left the pad 5 mm past the
+    # far end of an 8 mm edge, and the edge move along it toward that end, returning next to the edge beside the last
+    # contact, touched the faces round that end (normals 7° and 24° off the edge's faces) and failed; the vertex
+    # there was measured by nothing else, and the verification went round the object for 20 more moves until its
+    # budget ended it "incomplete after 31 moves: ... 1 vertices ... not measured". Returned beside the middle of
+    # the edge behind its end, the move locates the vertex, and the verification ends with every vertex in the
+    # hand's reach measured
+    rec = run_episode(EpisodeSpec(model="trapezohedron_06", seed=1, executor="physics",
+                                  models=_sized_corpus(tmp_path)))  # fmt: skip
+    assert rec.verified["reach_complete"], rec.detail
+    assert rec.perception["outside_bounds"] == 0
+
+
+def test_a_next_face_touched_along_the_edge_after_a_rim_reading_is_the_next_face(tmp_path):
+    # platonic_dodecahedron of the sized formula corpus, seed 1, default options: two face moves rolled over an edge
+    # near its end, and the touches afresh past it read the rims of the faces round the vertex (normals turned 58°
+    # and 59° from the face left, no face in their L); touched again along the edge, clear of the end, the pad
+    # measured the next face at the solid's 63.4°, 24° and 21° from the rim reading, and a 12° cone turned it away:
+    # both crossings failed "too few contacts on the next face", and the verification ended "incomplete after 34
+    # moves: ... 2 vertices ... not measured". Taken as the next face, the crossing goes on (one fails cleanly on,
+    # its edge's ridge a vertex), and every vertex in the hand's reach is measured
+    rec = run_episode(EpisodeSpec(model="platonic_dodecahedron", seed=1, executor="physics",
+                                  models=_sized_corpus(tmp_path)))  # fmt: skip
+    assert rec.verified["reach_complete"], rec.detail
+    assert rec.perception["outside_bounds"] == 0
+
+
+def test_a_verification_whose_every_way_to_a_vertex_failed_ends_saying_so(tmp_path, monkeypatch):
+    # trapezohedron_06 of the sized formula corpus, seed 1, default options, the edge move returning beside the last
+    # contact alone (as before it returned beside the middle of the edge): the one edge move in the hand's reach
+    # toward a vertex failed, is not asked again, and the verification went round the object for 20 moves measuring
+    # nothing until its budget ended it, "incomplete after 31 moves: ... 1 vertices ... not measured". With no way
+    # to the vertex left, it ends there and names the move that failed
+    from haptic.executor.physics import PhysicsExecutor
+
+    def beside_the_last_contact(self, rec, u, face, pieces, s0=None):
+        if s0 is None:
+            s0 = rec.param(self.contact_point() if self.toucher.contact[2] is not None else self.state.position)
+        return self._return_beside(rec, u, face, pieces, s0)
+
+    monkeypatch.setattr(PhysicsExecutor, "_return_next_to_edge", beside_the_last_contact)
+    rec = run_episode(EpisodeSpec(model="trapezohedron_06", seed=1, executor="physics",
+                                  models=_sized_corpus(tmp_path)))  # fmt: skip
+    assert "every edge move in the hand's reach toward them failed" in rec.detail, rec.detail
+    assert "could not return next to the edge" in rec.detail
+    assert rec.verified["moves"] < 20 and rec.verified["vertices_unreached"], rec.verified
+
+
 @pytest.mark.slow
 def test_a_verification_that_failed_a_way_in_finds_another(tmp_path):
     # antiprism_05 of the sized formula corpus, seed 1, default options: the verification ended "incomplete after

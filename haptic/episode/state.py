@@ -203,6 +203,8 @@ class EpisodeState:
         self.failed_in_a_row += 1
         self.last_failure = result.status
         self.failed_here.append(move)
+        if self.verifier is not None and self.verifying:
+            self.verifier.failed(move, result.reason or str(result.status))
         if move.kind == "probe":  # its line is where it is, whatever the state: not offered again
             self.probed.append(move)
         self.cost += result.cost

@@ -75,6 +75,8 @@ RIDGE_PROBE = 0.004
 """An edge measured from a roll alone is followed this far each way from where the roll ended [m] ..."""
 RIDGE_MIN_SPAN = 0.003
 """... and its ridge contacts must span at least this along it [m]."""
+RETURN_FAILED = "could not return next to the edge: "
+"""How a failed return next to an edge before an edge move begins its reason."""
 NEXT_FACE_LOST = ("too few contacts on the next face", "stepping onto the next face, the pad reached the rim")
 """How a crossing that rolled over the edge but measured too little of a face past it ends
 (:meth:`PhysicsExecutor._cross_and_acquire`). A stroke on the next face that was blocked is not among them: that is
@@ -167,7 +169,10 @@ class PhysicsSettings:
     corner_rows: int = 20
     """... judged on its last this many rows in contact [-]."""
     edge_reentry: float = 0.004
-    """An edge move that must first return next to its edge touches the face this far in from the edge [m]."""
+    """An edge move that must first return next to its edge touches the face this far in from the edge [m] ..."""
+    return_shift: float = 0.004
+    """... beside the last contact; when that fails, beside the middle of what is known of the edge if that lies at
+    least this far from it (``PhysicsExecutor._return_next_to_edge``) [m]."""
     reentry: ReentrySearch = field(default_factory=ReentrySearch)
     """... and, when that is within the pad's reach of the table, searches further along the edge."""
     edge_reach: float = 0.03
@@ -221,6 +226,10 @@ class PhysicsSettings:
     """... at a point this far from the edge on the guessed face [m] ..."""
     reacquire_cone: float = math.radians(12.0)
     """... skipping a guess within this of one tried [rad]."""
+    rim_reading_cone: float = math.radians(30.0)
+    """A face touched afresh along the edge after a first touch past it that read the rims at the edge's end is
+    the same face when its normal lies within this of that reading, turned as far from the face crossed from
+    (``PhysicsExecutor._same_next_face``) [rad]."""
     square_crossing: float = math.radians(25.0)
     """A face move whose travel crossed the convex edge it reports within this of square to it follows the ridge
     first: crossing square, a roll round a vertex onto a face sharing only it turns the normals about the same axis
@@ -784,7 +793,7 @@ class PhysicsExecutor(LandingSearch):
                     again = self._touch_next(kind, n_a, d, corner, moved, n, pieces, away_from)
                     if again == "table":
                         return "unreachable", "the edge lies on the table", None, None, None
-                    if not isinstance(again, str) and again[1] is not None and angle(again[0], n) <= s.reacquire_cone:
+                    if not isinstance(again, str) and again[1] is not None and self._same_next_face(n_a, n, again[0]):
                         self.recoveries.append(f"{why}: the next face touched afresh {step * 1000:.0f} mm along the "
                                                "edge, clear of its end")  # fmt: skip
                         return "ok", "", roll, again[2].trace, again[1]
@@ -792,6 +801,21 @@ class PhysicsExecutor(LandingSearch):
                 self.recoveries.append(f"{why}: the next face touched afresh")
                 return "ok", "", roll, st.trace, fit
         return "unreachable", why, None, None, None
+
+    def _same_next_face(self, n_a: np.ndarray, n: np.ndarray, again: np.ndarray) -> bool:
+        """For :meth:`_reacquire`: whether normal ``again``, touched farther along the edge where an L measured the
+        face, is that of the face touched first past the edge (normal ``n``; ``n_a`` the face crossed from): within
+        :attr:`PhysicsSettings.reacquire_cone` of it; or, the first touch having read the rims at the edge's end
+        (its L measured no face), turned from ``n_a`` as far as ``n`` within that cone and no farther from ``n``
+        than :attr:`PhysicsSettings.rim_reading_cone`. On the rims of the faces round the vertex the pad reads a
+        normal partway between them, turned about the edge about as far as the next face (platonic_dodecahedron of
+        the formula corpus, seed 1: the first touches read 58° and 59° turns 24° and 21° off the next face, which
+        the touches along the edge measured at the solid's 63.4°, and the crossings failed "too few contacts on the
+        next face")."""
+        s = self.settings
+        if angle(again, n) <= s.reacquire_cone:
+            return True
+        return angle(again, n) <= s.rim_reading_cone and abs(angle(again, n_a) - angle(n, n_a)) <= s.reacquire_cone
 
     def _touch_next(self, kind: str, n_a: np.ndarray, d: np.ndarray, corner: np.ndarray, target: np.ndarray,
                     n_guess: np.ndarray, pieces: list[PrimitiveResult], away_from):  # fmt: skip
@@ -1239,12 +1263,48 @@ class PhysicsExecutor(LandingSearch):
     ) -> str:
         """Put the pad on a face of edge ``rec`` next to it (beside parameter ``s0`` when given, else beside the
         last contact), before following it along ``u``: on the current face ``face`` when it is one of the edge's,
-        else on the other; when that touch fails, on the other face."""
+        else on the other; when that touch fails, on the other face. Beside the last contact, the pad may rest at a
+        vertex the edge ends at, where a touch next to the edge meets the faces round that vertex too (trapezohedron_06
+        of the formula corpus at seed 1: an edge move setting off from the vertex a vertex move had just reached
+        touched normals 7° and 24° off the edge's faces, and the vertex at its other end was never measured): when
+        the touches there fail, the pad returns beside the middle of what is known of the edge behind the end the
+        move runs to (:meth:`_known_middle`) instead, if that lies at least :attr:`PhysicsSettings.return_shift`
+        away (there the last contact lay 5 mm past that end)."""
+        last = s0 is None
+        if last:  # beside the last contact: the pad may be far off in free space (backed out after a tilted move)
+            s0 = rec.param(self.contact_point() if self.toucher.contact[2] is not None else self.state.position)
+        status = self._return_beside(rec, u, face, pieces, s0)
+        middle = self._known_middle(rec, u)
+        if not last or status in ("ok", "unstable") or abs(middle - s0) < self.settings.return_shift:
+            return status
+        why = self._why
+        again = self._return_beside(rec, u, face, pieces, middle)
+        if again == "ok":
+            self.recoveries.append(f"{why}: returned beside the middle of the edge behind its end, "
+                                   f"{abs(middle - s0) * 1000:.0f} mm from the last contact")  # fmt: skip
+            return again
+        if again != "unstable":
+            self._why = f"{why}; beside the middle of the edge: {self._why.removeprefix(RETURN_FAILED)}"
+        return again
+
+    def _known_middle(self, rec, u: np.ndarray) -> float:
+        """The parameter on edge ``rec`` halfway between the far end of its explored interval along ``u`` and, behind
+        it, the vertex the move sets off from (the state's, when it is one of the edge's), else the interval's other
+        end. An interval may reach over the end the move runs to (trapezohedron_06: an 8 mm edge from vertex to
+        vertex, its interval from the vertex move's roll 1.4 mm long and 0.7 mm over its far end), and its middle
+        then lies at that end: an edge move set off there locates the vertex behind its start, and fails."""
+        sign = 1.0 if float(u @ rec.direction) > 0 else -1.0
+        far = rec.interval[1] if sign > 0 else rec.interval[0]
+        back = rec.interval[0] if sign > 0 else rec.interval[1]
+        v = self.state.vertex
+        if v is not None and v in rec.vertices and sign * (rec.vertices[v] - back) < 0:
+            back = rec.vertices[v]
+        return 0.5 * (far + back)
+
+    def _return_beside(self, rec, u: np.ndarray, face: int, pieces: list[PrimitiveResult], s0: float) -> str:
+        """For :meth:`_return_next_to_edge`: the pad on a face of edge ``rec`` beside parameter ``s0``."""
         s, seg = self.settings, self.segmenter
         first = face if face in rec.faces else rec.faces[1]
-        # beside the last contact: the pad may be far off in free space (backed out after a tilted move)
-        if s0 is None:
-            s0 = rec.param(self.contact_point() if self.toucher.contact[2] is not None else self.state.position)
         if not rec.convex and None not in rec.faces:
             return self._touch_corner(rec, s0, u, first, pieces)
         status, why = "unreachable", "the edge next to the table is out of the pad's reach"
@@ -1258,7 +1318,7 @@ class PhysicsExecutor(LandingSearch):
                 self.recoveries.append("the edge approached from its other face")
             if status in ("ok", "unstable"):
                 return status
-            why = f"could not return next to the edge: {self._why}"
+            why = f"{RETURN_FAILED}{self._why}"
         self._why = why
         return status
 
