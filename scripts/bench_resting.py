@@ -39,15 +39,21 @@ class TakeResting:
 
     def __init__(self, policy) -> None:
         self.policy, self.name = policy, policy.name
-        self.offered = 0
+        self.offered: list[str] = []
+        """Per resting probe offered: its efficiency, expected eliminations and cost against the planner's choice's."""
 
     def choose(self, ctx, rng):
         decision = self.policy.choose(ctx, rng)
         resting = [c for c in decision.candidates if getattr(c.move, "resting", False)]
         if not resting:
             return decision
-        self.offered += 1
-        return Decision(resting[0].move, decision.candidates)
+        r = resting[0]
+        best = next((c for c in decision.candidates if c.move is decision.move), None)
+        mine = f"{r.score:.2f} classes/unit ({r.expected_eliminated:.2f} for {r.expected_cost:.2f})"
+        theirs = "" if best is None else (f" against the planner's {best.move.kind} {best.score:.2f} "
+                                          f"({best.expected_eliminated:.2f} for {best.expected_cost:.2f})")  # fmt: skip
+        self.offered.append(f"offered: {mine}{theirs}")
+        return Decision(r.move, decision.candidates)
 
 
 def within_bounds(face: DataFace, ep) -> bool:
@@ -93,6 +99,7 @@ def main() -> None:
                 observer = chain_observers(observer, recorder.observer())
             policy = TakeResting(make_policy("planner"))
             rec = ep.run(policy, observer)
+            rows = list(policy.offered)
             if recorder is not None:
                 recorded = bool(taken)
                 recorder.close(keep=recorded)
@@ -101,7 +108,6 @@ def main() -> None:
                 totals[k] += r.get(k, 0)
             totals["episodes"] += 1
             totals["correct"] += rec.outcome == "recognized" and rec.correct
-            rows = []
             for res in taken:
                 totals["taken"] += 1
                 status = res.info.get("finger_status") if res.ok else str(res.status)
