@@ -1159,3 +1159,72 @@ def test_a_stroke_on_the_next_face_stopped_by_another_link_tilts_the_tilted_hand
     assert not [x for x in failed if "too few contacts" in x], failed
     assert rec.outcome == "recognized" and rec.correct, rec.detail
     assert _within_bounds(ep)
+
+
+def test_a_stroke_riding_the_far_rim_of_a_narrow_next_face_keeps_the_face_within_its_bound(tmp_path):
+    # bipyramid_12 of the formula corpus at 30 mm, seed 2 (perception_report.py --corpus --sizes 30 --first-seed 2):
+    # a vertex move at the apex crossed onto a triangle 6.2 mm wide and stroked it along the edge crossed, the first
+    # half of the stroke 0.1-0.5 mm from the triangle's other long edge, its sensed normal leaning 1.75° toward it:
+    # the face 0.88° off, 1.06 bounds (the only component outside its bounds in the 300 episodes on aec5f4b). The
+    # steady rows split by 6.7 σ; the face's bound covers both halves (SegmentBounds.steady_lean_sigmas).
+    ep, _, _ = _replay(tmp_path, "bipyramid_12", 0.03, 6, corpus=True, seed=2)
+    assert len(ep.executor.components) > 11
+    assert _within_bounds(ep)
+
+
+def test_a_face_move_onto_a_kite_near_its_apex_crosses_again_square_where_it_is_wider(tmp_path):
+    # trapezohedron_12 of the sized formula corpus (77 mm), seed 1, default options: the verification asked five
+    # face moves across long edges of its kites (20° at the apex) 3.2-7.4 mm from the apex, where the next kite is
+    # 1.2-2.7 mm wide. The roll settled on it, the stroke stepped onto the rim of its other edge, and the face
+    # touched afresh was one round the apex: "no edge between the faces: ... (a roll round a vertex)". The shift
+    # told by the lean of the roll's normals (noise alone) ran on past the apex, the start lay off the face, and the
+    # episode stalled with 7 vertices not measured. The face touched afresh cuts the edge at the apex and leans
+    # toward it: the move crosses again square to the edge, out where the kite is wide enough. The episode is
+    # stopped once a face move has done so.
+    class Seen(Exception):
+        pass
+
+    said, failed = [], []
+
+    def on_move(n, r, *a) -> None:
+        if r.move.kind == "face":
+            said.extend(x for x in (r.info or {}).get("recoveries", ()) if "square to it" in x)
+        if said:
+            raise Seen
+
+    def on_failed(n, r) -> None:
+        if r.move.kind == "face" and "a roll round a vertex" in r.reason:
+            failed.append(r.reason)
+
+    spec = EpisodeSpec(model="trapezohedron_12", seed=1, executor="physics", models=_sized_corpus(tmp_path))
+    ep = build_episode(spec)
+    with pytest.raises(Seen):
+        ep.run(None, EpisodeObserver(on_move=on_move, on_failed_move=on_failed))
+    assert said and not failed, failed
+    assert _within_bounds(ep)
+
+
+def test_a_vertex_move_onto_a_narrow_triangle_near_its_apex_crosses_again_square_where_it_is_wider(tmp_path):
+    # bipyramid_11 of the sized formula corpus (55 mm), seed 1, default options: late in the verification a vertex
+    # circle met a long edge 7.5 mm from the apex, where the next triangle (20° there) is 2.8 mm wide. The roll
+    # settled on it, the stroke found too little of it, the face touched afresh was one round the apex, and the
+    # shift told by the roll's own lean ran back toward the apex: "no edge between the faces: ... (a roll round a
+    # vertex)". The circle now crosses again square to the edge, out where the triangle is wide enough, as a face
+    # move does. The episode is stopped once a vertex move has done so.
+    class Seen(Exception):
+        pass
+
+    said = []
+
+    def on_move(n, r, *a) -> None:
+        if r.move.kind == "vertex":
+            said.extend(x for x in (r.info or {}).get("recoveries", ()) if "square to it" in x)
+        if said:
+            raise Seen
+
+    spec = EpisodeSpec(model="bipyramid_11", seed=1, executor="physics", models=_sized_corpus(tmp_path))
+    ep = build_episode(spec)
+    with pytest.raises(Seen):
+        ep.run(None, EpisodeObserver(on_move=on_move))
+    assert said
+    assert _within_bounds(ep)

@@ -91,6 +91,15 @@ class EpisodeRecord:
     """On the simulated hand with several fingers, the planner's reach test of placements
     (:class:`haptic.executor.placement.PlacementReach`): placements ``asked`` about, ``reached``, and why the others
     were not (``reasons``, by the solver's reason); None otherwise."""
+    resting: list[dict] = field(default_factory=list)
+    """Each resting probe (another finger while the hand rests, ``ProbeMove.resting``) carried out or failed, in
+    order: its ``finger``, ``status`` ("ok" or why it failed) and the finger's (``finger_status``: "touched",
+    "missed" or why it failed)."""
+    resting_reach: dict | None = None
+    """On the simulated hand with several fingers, the planner's reach test of resting probes
+    (:class:`haptic.executor.placement.RestingReach`): ``decisions`` that asked, the ``lines`` within the fingers'
+    reach they generated, those ``asked`` about and ``reached``, and why the others were not (``reasons``); None
+    otherwise."""
     learned: dict | None = None
     """How learning the object went after ``no-match`` (``--learn DIR``: :mod:`haptic.episode.learning`; None:
     no learning)."""
@@ -226,7 +235,7 @@ def loop_steps(
     obs = observer or EpisodeObserver()
     if obs.on_start:
         obs.on_start(true_model, world_from_model)
-    view = EpisodeState.begin(library, noise, config, _verifier(spec, noise, config))
+    view = EpisodeState.begin(library, noise, config, _verifier(spec, noise, config, executor))
     sources = episode_sources(library, config, rng) if sources is None else sources
     end = _start(view, executor, obs)
     while end is None:
@@ -294,11 +303,15 @@ def _next_move(
     raise PlanningError(f"no move source proposed a move (asked: {', '.join(s.name for s in sources)})")
 
 
-def _verifier(spec: EpisodeSpec, noise: SensorNoise, config: PlannerConfig) -> Verifier | None:
-    """The episode's verification stage (None with ``spec.verify`` "none"), its bounds by executor."""
+def _verifier(spec: EpisodeSpec, noise: SensorNoise, config: PlannerConfig, executor: Executor | None = None
+              ) -> Verifier | None:  # fmt: skip
+    """The episode's verification stage (None with ``spec.verify`` "none"), its bounds by executor: an executor
+    whose bounds hold systematic floors says how (``bound_floors``,
+    :class:`~haptic.matching.acceptance.BoundFloors`)."""
     if spec.verify == "none":
         return None
-    return Verifier(spec.verify, noise, config, K_SIGMA_PHYSICS if spec.executor == "physics" else K_SIGMA)
+    return Verifier(spec.verify, noise, config, K_SIGMA_PHYSICS if spec.executor == "physics" else K_SIGMA,
+                    getattr(executor, "bound_floors", None))  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -410,6 +423,7 @@ def _record(
         probe_misses=n_probes - (len(view.probe_faces) - view.placement_faces),
         fingers=spec.fingers,
         placements=list(view.placements),
+        resting=list(view.resting),
     )
 
 

@@ -104,6 +104,8 @@ class EpisodeState:
     placements: list[dict] = field(default_factory=list)
     """Each placement of several fingertips carried out or failed: its ``status`` and, per finger, what it did
     (the executor's ``info["fingers"]``)."""
+    resting: list[dict] = field(default_factory=list)
+    """Each resting probe, as the record keeps it (``EpisodeRecord.resting``)."""
     _hypotheses: tuple[Recognition | None, list[Hypothesis]] = (None, [])
 
     @classmethod
@@ -172,7 +174,7 @@ class EpisodeState:
         if self.free:  # after every add: poses tighten, and leaves unposed or too many before become testable
             apply_probes(self.tree, self.free, self.probe_faces)
         if self.verifier is not None:  # with learned models in the library: each model held to its own bounds
-            keep = own_bounds_keep(self.tree, self.verifier.k_sigma)
+            keep = own_bounds_keep(self.tree, self.verifier.k_sigma, self.verifier.floors)
             if keep is not None and not keep.all():
                 self.tree.retain(keep)
         if self.config.touch_evidence:
@@ -188,6 +190,10 @@ class EpisodeState:
         self.kinds.append(result.move.kind if result.move is not None else "start")
 
     def _placed(self, result: MoveResult) -> None:
+        if result.move is not None and getattr(result.move, "resting", False):
+            self.resting.append({"finger": result.move.finger, "status": str(result.status),
+                                 "finger_status": result.info.get("finger_status"),
+                                 **({"reason": result.reason} if result.reason else {})})  # fmt: skip
         if result.move is not None and result.move.kind == "placement":
             fingers = [{"finger": f["finger"], "status": f["status"], **({"reason": f["reason"]} if f.get("reason")
                                                                           else {})}

@@ -26,7 +26,7 @@ import numpy as np
 from haptic.errors import HapticError
 from haptic.executor.landing import LandingSearch
 from haptic.executor.physics_probe import probe_move
-from haptic.executor.placement import finger_probe_move, placement_move
+from haptic.executor.placement import finger_probe_move, placement_move, resting_probe_move
 from haptic.executor.primitives import OPPOSED, PrimitiveResult, Toucher
 from haptic.executor.segment import (
     AT_END,
@@ -44,6 +44,7 @@ from haptic.executor.segment import (
 from haptic.executor.touch_config import TouchConfig
 from haptic.executor.workspace import ReentrySearch, Workspace, admissible_moves, toward_vertex
 from haptic.geometry.se3 import angle, unit
+from haptic.matching.acceptance import BoundFloors
 from haptic.matching.components import DataComponent
 from haptic.matching.trace import PHASES, ContactTrace
 from haptic.planning.moves import (
@@ -349,6 +350,11 @@ class PhysicsExecutor(LandingSearch):
         """Every component reported so far, in order (re-reported edges appear again)."""
         return self.segmenter.components
 
+    @property
+    def bound_floors(self) -> BoundFloors:
+        """How the components' bounds are made (the segmenter's floors), for the acceptance test."""
+        return self.bounds.floors()
+
     # ------------------------------------------------------------------------------------------ plumbing
     def _run(self, move: Move, body) -> MoveResult:
         t0, w0 = self.robot.time, time.perf_counter()
@@ -555,6 +561,8 @@ class PhysicsExecutor(LandingSearch):
             return self._run(move, lambda pieces: self._edge_move(move, pieces))
         if isinstance(move, VertexMove):
             return self._run(move, lambda pieces: self._vertex_move(move, pieces))
+        if isinstance(move, ProbeMove) and move.resting:  # another finger, the hand resting: haptic.executor.placement
+            return self._run(move, lambda pieces: resting_probe_move(self, move, pieces))
         if isinstance(move, ProbeMove) and move.finger is not None:
             # a named fingertip (the exploring one too), the wrist turned to point it along the line, the hand's way
             # the planner's: haptic.executor.placement
@@ -931,18 +939,24 @@ class PhysicsExecutor(LandingSearch):
                     line, why = None, f"no edge between the faces: {ridge}"
             if line is not None:
                 break
-            shift = self._away_from_vertex(fit_a.normal, fit_b.normal, roll) if recrosses < self.settings.recrosses \
-                else None
+            shift, across = None, heading
+            if recrosses < self.settings.recrosses:
+                shift = self._past_the_vertex(fit_a.normal, fit_b, roll, corner)
+                if shift is not None:  # the next face met lies round the vertex: crossed again square to the edge
+                    across = self._square_to(heading, shift, n_a)
+                else:
+                    shift = self._away_from_vertex(fit_a.normal, fit_b.normal, roll)
             recrosses += 1
             if shift is None:
                 return self.failed_result(move, "unreachable", why)
             # the roll went round the edge's end: cross again farther along the edge, inside it
-            way = self._recross_start(st.face, n_a, corner, heading, shift, self.settings.recross_back, r.trace,
+            way = self._recross_start(st.face, n_a, corner, across, shift, self.settings.recross_back, r.trace,
                                       pieces)  # fmt: skip
             if way is None:
                 return self.failed_result(move, "unreachable", why)
+            square = " square to it" if across is not heading and way is across else ""
             self.recoveries.append(f"{why}: crossed again {np.linalg.norm(shift) * 1000:.0f} mm along the edge"
-                                   f"{'' if way is heading else FROM_TOUCHED}")  # fmt: skip
+                                   f"{square}{'' if way is across else FROM_TOUCHED}")  # fmt: skip
             heading = way
         new_face = seg.next_id + 1
         edge = seg.add_edge(line, (st.face, new_face), kind == "convex", (fit_a.normal, fit_b.normal),
@@ -1066,6 +1080,58 @@ class PhysicsExecutor(LandingSearch):
         turned = np.flatnonzero(n @ n_a < math.cos(2.0 * self.toucher.config.edge_angle))
         i = int(turned[0]) if len(turned) else len(n) - k
         return unit(n[max(0, i):i + k].sum(axis=0))
+
+    @staticmethod
+    def _square_to(heading: np.ndarray, edge: np.ndarray, n: np.ndarray) -> np.ndarray:
+        """``heading`` turned in the plane of normal ``n`` square to ``edge``, still toward it, a unit vector
+        (``heading`` itself when it runs along the edge)."""
+        e = unit(edge)
+        across = in_plane(heading - float(heading @ e) * e, n)
+        return heading if across is None else unit(across)
+
+    def _past_the_vertex(self, n_a: np.ndarray, fit_b: FaceFit, roll: ContactTrace | None, corner: np.ndarray
+                         ) -> np.ndarray | None:  # fmt: skip
+        """After a crossing from face ``n_a`` at ``corner`` whose next face (``fit_b``, stroked or touched afresh)
+        is not the face the roll settled on (its normal more than :attr:`PhysicsSettings.reacquire_cone` from the
+        roll's first turn, :meth:`_first_turn`): the pad settled on a face too narrow there for the stroke (a kite
+        or a triangle near its acute corner), stepped onto the rim of its other edge, and the face stroked or
+        touched afresh past that rim lies round the vertex where the two edges meet. That face's plane cuts the
+        edge the roll turned about at the vertex, on the side the face leans to (every face at a convex vertex leans
+        toward it along an edge leaving it), and meets the settled face along the other edge: the shift along the
+        edge, away from the vertex, puts the crossing where the settled face is
+        :attr:`PhysicsSettings.reacquire_inset` wide, ``recross_shift`` at least (trapezohedron_12 of the sized
+        corpus, seed 1: kites of 20° at the apex crossed 4.6-7.4 mm from it, where they are 1.7-2.7 mm wide; the roll
+        turned about the edge to 0.8°, and the lean of its own normals, noise alone, shifted the crossing on past the
+        apex). None when the roll turned about no axis, ``fit_b`` is the face it settled on, leans too little along
+        the edge (within :attr:`SegmentBounds.sample_cone`) to tell a side, or its plane cuts the edge behind the
+        crossing or beyond the pad's radius plus ``recross_shift``, or the shift would be longer than that (not a
+        face round a vertex the pad reached: the start's slide along an edge into the apex, the roll over it); None
+        too when the roll did not settle on the face it first turned to (a roll round the vertex itself, its first
+        turn about no edge: prism_09 of the sized corpus, seed 1, met an edge 0.2 mm from its end)."""
+        if roll is None or not roll.in_contact.any():
+            return None
+        s, n_b = self.settings, fit_b.normal
+        n_t = self._first_turn(n_a, roll)
+        n = roll.normal_in_world[roll.in_contact]
+        settled = unit(n[-self.bounds.steady_window:].sum(axis=0))
+        e = np.cross(n_a, n_t)
+        if float(e @ e) < math.sin(self.bounds.min_edge_angle) ** 2 or angle(n_b, n_t) <= s.reacquire_cone \
+                or angle(settled, n_t) > s.reacquire_cone:  # fmt: skip
+            return None
+        e = unit(e)
+        lean = float(n_b @ e)
+        if abs(lean) < math.sin(self.bounds.sample_cone):
+            return None
+        to_vertex = (fit_b.offset - float(n_b @ corner)) / lean  # along e, from the crossing to the vertex
+        if not 0.0 < math.copysign(1.0, lean) * to_vertex <= self.toucher.pad_radius + s.recross_shift:
+            return None
+        other = np.cross(n_t, n_b)  # the settled face's other edge, from the vertex
+        wedge = float(np.linalg.norm(np.cross(unit(other), e)))  # sine of the face's angle at the vertex
+        need = max(s.recross_shift + self.toucher.pad_radius * abs(lean), s.reacquire_inset / max(wedge, 1e-3)
+                   - abs(to_vertex))  # fmt: skip
+        if need > self.toucher.pad_radius + s.recross_shift:
+            return None
+        return -math.copysign(need, lean) * e
 
     def _away_from_vertex(self, n_a: np.ndarray, n_b: np.ndarray, roll: ContactTrace) -> np.ndarray | None:
         """After a roll whose normals leaned along the edge between faces ``n_a`` and ``n_b`` (the pad rolled
@@ -1667,10 +1733,15 @@ class PhysicsExecutor(LandingSearch):
             fit_f, line, why = self._edge_between(f, r.trace, "circle", roll, fit_g, kind, corner)
             break
         if line is None:
-            shift = self._away_from_vertex(fit_f.normal, fit_g.normal, roll)
+            heading, where = r.info["direction"], "along the edge"
+            shift = self._past_the_vertex(fit_f.normal, fit_g, roll, corner)
+            if shift is not None:  # the next face met lies round a vertex past a narrow face: square to the edge
+                heading = self._square_to(heading, shift, n_f)
+                where = "along the edge square to it"
+            else:
+                shift = self._away_from_vertex(fit_f.normal, fit_g.normal, roll)
             again = None if shift is None else self._circle_crossed_again(
-                f, n_f, r.info["direction"], corner, shift, vtx, r.trace, pieces)
-            where = "along the edge"
+                f, n_f, heading, corner, shift, vtx, r.trace, pieces)
             if again is None:
                 # the roll's lean told no way, or a wrong one (the next face touched afresh round the vertex, its
                 # normal another face's): the edge met leaves the vertex circled, so out along it, clear of it

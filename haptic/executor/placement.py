@@ -47,6 +47,8 @@ from haptic.planning.handpath import CLEARANCE, LIFT, safe_height
 from haptic.planning.moves import FingerApproach, MoveResult, PlacementMove, ProbeMove, SensorState
 from haptic.sim.reach import FingertipTarget, ReachSettings, ReachSolver
 from haptic.sim.scene import ARM_HOME, FINGERS, HAND_TRACE, PAD_RADIUS, TABLE_TOP_Z
+from haptic.sim.scene import FINGER_PREFIX as _PREFIX
+from haptic.sim.scene import HAND_PREFIX as HAND_PREFIX_NAME
 
 PhysicsExecutor = Any
 """The :class:`~haptic.executor.physics.PhysicsExecutor` whose hand carries out the placement; not imported here,
@@ -464,7 +466,6 @@ def _travel(c: _Closing, move: PlacementMove, pieces: list[PrimitiveResult], fir
 
 def _place(ex: PhysicsExecutor, move: PlacementMove, c: _Closing, starts: np.ndarray, z_safe: float,
            pieces: list[PrimitiveResult], single: bool = False) -> MoveResult:  # fmt: skip
-    s = c.s
     names = [f.finger for f in move.fingers]
     axes = {f.finger: np.asarray(f.direction, dtype=float) for f in move.fingers}
     # 2. the planner's way to the lines (from the tracing posture, clear of the hypothesised object), else above the
@@ -480,6 +481,15 @@ def _place(ex: PhysicsExecutor, move: PlacementMove, c: _Closing, starts: np.nda
         why = _above_then_down(c, names, axes, starts, z_safe)
         if why:
             return ex.failed_result(move, "unreachable", why)
+    return _close_and_measure(ex, move, c, pieces, single)
+
+
+def _close_and_measure(ex: PhysicsExecutor, move: PlacementMove, c: _Closing, pieces: list[PrimitiveResult],
+                       single: bool = False) -> MoveResult:  # fmt: skip
+    """Steps 3 to 5 of a placement (module docstring), every pad at its line's start: the fingers close, press and
+    stroke; each finger's face component and free line."""
+    s = c.s
+    names = [f.finger for f in move.fingers]
     c.posture = c.q_now()
     # 3. close
     status: dict[str, str] = {}
@@ -756,6 +766,123 @@ def _restore(ex: PhysicsExecutor, c: _Closing, move: PlacementMove, z_safe: floa
     t.take_trace()
 
 
+# -- a resting probe: another finger while the hand rests ---------------------------------------------------------
+class _RestingClosing(_Closing):
+    """The servo of a resting probe: :class:`_Closing` with every joint but the probing finger's held where it was
+    (the arm and the exploring finger, its pad resting on its face), whose touch is not a touch on the way."""
+
+    def __init__(self, ex: PhysicsExecutor, move: PlacementMove, settings: PlacementSettings) -> None:
+        super().__init__(ex, move, settings)
+        self.finger = move.fingers[0].finger
+        self.free = _finger_dofs(self.finger)
+        self.rest = self.q_now()
+        speeds = {mujoco.mj_id2name(self.model, mujoco.mjtObj.mjOBJ_JOINT, j): (10.0 if j in set(self.free.tolist())
+                                                                               else 1e-9)
+                  for j in range(self.model.njnt)}  # fmt: skip
+        self.limits = [mink.ConfigurationLimit(self.model), mink.VelocityLimit(self.model, speeds)]
+
+    def solve(self, targets: dict[str, np.ndarray], axes: dict[str, np.ndarray] | None = None) -> np.ndarray:
+        q = super().solve(targets, None)
+        held = np.ones(len(q), dtype=bool)
+        held[self.free] = False
+        q[held] = self.rest[held]
+        return q
+
+    def link_on_object(self, reading) -> dict[str, str]:
+        return {k: v for k, v in super().link_on_object(reading).items() if k != self.ex.toucher.finger}
+
+    def _touched_on_the_way(self, reading) -> str | None:
+        k = FINGERS.index(self.finger)
+        if sum(c.normal_force for c in reading.contacts[k]) > self.ex.toucher.threshold:
+            where = "the table" if self.ex.workspace.touching_table(reading.contacts[k]) else "something"
+            return f"the {self.finger} fingertip touched {where}"
+        links = self.link_on_object(reading)
+        if links:
+            return f"the hand's {next(iter(links.values()))} touched something"
+        return None
+
+
+def resting_probe_move(ex: PhysicsExecutor, move: ProbeMove, pieces: list[PrimitiveResult],
+                       settings: PlacementSettings = PROBE_SETTINGS) -> MoveResult:  # fmt: skip
+    """Carry out resting probe ``move`` (``ProbeMove.resting``): the arm and the exploring finger held where the last
+    move left them, ``move.finger``'s joints alone bring its pad along its way (``move.path``, else the resting reach
+    on the robot and table alone) to the line's start; it closes, presses and strokes as a placement's finger does
+    (:func:`_close_and_measure`), retracts along its line and goes back the way it came. The face fitted from that
+    fingertip's contacts alone; the sensor state unchanged (the exploring pad still rests on its face). Cost:
+    :meth:`~haptic.planning.moves.CostModel.resting_probe` of the probing pad's way as it went."""
+    if (problem := move.problem()) is not None:
+        return ex.invalid_result(move, problem)
+    if move.finger is None or move.finger == ex.toucher.finger:
+        return ex.invalid_result(move, "a resting probe is made by a finger other than the exploring one")
+    approach = FingerApproach(str(move.finger), np.asarray(move.start, dtype=float),
+                              np.asarray(move.direction, dtype=float), float(move.length))  # fmt: skip
+    place = PlacementMove((approach,))
+    if move.room is not None:
+        settings = stroke_within(settings, float(move.room))
+    c = _RestingClosing(ex, place, settings)
+    rest = c.rest.copy()
+    if move.path is not None and len(move.path):
+        path = np.array(move.path, dtype=float)
+    else:
+        ok, path, why = _RestingIK(hand_solver(), approach.finger, False, RESTING).solve(rest, pad_target(approach))
+        if not ok:
+            return MoveResult(move=move, status="unreachable", state=ex.state, reason=f"the {approach.finger}: {why}",
+                              info={"finger": approach.finger, "resting": True})  # fmt: skip
+    held = np.ones(path.shape[1], dtype=bool)
+    held[c.free] = False
+    path[:, held] = rest[held]  # the hand as it rests now, whatever the planner read
+    path = np.vstack([rest, path])
+    c.hold(rest)
+    why = c.follow(path) or c.arrive({approach.finger: pad_target(approach)})
+    if why:
+        _resting_back(c, approach, path)
+        pieces.append(PrimitiveResult("ok", "done", c.trace(approach.finger), 0.0))
+        return MoveResult(move=move, status="unreachable", state=ex.state, reason=f"on the way to the line: {why}",
+                          cost=ex.costs.resting_probe(c.way(approach.finger), False),
+                          info={"finger": approach.finger, "resting": True})  # fmt: skip
+    res = _close_and_measure(ex, place, c, pieces, single=True)
+    _resting_back(c, approach, path)
+    info = dict(res.info)
+    fingers = info.pop("fingers", [])
+    mine = fingers[0] if fingers else {}
+    info.update(finger=approach.finger, finger_status=mine.get("status"), resting=True)
+    way = c.way(approach.finger)
+    touched = bool(res.components)
+    if touched:
+        info.update(contact=mine.get("contact"), hit_point=res.components[0].points.mean(axis=0).tolist())
+    elif res.status == "ok":
+        info["contact"] = None
+    reason = res.reason if res.status != "ok" else ""
+    if res.status != "ok" and mine.get("reason"):
+        reason = f"the {approach.finger}: {mine['reason']}"
+    return replace(res, move=move, distance=way, cost=ex.costs.resting_probe(way, touched), state=ex.state,
+                   reason=reason, info=info)  # fmt: skip
+
+
+def _resting_back(c: _RestingClosing, approach: FingerApproach, path: np.ndarray) -> None:
+    """The probing finger back along its line to its start (as it closed, a few steps at a time), then back along
+    its way to where it rested; every other joint held."""
+    s, f = c.s, approach.finger
+    now = c.ex.robot.read().fingertip_in_world[c.index[f]].copy()
+    start = pad_target(approach)
+    steps = max(1, int(np.ceil(float(np.linalg.norm(start - now)) / (3.0 * s.step))))
+    for k in range(1, steps + 1):
+        c.hold(c.solve({f: now + (start - now) * k / steps}))
+        for _ in range(s.step_ticks):
+            c.tick("free")
+    back = np.vstack([c.q_now()[None], path[::-1]])
+    held = np.setdiff1d(np.arange(back.shape[1]), c.free)
+    back[:, held] = c.rest[held]  # every joint but the finger's as it rests
+    for q in np.concatenate([_joint_path(a, b, s.path_step)[1:] for a, b in zip(back, back[1:], strict=False)]):
+        c.hold(q)
+        for _ in range(s.path_ticks):
+            c.tick("free")
+    c.hold(c.rest)
+    for _ in range(s.settle_ticks):
+        c.tick("free")
+    c.ex.toucher.take_trace()
+
+
 # -- the planner's test of reach -------------------------------------------------------------------------------
 class PlacementReach:
     """Whether the hand can take a placement up, asked by the planner before it offers one: the reach solver with
@@ -915,11 +1042,253 @@ def finger_reach(fingers: Sequence[str] = FINGERS, tilts: Sequence[float] = PROB
     return test
 
 
+# -- resting probes: another finger while the hand rests -----------------------------------------------------------
+@dataclass(frozen=True)
+class RestingSettings:
+    """The reach test of a resting probe (:class:`RestingReach`)."""
+
+    clearance: float = 0.006
+    """Least distance of the probing finger's links (its pad too) from the hypothesised object on the way to the
+    line's start [m] ..."""
+    closing_clearance: float = 0.002
+    """... and of its links but the pad while it closes along the line, its pad on the face [m]: a finger hanging
+    beside the face it presses sideways has its links 3.5 mm off it (the pad's radius 12 mm, the links' 8.5 mm) ..."""
+    table_clearance: float = TIP_TABLE_CLEARANCE
+    """... and from the table [m]."""
+    position_tol: float = 0.001
+    """The pad counts as at its target within this [m]."""
+    max_iters: int = 150
+    stall_iters: int = 15
+    stall_progress: float = 2e-4
+    """The solver stops when the pad has come closer by less than this over the last ``stall_iters`` steps [m]."""
+    dt: float = 0.02
+    max_speed: float = 2.5
+    """The probing finger's joints' speed limit of the QP [rad/s] (0.05 rad a step with ``dt``)."""
+    posture_cost: float = 1e-3
+    damping: float = 1e-3
+    grid: int = 7
+    """A finger's workspace is sampled at this many values of each of its joints (7⁴ = 2401 points)."""
+
+
+RESTING = RestingSettings()
+
+RESTING_FINGERS = ("middle", "ring", "thumb")
+"""The fingers that may probe while the exploring (index) pad rests."""
+
+
+def _finger_dofs(finger: str) -> np.ndarray:
+    """The joint indices (arm then hand) of ``finger``'s four joints."""
+    k = len(ARM_HOME) + 4 * FINGERS.index(finger)
+    return np.arange(k, k + 4)
+
+
+class _RestingIK:
+    """One finger's joints alone moving its pad to a target, every other joint of the robot held, its links kept from
+    the (hypothesised) object and the table: the reach of a finger while the hand rests."""
+
+    def __init__(self, solver: ReachSolver, finger: str, pad_exempt: bool, s: RestingSettings) -> None:
+        m = solver.model
+        self.solver, self.finger, self.s = solver, finger, s
+        self.free = _finger_dofs(finger)
+        prefix = f"{HAND_PREFIX_NAME}{_PREFIX[finger]}_"
+        body = {g: mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, int(m.geom_bodyid[g])) or ""
+                for g in solver._hand_geoms}  # fmt: skip
+        ids = [g for g, name in body.items() if name.startswith(prefix)]
+        pad = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, f"{prefix}pad")
+        self.moving = ids
+        self.links = [g for g in ids if not (pad_exempt and g == pad)]
+        speeds = {}
+        for j in range(m.njnt):
+            name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, j)
+            speeds[name] = s.max_speed if j in set(self.free.tolist()) else 1e-9
+        self.limits: list[mink.Limit] = [mink.ConfigurationLimit(m), mink.VelocityLimit(m, speeds),
+                                         mink.CollisionAvoidanceLimit(m, [(ids, solver._table_geoms)],
+                                                                      minimum_distance_from_collisions=s.table_clearance,
+                                                                      collision_detection_distance=0.05)]  # fmt: skip
+        if solver._object_geoms:
+            self.limits.append(mink.CollisionAvoidanceLimit(m, [(self.links, solver._object_geoms)],
+                                                            minimum_distance_from_collisions=(s.closing_clearance
+                                                                                              if pad_exempt
+                                                                                              else s.clearance),
+                                                            collision_detection_distance=0.05))  # fmt: skip
+        self.site = solver.site_name(finger)
+
+    def clear(self, path: np.ndarray) -> bool:
+        """Whether the finger's links keep their clearance from the object and the table at every configuration of
+        ``path``."""
+        solver, cfg = self.solver, self.solver.configuration
+        for q in path:
+            cfg.update(q)
+            if solver._distance(self.moving, solver._table_geoms) < self.s.table_clearance:
+                return False
+            if solver._object_geoms and solver._distance(self.links, solver._object_geoms) < self.s.clearance:
+                return False
+        return True
+
+    def solve(self, q0: np.ndarray, target: np.ndarray) -> tuple[bool, np.ndarray, str]:
+        """Whether the pad reaches ``target`` from ``q0``, the path (K, n) and why not."""
+        s, solver = self.s, self.solver
+        cfg = solver.configuration
+        q0 = np.asarray(q0, dtype=float)
+        cfg.update(q0)
+        task = mink.FrameTask(self.site, "site", position_cost=1.0, orientation_cost=0.0)
+        task.set_target(mink.SE3.from_translation(np.asarray(target, dtype=float)))
+        posture = mink.PostureTask(solver.model, cost=s.posture_cost)
+        posture.set_target(q0)
+        sid = mujoco.mj_name2id(solver.model, mujoco.mjtObj.mjOBJ_SITE, self.site)
+        path, progress, why = [q0.copy()], [], "its joints carry the pad no nearer"
+        for _ in range(s.max_iters):
+            try:
+                vel = mink.solve_ik(cfg, [task, posture], s.dt, solver="daqp", damping=s.damping, limits=self.limits)
+            except Exception:  # noqa: BLE001 -- an infeasible QP: a limit already broken holds the finger
+                why = "a limit holds the finger"
+                break
+            cfg.integrate_inplace(vel, s.dt)
+            q = cfg.q.copy()
+            held = np.ones(len(q), dtype=bool)
+            held[self.free] = False
+            q[held] = q0[held]
+            cfg.update(q)
+            if solver._object_geoms and solver._distance(self.links, solver._object_geoms) < 0.0:
+                why = "its links would meet the object"
+                break
+            path.append(q)
+            err = float(np.linalg.norm(cfg.data.site_xpos[sid] - target))
+            if err < s.position_tol:
+                return True, np.array(path), ""
+            progress.append(err)
+            if len(progress) > s.stall_iters and progress[-s.stall_iters - 1] - progress[-1] < s.stall_progress:
+                why = "its joints carry the pad no nearer"
+                break
+        return False, np.array(path), why
+
+
+class RestingReach:
+    """The planner's reach test of resting probes (``PlannerConfig.resting_reach``): where the hand's other fingers
+    are now (the robot's encoders, ``read_q``: never the object), and whether one of them, its joints alone moving,
+    can put its pad at a line's start clear of the most likely hypothesis (its model at its pose in the solver's
+    scene) and close along the line to where that hypothesis has the face (or the line's end)."""
+
+    def __init__(self, read_q: Callable[[], np.ndarray], fingers: Sequence[str] = RESTING_FINGERS,
+                 settings: RestingSettings = RESTING) -> None:  # fmt: skip
+        self.read_q = read_q
+        self.names = tuple(fingers)
+        self.s = settings
+        self._scenes = PlacementReach(REACH_CLEARANCE)
+        self._iks: dict[tuple, _RestingIK] = {}
+        self._grids: dict[tuple, tuple[np.ndarray, np.ndarray]] = {}
+        self.decisions = 0
+        """Planner decisions that asked for resting lines ..."""
+        self.lines = 0
+        """... the lines within the fingers' reach they generated ..."""
+        self.asked = 0
+        """... of them asked about ..."""
+        self.reached = 0
+        """... and reached."""
+        self.reasons: dict[str, int] = {}
+        """Why the others were not."""
+
+    def fingers(self) -> list:
+        """Each resting finger's place now (:class:`~haptic.planning.resting.RestingFinger`)."""
+        from haptic.planning.resting import RestingFinger
+
+        q = np.asarray(self.read_q(), dtype=float)
+        solver = hand_solver()
+        m, d = solver.model, solver.configuration.data
+        straight = q.copy()
+        out = []
+        for f in self.names:
+            straight[_finger_dofs(f)[1:]] = 0.0
+            solver.configuration.update(straight)
+            base = d.xpos[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, f"{HAND_PREFIX_NAME}{_PREFIX[f]}_proximal")]
+            pad = d.site_xpos[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, solver.site_name(f))]
+            reach, lowest = float(np.linalg.norm(pad - base)), float(pad[2])
+            base = base.copy()
+            solver.configuration.update(q)
+            pad = d.site_xpos[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, solver.site_name(f))].copy()
+            out.append(RestingFinger(f, pad, base, reach, lowest, self._workspace(q, f)[1]))
+        return out
+
+    def _workspace(self, q: np.ndarray, finger: str) -> tuple[np.ndarray, np.ndarray]:
+        """Where ``finger``'s pad centre can be from ``q``, its joints alone moving: over a grid of
+        :attr:`RestingSettings.grid` values of each of its joints across its range, the joints' values (K, 4)
+        [rad] and the pad's places (K, 3) [m]."""
+        key = (finger, *np.round(q, 4))
+        if key in self._grids:
+            return self._grids[key]
+        solver = hand_solver()
+        m, d = solver.model, solver.configuration.data
+        sid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, solver.site_name(finger))
+        dofs = _finger_dofs(finger)
+        axes = [np.linspace(*m.jnt_range[j], self.s.grid) for j in dofs]
+        values = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, len(dofs))
+        pads = []
+        qq = np.asarray(q, dtype=float).copy()
+        for v in values:
+            qq[dofs] = v
+            d.qpos[:] = qq
+            mujoco.mj_kinematics(m, d)
+            pads.append(d.site_xpos[sid].copy())
+        self._grids = {key: (values, np.array(pads))}  # the hand rests in one place a decision
+        return self._grids[key]
+
+    def decided(self, lines: int) -> None:
+        """Count a decision that generated ``lines`` lines."""
+        self.decisions += 1
+        self.lines += lines
+
+    def __call__(self, move: ProbeMove, hypotheses: Sequence) -> ProbeMove | None:
+        """``move`` with its finger's way from where it rests to the line's start (``path``), or None."""
+        from haptic.geometry.raycast import line_hits
+
+        h = hypotheses[0]
+        solver = self._scenes._solver(h)
+        finger = str(move.finger)
+        self.asked += 1
+        q0 = np.asarray(self.read_q(), dtype=float)
+        approach = FingerApproach(finger, np.asarray(move.start, dtype=float), np.asarray(move.direction, dtype=float),
+                                  float(move.length))  # fmt: skip
+        inv = h.world_from_model.inverse()
+        hits = line_hits(h.poly, inv.apply(approach.start[None]), inv.rotate(approach.direction[None]))
+        t = float(hits.first[0]) if np.isfinite(hits.first[0]) else math.inf
+        travel = min(t, float(move.length))
+        start = pad_target(approach)
+        ok, path, why = self._ik(solver, finger, False).solve(q0, start)
+        if not ok:  # from the grid's configuration nearest the start, gone to in joint space clear of the object
+            values, pads = self._workspace(q0, finger)
+            seed = q0.copy()
+            seed[_finger_dofs(finger)] = values[int(np.argmin(np.linalg.norm(pads - start, axis=1)))]
+            way = _joint_path(q0, seed, self.s.dt * self.s.max_speed)
+            if self._ik(solver, finger, False).clear(way):
+                ok, rest, why = self._ik(solver, finger, False).solve(seed, start)
+                path = np.vstack([way, rest[1:]])
+        why = f"to the line's start: {why}"
+        if ok:
+            ok, _, why = self._ik(solver, finger, True).solve(path[-1], pad_target(approach, travel))
+            why = f"along the line: {why}"
+        if not ok:
+            self.reasons[why] = self.reasons.get(why, 0) + 1
+            return None
+        self.reached += 1
+        return replace(move, path=path)
+
+    def _ik(self, solver: ReachSolver, finger: str, pad_exempt: bool) -> _RestingIK:
+        key = (id(solver), finger, pad_exempt)
+        if key not in self._iks:
+            self._iks[key] = _RestingIK(solver, finger, pad_exempt, self.s)
+        return self._iks[key]
+
+    def summary(self) -> dict:
+        return {"decisions": self.decisions, "lines": self.lines, "asked": self.asked, "reached": self.reached,
+                "reasons": dict(self.reasons)}  # fmt: skip
+
+
 def reach_oracle(fingers: int) -> Callable | None:
     """The planner's placement reach test for an episode of ``fingers`` fingers at once (None for one)."""
     return PlacementReach() if fingers > 1 else None
 
 
-__all__ = ["FINGER_PROBE_REACH", "HOLD_CLEARANCE", "PROBE_SETTINGS", "PROBE_TILTS", "REACH_CLEARANCE", "SETTINGS",
-           "TIP_TABLE_CLEARANCE", "PlacementReach", "PlacementSettings", "finger_probe", "finger_probe_move",
-           "finger_reach", "hand_solver", "pad_target", "placement_move", "reach_oracle"]
+__all__ = ["FINGER_PROBE_REACH", "HOLD_CLEARANCE", "PROBE_SETTINGS", "PROBE_TILTS", "REACH_CLEARANCE", "RESTING",
+           "RESTING_FINGERS", "SETTINGS", "TIP_TABLE_CLEARANCE", "PlacementReach", "PlacementSettings", "RestingReach",
+           "RestingSettings", "finger_probe", "finger_probe_move", "finger_reach", "hand_solver", "pad_target",
+           "placement_move", "reach_oracle", "resting_probe_move"]

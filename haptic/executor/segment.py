@@ -21,6 +21,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from haptic.geometry.se3 import perpendicular, unit
+from haptic.matching.acceptance import BoundFloors
 from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex, NoiseModel, SensorNoise
 from haptic.matching.trace import ContactTrace
 
@@ -180,6 +181,19 @@ class SegmentBounds:
     steady_sigmas: float = 3.0
     """... and a row whose averaged normal lies more than this many of that average's σ (with
     :attr:`normal_floor`) from the face's is dropped from the face's fit [-]."""
+    steady_lean_sigmas: float = 5.5
+    """The steady rows themselves split in two whose mean normals differ by more than this many σ of that
+    difference, at any noise level: the pad rode within a fraction of a millimetre of a rim over part of the stroke,
+    where its sensed normal leans toward the rim by 1-2° (on the formula corpus at 30 mm: rows within 0.3 mm of an
+    edge of their face leaned toward it by 0.8-2.1° on average, within 0.3-0.6 mm 0.4-1.4°, farther none), inside
+    :attr:`sample_cone` and, when half the rows lean, about the median :func:`steady_rows` centres on; the rows
+    themselves do not say which part leaned (an edge beside the stroke need not have been met), and the face's bound
+    covers both (:func:`lean_widened`). bipyramid_12 at 30 mm, seed 2: the next face of a vertex move, a triangle
+    6.2 mm wide, its stroke's first half 0.1-0.5 mm from the face's edge beyond (not the one crossed) and leaning
+    1.75° toward it, the face 1.06 bounds off (6.7 σ). Of 212 faces of 15 corpus models at 30 mm (seed 2) and the
+    seed library at 60 mm (seed 1), 2 split by more (6.2 and 6.7 σ, both bipyramid_12's), 3 by 4.7-5.5 σ (one of them
+    a face 1.73 bounds off that its move then discarded), the rest by less; a stroke ending in a roll whose first
+    rolling rows :func:`steady_rows` keeps splits by about 5 σ, its fit within half its bound [-]."""
     max_roll_offset: float = 2e-3
     """The contact points of a roll over a convex edge lie on the edge, hence on both faces' planes; a roll
     farther than this (median) from either plane was not over the edge between them [m]."""
@@ -213,6 +227,14 @@ class SegmentBounds:
 
     def bound(self, sigma: float, floor: float) -> float:
         return self.k * math.sqrt(sigma * sigma + floor * floor)
+
+    def floors(self) -> BoundFloors:
+        """How the components' bounds are made (:meth:`bound`), per quantity, for the acceptance test: a face's
+        points are single samples, their floor the larger of :attr:`position_floor` and σp
+        (:meth:`Segmenter.add_face`)."""
+        return BoundFloors(self.k, face_normal=self.normal_floor,
+                           face_point=max(self.position_floor, self.point_sigma), edge_direction=self.direction_floor,
+                           edge_line=self.position_floor, vertex=self.vertex_floor)  # fmt: skip
 
 
 @dataclass(frozen=True, eq=False)
@@ -320,7 +342,7 @@ def fit_face(points: np.ndarray, normals: np.ndarray, bounds: SegmentBounds) -> 
     return FaceFit(normal, offset, projected, s_n, s_off, nn)
 
 
-def lean_widened(fit: FaceFit, normals: np.ndarray, bounds: SegmentBounds) -> FaceFit:
+def lean_widened(fit: FaceFit, normals: np.ndarray, bounds: SegmentBounds, sigmas: float | None = None) -> FaceFit:
     """``fit`` with its normal's σ widened so that its bound covers a systematic lean of part of its rows.
 
     The face's rows (``normals``, time order) split in two where their mean normals differ most, in units of the
@@ -331,10 +353,14 @@ def lean_widened(fit: FaceFit, normals: np.ndarray, bounds: SegmentBounds) -> Fa
     difference of two nine-row means) then exceeds their fixed cone :attr:`~SegmentBounds.sample_cone` (noise
     level 2 and above). At noise level 4 (σn 4°) they let through a leg leaning 3-5° (BOX01N at 60 mm, seed 1:
     a step in whose normal turned from 1.8 to 5.2° off the top face, 3.5° on average, the other leg 1.1°, and the
-    face 2.3° off against a bound of 1.3°: no-match), which the legs' means tell apart."""
+    face 2.3° off against a bound of 1.3°: no-match), which the legs' means tell apart.
+
+    ``sigmas``: the split's threshold at every noise level instead (the steady rows,
+    :attr:`~SegmentBounds.steady_lean_sigmas`)."""
     n = len(normals)
     m = bounds.steady_window
-    if n < 2 * m or bounds.rim_sigmas * bounds.normal_sigma * math.sqrt(2.0 / m) <= bounds.sample_cone:
+    blind = bounds.rim_sigmas * bounds.normal_sigma * math.sqrt(2.0 / m) > bounds.sample_cone
+    if n < 2 * m or (sigmas is None and not blind):
         return fit
     c = np.cumsum(normals, axis=0)
     j = np.arange(m, n - m + 1)
@@ -343,7 +369,7 @@ def lean_widened(fit: FaceFit, normals: np.ndarray, bounds: SegmentBounds) -> Fa
     split = np.arccos(np.clip(cos, -1.0, 1.0))
     score = split / (bounds.normal_sigma * np.sqrt(1.0 / j + 1.0 / (n - j)))
     i = int(np.argmax(score))
-    if score[i] <= bounds.lean_sigmas or split[i] <= bounds.k * bounds.normal_floor:
+    if score[i] <= (bounds.lean_sigmas if sigmas is None else sigmas) or split[i] <= bounds.k * bounds.normal_floor:
         return fit
     lean = max(angle_between(a[i], fit.normal), angle_between(b[i], fit.normal))
     wide = bounds.bound(fit.normal_sigma, bounds.normal_floor) + lean
@@ -562,8 +588,10 @@ class Segmenter:
             # first leg, its normal turned 3° round the edge), and no row measures the face across
             return self._refuse("the steady rows are one leg")
         self.face_refusal = ""
-        return lean_widened(fit_face(trace.point_in_world[mask], trace.normal_in_world[mask], self.bounds), cone,
-                            self.bounds)  # fmt: skip
+        fit = fit_face(trace.point_in_world[mask], trace.normal_in_world[mask], self.bounds)
+        wide = (lean_widened(fit, cone, self.bounds),
+                lean_widened(fit, trace.normal_in_world[mask], self.bounds, self.bounds.steady_lean_sigmas))
+        return max(wide, key=lambda f: f.normal_sigma)
 
     def _refuse(self, why: str) -> None:
         """No face from a trace, and why (:attr:`face_refusal`, which a move's failure names)."""

@@ -346,7 +346,7 @@ OWN_BOUNDS_LEAVES = 64
 """Most interpretations :func:`own_bounds_keep` pose-checks (more: none eliminated)."""
 
 
-def own_bounds_keep(tree, k_sigma: float | None = None) -> np.ndarray | None:
+def own_bounds_keep(tree, k_sigma: float | None = None, floors: BoundFloors | None = None) -> np.ndarray | None:
     """Which interpretations of ``tree`` (:class:`~haptic.matching.tree.InterpretationTree`) pass the pose check
     (:func:`pose_check`) and the acceptance test (:func:`acceptance`, σ = bound / ``k_sigma``) with their own
     model's bounds, and whose model the data do not find far less likely than another's, shape (N,) bool; None when
@@ -369,7 +369,8 @@ def own_bounds_keep(tree, k_sigma: float | None = None) -> np.ndarray | None:
     taken again with the same bounds for every model (the tree's widening, :attr:`~InterpretationTree.widen`), at
     which the statistics' difference is twice the log of the models' likelihood ratio under the noise model; a model
     whose best statistic exceeds the best model's by more than :data:`LIKELIHOOD_GAP` (the data
-    ``1 / ACCEPT_ALPHA`` times less likely under it), over the same quantities, is dropped."""
+    ``1 / ACCEPT_ALPHA`` times less likely under it), over the same quantities, is dropped. ``floors``: how the
+    components' bounds are made (:func:`acceptance`)."""
     k_sigma = K_SIGMA if k_sigma is None else k_sigma
     if tree.widen is None or tree.count > OWN_BOUNDS_LEAVES or tree.count < 2:
         return None
@@ -384,9 +385,10 @@ def own_bounds_keep(tree, k_sigma: float | None = None) -> np.ndarray | None:
             chk = pose_check(it.model, data, it)
             # the test at the least-squares pose, or at the pose slid along what the data leave free
             at = tuple(dict.fromkeys((pose, chk.world_from_model)))
-            keep[i] = chk.ok and any(acceptance(it.model, data, it, p, k_sigma=k_sigma).ok for p in at)
+            keep[i] = chk.ok and any(acceptance(it.model, data, it, p, k_sigma=k_sigma, floors=floors).ok for p in at)
             if keep[i]:
-                same = [acceptance(it.model, data, it, p, k_sigma=k_sigma, model_bounds=tree.widen) for p in at]
+                same = [acceptance(it.model, data, it, p, k_sigma=k_sigma, model_bounds=tree.widen, floors=floors)
+                        for p in at]  # fmt: skip
                 common[i], dof[i] = min(a.statistic for a in same), same[0].dof
     posed = np.isfinite(common)
     if posed.any():
@@ -416,7 +418,44 @@ K_SIGMA_PHYSICS = 6.0
 physics executor's library objects (the four episodes of ``scripts/bench_unknown.py --executor physics`` that
 reached the test, PYR01 twice, BOX01, TETRA01L, and the recorded BOX01 fixture) the statistic at ``K_SIGMA`` summed
 to 0.14 of its degrees of freedom (44.2 of 312), i.e. the bounds are about 8 σ. 6 keeps a margin of 1.8 in
-variance over that estimate (every one of them then passes, the statistic at most 0.54 of its threshold)."""
+variance over that estimate (every one of them then passes, the statistic at most 0.54 of its threshold). It holds
+where the floors dominate the bounds (noise level 1); where the noise does, a bound is ``k`` of its σ, which the test
+takes from the executor's :class:`BoundFloors`."""
+
+
+@dataclass(frozen=True)
+class BoundFloors:
+    """How an executor's error bounds are made where they are not ``k σ`` alone: ``k √(σ² + floor²)``, σ the
+    statistical part (the sensor's noise over the samples a component is fitted from, the fit's residuals) and the
+    floor a systematic part taken at its worst (pad compliance, contact-point bias, detection delay: the simulated
+    hand's segmenter, :meth:`haptic.executor.segment.SegmentBounds.floors`), per measured quantity.
+
+    The acceptance test takes a residual's σ as its bound over ``k_sigma`` (:data:`K_SIGMA_PHYSICS`: at noise
+    level 1, where the floors dominate the bounds, the components scatter by about an eighth of them) or, where it
+    is more, the bound's statistical part ``√((bound / k)² − floor²)``: the noise a component's bound follows as
+    the noise level grows. At level 4 the face normals of the seed library at 60 and 150 mm scattered by a quarter
+    of their bounds per axis (σn 4° over each face's rows, the bound ``3 σ`` and the floor a fifth of it), twice the
+    sixth the test took: their terms summed to 3.2 per dimension, and BOX01P and HEXPRISM01 at 150 mm (seed 1), every
+    component within its bounds, were turned away (338 over a threshold of 269, 220 over 212)."""
+
+    k: float
+    """The bounds are ``k √(σ² + floor²)``."""
+    face_normal: float = 0.0
+    """Floor of a face normal's bound [rad]."""
+    face_point: float = 0.0
+    """... of a face's touched points' distance from its plane [m]."""
+    edge_direction: float = 0.0
+    """... of an edge direction [rad]."""
+    edge_line: float = 0.0
+    """... of an edge line's position [m]."""
+    vertex: float = 0.0
+    """... of a vertex position [m]."""
+
+    def statistical(self, bound: float, floor: float) -> float:
+        """The statistical σ inside ``bound`` whose floor is ``floor``: ``√((bound / k)² − floor²)`` (0 when the
+        floor is all of it)."""
+        s2 = (bound / self.k) ** 2 - floor * floor
+        return math.sqrt(s2) if s2 > 0.0 else 0.0
 
 
 @dataclass(frozen=True)
@@ -441,6 +480,7 @@ def acceptance(
     k_sigma: float = K_SIGMA,
     table_z: float | None = None,
     model_bounds: LearnedBounds | None = None,
+    floors: BoundFloors | None = None,
 ) -> Acceptance:
     """The statistical acceptance test of a fitted pose (after Grimson & Huttenlocher 1989: a threshold from the
     noise model and the number of measured features, not an ad-hoc fraction).
@@ -467,14 +507,15 @@ def acceptance(
 
     ``model_bounds``: how far the model's features are taken to be off (default: the model's own,
     :func:`_model_bounds`); two models' statistics at the same bounds compare as their likelihoods do
-    (:func:`own_bounds_keep`)."""
+    (:func:`own_bounds_keep`). ``floors``: how the components' bounds are made (:class:`BoundFloors`); a residual's
+    σ is then at least its bound's statistical part."""
     from scipy.stats import chi2
 
     mb = _model_bounds(model) if model_bounds is None else model_bounds
     resting = None
     if table_z is not None and len(data):
         resting = resting_vertices(model, world_from_model)
-    terms = _StatisticTerms(model, data, it, k_sigma, mb, table_z, resting)
+    terms = _StatisticTerms(model, data, it, k_sigma, mb, table_z, resting, floors)
     pose, total = world_from_model, terms.total(world_from_model)
     if resting is not None:
         refit = _refit(terms, world_from_model)
@@ -500,6 +541,14 @@ class _StatisticTerms:
     table_z: float | None
     resting: np.ndarray | None
     """Model vertices on the table (:func:`resting_vertices`), None without a table."""
+    floors: BoundFloors | None = None
+    """How the components' bounds are made (None: ``k σ`` alone)."""
+
+    def sigma(self, bound: float, model_bound: float, floor: float) -> float:
+        """A residual's σ: its bound (with the model's, in quadrature) over ``k_sigma``, or the bound's statistical
+        part (:meth:`BoundFloors.statistical`) where that is more."""
+        s = (math.hypot(bound, model_bound) + ROUND_OFF) / self.k_sigma
+        return s if self.floors is None else max(s, self.floors.statistical(bound, floor))
 
     @property
     def dims(self) -> int:
@@ -511,6 +560,7 @@ class _StatisticTerms:
     def total(self, world_from_model: SE3) -> float:
         """Σ (residual / σ)² over every quantity at ``world_from_model``."""
         model, data, it, k_sigma, mb = self.model, self.data, self.it, self.k_sigma, self.mb
+        fl = self.floors or BoundFloors(1.0)
         inv = world_from_model.inverse()
         total = 0.0
         for i, f in it.faces.items():
@@ -518,9 +568,9 @@ class _StatisticTerms:
             assert isinstance(c, DataFace)
             n_m = model.face_normals[f]
             turn = _angle(inv.rotate(c.normal), n_m)
-            total += (turn * k_sigma / (np.hypot(c.normal_bound, mb.normal) + ROUND_OFF)) ** 2
+            total += (turn / self.sigma(c.normal_bound, mb.normal, fl.face_normal)) ** 2
             off = float(np.mean(inv.apply(c.points) @ n_m - model.face_offsets[f]))
-            total += (off * k_sigma / (np.hypot(c.position_bound, mb.position) + ROUND_OFF)) ** 2
+            total += (off / self.sigma(c.position_bound, mb.position, fl.face_point)) ** 2
         for i, e in it.edges.items():
             c = data[i]
             assert isinstance(c, DataEdge)
@@ -528,15 +578,15 @@ class _StatisticTerms:
             s = it.edge_senses.get(i, 0)
             if s != 0:
                 turn = _angle(inv.rotate(c.direction), s * b_m)
-                total += (turn * k_sigma / (np.hypot(c.direction_bound, mb.direction) + ROUND_OFF)) ** 2
+                total += (turn / self.sigma(c.direction_bound, mb.direction, fl.edge_direction)) ** 2
             q = inv.apply(c.point) - p_m
             perp = float(np.linalg.norm(q - (q @ b_m) * b_m))
-            total += (perp * k_sigma / (np.hypot(c.position_bound, mb.position) + ROUND_OFF)) ** 2
+            total += (perp / self.sigma(c.position_bound, mb.position, fl.edge_line)) ** 2
         for i, v in it.vertices.items():
             c = data[i]
             assert isinstance(c, DataVertex)
             d = float(np.linalg.norm(inv.apply(c.position) - model.vertices[v]))
-            total += (d * k_sigma / (np.hypot(c.position_bound, mb.position) + ROUND_OFF)) ** 2
+            total += (d / self.sigma(c.position_bound, mb.position, fl.vertex)) ** 2
         if self.resting is not None and len(self.resting):
             height = world_from_model.apply(model.vertices[self.resting])[:, 2] - self.table_z
             bound = float(np.median([c.position_bound for c in data]))
@@ -826,6 +876,7 @@ __all__ = [
     "K_SIGMA",
     "K_SIGMA_PHYSICS",
     "Acceptance",
+    "BoundFloors",
     "TablePin",
     "acceptance",
     "PIN_SPAN",

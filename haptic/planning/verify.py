@@ -1042,13 +1042,17 @@ class Verifier:
     once one pose class is left, :meth:`verdict` says whether the data confirm it, contradict it, or must
     go on; :meth:`choose` picks the next verification move; :meth:`record` is what the episode reports."""
 
-    def __init__(self, mode: str, noise: SensorNoise, config: PlannerConfig, k_sigma: float | None = None) -> None:
+    def __init__(self, mode: str, noise: SensorNoise, config: PlannerConfig, k_sigma: float | None = None,
+                 floors=None) -> None:  # fmt: skip
         from haptic.matching.acceptance import K_SIGMA, check_verify_mode
 
         self.mode = check_verify_mode(mode)
         self.noise, self.config = noise, config
         self.k_sigma = K_SIGMA if k_sigma is None else k_sigma
         """Bounds over σ of the data components, for the acceptance test."""
+        self.floors = floors
+        """How the data components' bounds are made (:class:`~haptic.matching.acceptance.BoundFloors`; None: ``k σ``
+        alone), for the acceptance test."""
         self.started_at: float | None = None
         """Path cost when the verification began [units] (None: not begun)."""
         self.moves = 0
@@ -1239,7 +1243,7 @@ class Verifier:
                     self.status = "incomplete"
         if self.status in ("confirmed", "incomplete"):  # the final word: the statistical acceptance test
             self.accept = acceptance(cls.model, tree.data, it, self.check.world_from_model, k_sigma=self.k_sigma,
-                                     table_z=self.config.table_z)  # fmt: skip
+                                     table_z=self.config.table_z, floors=self.floors)  # fmt: skip
             if not self.accept.ok:
                 self.status = "rejected"
         return self.status

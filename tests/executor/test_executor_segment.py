@@ -522,3 +522,26 @@ def test_an_edge_from_a_roll_alone_bounds_a_lean_of_the_normals_over_the_turns_l
     monkeypatch.setattr(segment, "roll_axis_floor", lambda sin2, bounds: 0.0)
     before = [_roll_axes_held(lean) for lean in (0.5, 0.6)]
     assert min(held) >= 98 and before[0] <= 75 and before[1] <= 50, (held, before)
+
+
+def test_a_stroke_riding_a_rim_over_half_its_length_widens_the_faces_bound_to_hold_the_truth():
+    # bipyramid_12 of the formula corpus at 30 mm, seed 2: the next face of a vertex move, a triangle 6.2 mm wide,
+    # stroked 6 mm along the edge crossed; over the first half the pad ran 0.1-0.5 mm from the face's other long
+    # edge and its sensed normal leaned 1.75° toward it, over the second half 0.2°. The running means of the first
+    # half lie within the steady rows' cut of the median between the halves: the face came out 0.88° off (1.06
+    # bounds). The halves split by far more than the noise allows, and the bound covers both halves' means.
+    rng = np.random.default_rng(5)
+    z = np.array([0.0, 0.0, 1.0])
+    n_rows = 90
+    x = np.linspace(0.0, 0.006, n_rows)
+    lean = np.radians(np.where(np.arange(n_rows) < n_rows // 2, 1.75, 0.2))
+    true_n = np.column_stack([np.zeros(n_rows), np.sin(lean), np.cos(lean)])
+    noisy = true_n + np.radians(1.0) * rng.normal(size=true_n.shape)
+    noisy /= np.linalg.norm(noisy, axis=1)[:, None]
+    points = np.column_stack([x, np.zeros(n_rows), np.zeros(n_rows)]) + 2e-4 * rng.normal(size=(n_rows, 3))
+    trace = _trace(points + R_PAD * true_n, noisy, points)
+    for sigmas, holds in ((math.inf, False), (SegmentBounds().steady_lean_sigmas, True)):
+        seg = Segmenter(SegmentBounds(steady_lean_sigmas=sigmas))
+        face = seg.add_face(seg.fit_face_trace(trace, z))
+        err = math.acos(min(1.0, float(face.normal @ z)))
+        assert (err <= face.normal_bound) == holds, (sigmas, math.degrees(err), math.degrees(face.normal_bound))

@@ -234,3 +234,56 @@ def test_pose_check_slides_the_pose_along_what_the_data_leave_free():
     assert (chk.world_from_model.translation - it.world_from_model.translation) @ axis > 7e-3
     model, data, it, _ = _prism_data(-12e-3, off_plane=3e-3)
     assert not pose_check(model, data, it).ok
+
+
+def _noisy_box_data(level: float, rng: np.random.Generator):
+    """BOX01 at the identity, each face measured 4 times and each vertex twice as the hand's segmenter bounds them
+    at noise ``level`` (a face normal from 80 rows of σn, a vertex from σp over a few contacts; the bounds
+    ``k √(σ² + floor²)``), every quantity drawn off the truth by its statistical σ alone; and the true
+    interpretation."""
+    from haptic.executor.segment import SegmentBounds
+    from haptic.geometry.se3 import perpendicular
+    from haptic.matching.components import NoiseModel
+    from haptic.matching.tree import Interpretation
+
+    box, b = LIB["BOX01"], SegmentBounds.from_model(NoiseModel(level=level))
+    s_n, s_v = b.normal_sigma / np.sqrt(80), b.point_sigma
+    data, faces, vertices = [], {}, {}
+    for f in range(box.n_faces):
+        n = box.face_normals[f]
+        u = perpendicular(n)
+        w = np.cross(n, u)
+        centre = box.vertices[list(box.faces[f])].mean(axis=0)
+        for _ in range(4):
+            tilt = s_n * rng.standard_normal(2)
+            normal = n + tilt[0] * u + tilt[1] * w
+            pts = centre + 2e-3 * rng.standard_normal((6, 2)) @ np.array([u, w])
+            faces[len(data)] = f
+            data.append(DataFace(len(data), normal / np.linalg.norm(normal), pts, b.bound(s_n, b.normal_floor),
+                                 b.bound(s_v / np.sqrt(6), max(b.position_floor, b.point_sigma))))  # fmt: skip
+    for v in range(box.n_vertices):
+        for _ in range(2):
+            vertices[len(data)] = v
+            data.append(DataVertex(len(data), box.vertices[v] + s_v * rng.standard_normal(3),
+                                   b.bound(s_v, b.vertex_floor)))  # fmt: skip
+    return box, data, Interpretation(box, 0, faces, {}, vertices, {}, SE3(np.eye(3), np.zeros(3)), 0), b.floors()
+
+
+def test_the_acceptance_tests_sigma_follows_the_noise_level_where_the_noise_dominates_the_bounds():
+    """The hand's bounds are ``k √(σ² + floor²)``: at noise level 4 σ dominates them (a face normal from 80 rows of
+    σn 4°: 0.45° against a floor of 0.25°), and a component is off by about a third of its bound, not the sixth
+    :data:`K_SIGMA_PHYSICS` takes where the floors dominate (BOX01P and HEXPRISM01 at 150 mm, seed 1, noise 4:
+    every component within its bounds, turned away as no-match). With the segmenter's floors the test takes each
+    residual's σ from its bound's statistical part and keeps the true interpretation; at level 1, where the floors
+    dominate, the statistic is the same with or without them."""
+    rng = np.random.default_rng(7)
+    without = with_floors = 0
+    for _ in range(20):
+        box, data, it, floors = _noisy_box_data(4.0, rng)
+        without += acceptance(box, data, it, it.world_from_model, k_sigma=K_SIGMA_PHYSICS).ok
+        with_floors += acceptance(box, data, it, it.world_from_model, k_sigma=K_SIGMA_PHYSICS, floors=floors).ok
+    assert without <= 2 and with_floors >= 19, (without, with_floors)
+    box, data, it, floors = _noisy_box_data(1.0, rng)
+    a = acceptance(box, data, it, it.world_from_model, k_sigma=K_SIGMA_PHYSICS)
+    b = acceptance(box, data, it, it.world_from_model, k_sigma=K_SIGMA_PHYSICS, floors=floors)
+    assert a.ok and b.statistic == pytest.approx(a.statistic)
