@@ -325,30 +325,6 @@ def _mean(records: list[dict], key: str) -> float | None:
     return float(np.mean(v)) if v else None
 
 
-def print_resting(records: list[dict]) -> None:
-    """Resting probes (another finger while the hand rests): the planner's lines and reach test per decision, how
-    many were taken, their share of the moves, and how many succeeded (the finger touching a face, or missing)."""
-    if not any(r.get("fingers", 1) > 1 for r in records):
-        return
-    reach = [r.get("resting_reach") or {} for r in records]
-    n = {k: sum(x.get(k, 0) for x in reach) for k in ("decisions", "lines", "asked", "reached")}
-    why = Counter()
-    for x in reach:
-        why.update(x.get("reasons", {}))
-    print(f"resting probes: {n['decisions']} decisions asked for lines, {n['lines']} lines within the fingers' reach "
-          f"({n['lines'] / max(1, n['decisions']):.1f} a decision), {n['asked']} asked about, {n['reached']} reached"
-          + (f"; why not: {', '.join(f'{k} {v}' for k, v in why.most_common())}" if why else ""))  # fmt: skip
-    done = [p for r in records for p in r.get("resting", ())]
-    moves = sum(len(r.get("move_results", ())) for r in records)
-    ok = sum(p["status"] == "ok" for p in done)
-    faces = sum(p.get("finger_status") == "touched" for p in done)
-    print(f"resting probes taken {len(done)} ({100 * len(done) / max(1, moves):.1f} % of {moves} moves), {ok} "
-          f"succeeded, {faces} measured a face")
-    for p in done:
-        if p["status"] != "ok":
-            print(f"  failed: {p['finger']} {p['status']}: {p.get('reason', '')}")
-
-
 def print_placements(records: list[dict]) -> None:
     """Placements of several fingertips: how many, their share of the moves, how many succeeded, and each
     finger's outcome (a failed finger's reason)."""
@@ -455,7 +431,6 @@ def main(argv: list[str] | None = None) -> int:
     print_moves(records)
     print_reach(records)
     print_placements(records)
-    print_resting(records)
     if args.probe_costs:
         _print_probe_costs(records)
     if args.json:

@@ -91,15 +91,6 @@ class EpisodeRecord:
     """On the simulated hand with several fingers, the planner's reach test of placements
     (:class:`haptic.executor.placement.PlacementReach`): placements ``asked`` about, ``reached``, and why the others
     were not (``reasons``, by the solver's reason); None otherwise."""
-    resting: list[dict] = field(default_factory=list)
-    """Each resting probe (another finger while the hand rests, ``ProbeMove.resting``) carried out or failed, in
-    order: its ``finger``, ``status`` ("ok" or why it failed) and the finger's (``finger_status``: "touched",
-    "missed" or why it failed)."""
-    resting_reach: dict | None = None
-    """On the simulated hand with several fingers, the planner's reach test of resting probes
-    (:class:`haptic.executor.placement.RestingReach`): ``decisions`` that asked, the ``lines`` within the fingers'
-    reach they generated, those ``asked`` about and ``reached``, and why the others were not (``reasons``); None
-    otherwise."""
     learned: dict | None = None
     """How learning the object went after ``no-match`` (``--learn DIR``: :mod:`haptic.episode.learning`; None:
     no learning)."""
@@ -423,7 +414,6 @@ def _record(
         probe_misses=n_probes - (len(view.probe_faces) - view.placement_faces),
         fingers=spec.fingers,
         placements=list(view.placements),
-        resting=list(view.resting),
     )
 
 

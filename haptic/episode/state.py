@@ -104,8 +104,6 @@ class EpisodeState:
     placements: list[dict] = field(default_factory=list)
     """Each placement of several fingertips carried out or failed: its ``status`` and, per finger, what it did
     (the executor's ``info["fingers"]``)."""
-    resting: list[dict] = field(default_factory=list)
-    """Each resting probe, as the record keeps it (``EpisodeRecord.resting``)."""
     _hypotheses: tuple[Recognition | None, list[Hypothesis]] = (None, [])
 
     @classmethod
@@ -190,10 +188,6 @@ class EpisodeState:
         self.kinds.append(result.move.kind if result.move is not None else "start")
 
     def _placed(self, result: MoveResult) -> None:
-        if result.move is not None and getattr(result.move, "resting", False):
-            self.resting.append({"finger": result.move.finger, "status": str(result.status),
-                                 "finger_status": result.info.get("finger_status"),
-                                 **({"reason": result.reason} if result.reason else {})})  # fmt: skip
         if result.move is not None and result.move.kind == "placement":
             fingers = [{"finger": f["finger"], "status": f["status"], **({"reason": f["reason"]} if f.get("reason")
                                                                           else {})}

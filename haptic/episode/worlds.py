@@ -168,10 +168,6 @@ class PhysicsWorld:
         settings = PhysicsSettings()
         executor = PhysicsExecutor(RobotInterface(sim), bounds=bounds, costs=config.costs, rng=exec_rng,
                                    settings=settings)  # fmt: skip
-        if config.fingers > 1 and config.resting_reach is None:  # another finger while the hand rests: its encoders
-            from haptic.executor.placement import RestingReach
-
-            config = replace(config, resting_reach=RestingReach(executor.robot.joint_positions))
         # the circle the executor makes; the concave edges' ends it can tell; no move from a concave vertex
         clearance = max(config.min_vertex_clearance, settings.crossing_clearance)
         config = replace(config, vertex_radius=settings.vertex_radius, min_vertex_clearance=clearance,
@@ -191,8 +187,6 @@ class PhysicsWorld:
             if reach is not None and hasattr(reach, "asked"):
                 record.placement_reach = {"asked": reach.asked, "reached": reach.reached,
                                           "reasons": dict(reach.reasons)}  # fmt: skip
-            if config.resting_reach is not None and hasattr(config.resting_reach, "summary"):
-                record.resting_reach = config.resting_reach.summary()
 
         world_from_model = SE3.from_matrix(pose)
         return Episode(

@@ -26,7 +26,7 @@ import numpy as np
 from haptic.errors import HapticError
 from haptic.executor.landing import LandingSearch
 from haptic.executor.physics_probe import probe_move
-from haptic.executor.placement import finger_probe_move, placement_move, resting_probe_move
+from haptic.executor.placement import finger_probe_move, placement_move
 from haptic.executor.primitives import OPPOSED, PrimitiveResult, Toucher
 from haptic.executor.segment import (
     AT_END,
@@ -561,8 +561,6 @@ class PhysicsExecutor(LandingSearch):
             return self._run(move, lambda pieces: self._edge_move(move, pieces))
         if isinstance(move, VertexMove):
             return self._run(move, lambda pieces: self._vertex_move(move, pieces))
-        if isinstance(move, ProbeMove) and move.resting:  # another finger, the hand resting: haptic.executor.placement
-            return self._run(move, lambda pieces: resting_probe_move(self, move, pieces))
         if isinstance(move, ProbeMove) and move.finger is not None:
             # a named fingertip (the exploring one too), the wrist turned to point it along the line, the hand's way
             # the planner's: haptic.executor.placement

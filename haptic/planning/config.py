@@ -94,12 +94,6 @@ class PlannerConfig:
     the finger (``ProbeMove.finger``) and the hand's way to it, or None when no finger reaches the line. The
     verification asks it for the faces the exploring finger pointing down cannot press
     (:mod:`haptic.planning.finger_faces`). None: no such probe is offered (a point sensor)."""
-    resting_reach: object | None = None
-    """Which lines another finger can close along while the hand rests (``fingers`` > 1, on the simulated hand), as
-    the episode's world knows it: an object with ``fingers()``, the other fingers' places now
-    (:class:`~haptic.planning.resting.RestingFinger`), and a call with a resting :class:`~haptic.planning.moves.
-    ProbeMove` and the hypotheses (the most likely first) returning the probe with that finger's way to the line, or
-    None when it cannot close along it. None: no resting probes (the index finger alone, or the ideal sensor)."""
     moves: str = "tracing"
     """Admissible kinds of move (``MOVE_SETS``): "tracing" (face, edge and vertex moves), "probing" (free-space
     probes) or "all" (both, ranked together by one efficiency, seed §1.1)."""

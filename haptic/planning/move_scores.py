@@ -32,7 +32,6 @@ from haptic.planning.placements import (
 from haptic.planning.predict import Prediction, candidate_moves, crossed_edge, predict_moves
 from haptic.planning.probe_lines import ProbeConfig, candidate_probes
 from haptic.planning.probe_prediction import ProbePrediction, predict_probes
-from haptic.planning.resting import RestingConfig, resting_costs, resting_lines
 from haptic.planning.simulate import circled_vertex
 from haptic.planning.table import descent_risk, hand_trace
 
@@ -133,8 +132,7 @@ def _score_all(ctx: Context) -> list[tuple[Prediction | ProbePrediction | Placem
     probes = [s for s in (score_probe(pred, weights) for pred in lines) if s is not None]
     others = (*out, *probes)
     beat = (max((c[1] for c in others), default=-np.inf), max((c[2] for c in others), default=-np.inf))
-    return (out + probes + score_placements(ctx, weights, lines if ctx.config.moves != "tracing" else None, beat)
-            + score_resting(ctx, weights))
+    return out + probes + score_placements(ctx, weights, lines if ctx.config.moves != "tracing" else None, beat)
 
 
 def remeasures(ctx: Context, move: Move) -> bool:
@@ -205,44 +203,6 @@ def score_placements(ctx: Context, weights: np.ndarray, lines: Sequence[ProbePre
             costs = placement_path_costs(item[0].lines, move, ctx.state.position, ctx.config.costs, hand_start(ctx))
             pred = replace(item[0], move=move, costs=costs)
             return [(pred, *pred.score(weights), pred.risk(weights))]
-    return []
-
-
-def score_resting(ctx: Context, weights: np.ndarray) -> list[tuple]:
-    """Resting probes (``config.resting_reach``, every hypothesis posed), scored as :func:`score_all` scores moves,
-    ``(pred, efficiency, eliminations, cost, risk)``: lines for the hand's other fingers onto the pose classes' faces
-    within their reach (:func:`~haptic.planning.resting.resting_lines`), predicted per pose class as probes are and
-    costed as the finger's closing alone; the reach test is asked about the most efficient first (at most
-    ``RestingConfig.checks``), and the first it reaches is offered with that finger's way, none it cannot reach."""
-    reach = ctx.config.resting_reach
-    if reach is None or ctx.config.fingers < 2 or not ctx.hypotheses:
-        return []
-    if any(h.world_from_model is None for h in ctx.hypotheses):
-        return []
-    face = ctx.components.get(ctx.state.face)
-    if not isinstance(face, DataFace):
-        return []
-    cfg = RestingConfig()
-    fingers = {f.finger: f for f in reach.fingers()}
-    moves = resting_lines(ctx.hypotheses, weights, list(fingers.values()), ctx.state.position, face.normal, cfg,
-                          ctx.config.table_z, ctx.config.pad_radius, ctx.config.table_clearance)  # fmt: skip
-    moves = [m for m in moves if not any(same_move(m, bad) for bad in ctx.avoid)]
-    if not moves:
-        return []
-    preds = weak_probes(ctx, predict_probes(ctx.hypotheses, moves, ctx.state.position, ctx.components, ctx.noise,
-                                            ctx.config.costs))  # fmt: skip
-    preds = [p for p in preds if p.hit.any()]  # aimed at faces: a line no pose class meets tells nothing here
-    preds = [replace(p, costs=resting_costs(p, fingers[str(p.move.finger)], ctx.config.costs, ctx.config.pad_radius))
-             for p in preds]  # fmt: skip
-    scored = sorted(((p, *p.score(weights), 0.0) for p in preds), key=lambda c: -c[1])
-    likely = [ctx.hypotheses[k] for k in np.argsort(-weights, kind="stable")]
-    reach.decided(len(moves))
-    for item in scored[: cfg.checks]:
-        if item[2] <= 0.0:
-            break  # eliminates nothing in any world: not worth the finger's closing
-        move = reach(item[0].move, likely)
-        if move is not None:
-            return [(replace(item[0], move=move), *item[1:])]
     return []
 
 

@@ -107,12 +107,6 @@ class CostModel:
         four cost ``5 + c_s s`` against ``8 + c_s Σ s_i`` with a point sensor."""
         return self.c_m + self.c_s * s + fingers * self.c_q + strokes * self.c_n
 
-    def resting_probe(self, s: float, touched: bool) -> float:
-        """``c_q + c_s s + c_n`` (touched): a probe by another finger while the hand rests (``ProbeMove.resting``): one
-        finger's closing (``c_q``, as a placement's finger), its pad's way ``s`` to its line's start, along it and
-        back, and the stroke measuring the face's normal when it touched; no ``c_m``, no travel of the arm."""
-        return self.c_q + self.c_s * s + (self.c_n if touched else 0.0)
-
 
 @dataclass(frozen=True, eq=False)
 class SensorState:
@@ -207,11 +201,6 @@ class ProbeMove:
     """With ``finger``: how far the hypothesised face the line is aimed at extends around where the pad is to touch
     it (its contact's distance to the face's rim) [m]: the finger's stroke on it is kept within (a face leaning under
     is pressed clear of the table only near its top, often a narrow corner); None: the executor's own stroke."""
-    resting: bool = False
-    """With ``finger`` (not the exploring one): a resting probe. The arm and the exploring finger stay where the last
-    move left them, the pad resting on its face, and only ``finger``'s joints move: ``path`` is that finger's way
-    from where it rests to its pad at the line's start, the hand's other joints held (no travel of the arm through
-    free space). The sensor state stays where it was."""
 
     kind = "probe"
 

@@ -294,8 +294,7 @@ def move_name(move: Move) -> str:
         return f"vertex across f{move.across_face}"
     if kind == "probe":
         d = np.asarray(move.direction, dtype=float)
-        what = f"resting probe by the {move.finger}" if getattr(move, "resting", False) else "probe"
-        return f"{what} ({d[0]:+.2f}, {d[1]:+.2f}, {d[2]:+.2f}) {100 * float(move.length):.0f} cm"
+        return f"probe ({d[0]:+.2f}, {d[1]:+.2f}, {d[2]:+.2f}) {100 * float(move.length):.0f} cm"
     if kind == "placement":
         return f"placement of {len(move.fingers)} ({', '.join(f.finger for f in move.fingers)})"
     return str(move)

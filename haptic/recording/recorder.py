@@ -354,9 +354,7 @@ class EpisodeRecorder:
                         radii=ARROW_RADIUS),
         )  # fmt: skip
         self._log_hand(result, trace)
-        if kind == "probe" and getattr(result.move, "resting", False):
-            self._log_resting(result)
-        elif kind == "probe":
+        if kind == "probe":
             self._log_probe(result)
         if kind == "placement":
             self._log_placement(result)
@@ -405,28 +403,6 @@ class EpisodeRecorder:
             elif what.get("status") == "missed":
                 s.placed.setdefault(f.finger, []).append((np.asarray(f.start, dtype=float), f.end, None))
             done.append(f"{f.finger} {what.get('status', '?')}")
-        self._draw_placed()
-        rec.log("log/moves", rr.TextLog(f"placement: {', '.join(done)}", level=rr.TextLogLevel.INFO))
-
-    def _log_resting(self, result: MoveResult) -> None:
-        """A resting probe (another finger while the hand rests) drawn as that finger's part of a placement, in its
-        own colour (``world/placements/<finger>``): its line to the contact, the contact and its normal, or its whole
-        line when it met nothing."""
-        s, move = self._s, result.move
-        face = next((c for c in result.components if isinstance(c, DataFace)), None)
-        start = np.asarray(move.start, dtype=float)
-        if face is not None:
-            s.placed.setdefault(move.finger, []).append((start, np.atleast_2d(face.points)[0], np.asarray(face.normal)))
-        elif result.ok:
-            s.placed.setdefault(move.finger, []).append((start, move.end, None))
-        self._draw_placed()
-        what = "hit" if face is not None else ("miss" if result.ok else f"failed ({result.status})")
-        self.stream.log("log/moves", rr.TextLog(f"resting probe by the {move.finger}: {what}",
-                                                level=rr.TextLogLevel.INFO))  # fmt: skip
-
-    def _draw_placed(self) -> None:
-        """Every finger's closings so far under ``world/placements/<finger>``, each in its own colour."""
-        rec, s = self.stream, self._s
         for finger, closings in s.placed.items():
             color = FINGER_COLORS.get(finger, KIND_COLORS["placement"])
             lines = [np.array([a, b]) for a, b, _ in closings]
@@ -442,6 +418,7 @@ class EpisodeRecorder:
                 rec.log(f"world/placements/{finger}/normals",
                         rr.Arrows3D(origins=pts, vectors=nrm * NORMAL_SCALE * s.radius, colors=[color],
                                     radii=ARROW_RADIUS))  # fmt: skip
+        rec.log("log/moves", rr.TextLog(f"placement: {', '.join(done)}", level=rr.TextLogLevel.INFO))
 
     def _log_probe(self, result: MoveResult) -> None:
         """Every probe so far: a hit as its line from the start to the contact, the contact and its normal

@@ -150,11 +150,6 @@ class RobotInterface:
         drawn)."""
         return self._sim.data.qpos[self._sim.arm].copy()
 
-    def joint_positions(self) -> np.ndarray:
-        """The arm's and then the hand's joint angles (6 + 16,) [rad] from their encoders, without reading the other
-        sensors (no noise drawn: asking where the hand is leaves the episode's readings as they were)."""
-        return np.concatenate([self._sim.data.qpos[self._sim.arm], self._sim.data.qpos[self._sim.hand]])
-
     def reachable(
         self, finger: str, point_in_world: np.ndarray, rotation_in_world: np.ndarray | None = None,
         arm_q0: np.ndarray | None = None,
