@@ -392,6 +392,29 @@ class _Enough(Exception):
     """Ends a replay after the move that showed what it tests."""
 
 
+def _until_recovery(ep, kind: str | None, says: str, fails: str | None = None) -> tuple[list, list]:
+    """Run ``ep`` until a ``kind`` move (any kind where None) recovers saying ``says``, or a ``kind`` move fails with
+    ``fails`` in its reason: the recoveries said and the reasons of those failures (the episode may end first)."""
+    said, failed = [], []
+
+    def moved(n, r, *a) -> None:
+        if kind is None or r.move.kind == kind:
+            said.extend(x for x in (r.info or {}).get("recoveries", ()) if says in x)
+        if said:
+            raise _Enough
+
+    def not_moved(n, r) -> None:
+        if fails is not None and (kind is None or r.move.kind == kind) and fails in r.reason:
+            failed.append(r.reason)
+            raise _Enough
+
+    try:
+        ep.run(None, EpisodeObserver(on_move=moved, on_failed_move=not_moved))
+    except _Enough:
+        pass
+    return said, failed
+
+
 @pytest.mark.xfail(strict=False, reason=(
     "with the crossings, strokes and verification rules merged after it, the replay's moves differ and no edge move "
     "of its first 60 sets off past its vertex (every component stays within its bounds); the case is shown by "
@@ -887,26 +910,11 @@ def test_a_vertex_move_whose_circle_start_touches_the_far_rim_starts_halfway_to_
     # edge) with a normal 6-7° off the face: the pad met the rim of the face's far edge, and 5 of 47 moves failed
     # "could not reach the face next to the vertex". The circle now starts halfway to the edge instead. The episode
     # is stopped once a vertex move has met it.
-    class Seen(Exception):
-        pass
-
-    said, failed = [], []
-
-    def on_move(n, r, *a) -> None:
-        said.extend(x for x in (r.info or {}).get("recoveries", ()) if "the circle started halfway" in x)
-        if said:
-            raise Seen
-
-    def on_failed(n, r) -> None:
-        if r.move.kind == "vertex" and "could not reach the face next to the vertex" in r.reason:
-            failed.append(r.reason)
-            raise Seen
-
     spec = EpisodeSpec(model="bipyramid_12", seed=1, executor="physics",
                        models=_scaled_library(tmp_path, 0.07, corpus=True))  # fmt: skip
     ep = build_episode(spec)
-    with pytest.raises(Seen):
-        ep.run(None, EpisodeObserver(on_move=on_move, on_failed_move=on_failed))
+    said, failed = _until_recovery(ep, "vertex", "the circle started halfway",
+                                   fails="could not reach the face next to the vertex")  # fmt: skip
     assert said and not failed, failed
     assert _within_bounds(ep)
 
@@ -916,25 +924,9 @@ def test_a_vertex_move_whose_roll_went_round_the_edges_end_crosses_again_inside_
     # rolled round its end (the normals leaning 3-7° along it, more than the noise allows), and each failed "no edge
     # between the faces". The circle's roll is now crossed again as a face move's is: back on the face before where
     # it met the edge, shifted along the edge back inside it. The episode is stopped once a vertex move has done so.
-    class Seen(Exception):
-        pass
-
-    said, failed = [], []
-
-    def on_move(n, r, *a) -> None:
-        if r.move.kind == "vertex":
-            said.extend(x for x in (r.info or {}).get("recoveries", ()) if "crossed again" in x)
-        if said:
-            raise Seen
-
-    def on_failed(n, r) -> None:
-        if r.move.kind == "vertex" and "a roll round a vertex" in r.reason:
-            failed.append(r.reason)
-
     spec = EpisodeSpec(model="trapezohedron_06", seed=1, executor="physics", models=_sized_corpus(tmp_path))
     ep = build_episode(spec)
-    with pytest.raises(Seen):
-        ep.run(None, EpisodeObserver(on_move=on_move, on_failed_move=on_failed))
+    said, failed = _until_recovery(ep, "vertex", "crossed again", fails="a roll round a vertex")
     assert said and not failed, failed
     assert _within_bounds(ep)
 
@@ -1181,25 +1173,9 @@ def test_a_face_move_onto_a_kite_near_its_apex_crosses_again_square_where_it_is_
     # episode stalled with 7 vertices not measured. The face touched afresh cuts the edge at the apex and leans
     # toward it: the move crosses again square to the edge, out where the kite is wide enough. The episode is
     # stopped once a face move has done so.
-    class Seen(Exception):
-        pass
-
-    said, failed = [], []
-
-    def on_move(n, r, *a) -> None:
-        if r.move.kind == "face":
-            said.extend(x for x in (r.info or {}).get("recoveries", ()) if "square to it" in x)
-        if said:
-            raise Seen
-
-    def on_failed(n, r) -> None:
-        if r.move.kind == "face" and "a roll round a vertex" in r.reason:
-            failed.append(r.reason)
-
     spec = EpisodeSpec(model="trapezohedron_12", seed=1, executor="physics", models=_sized_corpus(tmp_path))
     ep = build_episode(spec)
-    with pytest.raises(Seen):
-        ep.run(None, EpisodeObserver(on_move=on_move, on_failed_move=on_failed))
+    said, failed = _until_recovery(ep, "face", "square to it", fails="a roll round a vertex")
     assert said and not failed, failed
     assert _within_bounds(ep)
 
@@ -1211,20 +1187,8 @@ def test_a_vertex_move_onto_a_narrow_triangle_near_its_apex_crosses_again_square
     # shift told by the roll's own lean ran back toward the apex: "no edge between the faces: ... (a roll round a
     # vertex)". The circle now crosses again square to the edge, out where the triangle is wide enough, as a face
     # move does. The episode is stopped once a vertex move has done so.
-    class Seen(Exception):
-        pass
-
-    said = []
-
-    def on_move(n, r, *a) -> None:
-        if r.move.kind == "vertex":
-            said.extend(x for x in (r.info or {}).get("recoveries", ()) if "square to it" in x)
-        if said:
-            raise Seen
-
     spec = EpisodeSpec(model="bipyramid_11", seed=1, executor="physics", models=_sized_corpus(tmp_path))
     ep = build_episode(spec)
-    with pytest.raises(Seen):
-        ep.run(None, EpisodeObserver(on_move=on_move))
+    said, _ = _until_recovery(ep, "vertex", "square to it")
     assert said
     assert _within_bounds(ep)
