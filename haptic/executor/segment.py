@@ -857,6 +857,21 @@ class Segmenter:
         hi = rec.vertices[stops[0]] if stops else max(ends)
         rec.interval = (lo, hi)
 
+    def behind_interval(self, eid: int, s_vertex: float, sense: int) -> bool:
+        """Whether a vertex located at parameter ``s_vertex`` by an edge move in ``sense`` (+1 along the data edge's
+        direction, −1 against it) lies behind the back end of edge ``eid``'s explored interval, or ahead of it by
+        less than :attr:`SegmentBounds.length_floor`: the edge was sensed from that end on toward the move's, so the
+        end the move ran toward lies ahead of it, and a vertex located there is the edge's other end, which the pad
+        set off past and came back over. Reported as the end the move ran toward, the explored interval would be
+        dropped for one running from that vertex the other way, away from the edge (trapezohedron_11 of the formula
+        corpus, seed 1: a move against the edge's direction acquired the ridge 3.2 mm past the interval's back end,
+        beyond the edge's end, was blocked 0.5 mm on where the faces there meet the edge's line, 0.3 mm behind the
+        interval, and the edge, re-reported as starting at that vertex and running on past it, pruned the true
+        object: no-match)."""
+        lo, hi = self.edges[eid].interval
+        back = lo if sense > 0 else hi
+        return sense * (s_vertex - back) < self.bounds.length_floor
+
     def extend_edge(
         self, eid: int, s_from: float, s_vertex: float, vertex_sigma: float, sense: int
     ) -> tuple[DataEdge, DataVertex]:
@@ -866,7 +881,8 @@ class Segmenter:
 
         The vertex is the end of the interval the move ran toward, whatever the measured parameters say: a
         contact point measured a fraction of a millimetre past the corner must not turn the vertex into the
-        other end of the edge (``start_vertex``/``end_vertex`` state which way the edge runs from it)."""
+        other end of the edge (``start_vertex``/``end_vertex`` state which way the edge runs from it); the mover
+        checks first that it is not the edge's other end (:meth:`behind_interval`)."""
         rec = self.edges[eid]
         b = self.bounds
         vid = self._id()
