@@ -330,6 +330,27 @@ def test_an_edge_move_from_past_a_known_vertex_keeps_the_edge_starting_there():
     assert abs(rec.at(rec.interval[0])[0]) < 1e-6 and abs(rec.at(rec.interval[1])[0] - 0.0126) < 1e-6
 
 
+def test_a_vertex_behind_the_explored_interval_is_not_the_end_the_move_ran_toward():
+    """trapezohedron_11 of the formula corpus, seed 1 (its numbers, in mm along the data edge): an edge known over
+    -0.72..0.63 from a crossing, no vertex known; a move against the edge's direction set off at 3.87, past the edge's
+    other end, and located that end at 0.94, 2.9 ahead of its start but behind the interval: not the end it ran
+    toward. With a vertex known behind the interval (trapezohedron_06: an interval -0.80..0.61 from a vertex move's
+    roll round the vertex at 6, reaching over the end the move runs to) the pad set off on the edge, and a vertex
+    0.7 ahead of the interval's back end is that end."""
+    mm = 1e-3
+    seg = Segmenter(SegmentBounds())
+    top, side = np.array([0.0, 0.0, 1.0]), np.array([0.0, 1.0, 0.0])
+    crossed = seg.add_edge(LineFit(np.zeros(3), np.array([1.0, 0.0, 0.0]), 1e-3, 1e-4, (-0.72 * mm, 0.63 * mm)),
+                           (0, 1), True, (top, side), adjacent=(0,))  # fmt: skip
+    assert seg.behind_interval(crossed.id, 0.94 * mm, 3.87 * mm, -1)  # the other end, come back over
+    assert not seg.behind_interval(crossed.id, -5.0 * mm, 3.87 * mm, -1)  # ahead of the interval
+    assert seg.behind_interval(crossed.id, -0.2 * mm, 3.87 * mm, -1)  # within the interval: either end
+    rolled = seg.add_edge(LineFit(np.zeros(3), np.array([1.0, 0.0, 0.0]), 1e-3, 1e-4, (-0.80 * mm, 0.61 * mm)),
+                          (0, 1), True, (top, side), adjacent=(0,), vertex=(99, 6.0 * mm))  # fmt: skip
+    assert not seg.behind_interval(rolled.id, -0.1 * mm, 3.24 * mm, -1)
+    assert seg.behind_interval(rolled.id, 2.8 * mm, 3.24 * mm, -1)  # behind the move's start
+
+
 def test_at_noise_level_4_a_face_is_picked_about_its_own_rows_not_about_the_guess():
     # σn 4° per axis: rows picked within the fixed 4° cone of a guess 3° off kept those about the guess and pulled the
     # face's normal toward it, 0.8-1.6 times its bound over 20 strokes (BOX01 at 60 mm on the hand, seed 1: three
