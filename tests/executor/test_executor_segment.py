@@ -334,9 +334,10 @@ def test_a_vertex_behind_the_explored_interval_is_not_the_end_the_move_ran_towar
     """trapezohedron_11 of the formula corpus, seed 1 (its numbers, in mm along the data edge): an edge known over
     -0.72..0.63 from a crossing, no vertex known; a move against the edge's direction set off at 3.87, past the edge's
     other end, and located that end at 0.94, 2.9 ahead of its start but behind the interval: not the end it ran
-    toward. With a vertex known behind the interval (trapezohedron_06: an interval -0.80..0.61 from a vertex move's
-    roll round the vertex at 6, reaching over the end the move runs to) the pad set off on the edge, and a vertex
-    0.7 ahead of the interval's back end is that end."""
+    toward. Within the interval it may be the end the move runs to: a crossing's or a roll's interval may reach over
+    it (antiprism_11, seed 1: 0.95 ahead of the back end). With a vertex known behind the interval (trapezohedron_06:
+    an interval -0.80..0.61 from a vertex move's roll round the vertex at 6) the pad set off on the edge, and only a
+    vertex behind its start is refused."""
     mm = 1e-3
     seg = Segmenter(SegmentBounds())
     top, side = np.array([0.0, 0.0, 1.0]), np.array([0.0, 1.0, 0.0])
@@ -344,10 +345,10 @@ def test_a_vertex_behind_the_explored_interval_is_not_the_end_the_move_ran_towar
                            (0, 1), True, (top, side), adjacent=(0,))  # fmt: skip
     assert seg.behind_interval(crossed.id, 0.94 * mm, 3.87 * mm, -1)  # the other end, come back over
     assert not seg.behind_interval(crossed.id, -5.0 * mm, 3.87 * mm, -1)  # ahead of the interval
-    assert seg.behind_interval(crossed.id, -0.2 * mm, 3.87 * mm, -1)  # within the interval: either end
+    assert not seg.behind_interval(crossed.id, -0.2 * mm, 3.87 * mm, -1)  # within it: the interval may reach over
     rolled = seg.add_edge(LineFit(np.zeros(3), np.array([1.0, 0.0, 0.0]), 1e-3, 1e-4, (-0.80 * mm, 0.61 * mm)),
                           (0, 1), True, (top, side), adjacent=(0,), vertex=(99, 6.0 * mm))  # fmt: skip
-    assert not seg.behind_interval(rolled.id, -0.1 * mm, 3.24 * mm, -1)
+    assert not seg.behind_interval(rolled.id, 0.7 * mm, 3.24 * mm, -1)  # behind the interval, ahead of the start
     assert seg.behind_interval(rolled.id, 2.8 * mm, 3.24 * mm, -1)  # behind the move's start
 
 
