@@ -871,7 +871,7 @@ class Segmenter:
         vertex and running on past it, pruned the true object: no-match). The end the move runs to lies ahead of the
         interval's back end, though not by the floor: an interval from a crossing or a roll may reach over it
         (antiprism_11, seed 1: a crossing's interval 1.1 mm long straddled the vertex the move then located 0.95 mm
-        ahead of its back end; trapezohedron_06: an interval from a vertex move's roll, 0.7 mm over its far end). With
+        ahead of its back end; trapezohedron_06: an interval from a vertex move's roll reaching over its far end). With
         a vertex known behind the interval the pad set off on the edge when it set off ahead of that vertex (one
         located at that vertex is checked on its own)."""
         rec = self.edges[eid]
