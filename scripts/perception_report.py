@@ -420,12 +420,14 @@ def _plot(rows: list, path: str) -> None:
 
     from haptic.episode.evaluate import BOUND_QUANTITIES
 
-    fig, axes = plt.subplots(2, 3, figsize=(12, 6), sharex=True)
+    fig, axes = plt.subplots(2, 4, figsize=(16, 6), sharex=True)
+    for ax in axes.ravel()[len(BOUND_QUANTITIES) :]:
+        ax.axis("off")
     # every ratio shows: zeros (an edge's extent within its explored interval) are counted in the title, not drawn
     # at the left edge, and the range reaches the largest ratio
     top = max([1.5] + [math.ceil(10 * math.log10(x)) / 10 + 0.1 for x, _, _, _ in rows if x > 0])
     bins = np.linspace(-3, top, int(round(10 * (top + 3))) + 1)
-    for ax, what in zip(axes.ravel(), BOUND_QUANTITIES, strict=True):
+    for ax, what in zip(axes.ravel()[: len(BOUND_QUANTITIES)], BOUND_QUANTITIES, strict=True):
         a = np.array([x for x, w, _, _ in rows if w == what])
         pos = a[a > 0]
         ax.hist(np.clip(np.log10(pos), bins[0], bins[-1]), bins=bins, color="tab:blue")

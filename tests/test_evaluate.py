@@ -1,6 +1,7 @@
 """Evaluation (outside the executor): coplanar faces are told apart by where the touched points lie."""
 
 import numpy as np
+import pytest
 
 from haptic.episode.evaluate import EvaluationTolerances, score_face
 from haptic.geometry import load_library
@@ -102,3 +103,38 @@ def test_bound_ratios_measure_each_quantity_in_units_of_its_bound():
     assert moved[(1, "edge extent")] < 1e-6
     past, _ = ratios(0.0, 0.0, 0.0, 12.5)  # ... and 2.5 mm past it: 2.5 length bounds
     assert np.isclose(past[(1, "edge extent")], 2.5, rtol=1e-3)
+
+
+def test_bound_ratios_see_an_edge_reported_starting_at_the_vertex_it_ends_at():
+    # trapezohedron_11 of the formula corpus, seed 1: an edge move against the edge's direction set off past the
+    # edge's end behind it and located that end; the edge was re-reported as starting at the vertex and running on
+    # 2.9 mm past it, every quantity of the pose check within its bound (the extent 2 mm past the end, 0.66 of its
+    # 3 mm length bound), and the interpretation tree, holding a reported start to the model edge's start, pruned
+    # the true object. Scored at the end it claims, the start lies a whole edge from it.
+    from haptic.episode.evaluate import bound_ratios
+    from haptic.geometry import SE3
+    from haptic.matching.components import DataEdge, DataVertex
+
+    poly = LIB["BOX01"]
+    pose = SE3.from_matrix(np.array([[0.0, -1, 0, 0.4], [1, 0, 0, -0.1], [0, 0, 1, 0.02], [0, 0, 0, 1]]))
+    e = 0
+    a, b = pose.apply(poly.vertices[poly.edges[e]])
+    length = float(np.linalg.norm(b - a))
+    u = (b - a) / length
+    v = int(poly.edges[e, 1])
+    vertex = DataVertex(2, b - 0.95e-3 * u, 2.4e-3, adjacent=(1,))
+    # the interval known before the move, ended at the vertex the move located: the end it claims is the true one
+    honest = DataEdge(1, u, b - 2.3e-3 * u, 1.35e-3, 0.017, 7.5e-4, 3e-3, end_vertex=2)
+    # as reported: starting at the vertex and running on past it
+    reported = DataEdge(1, u, vertex.position, 2.93e-3, 0.017, 7.5e-4, 3e-3, start_vertex=2)
+
+    def ratios(edge):
+        return {(r.id, r.what): (r.ratio, r.true_id) for r in bound_ratios([edge, vertex], poly, pose)}
+
+    fine = ratios(honest)
+    assert fine[(1, "edge vertex")] == (pytest.approx(0.95 / 3, rel=1e-3), e)
+    assert max(r for r, _ in fine.values()) <= 1.0
+    bad = ratios(reported)
+    assert max(r for r, _ in bad.values()) > 1.0  # a component outside its bounds
+    assert bad[(1, "edge extent")][0] < 1.0 and bad[(2, "vertex")] == (pytest.approx(0.95 / 2.4, rel=1e-3), v)
+    assert bad[(1, "edge vertex")][0] == pytest.approx((length - 0.95e-3) / 3e-3, rel=1e-3)

@@ -32,7 +32,7 @@ from haptic.geometry import tracing
 from haptic.geometry.distance import point_triangle_distance, surface_distance
 from haptic.geometry.polyhedron import Polyhedron
 from haptic.geometry.se3 import SE3, plane_basis
-from haptic.matching.acceptance import residual_ratios
+from haptic.matching.acceptance import ROUND_OFF, residual_ratios
 from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex
 from haptic.matching.trace import PHASES
 from haptic.matching.tree import Interpretation
@@ -129,8 +129,11 @@ class PerceptionScore:
         }
 
 
-BOUND_QUANTITIES = ("face normal", "face point", "edge direction", "edge line", "edge extent", "vertex")
-"""What :func:`bound_ratios` scores, as the pose check names it."""
+BOUND_QUANTITIES = (
+    "face normal", "face point", "edge direction", "edge line", "edge extent", "edge vertex", "vertex"
+)  # fmt: skip
+"""What :func:`bound_ratios` scores, as the pose check names it, and an edge's ends at its vertices
+(:func:`vertex_end_ratios`), which the pose check leaves to the interpretation tree."""
 
 
 @dataclass(frozen=True)
@@ -167,6 +170,8 @@ def bound_ratios(components, model: Polyhedron, world_from_model: SE3) -> list[B
         for faces, edges, vertices, senses in options:
             it = Interpretation(model, 0, faces, edges, vertices, senses, world_from_model, 0)
             rows = residual_ratios(model, data, it, world_from_model)
+            if isinstance(c, DataEdge):
+                rows += vertex_end_ratios(c, model, edges[c.id], senses[c.id], world_from_model)
             worst = max(r for r, _, _ in rows)
             if best is None or worst < best[0]:
                 true_id = next(iter((faces or edges or vertices).values()))
@@ -176,6 +181,30 @@ def bound_ratios(components, model: Polyhedron, world_from_model: SE3) -> list[B
         for r, _, what in best[1]:
             per[what] = max(per.get(what, 0.0), float(r))
         out += [BoundRatio(c.id, what, r, best[2]) for what, r in per.items()]
+    return out
+
+
+def vertex_end_ratios(
+    c: DataEdge, model: Polyhedron, edge: int, sense: int, world_from_model: SE3
+) -> list[tuple[float, int, str]]:
+    """``(residual / bound, data id, "edge vertex")`` of each end of data edge ``c``'s explored interval that it
+    reports at a vertex (``start_vertex`` at ``p``, ``end_vertex`` at ``p + l b``), paired with model ``edge`` in
+    ``sense``: how far along the model edge's line that end lies from the model edge's end it claims (its start in
+    that sense, or its end), over the edge's length bound λ. The interpretation tree holds such an end to that
+    model end within λ and the vertex's bound (:func:`~haptic.matching.constraints.edge_position_test`,
+    :func:`~haptic.matching.constraints.vertex_edge_test`, tight at a known vertex); an interval reported starting at
+    the vertex it ends at, running on past it, lies a whole edge from the end it claims."""
+    out: list[tuple[float, int, str]] = []
+    if c.start_vertex is None and c.end_vertex is None:
+        return out
+    inv = world_from_model.inverse()
+    b = model.edge_directions[edge]
+    first, last = model.edge_points[edge], model.edge_points[edge] + model.edge_lengths[edge] * b
+    start, end = (first, last) if sense > 0 else (last, first)
+    for vertex, at, model_end in ((c.start_vertex, c.point, start), (c.end_vertex, c.end_point, end)):
+        if vertex is not None:
+            along = abs(float((inv.apply(np.asarray(at, float)) - model_end) @ b))
+            out.append((along / (c.length_bound + ROUND_OFF), c.id, "edge vertex"))
     return out
 
 

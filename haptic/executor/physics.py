@@ -1456,15 +1456,17 @@ class PhysicsExecutor(LandingSearch):
                    "contacts off the edge's line, on an edge turning little from it, or the pad spanning a gap in the "
                    "ridge before what blocked it)")  # fmt: skip
             return self.failed_result(move, "unreachable", why)
-        # the vertex lies ahead of everything behind the move: the explored interval's back end and the start (BOX01N
-        # at 60 mm, seed 2: a move along +e set off 23 mm behind the interval, past the edge's other end, and located
-        # that end's vertex behind its start; reported as the end it ran toward, with the interval collapsed onto it,
-        # the edge's two ends were one vertex and the true object was pruned)
+        # the vertex lies ahead of what lies behind the move: its start, and with no vertex known behind the explored
+        # interval, the interval (BOX01N at 60 mm, seed 2: a move along +e set off 23 mm behind the interval, past the
+        # edge's other end, and located that end's vertex behind its start; reported as the end it ran toward, with
+        # the interval collapsed onto it, the edge's two ends were one vertex and the true object was pruned;
+        # trapezohedron_11 of the formula corpus, seed 1: a move set off 3.2 mm behind the interval, past the edge's
+        # other end, and located that end 2.9 mm ahead of its start, 0.3 mm behind the interval;
+        # :meth:`Segmenter.behind_interval`)
         sign = 1.0 if float(u @ rec.direction) > 0 else -1.0
-        back = min(rec.interval[0], s_from) if sign > 0 else max(rec.interval[1], s_from)
-        if sign * (s_v - back) < seg.bounds.length_floor:
-            return "unreachable", "the vertex located lies behind the move's start, at the edge's other end (the pad " \
-                                  "set off past it)"
+        if seg.behind_interval(st.edge, s_v, s_from, int(sign)):
+            return "unreachable", "the vertex located lies behind the move's start or the edge's explored interval, " \
+                                  "at the edge's other end (the pad set off past it)"
         # ... nor is it, within its bound, the vertex known at the edge's end behind the move: the pad set off past
         # that end and located it as it came onto the edge (trapezohedron_12 of the formula corpus at 77 mm, seed 1: a
         # move set off 2 mm past one end of a 9 mm edge toward the other and put a vertex 0.3 mm from the end it

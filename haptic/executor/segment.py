@@ -857,6 +857,33 @@ class Segmenter:
         hi = rec.vertices[stops[0]] if stops else max(ends)
         rec.interval = (lo, hi)
 
+    def behind_interval(self, eid: int, s_vertex: float, s_from: float, sense: int) -> bool:
+        """Whether a vertex located at parameter ``s_vertex`` by an edge move in ``sense`` (+1 along the data edge's
+        direction, −1 against it) that set off at ``s_from`` is not the end the move ran toward: less than
+        :attr:`SegmentBounds.length_floor` ahead of the farther back of its start and edge ``eid``'s explored interval's
+        back end, or, while no vertex of the edge is known behind the interval, behind the interval itself.
+
+        A pad setting off behind the interval with no vertex known there may have set off past the edge's other end,
+        on the faces beyond it, and come back over that end, which it then locates ahead of its start but behind the
+        interval (trapezohedron_11 of the formula corpus, seed 1: a move against the edge's direction acquired the
+        ridge 3.2 mm behind the interval, past the edge's end, was blocked 0.5 mm on where the faces there meet the
+        edge's line, 2.9 mm ahead of its start, 0.3 mm behind the interval; the edge, re-reported as starting at that
+        vertex and running on past it, pruned the true object: no-match). The end the move runs to lies ahead of the
+        interval's back end, though not by the floor: an interval from a crossing or a roll may reach over it
+        (antiprism_11, seed 1: a crossing's interval 1.1 mm long straddled the vertex the move then located 0.95 mm
+        ahead of its back end; trapezohedron_06: an interval from a vertex move's roll reaching over its far end). With
+        a vertex known behind the interval the pad set off on the edge when it set off ahead of that vertex (one
+        located at that vertex is checked on its own)."""
+        rec = self.edges[eid]
+        lo, hi = rec.interval
+        back = lo if sense > 0 else hi
+        start = min(back, s_from) if sense > 0 else max(back, s_from)
+        if sense * (s_vertex - start) < self.bounds.length_floor:
+            return True
+        if any(sense * (s - back) < 0 for s in rec.vertices.values()):
+            return False
+        return sense * (s_vertex - back) < 0
+
     def extend_edge(
         self, eid: int, s_from: float, s_vertex: float, vertex_sigma: float, sense: int
     ) -> tuple[DataEdge, DataVertex]:
@@ -866,7 +893,8 @@ class Segmenter:
 
         The vertex is the end of the interval the move ran toward, whatever the measured parameters say: a
         contact point measured a fraction of a millimetre past the corner must not turn the vertex into the
-        other end of the edge (``start_vertex``/``end_vertex`` state which way the edge runs from it)."""
+        other end of the edge (``start_vertex``/``end_vertex`` state which way the edge runs from it); the mover
+        checks first that it is not the edge's other end (:meth:`behind_interval`)."""
         rec = self.edges[eid]
         b = self.bounds
         vid = self._id()

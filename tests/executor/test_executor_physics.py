@@ -406,6 +406,27 @@ def test_an_edge_move_that_locates_the_end_it_set_off_past_reports_no_vertex(mon
     assert dict(seg.edges[ex.state.edge].vertices) == ends
 
 
+def test_an_edge_move_that_locates_a_vertex_behind_the_explored_interval_reports_no_vertex(monkeypatch):
+    """An edge move whose pad set off behind the edge's explored interval, past the edge's other end, and came back
+    over that end locates it ahead of where it set off but behind the interval (trapezohedron_11 of the formula
+    corpus, seed 1: the ridge acquired 3.2 mm behind the interval, the vertex located 2.9 mm ahead of that, 0.3 mm
+    behind the interval). Reported as the end the move ran toward, the edge started at that vertex and ran on past
+    it, away from the interval explored: the matcher pruned the true object (no-match). Here the box's edge, crossed
+    by a face move, is known over an interval put 3 mm ahead of the pad, and the vertex the move locates 0.5 mm
+    behind that: the move reports nothing and the edge keeps no vertex."""
+    _, sim = _setup("BOX01", 3)
+    ex, _ = _start_and_face_move(sim, 3)
+    seg = ex.segmenter
+    rec = seg.edges[ex.state.edge]
+    here = rec.param(ex.contact_point())
+    rec.interval = (here + 3e-3, here + 4.35e-3)
+    monkeypatch.setattr(ex, "_vertex_param", lambda *a, **k: (here + 2.5e-3, 1e-4))
+    reported = len(ex.components)
+    r = ex.execute(EdgeMove(1))  # along the data edge's direction, toward the interval
+    assert not r.ok and "the edge's explored interval" in r.reason, (r.status, r.reason)
+    assert len(ex.components) == reported and not rec.vertices
+
+
 def _ridge_rows(inside: float, n: int = 40, seed: int = 0):
     """A ridge trace along +x under the pad: contacts on the line (the x axis) with the sensor's noise at level 1,
     the pad's centre above each at the model's radius less ``inside`` [m]."""

@@ -330,6 +330,28 @@ def test_an_edge_move_from_past_a_known_vertex_keeps_the_edge_starting_there():
     assert abs(rec.at(rec.interval[0])[0]) < 1e-6 and abs(rec.at(rec.interval[1])[0] - 0.0126) < 1e-6
 
 
+def test_a_vertex_behind_the_explored_interval_is_not_the_end_the_move_ran_toward():
+    """trapezohedron_11 of the formula corpus, seed 1 (its numbers, in mm along the data edge): an edge known over
+    -0.72..0.63 from a crossing, no vertex known; a move against the edge's direction set off at 3.87, past the edge's
+    other end, and located that end at 0.94, 2.9 ahead of its start but behind the interval: not the end it ran
+    toward. Within the interval it may be the end the move runs to: a crossing's or a roll's interval may reach over
+    it (antiprism_11, seed 1: 0.95 ahead of the back end). With a vertex known behind the interval (trapezohedron_06:
+    an interval -0.80..0.61 from a vertex move's roll round the vertex at 6) the pad set off on the edge, and only a
+    vertex behind its start is refused."""
+    mm = 1e-3
+    seg = Segmenter(SegmentBounds())
+    top, side = np.array([0.0, 0.0, 1.0]), np.array([0.0, 1.0, 0.0])
+    crossed = seg.add_edge(LineFit(np.zeros(3), np.array([1.0, 0.0, 0.0]), 1e-3, 1e-4, (-0.72 * mm, 0.63 * mm)),
+                           (0, 1), True, (top, side), adjacent=(0,))  # fmt: skip
+    assert seg.behind_interval(crossed.id, 0.94 * mm, 3.87 * mm, -1)  # the other end, come back over
+    assert not seg.behind_interval(crossed.id, -5.0 * mm, 3.87 * mm, -1)  # ahead of the interval
+    assert not seg.behind_interval(crossed.id, -0.2 * mm, 3.87 * mm, -1)  # within it: the interval may reach over
+    rolled = seg.add_edge(LineFit(np.zeros(3), np.array([1.0, 0.0, 0.0]), 1e-3, 1e-4, (-0.80 * mm, 0.61 * mm)),
+                          (0, 1), True, (top, side), adjacent=(0,), vertex=(99, 6.0 * mm))  # fmt: skip
+    assert not seg.behind_interval(rolled.id, 0.7 * mm, 3.24 * mm, -1)  # behind the interval, ahead of the start
+    assert seg.behind_interval(rolled.id, 2.8 * mm, 3.24 * mm, -1)  # behind the move's start
+
+
 def test_at_noise_level_4_a_face_is_picked_about_its_own_rows_not_about_the_guess():
     # σn 4° per axis: rows picked within the fixed 4° cone of a guess 3° off kept those about the guess and pulled the
     # face's normal toward it, 0.8-1.6 times its bound over 20 strokes (BOX01 at 60 mm on the hand, seed 1: three

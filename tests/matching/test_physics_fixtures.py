@@ -89,3 +89,35 @@ def test_vertex_reported_at_the_wrong_end_of_its_interval():
     )
     honest = [*comps[:3], fixed, *comps[4:]]
     assert _survival(honest, model, truth, library) == [1] * len(honest)
+
+
+def test_an_edge_reported_starting_at_the_vertex_it_ends_at_is_what_pruned_trapezohedron_11():
+    """trapezohedron_11 of the formula corpus (seed 1, the physics executor before edge moves refused a vertex behind
+    the explored interval), which ended no-match: the last edge move, against data edge 82's direction, set off past
+    the end of the edge behind it (model edge 16, 12.6 mm, from vertex 8 to vertex 18), was blocked coming back over
+    vertex 18, and re-reported edge 82 as starting at that vertex (data vertex 84, 0.95 mm from vertex 18, within its
+    bound) and running 2.9 mm on past it. Every other test of the tree holds the true pairing; the edge-pair tests
+    of 17 earlier edges, tight at a reported start, put the start 11.4-12.0 mm from the model edge's start (their
+    bounds 5.3-11.8 mm) and pruned it. The matcher is right: that report claims the vertex at the edge's wrong end.
+    Reported as the interval explored, ended at the vertex, the true interpretation survives every report, and so
+    it does without the claim; the evaluation sees the claim as a component outside its bounds (edge vertex)."""
+    from haptic.episode.evaluate import bound_ratios
+    from haptic.geometry import SE3, Polyhedron
+
+    comps, meta = _load("physics_trapezohedron_11_seed1.json")
+    model = Polyhedron.from_faces(np.array(meta["vertices"]), meta["faces"], name=meta["model"])
+    library, truth = {model.name: model}, meta["truth"]
+    survived = _survival(comps, model.name, truth, library)
+    bad, vertex = comps[-2:]
+    assert isinstance(bad, DataEdge) and bad.id == 82 and bad.start_vertex == vertex.id == 84
+    assert survived[:-2] == [1] * (len(comps) - 2) and survived[-2:] == [0, 0]
+    assert truth[82] == ["edge", 16, 1] and truth[84] == ["vertex", 18]
+    assert _survival([*comps[:-2], replace(bad, start_vertex=None), vertex], model.name, truth, library)[-2:] == [1, 1]
+    known = next(c for c in reversed(comps[:-2]) if c.id == bad.id)  # the interval before the move
+    honest = replace(known, length=float((vertex.position - known.point) @ known.direction), end_vertex=vertex.id)
+    assert _survival([*comps[:-2], honest, vertex], model.name, truth, library) == [1] * len(comps)
+    pose = SE3.from_matrix(np.array(meta["world_from_model"]))
+    ratios = {(r.id, r.what): r.ratio for r in bound_ratios(comps, model, pose)}
+    assert ratios[(82, "edge extent")] < 1.0 and ratios[(84, "vertex")] < 1.0
+    assert ratios[(82, "edge vertex")] > 3.0
+    assert [i for (i, _), r in ratios.items() if r > 1.0] == [82]
