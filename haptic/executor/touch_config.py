@@ -60,7 +60,10 @@ class TouchConfig:
     roll_window: float = 0.001
     """A roll is over when the normal turned less than ``roll_settled`` over this much travel [m] ..."""
     roll_settled: float = math.radians(1.5)
-    """... [rad]."""
+    """... [rad] ..."""
+    roll_settle_sigmas: float = 3.5
+    """... or over the travel in which a roll turns by ``roll_settled`` and this many σ of the difference of two
+    filtered normals more, when the sensor is noisier (:meth:`roll_settle_window`) [-]."""
     undercut_slack: float = math.radians(3.0)
     """Rolling off a face that itself leans under near the limit, the roll ends for the undercut only once the
     normal leans this much further than the face's (not on a noisy first reading) [rad]."""
@@ -209,6 +212,19 @@ class TouchConfig:
         """The undercut the planner's reach model takes the hand to reach: ``max_undercut`` less
         ``undercut_margin`` [rad]."""
         return self.max_undercut - self.undercut_margin
+
+    def roll_settle_window(self, normal_sigma: float, pad_radius: float) -> float:
+        """The travel over which a roll's settle test compares the filtered normal [m]: ``roll_window``, or longer where
+        the noise of the difference of two filtered normals (σn √(2 w / (2 − w)) per axis, ``w`` the
+        ``normal_filter``, the two a roll's window apart nearly independent) could cancel the turn of a pad still
+        rolling over the window (its length over the pad's radius): the window in which the roll turns
+        ``roll_settled`` plus ``roll_settle_sigmas`` of that noise. At noise level 4 (σn 4°) the difference scatters
+        by 2.1° per axis, and over the 1 mm window a pad rolling at 4.8°/mm read a turn under 1.5° often enough
+        that most rolls of HEXPRISM01 at 150 mm (seed 1) settled 20-44° short of the next face; the window is then
+        1.9 mm. At noise level 1 (0.5° per axis) it is ``roll_window``."""
+        w = self.normal_filter
+        sigma = normal_sigma * math.sqrt(2.0 * w / (2.0 - w))
+        return max(self.roll_window, pad_radius * (self.roll_settled + self.roll_settle_sigmas * sigma))
 
     def contact_threshold(self, force_sigma: float) -> float:
         """Sensed force above which a contact counts [N], for a force sensor of σ ``force_sigma`` [N]."""
