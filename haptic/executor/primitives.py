@@ -864,7 +864,7 @@ class Toucher:
         above sin 15°, or contact is lost once it leaned along it, or progress stalls). ``toward_a``: the sideways
         direction that turns the normal towards ``n_a``. With ``acquire_only`` it stops once the normal is on
         the bisector. Contact lost before the normal leaned along the edge (:attr:`TouchConfig.loss_lean_sin`)
-        is no vertex: ``no-contact``, event ``lost``.
+        is no vertex: ``no-contact``, event ``lost`` (:meth:`TouchConfig.loss_lean`: a lean beyond the noise).
 
         ``concave``: the edge is a valley, where the pad rests in the corner against both faces and no sideways
         motion turns the sensed normal (the force-weighted mean of the two contacts') onto the bisector: pressed
@@ -937,7 +937,7 @@ class Toucher:
                     return self._result("timeout", "limit", 0.0, error=err)
                 continue
             if self.weak_ticks * self.dt >= cfg.loss_time:
-                if lean < cfg.loss_lean_sin:
+                if lean < cfg.loss_lean(self.bounds.normal_sigma):
                     return self._result("no-contact", "lost", 0.0, lean=lean)
                 return self._result("ok", "vertex", 0.0, event_sign=1, lost=True)
             if self.normal is not None:
