@@ -90,20 +90,17 @@ def fitting(classes, tree: InterpretationTree, fits) -> tuple[PoseClass, ...]:
     paired an edge elsewhere and sat 4.6° off the true pose, through the table; the class was set aside, the one
     left was wrong, and verification found a face 80 bounds off it (no-match). A class is set aside only when none
     of its interpretations fits."""
-    out = []
-    for c in classes:
-        if fits(c):
-            out.append(c)
+    out = [c if fits(c) else None for c in classes]
+    todo = [(i, leaf) for i, c in enumerate(classes) if out[i] is None for leaf in c.leaves[1:MAX_CLASS_LEAVES]]
+    poses = tree.poses([leaf for _, leaf in todo], refine=True) if todo else []
+    for (i, leaf), pose in zip(todo, poses, strict=True):
+        if out[i] is not None or pose is None:
             continue
-        for leaf in c.leaves[1:MAX_CLASS_LEAVES]:
-            pose = tree.interpretation(leaf, with_pose=True, refine=True).world_from_model
-            if pose is None:
-                continue
-            alt = PoseClass(c.model, (leaf, *(k for k in c.leaves if k != leaf)), pose)
-            if fits(alt):
-                out.append(alt)
-                break
-    return tuple(out)
+        c = classes[i]
+        alt = PoseClass(c.model, (leaf, *(k for k in c.leaves if k != leaf)), pose)
+        if fits(alt):
+            out[i] = alt
+    return tuple(c for c in out if c is not None)
 
 
 def on_the_table(

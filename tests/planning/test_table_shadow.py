@@ -130,8 +130,7 @@ def test_a_pose_class_is_set_aside_only_when_none_of_its_interpretations_rests_o
     tilted = SE3(tilt @ pose.rotation, pose.translation + np.array([0.0, 0.0, 0.006]))  # floating off the table
     turned = SE3(np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]) @ pose.rotation, pose.translation)
     poses = {0: tilted, 1: pose, 2: turned, 3: tilted}
-    tree = SimpleNamespace(interpretation=lambda leaf, with_pose=True, refine=True: SimpleNamespace(
-        world_from_model=poses[leaf]), data=())  # fmt: skip
+    tree = SimpleNamespace(poses=lambda leaves, refine=True: [poses[k] for k in leaves], data=())
     true, other = PoseClass(poly, (0, 1), tilted), PoseClass(poly, (2,), turned)
     rec = Recognition(EXPLORING, None, None, (true, other), 3, (poly.name,))
     vertex = {0: DataVertex(id=0, position=pose.apply(poly.vertices[:1])[0], position_bound=1e-3)}
