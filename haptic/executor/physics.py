@@ -1616,7 +1616,7 @@ class PhysicsExecutor(LandingSearch):
         line: their centre (the median offset per axis across the line) farther from it than the line's bound and the
         noise of that centre (each contact off by σp per axis, the median of k by about ``√(π/2) σp / √k``) allow.
         Each contact alone lies off the line by its noise, a 2-D error whose median length is ``1.18 σp``: at noise
-        level 4 (σp 0.8 mm) 0.9-1.3 mm where the line's bound was 0.8 mm, and 15 of 18 edge moves of HEXPRISM01 at
+        level 4 (σp 0.8 mm) 0.9-1.3 mm where the line's bound was 0.8 mm, and 14 of 17 edge moves of HEXPRISM01 at
         150 mm (seed 1) that rolled on their vertex located none, their contacts' centre 0.04-0.41 mm off the
         line."""
         b = self.bounds

@@ -494,7 +494,7 @@ def _rolling_on_a_vertex(level: float, turn: float = 0.0, n: int = 25, seed: int
 def test_a_vertex_the_pad_rolls_on_is_located_at_noise_level_4():
     """Rolling on the vertex the pad's contacts stay at one point of the edge's line; each lies off it by the sensor's
     noise, a 2-D error whose median length is 1.18 σp: 0.94 mm at noise level 4, past the line's bound of 0.8 mm, so
-    that 15 of 18 edge moves of HEXPRISM01 at 150 mm (seed 1, noise level 4) located no vertex. Their centre lies on
+    that 14 of 17 edge moves of HEXPRISM01 at 150 mm (seed 1, noise level 4) located no vertex. Their centre lies on
     the line within the noise of a centre: the vertex is located, at every level, and contacts running on past the
     vertex along an edge turning 30° off the line are still told."""
     import types
