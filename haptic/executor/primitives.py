@@ -51,6 +51,17 @@ STOPS = ("table", "hand")
 FAILURES = ("no-contact", "unreachable", "timeout", "unstable")
 """Failure statuses of a primitive (the move statuses of :class:`~haptic.planning.moves.MoveResult`)."""
 _FREE = PHASES.index("free")
+def roll_settled(hist: list[tuple[float, np.ndarray]], travelled: float, normal: np.ndarray, window: float,
+                 settled: float) -> bool:  # fmt: skip
+    """Whether a roll is over: the filtered ``normal`` turned less than ``settled`` [rad] from the last one of ``hist``
+    (the roll's (travel, filtered normal) so far) at least ``window`` [m] of travel before ``travelled``
+    (:meth:`~haptic.executor.touch_config.TouchConfig.roll_settle_window`)."""
+    for s, nn in reversed(hist):
+        if s <= travelled - window:
+            return angle(nn, normal) < settled
+    return False
+
+
 ROLL_ON_FACE = 0.004
 """A roll over a convex edge whose sensed normal has not yet turned past the edge angle from the face it left after
 this much travel [m] slides on that face (event ``"face"``): the slide's contact weakened with no edge there, or was
@@ -683,6 +694,7 @@ class Toucher:
         lost = 0
         met = None  # a link of the finger on the object when the contact was lost
         turned = False  # the sensed normal turned past the edge angle from n_a
+        window = cfg.roll_settle_window(self.bounds.normal_sigma, self.pad_radius)
         for _ in range(int(cfg.roll_max / cfg.roll_speed * 2.0 / self.dt)):
             n = self.normal if self.normal is not None else n_a
             if angle(n, n_a) > self.bounds.sample_cone:
@@ -730,9 +742,7 @@ class Toucher:
                 self.tick("roll")
                 return self._result("unreachable", "undercut", 0.0)
             if angle(self.normal, n_a) > cfg.edge_angle:
-                # settled: the normal turned less than roll_settled over the last roll_window of travel
-                old = [nn for s, nn in hist if s <= travelled - cfg.roll_window]
-                if old and angle(old[-1], self.normal) < cfg.roll_settled:
+                if roll_settled(hist, travelled, self.normal, window, cfg.roll_settled):
                     n_b = self.normal.copy()
                     away = unit(cross(n_b, e))
                     if float(away @ t) < 0:
@@ -854,7 +864,7 @@ class Toucher:
         above sin 15°, or contact is lost once it leaned along it, or progress stalls). ``toward_a``: the sideways
         direction that turns the normal towards ``n_a``. With ``acquire_only`` it stops once the normal is on
         the bisector. Contact lost before the normal leaned along the edge (:attr:`TouchConfig.loss_lean_sin`)
-        is no vertex: ``no-contact``, event ``lost``.
+        is no vertex: ``no-contact``, event ``lost`` (:meth:`TouchConfig.loss_lean`: a lean beyond the noise).
 
         ``concave``: the edge is a valley, where the pad rests in the corner against both faces and no sideways
         motion turns the sensed normal (the force-weighted mean of the two contacts') onto the bisector: pressed
@@ -927,7 +937,7 @@ class Toucher:
                     return self._result("timeout", "limit", 0.0, error=err)
                 continue
             if self.weak_ticks * self.dt >= cfg.loss_time:
-                if lean < cfg.loss_lean_sin:
+                if lean < cfg.loss_lean(self.bounds.normal_sigma):
                     return self._result("no-contact", "lost", 0.0, lean=lean)
                 return self._result("ok", "vertex", 0.0, event_sign=1, lost=True)
             if self.normal is not None:
@@ -1091,5 +1101,6 @@ __all__ = [
     "angle",
     "empty_trace",
     "perpendicular",
+    "roll_settled",
     "unit",
 ]

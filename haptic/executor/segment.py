@@ -27,6 +27,8 @@ from haptic.matching.trace import ContactTrace
 
 MEDIAN_ABS_NORMAL = 0.6745
 """The median of ``|x|`` for ``x`` normal with σ 1 [-]."""
+MEDIAN_EFFICIENCY = math.sqrt(math.pi / 2.0)
+"""The median of ``k`` normal samples of σ scatters by about this times ``σ / √k`` (their mean by ``σ / √k``) [-]."""
 
 
 @dataclass(frozen=True)
@@ -934,6 +936,7 @@ class Segmenter:
 
 __all__ = [
     "AT_END",
+    "MEDIAN_EFFICIENCY",
     "MM",
     "EdgeRecord",
     "FaceFit",

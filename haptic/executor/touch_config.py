@@ -56,11 +56,20 @@ class TouchConfig:
     """Contact lost while following a ridge is its vertex (the surface fell away) only when the filtered normal
     had leaned at least this far along the edge: the pad cannot leave the end of an edge without rolling on to
     the vertex. Lost with the normal still across the edge, the pad was lifted off it -- another part of the
-    finger met the object (a frame's rim above a valley) -- and the edge goes on [-]."""
+    finger met the object (a frame's rim above a valley) -- and the edge goes on [-] ..."""
+    loss_lean_sigmas: float = 5.0
+    """... and at least this many σ of the filtered normal (:meth:`filtered_sigma`) when that is more: the lean is
+    the largest over the whole ridge trace, and at noise level 4 (σn 4°, the filtered normal's 1.5° per axis) the
+    noise alone took it past 5° on HEXPRISM01 at 150 mm (seed 1): a link of the finger lifted the pad off 2.5 mm
+    into an edge move, and the vertex was put where the pad left the ridge, 24 mm from the edge's end (14.7 bounds;
+    no-match) [-]."""
     roll_window: float = 0.001
     """A roll is over when the normal turned less than ``roll_settled`` over this much travel [m] ..."""
     roll_settled: float = math.radians(1.5)
-    """... [rad]."""
+    """... [rad] ..."""
+    roll_settle_sigmas: float = 3.5
+    """... or over the travel in which a roll turns by ``roll_settled`` and this many σ of the difference of two
+    filtered normals more, when the sensor is noisier (:meth:`roll_settle_window`) [-]."""
     undercut_slack: float = math.radians(3.0)
     """Rolling off a face that itself leans under near the limit, the roll ends for the undercut only once the
     normal leans this much further than the face's (not on a noisy first reading) [rad]."""
@@ -209,6 +218,29 @@ class TouchConfig:
         """The undercut the planner's reach model takes the hand to reach: ``max_undercut`` less
         ``undercut_margin`` [rad]."""
         return self.max_undercut - self.undercut_margin
+
+    def filtered_sigma(self, normal_sigma: float) -> float:
+        """σ per tangent axis of the low-passed normal (weight ``normal_filter`` per tick) of a sensor of σ
+        ``normal_sigma`` per sample: ``σn √(w / (2 − w))`` [rad]."""
+        w = self.normal_filter
+        return normal_sigma * math.sqrt(w / (2.0 - w))
+
+    def loss_lean(self, normal_sigma: float) -> float:
+        """The lean along the edge [sin] a ridge trace's filtered normal must have reached for a lost contact to be
+        its vertex: :attr:`loss_lean_sin`, or :attr:`loss_lean_sigmas` of the filtered normal's noise."""
+        return max(self.loss_lean_sin, math.sin(self.loss_lean_sigmas * self.filtered_sigma(normal_sigma)))
+
+    def roll_settle_window(self, normal_sigma: float, pad_radius: float) -> float:
+        """The travel over which a roll's settle test compares the filtered normal [m]: ``roll_window``, or longer where
+        the noise of the difference of two filtered normals (σn √(2 w / (2 − w)) per axis, ``w`` the
+        ``normal_filter``, the two a roll's window apart nearly independent) could cancel the turn of a pad still
+        rolling over the window (its length over the pad's radius): the window in which the roll turns
+        ``roll_settled`` plus ``roll_settle_sigmas`` of that noise. At noise level 4 (σn 4°) the difference scatters
+        by 2.1° per axis, and over the 1 mm window a pad rolling at 4.8°/mm read a turn under 1.5° often enough
+        that most rolls of HEXPRISM01 at 150 mm (seed 1) settled 20-44° short of the next face; the window is then
+        1.9 mm. At noise level 1 (0.5° per axis) it is ``roll_window``."""
+        sigma = math.sqrt(2.0) * self.filtered_sigma(normal_sigma)
+        return max(self.roll_window, pad_radius * (self.roll_settled + self.roll_settle_sigmas * sigma))
 
     def contact_threshold(self, force_sigma: float) -> float:
         """Sensed force above which a contact counts [N], for a force sensor of σ ``force_sigma`` [N]."""
