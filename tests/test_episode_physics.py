@@ -1228,3 +1228,17 @@ def test_a_vertex_move_onto_a_narrow_triangle_near_its_apex_crosses_again_square
         ep.run(None, EpisodeObserver(on_move=on_move))
     assert said
     assert _within_bounds(ep)
+
+
+def test_a_roll_round_a_vertex_down_to_the_tables_clearance_crosses_again_inside_the_edge(tmp_path):
+    # platonic_octahedron of the sized formula corpus, seed 1: the first face move traced the level top face into an
+    # edge at its vertex; the pad rolled round the vertex and down the faces there to the table's clearance, 20 mm
+    # below where it met the edge, and no edge came from the roll ("the roll turned about more than one axis"): the
+    # move failed. It now crosses again farther inside the edge, away from that vertex, and measures the edge and
+    # the next face within their bounds.
+    ep, results = _moves("platonic_octahedron", 1, _sized_corpus(tmp_path), 1)
+    face = [r for r in results[1:] if r.move is not None and r.move.kind == "face"]  # the start aside
+    assert face and face[0].ok, face[0].reason if face else results
+    assert any("the table's clearance before the next face" in x and "crossed again" in x
+               for x in face[0].info.get("recoveries", ())), face[0].info
+    assert _within_bounds(ep)

@@ -86,6 +86,8 @@ episode went on to fail four moves in a row at the slot (with ``--verify none``,
 
 FROM_TOUCHED = ", from where the face was touched"
 """Said of a crossing made again from a point the face was touched at, its start beside the first lying off the face."""
+TABLE_BEFORE_NEXT = "the pad reached the table's clearance before the next face"
+"""How a roll over a convex edge that the table stopped ends (:meth:`PhysicsExecutor._cross_and_acquire`)."""
 
 
 TOUCH_PHASES = ("face", "circle")
@@ -655,7 +657,7 @@ class PhysicsExecutor(LandingSearch):
                     None, None
             if r.event in ("undercut", "table"):  # the next face out of the pad's reach: the roll gives the edge
                 why = ("the next face leans under, out of the pad's reach" if r.event == "undercut"
-                       else "the pad reached the table's clearance before the next face")  # fmt: skip
+                       else TABLE_BEFORE_NEXT)  # fmt: skip
                 return "undercut", f"crossing the {kind} edge: {why}", r.trace, None, None
             if r.event == "face":
                 return "face", f"crossing the {kind} edge: the pad stayed on the face", None, None, None
@@ -893,7 +895,25 @@ class PhysicsExecutor(LandingSearch):
                                                                           r.info["direction"], pieces,
                                                                           overhang=True)  # fmt: skip
             if status in ("undercut", "overhang"):
-                return self._edge_only(move, r, roll, reason, pieces)
+                alone = self._edge_only(move, r, roll, reason, pieces)
+                if alone.ok or not reason.endswith(TABLE_BEFORE_NEXT) or recrosses >= self.settings.recrosses:
+                    return alone
+                # met near the edge's end, the pad rolled round the vertex and down the faces there to the table's
+                # clearance, high above it where the crossing met the edge (platonic_octahedron and bipyramid_04 of
+                # the formula corpus, seed 1: from a level top face, 4 mm from a vertex, 15-20 mm above the table):
+                # crossed again farther inside the edge, away from that vertex, as after a roll that gave no edge
+                shift = self._round_the_vertex(r.info["face_normal"], roll)
+                way = None
+                if shift is not None:  # as far back as aside: inside the face narrowing to the vertex
+                    back = self.settings.recross_back + float(np.linalg.norm(shift))
+                    way = self._recross_start(st.face, n_a, corner, heading, shift, back, r.trace, pieces)
+                if way is None:
+                    return alone
+                recrosses += 1
+                self.recoveries.append(f"{alone.reason}: crossed again {np.linalg.norm(shift) * 1000:.0f} mm along "
+                                       f"the edge{'' if way is heading else FROM_TOUCHED}")  # fmt: skip
+                heading = way
+                continue
             if status == "face" and not resumed:
                 # the slide's contact weakened where no edge was: the roll came back onto the face, and the slide
                 # goes on from there, once
@@ -1068,6 +1088,19 @@ class PhysicsExecutor(LandingSearch):
         if away is None or abs(float(unit(away) @ side)) < self.settings.recross_side_cos:
             return None
         return math.copysign(self.settings.recross_shift + self.toucher.pad_radius, float(away @ side)) * side
+
+    def _round_the_vertex(self, n_a: np.ndarray, roll: ContactTrace | None) -> np.ndarray | None:
+        """After a roll off face ``n_a`` that the table stopped and that gave no edge alone: the shift along the edge
+        it first turned about (:meth:`_first_turn`) back inside the edge, away from the vertex its normals lean from
+        (:meth:`_away_from_vertex`); None when it has no contacts or turned about no axis (the pad stood turned at
+        the table's clearance next to the edge, a crossing farther along it no higher)."""
+        if roll is None or not roll.in_contact.any():
+            return None
+        n_t = self._first_turn(n_a, roll)
+        e = np.cross(n_a, n_t)
+        if float(e @ e) < math.sin(self.bounds.min_edge_angle) ** 2:
+            return None
+        return self._away_from_vertex(n_a, n_t, roll)
 
     def _first_turn(self, n_a: np.ndarray, roll: ContactTrace) -> np.ndarray:
         """The normal a roll (in contact somewhere) off face ``n_a`` first turned to: the mean of its normals where they
