@@ -1242,3 +1242,31 @@ def test_a_roll_round_a_vertex_down_to_the_tables_clearance_crosses_again_inside
     assert any("the table's clearance before the next face" in x and "crossed again" in x
                for x in face[0].info.get("recoveries", ())), face[0].info
     assert _within_bounds(ep)
+
+
+def test_a_face_measured_tilted_that_reads_off_when_touched_upright_is_touched_again_tilted(tmp_path):
+    # bipyramid_08 of the sized formula corpus, seed 1: a vertex move measured a face leaning 17° under with the hand
+    # tilted 30° away from a link of the finger that met the object. The next two face moves returned to that face
+    # upright, 3 mm from its upper edge, and read normals 13-18° off it: "could not return to the current face", twice.
+    # A face measured tilted is touched again tilted the same way when the upright touch reads off it, as when the
+    # upright approach fails. The episode is stopped at its seventh move.
+    class Seen(Exception):
+        pass
+
+    said, failed = [], []
+
+    def on_move(n, r, *a) -> None:
+        said.extend(x for x in r.info.get("recoveries", ()) if "touched again with the hand tilted" in x)
+        if n >= 7:
+            raise Seen
+
+    def on_failed(n, r) -> None:
+        failed.append(r.reason)
+        if n >= 7:
+            raise Seen
+
+    ep = build_episode(EpisodeSpec(model="bipyramid_08", seed=1, executor="physics", models=_sized_corpus(tmp_path)))
+    with pytest.raises(Seen):
+        ep.run(None, EpisodeObserver(on_move=on_move, on_failed_move=on_failed))
+    assert said and not any(w.startswith("could not return to the current face") for w in failed), failed
+    assert _within_bounds(ep)
