@@ -1192,3 +1192,45 @@ def test_a_vertex_move_onto_a_narrow_triangle_near_its_apex_crosses_again_square
     said, _ = _until_recovery(ep, "vertex", "square to it")
     assert said
     assert _within_bounds(ep)
+
+
+def test_a_roll_round_a_vertex_down_to_the_tables_clearance_crosses_again_inside_the_edge(tmp_path):
+    # platonic_octahedron of the sized formula corpus, seed 1: the first face move traced the level top face into an
+    # edge at its vertex; the pad rolled round the vertex and down the faces there to the table's clearance, 20 mm
+    # below where it met the edge, and no edge came from the roll ("the roll turned about more than one axis"): the
+    # move failed. It now crosses again farther inside the edge, away from that vertex, and measures the edge and
+    # the next face within their bounds.
+    ep, results = _moves("platonic_octahedron", 1, _sized_corpus(tmp_path), 1)
+    face = [r for r in results[1:] if r.move is not None and r.move.kind == "face"]  # the start aside
+    assert face and face[0].ok, face[0].reason if face else results
+    assert any("the table's clearance before the next face" in x and "crossed again" in x
+               for x in face[0].info.get("recoveries", ())), face[0].info
+    assert _within_bounds(ep)
+
+
+def test_a_face_measured_tilted_that_reads_off_when_touched_upright_is_touched_again_tilted(tmp_path):
+    # bipyramid_08 of the sized formula corpus, seed 1: a vertex move measured a face leaning 17° under with the hand
+    # tilted 30° away from a link of the finger that met the object. The next two face moves returned to that face
+    # upright, 3 mm from its upper edge, and read normals 13-18° off it: "could not return to the current face", twice.
+    # A face measured tilted is touched again tilted the same way when the upright touch reads off it, as when the
+    # upright approach fails. The episode is stopped at its seventh move.
+    class Seen(Exception):
+        pass
+
+    said, failed = [], []
+
+    def on_move(n, r, *a) -> None:
+        said.extend(x for x in r.info.get("recoveries", ()) if "touched again with the hand tilted" in x)
+        if n >= 7:
+            raise Seen
+
+    def on_failed(n, r) -> None:
+        failed.append(r.reason)
+        if n >= 7:
+            raise Seen
+
+    ep = build_episode(EpisodeSpec(model="bipyramid_08", seed=1, executor="physics", models=_sized_corpus(tmp_path)))
+    with pytest.raises(Seen):
+        ep.run(None, EpisodeObserver(on_move=on_move, on_failed_move=on_failed))
+    assert said and not any(w.startswith("could not return to the current face") for w in failed), failed
+    assert _within_bounds(ep)
