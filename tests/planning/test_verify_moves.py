@@ -400,3 +400,45 @@ def test_the_inner_corner_of_an_l_block_out_of_reach_is_not_probed_and_the_verif
     assert not asked and ver.corner_probes.open_edges == [3, 9]
     assert "an edge at each of vertices 3, 9 with neither itself nor its other end measured" in why
     assert "faces 0 at 3, 1 at 9 nowhere within the corner" in why
+
+
+def _trapezohedron_09(short: float):
+    """trapezohedron_09 of the formula corpus scaled so that its kites' short edges are ``short`` long [m], resting
+    on a kite: its apexes lie one at the table, one up, and the kites round the lower apex meet those round the
+    upper one along the short edges alone."""
+    from dataclasses import replace
+
+    from haptic.geometry.corpus import corpus_solids
+    from haptic.geometry.polyhedron import Polyhedron
+
+    base = next(p for s, p in corpus_solids() if s.name == "trapezohedron_09")
+    poly = Polyhedron.from_faces(np.array(base.vertices) * short / float(base.edge_lengths.min()), base.faces)
+    apex = max(range(poly.n_vertices), key=lambda v: len(poly.vertex_edges[v]))
+    pose, config = _resting_on(poly, int(poly.vertex_faces[apex][0]))
+    # the hand's planner: its crossing clearance, its vertex circle (the world sets both on the simulated hand)
+    return poly, pose, replace(config, min_vertex_clearance=0.006, vertex_radius=0.008, concave_end_block=0.5)
+
+
+def test_vertices_no_traced_move_can_reach_from_what_is_measured_are_out_of_reach():
+    """trapezohedron_09 of the formula corpus (seed 1) lying on a kite: its verification measured the kites round
+    the upper apex and then spent 37 moves measuring nothing of the five vertices 17-30 mm up between the lower
+    apex's kites, joined to the upper ones by 7.3 mm edges alone: no face move crosses such an edge clear of its
+    ends, and a vertex circle of 8 mm round their ends leaves the face. Counted from the faces measured, those
+    vertices are out of the verification's reach (hidden: the verification ends incomplete, never confirmed); with
+    9 mm edges a face move crosses them and they are in reach, as they are when nothing says where the pad is."""
+    from haptic.matching.acceptance import Coverage
+    from haptic.planning.verify import hidden_vertices, reachable_features
+
+    for short, out in ((0.0073, True), (0.009, False)):
+        poly, pose, config = _trapezohedron_09(short)
+        z = pose.apply(poly.vertices)[:, 2]
+        top = int(np.argmax(pose.rotate(poly.face_normals)[:, 2]))
+        low = min((v for v in range(poly.n_vertices) if len(poly.vertex_edges[v]) > 3), key=lambda v: z[v])
+        f, e, every = reachable_features(poly, pose, config)
+        f, e, v = reachable_features(poly, pose, config, (frozenset([top]), frozenset()))
+        # the vertices joined to the lower apex by the long edges of its kites
+        far = {int(k) for k in every if any(low in poly.edges[x] for x in poly.vertex_edges[k])}
+        assert len(far) == 5
+        assert v == (every - far if out else every)
+        cov = Coverage(frozenset(), frozenset(), frozenset(v), f, e, v)
+        assert set(hidden_vertices(poly, pose, cov, config)) >= (far if out else set())
