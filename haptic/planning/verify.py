@@ -436,13 +436,24 @@ def aimed_face_moves(
     that edge is kept where the edge move toward it is refused (its end hidden: the surface falls away past it),
     else it is an edge move's business. The edge move from where such a move ends runs into the corner, which
     blocks the pad at the vertex."""
+    return [m for m, _ in _aimed_face_moves(h, state, components, missing, config)]
+
+
+def _aimed_face_moves(
+    h: Hypothesis,
+    state: SensorState,
+    components: Mapping[int, DataComponent],
+    missing: tuple[frozenset[int], frozenset[int], frozenset[int]],
+    config: PlannerConfig | None = None,
+) -> list[tuple[FaceMove, float]]:
+    """:func:`aimed_face_moves`, each with the length of the model edge it is aimed at [m]."""
     face = components.get(state.face)
     f_m = h.faces.get(state.face)
     if not isinstance(face, DataFace) or f_m is None or h.world_from_model is None:
         return []
     poly, t = h.poly, h.world_from_model
     loop = [int(v) for v in poly.faces[f_m]]
-    targets: list[tuple[np.ndarray, int | None]] = []  # (point, the missing vertex it is beside)
+    targets: list[tuple[np.ndarray, int | None, float]] = []  # (point, the missing vertex it is beside, edge length)
     hand = config is not None and config.concave_end_block is not None
     ids = {frozenset(int(x) for x in poly.edges[e]): int(e) for e in poly.face_edges[f_m]}
     for k, v in enumerate(loop):
@@ -462,10 +473,11 @@ def aimed_face_moves(
             else:  # the pad crossing nearer the vertex than its radius rolls onto the third face there too
                 aim, cap = (AIM_NEAR_VERTEX if beside or reflex else 0.0) + config.pad_radius, 0.5
             if length > 0:
-                targets.append((poly.vertices[v] + min(aim, cap * length) * d / length, v))
+                targets.append((poly.vertices[v] + min(aim, cap * length) * d / length, v, length))
     for e in poly.face_edges[f_m]:
         if int(e) in missing[1]:
-            targets.append((poly.edge_points[e] + 0.5 * poly.edge_lengths[e] * poly.edge_directions[e], None))
+            targets.append((poly.edge_points[e] + 0.5 * poly.edge_lengths[e] * poly.edge_directions[e], None,
+                            float(poly.edge_lengths[e])))
     edge = components.get(state.edge) if state.edge is not None else None
     along = edge.direction if isinstance(edge, DataEdge) else None
     origin = state.position
@@ -478,7 +490,7 @@ def aimed_face_moves(
         out_of_corner = t.rotate(_inward(poly, e_m, f_m))
         origin = on_line + (config.pad_radius + CONCAVE_STEP_OFF) * out_of_corner
     out = []
-    for p, v in targets:
+    for p, v, length in targets:
         if float(np.linalg.norm(_in_plane(t.apply(p) - state.position, face.normal))) < AIM_NEAR_VERTEX:
             continue  # at hand
         d = _in_plane(t.apply(p) - origin, face.normal)
@@ -493,7 +505,7 @@ def aimed_face_moves(
         if along is not None and abs(d @ along) > 0.95 * n and not (
                 v is not None and _edge_move_refused(h, state, components, config, v, along)):
             continue  # along the edge the sensor is on: an edge move's business
-        out.append(FaceMove(d / n))
+        out.append((FaceMove(d / n), length))
     return out
 
 
@@ -527,13 +539,19 @@ def _moves(
     from haptic.planning.move_scores import refusal, same_move
 
     out = []
-    aimed = aimed_face_moves(h, state, components, missing, config) if missing is not None else []
+    aimed_at = _aimed_face_moves(h, state, components, missing, config) if missing is not None else []
+    aimed = [m for m, _ in aimed_at]
     fixed_faces = fixed_faces and not aimed
     planner = [m for m in candidate_moves(state, components, config) if fixed_faces or m.kind != "face"]
     fresh = [m for m in planner + aimed if not any(same_move(m, bad) for bad in avoid)]
+    # on the hand, a move aimed at the middle of an edge too short for the hand's crossing clearance either side
+    # crosses it there, as near its ends as any crossing of it can (:attr:`PlannerConfig.min_crossed_edge`)
+    middle = {id(m) for m, length in aimed_at if config.table_z is not None
+              and config.min_crossed_edge <= length < 2.0 * config.min_vertex_clearance}  # fmt: skip
+    at_middle = replace(config, min_vertex_clearance=0.5 * config.min_crossed_edge)
     for m, pred in zip(fresh, predict_moves([h], fresh, state, components, noise, config), strict=True):
         risk = 1.0 - (1.0 - refusal(pred, config)) * (1.0 - descent_risk(m, config))
-        out.append((m, float(pred.costs[0]), risk, pred.reliable(config)))
+        out.append((m, float(pred.costs[0]), risk, pred.reliable(at_middle if id(m) in middle else config)))
     good = [(m, c, r) for m, c, r, rel in out if rel and r < config.table_risk]
     return good or [(m, c, r) for m, c, r, _ in out]
 
