@@ -169,14 +169,17 @@ def entered_edges(
     of an edge move, and on an edge the pad arrives only by a face move crossing it or a vertex move circling onto it.
 
     A face move from a face reached crosses an edge of it at least ``config.min_crossed_edge`` long (a shorter one
-    has no crossing clear of its ends: the planner offers none there while another move is left); a vertex
+    has no crossing clear enough of its ends: the planner offers none there while another move is left); a vertex
     move circles ``config.vertex_radius`` round a vertex that an edge move along an edge reached locates (``located``:
     the (edge, end) pairs an edge move locates) across a face of that edge onto the face's other edge there, where
     the circle stays on the face (:func:`arc_leaves_face`: on the hand the verification makes no other). The faces
     along an edge reached are reached. The verification asks no move toward a vertex at the end of none of these
     edges (a move that ends elsewhere than predicted may measure one all the same, and it is then not hidden):
-    the kites round the lower apex of trapezohedron_09 of the formula corpus lying on a kite (seed 1), joined to the
-    faces measured only by 7.3 mm edges, drew 37 verification moves that measured none of their five vertices."""
+    trapezohedron_09 of the formula corpus lying on a kite (seed 1), the kites round its lower apex joined to those
+    measured round the upper one only by 7.3 mm edges, went round the upper kites for 37 verification moves that
+    measured none of their five vertices while its face moves did not cross such edges; they now cross them at
+    their middles (:func:`_moves`), and with kite edges under ``config.min_crossed_edge`` those vertices are named
+    out of reach."""
     crossable = {int(e) for e in edges if float(poly.edge_lengths[e]) >= config.min_crossed_edge}
     reached_faces = set(int(f) for f in measured_faces)
     entered = {int(e) for e in measured_edges if int(e) in edges}
@@ -532,7 +535,11 @@ def _moves(
     fixed_faces: bool = True,
 ) -> list[tuple[Move, float, float]]:
     """Fresh candidate moves (the planner's, and those aimed at ``missing``) with their predicted cost and risk
-    (as the planner scores them), reliable and not predicted to run into the table (unless no other is left).
+    (as the planner scores them), reliable and not predicted to run into the table (unless no other is left). On
+    the hand a move aimed at the middle of an edge shorter than twice ``config.min_vertex_clearance`` (the hand's
+    crossing clearance, 6 mm) is reliable crossing it half ``config.min_crossed_edge`` or more from either end: no
+    crossing of such an edge keeps the clearance, and without it the vertices beyond trapezohedron_09's 7.3 mm kite
+    edges were never asked for (of the 9 such moves its verification then made, 6 ended on the edge aimed at).
     The planner's face moves in fixed directions are left out when moves are aimed at something of the current
     face, and always with ``fixed_faces`` False (the second move of a look-ahead): what they can measure the
     aimed moves measure more cheaply, and each costs a prediction."""
