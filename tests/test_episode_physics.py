@@ -1237,3 +1237,33 @@ def test_a_face_measured_tilted_that_reads_off_when_touched_upright_is_touched_a
         ep.run(None, EpisodeObserver(on_move=on_move, on_failed_move=on_failed))
     assert said and not any(w.startswith("could not return to the current face") for w in failed), failed
     assert _within_bounds(ep)
+
+
+@pytest.mark.slow
+def test_a_face_move_whose_ridge_acquisition_meets_a_slots_wall_acquires_it_again_a_pads_radius_away(tmp_path):
+    # cad_slotted of the sized formula corpus, seed 1, default options: face moves up the floor of its slot (30 mm
+    # wide, for the 24 mm pad) crossed the top edge 12.6 mm from a wall; the stroke on the top face left the pad 7 mm
+    # from the wall, and rolling back onto the ridge to check the edge the pad met the wall's rim and never settled:
+    # four moves failed "no edge between the faces: acquiring the ridge: limit". The ridge is now acquired again a
+    # pad's radius from where the pad met the wall, back toward the crossing. The episode is stopped once a face
+    # move has done so.
+    spec = EpisodeSpec(model="cad_slotted", seed=1, executor="physics", models=_sized_corpus(tmp_path))
+    ep = build_episode(spec)
+    said, failed = _until_recovery(ep, "face", "acquired again a pad's radius from it", fails="acquiring the ridge")
+    assert said and not failed, failed
+    assert _within_bounds(ep)
+
+
+@pytest.mark.slow
+def test_a_face_move_whose_ridge_probe_meets_a_slots_wall_follows_back_from_where_it_set_off():
+    # BOX01N seed 2 (physics_episodes.py --verify full) stands on an end with its slot upright, 30 mm wide for the 24
+    # mm pad. A face move up the slot's floor crossed its top edge; following the ridge to check the edge, the way
+    # out met a wall after 1.5 mm and left the pad's contact on the wall's rim, and the way back pressed there until
+    # its time ran out: "no edge along the roll's axis (the ridge spans 1.5 mm: a vertex?)". A way back that finds no
+    # ridge now sets off again from the ridge acquired again where the way out began. The episode is stopped once a
+    # face move has done so.
+    ep = build_episode(EpisodeSpec(model="BOX01N", seed=2, executor="physics", verify="full"))
+    said, failed = _until_recovery(ep, "face", "the pad found none: acquired again where it set off",
+                                   fails="no edge along the roll's axis")  # fmt: skip
+    assert said and not failed, failed
+    assert _within_bounds(ep)

@@ -965,7 +965,7 @@ class PhysicsExecutor(LandingSearch):
                 # one over an edge when the crossing is square to the line between the faces (the next face narrow
                 # along it where the pad met it, or the travel square to it): the ridge along that line is there
                 # only over an edge
-                ridge = self._probe_ridge(line.direction, fit_a.normal, fit_b.normal, pieces)
+                ridge = self._probe_ridge(line, fit_a.normal, fit_b.normal, pieces)
                 if isinstance(ridge, str):
                     line, why = None, f"no edge between the faces: {ridge}"
             if line is not None:
@@ -1216,7 +1216,7 @@ class PhysicsExecutor(LandingSearch):
         # vertex 0.4 mm from the roll); a vertex closer to the roll than its own bound cannot be told from one the
         # pad rolled on
         b = seg.bounds
-        ridge = self._probe_ridge(line.direction, fit_a.normal, n_last, pieces,
+        ridge = self._probe_ridge(line, fit_a.normal, n_last, pieces,
                                   end_clearance=b.bound(b.point_sigma, b.vertex_floor))  # fmt: skip
         if isinstance(ridge, str):
             return self.failed_result(move, "unreachable", f"{reason}; {ridge}")
@@ -1254,14 +1254,30 @@ class PhysicsExecutor(LandingSearch):
         return ok & (np.abs(along) < math.sin(self.bounds.ridge_row_cone))
 
     def _probe_ridge(
-        self, e: np.ndarray, n_a: np.ndarray, n_b: np.ndarray, pieces: list[PrimitiveResult],
+        self, line: LineFit, n_a: np.ndarray, n_b: np.ndarray, pieces: list[PrimitiveResult],
         end_clearance: float = 0.0,
     ) -> np.ndarray | str:  # fmt: skip
-        """From a roll over an edge of direction ``e`` between face ``n_a`` and the normal ``n_b`` the roll
+        """From a roll over the edge ``line`` (direction ``e``) between face ``n_a`` and the normal ``n_b`` the roll
         ended at, follow the ridge ``RIDGE_PROBE`` along ``e`` and back past the start as far again: the
         contact points on the ridge, or why there is no edge along ``e`` (they span less than
-        ``RIDGE_MIN_SPAN``, or a vertex lies within ``end_clearance`` of where the roll ended)."""
-        t = self.toucher
+        ``RIDGE_MIN_SPAN``, or a vertex lies within ``end_clearance`` of where the roll ended).
+
+        The pad acquires the ridge where the stroke on the next face left it, and the stroke's leg along the edge
+        may end near a corner where a third face rises (a wall of a slot 30 mm wide, for the 24 mm pad). An
+        acquisition that fails with its last normals leaning along the edge by more than
+        :attr:`PhysicsSettings.corner_lean` met that face (:meth:`_third_face`; cad_slotted of the formula corpus, seed
+        1: moves up the floor of its slot crossed the top edge 12.6 mm from a wall, the stroke left the pad 7 mm from
+        it, and rolling back onto the ridge the pad met the wall's rim: four moves failed "acquiring the ridge:
+        limit"). As an edge move does (:meth:`_off_the_corner`), the pad acquires the ridge again a pad's radius from
+        where it met that face, back toward where the roll crossed the edge (``line``'s point, the mean of its
+        contacts), where the edge runs on (:meth:`_acquire_beside`). The way out may end within the pad's reach of such
+        a wall's rim, and the pad's contact, on the rim, never settles on the bisector on the way back (BOX01N seed 2
+        at the top of its upright slot: the way out met a wall after 1.5 mm, the way back pressed on the wall's rim
+        until its time ran out, and two moves failed "no edge along the roll's axis (the ridge spans 1.5 mm: a
+        vertex?)"; cad_slotted: the way back left the pad on the rim, and the edge move after it, setting off beside
+        that contact, failed "acquiring the ridge: limit"): a way back that found no ridge sets off again,
+        ``RIDGE_PROBE`` long, from the ridge acquired again where the way out began."""
+        t, e = self.toucher, line.direction
         # sideways toward face a: into face a away from the edge, and on face b toward the edge (as an edge move's
         # frame); into face a alone has no component on face b across a square edge, and a pad resting on face b
         # after its stroke never reached the ridge
@@ -1269,8 +1285,17 @@ class PhysicsExecutor(LandingSearch):
         in_a = -in_a if float(in_a @ n_b) > 0 else in_a
         in_b = -in_b if float(in_b @ n_a) > 0 else in_b
         toward_a = unit(in_a - in_b)
+        frame = (n_a, n_b, toward_a, ((n_b, in_b), (n_a, in_a)))  # the pad rests on face b after its stroke
         acq = t.follow_edge(e, n_a, n_b, toward_a, 0.0, acquire_only=True)
         pieces.append(acq)
+        met = None if acq.ok else self._third_face(acq, line)
+        if met is not None:
+            acq = self._acquire_beside(line, met - math.copysign(t.pad_radius, met), frame, pieces)
+            if isinstance(acq, str):
+                return f"acquiring the ridge, the pad met a face at the edge's end: {acq}"
+            if acq.ok:
+                self.recoveries.append("acquiring the ridge, the pad met a face at the edge's end: acquired again a "
+                                       "pad's radius from it")  # fmt: skip
         if not acq.ok:
             return f"acquiring the ridge: {acq.event}"
         pts = []
@@ -1280,7 +1305,17 @@ class PhysicsExecutor(LandingSearch):
         for sense, reach in ((1.0, RIDGE_PROBE), (-1.0, 2.0 * RIDGE_PROBE)):
             f = t.follow_edge(sense * e, n_a, n_b, toward_a, reach)
             pieces.append(f)
-            pts.append(f.trace.point_in_world[self._on_ridge(f.trace, e)])
+            on = self._on_ridge(f.trace, e)
+            if sense < 0 and not on.any() and origin is not None:
+                again = self._acquire_beside(line, float((origin - line.point) @ e), frame, pieces)
+                if not isinstance(again, str) and again.ok:
+                    f = t.follow_edge(sense * e, n_a, n_b, toward_a, RIDGE_PROBE)
+                    pieces.append(f)
+                    on = self._on_ridge(f.trace, e)
+                    if on.any():
+                        self.recoveries.append("following the ridge back, the pad found none: acquired again where "
+                                               "it set off")  # fmt: skip
+            pts.append(f.trace.point_in_world[on])
             if origin is None and f.trace.in_contact.any():
                 origin = f.trace.point_in_world[f.trace.in_contact][0]
             if not f.ok and f.event != "limit":
@@ -1295,6 +1330,50 @@ class PhysicsExecutor(LandingSearch):
         if len(pts) < self.bounds.min_line_points or span < RIDGE_MIN_SPAN:
             return f"no edge along the roll's axis (the ridge spans {span * MM:.1f} mm: a vertex?)"
         return pts
+
+    def _third_face(self, r: PrimitiveResult, line: LineFit) -> float | None:
+        """For :meth:`_probe_ridge`: where along edge ``line`` (from its point) a ridge acquisition ``r`` that failed
+        met a third face at the edge's end: its last contact, when its last normals
+        (:attr:`PhysicsSettings.corner_rows`) lean along the edge by more than :attr:`PhysicsSettings.corner_lean`;
+        None when they do not (or it has no contact there, or went unstable)."""
+        s, tr = self.settings, r.trace
+        rows = np.flatnonzero(tr.in_contact)[-s.corner_rows:]
+        if r.status == "unstable" or not len(rows):
+            return None
+        e = line.direction
+        if abs(float(np.median(tr.normal_in_world[rows] @ e))) < math.sin(s.corner_lean):
+            return None
+        met = float((tr.point_in_world[rows[-1]] - line.point) @ e)
+        return met if met != 0.0 else None
+
+    def _acquire_beside(self, line: LineFit, along: float, frame, pieces: list[PrimitiveResult]
+                        ) -> PrimitiveResult | str:  # fmt: skip
+        """For :meth:`_probe_ridge`: lifted off, touch the face the pad rested on next to edge ``line`` (else the
+        other; ``frame``: the faces' normals, the sideways way toward face a, each face's normal with its way in from
+        the edge) :attr:`PhysicsSettings.edge_reentry` in from the edge, ``along`` it from its point, and acquire the
+        ridge there. The acquisition, or why the pad reached neither face there."""
+        t, s = self.toucher, self.settings
+        n_a, n_b, toward_a, faces = frame
+        floor = TABLE_TOP_Z + t.pad_radius + s.table_margin
+        why = "the touch would put the pad on the table"
+        for n, inward in faces:
+            target = line.point + along * line.direction + s.edge_reentry * inward
+            if self.workspace.pad_clearance(target, n) < s.pad_clearance:
+                continue
+            r = t.lift_and_approach(target, n, floor_z=floor)
+            pieces.append(r)
+            if not r.ok:
+                why = f"touching a face next to the edge: {r.status}/{r.event}"
+                if r.status == "unstable":
+                    return why
+                continue
+            if angle(r.info["normal"], n) > self.bounds.retouch_cone:
+                why = f"touched a normal {math.degrees(angle(r.info['normal'], n)):.0f}° off a face next to the edge"
+                continue
+            acq = t.follow_edge(line.direction, n_a, n_b, toward_a, 0.0, acquire_only=True)
+            pieces.append(acq)
+            return acq
+        return why
 
     def _edge_frame(self, eid: int):
         rec = self.segmenter.edges[eid]
