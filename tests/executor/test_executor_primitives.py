@@ -254,3 +254,31 @@ def test_the_vertex_circle_measures_how_far_it_went_round_despite_the_contacts_n
     r = t.circle_vertex(centre, up, np.array([0.0, 1.0, 0.0]), radius, max_sweep=np.pi / 2)
     assert r.event == "table"  # given up where the circle would meet the table
     assert abs(_net_turn(r.trace, centre) - np.pi / 2) < 0.2 * np.pi / 2
+
+
+def test_a_reposition_round_over_the_top_clears_the_highest_point_touched():
+    """Going round over the top, the pad rises above the highest point it touched, not only above its start and
+    target: from beside a tall box, 65 mm below its top, a rise of the overpass alone leaves the finger to meet the
+    box on the way across to its other side (BOX01N at 150 mm on an end: the links rested on the top face's rim and
+    every way back to a side face was held there)."""
+    half = np.array([0.025, 0.03, 0.05])
+    centre = np.array([0.56, 0.0, TABLE_TOP_Z + half[2]])
+    parts = [np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]) * half]
+    pose = np.eye(4)
+    pose[:3, 3] = centre
+    sim = Simulation(compose_scene(scene_object_from_parts("tall", parts), pose),
+                     noise=SimulatedSensorNoise.from_notes(), seed=0)  # fmt: skip
+    t = Toucher(RobotInterface(sim))
+    top = centre[2] + half[2]
+    assert t.move_free(np.array([centre[0], centre[1], top + 0.03])).ok
+    assert t.approach(np.array([0.0, 0.0, -1.0]), 0.05).event == "contact"
+    assert t.top_z is not None and abs(t.top_z - top) < 1e-3
+    low = TABLE_TOP_Z + 0.035
+    off = half[0] + 0.02
+    assert t.move_free(np.array([centre[0], centre[1], top + 0.03])).ok
+    assert t.move_free(np.array([centre[0] + off, centre[1], top + 0.03])).ok
+    assert t.move_free(np.array([centre[0] + off, centre[1], low])).ok  # beside the +x face, low down
+    pieces = []
+    r = t._over_the_top(np.array([centre[0] - off, centre[1], low]), t.config.overpass, pieces)
+    assert r.ok, (r.status, r.event)
+    assert float(t.tip[0]) < centre[0] - half[0]  # beside the -x face
