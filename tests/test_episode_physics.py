@@ -1228,3 +1228,15 @@ def test_a_vertex_move_onto_a_narrow_triangle_near_its_apex_crosses_again_square
         ep.run(None, EpisodeObserver(on_move=on_move))
     assert said
     assert _within_bounds(ep)
+
+
+def test_a_slide_down_a_tall_face_held_by_the_fingers_on_the_top_goes_on_level(tmp_path):
+    # BOX01 at 150 mm on an end, seed 1 (perception_report.py --sizes 150): a face move slid down a side face 150 mm
+    # tall, and 100 mm below the top the middle and ring fingers came to rest on the top face and held the hand
+    # ("trace across the face: blocked"; the same move failed so on BOX01N and BOX01P at 150 mm). The slide goes on
+    # nearly level, as when the table stops it, to the edge at the face's side.
+    ep, failed, results = _replay(tmp_path, "BOX01", 0.15, 8)
+    said = [w for r in results for w in (r.info or {}).get("recoveries", ())]
+    assert not failed, [r.reason for r in failed]
+    assert any("rested on the object above: the slide went on level" in w for w in said), said
+    assert _within_bounds(ep)
