@@ -584,20 +584,26 @@ class Toucher:
             # blocked: the straight legs cut a corner of a non-convex solid. Go round over the top instead:
             # straight up, across above the target, down to it (objects rest on the table; nothing is above)
             res = self._over_the_top(above, cfg.overpass, pieces)
+        if res.status == "timeout" and self.top_z is not None \
+                and self.top_z + self.pad_radius > max(float(self.tip[2]), float(above[2])):  # fmt: skip
+            # still blocked: below the object's top the finger's links may reach over it (BOX01N at 150 mm on an
+            # end, seed 1: beside its slot's floor, measured with the hand tilted and turned upright 57 mm below the
+            # top face, the links rested on that face's rim, and every way across at the pad's height was held
+            # there). Round over the top once more, the pad clear of the highest point it touched
+            res = self._over_the_top(above, cfg.overpass, pieces, clear_top=True)
         if res.ok:
             res = self.approach(-n_t, 2 * lift + cfg.approach_overshoot)
             pieces.append(res)
         return PrimitiveResult(res.status, res.event, ContactTrace.concatenate([p.trace for p in pieces]),
                                sum(p.distance for p in pieces), res.info)  # fmt: skip
 
-    def _over_the_top(self, above: np.ndarray, rise: float, pieces: list[PrimitiveResult]) -> PrimitiveResult:
-        """Free moves from the pad's position straight up to ``rise`` above the highest of it, ``above`` and the
-        pad resting on the highest point touched (:attr:`top_z`), across, and down to ``above``. The last result
-        (status ``timeout`` when still blocked). Below the object's top the finger's links may reach over it: beside
-        a side face measured with the hand tilted (BOX01N at 150 mm on an end, seed 1), turned upright 57 mm below
-        the top face, the links rested on its rim, and every way across at the pad's height was held there."""
+    def _over_the_top(self, above: np.ndarray, rise: float, pieces: list[PrimitiveResult], clear_top: bool = False
+                      ) -> PrimitiveResult:  # fmt: skip
+        """Free moves from the pad's position straight up to ``rise`` above the higher of it and ``above`` (with
+        ``clear_top``, the highest of those and the pad resting on the highest point touched, :attr:`top_z`),
+        across, and down to ``above``. The last result (status ``timeout`` when still blocked)."""
         cfg = self.config
-        top = -math.inf if self.top_z is None else self.top_z + self.pad_radius
+        top = self.top_z + self.pad_radius if clear_top and self.top_z is not None else -math.inf
         z = max(float(self.tip[2]), float(above[2]), top) + rise
         res = self._result("ok", "done", 0.0)
         for w, tol in ((np.array([self.tip[0], self.tip[1], z]), cfg.via_tol),

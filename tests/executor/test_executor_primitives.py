@@ -257,10 +257,11 @@ def test_the_vertex_circle_measures_how_far_it_went_round_despite_the_contacts_n
 
 
 def test_a_reposition_round_over_the_top_clears_the_highest_point_touched():
-    """Going round over the top, the pad rises above the highest point it touched, not only above its start and
-    target: from beside a tall box, 65 mm below its top, a rise of the overpass alone leaves the finger to meet the
-    box on the way across to its other side (BOX01N at 150 mm on an end: the links rested on the top face's rim and
-    every way back to a side face was held there)."""
+    """Round over the top, a rise of the overpass above the pad and its target alone leaves the finger to meet the
+    object on the way across when both lie well below its top (BOX01N at 150 mm on an end: the finger's links
+    rested on the top face's rim and every way back to a side face was held there); once more clear of the highest
+    point the pad touched (what a reposition still blocked does), it gets across: here from beside a tall box,
+    65 mm below its top, to its other side."""
     half = np.array([0.025, 0.03, 0.05])
     centre = np.array([0.56, 0.0, TABLE_TOP_Z + half[2]])
     parts = [np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]) * half]
@@ -278,7 +279,9 @@ def test_a_reposition_round_over_the_top_clears_the_highest_point_touched():
     assert t.move_free(np.array([centre[0], centre[1], top + 0.03])).ok
     assert t.move_free(np.array([centre[0] + off, centre[1], top + 0.03])).ok
     assert t.move_free(np.array([centre[0] + off, centre[1], low])).ok  # beside the +x face, low down
+    above = np.array([centre[0] - off, centre[1], low])
     pieces = []
-    r = t._over_the_top(np.array([centre[0] - off, centre[1], low]), t.config.overpass, pieces)
+    assert t._over_the_top(above, t.config.overpass, pieces).status == "timeout"
+    r = t._over_the_top(above, t.config.overpass, pieces, clear_top=True)
     assert r.ok, (r.status, r.event)
     assert float(t.tip[0]) < centre[0] - half[0]  # beside the -x face
