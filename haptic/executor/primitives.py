@@ -584,18 +584,26 @@ class Toucher:
             # blocked: the straight legs cut a corner of a non-convex solid. Go round over the top instead:
             # straight up, across above the target, down to it (objects rest on the table; nothing is above)
             res = self._over_the_top(above, cfg.overpass, pieces)
-        if res.status == "timeout" and self.top_z is not None \
-                and self.top_z + self.pad_radius > max(float(self.tip[2]), float(above[2])):  # fmt: skip
-            # still blocked: below the object's top the finger's links may reach over it (BOX01N at 150 mm on an
-            # end, seed 1: beside its slot's floor, measured with the hand tilted and turned upright 57 mm below the
-            # top face, the links rested on that face's rim, and every way across at the pad's height was held
-            # there). Round over the top once more, the pad clear of the highest point it touched
+        if res.status == "timeout" and self._held_over_the_top(above):
+            # still blocked, a link of the finger on the object above the pad: below the object's top the links
+            # reach over it (BOX01N at 150 mm on an end, seed 1: beside its slot's floor, measured with the hand
+            # tilted and turned upright 57 mm below the top face, the links rested on that face's rim, and every way
+            # across at the pad's height was held there). Round over the top once more, the pad clear of the highest
+            # point it touched
             res = self._over_the_top(above, cfg.overpass, pieces, clear_top=True)
         if res.ok:
             res = self.approach(-n_t, 2 * lift + cfg.approach_overshoot)
             pieces.append(res)
         return PrimitiveResult(res.status, res.event, ContactTrace.concatenate([p.trace for p in pieces]),
                                sum(p.distance for p in pieces), res.info)  # fmt: skip
+
+    def _held_over_the_top(self, above: np.ndarray) -> bool:
+        """Whether a way round over the top that is held (``above`` its target) would rise higher clear of the
+        highest point touched (:attr:`top_z`), and a link of the hand touches the object above the pad now."""
+        if self.top_z is None or self.top_z + self.pad_radius <= max(float(self.tip[2]), float(above[2])):
+            return False
+        link = self.link_touch()
+        return link is not None and float(link.point_in_world[2]) > float(self.tip[2])
 
     def _over_the_top(self, above: np.ndarray, rise: float, pieces: list[PrimitiveResult], clear_top: bool = False
                       ) -> PrimitiveResult:  # fmt: skip
