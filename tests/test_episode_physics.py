@@ -1230,6 +1230,7 @@ def test_a_vertex_move_onto_a_narrow_triangle_near_its_apex_crosses_again_square
     assert _within_bounds(ep)
 
 
+@pytest.mark.slow
 def test_a_slide_down_a_tall_face_held_by_the_fingers_on_the_top_goes_on_level(tmp_path):
     # BOX01 at 150 mm on an end, seed 1 (perception_report.py --sizes 150): a face move slid down a side face 150 mm
     # tall, and 100 mm below the top the middle and ring fingers came to rest on the top face and held the hand
