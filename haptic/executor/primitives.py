@@ -147,8 +147,9 @@ class Toucher:
         workspace prior set by the executor); a slide heading down stops there with event ``"table"``. None:
         no floor."""
         self.top_z: float | None = None
-        """Height [m] of the highest point the pad has touched (None before any touch): a reposition blocked on
-        its straight legs goes round over it (:meth:`_over_the_top`)."""
+        """Height [m] of the highest point the pad has touched (None before any touch): a reposition held on its
+        way round over the top, a link of the hand on the object above the pad, goes round clear of it
+        (:meth:`_held_over_the_top`)."""
 
     # -- the tick ---------------------------------------------------------------------------------------------
     def tick(self, phase: str) -> None:
