@@ -1237,3 +1237,16 @@ def test_a_face_measured_tilted_that_reads_off_when_touched_upright_is_touched_a
         ep.run(None, EpisodeObserver(on_move=on_move, on_failed_move=on_failed))
     assert said and not any(w.startswith("could not return to the current face") for w in failed), failed
     assert _within_bounds(ep)
+
+
+@pytest.mark.slow
+def test_a_slide_down_a_tall_face_held_by_the_fingers_on_the_top_goes_on_level(tmp_path):
+    # BOX01 at 150 mm on an end, seed 1 (perception_report.py --sizes 150): a face move slid down a side face 150 mm
+    # tall, and 100 mm below the top the middle and ring fingers came to rest on the top face and held the hand
+    # ("trace across the face: blocked"; the same move failed so on BOX01N and BOX01P at 150 mm). The slide goes on
+    # nearly level, as when the table stops it, to the edge at the face's side.
+    ep, failed, results = _replay(tmp_path, "BOX01", 0.15, 8)
+    said = [w for r in results for w in (r.info or {}).get("recoveries", ())]
+    assert not failed, [r.reason for r in failed]
+    assert any("rested on the object above: the slide went on level" in w for w in said), said
+    assert _within_bounds(ep)

@@ -157,6 +157,10 @@ class Toucher:
         """Lowest height [m] the pad's lowest point may reach while sliding (the table top plus a margin, a
         workspace prior set by the executor); a slide heading down stops there with event ``"table"``. None:
         no floor."""
+        self.top_z: float | None = None
+        """Height [m] of the highest point the pad has touched (None before any touch): a reposition held on its
+        way round over the top, a link of the hand on the object above the pad, goes round clear of it
+        (:meth:`_held_over_the_top`)."""
 
     # -- the tick ---------------------------------------------------------------------------------------------
     def tick(self, phase: str) -> None:
@@ -179,6 +183,7 @@ class Toucher:
             lo, hi = self.config.pad_radius_range
             if lo < d < hi:
                 self.pad_radius += self.config.pad_radius_gain * (d - self.pad_radius)
+            self.top_z = float(p[2]) if self.top_z is None else max(self.top_z, float(p[2]))
         else:
             self.contact_ticks = 0
         self.weak_ticks = self.weak_ticks + 1 if f < self.config.loss_fraction * self.config.force else 0
@@ -591,17 +596,35 @@ class Toucher:
             # blocked: the straight legs cut a corner of a non-convex solid. Go round over the top instead:
             # straight up, across above the target, down to it (objects rest on the table; nothing is above)
             res = self._over_the_top(above, cfg.overpass, pieces)
+        if res.status == "timeout" and self._held_over_the_top(above):
+            # still blocked, a link of the finger on the object above the pad: below the object's top the links
+            # reach over it (BOX01N at 150 mm on an end, seed 1: beside its slot's floor, measured with the hand
+            # tilted and turned upright 57 mm below the top face, the links rested on that face's rim, and every way
+            # across at the pad's height was held there). Round over the top once more, the pad clear of the highest
+            # point it touched
+            res = self._over_the_top(above, cfg.overpass, pieces, clear_top=True)
         if res.ok:
             res = self.approach(-n_t, 2 * lift + cfg.approach_overshoot)
             pieces.append(res)
         return PrimitiveResult(res.status, res.event, ContactTrace.concatenate([p.trace for p in pieces]),
                                sum(p.distance for p in pieces), res.info)  # fmt: skip
 
-    def _over_the_top(self, above: np.ndarray, rise: float, pieces: list[PrimitiveResult]) -> PrimitiveResult:
-        """Free moves from the pad's position straight up to ``rise`` above the higher of it and ``above``,
+    def _held_over_the_top(self, above: np.ndarray) -> bool:
+        """Whether a way round over the top that is held (``above`` its target) would rise higher clear of the
+        highest point touched (:attr:`top_z`), and a link of the hand touches the object above the pad now."""
+        if self.top_z is None or self.top_z + self.pad_radius <= max(float(self.tip[2]), float(above[2])):
+            return False
+        link = self.link_touch()
+        return link is not None and float(link.point_in_world[2]) > float(self.tip[2])
+
+    def _over_the_top(self, above: np.ndarray, rise: float, pieces: list[PrimitiveResult], clear_top: bool = False
+                      ) -> PrimitiveResult:  # fmt: skip
+        """Free moves from the pad's position straight up to ``rise`` above the higher of it and ``above`` (with
+        ``clear_top``, the highest of those and the pad resting on the highest point touched, :attr:`top_z`),
         across, and down to ``above``. The last result (status ``timeout`` when still blocked)."""
         cfg = self.config
-        z = max(float(self.tip[2]), float(above[2])) + rise
+        top = self.top_z + self.pad_radius if clear_top and self.top_z is not None else -math.inf
+        z = max(float(self.tip[2]), float(above[2]), top) + rise
         res = self._result("ok", "done", 0.0)
         for w, tol in ((np.array([self.tip[0], self.tip[1], z]), cfg.via_tol),
                        (np.array([above[0], above[1], z]), cfg.via_tol), (above, cfg.target_tol)):  # fmt: skip
