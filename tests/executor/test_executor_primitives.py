@@ -361,12 +361,14 @@ def test_a_reposition_round_over_the_top_clears_the_highest_point_touched():
     off = half[0] + 0.02
     assert t.move_free(np.array([centre[0], centre[1], top + 0.03])).ok
     assert t.move_free(np.array([centre[0] + off, centre[1], top + 0.03])).ok
-    assert t.move_free(np.array([centre[0] + off, centre[1], low])).ok  # beside the +x face, low down
+    start = np.array([centre[0] + off, centre[1], low])
+    assert t.move_free(start).ok  # beside the +x face, low down
     above = np.array([centre[0] - off, centre[1], low])
     pieces = []
     crossed = t._overpass_height(above, t.config.overpass)
     assert t._over_the_top(above, t.config.overpass, pieces).status == "timeout"
-    assert t._held_over_the_top(above, crossed)  # a link on the box, above the pad
+    assert t._held_over_the_top(above, crossed)  # a link on the box, above the height the way was to cross at
+    assert t.move_free(start).ok  # back where the way set off
     r = t._over_the_top(above, t.config.overpass, pieces, clear_top=True)
     assert r.ok, (r.status, r.event)
     assert float(t.tip[0]) < centre[0] - half[0]  # beside the -x face
