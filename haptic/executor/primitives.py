@@ -159,8 +159,8 @@ class Toucher:
         no floor."""
         self.top_z: float | None = None
         """Height [m] of the highest point the pad has touched (None before any touch): a reposition held on its
-        way round over the top, a link of the hand on the object above the pad, goes round clear of it
-        (:meth:`_held_over_the_top`)."""
+        way round over the top lower than the pad resting on it, a link of the hand on the object above the height
+        the way was to cross at, goes round clear of it (:meth:`_held_over_the_top`)."""
 
     # -- the tick ---------------------------------------------------------------------------------------------
     def tick(self, phase: str) -> None:
