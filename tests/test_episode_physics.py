@@ -1255,6 +1255,19 @@ def test_a_face_move_whose_ridge_acquisition_meets_a_slots_wall_acquires_it_agai
 
 
 @pytest.mark.slow
+def test_a_slide_down_a_tall_face_held_by_the_fingers_on_the_top_goes_on_level(tmp_path):
+    # BOX01 at 150 mm on an end, seed 1 (perception_report.py --sizes 150): a face move slid down a side face 150 mm
+    # tall, and 100 mm below the top the middle and ring fingers came to rest on the top face and held the hand
+    # ("trace across the face: blocked"; the same move failed so on BOX01N and BOX01P at 150 mm). The slide goes on
+    # nearly level, as when the table stops it, to the edge at the face's side.
+    ep, failed, results = _replay(tmp_path, "BOX01", 0.15, 8)
+    said = [w for r in results for w in (r.info or {}).get("recoveries", ())]
+    assert not failed, [r.reason for r in failed]
+    assert any("rested on the object above: the slide went on level" in w for w in said), said
+    assert _within_bounds(ep)
+
+
+@pytest.mark.slow
 def test_a_face_move_whose_ridge_probe_meets_a_slots_wall_follows_back_from_where_it_set_off():
     # BOX01N seed 2 (physics_episodes.py --verify full) stands on an end with its slot upright, 30 mm wide for the 24
     # mm pad. A face move up the slot's floor crossed its top edge; following the ridge to check the edge, the way
@@ -1267,3 +1280,17 @@ def test_a_face_move_whose_ridge_probe_meets_a_slots_wall_follows_back_from_wher
                                    fails="no edge along the roll's axis")  # fmt: skip
     assert said and not failed, failed
     assert _within_bounds(ep)
+
+
+@pytest.mark.slow
+def test_a_way_over_the_top_held_below_the_height_it_crosses_at_goes_round_once(tmp_path):
+    # cad_slotted of the sized formula corpus, seed 1, default options: a reposition into the slot went round over
+    # the top and was held with the finger's distal link on the object 10 mm below the height the way was to cross
+    # at. Taken round a second time, clear of the highest point touched (as for BOX01N at 150 mm, whose links rested
+    # on the top face's rim 55 mm above that height), the episode went another way: 50 moves instead of 42, and the
+    # verification ended "incomplete after 44 moves: ... 1 vertices ... not measured". A way over the top goes round
+    # again only when a link touches the object above the height it was to cross at, and the verification measures
+    # every vertex in the hand's reach.
+    rec = run_episode(EpisodeSpec(model="cad_slotted", seed=1, executor="physics", models=_sized_corpus(tmp_path)))
+    assert rec.verified["reach_complete"], rec.detail
+    assert rec.perception["outside_bounds"] == 0

@@ -889,6 +889,16 @@ class PhysicsExecutor(LandingSearch):
                 self.recoveries.append("the finger would meet the table before an edge: the slide went on level")
                 r = t.trace_face(heading, n_a, self.settings.max_face_trace)
                 pieces.append(r)
+            held = self._held_from_above(r, heading)
+            level = level_heading(heading, n_a) if held is not None and not levelled else None
+            if level is not None:
+                # down a face taller than the hand reaches below the top, the other fingers came to rest on the top
+                # face and held the hand: the slide goes on nearly level, as the table's would
+                levelled, heading, lead = True, level, lead + r.distance
+                self.recoveries.append(f"the hand's {held.link} rested on the object above: the slide went on level")
+                r = t.trace_face(heading, n_a, self.settings.max_face_trace)
+                pieces.append(r)
+                held = self._held_from_above(r, heading)
             if r.event == "hand":
                 why = f"trace across the face: the finger's {r.info['link']} met the object"
                 if tilted or not self._tilt_away(r, st.face, self._last_on(r.trace, st.face, heading), pieces):
@@ -898,7 +908,8 @@ class PhysicsExecutor(LandingSearch):
             if not r.ok:
                 if r.event == "table":
                     return self.failed_result(move, r, "the finger would meet the table before an edge")
-                return self.failed_result(move, r, f"trace across the face: {r.event}")
+                on = f", the hand's {held.link} resting on the object above" if held is not None else ""
+                return self.failed_result(move, r, f"trace across the face: {r.event}{on}")
             if r.event == "done":
                 return self.failed_result(move, "unreachable", "no edge within the longest trace")
             kind = r.info["kind"]
@@ -1000,6 +1011,19 @@ class PhysicsExecutor(LandingSearch):
         run = lead + r.distance
         return MoveResult(move=move, status="ok", components=(edge, face), distance=run,
                           cost=self.costs.face_move(run), state=self.state, info={"kind": kind})  # fmt: skip
+
+    def _held_from_above(self, r: PrimitiveResult, heading: np.ndarray):
+        """The link contact that held a slide heading down across a face (``r`` stalled, event ``"blocked"``): a
+        link of the hand resting on the object above the pad, its contact's normal upward (the middle and ring
+        fingers on the top face as the index slid down a side face 100 mm below it: BOX01, BOX01N and BOX01P at
+        150 mm, seed 1); None when the slide was not so held."""
+        t = self.toucher
+        if r.event != "blocked" or float(heading[2]) >= 0.0:
+            return None
+        c = t.link_touch()
+        if c is None or float(c.normal_in_world[2]) < t.config.table_link_cos or float(c.point_in_world[2]) <= t.tip[2]:
+            return None
+        return c
 
     def _last_on(self, trace: ContactTrace, fid: int, d: np.ndarray) -> np.ndarray:
         """Where to touch data face ``fid`` again after a slide along ``d`` that a link of the finger stopped:

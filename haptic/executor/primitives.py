@@ -157,6 +157,10 @@ class Toucher:
         """Lowest height [m] the pad's lowest point may reach while sliding (the table top plus a margin, a
         workspace prior set by the executor); a slide heading down stops there with event ``"table"``. None:
         no floor."""
+        self.top_z: float | None = None
+        """Height [m] of the highest point the pad has touched (None before any touch): a reposition held on its
+        way round over the top lower than the pad resting on it, a link of the hand on the object above the height
+        the way was to cross at, goes round clear of it (:meth:`_held_over_the_top`)."""
 
     # -- the tick ---------------------------------------------------------------------------------------------
     def tick(self, phase: str) -> None:
@@ -179,6 +183,7 @@ class Toucher:
             lo, hi = self.config.pad_radius_range
             if lo < d < hi:
                 self.pad_radius += self.config.pad_radius_gain * (d - self.pad_radius)
+            self.top_z = float(p[2]) if self.top_z is None else max(self.top_z, float(p[2]))
         else:
             self.contact_ticks = 0
         self.weak_ticks = self.weak_ticks + 1 if f < self.config.loss_fraction * self.config.force else 0
@@ -590,18 +595,47 @@ class Toucher:
         if res.status == "timeout":
             # blocked: the straight legs cut a corner of a non-convex solid. Go round over the top instead:
             # straight up, across above the target, down to it (objects rest on the table; nothing is above)
+            crossed = self._overpass_height(above, cfg.overpass)
             res = self._over_the_top(above, cfg.overpass, pieces)
+            if res.status == "timeout" and self._held_over_the_top(above, crossed):
+                # still blocked, a link of the finger on the object above the pad, the way across lower than the
+                # pad resting on the highest point it touched: below the object's top the links reach over it
+                # (BOX01N at 150 mm on an end, seed 1: beside its slot's floor, measured with the hand tilted and
+                # turned upright 57 mm below the top face, the links rested on that face's rim, and every way across
+                # 20 mm above the pad was held there). Round over the top once more, the pad clear of that point
+                res = self._over_the_top(above, cfg.overpass, pieces, clear_top=True)
         if res.ok:
             res = self.approach(-n_t, 2 * lift + cfg.approach_overshoot)
             pieces.append(res)
         return PrimitiveResult(res.status, res.event, ContactTrace.concatenate([p.trace for p in pieces]),
                                sum(p.distance for p in pieces), res.info)  # fmt: skip
 
-    def _over_the_top(self, above: np.ndarray, rise: float, pieces: list[PrimitiveResult]) -> PrimitiveResult:
-        """Free moves from the pad's position straight up to ``rise`` above the higher of it and ``above``,
-        across, and down to ``above``. The last result (status ``timeout`` when still blocked)."""
+    def _held_over_the_top(self, above: np.ndarray, crossed: float) -> bool:
+        """Whether a way round over the top that is held (``above`` its target), meant to go across with the pad at
+        height ``crossed`` [m], went lower than the pad resting on the highest point touched (:attr:`top_z`), and
+        a link of the hand touches the object above that height now: across there the links meet the object (BOX01N
+        at 150 mm, seed 1: the index finger's medial link on the top face's rim, 55 mm above the height the way was
+        to cross at). A link touching the object below that height was not held by what the way goes over (the
+        distal link in a slot 4-9 mm below the top of cad_slotted of the formula corpus, seed 1, 10 mm below the
+        height the way was to cross at), and a way higher still would not free it."""
+        if self.top_z is None or self.top_z + self.pad_radius <= crossed:
+            return False
+        link = self.link_touch()
+        return link is not None and float(link.point_in_world[2]) > crossed
+
+    def _overpass_height(self, above: np.ndarray, rise: float, clear_top: bool = False) -> float:
+        """The pad's height [m] across a way round over the top from where it is to ``above``: ``rise`` above the
+        higher of the two (with ``clear_top``, the highest of those and the pad resting on the highest point
+        touched, :attr:`top_z`)."""
+        top = self.top_z + self.pad_radius if clear_top and self.top_z is not None else -math.inf
+        return max(float(self.tip[2]), float(above[2]), top) + rise
+
+    def _over_the_top(self, above: np.ndarray, rise: float, pieces: list[PrimitiveResult], clear_top: bool = False
+                      ) -> PrimitiveResult:  # fmt: skip
+        """Free moves from the pad's position straight up to :meth:`_overpass_height`, across, and down to
+        ``above``. The last result (status ``timeout`` when still blocked)."""
         cfg = self.config
-        z = max(float(self.tip[2]), float(above[2])) + rise
+        z = self._overpass_height(above, rise, clear_top)
         res = self._result("ok", "done", 0.0)
         for w, tol in ((np.array([self.tip[0], self.tip[1], z]), cfg.via_tol),
                        (np.array([above[0], above[1], z]), cfg.via_tol), (above, cfg.target_tol)):  # fmt: skip

@@ -337,3 +337,38 @@ def test_a_lost_contact_is_a_vertex_only_when_the_normal_leaned_beyond_its_noise
     leans = largest_leans(4.0)
     assert (leans >= cfg.loss_lean_sin).sum() >= 5  # 5° alone: the noise passes it
     assert (leans >= cfg.loss_lean(math.radians(4.0))).sum() <= 2
+
+
+def test_a_reposition_round_over_the_top_clears_the_highest_point_touched():
+    """Round over the top, a rise of the overpass above the pad and its target alone leaves the finger to meet the
+    object on the way across when both lie well below its top (BOX01N at 150 mm on an end: the finger's links
+    rested on the top face's rim and every way back to a side face was held there); once more clear of the highest
+    point the pad touched (what a reposition still blocked does), it gets across: here from beside a tall box,
+    65 mm below its top, to its other side."""
+    half = np.array([0.025, 0.03, 0.05])
+    centre = np.array([0.56, 0.0, TABLE_TOP_Z + half[2]])
+    parts = [np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]) * half]
+    pose = np.eye(4)
+    pose[:3, 3] = centre
+    sim = Simulation(compose_scene(scene_object_from_parts("tall", parts), pose),
+                     noise=SimulatedSensorNoise.from_notes(), seed=0)  # fmt: skip
+    t = Toucher(RobotInterface(sim))
+    top = centre[2] + half[2]
+    assert t.move_free(np.array([centre[0], centre[1], top + 0.03])).ok
+    assert t.approach(np.array([0.0, 0.0, -1.0]), 0.05).event == "contact"
+    assert t.top_z is not None and abs(t.top_z - top) < 1e-3
+    low = TABLE_TOP_Z + 0.035
+    off = half[0] + 0.02
+    assert t.move_free(np.array([centre[0], centre[1], top + 0.03])).ok
+    assert t.move_free(np.array([centre[0] + off, centre[1], top + 0.03])).ok
+    start = np.array([centre[0] + off, centre[1], low])
+    assert t.move_free(start).ok  # beside the +x face, low down
+    above = np.array([centre[0] - off, centre[1], low])
+    pieces = []
+    crossed = t._overpass_height(above, t.config.overpass)
+    assert t._over_the_top(above, t.config.overpass, pieces).status == "timeout"
+    assert t._held_over_the_top(above, crossed)  # a link on the box, above the height the way was to cross at
+    assert t.move_free(start).ok  # back where the way set off
+    r = t._over_the_top(above, t.config.overpass, pieces, clear_top=True)
+    assert r.ok, (r.status, r.event)
+    assert float(t.tip[0]) < centre[0] - half[0]  # beside the -x face
