@@ -138,3 +138,42 @@ def test_bound_ratios_see_an_edge_reported_starting_at_the_vertex_it_ends_at():
     assert max(r for r, _ in bad.values()) > 1.0  # a component outside its bounds
     assert bad[(1, "edge extent")][0] < 1.0 and bad[(2, "vertex")] == (pytest.approx(0.95 / 2.4, rel=1e-3), v)
     assert bad[(1, "edge vertex")][0] == pytest.approx((length - 0.95e-3) / 3e-3, rel=1e-3)
+
+
+
+def _score_face_every_face(c, model, rot, trans, tol):
+    """:func:`score_face` with every face's outside distance measured (the form it prunes)."""
+    import math
+
+    from haptic.episode.evaluate import ComponentScore, _outside_distance
+
+    normals = model.face_normals @ rot.T
+    offsets = model.face_offsets + normals @ trans
+    ang = np.degrees(np.arccos(np.clip(normals @ c.normal, -1, 1)))
+    dist = np.abs(c.points @ normals.T - offsets).mean(axis=0)
+    points_m = (np.asarray(c.points, dtype=float) - trans) @ rot
+    outside = np.array([_outside_distance(model, f, points_m) for f in range(model.n_faces)])
+    cost = ang / math.degrees(tol.normal) + dist / tol.plane + outside / tol.plane
+    k = int(np.argmin(cost))
+    ok = ang[k] <= math.degrees(tol.normal) and dist[k] <= tol.plane
+    return ComponentScore(c.id, "face", k if ok else None, float(ang[k]), float(dist[k] * 1e3))
+
+
+@pytest.mark.parametrize("name", sorted(LIB))
+def test_score_face_measures_only_the_faces_that_can_win(name):
+    # points on each face, near it, off it and beside it, with normals near and far from the face's: the same
+    # face and errors as when the outside distance of every face is measured
+    from haptic.geometry import SE3
+
+    poly, tol = LIB[name], EvaluationTolerances()
+    rng = np.random.default_rng(7)
+    for _ in range(3):
+        pose = SE3.random(rng, 0.2)
+        rot, trans = pose.rotation, pose.translation
+        for f in range(poly.n_faces):
+            loop = poly.vertices[list(poly.faces[f])]
+            pts = rng.dirichlet(np.ones(len(loop)), size=5) @ loop
+            pts = pts + rng.normal(scale=rng.choice([1e-4, 2e-3, 2e-2]), size=pts.shape)
+            normal = poly.face_normals[f] + rng.normal(scale=rng.choice([1e-3, 0.1, 0.5]), size=3)
+            c = DataFace(0, rot @ (normal / np.linalg.norm(normal)), pts @ rot.T + trans, 0.01, 0.001)
+            assert score_face(c, poly, rot, trans, tol) == _score_face_every_face(c, poly, rot, trans, tol)

@@ -238,8 +238,17 @@ def score_face(c: DataFace, model: Polyhedron, rot: np.ndarray, trans: np.ndarra
     # coplanar faces (BOX01N/P's two top faces) have the same normal and plane: tell them apart by whether the
     # points lie inside the face polygon, else the lower index would always win
     points_m = (np.asarray(c.points, dtype=float) - trans) @ rot
-    outside = np.array([_outside_distance(model, f, points_m) for f in range(model.n_faces)])
-    cost = ang / math.degrees(tol.normal) + dist / tol.plane + outside / tol.plane
+    near = ang / math.degrees(tol.normal) + dist / tol.plane
+    # the distance outside a face's polygon only adds (a sum never falls by adding a number >= 0): a face whose
+    # angle and plane distance alone cost more than a face's full cost cannot win, and is not measured (the
+    # polygon test of every point is most of a component's scoring); ties keep the lowest index as before
+    cost = np.full(model.n_faces, math.inf)
+    best = math.inf
+    for f in np.argsort(near, kind="stable").tolist():
+        if near[f] > best:
+            break
+        cost[f] = near[f] + _outside_distance(model, f, points_m) / tol.plane
+        best = min(best, float(cost[f]))
     k = int(np.argmin(cost))
     ok = ang[k] <= math.degrees(tol.normal) and dist[k] <= tol.plane
     return ComponentScore(c.id, "face", k if ok else None, float(ang[k]), float(dist[k] * 1e3))
