@@ -1300,7 +1300,9 @@ class PhysicsExecutor(LandingSearch):
         until its time ran out, and two moves failed "no edge along the roll's axis (the ridge spans 1.5 mm: a
         vertex?)"; cad_slotted: the way back left the pad on the rim, and the edge move after it, setting off beside
         that contact, failed "acquiring the ridge: limit"): a way back that found no ridge sets off again,
-        ``RIDGE_PROBE`` long, from the ridge acquired again where the way out began."""
+        ``RIDGE_PROBE`` long, from the ridge acquired again where the way out began. A check that fails after a leg
+        heading down took the pad into the table's clearance is made again from the ridge acquired again where the
+        roll ended, no leg going lower than that clearance (:meth:`_ridge_reach`)."""
         t, e = self.toucher, line.direction
         # sideways toward face a: into face a away from the edge, and on face b toward the edge (as an edge move's
         # frame); into face a alone has no component on face b across a square edge, and a pad resting on face b
@@ -1322,13 +1324,37 @@ class PhysicsExecutor(LandingSearch):
                                        "pad's radius from it")  # fmt: skip
         if not acq.ok:
             return f"acquiring the ridge: {acq.event}"
-        pts = []
         # where the roll ended: the last contact of the acquisition (else the first of the ridge's); the way back
         # starts from where the way out stopped, so a vertex's distance from the roll is measured from here
         origin = acq.trace.point_in_world[acq.trace.in_contact][-1] if acq.trace.in_contact.any() else None
+        got, low = self._ridge_legs(line, frame, origin, pieces, end_clearance)
+        if isinstance(got, str) and low and origin is not None:
+            # a leg heading down took the pad into the table's clearance, resting on the table and the ridge at once:
+            # acquired again where the roll ended, the ridge is followed down no farther than that clearance
+            again = self._acquire_beside(line, float((origin - line.point) @ e), frame, pieces)
+            if not isinstance(again, str) and again.ok:
+                clear, _ = self._ridge_legs(line, frame, origin, pieces, end_clearance, above_table=True)
+                if not isinstance(clear, str):
+                    self.recoveries.append(f"{got}, the pad down at the table: followed again no lower than the "
+                                           "table's clearance")  # fmt: skip
+                    got = clear
+        return got
+
+    def _ridge_legs(self, line: LineFit, frame, origin: np.ndarray | None, pieces: list[PrimitiveResult],
+                    end_clearance: float, above_table: bool = False) -> tuple[np.ndarray | str, bool]:  # fmt: skip
+        """For :meth:`_probe_ridge`, the pad on the ridge of edge ``line`` (``frame`` as for :meth:`_acquire_beside`;
+        ``origin``: where the roll ended): the way out and the way back. Their contacts on the ridge, or why there is
+        no edge (as :meth:`_probe_ridge`); and whether a leg heading down ended with the pad within the table's
+        clearance (:meth:`Toucher.below_floor`). With ``above_table`` a leg heading down goes no farther than that
+        clearance (:meth:`_ridge_reach`)."""
+        t, e = self.toucher, line.direction
+        n_a, n_b, toward_a, _ = frame
+        pts, low = [], False
         for sense, reach in ((1.0, RIDGE_PROBE), (-1.0, 2.0 * RIDGE_PROBE)):
-            f = t.follow_edge(sense * e, n_a, n_b, toward_a, reach)
+            f = t.follow_edge(sense * e, n_a, n_b, toward_a, self._ridge_reach(sense * e, reach) if above_table
+                              else reach)  # fmt: skip
             pieces.append(f)
+            low = low or t.below_floor(sense * e)
             on = self._on_ridge(f.trace, e)
             if sense < 0 and not on.any() and origin is not None:
                 again = self._acquire_beside(line, float((origin - line.point) @ e), frame, pieces)
@@ -1343,17 +1369,30 @@ class PhysicsExecutor(LandingSearch):
             if origin is None and f.trace.in_contact.any():
                 origin = f.trace.point_in_world[f.trace.in_contact][0]
             if not f.ok and f.event != "limit":
-                return f"following the edge: {f.event}"
+                return f"following the edge: {f.event}", low
             if end_clearance > 0.0 and f.event == "vertex" and origin is not None and f.trace.in_contact.any():
                 gap = float((f.trace.point_in_world[f.trace.in_contact][-1] - origin) @ (sense * e))
                 if gap < end_clearance:
                     return (f"the roll crossed the edge {max(gap, 0.0) * MM:.1f} mm from its end: its normals "
-                            "turned round the vertex too")  # fmt: skip
+                            "turned round the vertex too"), low  # fmt: skip
         pts = np.concatenate(pts)
         span = float(np.ptp(pts @ e)) if len(pts) else 0.0
         if len(pts) < self.bounds.min_line_points or span < RIDGE_MIN_SPAN:
-            return f"no edge along the roll's axis (the ridge spans {span * MM:.1f} mm: a vertex?)"
-        return pts
+            return f"no edge along the roll's axis (the ridge spans {span * MM:.1f} mm: a vertex?)", low
+        return pts, low
+
+    def _ridge_reach(self, u: np.ndarray, reach: float) -> float:
+        """For :meth:`_ridge_legs`: how far the pad may follow the ridge along ``u`` from where it is, ``reach`` at
+        most, heading down no farther than the table's clearance (:attr:`Toucher.floor_z`). Followed on down, the pad
+        rests on the table and the ridge at once, and the way back may lose the ridge (HEXPRISM01 seed 1, lying on a
+        side: an end's edge running down at 60° to the table, the way out went on 4.7 mm, the pad's lowest point at
+        the table top, the way back lost the contact after 1.9 mm, and the move failed "no edge between the faces:
+        following the edge: lost")."""
+        t = self.toucher
+        down = -float(u[2])
+        if t.floor_z is None or down <= 0.0:
+            return reach
+        return float(np.clip((float(t.tip[2]) - t.pad_radius - t.floor_z) / down, 0.0, reach))
 
     def _third_face(self, r: PrimitiveResult, line: LineFit) -> float | None:
         """For :meth:`_probe_ridge`: where along edge ``line`` (from its point) a ridge acquisition ``r`` that failed
