@@ -1318,3 +1318,17 @@ def test_a_ridge_check_heading_down_stops_at_the_tables_clearance():
     assert rec.outcome == "recognized" and rec.correct, rec.detail
     assert _within_bounds(ep)
 
+
+@pytest.mark.slow
+def test_a_vertex_move_onto_a_face_leaning_under_measures_it_by_several_short_ls():
+    # HEXPRISM01 seed 3 (physics_episodes.py --verify full) lies on a side. A vertex move circled a top corner of an
+    # end and rolled, the hand tilted away from the end, onto a side leaning under 30°: the stroke's step in was held
+    # by the distal link, and five touches afresh past the edge read the side's normal, but each L's legs along the
+    # edge were stopped by the distal link on the ridge above within 1.5 mm, and three L's first legs, 1-3 mm long
+    # and 5-10 mm apart, each measured too little of the face: "stroke on the next face failed: blocked". Such Ls
+    # that agree measure the face together. The episode is stopped once a vertex move has done so.
+    ep = build_episode(EpisodeSpec(model="HEXPRISM01", seed=3, executor="physics", verify="full"))
+    said, failed = _until_recovery(ep, "vertex", "Ls touched afresh together",
+                                   fails="stroke on the next face failed")  # fmt: skip
+    assert said and not failed, failed
+    assert _within_bounds(ep)

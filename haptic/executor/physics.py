@@ -764,8 +764,9 @@ class PhysicsExecutor(LandingSearch):
         next face's, and an L stroke on it measures it. An L that measures too little of a face touched past the
         edge (met near its end, the pad rides the rim of the face beyond that end too) is made again
         :attr:`PhysicsSettings.recross_shift` (plus the touched normal's lean times the pad's radius) farther along
-        the edge, away from where that normal leans first, once. Returns what :meth:`_cross_and_acquire` returns;
-        the failure ``why`` when no guess gives the face."""
+        the edge, away from where that normal leans first, once. Ls that each measured too little of one face
+        measure it together (:meth:`_joined_ls`). Returns what :meth:`_cross_and_acquire` returns; the failure
+        ``why`` when no guess gives the face."""
         t, s = self.toucher, self.settings
         d = in_plane(np.asarray(direction, dtype=float), n_a)
         if d is None:
@@ -776,6 +777,7 @@ class PhysicsExecutor(LandingSearch):
         guesses += [math.cos(a) * n_a + sign * math.sin(a) * d for a in s.reacquire_turns]
         tried: list[np.ndarray] = []
         shifted = False
+        short: list[PrimitiveResult] = []  # the Ls that measured too little of a face past the edge
         for n_b in guesses:
             if any(angle(n_b, m) < s.reacquire_cone for m in tried):
                 continue
@@ -794,6 +796,7 @@ class PhysicsExecutor(LandingSearch):
                     return "unreachable", "the edge lies on the table", None, None, None
                 continue
             n, fit, st = out
+            self._short_l(short, st, fit)
             if fit is None and not shifted:
                 # the face is there but the L measured too little of it: the pad touched the rim of the face
                 # beyond the edge's end too (met near a vertex). Touched again farther along the edge, away from
@@ -808,6 +811,8 @@ class PhysicsExecutor(LandingSearch):
                     again = self._touch_next(kind, n_a, d, corner, moved, n, pieces, away_from)
                     if again == "table":
                         return "unreachable", "the edge lies on the table", None, None, None
+                    if not isinstance(again, str):
+                        self._short_l(short, again[2], again[1])
                     if not isinstance(again, str) and again[1] is not None and self._same_next_face(n_a, n, again[0]):
                         self.recoveries.append(f"{why}: the next face touched afresh {step * 1000:.0f} mm along the "
                                                "edge, clear of its end")  # fmt: skip
@@ -815,7 +820,42 @@ class PhysicsExecutor(LandingSearch):
             if fit is not None:
                 self.recoveries.append(f"{why}: the next face touched afresh")
                 return "ok", "", roll, st.trace, fit
+        joined = self._joined_ls(short)
+        if joined is not None:
+            fit, trace, k = joined
+            self.recoveries.append(f"{why}: the next face measured by {k} Ls touched afresh together")
+            return "ok", "", roll, trace, fit
         return "unreachable", why, None, None, None
+
+    @staticmethod
+    def _short_l(short: list[PrimitiveResult], st: PrimitiveResult, fit: FaceFit | None) -> None:
+        """For :meth:`_reacquire`: keep the L ``st`` on a face touched afresh past the edge when it measured too little
+        of it (``fit`` None) but slid on the face: not failed, its first leg not onto a rim, its legs along the edge
+        not both stopped by edges (the pad on a narrow strip or a rim)."""
+        if fit is None and st.ok and not st.info["rim"] and not st.info["blocked"]:
+            short.append(st)
+
+    def _joined_ls(self, short: list[PrimitiveResult]) -> tuple[FaceFit, ContactTrace, int] | None:
+        """For :meth:`_reacquire`: the face measured by the Ls of ``short`` together, each of which measured too little
+        of it alone, touched afresh at different points past the edge: those whose mean normals lie within
+        :attr:`~SegmentBounds.row_cone` of one L's (the latest first), two at least. A face leaning under next to a
+        face that rises above it lets the pad slide only a millimetre or three before a link of the finger meets the
+        object (HEXPRISM01 seed 3, a vertex move from an end onto a side leaning under 30°: five touches afresh past
+        the edge read the side's normal, each L's legs along the edge stopped by the distal link on the ridge above,
+        three L's first legs 1-3 mm long 5-10 mm apart, and the move failed "stroke on the next face failed:
+        blocked"): their rows together span the face both ways. The fit, the rows and how many Ls; None when no two
+        agree or their rows together measure no face (:meth:`Segmenter.fit_face_trace` judges them as one L's)."""
+        seg = self.segmenter
+        for st in reversed(short):
+            n = st.info["normal"]
+            same = [o for o in short if angle(o.info["normal"], n) <= seg.bounds.row_cone]
+            if len(same) < 2:
+                continue
+            trace = ContactTrace.concatenate([o.trace for o in same])
+            fit = seg.fit_face_trace(trace, unit(np.sum([o.info["normal"] for o in same], axis=0)), two_d=True)
+            if fit is not None:
+                return fit, trace, len(same)
+        return None
 
     def _same_next_face(self, n_a: np.ndarray, n: np.ndarray, again: np.ndarray) -> bool:
         """For :meth:`_reacquire`: whether normal ``again``, touched farther along the edge where an L measured the
