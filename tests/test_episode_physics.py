@@ -1302,3 +1302,33 @@ def test_a_way_over_the_top_held_below_the_height_it_crosses_at_goes_round_once(
     rec = run_episode(EpisodeSpec(model="cad_slotted", seed=1, executor="physics", models=_sized_corpus(tmp_path)))
     assert rec.verified["reach_complete"], rec.detail
     assert rec.perception["outside_bounds"] == 0
+
+
+@pytest.mark.slow
+def test_a_ridge_check_heading_down_stops_at_the_tables_clearance():
+    # HEXPRISM01 seed 1 (physics_episodes.py --verify full) lies on a side. A face move across a side leaning under
+    # crossed onto an end and checked the edge between them, which runs down to the table at 60°: the way out
+    # followed the ridge 4.7 mm on down, the pad into the table's clearance, resting on the table and the ridge at
+    # once, and the way back lost the contact after 1.9 mm: "no edge between the faces: following the edge: lost",
+    # and the move after it failed too. Such a check is made again, the ridge followed down no farther than the
+    # table's clearance.
+    ep, rec, said, failed = _watched(EpisodeSpec(model="HEXPRISM01", seed=1, executor="physics", verify="full"))
+    assert not [w for w in failed if "following the edge" in w], failed
+    assert any("followed again no lower than the table's clearance" in w for w in said), said
+    assert rec.outcome == "recognized" and rec.correct, rec.detail
+    assert _within_bounds(ep)
+
+
+@pytest.mark.slow
+def test_a_vertex_move_onto_a_face_leaning_under_measures_it_by_several_short_ls():
+    # HEXPRISM01 seed 3 (physics_episodes.py --verify full) lies on a side. A vertex move circled a top corner of an
+    # end and rolled, the hand tilted away from the end, onto a side leaning under 30°: the stroke's step in was held
+    # by the distal link, and five touches afresh past the edge read the side's normal, but each L's legs along the
+    # edge were stopped by the distal link on the ridge above within 1.5 mm, and three L's first legs, 1-3 mm long
+    # and 5-10 mm apart, each measured too little of the face: "stroke on the next face failed: blocked". Such Ls
+    # that agree measure the face together. The episode is stopped once a vertex move has done so.
+    ep = build_episode(EpisodeSpec(model="HEXPRISM01", seed=3, executor="physics", verify="full"))
+    said, failed = _until_recovery(ep, "vertex", "Ls touched afresh together",
+                                   fails="stroke on the next face failed")  # fmt: skip
+    assert said and not failed, failed
+    assert _within_bounds(ep)

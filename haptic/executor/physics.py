@@ -764,8 +764,9 @@ class PhysicsExecutor(LandingSearch):
         next face's, and an L stroke on it measures it. An L that measures too little of a face touched past the
         edge (met near its end, the pad rides the rim of the face beyond that end too) is made again
         :attr:`PhysicsSettings.recross_shift` (plus the touched normal's lean times the pad's radius) farther along
-        the edge, away from where that normal leans first, once. Returns what :meth:`_cross_and_acquire` returns;
-        the failure ``why`` when no guess gives the face."""
+        the edge, away from where that normal leans first, once. Ls that each measured too little of one face
+        measure it together (:meth:`_joined_ls`). Returns what :meth:`_cross_and_acquire` returns; the failure
+        ``why`` when no guess gives the face."""
         t, s = self.toucher, self.settings
         d = in_plane(np.asarray(direction, dtype=float), n_a)
         if d is None:
@@ -776,6 +777,7 @@ class PhysicsExecutor(LandingSearch):
         guesses += [math.cos(a) * n_a + sign * math.sin(a) * d for a in s.reacquire_turns]
         tried: list[np.ndarray] = []
         shifted = False
+        short: list[PrimitiveResult] = []  # the Ls that measured too little of a face past the edge
         for n_b in guesses:
             if any(angle(n_b, m) < s.reacquire_cone for m in tried):
                 continue
@@ -794,6 +796,7 @@ class PhysicsExecutor(LandingSearch):
                     return "unreachable", "the edge lies on the table", None, None, None
                 continue
             n, fit, st = out
+            self._short_l(short, st, fit)
             if fit is None and not shifted:
                 # the face is there but the L measured too little of it: the pad touched the rim of the face
                 # beyond the edge's end too (met near a vertex). Touched again farther along the edge, away from
@@ -808,6 +811,8 @@ class PhysicsExecutor(LandingSearch):
                     again = self._touch_next(kind, n_a, d, corner, moved, n, pieces, away_from)
                     if again == "table":
                         return "unreachable", "the edge lies on the table", None, None, None
+                    if not isinstance(again, str):
+                        self._short_l(short, again[2], again[1])
                     if not isinstance(again, str) and again[1] is not None and self._same_next_face(n_a, n, again[0]):
                         self.recoveries.append(f"{why}: the next face touched afresh {step * 1000:.0f} mm along the "
                                                "edge, clear of its end")  # fmt: skip
@@ -815,7 +820,42 @@ class PhysicsExecutor(LandingSearch):
             if fit is not None:
                 self.recoveries.append(f"{why}: the next face touched afresh")
                 return "ok", "", roll, st.trace, fit
+        joined = self._joined_ls(short)
+        if joined is not None:
+            fit, trace, k = joined
+            self.recoveries.append(f"{why}: the next face measured by {k} Ls touched afresh together")
+            return "ok", "", roll, trace, fit
         return "unreachable", why, None, None, None
+
+    @staticmethod
+    def _short_l(short: list[PrimitiveResult], st: PrimitiveResult, fit: FaceFit | None) -> None:
+        """For :meth:`_reacquire`: keep the L ``st`` on a face touched afresh past the edge when it measured too little
+        of it (``fit`` None) but slid on the face: not failed, its first leg not onto a rim, its legs along the edge
+        not both stopped by edges (the pad on a narrow strip or a rim)."""
+        if fit is None and st.ok and not st.info["rim"] and not st.info["blocked"]:
+            short.append(st)
+
+    def _joined_ls(self, short: list[PrimitiveResult]) -> tuple[FaceFit, ContactTrace, int] | None:
+        """For :meth:`_reacquire`: the face measured by the Ls of ``short`` together, each of which measured too little
+        of it alone, touched afresh at different points past the edge: those whose mean normals lie within
+        :attr:`~SegmentBounds.row_cone` of one L's (the latest first), two at least. A face leaning under next to a
+        face that rises above it lets the pad slide only a millimetre or three before a link of the finger meets the
+        object (HEXPRISM01 seed 3, a vertex move from an end onto a side leaning under 30°: five touches afresh past
+        the edge read the side's normal, each L's legs along the edge stopped by the distal link on the ridge above,
+        three L's first legs 1-3 mm long 5-10 mm apart, and the move failed "stroke on the next face failed:
+        blocked"): their rows together span the face both ways. The fit, the rows and how many Ls; None when no two
+        agree or their rows together measure no face (:meth:`Segmenter.fit_face_trace` judges them as one L's)."""
+        seg = self.segmenter
+        for st in reversed(short):
+            n = st.info["normal"]
+            same = [o for o in short if angle(o.info["normal"], n) <= seg.bounds.row_cone]
+            if len(same) < 2:
+                continue
+            trace = ContactTrace.concatenate([o.trace for o in same])
+            fit = seg.fit_face_trace(trace, unit(np.sum([o.info["normal"] for o in same], axis=0)), two_d=True)
+            if fit is not None:
+                return fit, trace, len(same)
+        return None
 
     def _same_next_face(self, n_a: np.ndarray, n: np.ndarray, again: np.ndarray) -> bool:
         """For :meth:`_reacquire`: whether normal ``again``, touched farther along the edge where an L measured the
@@ -1300,7 +1340,9 @@ class PhysicsExecutor(LandingSearch):
         until its time ran out, and two moves failed "no edge along the roll's axis (the ridge spans 1.5 mm: a
         vertex?)"; cad_slotted: the way back left the pad on the rim, and the edge move after it, setting off beside
         that contact, failed "acquiring the ridge: limit"): a way back that found no ridge sets off again,
-        ``RIDGE_PROBE`` long, from the ridge acquired again where the way out began."""
+        ``RIDGE_PROBE`` long, from the ridge acquired again where the way out began. A check that fails after a leg
+        heading down took the pad into the table's clearance is made again from the ridge acquired again where the
+        roll ended, no leg going lower than that clearance (:meth:`_ridge_reach`)."""
         t, e = self.toucher, line.direction
         # sideways toward face a: into face a away from the edge, and on face b toward the edge (as an edge move's
         # frame); into face a alone has no component on face b across a square edge, and a pad resting on face b
@@ -1322,13 +1364,37 @@ class PhysicsExecutor(LandingSearch):
                                        "pad's radius from it")  # fmt: skip
         if not acq.ok:
             return f"acquiring the ridge: {acq.event}"
-        pts = []
         # where the roll ended: the last contact of the acquisition (else the first of the ridge's); the way back
         # starts from where the way out stopped, so a vertex's distance from the roll is measured from here
         origin = acq.trace.point_in_world[acq.trace.in_contact][-1] if acq.trace.in_contact.any() else None
+        got, low = self._ridge_legs(line, frame, origin, pieces, end_clearance)
+        if isinstance(got, str) and low and origin is not None:
+            # a leg heading down took the pad into the table's clearance, resting on the table and the ridge at once:
+            # acquired again where the roll ended, the ridge is followed down no farther than that clearance
+            again = self._acquire_beside(line, float((origin - line.point) @ e), frame, pieces)
+            if not isinstance(again, str) and again.ok:
+                clear, _ = self._ridge_legs(line, frame, origin, pieces, end_clearance, above_table=True)
+                if not isinstance(clear, str):
+                    self.recoveries.append(f"{got}, the pad down at the table: followed again no lower than the "
+                                           "table's clearance")  # fmt: skip
+                    got = clear
+        return got
+
+    def _ridge_legs(self, line: LineFit, frame, origin: np.ndarray | None, pieces: list[PrimitiveResult],
+                    end_clearance: float, above_table: bool = False) -> tuple[np.ndarray | str, bool]:  # fmt: skip
+        """For :meth:`_probe_ridge`, the pad on the ridge of edge ``line`` (``frame`` as for :meth:`_acquire_beside`;
+        ``origin``: where the roll ended): the way out and the way back. Their contacts on the ridge, or why there is
+        no edge (as :meth:`_probe_ridge`); and whether a leg heading down ended with the pad within the table's
+        clearance (:meth:`Toucher.below_floor`). With ``above_table`` a leg heading down goes no farther than that
+        clearance (:meth:`_ridge_reach`)."""
+        t, e = self.toucher, line.direction
+        n_a, n_b, toward_a, _ = frame
+        pts, low = [], False
         for sense, reach in ((1.0, RIDGE_PROBE), (-1.0, 2.0 * RIDGE_PROBE)):
-            f = t.follow_edge(sense * e, n_a, n_b, toward_a, reach)
+            f = t.follow_edge(sense * e, n_a, n_b, toward_a, self._ridge_reach(sense * e, reach) if above_table
+                              else reach)  # fmt: skip
             pieces.append(f)
+            low = low or t.below_floor(sense * e)
             on = self._on_ridge(f.trace, e)
             if sense < 0 and not on.any() and origin is not None:
                 again = self._acquire_beside(line, float((origin - line.point) @ e), frame, pieces)
@@ -1343,17 +1409,30 @@ class PhysicsExecutor(LandingSearch):
             if origin is None and f.trace.in_contact.any():
                 origin = f.trace.point_in_world[f.trace.in_contact][0]
             if not f.ok and f.event != "limit":
-                return f"following the edge: {f.event}"
+                return f"following the edge: {f.event}", low
             if end_clearance > 0.0 and f.event == "vertex" and origin is not None and f.trace.in_contact.any():
                 gap = float((f.trace.point_in_world[f.trace.in_contact][-1] - origin) @ (sense * e))
                 if gap < end_clearance:
                     return (f"the roll crossed the edge {max(gap, 0.0) * MM:.1f} mm from its end: its normals "
-                            "turned round the vertex too")  # fmt: skip
+                            "turned round the vertex too"), low  # fmt: skip
         pts = np.concatenate(pts)
         span = float(np.ptp(pts @ e)) if len(pts) else 0.0
         if len(pts) < self.bounds.min_line_points or span < RIDGE_MIN_SPAN:
-            return f"no edge along the roll's axis (the ridge spans {span * MM:.1f} mm: a vertex?)"
-        return pts
+            return f"no edge along the roll's axis (the ridge spans {span * MM:.1f} mm: a vertex?)", low
+        return pts, low
+
+    def _ridge_reach(self, u: np.ndarray, reach: float) -> float:
+        """For :meth:`_ridge_legs`: how far the pad may follow the ridge along ``u`` from where it is, ``reach`` at
+        most, heading down no farther than the table's clearance (:attr:`Toucher.floor_z`). Followed on down, the pad
+        rests on the table and the ridge at once, and the way back may lose the ridge (HEXPRISM01 seed 1, lying on a
+        side: an end's edge running down at 60° to the table, the way out went on 4.7 mm, the pad's lowest point at
+        the table top, the way back lost the contact after 1.9 mm, and the move failed "no edge between the faces:
+        following the edge: lost")."""
+        t = self.toucher
+        down = -float(u[2])
+        if t.floor_z is None or down <= 0.0:
+            return reach
+        return float(np.clip((float(t.tip[2]) - t.pad_radius - t.floor_z) / down, 0.0, reach))
 
     def _third_face(self, r: PrimitiveResult, line: LineFit) -> float | None:
         """For :meth:`_probe_ridge`: where along edge ``line`` (from its point) a ridge acquisition ``r`` that failed
