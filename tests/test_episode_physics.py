@@ -1190,6 +1190,20 @@ def test_a_face_move_onto_a_narrow_face_near_its_apex_crosses_again_square_where
     assert _within_bounds(ep)
 
 
+def test_a_face_move_that_slid_into_the_edges_end_at_a_glancing_angle_crosses_again_square_to_it(tmp_path):
+    # prism_09 of the sized formula corpus, seed 1, default options: a face move slid up a side face 11° from the
+    # top edge it met and met it at its vertex, 0.2 mm from the end; the pad rolled round the vertex ("no edge between
+    # the faces: ... (a roll round a vertex)"). Crossed again 9 mm inside the edge along the same heading, the slide
+    # rode the edge's rim at that glancing angle back to the same vertex, twice, and the move failed. It now crosses
+    # again square to the edge, and the episode is replayed until a face move has done so.
+    spec = EpisodeSpec(model="prism_09", seed=1, executor="physics", models=_sized_corpus(tmp_path))
+    ep = build_episode(spec)
+    said, failed = _until_recovery(ep, "face", "square to it", fails="a roll round a vertex")
+    assert said and not failed, failed
+    assert "lean" in said[0], said
+    assert _within_bounds(ep)
+
+
 def test_a_vertex_move_onto_a_narrow_triangle_near_its_apex_crosses_again_square_where_it_is_wider(tmp_path):
     # bipyramid_11 of the sized formula corpus (55 mm), seed 1, default options: late in the verification a vertex
     # circle met a long edge 7.5 mm from the apex, where the next triangle (20° there) is 2.8 mm wide. The roll

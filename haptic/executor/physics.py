@@ -256,6 +256,12 @@ class PhysicsSettings:
     recrosses: int = 2
     """A face move crosses again at most this many times (a crossing made again may roll round the vertex too, less
     far from it) [-]."""
+    recross_glancing: float = math.radians(20.0)
+    """A face move whose slide met its edge within this of along it, and rolled round the edge's end, crosses again
+    square to the edge: slid again along the same heading from a start shifted along the edge, the pad rides the
+    edge's rim at that glancing angle back to the same end (prism_09 of the formula corpus, seed 1: slides 11° from
+    the edge met it at the vertex, 0.2 mm from its end, and two crossings made again 9 mm inside it met the same vertex
+    again, 0.3 mm from it) [rad]."""
     recross_slant: float = math.radians(60.0)
     """A crossing made again from a point the face was touched at (the start beside the first crossing off the face,
     on a face narrowing to a vertex) heads at least this far from along the edge: at 30° such a slanted crossing
@@ -988,6 +994,10 @@ class PhysicsExecutor(LandingSearch):
                     across = self._square_to(heading, shift, n_a)
                 else:
                     shift = self._away_from_vertex(fit_a.normal, fit_b.normal, roll)
+                    if shift is not None and abs(float(unit(shift) @ unit(heading))) > math.cos(
+                        self.settings.recross_glancing
+                    ):  # slid at a glancing angle, the pad rode the rim to the edge's end: crossed again square to it
+                        across = self._square_to(heading, shift, n_a)
             recrosses += 1
             if shift is None:
                 return self.failed_result(move, "unreachable", why)
