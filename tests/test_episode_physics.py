@@ -1228,7 +1228,6 @@ def test_a_vertex_move_onto_a_narrow_triangle_near_its_apex_crosses_again_square
     assert _within_bounds(ep)
 
 
-@pytest.mark.slow
 def test_a_vertex_move_whose_crossing_made_again_rolled_round_the_apex_too_crosses_farther_out(tmp_path):
     # bipyramid_11 of the sized formula corpus, seed 1, default options: a vertex circle round an apex of eleven
     # triangles met an edge 7.9 mm from it, where the next triangle is 2.7 mm wide; the pad rolled round the apex
