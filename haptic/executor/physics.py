@@ -1994,10 +1994,11 @@ class PhysicsExecutor(LandingSearch):
             return None
         s = self.settings
         dist = float(np.linalg.norm(out))
+        if rolled is None:
+            return max(s.recross_shift, self.toucher.pad_radius + s.recross_shift - dist) * (out / dist)
         out = out / dist
         need = max(dist + s.recross_shift, self.toucher.pad_radius + s.recross_shift)
-        if rolled is not None:
-            need = max(need, float((rolled - vtx) @ out) + s.recross_shift)
+        need = max(need, float((rolled - vtx) @ out) + s.recross_shift)
         return (need - dist) * out
 
     def _valley_circle(self, rec, f: int, rho: float, beta: float) -> tuple[float, float] | None:
