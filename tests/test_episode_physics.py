@@ -1190,18 +1190,55 @@ def test_a_face_move_onto_a_narrow_face_near_its_apex_crosses_again_square_where
     assert _within_bounds(ep)
 
 
-def test_a_vertex_move_onto_a_narrow_triangle_near_its_apex_crosses_again_square_where_it_is_wider(tmp_path):
+def test_a_face_move_that_slid_into_the_edges_end_at_a_glancing_angle_crosses_again_square_to_it(tmp_path):
+    # prism_09 of the sized formula corpus, seed 1, default options: a face move slid up a side face 11° from the
+    # top edge it met and met it at its vertex, 0.2 mm from the end; the pad rolled round the vertex ("no edge between
+    # the faces: ... (a roll round a vertex)"). Crossed again 9 mm inside the edge along the same heading, the slide
+    # rode the edge's rim at that glancing angle back to the same vertex, twice, and the move failed. It now crosses
+    # again square to the edge, and the episode is replayed until a face move has done so.
+    spec = EpisodeSpec(model="prism_09", seed=1, executor="physics", models=_sized_corpus(tmp_path))
+    ep = build_episode(spec)
+    said, failed = _until_recovery(ep, "face", "square to it", fails="a roll round a vertex")
+    assert said and not failed, failed
+    assert "lean" in said[0], said
+    assert _within_bounds(ep)
+
+
+def test_a_vertex_move_onto_a_narrow_triangle_near_its_apex_crosses_again_square_where_it_is_wider(
+    tmp_path, monkeypatch
+):
     # bipyramid_11 of the sized formula corpus (55 mm), seed 1, default options: late in the verification a vertex
     # circle met a long edge 7.5 mm from the apex, where the next triangle (20° there) is 2.8 mm wide. The roll
     # settled on it, the stroke found too little of it, the face touched afresh was one round the apex, and the
     # shift told by the roll's own lean ran back toward the apex: "no edge between the faces: ... (a roll round a
     # vertex)". The circle now crosses again square to the edge, out where the triangle is wide enough, as a face
     # move does. With the ridge checks beside a third face that episode goes another way; bipyramid_10 (seed 1)
-    # makes such a circle, and is replayed until a vertex move has crossed again square to the edge.
+    # makes such a circle, and is replayed until a vertex move has crossed again square to the edge. An earlier
+    # circle of that episode now crosses a third time farther out (its crossing made again rolled round the apex
+    # too) and the episode goes another way: the replay makes it as recorded, that rule switched off.
+    from haptic.executor.physics import PhysicsExecutor
+
+    clear = PhysicsExecutor._clear_of_vertex
+    monkeypatch.setattr(PhysicsExecutor, "_clear_of_vertex", lambda self, n_f, corner, vtx, rolled=None:
+                        clear(self, n_f, corner, vtx))  # fmt: skip
     spec = EpisodeSpec(model="bipyramid_10", seed=1, executor="physics", models=_sized_corpus(tmp_path))
     ep = build_episode(spec)
     said, _ = _until_recovery(ep, "vertex", "square to it")
     assert said
+    assert _within_bounds(ep)
+
+
+def test_a_vertex_move_whose_crossing_made_again_rolled_round_the_apex_too_crosses_farther_out(tmp_path):
+    # bipyramid_11 of the sized formula corpus, seed 1, default options: a vertex circle round an apex of eleven
+    # triangles met an edge 7.9 mm from it, where the next triangle is 2.7 mm wide; the pad rolled round the apex
+    # ("no edge between the faces: ... (a roll round a vertex)"), the crossing made again 18.4 mm out rolled round
+    # it too, and the last one, the pad's radius plus 6 mm from the vertex, crossed 18.0 mm out, the same: the move
+    # failed. The last crossing now lies 6 mm farther out than the one made again, and the episode is replayed until
+    # a vertex move has crossed so.
+    spec = EpisodeSpec(model="bipyramid_11", seed=1, executor="physics", models=_sized_corpus(tmp_path))
+    ep = build_episode(spec)
+    said, failed = _until_recovery(ep, "vertex", "clear of the vertex", fails="a roll round a vertex")
+    assert said and not failed, failed
     assert _within_bounds(ep)
 
 

@@ -256,6 +256,12 @@ class PhysicsSettings:
     recrosses: int = 2
     """A face move crosses again at most this many times (a crossing made again may roll round the vertex too, less
     far from it) [-]."""
+    recross_glancing: float = math.radians(20.0)
+    """A face move whose slide met its edge within this of along it, and rolled round the edge's end, crosses again
+    square to the edge: slid again along the same heading from a start shifted along the edge, the pad rides the
+    edge's rim at that glancing angle back to the same end (prism_09 of the formula corpus, seed 1: slides 11° from
+    the edge met it at the vertex, 0.2 mm from its end, and two crossings made again 9 mm inside it met the same vertex
+    again, 0.3 mm from it) [rad]."""
     recross_slant: float = math.radians(60.0)
     """A crossing made again from a point the face was touched at (the start beside the first crossing off the face,
     on a face narrowing to a vertex) heads at least this far from along the edge: at 30° such a slanted crossing
@@ -342,6 +348,7 @@ class PhysicsExecutor(LandingSearch):
         self._finger = finger
         self._why = ""  # detail of the last repositioning failure
         self._stroke_blocked = False  # the last stroke on a next face met an edge along both of its legs
+        self._rolled_round: np.ndarray | None = None  # where a circle's crossing made again rolled round the vertex
         self._met: PrimitiveResult | None = None  # the last crossing a link of the finger stopped
         self._roll: ContactTrace | None = None  # the last crossing's roll (or climb) over the edge
         self._past: list[np.ndarray] = []  # normals the last crossing's touches afresh met past the edge
@@ -1028,6 +1035,10 @@ class PhysicsExecutor(LandingSearch):
                     across = self._square_to(heading, shift, n_a)
                 else:
                     shift = self._away_from_vertex(fit_a.normal, fit_b.normal, roll)
+                    if shift is not None and abs(float(unit(shift) @ unit(heading))) > math.cos(
+                        self.settings.recross_glancing
+                    ):  # slid at a glancing angle, the pad rode the rim to the edge's end: crossed again square to it
+                        across = self._square_to(heading, shift, n_a)
             recrosses += 1
             if shift is None:
                 return self.failed_result(move, "unreachable", why)
@@ -1976,8 +1987,10 @@ class PhysicsExecutor(LandingSearch):
             break
         if line is None:
             heading, where = r.info["direction"], "along the edge"
+            self._rolled_round = None
             shift = self._past_the_vertex(fit_f.normal, fit_g, roll, corner)
-            if shift is not None:  # the next face met lies round a vertex past a narrow face: square to the edge
+            narrow = shift is not None
+            if narrow:  # the next face met lies round a vertex past a narrow face: square to the edge
                 heading = self._square_to(heading, shift, n_f)
                 where = "along the edge square to it"
             else:
@@ -1986,8 +1999,9 @@ class PhysicsExecutor(LandingSearch):
                 f, n_f, heading, corner, shift, vtx, r.trace, pieces)
             if again is None:
                 # the roll's lean told no way, or a wrong one (the next face touched afresh round the vertex, its
-                # normal another face's): the edge met leaves the vertex circled, so out along it, clear of it
-                shift = self._clear_of_vertex(n_f, corner, vtx)
+                # normal another face's): the edge met leaves the vertex circled, so out along it, clear of it;
+                # crossed again where the narrow face was to be wide enough and round the vertex again, farther out
+                shift = self._clear_of_vertex(n_f, corner, vtx, self._rolled_round if narrow else None)
                 again = None if shift is None else self._circle_crossed_again(
                     f, n_f, r.info["direction"], corner, shift, vtx, r.trace, pieces)
                 where = "out along the edge, clear of the vertex"
@@ -2040,19 +2054,31 @@ class PhysicsExecutor(LandingSearch):
         out = float((corner - vtx) @ e)
         return math.copysign(self.settings.recross_shift + 0.5 * self.toucher.pad_radius, out) * e
 
-    def _clear_of_vertex(self, n_f: np.ndarray, corner: np.ndarray, vtx: np.ndarray) -> np.ndarray | None:
+    def _clear_of_vertex(self, n_f: np.ndarray, corner: np.ndarray, vtx: np.ndarray,
+                         rolled: np.ndarray | None = None) -> np.ndarray | None:  # fmt: skip
         """After a vertex circle on face ``n_f`` round ``vtx`` that met an edge at ``corner`` and rolled round the
         vertex: the shift along that edge (from the vertex through ``corner``, in the face) that puts the crossing
         the pad's radius plus ``recross_shift`` from the vertex, ``recross_shift`` at least (bipyramid_08 of the
         sized corpus at 130 mm, seed 1: met 8.7 mm from the apex, the pad rolled round it, and the shift told by the
         roll's lean, the next face touched afresh round the apex, ran back toward it); None when the crossing lies
-        at the vertex."""
+        at the vertex. ``rolled``: where a crossing made again farther out, where the face past the edge was to be
+        wide enough (:meth:`_past_the_vertex`, :meth:`_circle_crossed_again`), met the edge and rolled round the
+        vertex too; the crossing then lies ``recross_shift`` farther out than that one
+        (bipyramid_11 of the formula corpus, seed 1: a circle round an apex of eleven triangles met an edge 7.9 mm from
+        it, where the next triangle is 2.7 mm wide, crossed again 18.4 mm out and rolled round the apex again onto the
+        triangle beyond; the pad's radius plus ``recross_shift`` from the vertex put the last crossing 18.0 mm out, the
+        same, and the move failed; 24.5 mm out it measures the edge and the next triangle)."""
         out = in_plane(np.asarray(corner - vtx, dtype=float), n_f)
         if out is None or float(np.linalg.norm(out)) < self.bounds.position_floor:
             return None
         s = self.settings
         dist = float(np.linalg.norm(out))
-        return max(s.recross_shift, self.toucher.pad_radius + s.recross_shift - dist) * (out / dist)
+        if rolled is None:
+            return max(s.recross_shift, self.toucher.pad_radius + s.recross_shift - dist) * (out / dist)
+        out = out / dist
+        need = max(dist + s.recross_shift, self.toucher.pad_radius + s.recross_shift)
+        need = max(need, float((rolled - vtx) @ out) + s.recross_shift)
+        return (need - dist) * out
 
     def _valley_circle(self, rec, f: int, rho: float, beta: float) -> tuple[float, float] | None:
         """The radius and start angle of a vertex move's circle on face ``f`` around a vertex at the end of edge
@@ -2091,6 +2117,7 @@ class PhysicsExecutor(LandingSearch):
         stroke, next face's fit, face ``f``'s fit, the line, the shift [m], whether it set off from such a point), or
         None when it gives no edge."""
         t, s = self.toucher, self.settings
+        self._rolled_round = None
         d = in_plane(np.asarray(direction, dtype=float), n_f)
         if d is None:
             return None
@@ -2123,6 +2150,7 @@ class PhysicsExecutor(LandingSearch):
             return None
         fit_f, line, _ = self._edge_between(f, r.trace, "face", roll, fit_g, kind, corner)
         if line is None:
+            self._rolled_round = corner
             return None
         return r, kind, roll, stroke, fit_g, fit_f, line, float(np.linalg.norm(shift)), way is not d
 
