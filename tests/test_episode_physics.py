@@ -776,11 +776,13 @@ def test_an_edge_move_that_set_off_past_its_end_onto_the_next_edge_sets_off_agai
     # known 2 mm long from a crossing, set off 5 mm past the vertex it ran toward, acquired the next kite edge (25°
     # from it) 2.4 mm past the explored interval and rolled off its end there, 1.5 mm off the edge's line: "could not
     # locate the vertex". Set off again from the middle of the explored interval, the move locates it
-    failed = []
-    obs = EpisodeObserver(on_failed_move=lambda i, res: failed.append(res.reason or ""))
+    failed, recovered = [], []
+    obs = EpisodeObserver(on_move=lambda i, res, *a: recovered.extend(res.info.get("recoveries", ())),
+                          on_failed_move=lambda i, res: failed.append(res.reason or ""))  # fmt: skip
     rec = run_episode(EpisodeSpec(model="trapezohedron_11", seed=1, executor="physics",
                                   models=_sized_corpus(tmp_path)), observer=obs)  # fmt: skip
     assert not [why for why in failed if "could not locate the vertex" in why], failed
+    assert any("could not locate the vertex" in why and "set off again" in why for why in recovered), recovered
     assert rec.outcome != "no-match" and (rec.outcome != "recognized" or rec.correct), rec.detail
 
 
