@@ -770,6 +770,22 @@ def test_an_edge_move_whose_return_beside_the_last_contact_fails_returns_beside_
     assert rec.perception["outside_bounds"] == 0
 
 
+@pytest.mark.slow
+def test_an_edge_move_that_set_off_past_its_end_onto_the_next_edge_sets_off_again_from_the_middle(tmp_path):
+    # trapezohedron_11 of the sized formula corpus, seed 1, default options: an edge move along a 13 mm kite edge,
+    # known 2 mm long from a crossing, set off 5 mm past the vertex it ran toward, acquired the next kite edge (25°
+    # from it) 2.4 mm past the explored interval and rolled off its end there, 1.5 mm off the edge's line: "could not
+    # locate the vertex". Set off again from the middle of the explored interval, the move locates it
+    failed, recovered = [], []
+    obs = EpisodeObserver(on_move=lambda i, res, *a: recovered.extend(res.info.get("recoveries", ())),
+                          on_failed_move=lambda i, res: failed.append(res.reason or ""))  # fmt: skip
+    rec = run_episode(EpisodeSpec(model="trapezohedron_11", seed=1, executor="physics",
+                                  models=_sized_corpus(tmp_path)), observer=obs)  # fmt: skip
+    assert not [why for why in failed if "could not locate the vertex" in why], failed
+    assert any("could not locate the vertex" in why and "set off again" in why for why in recovered), recovered
+    assert rec.outcome != "no-match" and (rec.outcome != "recognized" or rec.correct), rec.detail
+
+
 def test_a_next_face_touched_along_the_edge_after_a_rim_reading_is_the_next_face(tmp_path):
     # platonic_dodecahedron of the sized formula corpus, seed 1, default options: two face moves rolled over an edge
     # near its end, and the touches afresh past it read the rims of the faces round the vertex (normals turned 58°

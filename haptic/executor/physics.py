@@ -1694,6 +1694,14 @@ class PhysicsExecutor(LandingSearch):
             why = ("could not locate the vertex (no contact there, a concave edge's end, which its faces run past, "
                    "contacts off the edge's line, on an edge turning little from it, or the pad spanning a gap in the "
                    "ridge before what blocked it)")  # fmt: skip
+            b = self.bounds
+            if past > b.bound(b.point_sigma, b.vertex_floor):
+                # the pad acquired the ridge past the edge's explored interval: it may have set off past the end it
+                # ran toward, on the next edge there, and rolled off that edge's end (trapezohedron_09, 11 and 12 of
+                # the formula corpus, seed 1: four moves along a 7-13 mm edge known from a crossing set off 5-6 mm
+                # past its end, acquired the next edge, turning 23-30° from it, 2.4-3.2 mm past the interval, and
+                # their contacts at its end lay 1-2 mm off the edge's line)
+                return "unreachable", f"{why}, the ridge acquired {past * MM:.1f} mm past the edge's explored interval"
             return self.failed_result(move, "unreachable", why)
         # the vertex lies ahead of what lies behind the move: its start, and with no vertex known behind the explored
         # interval, the interval (BOX01N at 60 mm, seed 2: a move along +e set off 23 mm behind the interval, past the
