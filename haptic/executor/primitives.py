@@ -51,6 +51,18 @@ STOPS = ("table", "hand")
 FAILURES = ("no-contact", "unreachable", "timeout", "unstable")
 """Failure statuses of a primitive (the move statuses of :class:`~haptic.planning.moves.MoveResult`)."""
 _FREE = PHASES.index("free")
+_NAN3 = (math.nan, math.nan, math.nan)
+"""A trace row's point and normal without a valid contact."""
+
+
+def _filtered(normal: np.ndarray, sample: np.ndarray, weight: float) -> np.ndarray:
+    """``unit(normal + weight * (sample - normal))``, the low-pass of a unit normal, element by element on floats
+    (the vector form's arithmetic without numpy's per-call overhead; the norm's dot product by numpy)."""
+    a0, a1, a2 = normal.tolist()
+    b0, b1, b2 = sample.tolist()
+    return unit(np.array([a0 + weight * (b0 - a0), a1 + weight * (b1 - a1), a2 + weight * (b2 - a2)]))
+
+
 def roll_settled(hist: list[tuple[float, np.ndarray]], travelled: float, normal: np.ndarray, window: float,
                  settled: float) -> bool:  # fmt: skip
     """Whether a roll is over: the filtered ``normal`` turned less than ``settled`` [rad] from the last one of ``hist``
@@ -165,40 +177,41 @@ class Toucher:
     # -- the tick ---------------------------------------------------------------------------------------------
     def tick(self, phase: str) -> None:
         """Advance one control tick, sense, record a row."""
-        r = self.robot
+        r, cfg = self.robot, self.config
         r.step(1)
-        c = r.last_contact() if self.hybrid else r.sense_contact(self.finger)
+        f, n, p, _ = r.last_contact_values() if self.hybrid else r.sense_contact_values(self.finger)
         tip, rot = r.fingertip_pose()
         self.tip, self.rotation = tip, rot
-        f, n, p = c.normal_force, c.normal_in_world, c.point_in_world
         valid = n is not None and f > self.threshold and finite3(n)
         if valid:
             self.contact_ticks += 1
             if self.normal is None or self.contact_ticks == 1:
                 self.normal = n.copy()
             else:
-                nf = self.normal + self.config.normal_filter * (n - self.normal)
-                self.normal = unit(nf)
-            d = math.sqrt(float((tip - p) @ (tip - p)))
-            lo, hi = self.config.pad_radius_range
+                self.normal = _filtered(self.normal, n, cfg.normal_filter)
+            off = tip - p
+            d = math.sqrt(float(off.dot(off)))
+            lo, hi = cfg.pad_radius_range
             if lo < d < hi:
-                self.pad_radius += self.config.pad_radius_gain * (d - self.pad_radius)
-            self.top_z = float(p[2]) if self.top_z is None else max(self.top_z, float(p[2]))
+                self.pad_radius += cfg.pad_radius_gain * (d - self.pad_radius)
+            z = float(p[2])
+            self.top_z = z if self.top_z is None else max(self.top_z, z)
+            self.contact = (f, n, p)
         else:
             self.contact_ticks = 0
-        self.weak_ticks = self.weak_ticks + 1 if f < self.config.loss_fraction * self.config.force else 0
-        self.contact = (f, n if valid else None, p if valid else None)
-        nan3 = (math.nan, math.nan, math.nan)
-        self._rows.append((r.time, tip, rot, p if valid else nan3, n if valid else nan3, f, PHASES.index(phase)))
+            self.contact = (f, None, None)
+        self.weak_ticks = self.weak_ticks + 1 if f < cfg.loss_fraction * cfg.force else 0
+        rows = self._rows
+        rows.append((r.time, tip, rot, p if valid else _NAN3, n if valid else _NAN3, f, PHASES.index(phase)))
         if not (finite3(tip) and math.isfinite(f)):
             self._unhealthy = True
-        elif len(self._rows) % self.config.stability_every == 0 and not r.is_stable():
+        elif len(rows) % cfg.stability_every == 0 and not r.is_stable():
             self._unhealthy = True
         self._ticks += 1
-        every = self.config.link_every
+        every = cfg.link_every
         if every > 0 and self._ticks % every == 0:
             self._links.append((r.time, r.link_poses()))
-        watch = self.config.watch_every
+        watch = cfg.watch_every
         if watch > 0 and self._ticks % watch == 0:
             self._watch_links()
 

@@ -120,8 +120,14 @@ class HybridStatus:
 
 def _rotation_error(r: np.ndarray, r_des: np.ndarray) -> np.ndarray:
     """Small-angle orientation error (3,) [rad] taking r to r_des, world frame: ½ Σ_i r_i × r_des_i."""
-    a = r_des @ r.T
-    return 0.5 * np.array([a[2, 1] - a[1, 2], a[0, 2] - a[2, 0], a[1, 0] - a[0, 1]])
+    return np.array(_rotation_error_list(r, r_des))
+
+
+def _rotation_error_list(r: np.ndarray, r_des: np.ndarray) -> list[float]:
+    """:func:`_rotation_error` as a list of floats (the control law's per-tick path): the same product and the same
+    differences, without numpy's per-call overhead on its three entries."""
+    a = r_des.dot(r.T).ravel().tolist()
+    return [0.5 * (a[7] - a[5]), 0.5 * (a[2] - a[6]), 0.5 * (a[3] - a[1])]
 
 
 def solve_fingertip_ik(
@@ -232,10 +238,21 @@ class Controller:
         self._hand_kp = sim.hand_kp
         self._eye3 = np.eye(3)
         self._rotation_tol = ROTATION_ATOL + 1e-5 * self._eye3  # np.allclose's atol + rtol |I| (rtol 1e-5)
+        self._rotation_passed = b""  # the bytes of the last rotation argument that passed the check
         self._hand_site = int(sim.flange_site)
         self._m, self._d = sim.model, sim.data
         self._a6 = np.zeros(6)
         self._y6 = np.zeros(6)
+        self._jjt = np.zeros((6, 6))
+        d = sim.data
+        # views into the simulation's state (MjData keeps its buffers): the tick reads and writes them without
+        # looking the arrays up again
+        self._m6 = self._mfull[:N_ARM, :N_ARM]
+        self._qpos_arm, self._qvel, self._qvel_arm = d.qpos[:N_ARM], d.qvel, d.qvel[:N_ARM]
+        self._bias_arm, self._bias_hand = d.qfrc_bias[:N_ARM], d.qfrc_bias[N_ARM:]
+        self._ctrl_arm, self._ctrl_hand = d.ctrl[:N_ARM], d.ctrl[N_ARM:]
+        self._hand_servo = np.zeros(self._hand_kp.size)
+        self._hand_xmat = d.site_xmat[self._hand_site].reshape(3, 3)
         self._dt = self.gains.control_every * sim.timestep
         self._threshold = 0.0
         self._finger = 0
@@ -244,6 +261,7 @@ class Controller:
         self._arm_ref = sim.data.qpos[sim.arm].copy()
         self._hand_ref = sim.data.qpos[sim.hand].copy()
         self._x_ref = np.zeros(3)
+        self._x_ref_list = [0.0, 0.0, 0.0]
         self._r_ref: np.ndarray | None = None
         self._hybrid: _Hybrid | None = None
 
@@ -256,6 +274,7 @@ class Controller:
     def set_finger(self, finger: str) -> None:
         self._finger = finger_index(finger)
         self._site = int(self.sim.tip_site[self._finger])
+        self._tip_xpos = self._d.site_xpos[self._site]  # a view: the active fingertip's position as simulated
 
     @property
     def mode(self) -> str:
@@ -293,11 +312,11 @@ class Controller:
 
     def fingertip_position(self) -> np.ndarray:
         """Active fingertip site position (3,) [m] in the world (forward kinematics)."""
-        return self.sim.data.site_xpos[self._site].copy()
+        return self._tip_xpos.copy()
 
     def hand_rotation(self) -> np.ndarray:
         """Rotation (3, 3) ``world_from_hand`` of the hand frame (the flange site, z along the fingers)."""
-        return self.sim.data.site_xmat[self._hand_site].reshape(3, 3).copy()
+        return self._hand_xmat.copy()
 
     def move_fingertip(self, point_in_world: np.ndarray, rotation_in_world: np.ndarray | str | None = "hold") -> None:
         """Servo the active fingertip to ``point_in_world`` [m].
@@ -312,8 +331,9 @@ class Controller:
             raise SceneError(f"fingertip target: expected a finite (3,) point, got {x!r}")
         self._mode = "fingertip"
         self._x_ref = x.copy()
+        self._x_ref_list = x.tolist()
         self._r_ref = self._rotation_arg(rotation_in_world)
-        self._arm_ref = self.sim.data.qpos[self.sim.arm].copy()
+        self._arm_ref = self._qpos_arm.copy()
         self._hybrid = None
 
     def set_hybrid(
@@ -333,7 +353,7 @@ class Controller:
         normal estimate and reference (use it to change the velocity or force mid-stroke).
         """
         v = np.asarray(velocity_in_world, dtype=float)
-        if v.shape != (3,) or not finite3(v) or not np.isfinite(force) or force <= 0:
+        if v.shape != (3,) or not finite3(v) or not math.isfinite(force) or force <= 0:
             raise SceneError(f"hybrid target: need force > 0 [N] and a finite (3,) velocity, got {force}, {v!r}")
         prev = self._hybrid if (keep_state and self._mode == "hybrid") else None
         if prev is not None and normal_hint is None:  # a running press, its hint kept (the fast path of a slide)
@@ -372,9 +392,13 @@ class Controller:
 
     def last_contact(self) -> ContactSummary:
         """The active fingertip's contact as sensed at the last hybrid tick (or now, in other modes)."""
+        return ContactSummary(*self.last_contact_values())
+
+    def last_contact_values(self) -> tuple[float, np.ndarray | None, np.ndarray | None, int]:
+        """:meth:`last_contact` as a plain tuple (normal force, normal, point, count): the per-tick path."""
         if self._hybrid is not None:
-            return ContactSummary(*self._hybrid.sensed)
-        return self.sim.contact_summary(self._finger)
+            return self._hybrid.sensed
+        return self.sim.sense_contact(self._finger)
 
     def _rotation_arg(self, rot: np.ndarray | str | None) -> np.ndarray | None:
         if rot is None:
@@ -384,9 +408,15 @@ class Controller:
                 raise SceneError(f"rotation_in_world: expected a (3, 3) rotation, 'hold' or None, got {rot!r}")
             return self.hand_rotation()
         r = np.asarray(rot, dtype=float)
-        # np.allclose(rᵀr, I, atol=ROTATION_ATOL) entry by entry, without its overhead (a free move asks every tick)
-        if r.shape != (3, 3) or not bool((np.abs(r.T @ r - self._eye3) <= self._rotation_tol).all()):
+        if r.shape != (3, 3):
             raise SceneError(f"rotation_in_world: expected a (3, 3) rotation matrix, got {r!r}")
+        # np.allclose(rᵀr, I, atol=ROTATION_ATOL) entry by entry, without its overhead, and only for a rotation
+        # other than the last one that passed (a free move asks every tick with the same one)
+        key = r.tobytes()
+        if key != self._rotation_passed:
+            if not bool((np.abs(r.T @ r - self._eye3) <= self._rotation_tol).all()):
+                raise SceneError(f"rotation_in_world: expected a (3, 3) rotation matrix, got {r!r}")
+            self._rotation_passed = key
         return r.copy()
 
     # -- running -----------------------------------------------------------------------------------------------
@@ -416,18 +446,18 @@ class Controller:
         self._tick()
 
     def _tick(self) -> None:
-        m, d, g = self._m, self._d, self.gains
-        mujoco.mj_fullM(m, d, self._mfull)
-        m6 = self._mfull[:N_ARM, :N_ARM]
-        bias = d.qfrc_bias
+        g = self.gains
+        mujoco.mj_fullM(self._m, self._d, self._mfull)
+        m6 = self._m6
         if self._mode == "posture":
-            e = self._arm_ref - d.qpos[:N_ARM]
-            tau = m6 @ (g.posture_kp * e - g.posture_kd * d.qvel[:N_ARM])
+            e = self._arm_ref - self._qpos_arm
+            tau = m6.dot(g.posture_kp * e - g.posture_kd * self._qvel_arm)
         else:
             tau = self._task_torque(m6)
         # MuJoCo clamps ctrl to the actuators' ctrlrange (torque limits, joint ranges) itself
-        d.ctrl[:N_ARM] = tau + bias[:N_ARM]
-        d.ctrl[N_ARM:] = self._hand_ref + bias[N_ARM:] / self._hand_kp
+        np.add(tau, self._bias_arm, out=self._ctrl_arm)
+        np.divide(self._bias_hand, self._hand_kp, out=self._hand_servo)
+        np.add(self._hand_ref, self._hand_servo, out=self._ctrl_hand)
 
     def _task_torque(self, m6: np.ndarray) -> np.ndarray:
         """Operational-space torque (6,) of the fingertip / hybrid task (bias not included).
@@ -435,32 +465,43 @@ class Controller:
         With orientation the task is square: tau = M J^-1 a + J^T f (damped inverse near singularities),
         which equals J^T (Lambda a + f) with Lambda = J^-T M J^-1. Position-only: tau = J^T (Lambda a + f)
         plus a joint-posture task in the dynamically consistent null space.
+
+        The per-tick arithmetic on 3-vectors is done on floats, element by element, and every product of
+        vectors and matrices by numpy's own (BLAS) routines: the same operations in the same order as the
+        vector form, so the same torques to the last bit (``tests/sim/test_control_law.py``).
         """
-        m, d, g = self._m, self._d, self.gains
+        g = self.gains
         jacp, jacr = self._jacp, self._jacr
-        mujoco.mj_jacSite(m, d, jacp, jacr, self._site)  # views into self._jac (6, nv)
-        x = d.site_xpos[self._site]
-        qvel = d.qvel
-        v = jacp @ qvel
+        mujoco.mj_jacSite(self._m, self._d, jacp, jacr, self._site)  # views into self._jac (6, nv)
+        x = self._tip_xpos
+        qvel = self._qvel
+        v = jacp.dot(qvel)
         if self._mode == "fingertip":
-            a_pos = g.pos_kp * (self._x_ref - x) - g.pos_kd * v
+            kp, kd = g.pos_kp, g.pos_kd
+            x0, x1, x2 = x.tolist()
+            r0, r1, r2 = self._x_ref_list
+            v0, v1, v2 = v.tolist()
+            a_pos = [kp * (r0 - x0) - kd * v0, kp * (r1 - x1) - kd * v1, kp * (r2 - x2) - kd * v2]
             force = None
         else:
             a_pos, force = self._hybrid_terms(x, v)
         if self._r_ref is not None:
             j = self._jac_arm
             a = self._a6
-            a[:3] = a_pos
-            a[3:] = g.rot_kp * _rotation_error(d.site_xmat[self._hand_site].reshape(3, 3), self._r_ref) - (
-                g.rot_kd * (jacr @ qvel)
-            )
-            jjt = j @ j.T
+            e0, e1, e2 = _rotation_error_list(self._hand_xmat, self._r_ref)
+            w0, w1, w2 = jacr.dot(qvel).tolist()
+            kp, kd = g.rot_kp, g.rot_kd
+            a[:] = [*a_pos, kp * e0 - kd * w0, kp * e1 - kd * w1, kp * e2 - kd * w2]
+            jjt = self._jjt
+            j.dot(j.T, out=jjt)
             mujoco.mju_cholFactor(jjt, g.task_damping)  # damped least squares: exact away from singularities
             mujoco.mju_cholSolve(self._y6, jjt, a)
-            tau = m6 @ (self._y6 @ j)
+            tau = m6.dot(self._y6.dot(j))
             if force is not None:
                 tau += j[:3].T @ force
             return tau
+        a_pos = np.array(a_pos)
+        d = self._d
         jp = jacp[:, :N_ARM]
         m6_inv = np.linalg.inv(m6)
         lam_inv = jp @ m6_inv @ jp.T
@@ -475,40 +516,62 @@ class Controller:
         tau += (m6 @ (g.posture_kp * e - g.posture_kd * qvel[:N_ARM])) @ (np.eye(N_ARM) - jbar @ jp)
         return tau
 
-    def _hybrid_terms(self, x: np.ndarray, v: np.ndarray):
-        """Task acceleration (3,) and the normal force to add (3,) or None, of the hybrid law."""
+    def _hybrid_terms(self, x: np.ndarray, v: np.ndarray) -> tuple[list[float], np.ndarray | None]:
+        """Task acceleration (3,) and the normal force to add (3,) or None, of the hybrid law.
+
+        Element-wise arithmetic on floats, the dot products by numpy (see :meth:`_task_torque`)."""
         g, h = self.gains, self._hybrid
         t = self._d.time
-        force, normal, point, count = self.sim.sense_contact(self._finger)
-        h.sensed = (force, normal, point, count)
+        sensed = self.sim.sense_contact(self._finger)
+        h.sensed = sensed
+        force, normal = sensed[0], sensed[1]
         if normal is not None and force > self._threshold:
             if h.normal is None:
                 h.normal = normal
             else:
-                nf = h.normal + g.normal_filter * (normal - h.normal)
-                h.normal = nf / math.sqrt(float(nf @ nf))
+                k = g.normal_filter
+                p0, p1, p2 = h.normal.tolist()
+                q0, q1, q2 = normal.tolist()
+                nf = np.array([p0 + k * (q0 - p0), p1 + k * (q1 - p1), p2 + k * (q2 - p2)])
+                nf /= math.sqrt(float(nf.dot(nf)))
+                h.normal = nf
             h.last_contact = t
         n = h.hint if h.normal is None else h.normal
-        v_n = float(n @ v)
+        n0, n1, n2 = n.tolist()
+        x0, x1, x2 = x.tolist()
+        v0, v1, v2 = v.tolist()
+        v_n = float(n.dot(v))
+        kp, kd = g.pos_kp, g.pos_kd
         if t - h.last_contact > g.contact_lost_after:
             # approach (or re-acquire) along -n at approach_speed, hold the tangential position
             d_ref = h.reference - x
-            d_ref -= float(n @ d_ref) * n
-            h.reference = x + d_ref
-            e = g.pos_kp * d_ref - g.pos_kd * v
-            a = e + (g.pos_kd * (-g.approach_speed - v_n) - float(n @ e)) * n
-            return a, None
+            s = float(n.dot(d_ref))
+            d0, d1, d2 = d_ref.tolist()
+            d0, d1, d2 = d0 - s * n0, d1 - s * n1, d2 - s * n2
+            h.reference = np.array([x0 + d0, x1 + d1, x2 + d2])
+            e = np.array([kp * d0 - kd * v0, kp * d1 - kd * v1, kp * d2 - kd * v2])
+            c = kd * (-g.approach_speed - v_n) - float(n.dot(e))
+            e0, e1, e2 = e.tolist()
+            return [e0 + c * n0, e1 + c * n1, e2 + c * n2], None
         dt = self._dt
         err = h.force - force
         h.integral = min(max(h.integral + g.force_ki * err * dt, -g.force_integral_limit), g.force_integral_limit)
         f_n = max(h.force + g.force_kp * err + h.integral, 0.0)
-        v_t = h.velocity - float(n @ h.velocity) * n
-        lead = h.reference - x + dt * v_t
-        lead -= float(n @ lead) * n  # re-anchor on the tangent plane through the tip
-        dist = math.sqrt(float(lead @ lead))
+        u = h.velocity
+        s = float(n.dot(u))
+        u0, u1, u2 = u.tolist()
+        t0, t1, t2 = u0 - s * n0, u1 - s * n1, u2 - s * n2  # the velocity in the tangent plane
+        r0, r1, r2 = h.reference.tolist()
+        lead = np.array([r0 - x0 + dt * t0, r1 - x1 + dt * t1, r2 - x2 + dt * t2])
+        s = float(n.dot(lead))
+        l0, l1, l2 = lead.tolist()
+        lead = np.array([l0 - s * n0, l1 - s * n1, l2 - s * n2])  # re-anchor on the tangent plane through the tip
+        dist = math.sqrt(float(lead.dot(lead)))
         if dist > g.lead_cap:
             lead *= g.lead_cap / dist  # cap the lead of the reference
-        h.reference = x + lead
-        e = g.pos_kp * lead + g.pos_kd * (v_t - v)
-        a = e - (float(n @ e) + g.normal_kd * v_n) * n
-        return a, -f_n * n
+        l0, l1, l2 = lead.tolist()
+        h.reference = np.array([x0 + l0, x1 + l1, x2 + l2])
+        e = np.array([kp * l0 + kd * (t0 - v0), kp * l1 + kd * (t1 - v1), kp * l2 + kd * (t2 - v2)])
+        c = float(n.dot(e)) + g.normal_kd * v_n
+        e0, e1, e2 = e.tolist()
+        return [e0 - c * n0, e1 - c * n1, e2 - c * n2], np.array([-f_n * n0, -f_n * n1, -f_n * n2])

@@ -334,6 +334,7 @@ class Simulation:
         root = int(m.site_bodyid[self.wrist_site])
         below = [b for b in range(m.nbody) if b == root or self._descends(b, root)]
         self._hand_bodies = tuple(below)  # the bodies whose weight and motion the wrist's sensor carries
+        self._hand_masses = tuple((b, float(m.body_mass[b])) for b in below)
         self._acc6 = np.zeros(6)
         self.home_key = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_KEY, "home")
         self._force6 = np.zeros(6)
@@ -430,19 +431,20 @@ class Simulation:
         if d.ncon == 0:
             return out
         owner = self._geom_finger_list
-        for i, (g1, g2) in enumerate(d.contact.geom.tolist()):
+        contacts = d.contact
+        for i, (g1, g2) in enumerate(contacts.geom.tolist()):
             k1, k2 = owner[g1], owner[g2]
             if finger is None:
                 if k1 < 0 and k2 < 0:
                     continue
             elif k1 != finger and k2 != finger:
                 continue
-            c = d.contact[i]
+            c = contacts[i]
             if c.efc_address < 0:  # excluded or inactive contact
                 continue
             mujoco.mj_contactForce(self.model, d, i, self._force6)
             frame = c.frame.reshape(3, 3)
-            f = self._force6[:3] @ frame  # force of geom1 on geom2, world frame
+            f = self._force6[:3].dot(frame)  # force of geom1 on geom2, world frame
             if k1 >= 0 and (finger is None or k1 == finger):
                 # the pad is geom1: flip into "on the pad, out of the touched surface" (normal: geom1 -> geom2)
                 out.append((k1, c.pos.copy(), -frame[0], -f))
@@ -468,21 +470,26 @@ class Simulation:
             return 0.0, None, None, 0
         if len(raw) == 1:
             _, point, normal, f = raw[0]
-            total = max(float(f @ normal), 0.0)
+            total = max(float(f.dot(normal)), 0.0)
         else:
             fn = np.array([max(float(f @ n), 0.0) for _, _, n, f in raw])
             total = float(fn.sum())
             point, normal = merge_patches(np.array([p for _, p, _, _ in raw]), np.array([n for _, _, n, _ in raw]), fn)
         nz = self.noise
-        if nz.any:
-            z = self._rng.standard_normal(7)
-            total += nz.force_std * float(z[0])
+        if nz.any:  # element by element on floats, the dot products by numpy: the vector form's arithmetic
+            z0, z1, z2, z3, z4, z5, z6 = self._rng.standard_normal(7).tolist()
+            total += nz.force_std * z0
             if nz.point_std > 0:
-                point = point + nz.point_std * z[1:4]
+                s = nz.point_std
+                p0, p1, p2 = point.tolist()
+                point = np.array([p0 + s * z1, p1 + s * z2, p2 + s * z3])
             if nz.normal_std > 0:
-                pert = nz.normal_std * z[4:7]
-                normal = normal + (pert - (pert @ normal) * normal)  # tangent-plane perturbation
-                normal /= math.sqrt(float(normal @ normal))
+                s = nz.normal_std
+                e0, e1, e2 = s * z4, s * z5, s * z6
+                c = float(np.array([e0, e1, e2]).dot(normal))
+                n0, n1, n2 = normal.tolist()
+                normal = np.array([n0 + (e0 - c * n0), n1 + (e1 - c * n1), n2 + (e2 - c * n2)])  # tangent-plane
+                normal /= math.sqrt(float(normal.dot(normal)))
         return total, normal, point, len(raw)
 
     def wrist_wrench(self, watch: bool = False) -> tuple[np.ndarray, np.ndarray]:
@@ -506,11 +513,13 @@ class Simulation:
         (the robot's own model and the motion of its joints; at rest :meth:`hand_weight`). Carried between moves the
         arm swings the hand by up to 17 N off its weight."""
         m, d = self.model, self.data
-        out = np.zeros(3)
-        for b in self._hand_bodies:
-            mujoco.mj_objectAcceleration(m, d, mujoco.mjtObj.mjOBJ_BODY, b, self._acc6, 0)
-            out += m.body_mass[b] * self._acc6[3:]
-        return out
+        acc, body = self._acc6, mujoco.mjtObj.mjOBJ_BODY
+        f0 = f1 = f2 = 0.0  # summed body by body on floats: the arithmetic of the vector sum, without its overhead
+        for b, mass in self._hand_masses:
+            mujoco.mj_objectAcceleration(m, d, body, b, acc, 0)
+            _, _, _, a0, a1, a2 = acc.tolist()
+            f0, f1, f2 = f0 + mass * a0, f1 + mass * a1, f2 + mass * a2
+        return np.array([f0, f1, f2])
 
     def hand_weight(self) -> np.ndarray:
         """What the wrist's force sensor reads of the hand at rest touching nothing (3,) [N], world frame: the

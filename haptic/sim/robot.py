@@ -53,6 +53,10 @@ class RobotInterface:
         """Aggregated contact of one fingertip (total normal force, mean normal and point), noise applied."""
         return self._sim.contact_summary(self._ctl_finger_index(finger))
 
+    def sense_contact_values(self, finger: str) -> tuple[float, np.ndarray | None, np.ndarray | None, int]:
+        """:meth:`sense_contact` as a plain tuple (normal force, normal, point, count): the per-tick path."""
+        return self._sim.sense_contact(finger_index(finger))
+
     def link_contacts(self) -> tuple[LinkContact, ...]:
         """The contacts of the robot's links other than the fingertip pads (:attr:`SensorReading.link_contacts`)
         alone, noise applied, without reading the other sensors (no noise drawn when there are none)."""
@@ -120,6 +124,10 @@ class RobotInterface:
         """The active fingertip's contact as the controller sensed it at its last hybrid tick (noise applied);
         in the other modes, sensed now."""
         return self._ctl.last_contact()
+
+    def last_contact_values(self) -> tuple[float, np.ndarray | None, np.ndarray | None, int]:
+        """:meth:`last_contact` as a plain tuple (normal force, normal, point, count): the per-tick path."""
+        return self._ctl.last_contact_values()
 
     def is_stable(self) -> bool:
         """False when the simulation state is not finite or MuJoCo has raised a warning (instability)."""
