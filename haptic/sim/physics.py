@@ -407,9 +407,13 @@ class Simulation:
         w = self.data.warning
         return {name: int(w[i].number) for name, i in WARNINGS.items() if w[i].number}
 
+    def warned(self) -> bool:
+        """Whether some MuJoCo warning counter is non-zero (:meth:`warnings` without naming them)."""
+        return bool(self.data.warning.number.any())
+
     def state_is_finite(self) -> bool:
         d = self.data
-        return bool(np.all(np.isfinite(d.qpos)) and np.all(np.isfinite(d.qvel)) and np.all(np.isfinite(d.qacc)))
+        return bool(np.isfinite(d.qpos).all() and np.isfinite(d.qvel).all() and np.isfinite(d.qacc).all())
 
     def ground_truth(self) -> GroundTruth:
         """The object and its pose -- for evaluation only; never hand this to an executor."""

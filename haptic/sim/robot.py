@@ -131,7 +131,7 @@ class RobotInterface:
 
     def is_stable(self) -> bool:
         """False when the simulation state is not finite or MuJoCo has raised a warning (instability)."""
-        return self._sim.state_is_finite() and not self._sim.warnings()
+        return self._sim.state_is_finite() and not self._sim.warned()
 
     def link_array(self) -> np.ndarray:
         """World positions (len(link_names), 3) [m] of the robot's own links (elbow, wrist, palm, each
