@@ -9,6 +9,9 @@ from the same saved state; the raw figure holds the last control (no controller)
 ``control_every`` like the controller does.
 
     .venv/bin/python scripts/bench_sim.py [--seconds 4] [--control-every 4] [--repeats 3]
+
+Last, the control law alone (``Controller.update``: one tick's law, no physics step) on the saved state, in each
+mode: µs of CPU a tick, the best of the repeats.
 """
 
 from __future__ import annotations
@@ -77,6 +80,26 @@ def main(argv: list[str] | None = None) -> int:
             forces.append(ctl.last_contact().normal_force)
         ctrl.append(10 * (ticks // 10) * every / (time.process_time() - t0))
 
+    top = ctl.fingertip_position()
+    modes = {
+        "posture": lambda: ctl.hold_posture(),
+        "fingertip (pose)": lambda: ctl.move_fingertip(top + [0.0, 0.0, 0.005], "hold"),
+        "hybrid (pressing, sliding)": lambda: ctl.set_hybrid(1.0, np.array([0.02, 0.0, 0.0]),
+                                                             normal_hint=np.array([0.0, 0.0, 1.0])),
+    }  # fmt: skip
+    law = {}
+    for name, command in modes.items():
+        calls, best = 2000, np.inf
+        for _ in range(args.repeats):
+            mujoco.mj_setState(m, d, state, spec)
+            mujoco.mj_forward(m, d)
+            command()
+            t0 = time.process_time()
+            for _ in range(calls):
+                ctl.update()
+            best = min(best, (time.process_time() - t0) / calls)
+        law[name] = best
+
     r, c = max(raw), max(ctrl)
     print(
         f"scene: {m.nbody} bodies, {m.nv} dofs, {m.ngeom} geoms; dt {m.opt.timestep * 1e3:g} ms; "
@@ -87,6 +110,9 @@ def main(argv: list[str] | None = None) -> int:
     print(f"ratio:                  {c / r:10.2f}  (goal >= 0.5)")
     print(f"sensed normal force while sliding: {np.mean(forces):.3f} +- {np.std(forces):.3f} N")
     print(f"warnings: {sim.warnings() or 'none'}")
+    print("the control law alone on the saved state (Controller.update, CPU):")
+    for name, t in law.items():
+        print(f"  {name:<28} {1e6 * t:6.1f} us a tick")
     return 0
 
 

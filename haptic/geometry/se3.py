@@ -160,7 +160,7 @@ def finite3(v: np.ndarray) -> bool:
 
 def unit(v: np.ndarray) -> np.ndarray:
     """``v`` normalised (``v`` itself when it is zero)."""
-    n = math.sqrt(float(v @ v))
+    n = math.sqrt(float(v.dot(v)))  # numpy's product as v @ v, at less overhead (the primitives ask every tick)
     return v / n if n > 0 else v
 
 

@@ -241,6 +241,7 @@ class Controller:
         self._rotation_passed = b""  # the bytes of the last rotation argument that passed the check
         self._hand_site = int(sim.flange_site)
         self._m, self._d = sim.model, sim.data
+        self._opt = sim.model.opt  # the model's options (a view: the physics steps toggle the sensors in it)
         self._a6 = np.zeros(6)
         self._y6 = np.zeros(6)
         self._jjt = np.zeros((6, 6))
@@ -426,8 +427,8 @@ class Controller:
         The sensors are computed in each tick's last physics step alone: nothing reads them in between, and
         they do not act on the dynamics (the same trajectory and readings, at less cost per step)."""
         m, d, n = self._m, self._d, self.gains.control_every
-        tick = self._tick
-        opt = m.opt
+        tick, step = self._tick, mujoco.mj_step
+        opt = self._opt
         flags = opt.disableflags
         quiet = flags | _SENSORS_OFF
         try:
@@ -435,9 +436,9 @@ class Controller:
                 tick()
                 if n > 1:
                     opt.disableflags = quiet
-                    mujoco.mj_step(m, d, nstep=n - 1)
+                    step(m, d, n - 1)
                     opt.disableflags = flags
-                mujoco.mj_step(m, d)
+                step(m, d)
         finally:
             opt.disableflags = flags
 
