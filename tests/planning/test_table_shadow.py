@@ -140,3 +140,62 @@ def test_a_pose_class_is_set_aside_only_when_none_of_its_interpretations_rests_o
     assert kept.leaves[0] == 1 and kept.world_from_model is pose
     alone = Recognition(EXPLORING, None, None, (PoseClass(poly, (0, 3), tilted), other), 3, (poly.name,))
     assert on_the_table(alone, tree, vertex, config).model is not None  # none of the first rests: set aside
+
+
+def test_an_edge_rising_out_of_the_shadow_is_not_placed_by_its_other_end_and_the_corners_beside_it():
+    """An eight-sided bipyramid (50 mm across, 40 mm tall) lying on a face: a vertex of its equator 9 mm over the
+    table has two faces whose corners rise out of their shadow, the edge between them (to the apex) rising too, and
+    an edge along the equator rising out of its shadow to the next vertex, a face in its shadow on the ridge's other
+    side (the formula corpus's bipyramids lie so). The two corners measured within them, the edge to the apex
+    measured and the equator's next vertex measured -- what placing a vertex by its faces' corners
+    (:func:`~haptic.matching.acceptance.placed_near`) asks of an edge -- still leave the vertex free to slide along
+    the edge to the apex: 2, 4 or 8 mm down it, within the vertex's shadow, keeps both corners' planes, that edge's
+    line and the next vertex where they are, and turns the equator's ridge above its shadow, where a pad touches
+    it. So that ridge must itself be measured, and the shadow does not take the vertex without it."""
+    from haptic.geometry import Polyhedron
+    from haptic.geometry.shapes import bipyramid
+    from haptic.matching.acceptance import corner_triangle
+    from haptic.planning.verify import shadow_of
+    from tests.planning.test_verify_moves import _resting_on
+
+    poly = bipyramid(8, 0.025, 0.02)
+    pose, _ = _resting_on(poly, 0)  # on the table at TABLE
+    z = pose.apply(poly.vertices)[:, 2] - TABLE
+    n = pose.rotate(poly.face_normals)
+
+    def edge_shadow(e: int) -> float:
+        return shadow_of(cone_top(n[[int(poly.edge_left_face[e]), int(poly.edge_right_face[e])]]), CONFIG)
+
+    found = 0
+    for v in range(poly.n_vertices):
+        faces = [int(f) for f in poly.vertex_faces[v]]
+        if z[v] <= 1e-3 or z[v] >= shadow_of(cone_top(n[faces]), CONFIG):
+            continue
+        rising = [int(e) for e in poly.vertex_edges[v]
+                  if max(z[v], z[int(sum(poly.edges[int(e)])) - v]) >= edge_shadow(int(e))]  # fmt: skip
+        out = [f for f in faces
+               if (pose.apply(corner_triangle(poly, v, f))[:, 2] - TABLE).max() >= shadow_of(n[f, 2], CONFIG)]
+        if len(out) != 2:
+            continue
+        between = [e for e in rising if {int(poly.edge_left_face[e]), int(poly.edge_right_face[e])} == set(out)]
+        ridges = [e for e in rising if e not in between]
+        if len(between) != 1 or len(ridges) != 1:
+            continue
+        found += 1
+        e = ridges[0]
+        u = int(sum(poly.edges[e])) - v
+        # both corners and the edge between them measured: the ridge along the equator keeps it out of the shadow
+        assert table_shadow(poly, pose, v, CONFIG, frozenset(out), frozenset(between)) is None
+        assert table_shadow(poly, pose, v, CONFIG, frozenset(out), frozenset(rising)) is not None
+        along = poly.vertices[v] - poly.vertices[int(sum(poly.edges[between[0]])) - v]
+        along /= np.linalg.norm(along)
+        for mm in (2, 4, 8):  # away from the apex: down, the vertex kept in its shadow
+            moved = poly.vertices.copy()
+            moved[v] = moved[v] + mm * 1e-3 * along
+            assert pose.apply(moved[v])[2] - TABLE < shadow_of(cone_top(n[faces]), CONFIG)
+            variant = Polyhedron.from_faces(moved, [tuple(f) for f in poly.faces], name="slid")
+            for f in out:  # the measured corners keep their planes
+                assert np.allclose(variant.face_normals[f], poly.face_normals[f], atol=1e-9)
+            assert np.allclose(variant.vertices[u], poly.vertices[u])  # the ridge's other end stays
+            assert _changed_top(variant, poly, pose) > edge_shadow(e) + 1e-3  # the ridge turns above its shadow
+    assert found >= 2
