@@ -199,3 +199,50 @@ def test_an_edge_rising_out_of_the_shadow_is_not_placed_by_its_other_end_and_the
             assert np.allclose(variant.vertices[u], poly.vertices[u])  # the ridge's other end stays
             assert _changed_top(variant, poly, pose) > edge_shadow(e) + 1e-3  # the ridge turns above its shadow
     assert found >= 2
+
+
+def test_a_ridge_rising_out_of_the_shadow_is_crossed_above_it():
+    """A nine-sided bipyramid (30 mm across, 80 mm tall) lying on a face: an edge rises from a vertex 6 mm over the
+    table to one 27 mm up, between a face leaning under 35° and a face standing nearly upright; no pad pressing it
+    clear of the table reaches it under 16.5 mm, and its middle lies under that. A face move from the upright face
+    aimed at its middle meets it in the shadow, where the pad would meet the table's clearance first; aimed at it as
+    an edge the table's shadow needs (:func:`~haptic.planning.verify.ridge_target`), it meets it above, where a
+    crossing measures it (bipyramid_10 of the formula corpus)."""
+    from haptic.geometry.shapes import bipyramid
+    from haptic.matching.components import DataFace
+    from haptic.planning.hypothesis import Hypothesis
+    from haptic.planning.moves import SensorState
+    from haptic.planning.search import simulate
+    from haptic.planning.verify import aimed_face_moves, ridges_out_of_shadow, shadow_of
+    from tests.planning.test_verify_moves import _resting_on
+
+    poly = bipyramid(9, 0.015, 0.04)
+    pose, _ = _resting_on(poly, 0)
+    hand = replace(CONFIG, concave_end_block=0.2)
+    z = pose.apply(poly.vertices)[:, 2] - TABLE
+    n = pose.rotate(poly.face_normals)
+    crossed = 0
+    for v in range(poly.n_vertices):
+        if z[v] < 1e-3 or z[v] >= shadow_of(cone_top(n[[int(f) for f in poly.vertex_faces[v]]]), hand):
+            continue
+        for e in ridges_out_of_shadow(poly, pose, v, hand):
+            faces = [int(poly.edge_left_face[e]), int(poly.edge_right_face[e])]
+            height = shadow_of(cone_top(n[faces]), hand)
+            ends = z[[int(u) for u in poly.edges[e]]]
+            if float(ends.mean()) >= height:
+                continue  # its middle above the shadow: aimed at as ever
+            upright = max(faces, key=lambda f: float(n[f, 2]))
+            loop = poly.vertices[list(poly.faces[upright])]
+            centre = loop.mean(axis=0)
+            face = DataFace(1, n[upright], pose.apply(centre + 0.3 * (loop - centre)), 1e-2, 1e-3)
+            h = Hypothesis(poly.name, poly, pose, {1: upright}, {}, {})
+            state = SensorState(pose.apply(centre) + 1e-3 * n[upright], face=1)
+            missing = (frozenset(), frozenset({e}), frozenset())
+            for ridges, above in ((frozenset(), False), (frozenset({e}), True)):
+                moves = aimed_face_moves(h, state, {1: face}, missing, hand, ridges)
+                assert len(moves) == 1
+                h1, s1, _ = simulate(h, moves[0], state, {1: face}, hand)
+                assert h1.edges[s1.edge] == e
+                assert (float(s1.position[2]) - TABLE >= height) == above
+            crossed += 1
+    assert crossed >= 2
