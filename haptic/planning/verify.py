@@ -390,6 +390,20 @@ def ridges_out_of_shadow(poly: Polyhedron, world_from_model: SE3, v: int, config
     return frozenset(out)
 
 
+def above_shadow(poly: Polyhedron, world_from_model: SE3, e: int, config: PlannerConfig) -> float:
+    """How long a part of edge ``e`` of ``poly`` at ``world_from_model`` lies above its shadow (:func:`table_shadow`)
+    [m]: the whole edge without a table."""
+    length = float(poly.edge_lengths[e])
+    if config.table_z is None:
+        return length
+    za, zb = sorted(float(world_from_model.apply(poly.vertices[int(u)])[2]) - config.table_z for u in poly.edges[e])
+    n = world_from_model.rotate(poly.face_normals[[int(poly.edge_left_face[e]), int(poly.edge_right_face[e])]])
+    h = shadow_of(cone_top(n), config)
+    if zb <= h:
+        return 0.0
+    return length if za >= h else length * (zb - h) / (zb - za)
+
+
 def ridge_target(poly: Polyhedron, world_from_model: SE3, e: int, config: PlannerConfig,
                  start: np.ndarray | None = None) -> np.ndarray:
     """Where a move measuring edge ``e`` of ``poly`` at ``world_from_model`` is aimed (model frame): its middle, or,
@@ -1430,10 +1444,13 @@ class Verifier:
         left out of reach (:attr:`hidden`, :attr:`unpinnable`), kept as :attr:`ridges`: when every such vertex is
         kept out of the shadow by such edges alone (:func:`table_shadow` takes it with them measured; an edge's
         other end measured is not enough: a move of the vertex along its measured edge to the apex turns the
-        ridge's part above the shadow, `tests/planning/test_table_shadow.py`), and :meth:`_stall_moves` moves have
-        not passed since one was last measured. Such an edge lies where the index pointing down cannot follow it
-        (one of its faces leans under into the shadow) but a face move crossing it from its other face above the
-        shadow measures it (:func:`ridge_target`)."""
+        ridge's part above the shadow, `tests/planning/test_table_shadow.py`), each such edge's part above the
+        shadow is at least ``config.min_crossed_edge`` long (:func:`above_shadow`: the shortest edge a verification
+        asks a face move to cross; bipyramid_11 and bipyramid_12 of the formula corpus, 5.9 and 0.8 mm, drew 16
+        moves each that measured none), and :meth:`_stall_moves` moves have not passed since one was last
+        measured. Such an edge lies where the index pointing down cannot follow it (one of its faces leans under
+        into the shadow) but a face move crossing it from its other face above the shadow measures it
+        (:func:`ridge_target`)."""
         pose = self.check.world_from_model if self.check is not None else None
         if self.config.table_z is None or self.mode != "full" or pose is None or self._model is None:
             return False
@@ -1441,7 +1458,8 @@ class Verifier:
         for v in (*self.hidden, *self.unpinnable):
             ridges = ridges_out_of_shadow(model, pose, v, self.config, self.coverage.edges)
             near = faces_measured_near(model, data, it, pose, v)
-            if not ridges or table_shadow(model, pose, v, self.config, near, self.coverage.edges | ridges) is None:
+            if (not ridges or table_shadow(model, pose, v, self.config, near, self.coverage.edges | ridges) is None
+                    or any(above_shadow(model, pose, e, self.config) < self.config.min_crossed_edge for e in ridges)):
                 self.ridges = frozenset()
                 return False
             need |= ridges
