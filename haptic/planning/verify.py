@@ -486,8 +486,7 @@ def aimed_face_moves(
     these do, so that the vertex costs a short edge move rather than an edge's length. On the hand
     (``config.concave_end_block`` set) the target is the pad's radius from the vertex (at most half the edge):
     crossing nearer, the pad rolling over the edge touches the third face at the vertex too, and the stroke on the
-    next face measures a rim rather
-    than a face ("too few contacts on the next face").
+    next face measures a rim rather than a face ("too few contacts on the next face").
 
     On the hand (``config.concave_end_block`` set), at a reflex corner (a missing vertex where a concave edge
     of the face ends, or whose corner of the face is reflex): no target on a concave edge (the pad in the corner
@@ -1115,9 +1114,9 @@ def _target_points(poly: Polyhedron, missing: tuple[frozenset[int], frozenset[in
     return np.array(pts).reshape(-1, 3)
 
 
-__all__ = ["aimed_face_moves", "choose_verification_move", "cone_top", "hidden_vertices", "plan_verification_move",
-           "face_middle", "reachable_features", "shadow_of", "table_shadow", "unmeasured_middles",
-           "verification_probes", "verify_move_budget"]
+__all__ = ["above_shadow", "aimed_face_moves", "choose_verification_move", "cone_top", "hidden_vertices",
+           "plan_verification_move", "face_middle", "reachable_features", "ridge_target", "ridges_out_of_shadow",
+           "shadow_of", "table_shadow", "unmeasured_middles", "verification_probes", "verify_move_budget"]
 
 
 MIDDLE_REACH = 5e-3
