@@ -20,7 +20,10 @@ on faces leaning under by at most ``PlannerConfig.max_undercut``. Here, per face
 A vertex no pad position of any of its faces out of reach can touch is out of reach for a 12 mm pad whatever the
 finger (a slot narrower than the pad, a face against the table); one whose pad positions no finger reaches is out
 of the hand's reach; otherwise the fingers and approaches that reach are listed. For each vertex off the table, the
-verification's probes at its faces' corners (:func:`corner_verdict`): whether they could place it. A vertex *has
+verification's probes at its faces' corners (:func:`corner_verdict`): whether they could place it. For every such
+vertex, what the table's shadow still needs to take it on trust (:func:`shadow_verdict`): the edges and the faces'
+corners at it that rise out of their shadow, and whether an edge move or a probe within the corner would measure
+each. A vertex *has
 enough planes in some finger's reach* when three of its faces (two besides the table's, for one on the table) are in the
 verification's reach or reached here: those planes alone would place it (touching one face near it does not).
 Geometry and inverse kinematics only, unless ``--probe``: then each face some finger reaches is probed on the
@@ -58,6 +61,8 @@ TABLE_LIMIT = 0.002
 """The pad's lowest point at least this above the table (the executor's limit) [m]."""
 ON_FACE = 1e-4
 """A grid point within this of the surface is on it [m]."""
+NO_PROBE = ("reflex corner", "no pad position", "no finger")
+"""What :func:`shadow_verdict` says of a face corner no probe measures."""
 
 
 def approaches(n: np.ndarray) -> dict[str, np.ndarray]:
@@ -150,6 +155,68 @@ def corner_verdict(poly, pose, cfg, reach, v: int, test) -> dict:
     return {"spans": spans, "edges": edges, "faces": faces, "placeable": placeable}
 
 
+def shadow_verdict(poly, pose, cfg, reach, v: int, test) -> dict:
+    """What the table's shadow (:func:`~haptic.planning.verify.table_shadow`) still needs to take vertex ``v`` on
+    trust, with every vertex and edge in the pad's reach taken as measured: whether ``v`` itself lies above its
+    shadow (then nothing else is asked); each edge at ``v`` that rises out of its shadow, and whether it is in the
+    pad's reach (an edge move measures it), only its other end is ("other end": a move of ``v`` turns the edge's
+    touchable part about that end, which that end does not see), or neither; each face (off the table) whose
+    corner at ``v`` rises out of its shadow, and what a probe within that corner
+    (:func:`~haptic.planning.finger_faces.corner_lines`) finds: "reflex corner", "no pad position", "no finger" or
+    the finger the reach test (``test``) finds for the first line it reaches. Complete when ``v`` is in its shadow,
+    every such edge is in reach and every such face has a finger; ``with_other_ends`` the same with an edge's other
+    end in reach counted (not sound: named for the bound)."""
+    from haptic.matching.acceptance import corner_triangle
+    from haptic.planning.finger_faces import corner_lines
+    from haptic.planning.hypothesis import Hypothesis
+    from haptic.planning.verify import cone_top, shadow_of
+
+    h = Hypothesis(model=poly.name, poly=poly, world_from_model=pose, faces={}, edges={}, vertices={})
+    z = pose.apply(poly.vertices)[:, 2] - cfg.table_z
+    n = pose.rotate(poly.face_normals)
+    faces = [int(f) for f in poly.vertex_faces[v]]
+    above = bool(z[v] >= shadow_of(cone_top(n[faces]), cfg))
+    edges, out = [], []
+    for e in (int(e) for e in poly.vertex_edges[v] if not above):
+        u = int(sum(poly.edges[e])) - v
+        height = shadow_of(cone_top(n[[int(poly.edge_left_face[e]), int(poly.edge_right_face[e])]]), cfg)
+        if max(z[v], z[u]) >= height:
+            what = "in reach" if e in reach[1] else "other end" if u in reach[2] else "neither"
+            edges.append({"edge": e, "to": u, "top_mm": round(float(max(z[v], z[u])) * 1000, 1),
+                          "shadow_mm": round(height * 1000, 1), "what": what})
+    for f in faces:
+        loop = [int(u) for u in poly.faces[f]]
+        if above or np.all(z[loop] <= TABLE_CONTACT):
+            continue
+        tri = corner_triangle(poly, v, f)
+        top = float(z[loop].max()) if tri is None else float((pose.apply(tri)[:, 2] - cfg.table_z).max())
+        height = shadow_of(float(n[f, 2]), cfg)
+        if top < height:
+            continue
+        if tri is None:
+            what = "reflex corner"
+        else:
+            lines = corner_lines(poly, pose, v, f, cfg)
+            got = next((g for g in (test(line, [h]) for line in lines) if g is not None), None)
+            what = "no pad position" if not lines else "no finger" if got is None else str(got.finger)
+        out.append({"face": f, "top_mm": round(top * 1000, 1), "shadow_mm": round(height * 1000, 1), "what": what})
+    fingers = all(x["what"] not in NO_PROBE for x in out)
+    return {"above": above, "edges": edges, "faces": out,
+            "complete": not above and fingers and all(x["what"] == "in reach" for x in edges),
+            "with_other_ends": not above and fingers and all(x["what"] != "neither" for x in edges)}
+
+
+def _shadow_kind(sh: dict) -> str:
+    """A vertex's :func:`shadow_verdict` in a few words."""
+    if sh["above"]:
+        return "above its shadow"
+    if not sh["edges"] and not sh["faces"]:
+        return "in the shadow"
+    if sh["complete"]:
+        return "in the shadow once probed and traced"
+    return "in the shadow with an edge's other end counted" if sh["with_other_ends"] else "out of the shadow"
+
+
 def study(model: str, seed: int, library, probe: bool = False) -> dict:
     """The hidden and unpinnable vertices of one episode's object at its pose, and what reaches their faces (with
     ``probe``: each face some finger reaches probed on the hand, :func:`probe_face`); for each hidden vertex, what
@@ -205,7 +272,8 @@ def study(model: str, seed: int, library, probe: bool = False) -> dict:
         out["vertices"].append({"vertex": int(v), "height_mm": round(float(z[v]) * 1000, 1),
                                 "on_table": bool(v in unpinned), "verdict": verdict, "planes": bool(planes),
                                 "faces": faces,
-                                "corner": corner_verdict(poly, pose, cfg, reach, v, test) if v in hidden else None})
+                                "corner": corner_verdict(poly, pose, cfg, reach, v, test) if v in hidden else None,
+                                "shadow": shadow_verdict(poly, pose, cfg, reach, v, test)})
     return out
 
 
@@ -229,7 +297,7 @@ def main(argv: list[str] | None = None) -> int:
             pairs = [(m, int(s)) for m in names for s in args.seeds.split(",")]
         rows, verdicts, by, fingers, probes = [], Counter(), Counter(), Counter(), Counter()
         placed = 0
-        corners = Counter()
+        corners, shadows, shadow_parts = Counter(), Counter(), Counter()
         for model, seed in pairs:
             r = study(model, seed, library, args.probe)
             rows.append(r)
@@ -262,6 +330,17 @@ def main(argv: list[str] | None = None) -> int:
                           f"{'in reach' if c['edges'] else 'not all in reach'}; "
                           + ", ".join(f"f{f} {w}" for f, w in c["faces"].items())
                           + (" -> placeable" if c["placeable"] else " -> not placeable"), flush=True)
+                sh = x["shadow"]
+                shadows[_shadow_kind(sh)] += 1
+                shadow_parts.update(f"edge {e['what']}" for e in sh["edges"])
+                shadow_parts.update(f"face corner: {f['what'] if f['what'] in NO_PROBE else 'a finger'}"
+                                    for f in sh["faces"])  # fmt: skip
+                print("    table's shadow: " + ("the vertex above its shadow" if sh["above"] else "; ".join(
+                    [f"e{e['edge']} to v{e['to']} rises to {e['top_mm']} mm over its {e['shadow_mm']} mm: {e['what']}"
+                     for e in sh["edges"]]
+                    + [f"f{f['face']}'s corner rises to {f['top_mm']} mm over its {f['shadow_mm']} mm: {f['what']}"
+                       for f in sh["faces"]]) or "nothing rises out of it")
+                      + f" -> {_shadow_kind(sh)}", flush=True)
         n_eps = sum(1 for r in rows if r["vertices"])
         print(f"\n{n_eps} of {len(rows)} episodes with vertices out of the verification's reach; "
               f"{sum(verdicts.values())} vertices: " + ", ".join(f"{k} {v}" for k, v in verdicts.most_common())
@@ -270,6 +349,14 @@ def main(argv: list[str] | None = None) -> int:
               f"{corners[True] + corners[False]}")
         complete = sum(1 for r in rows if r["vertices"] and all(x["planes"] for x in r["vertices"]))
         print(f"episodes whose every such vertex has enough planes in some finger's reach: {complete} of {n_eps}")
+        print("the table's shadow, vertices: " + ", ".join(f"{k} {v}" for k, v in shadows.most_common()))
+        print("  what rises out of it unmeasured: " + ", ".join(f"{k} {v}" for k, v in shadow_parts.most_common()))
+        done = [f"{r['model']}:{r['seed']}" for r in rows
+                if r["vertices"] and all(x["shadow"]["complete"] for x in r["vertices"])]  # fmt: skip
+        ends = [f"{r['model']}:{r['seed']}" for r in rows
+                if r["vertices"] and all(x["shadow"]["with_other_ends"] for x in r["vertices"])]  # fmt: skip
+        print(f"episodes whose every such vertex the shadow would take with its corners probed and its edges traced: "
+              f"{len(done)} of {n_eps} {done}; with an edge's other end counted (not sound): {len(ends)} {ends}")
         if by:
             print("approaches that reach a face out of the verification's reach (faces): "
                   + ", ".join(f"{k} {v}" for k, v in by.most_common()))

@@ -140,3 +140,109 @@ def test_a_pose_class_is_set_aside_only_when_none_of_its_interpretations_rests_o
     assert kept.leaves[0] == 1 and kept.world_from_model is pose
     alone = Recognition(EXPLORING, None, None, (PoseClass(poly, (0, 3), tilted), other), 3, (poly.name,))
     assert on_the_table(alone, tree, vertex, config).model is not None  # none of the first rests: set aside
+
+
+def test_an_edge_rising_out_of_the_shadow_is_not_placed_by_its_other_end_and_the_corners_beside_it():
+    """An eight-sided bipyramid (50 mm across, 40 mm tall) lying on a face: a vertex of its equator 9 mm over the
+    table has two faces whose corners rise out of their shadow, the edge between them (to the apex) rising too, and
+    an edge along the equator rising out of its shadow to the next vertex, a face in its shadow on the ridge's other
+    side (the formula corpus's bipyramids lie so). The two corners measured within them, the edge to the apex
+    measured and the equator's next vertex measured -- what placing a vertex by its faces' corners
+    (:func:`~haptic.matching.acceptance.placed_near`) asks of an edge -- still leave the vertex free to slide along
+    the edge to the apex: 2, 4 or 8 mm down it, within the vertex's shadow, keeps both corners' planes, that edge's
+    line and the next vertex where they are, and turns the equator's ridge above its shadow, where a pad touches
+    it. So that ridge must itself be measured, and the shadow does not take the vertex without it."""
+    from haptic.geometry import Polyhedron
+    from haptic.geometry.shapes import bipyramid
+    from haptic.matching.acceptance import corner_triangle
+    from haptic.planning.verify import shadow_of
+    from tests.planning.test_verify_moves import _resting_on
+
+    poly = bipyramid(8, 0.025, 0.02)
+    pose, _ = _resting_on(poly, 0)  # on the table at TABLE
+    z = pose.apply(poly.vertices)[:, 2] - TABLE
+    n = pose.rotate(poly.face_normals)
+
+    def edge_shadow(e: int) -> float:
+        return shadow_of(cone_top(n[[int(poly.edge_left_face[e]), int(poly.edge_right_face[e])]]), CONFIG)
+
+    found = 0
+    for v in range(poly.n_vertices):
+        faces = [int(f) for f in poly.vertex_faces[v]]
+        if z[v] <= 1e-3 or z[v] >= shadow_of(cone_top(n[faces]), CONFIG):
+            continue
+        rising = [int(e) for e in poly.vertex_edges[v]
+                  if max(z[v], z[int(sum(poly.edges[int(e)])) - v]) >= edge_shadow(int(e))]  # fmt: skip
+        out = [f for f in faces
+               if (pose.apply(corner_triangle(poly, v, f))[:, 2] - TABLE).max() >= shadow_of(n[f, 2], CONFIG)]
+        if len(out) != 2:
+            continue
+        between = [e for e in rising if {int(poly.edge_left_face[e]), int(poly.edge_right_face[e])} == set(out)]
+        ridges = [e for e in rising if e not in between]
+        if len(between) != 1 or len(ridges) != 1:
+            continue
+        found += 1
+        e = ridges[0]
+        u = int(sum(poly.edges[e])) - v
+        # both corners and the edge between them measured: the ridge along the equator keeps it out of the shadow
+        assert table_shadow(poly, pose, v, CONFIG, frozenset(out), frozenset(between)) is None
+        assert table_shadow(poly, pose, v, CONFIG, frozenset(out), frozenset(rising)) is not None
+        along = poly.vertices[v] - poly.vertices[int(sum(poly.edges[between[0]])) - v]
+        along /= np.linalg.norm(along)
+        for mm in (2, 4, 8):  # away from the apex: down, the vertex kept in its shadow
+            moved = poly.vertices.copy()
+            moved[v] = moved[v] + mm * 1e-3 * along
+            assert pose.apply(moved[v])[2] - TABLE < shadow_of(cone_top(n[faces]), CONFIG)
+            variant = Polyhedron.from_faces(moved, [tuple(f) for f in poly.faces], name="slid")
+            for f in out:  # the measured corners keep their planes
+                assert np.allclose(variant.face_normals[f], poly.face_normals[f], atol=1e-9)
+            assert np.allclose(variant.vertices[u], poly.vertices[u])  # the ridge's other end stays
+            assert _changed_top(variant, poly, pose) > edge_shadow(e) + 1e-3  # the ridge turns above its shadow
+    assert found >= 2
+
+
+def test_a_ridge_rising_out_of_the_shadow_is_crossed_above_it():
+    """A nine-sided bipyramid (30 mm across, 80 mm tall) lying on a face: an edge rises from a vertex 6 mm over the
+    table to one 27 mm up, between a face leaning under 35° and a face standing nearly upright; no pad pressing it
+    clear of the table reaches it under 16.5 mm, and its middle lies under that. A face move from the upright face
+    aimed at its middle meets it in the shadow, where the pad would meet the table's clearance first; aimed at it as
+    an edge the table's shadow needs (:func:`~haptic.planning.verify.ridge_target`), it meets it above, where a
+    crossing measures it (bipyramid_10 of the formula corpus)."""
+    from haptic.geometry.shapes import bipyramid
+    from haptic.matching.components import DataFace
+    from haptic.planning.hypothesis import Hypothesis
+    from haptic.planning.moves import SensorState
+    from haptic.planning.search import simulate
+    from haptic.planning.verify import aimed_face_moves, ridges_out_of_shadow, shadow_of
+    from tests.planning.test_verify_moves import _resting_on
+
+    poly = bipyramid(9, 0.015, 0.04)
+    pose, _ = _resting_on(poly, 0)
+    hand = replace(CONFIG, concave_end_block=0.2)
+    z = pose.apply(poly.vertices)[:, 2] - TABLE
+    n = pose.rotate(poly.face_normals)
+    crossed = 0
+    for v in range(poly.n_vertices):
+        if z[v] < 1e-3 or z[v] >= shadow_of(cone_top(n[[int(f) for f in poly.vertex_faces[v]]]), hand):
+            continue
+        for e in ridges_out_of_shadow(poly, pose, v, hand):
+            faces = [int(poly.edge_left_face[e]), int(poly.edge_right_face[e])]
+            height = shadow_of(cone_top(n[faces]), hand)
+            ends = z[[int(u) for u in poly.edges[e]]]
+            if float(ends.mean()) >= height:
+                continue  # its middle above the shadow: aimed at as ever
+            upright = max(faces, key=lambda f: float(n[f, 2]))
+            loop = poly.vertices[list(poly.faces[upright])]
+            centre = loop.mean(axis=0)
+            face = DataFace(1, n[upright], pose.apply(centre + 0.3 * (loop - centre)), 1e-2, 1e-3)
+            h = Hypothesis(poly.name, poly, pose, {1: upright}, {}, {})
+            state = SensorState(pose.apply(centre) + 1e-3 * n[upright], face=1)
+            missing = (frozenset(), frozenset({e}), frozenset())
+            for ridges, above in ((frozenset(), False), (frozenset({e}), True)):
+                moves = aimed_face_moves(h, state, {1: face}, missing, hand, ridges)
+                assert len(moves) == 1
+                h1, s1, _ = simulate(h, moves[0], state, {1: face}, hand)
+                assert h1.edges[s1.edge] == e
+                assert (float(s1.position[2]) - TABLE >= height) == above
+            crossed += 1
+    assert crossed >= 2
