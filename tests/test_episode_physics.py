@@ -681,6 +681,7 @@ def test_a_next_face_met_near_its_end_is_touched_again_along_the_edge(monkeypatc
     assert rec.outcome == "recognized" and rec.correct, rec.detail
 
 
+@pytest.mark.slow
 def test_a_vertex_move_onto_a_side_leaning_under_measures_it_tilted_past_the_ridge():
     # HEXPRISM01 seed 2 lies on a side: a vertex move circling an end crossed onto a side leaning under 29°. The
     # roll settled on the ridge 14° short of the side, the stroke there ran away, and touched afresh past the edge
