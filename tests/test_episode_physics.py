@@ -681,6 +681,23 @@ def test_a_next_face_met_near_its_end_is_touched_again_along_the_edge(monkeypatc
     assert rec.outcome == "recognized" and rec.correct, rec.detail
 
 
+@pytest.mark.slow
+def test_a_vertex_move_onto_a_side_leaning_under_measures_it_tilted_past_the_ridge():
+    # HEXPRISM01 seed 2 lies on a side: a vertex move circling an end crossed onto a side leaning under 29°. The
+    # roll settled on the ridge 14° short of the side, the stroke there ran away, and touched afresh past the edge
+    # the pad read the ridge again (a normal turned partway about the edge); touched again 5 mm along the edge it
+    # read the side, but every L there stopped within 2.5 mm, the distal link on the ridge above the side (the side
+    # leans under the ridge between it and the next side): "stroke on the next face failed: runaway". An L a link
+    # of the finger stopped is made again with the hand tilted away from that link, and the side it measures is the
+    # next face when turned farther about the edge than the ridge reading.
+    ep, rec, said, failed = _watched(EpisodeSpec(model="HEXPRISM01", seed=2, executor="physics", verify="full"))
+    assert not [w for w in failed if "stroke on the next face failed" in w], failed
+    assert any("stepping onto the next face, the finger's index_distal met the object: the hand tilted" in x
+               for x in said), said  # fmt: skip
+    assert rec.outcome == "recognized" and rec.correct, rec.detail
+    assert _within_bounds(ep)
+
+
 def test_a_tetrahedron_taller_than_the_model_is_not_confirmed_with_its_base_on_the_table(tmp_path):
     # TETRA01R made 3 % taller (scripts/bench_learn.py --executor physics --models-only
     # PYR01,TETRA01L,TETRA01R,WEDGE01,BOX01 --variants dim, seed 1777477784) rests on its base: the hand measures the
@@ -1373,13 +1390,21 @@ def test_a_ridge_check_heading_down_stops_at_the_tables_clearance():
 
 
 @pytest.mark.slow
-def test_a_vertex_move_onto_a_face_leaning_under_measures_it_by_several_short_ls():
+def test_a_vertex_move_onto_a_face_leaning_under_measures_it_by_several_short_ls(monkeypatch):
     # HEXPRISM01 seed 3 (physics_episodes.py --verify full) lies on a side. A vertex move circled a top corner of an
     # end and rolled, the hand tilted away from the end, onto a side leaning under 30°: the stroke's step in was held
     # by the distal link, and five touches afresh past the edge read the side's normal, but each L's legs along the
     # edge were stopped by the distal link on the ridge above within 1.5 mm, and three L's first legs, 1-3 mm long
     # and 5-10 mm apart, each measured too little of the face: "stroke on the next face failed: blocked". Such Ls
-    # that agree measure the face together. The episode is stopped once a vertex move has done so.
+    # that agree measure the face together. The episode is stopped once a vertex move has done so. An L touched
+    # afresh that a link stopped is now made again with the hand tilted away from the link, which measures the side
+    # at the first touch (test_a_vertex_move_onto_a_side_leaning_under_measures_it_tilted_past_the_ridge): switched
+    # off here, the Ls measure it together as before.
+    from haptic.executor.physics import PhysicsExecutor
+
+    real = PhysicsExecutor._stroke_tilted
+    monkeypatch.setattr(PhysicsExecutor, "_stroke_tilted",
+                        lambda self, *a, step_in=None: None if step_in is not None else real(self, *a))  # fmt: skip
     ep = build_episode(EpisodeSpec(model="HEXPRISM01", seed=3, executor="physics", verify="full"))
     said, failed = _until_recovery(ep, "vertex", "Ls touched afresh together",
                                    fails="stroke on the next face failed")  # fmt: skip

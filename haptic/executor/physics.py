@@ -716,8 +716,8 @@ class PhysicsExecutor(LandingSearch):
             return self._reacquire(kind, n_a, direction, corner, r.trace, n_b, pieces, away_from, why)
         return "ok", "", r.trace, st.trace, fit
 
-    def _stroke_tilted(self, st: PrimitiveResult, away: np.ndarray, along: np.ndarray,
-                       pieces: list[PrimitiveResult]) -> tuple[FaceFit, PrimitiveResult] | None:  # fmt: skip
+    def _stroke_tilted(self, st: PrimitiveResult, away: np.ndarray, along: np.ndarray, pieces: list[PrimitiveResult],
+                       step_in: float | None = None) -> tuple[FaceFit, PrimitiveResult] | None:  # fmt: skip
         """For :meth:`_cross_and_acquire`: a stroke on the next face (``st``) whose legs a link of the finger
         stopped, lifting the pad off, and which measured too little of the face. On a face leaning under,
         the finger's links meet the edge above it as the pad slides (antiprism_03 of the formula corpus at 78 mm,
@@ -729,7 +729,8 @@ class PhysicsExecutor(LandingSearch):
         anew from the upright posture, away from this link's (antiprism_05, seed 1: tilted away from the distal
         link's contact on the face traced, the medial link met the edge as the pad stepped onto the next face). The
         fit and the stroke, the hand left tilted (the move turns it upright when it ends); None, the hand as it
-        was, when no tilt measures the face."""
+        was, when no tilt measures the face. ``step_in``: the L's first leg, as :meth:`Toucher.stroke` takes it (an L
+        touched afresh past the edge, :meth:`_touch_next`: it then measures the face both ways)."""
         t, s = self.toucher, self.settings
         rows = np.flatnonzero(st.trace.in_contact)
         if not len(rows):
@@ -738,11 +739,11 @@ class PhysicsExecutor(LandingSearch):
         n = unit(st.info["normal"])
         target = st.trace.point_in_world[rows[0]] + s.reacquire_inset * unit(away - float(away @ n) * n)
         for a, r in self._tilted_touches(st.info["link_normal"], target, n, pieces, held):
-            again = t.stroke(r.info["normal"], away, along)
+            again = t.stroke(r.info["normal"], away, along, step_in=step_in)
             pieces.append(again)
             if not again.ok or again.info["rim"]:
                 continue
-            fit = self.segmenter.fit_face_trace(again.trace, again.info["normal"])
+            fit = self.segmenter.fit_face_trace(again.trace, again.info["normal"], two_d=step_in is not None)
             if fit is not None:
                 self.recoveries.append(f"stepping onto the next face, the finger's {st.info['link']} met the object: "
                                        f"the hand tilted {math.degrees(a):.0f}° away")  # fmt: skip
@@ -873,17 +874,34 @@ class PhysicsExecutor(LandingSearch):
         normal partway between them, turned about the edge about as far as the next face (platonic_dodecahedron of
         the formula corpus, seed 1: the first touches read 58° and 59° turns 24° and 21° off the next face, which
         the touches along the edge measured at the solid's 63.4°, and the crossings failed "too few contacts on the
-        next face")."""
+        next face"). Or the first touch read the ridge of the edge crossed, its normal turned only partway about the
+        edge, and ``again`` is turned farther about the same axis (off the plane of ``n_a`` and ``n`` by no more than
+        ``reacquire_cone``), within ``rim_reading_cone`` of ``n`` (HEXPRISM01 seed 2: past an end's edge the first
+        touch read 76.6° of the side's 90°, the links held on the ridge above the side leaning under; touched 5 mm
+        along the edge the pad read the side 13.4° farther round, in that plane). A face turned less far than
+        the reading, or about another axis, is another face's."""
         s = self.settings
         if angle(again, n) <= s.reacquire_cone:
             return True
-        return angle(again, n) <= s.rim_reading_cone and abs(angle(again, n_a) - angle(n, n_a)) <= s.reacquire_cone
+        if angle(again, n) > s.rim_reading_cone:
+            return False
+        if abs(angle(again, n_a) - angle(n, n_a)) <= s.reacquire_cone:
+            return True
+        axis = np.cross(n_a, n)
+        if float(axis @ axis) < math.sin(self.bounds.min_edge_angle) ** 2:
+            return False
+        return abs(float(again @ unit(axis))) <= math.sin(s.reacquire_cone) and angle(again, n_a) > angle(n, n_a)
 
     def _touch_next(self, kind: str, n_a: np.ndarray, d: np.ndarray, corner: np.ndarray, target: np.ndarray,
                     n_guess: np.ndarray, pieces: list[PrimitiveResult], away_from):  # fmt: skip
         """For :meth:`_reacquire`: lifted off, touch the face past the edge at ``target`` (its normal guessed
-        ``n_guess``) and measure it by an L. "miss" when nothing past the edge was touched, "table" when the
-        table was; else the touched normal, the face's fit (None: the L measured too little) and the stroke."""
+        ``n_guess``) and measure it by an L. An L whose legs a link of the finger stopped, measuring too little, is
+        made again with the hand tilted away from that link (:meth:`_stroke_tilted`, the step in as long): on a face
+        leaning under, the ridge above it holds the links (HEXPRISM01 seed 2, a vertex move from an end onto a side
+        leaning under 29°: touched afresh, the side's Ls stopped within 2.5 mm, the distal link on the ridge between
+        the side and the next, and the move failed "stroke on the next face failed: runaway"; tilted 30° away the L
+        measures the side). "miss" when nothing past the edge was touched, "table" when the table was; else the
+        touched normal, the face's fit (None: the L measured too little) and the stroke."""
         t, s, seg = self.toucher, self.settings, self.segmenter
         floor = TABLE_TOP_Z + t.pad_radius + s.table_margin
         sign = 1.0 if kind == "convex" else -1.0
@@ -908,6 +926,10 @@ class PhysicsExecutor(LandingSearch):
         st = t.stroke(n, away, along, step_in=s.reacquire_step_in)
         pieces.append(st)
         fit = seg.fit_face_trace(st.trace, st.info["normal"], two_d=True) if st.ok else None
+        if fit is None and st.ok and st.info["link_normal"] is not None:
+            tilted = self._stroke_tilted(st, away, along, pieces, step_in=s.reacquire_step_in)
+            if tilted is not None:
+                fit, st = tilted
         return n, fit, st
 
     def _face_move(self, move: FaceMove, pieces: list[PrimitiveResult]) -> MoveResult:

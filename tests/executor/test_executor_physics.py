@@ -536,3 +536,34 @@ def test_a_vertex_the_pad_rolls_on_is_located_at_noise_level_4():
             assert abs(s_v - 0.02) < ex.bounds.bound(sigma, ex.bounds.vertex_floor)
             turned = _rolling_on_a_vertex(level, turn=np.radians(30.0), seed=seed)
             assert PhysicsExecutor._vertex_param(ex, rec, turned, u, 1)[0] is None, (level, seed)
+
+
+def _turned(n_a: np.ndarray, axis: np.ndarray, degrees: float) -> np.ndarray:
+    """``n_a`` turned about the unit ``axis`` by ``degrees`` (Rodrigues)."""
+    a = np.radians(degrees)
+    return n_a * np.cos(a) + np.cross(axis, n_a) * np.sin(a) + axis * float(axis @ n_a) * (1.0 - np.cos(a))
+
+
+def test_a_face_touched_along_the_edge_past_a_ridge_reading_is_the_next_face():
+    """Touched afresh past an edge, the pad may read the ridge itself, its normal turned only partway about the edge
+    (HEXPRISM01 seed 2: 76.6° of the side's 90°, the links held on the ridge above a side leaning under); touched
+    again along the edge it reads the side. A normal turned farther about the same axis is the next face; one turned
+    less far, or about another axis, is not."""
+    from haptic.executor.physics import PhysicsSettings
+    from haptic.executor.segment import SegmentBounds
+
+    ex = object.__new__(PhysicsExecutor)  # the rule reads the settings and bounds alone
+    ex.settings, ex.bounds = PhysicsSettings(), SegmentBounds()
+    n_a = np.array([-0.923, -0.385, 0.0])
+    n_a /= np.linalg.norm(n_a)
+    e = np.cross(n_a, np.array([-0.539, 0.689, -0.484]))
+    e /= np.linalg.norm(e)
+    ridge = _turned(n_a, e, 76.6)
+    assert ex._same_next_face(n_a, ridge, _turned(n_a, e, 90.0))
+    assert ex._same_next_face(n_a, ridge, _turned(n_a, e, 100.0))
+    assert not ex._same_next_face(n_a, ridge, _turned(n_a, e, 60.0))  # turned less far than the ridge reading
+    side = _turned(n_a, e, 90.0)
+    lean = np.cross(side, e)
+    aside = _turned(side, lean / np.linalg.norm(lean), 18.0)  # as far round, leaning 18° along the edge
+    assert not ex._same_next_face(n_a, ridge, aside)
+    assert not ex._same_next_face(n_a, ridge, _turned(n_a, e, 110.0))  # beyond the rim reading's cone
