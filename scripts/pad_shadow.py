@@ -11,13 +11,13 @@ The moves: along the vertex normal by 2, 4 and 8 mm (:func:`~haptic.geometry.per
 with the vertex moved: a move in a face's plane keeps that face's plane and moves its rim); and 4 mm chamfers of its
 convex edges (:func:`~haptic.geometry.perturb.chamfer_edge`; "refused" where the chamfer's plane would cut other
 vertices of a concave model). A pad centre on a grid (``--step``, 2 mm) near where the two differ, at least the
-executor's limit over the table (its lowest point 2 mm up), that lies clear of one of them and inside the other by
-more than :data:`FELT` feels the difference; its depth is how far in, and the model faces nearest such centres say
-where. A vertex every one of whose moves no such pad feels lies in the pad's shadow: no measurement by any finger
-could tell those moves apart, and the verification could take it on trust, as it takes the table's shadow
-(:func:`~haptic.planning.verify.table_shadow`). A free pad reaches more than the hand's fingers do, so a move it
-feels is one some finger might measure, not one the hand does. Geometry only; ground truth is read here (this is
-evaluation), never by the executor.
+executor's limit over the table (its lowest point 2 mm up), clear of one of them and within a step of touching the
+other, feels the difference when its distances to the two differ by more than :data:`FELT` (how far apart a pad
+pressing from there meets them); the model faces nearest such centres say where. A vertex every one of whose
+moves no such pad feels lies in the pad's shadow: no measurement by any finger could tell those moves apart, and the
+verification could take it on trust, as it takes the table's shadow (:func:`~haptic.planning.verify.table_shadow`).
+A free pad reaches more than the hand's fingers do, so a move it feels is one some finger might measure, not one the
+hand does. Geometry only; ground truth is read here (this is evaluation), never by the executor.
 """
 
 from __future__ import annotations
@@ -90,9 +90,10 @@ def felt(model: Polyhedron, moved, world_from_model: SE3, table_z: float, radius
     """How deep a free pad of ``radius``, its lowest point at least :data:`PAD_LIMIT` over the table (``table_z``),
     feels ``moved`` (a :class:`Polyhedron` or a :class:`Surface`, model frame) apart from ``model`` at
     ``world_from_model`` [m], and the model faces nearest the pad centres that feel it by more than :data:`FELT`:
-    the largest depth to which a centre clear of one (by ``radius``) lies inside the other's pad-sized neighbourhood,
-    over a grid of ``step`` within reach of where the two differ. (0, []) where they do not differ or no pad clear of
-    the table comes near."""
+    over a grid of ``step`` within reach of where the two differ, at the centres clear of one surface (by
+    ``radius``) and within ``step`` of touching the other, the largest difference of their distances to the two --
+    how far apart a pad pressing from there meets them. (0, []) where they do not differ or no pad clear of the
+    table comes near."""
     from scipy.spatial import cKDTree
 
     pm, pv = _surface_points(model), _surface_points(moved)
@@ -107,7 +108,11 @@ def felt(model: Polyhedron, moved, world_from_model: SE3, table_z: float, radius
     if not len(g):
         return 0.0, []
     dm, dv = _signed(model, g), _signed(moved, g)
-    depth = np.maximum(np.where(dm >= radius, radius - dv, 0.0), np.where(dv >= radius, radius - dm, 0.0))
+    # a centre clear of one surface and within a step of touching the other: a pad pressing toward the surfaces
+    # from there meets them that much apart (a grid finds a centre exactly at touching only by chance, and a
+    # difference narrower than a step would slip between the centres)
+    near = (np.maximum(dm, dv) >= radius) & (np.minimum(dm, dv) <= radius + step)
+    depth = np.where(near, np.abs(dm - dv), 0.0)
     hit = depth > FELT
     faces = []
     if hit.any():
