@@ -46,7 +46,10 @@ def move_vertex(poly: Polyhedron, vertex: int, offset: float, name: str | None =
     Each face at the vertex keeps its plane away from it: the corner triangle (the vertex and its two
     neighbours in the loop) becomes a face of its own, tilted, and the rest of the face stays (a triangle face
     tilts whole; a face the move runs in the plane of stays whole). Where the corner triangle would leave the
-    face (a reflex corner) the face is triangulated.
+    face (a reflex corner: the inner corners of a slot or a step on its end faces) the face's triangles at the
+    vertex (:func:`reflex_fan`) tilt, each a face of its own, and the rest of the face stays, one face per piece
+    between them: triangulated whole, the triangles away from the vertex would stay coplanar neighbours, which no
+    model may have.
     """
     v = np.array(poly.vertices)
     moved = v.copy()
@@ -71,8 +74,45 @@ def move_vertex(poly: Polyhedron, vertex: int, offset: float, name: str | None =
             faces.append((prev, vertex, nxt))
             faces.append(tuple(i for i in loop if i != vertex))
         else:
-            faces.extend(triangulate_polygon(v, loop, n))
+            fan, rest = reflex_fan(v, loop, n, vertex)
+            faces.extend(fan)
+            faces.extend(rest)
     return Polyhedron.from_faces(moved, faces, name=name or f"{poly.name}_v{vertex}_{offset * 1e3:g}mm")
+
+
+def reflex_fan(v: np.ndarray, loop: tuple[int, ...], normal: np.ndarray, vertex: int
+               ) -> tuple[list[tuple[int, ...]], list[tuple[int, ...]]]:  # fmt: skip
+    """A face's loop (``v`` the vertex positions, ``normal`` its outward normal) split at ``vertex``: the triangles
+    of its triangulation (:func:`~haptic.geometry.polyhedron.triangulate_polygon`) that have ``vertex`` as a
+    corner, and the rest of the face as loops, one per piece of the face that they leave (the triangles of a piece
+    joined across their shared edges; every loop counterclockwise about ``normal``, as the face's). A move of
+    ``vertex`` off the face's plane tilts those triangles and no more of the face."""
+    tris = triangulate_polygon(v, loop, normal)
+    fan = [t for t in tris if vertex in t]
+    rest = [t for t in tris if vertex not in t]
+    pieces: list[list[tuple[int, int, int]]] = []
+    for t in rest:  # join the triangles that share an edge, piece by piece
+        sides = {frozenset(e) for e in ((t[0], t[1]), (t[1], t[2]), (t[2], t[0]))}
+        joined = [p for p in pieces if any(sides & {frozenset(e) for q in p
+                                                    for e in ((q[0], q[1]), (q[1], q[2]), (q[2], q[0]))})]  # fmt: skip
+        merged = [t] + [q for p in joined for q in p]
+        pieces = [p for p in pieces if p not in joined] + [merged]
+    loops = []
+    for p in pieces:
+        directed = [e for q in p for e in ((q[0], q[1]), (q[1], q[2]), (q[2], q[0]))]
+        inner = set(directed) & {(b, a) for a, b in directed}
+        nxt = {a: b for a, b in directed if (a, b) not in inner}
+        start = next(iter(nxt))
+        out, cur = [start], nxt[start]
+        while cur != start:
+            if len(out) > len(nxt):
+                raise ModelError(f"the rest of face {list(loop)} past vertex {vertex} is not one loop per piece")
+            out.append(cur)
+            cur = nxt[cur]
+        if len(out) != len(nxt):
+            raise ModelError(f"the rest of face {list(loop)} past vertex {vertex} is not one loop per piece")
+        loops.append(tuple(out))
+    return fan, loops
 
 
 def _in_triangle(v: np.ndarray, tri: tuple[int, int, int], i: int, normal: np.ndarray) -> bool:
@@ -147,4 +187,4 @@ def chamfer_edge(poly: Polyhedron, edge: int, size: float, name: str | None = No
     return Polyhedron.from_faces(np.array(points), faces, name=name or f"{poly.name}_e{edge}_ch{size * 1e3:g}mm")
 
 
-__all__ = ["chamfer_edge", "move_vertex", "scale_dimension", "vertex_normal"]
+__all__ = ["chamfer_edge", "move_vertex", "reflex_fan", "scale_dimension", "vertex_normal"]

@@ -5,6 +5,7 @@ import pytest
 
 from haptic.errors import ModelError
 from haptic.geometry import load_library
+from haptic.geometry.distance import surface_distance
 from haptic.geometry.perturb import chamfer_edge, move_vertex, scale_dimension, vertex_normal
 from haptic.geometry.shapes import box
 
@@ -66,3 +67,49 @@ def test_a_corner_whose_triangle_holds_another_vertex_is_refused():
         move_vertex(lblock, 0, 0.004)
     q = move_vertex(lblock, 2, 0.004)
     assert q.n_faces == lblock.n_faces + 3 and q.volume > lblock.volume
+
+
+@pytest.mark.parametrize("name", ["BOX01N", "BOX01P"])
+def test_a_slot_or_step_corner_moves_tilting_its_end_faces_triangles_at_it(name):
+    """The inner corners of BOX01N's slot and BOX01P's step are reflex on the end faces (their corner triangle lies
+    off the face). Triangulated whole, an end face left coplanar neighbours and the move was refused at every such
+    corner, so the benchmarks never moved one. Now the end face's triangles at the corner tilt, the rest of it
+    stays one face per piece in its plane, and the variant differs from the model only on the triangles at the
+    corner."""
+    p = LIB[name]
+    reflex = [v for v in range(p.n_vertices) if any(
+        float(np.cross(p.vertices[v] - p.vertices[lp[lp.index(v) - 1]],
+                       p.vertices[lp[(lp.index(v) + 1) % len(lp)]] - p.vertices[v]) @ p.face_normals[f]) < 0
+        for f, lp in enumerate(p.faces) if v in lp)]  # fmt: skip
+    assert len(reflex) == 4
+    for v in reflex:
+        for mm in (2, 4, 8):
+            q = move_vertex(p, v, mm * 1e-3)
+            w = int(np.argmin(np.linalg.norm(q.vertices - (p.vertices[v] + mm * 1e-3 * vertex_normal(p, v)), axis=1)))
+            assert np.linalg.norm(q.vertices[w] - p.vertices[v]) > 1e-3
+            for f, loop in enumerate(q.faces):
+                if w in loop:
+                    continue
+                pts = q.vertices[list(loop)]
+                assert np.all(surface_distance(p, np.vstack([pts, pts.mean(axis=0)])) < 1e-9), (v, mm, f)
+            assert q.volume > p.volume
+
+
+def test_a_reflex_corners_fan_and_the_rest_of_its_face_cover_the_face():
+    """BOX01N's front face split at its slot's corner: triangles at the corner, and the rest in pieces whose loops
+    turn as the face's, the areas adding up to the face's."""
+    from haptic.geometry.perturb import reflex_fan
+
+    p = LIB["BOX01N"]
+    f = next(f for f, lp in enumerate(p.faces) if len(lp) == 8)
+    n = p.face_normals[f]
+
+    def area(loop):
+        pts = p.vertices[list(loop)]
+        return 0.5 * float(sum(np.cross(pts[k], pts[(k + 1) % len(pts)]) for k in range(len(pts))) @ n)
+
+    for v in p.faces[f]:
+        fan, rest = reflex_fan(p.vertices, p.faces[f], n, v)
+        assert fan and all(v in t for t in fan) and all(v not in lp for lp in rest)
+        assert all(area(x) > 0 for x in (*fan, *rest))
+        assert abs(sum(area(x) for x in (*fan, *rest)) - area(p.faces[f])) < 1e-12
