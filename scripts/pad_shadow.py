@@ -34,6 +34,7 @@ from haptic.episode.worlds import build_episode
 from haptic.errors import HapticError, ModelError
 from haptic.geometry import Polyhedron, load_library
 from haptic.geometry.distance import point_triangle_distance, surface_distance
+from haptic.geometry.io import atomic_write
 from haptic.geometry.kernels import contains
 from haptic.geometry.perturb import chamfer_edge, move_vertex
 from haptic.geometry.se3 import SE3
@@ -214,8 +215,7 @@ def main(argv: list[str] | None = None) -> int:
               f"of {len(rows)} episodes; {shadowed} in the pad's shadow (no move felt by a free pad clear of the "
               f"table){felt_by}")  # fmt: skip
         if args.json:
-            with open(args.json, "w") as fh:
-                json.dump(rows, fh, indent=1)
+            atomic_write(args.json, json.dumps(rows, indent=1))
         return 0
     except HapticError as exc:
         print(f"error: {exc}", file=sys.stderr)

@@ -46,6 +46,7 @@ from haptic.episode.worlds import build_episode
 from haptic.errors import HapticError
 from haptic.geometry import load_library
 from haptic.geometry.distance import surface_distance
+from haptic.geometry.io import atomic_write
 from haptic.planning.verify import TABLE_CONTACT, reachable_features, table_pins
 from haptic.sim import compose_scene
 from haptic.sim.reach import FingertipTarget, ReachSolver
@@ -365,8 +366,7 @@ def main(argv: list[str] | None = None) -> int:
             print("probes on the hand of the faces some finger reaches: "
                   + ", ".join(f"{k} {v}" for k, v in probes.most_common()))
         if args.json:
-            with open(args.json, "w") as fh:
-                json.dump(rows, fh, indent=1)
+            atomic_write(args.json, json.dumps(rows, indent=1))
         return 0
     except HapticError as exc:
         print(f"error: {exc}", file=sys.stderr)
