@@ -76,31 +76,19 @@ def variants(poly: Polyhedron, rng: np.random.Generator) -> list[tuple[str, str,
     return out
 
 
-def _surface_points(poly: Polyhedron, spacing: float) -> np.ndarray:
-    """Points over every face of ``poly`` about ``spacing`` apart [m] (vertices and edges included)."""
-    out = [np.asarray(poly.vertices, dtype=float)]
-    for i, j, k in poly.triangles:
-        a, b, c = (np.asarray(poly.vertices[x], dtype=float) for x in (i, j, k))
-        n = max(1, int(np.ceil(max(np.linalg.norm(b - a), np.linalg.norm(c - a), np.linalg.norm(c - b)) / spacing)))
-        u, v = np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij")
-        keep = u + v <= n
-        out.append(a + (u[keep] / n)[:, None] * (b - a) + (v[keep] / n)[:, None] * (c - a))
-    return np.concatenate(out)
-
-
 def difference_top(variant: Polyhedron, base: Polyhedron, pose: dict, table_z: float, spacing: float = 1e-3,
                    tol: float = 3e-4) -> float | None:  # fmt: skip
     """How high above the table (``table_z``) the highest point lies where ``variant`` and ``base`` (one model
     frame) differ, at the variant's resting ``pose`` (a record's ``pose``): points of either surface farther than
     ``tol`` from the other's [m]; None where they do not differ."""
-    from haptic.geometry.distance import surface_distance
+    from haptic.geometry.distance import surface_distance, surface_grid
     from haptic.geometry.se3 import quat_to_matrix
 
     rot = quat_to_matrix(np.asarray(pose["quat_wxyz"], dtype=float))
     t = np.asarray(pose["translation_m"], dtype=float)
     tops = []
     for a, b in ((variant, base), (base, variant)):
-        p = _surface_points(a, spacing)
+        p = surface_grid(a, spacing)
         off = p[surface_distance(b, p) > tol]
         if len(off):
             tops.append(float((off @ rot.T + t)[:, 2].max()) - table_z)

@@ -33,7 +33,7 @@ from haptic.episode.spec import EpisodeSpec
 from haptic.episode.worlds import build_episode
 from haptic.errors import HapticError, ModelError
 from haptic.geometry import Polyhedron, load_library
-from haptic.geometry.distance import point_triangle_distance, surface_distance
+from haptic.geometry.distance import point_triangle_distance, surface_distance, surface_grid
 from haptic.geometry.io import atomic_write
 from haptic.geometry.kernels import contains
 from haptic.geometry.perturb import chamfer_edge, move_vertex
@@ -75,17 +75,6 @@ def _signed(surface, points: np.ndarray) -> np.ndarray:
     return np.where(surface.contains(points), -d, d)
 
 
-def _surface_points(surface) -> np.ndarray:
-    out = [np.asarray(surface.vertices, dtype=float)]
-    for i, j, k in surface.triangles:
-        a, b, c = (np.asarray(surface.vertices[x], dtype=float) for x in (i, j, k))
-        n = max(1, int(np.ceil(max(np.linalg.norm(b - a), np.linalg.norm(c - a), np.linalg.norm(c - b)) / SAMPLE)))
-        u, v = np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij")
-        keep = u + v <= n
-        out.append(a + (u[keep] / n)[:, None] * (b - a) + (v[keep] / n)[:, None] * (c - a))
-    return np.concatenate(out)
-
-
 def felt(model: Polyhedron, moved, world_from_model: SE3, table_z: float, radius: float,
          step: float = 0.002) -> tuple[float, list[int]]:  # fmt: skip
     """How deep a free pad of ``radius``, its lowest point at least :data:`PAD_LIMIT` over the table (``table_z``),
@@ -97,7 +86,7 @@ def felt(model: Polyhedron, moved, world_from_model: SE3, table_z: float, radius
     table comes near."""
     from scipy.spatial import cKDTree
 
-    pm, pv = _surface_points(model), _surface_points(moved)
+    pm, pv = surface_grid(model, SAMPLE), surface_grid(moved, SAMPLE)
     where = np.concatenate([pm[surface_distance(moved, pm) > DIFFER], pv[surface_distance(model, pv) > DIFFER]])
     if not len(where):
         return 0.0, []
