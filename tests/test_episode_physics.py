@@ -1410,3 +1410,26 @@ def test_a_vertex_move_onto_a_face_leaning_under_measures_it_by_several_short_ls
                                    fails="stroke on the next face failed")  # fmt: skip
     assert said and not failed, failed
     assert _within_bounds(ep)
+
+
+@pytest.mark.parametrize(("model", "moves"), [("cad_lbracket", 1), ("hull_06", 4)])
+def test_a_next_face_lost_after_a_slanted_crossing_is_touched_afresh_in_the_rolls_frame(tmp_path, model, moves):
+    # hull_06 of the sized formula corpus, seed 1: the fourth move slid across the top 20° off the line of the edge it
+    # crossed, 2.8 mm from the edge's end; the roll read the next face 0.7° off and the edge 0.5° off, but the stroke
+    # there ran into the corner (its rows spanning 1.4 mm), and the touches afresh, the edge taken square to the
+    # travel (70° off it), read the rims round the corner six times: "too few contacts on the next face". cad_lbracket,
+    # seed 1: the first move crossed the top's edge onto an inner wall of the L 8 mm from its inner corner, 22° off
+    # square; touched afresh so, the pad read rims or nothing. Touched afresh once more with the edge as the roll
+    # measured it, both measure the next face (hull_06 clear of the edge's end, cad_lbracket straight down the wall).
+    from haptic.executor.physics import NEXT_FACE_LOST
+
+    results = []
+    obs = EpisodeObserver(on_move=lambda n, r, *a: results.append(r), on_failed_move=lambda n, r: results.append(r))
+    ep = build_episode(EpisodeSpec(model=model, seed=1, executor="physics", verify="full",
+                                   models=_sized_corpus(tmp_path), max_moves=moves))  # fmt: skip
+    ep.run(None, obs)
+    face = [r for r in results if r.move is not None and r.move.kind == "face"]
+    rolled = [r for r in face if any("the edge as the roll measured it" in x for x in r.info.get("recoveries", ()))]
+    assert rolled and all(r.ok for r in rolled), [r.reason for r in face]
+    assert not any(r.reason.startswith(NEXT_FACE_LOST) for r in face if not r.ok), [r.reason for r in face]
+    assert _within_bounds(ep)

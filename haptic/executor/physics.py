@@ -713,8 +713,40 @@ class PhysicsExecutor(LandingSearch):
                    else f"too few contacts on the next face ({self.segmenter.face_refusal})")  # fmt: skip
             if st.status == "unstable":
                 return st.status, why, None, None, None
-            return self._reacquire(kind, n_a, direction, corner, r.trace, n_b, pieces, away_from, why)
+            out = self._reacquire(kind, n_a, direction, corner, r.trace, n_b, pieces, away_from, why)
+            if out[0] == "unreachable" and out[1] == why and st.ok and not rim:
+                again = self._reacquire_rolled(kind, n_a, direction, corner, r, pieces, away_from, why)
+                if again is not None:
+                    return again
+            return out
         return "ok", "", r.trace, st.trace, fit
+
+    def _reacquire_rolled(self, kind: str, n_a: np.ndarray, direction: np.ndarray, corner: np.ndarray,
+                          roll: PrimitiveResult, pieces: list[PrimitiveResult], away_from, why: str):  # fmt: skip
+        """For :meth:`_cross_and_acquire`: a roll that settled on the next face, a stroke there that measured too
+        little of it (``why``), and touches afresh past the edge in the frame of the travel (``direction``) that
+        found no face either: the face touched afresh once more in the roll's frame, the edge as the roll measured
+        it (``edge_direction``, from its settled normal) and that normal the first guess. :meth:`_reacquire` takes
+        the edge square to the travel, and a travel crossing at a slant puts it off the edge by as much (hull_06 of
+        the formula corpus, seed 1: a slide 20° off the edge's line, the edge so taken 70° off, the normal guessed
+        from the roll's turned the wrong way, and six touches afresh read the rims at the corner beyond; the roll had
+        read the next face 0.7° off and the edge 0.5° off). Only after the travel's frame failed: the roll's normal
+        may itself be a rim's or a corner's reading (cad_lbracket, seed 1: the pad in an inner corner between two
+        walls), where the travel's frame finds the face and the roll's would not. What :meth:`_reacquire` returns
+        when it measured the face so; None when it did not, or when the two frames' edges lie within
+        :attr:`PhysicsSettings.reacquire_cone` of each other (tried already)."""
+        d = in_plane(np.asarray(direction, dtype=float), n_a)
+        square = in_plane(np.cross(roll.info["edge_direction"], n_a), n_a)
+        if d is None or square is None:
+            return None
+        d, square = unit(d), unit(square)
+        if float(square @ d) < 0:
+            square = -square
+        if float(square @ d) > math.cos(self.settings.reacquire_cone):
+            return None
+        out = self._reacquire(kind, n_a, square, corner, roll.trace, roll.info["normal"], pieces, away_from,
+                              f"{why}, the edge as the roll measured it")  # fmt: skip
+        return out if out[0] == "ok" else None
 
     def _stroke_tilted(self, st: PrimitiveResult, away: np.ndarray, along: np.ndarray, pieces: list[PrimitiveResult],
                        step_in: float | None = None) -> tuple[FaceFit, PrimitiveResult] | None:  # fmt: skip
