@@ -888,10 +888,13 @@ distal link close above: antiprism_08 of the formula corpus, seed 1, the index t
 is 4.9 mm clear. Measured (the formula corpus's twelve episodes that probe, seed 1): 1 mm and 6 mm send the same
 probes as 3 mm, every one measured."""
 
-TOUCH_REACH = ReachSettings(clearance=TOUCH_CLEARANCE, pads_touch=True, tip_table_clearance=0.0)
-"""The reach test of a probe's touch (:func:`finger_probe`): the probing pad on the hypothesised object, every other
-link :data:`TOUCH_CLEARANCE` from it and from the table (the fingertip may be near the table: the pad's place on the
-face is chosen clear of it)."""
+TOUCH_REACH = ReachSettings(clearance=0.0, pads_touch=True, tip_table_clearance=0.0)
+"""The reach test of a probe's touch (:func:`finger_probe`): the probing pad on the hypothesised object, the finger
+pointing as it came, every other link kept out of the object and the table but not held off them, as the closing
+does not hold them (its configurations the solver's for the pad's target alone, near the posture it arrived in); their
+clearance there is then weighed against :data:`TOUCH_CLEARANCE`. Held off by the solver (its ``clearance`` 3 mm), the
+hand turned about the finger to keep the link clear, and the index tilted 30° passed where the closing leaves its
+link 0.06 mm from the face above."""
 
 TOUCH_STEP = 2.5e-4
 """The pad's way along a probe's line is swept in steps of this for where it touches the hypothesised object [m]."""
@@ -916,7 +919,9 @@ def _clear_at_touch(touch: PlacementReach, h, name: str, point: np.ndarray | Non
     meets nothing)."""
     if point is None:
         return True
-    return touch._solver(h).solve([FingertipTarget(name, point, unit(axis))], start=np.asarray(path)[-1]).ok
+    solver = touch._solver(h)
+    r = solver.solve([FingertipTarget(name, point, unit(axis))], start=np.asarray(path)[-1])
+    return r.ok and solver.object_clearance(r.qpos, [name]) >= TOUCH_CLEARANCE
 
 
 def finger_probe(move: ProbeMove, hypotheses: Sequence, reach: PlacementReach | None = None,

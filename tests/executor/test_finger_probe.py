@@ -7,6 +7,8 @@ executor."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
@@ -180,3 +182,15 @@ def test_the_touch_is_where_the_pad_first_meets_the_hypothesised_model():
     grazing = touch_point(line(0.045), h)
     assert grazing is not None and abs(grazing[0] - (0.04 + np.sqrt(PAD_RADIUS**2 - 0.005**2))) < 3e-4
     assert touch_point(line(0.06), h) is None  # 20 mm past the rim: the pad passes by
+
+
+def test_a_finger_whose_link_would_lie_on_the_face_above_is_not_sent(tmp_path):
+    # The index tilted 30° reaches the starts of the three lines to that face, every link 8 mm clear there; at the
+    # touch, pointing as it came, its distal link lies 0.06-0.6 mm from the face above (the probe along the first line
+    # measured nothing, along the second it measured the face). With no other tilt no finger is sent
+    ep = build_episode(EpisodeSpec(model="antiprism_08", seed=1, executor="physics", verify="full",
+                                   models=_sized_corpus(tmp_path)))  # fmt: skip
+    poly, pose = ep.true_model, ep.world_from_model
+    h = Hypothesis(model="antiprism_08", poly=poly, world_from_model=pose, faces={}, edges={}, vertices={})
+    for line in table_face_lines(poly, pose, *PRESSED_FROM_BEHIND, ep.config):
+        assert finger_probe(line, [h], tilts=(math.radians(30.0),)) is None
