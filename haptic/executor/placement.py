@@ -885,8 +885,9 @@ start, 30 mm before the touch; a finger tilted less than its face leans under to
 distal link close above: antiprism_08 of the formula corpus, seed 1, the index tilted 30° toward a face leaning under
 45°, its distal link 0.06 mm from the face above at the touch, met that face pressing and stroking (the pad sensed
 0.1-0.4 N against the 1 N asked, its stroke spanned 6.5 × 1.4 mm, the probe measured nothing); tilted 55° the link
-is 4.9 mm clear. Measured (the formula corpus's twelve episodes that probe, seed 1): 1 mm and 6 mm send the same
-probes as 3 mm, every one measured."""
+is 4.9 mm clear. Measured (the formula corpus's twelve episodes that probe, seed 1): 1 mm measures every probe as 3 mm
+does (19 of 19, hull_02 along other lines); 6 mm leaves faces no finger reaches and picks postures that fail:
+probes 15 of 17, antiprism_05 no longer confirmed."""
 
 TOUCH_REACH = ReachSettings(clearance=0.0, pads_touch=True, tip_table_clearance=0.0)
 """The reach test of a probe's touch (:func:`finger_probe`): the probing pad on the hypothesised object, the finger
