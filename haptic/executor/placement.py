@@ -41,6 +41,7 @@ import numpy as np
 
 from haptic.executor.physics_probe import _highest_contact, _leading_segment, rise
 from haptic.executor.primitives import PrimitiveResult
+from haptic.geometry.distance import surface_distance
 from haptic.geometry.se3 import perpendicular, unit
 from haptic.matching.trace import PHASES, ContactTrace
 from haptic.planning.handpath import CLEARANCE, LIFT, safe_height
@@ -868,49 +869,104 @@ object and the table, the path held to at least 4 mm (a placement's 20 mm leave 
 overhang: BOX01P, seed 1, the side under its step, which the thumb turned along the line touches with 8 mm)."""
 
 
-PROBE_TILTS = (math.radians(60.0), math.radians(30.0))
+PROBE_TILTS = tuple(math.radians(a) for a in (60.0, 55.0, 50.0, 45.0, 40.0, 35.0, 30.0))
 """Where no finger reaches a probe's line pointing along it, the finger's axis turned from straight down toward the
-line's level direction by these angles, in turn (:func:`finger_probe`): a face leaning under is pressed level with
-the finger tilted (trapezohedron_05 of the formula corpus, seed 1, a face leaning under 35.5°: the index pointing
-down met it with its medial link, tilted 60° it measured the face within 0.2°)."""
+line's level direction by these angles, in turn, the most first (:func:`finger_probe`): a face leaning under is pressed
+level with the finger tilted (trapezohedron_05 of the formula corpus, seed 1, a face leaning under 35.5°: the index
+pointing down met it with its medial link, tilted 60° it measured the face within 0.2°). The solver's path to a
+line's start may stop short at one tilt and not at the next (antiprism_08 of the formula corpus, seed 1, a face leaning
+under 45°: the index reaches the start tilted 55° and 40°, not 60°, 50° or 45°), hence the 5° steps."""
+
+
+TOUCH_CLEARANCE = 0.003
+"""Least distance of the probing finger's links (its pad aside) from the hypothesised object where its pad touches
+the face, pointing as it came (:func:`finger_probe`) [m]. The reach test keeps every link 8 mm clear at the line's
+start, 30 mm before the touch; a finger tilted less than its face leans under touches it with the back of its pad, the
+distal link close above: antiprism_08 of the formula corpus, seed 1, the index tilted 30° toward a face leaning under
+45°, its distal link 0.06 mm from the face above at the touch, met that face pressing and stroking (the pad sensed
+0.1-0.4 N against the 1 N asked, its stroke spanned 6.5 × 1.4 mm, the probe measured nothing); tilted 55° the link
+is 4.9 mm clear. Measured (the formula corpus's twelve episodes that probe, seed 1): 1 mm measures every probe as 3 mm
+does (19 of 19, hull_02 along other lines); 6 mm leaves faces no finger reaches and picks postures that fail:
+probes 15 of 17, antiprism_05 no longer confirmed."""
+
+TOUCH_REACH = ReachSettings(clearance=0.0, pads_touch=True, tip_table_clearance=0.0)
+"""The reach test of a probe's touch (:func:`finger_probe`): the probing pad on the hypothesised object, the finger
+pointing as it came, every other link kept out of the object and the table but not held off them, as the closing
+does not hold them (its configurations the solver's for the pad's target alone, near the posture it arrived in); their
+clearance there is then weighed against :data:`TOUCH_CLEARANCE`. Held off by the solver (its ``clearance`` 3 mm), the
+hand turned about the finger to keep the link clear, and the index tilted 30° passed where the closing leaves its
+link 0.06 mm from the face above."""
+
+TOUCH_STEP = 2.5e-4
+"""The pad's way along a probe's line is swept in steps of this for where it touches the hypothesised object [m]."""
+
+
+def touch_point(move: ProbeMove, h) -> np.ndarray | None:
+    """Where the pad centre is when the pad, following ``move``'s line, first touches hypothesis ``h``'s model at its
+    pose (the line's leading point at the start, as :func:`pad_target` puts it), or None when it meets nothing."""
+    if h.world_from_model is None:
+        return None
+    u = np.asarray(move.direction, dtype=float)
+    t = np.arange(0.0, float(move.length) + TOUCH_STEP, TOUCH_STEP)
+    centres = np.asarray(move.start, dtype=float) + (t - PAD_RADIUS)[:, None] * u
+    near = surface_distance(h.poly, h.model_from_world.apply(centres)) <= PAD_RADIUS
+    return centres[int(np.argmax(near))] if near.any() else None
+
+
+def _clear_at_touch(touch: PlacementReach, h, name: str, point: np.ndarray | None, axis: np.ndarray,
+                    path: np.ndarray) -> bool:  # fmt: skip
+    """Whether finger ``name``, its pad brought from the end of ``path`` to its touch ``point`` pointing along
+    ``axis``, keeps its other links :data:`TOUCH_CLEARANCE` clear of hypothesis ``h``'s model (True where the line
+    meets nothing)."""
+    if point is None:
+        return True
+    solver = touch._solver(h)
+    r = solver.solve([FingertipTarget(name, point, unit(axis))], start=np.asarray(path)[-1])
+    return r.ok and solver.object_clearance(r.qpos, [name]) >= TOUCH_CLEARANCE
 
 
 def finger_probe(move: ProbeMove, hypotheses: Sequence, reach: PlacementReach | None = None,
-                 fingers: Sequence[str] = FINGERS,
-                 tilts: Sequence[float] = PROBE_TILTS) -> ProbeMove | None:  # fmt: skip
+                 fingers: Sequence[str] = FINGERS, tilts: Sequence[float] = PROBE_TILTS,
+                 touch: PlacementReach | None = None) -> ProbeMove | None:  # fmt: skip
     """Probe ``move`` carried out by the first of ``fingers`` whose pad the hand can put at the line's start pointing
     along the line, clear of the most likely of ``hypotheses`` (its model at its pose; the planner's reach test of
     placements, ``reach``, asked for a placement of that one finger); failing that, the first with its axis turned
-    from straight down toward the line by one of ``tilts`` [rad] (a line with a level part). The move with that
-    finger and the path, or None when no finger reaches. The finger and the wrist's turn are the reach solver's
-    choice, the hand's way with them the path the executor follows (:func:`finger_probe_move`)."""
+    from straight down toward the line by one of ``tilts`` [rad] (a line with a level part). A finger counts only if,
+    pointing so, it can also follow the line to where its pad touches the model with its other links clear of it
+    (``touch``, :data:`TOUCH_REACH`). The move with that finger and the path, or None when no finger reaches. The
+    finger and the wrist's turn are the reach solver's choice, the hand's way with them the path the executor follows
+    (:func:`finger_probe_move`)."""
     reach = reach if reach is not None else PlacementReach(FINGER_PROBE_REACH)
+    touch = touch if touch is not None else PlacementReach(TOUCH_REACH)
+    h = hypotheses[0]
     line = (np.asarray(move.start, dtype=float), np.asarray(move.direction, dtype=float), float(move.length))
+    point = touch_point(move, h)
     for name in fingers:
         got = reach(PlacementMove((FingerApproach(name, *line),)), hypotheses, own_only=True)
-        if got is not None:
+        if got is not None and _clear_at_touch(touch, h, got.fingers[0].finger, point, line[1], got.path):
             return replace(move, finger=got.fingers[0].finger, path=got.path)
     level = line[1] * np.array([1.0, 1.0, 0.0])
     if not tilts or float(np.linalg.norm(level)) < 0.1:
         return None
     level = unit(level)
-    solver = reach._solver(hypotheses[0])
+    solver = reach._solver(h)
     for tilt in tilts:
         axis = math.cos(tilt) * np.array([0.0, 0.0, -1.0]) + math.sin(tilt) * level
         for name in fingers:
             r = solver.solve([FingertipTarget(name, pad_target(FingerApproach(name, *line)), axis)])
-            if r.ok:
+            if r.ok and _clear_at_touch(touch, h, name, point, axis, r.path):
                 return replace(move, finger=name, path=r.path)
     return None
 
 
 def finger_reach(fingers: Sequence[str] = FINGERS, tilts: Sequence[float] = PROBE_TILTS) -> Callable:
     """The planner's reach test of a probe by any finger (``PlannerConfig.finger_reach``): :func:`finger_probe` with
-    one reach test (:data:`FINGER_PROBE_REACH`, its compiled scenes kept) for the episode."""
-    reach = PlacementReach(FINGER_PROBE_REACH)
+    one reach test of the lines' starts (:data:`FINGER_PROBE_REACH`) and one of the touches (:data:`TOUCH_REACH`), their
+    compiled scenes kept, for the episode."""
+    reach, touch = PlacementReach(FINGER_PROBE_REACH), PlacementReach(TOUCH_REACH)
 
     def test(move: ProbeMove, hypotheses: Sequence) -> ProbeMove | None:
-        return finger_probe(move, hypotheses, reach, fingers, tilts)
+        return finger_probe(move, hypotheses, reach, fingers, tilts, touch)
 
     return test
 
@@ -921,5 +977,6 @@ def reach_oracle(fingers: int) -> Callable | None:
 
 
 __all__ = ["FINGER_PROBE_REACH", "HOLD_CLEARANCE", "PROBE_SETTINGS", "PROBE_TILTS", "REACH_CLEARANCE", "SETTINGS",
-           "TIP_TABLE_CLEARANCE", "PlacementReach", "PlacementSettings", "finger_probe", "finger_probe_move",
-           "finger_reach", "hand_solver", "pad_target", "placement_move", "reach_oracle"]
+           "TIP_TABLE_CLEARANCE", "TOUCH_CLEARANCE", "TOUCH_REACH", "PlacementReach", "PlacementSettings",
+           "finger_probe", "finger_probe_move", "finger_reach", "hand_solver", "pad_target", "placement_move",
+           "reach_oracle"]

@@ -194,6 +194,13 @@ class ReachSolver:
         self.configuration.update(np.asarray(qpos, dtype=float))
         return self._distance(self._hand_geoms, self._table_geoms)
 
+    def object_clearance(self, qpos: np.ndarray, fingers: Sequence[str] = ()) -> float:
+        """Least distance of the hand's links from the object at joint configuration ``qpos`` [m] (negative: inside
+        it), the ``fingers``' pads left out where they may touch it (``pads_touch``); 1 m in a scene without one."""
+        self.configuration.update(np.asarray(qpos, dtype=float))
+        pads = self._exempt(fingers)
+        return self._distance([g for g in self._hand_geoms if g not in pads], self._object_geoms)
+
     # -- construction helpers --------------------------------------------------------------------------------
     def _geom(self, name: str) -> int:
         g = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_GEOM, name)

@@ -7,13 +7,18 @@ executor."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
 from haptic.episode.spec import EpisodeSpec
 from haptic.episode.worlds import build_episode
-from haptic.executor.placement import finger_probe
+from haptic.executor.placement import finger_probe, touch_point
+from haptic.geometry.se3 import SE3
+from haptic.geometry.shapes import box
 from haptic.matching.trace import PHASES
+from haptic.planning.finger_faces import table_face_lines
 from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import FINGER_NAMES, ProbeMove
 from haptic.sim.scene import FINGERS, PAD_RADIUS
@@ -137,3 +142,55 @@ def test_the_hand_keeps_to_the_planned_way_under_a_face_leaning_over_it(tmp_path
                                               models=_sized_corpus(tmp_path)))  # fmt: skip
     assert not [x for x in failed if "on the planned way" in x], failed
     assert rec.probes >= 2 and rec.outcome == "recognized" and rec.correct, rec.detail
+
+
+PRESSED_FROM_BEHIND = (3, 13)
+"""antiprism_08 of the sized formula corpus at seed 1: a vertex resting on the table and a face at it leaning under
+45°, which the verification probes with the index tilted toward it."""
+
+
+def test_a_finger_tilted_less_than_its_face_leans_is_not_sent(tmp_path):
+    # The verification's first line to the face (nearest the vertex, 10 mm of room) was given the index tilted 30°:
+    # less than the face leans under, so the pad touched it with its back and the distal link, 0.06 mm from the face
+    # above, met it; the pad sensed 0.1-0.4 N, its stroke spanned 6.5 × 1.4 mm, and the probe measured nothing ("the
+    # stroke found no face"). The reach test now follows the finger to its touch, its links clear of the object
+    ep = _episode("antiprism_08", _sized_corpus(tmp_path))
+    poly, pose = ep.true_model, ep.world_from_model
+    v, f = PRESSED_FROM_BEHIND
+    line = table_face_lines(poly, pose, v, f, ep.config)[0]
+    h = Hypothesis(model="antiprism_08", poly=poly, world_from_model=pose, faces={}, edges={}, vertices={})
+    move = finger_probe(line, [h])
+    assert move is not None and move.path is not None
+    res = ep.executor.execute(move)
+    assert res.ok and len(res.components) == 1, res.reason
+    n = pose.rotate(poly.face_normals[f])
+    assert np.degrees(np.arccos(np.clip(res.components[0].normal @ n, -1.0, 1.0))) < 1.0
+
+
+def test_the_touch_is_where_the_pad_first_meets_the_hypothesised_model():
+    # a 40 mm cube with a corner at the origin; level lines toward its +x face (x = 40 mm), each starting (the pad's
+    # leading point) 50 mm out from it, at mid-height
+    h = Hypothesis(model="cube", poly=box(0.04, 0.04, 0.04), world_from_model=SE3.identity(), faces={}, edges={},
+                   vertices={})  # fmt: skip
+
+    def line(y: float) -> ProbeMove:
+        return ProbeMove(np.array([0.09, y, 0.02]), np.array([-1.0, 0.0, 0.0]), 0.06)
+
+    at = touch_point(line(0.02), h)
+    assert at is not None and np.allclose(at, [0.04 + PAD_RADIUS, 0.02, 0.02], atol=3e-4)
+    # 5 mm past the face's rim the pad meets the cube's edge, before the line's leading point would reach x = 40 mm
+    grazing = touch_point(line(0.045), h)
+    assert grazing is not None and abs(grazing[0] - (0.04 + np.sqrt(PAD_RADIUS**2 - 0.005**2))) < 3e-4
+    assert touch_point(line(0.06), h) is None  # 20 mm past the rim: the pad passes by
+
+
+def test_a_finger_whose_link_would_lie_on_the_face_above_is_not_sent(tmp_path):
+    # The index tilted 30° reaches the starts of the three lines to that face, every link 8 mm clear there; at the
+    # touch, pointing as it came, its distal link lies 0.06-0.6 mm from the face above (the probe along the first line
+    # measured nothing, along the second it measured the face). With no other tilt no finger is sent
+    ep = build_episode(EpisodeSpec(model="antiprism_08", seed=1, executor="physics", verify="full",
+                                   models=_sized_corpus(tmp_path)))  # fmt: skip
+    poly, pose = ep.true_model, ep.world_from_model
+    h = Hypothesis(model="antiprism_08", poly=poly, world_from_model=pose, faces={}, edges={}, vertices={})
+    for line in table_face_lines(poly, pose, *PRESSED_FROM_BEHIND, ep.config):
+        assert finger_probe(line, [h], tilts=(math.radians(30.0),)) is None
