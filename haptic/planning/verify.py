@@ -395,7 +395,7 @@ def corners_out_of_shadow(poly: Polyhedron, world_from_model: SE3, v: int, confi
     """The faces at vertex ``v`` of ``poly`` at ``world_from_model`` not in ``near`` (measured within their corner
     at ``v``) whose corner at ``v`` rises out of the face's shadow (:func:`table_shadow`'s test: a corner above
     the height under which no pad pressing the face clear of the table reaches it; the whole face where the corner
-    is reflex); a face on the table is the table's. None without a table."""
+    is reflex); a face on the table is the table's. None without a table (an empty set)."""
     if config.table_z is None:
         return frozenset()
     z = world_from_model.apply(poly.vertices)[:, 2] - config.table_z
@@ -1137,9 +1137,9 @@ def _target_points(poly: Polyhedron, missing: tuple[frozenset[int], frozenset[in
 
 
 __all__ = ["above_shadow", "aimed_face_moves", "choose_verification_move", "cone_top", "corners_out_of_shadow",
-           "hidden_vertices",
-           "plan_verification_move", "face_middle", "reachable_features", "ridge_target", "ridges_out_of_shadow",
-           "shadow_of", "table_shadow", "unmeasured_middles", "verification_probes", "verify_move_budget"]
+           "hidden_vertices", "plan_verification_move", "face_middle", "reachable_features", "ridge_target",
+           "ridges_out_of_shadow", "shadow_of", "table_shadow", "unmeasured_middles", "verification_probes",
+           "verify_move_budget"]
 
 
 MIDDLE_REACH = 5e-3
