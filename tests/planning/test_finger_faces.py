@@ -371,7 +371,22 @@ def test_the_verification_probes_the_corners_that_keep_a_vertex_out_of_the_table
     ver.coverage = Coverage(every, edges, vertices, every, edges, vertices)
     it = Interpretation(poly, 0, {}, {}, {}, {}, pose, 0)
     assert not ver._corner_probe_next([], it) and not ver._ridges_next([], it)
-    assert ver._shadow_probe_next([], it) and len(asked) == 1
+    # the faces rising from the middle measured, the top one 5 mm off its place: the acceptance test rejects the
+    # data as they are, and nothing is probed
+    up = pose.rotate(poly.face_normals)[:, 2]
+    faces = [int(f) for f in np.flatnonzero(up > 0.1)]
+    top = int(np.argmax(up))
+    data = []
+    for shift in (0.005, 0.0):
+        data = []
+        for i, f in enumerate(faces):
+            loop = poly.vertices[list(poly.faces[f])]
+            touched = pose.apply(0.8 * loop.mean(axis=0) + 0.2 * loop)
+            touched += (shift if f == top else 0.0) * pose.rotate(poly.face_normals[f])
+            data.append(DataFace(i, pose.rotate(poly.face_normals[f]), touched, math.radians(1.0), 8e-4))
+        measured = Interpretation(poly, 0, dict(enumerate(faces)), {}, {}, {}, pose, 0)
+        assert len(faces) >= 4 and ver._shadow_probe_next(data, measured) == (shift == 0.0)
+    assert len(asked) == 1
     v, f = next(iter(ver.corner_probes.probed))
     assert v == hidden[0] and f in corners_out_of_shadow(poly, pose, v, config)
     move = ver.choose(ver._hyp, None, {}, ())
