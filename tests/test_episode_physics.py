@@ -528,6 +528,28 @@ def test_vertices_whose_moves_change_only_the_tables_shadow_are_taken_on_trust(t
     assert v["table_shadow_mm"] == v["table_band_mm"] and 25.0 < v["table_shadow_mm"] < 28.0, v
     assert "6 out of the hand's reach off the table" in rec.detail and "on the table" not in rec.detail, rec.detail
 
+@pytest.mark.slow
+def test_vertices_out_of_the_tables_shadow_are_taken_with_their_corners_probed_and_their_ridges_crossed(tmp_path):
+    # trapezohedron_08 of the sized formula corpus (112 mm), seed 1, default options: lying on a kite, two vertices
+    # 11 mm up are out of reach, and nothing placed them by their corners (a kite leaning under 56° leaves the pad no
+    # position within its corner): the verification ended incomplete. The table's shadow takes them with the two
+    # upright kites measured within their corners at each and the edges rising out of the shadow measured: the
+    # verification probes those corners, then crosses the edges, and confirms. Along the way, the index's level
+    # stroke on a kite rising 12° spanned 1 mm across it, under the 1.5 mm a face needs, and the thumb is asked next;
+    # after the thumb's probes the index lay on the table far from the object, and every later move failed rising
+    # from there, until it is brought back over the face it left.
+    failed = []
+    obs = EpisodeObserver(on_failed_move=lambda n, r: failed.append(r.reason))
+    rec = run_episode(EpisodeSpec(model="trapezohedron_08", seed=1, executor="physics",
+                                  models=_sized_corpus(tmp_path)), observer=obs)  # fmt: skip
+    v = rec.verified
+    assert rec.outcome == "recognized" and rec.correct and v["status"] == "confirmed", rec.detail
+    assert v["vertices_shadowed"] == 4 and v["ridges_asked"] and 25.0 < v["table_shadow_mm"] < 27.0, v
+    probes = v["corner_probes"]
+    assert probes["corners_probed"] == 3 and probes["fingers"].get("thumb", 0) >= 1, probes
+    assert not [w for w in failed if "rising above the object" in w], failed
+
+
 def test_a_stalled_verification_relocates_over_the_object_and_measures_what_is_in_reach():
     # BOX01P seed 1 stands upright, its tab 30 mm high on a side. The traced verification measured the top and the
     # tab's upper corners; the tour, pricing the way to the tab's lower corners as a straight line, then kept the pad

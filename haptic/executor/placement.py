@@ -356,6 +356,7 @@ def _placement(ex: PhysicsExecutor, move: PlacementMove, pieces: list[PrimitiveR
         return ex.invalid_result(move, "a finger's line would bring its pad onto the table")
     # 1. leave the surface and rise
     first_piece = len(pieces)  # the placement's way starts here (:func:`_travel`)
+    tip0 = t.tip.copy()
     if t.contact[1] is not None and t.normal is not None:
         res = t.move_free(t.tip + s.lift * t.normal, timeout=t.config.lift_timeout, tol=t.config.lift_tol)
         pieces.append(res)
@@ -370,6 +371,17 @@ def _placement(ex: PhysicsExecutor, move: PlacementMove, pieces: list[PrimitiveR
     c = _Closing(ex, move, s)
     result = _place(ex, move, c, starts, z_safe, pieces, single)
     _restore(ex, c, move, z_safe, pieces, to_start=single)
+    if single and float(t.tip[2]) < z_safe and t.finger not in {f.finger for f in move.fingers}:
+        # the hand turned back to the tracing posture about another finger's pad, which left the exploring pad
+        # wherever that put it: back over where it set out from, straight or else in joint space in its home
+        # posture family (trapezohedron_08 of the formula corpus, seed 1: after the thumb's probe of a kite the
+        # index lay on the table 25 cm from the object, and every later move failed rising from there)
+        over = np.array([tip0[0], tip0[1], z_safe])
+        back = t.move_free(over, timeout=t.config.via_timeout, tol=t.config.via_tol)
+        pieces.append(back)
+        if not back.ok and t.back_to_home_posture(over, at=over):
+            pieces.append(t.move_free(over, timeout=t.config.via_timeout, tol=t.config.via_tol))
+        t.take_trace()
     if result.status != "ok":
         return result
     touched = [i for i in result.info["fingers"] if i["status"] == "touched"]
@@ -962,11 +974,13 @@ def finger_probe(move: ProbeMove, hypotheses: Sequence, reach: PlacementReach | 
 def finger_reach(fingers: Sequence[str] = FINGERS, tilts: Sequence[float] = PROBE_TILTS) -> Callable:
     """The planner's reach test of a probe by any finger (``PlannerConfig.finger_reach``): :func:`finger_probe` with
     one reach test of the lines' starts (:data:`FINGER_PROBE_REACH`) and one of the touches (:data:`TOUCH_REACH`), their
-    compiled scenes kept, for the episode."""
+    compiled scenes kept, for the episode; asked to ``avoid`` some fingers, by the others alone (None when none is
+    left)."""
     reach, touch = PlacementReach(FINGER_PROBE_REACH), PlacementReach(TOUCH_REACH)
 
-    def test(move: ProbeMove, hypotheses: Sequence) -> ProbeMove | None:
-        return finger_probe(move, hypotheses, reach, fingers, tilts, touch)
+    def test(move: ProbeMove, hypotheses: Sequence, avoid: Sequence[str] = ()) -> ProbeMove | None:
+        others = [f for f in fingers if f not in avoid]
+        return finger_probe(move, hypotheses, reach, others, tilts, touch) if others else None
 
     return test
 

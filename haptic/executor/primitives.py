@@ -431,12 +431,13 @@ class Toucher:
                 return self._result("unreachable", "runaway", 0.0, target=point)
         return self._result("timeout", "limit", 0.0)
 
-    def back_to_home_posture(self, point: np.ndarray) -> bool:
+    def back_to_home_posture(self, point: np.ndarray, at: np.ndarray | None = None) -> bool:
         """After a free move ran away: move the arm in joint space to the posture, of the family it started in
-        (:attr:`home_q`), that puts the pad ``overpass`` above the higher of where it is and ``point``; False
-        when there is none or the arm does not get there."""
+        (:attr:`home_q`), that puts the pad ``overpass`` above the higher of where it is and ``point`` (over where
+        it is, or over ``at``); False when there is none or the arm does not get there."""
         cfg = self.config
-        above = np.array([self.tip[0], self.tip[1], max(float(self.tip[2]), float(point[2])) + cfg.overpass])
+        xy = self.tip if at is None else np.asarray(at, dtype=float)
+        above = np.array([xy[0], xy[1], max(float(self.tip[2]), float(point[2])) + cfg.overpass])
         ik = self.robot.reachable(self.finger, above, self.hand_rotation, arm_q0=self.home_q)
         if not ik.reachable:
             return False

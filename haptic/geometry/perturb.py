@@ -40,8 +40,10 @@ def vertex_normal(poly: Polyhedron, vertex: int) -> np.ndarray:
     return n / max(float(np.linalg.norm(n)), 1e-12)
 
 
-def move_vertex(poly: Polyhedron, vertex: int, offset: float, name: str | None = None) -> Polyhedron:
-    """The model with one vertex moved ``offset`` [m] along its outward vertex normal (:func:`vertex_normal`).
+def move_vertex(poly: Polyhedron, vertex: int, offset: float, name: str | None = None,
+                direction: np.ndarray | None = None) -> Polyhedron:  # fmt: skip
+    """The model with one vertex moved ``offset`` [m] along its outward vertex normal (:func:`vertex_normal`), or
+    along the unit ``direction`` where given (along a face's normal, along an edge).
 
     Each face at the vertex keeps its plane away from it: the corner triangle (the vertex and its two
     neighbours in the loop) becomes a face of its own, tilted, and the rest of the face stays (a triangle face
@@ -53,7 +55,7 @@ def move_vertex(poly: Polyhedron, vertex: int, offset: float, name: str | None =
     """
     v = np.array(poly.vertices)
     moved = v.copy()
-    along = vertex_normal(poly, vertex)
+    along = vertex_normal(poly, vertex) if direction is None else np.asarray(direction, dtype=float)
     moved[vertex] = v[vertex] + offset * along
     faces: list[tuple[int, ...]] = []
     for fi, loop in enumerate(poly.faces):

@@ -151,13 +151,16 @@ def table_face_lines(poly: Polyhedron, world_from_model: SE3, v: int, f: int, co
     return [face_line(world_from_model, poly, f, p, config.pad_radius) for p in picked]
 
 
-def _first_reached(probes, lines: list[ProbeMove], key, h) -> ProbeMove | None:
+def _first_reached(probes, lines: list[ProbeMove], key, h, avoid: Sequence[str] = ()) -> ProbeMove | None:
     """The first of ``lines`` (taken off the list as asked) that ``probes``' reach test reaches in hypothesis ``h``'s
-    world, booked as ``probes``' pending probe of ``key`` with its finger; None when none is reached."""
+    world, booked as ``probes``' pending probe of ``key`` with its finger; None when none is reached. With
+    ``avoid``, the reach test is asked for a finger other than those first, then for any."""
     while lines:
         line = lines.pop(0)
         probes.asked += 1
-        got = probes.reach(line, [h])
+        got = probes.reach(line, [h], avoid=tuple(avoid)) if avoid else None
+        if got is None:
+            got = probes.reach(line, [h])
         if got is not None:
             probes.pending = got
             probes.probed[key] = probes.probed.get(key, 0) + 1
@@ -294,6 +297,11 @@ class CornerProbes:
     seen: :func:`~haptic.matching.acceptance.placed_near`)."""
     probed: dict[tuple[int, int], int] = field(default_factory=dict)
     """Probes made per (vertex, face)."""
+    tried: dict[tuple[int, int], list[str]] = field(default_factory=dict)
+    """The fingers of the probes made per (vertex, face): while it is still to measure, each measured nothing there,
+    and the next line is asked of another finger first (trapezohedron_08 of the formula corpus, seed 1: the index,
+    level toward a kite rising 12°, stroked 0.6-1.2 mm across it at three pad positions, under the 1.5 mm a face's
+    stroke must span, where the thumb stroked 2.2 mm and measured it)."""
     fingers: dict[str, int] = field(default_factory=dict)
     """Probes made per finger."""
     asked: int = 0
@@ -302,22 +310,25 @@ class CornerProbes:
     """The probe chosen for the next verification move (None: none)."""
 
     def next(self, h, todo: Mapping[int, frozenset[int]], edges: frozenset[int], vertices: frozenset[int],
-             config: PlannerConfig) -> ProbeMove | None:  # fmt: skip
+             config: PlannerConfig, placing: bool = True) -> ProbeMove | None:  # fmt: skip
         """The next probe for hypothesis ``h`` (a pose): ``todo`` maps each vertex out of reach to its faces not yet
         measured within their corner at it; ``edges`` and ``vertices``: the model edges and vertices measured. Kept
         as :attr:`pending`; None when some vertex cannot be placed (too few faces, an edge at it with neither
         itself nor its other end measured, a face with no line within its corner: each named) or the lines of a
-        face left are used up."""
+        face left are used up. With ``placing`` False the probes serve the table's shadow
+        (:meth:`~haptic.planning.verify.Verifier._shadow_probe_next`: ``todo`` holds the corners rising out of
+        it), which asks neither that the faces span space nor anything of the edges: only a line within each
+        corner."""
         self.pending = None
         blocked = False
         for v, faces in todo.items():
-            if not corner_spans(h.poly, v):
+            if placing and not corner_spans(h.poly, v):
                 blocked = True
                 if v not in self.too_few:
                     self.too_few.append(v)
                 continue
-            if not all(int(e) in edges or int(sum(h.poly.edges[int(e)])) - v in vertices
-                       for e in h.poly.vertex_edges[v]):  # fmt: skip
+            if placing and not all(int(e) in edges or int(sum(h.poly.edges[int(e)])) - v in vertices
+                                   for e in h.poly.vertex_edges[v]):  # fmt: skip
                 blocked = True
                 if v not in self.open_edges:
                     self.open_edges.append(v)
@@ -332,8 +343,9 @@ class CornerProbes:
         for v, faces in todo.items():
             for f in sorted(faces):
                 key = (v, f)
-                got = _first_reached(self, self.lines[key], key, h)
+                got = _first_reached(self, self.lines[key], key, h, self.tried.get(key, ()))
                 if got is not None:
+                    self.tried.setdefault(key, []).append(str(got.finger))
                     return got
                 if key not in self.used_up:
                     self.used_up.append(key)

@@ -246,3 +246,110 @@ def test_a_ridge_rising_out_of_the_shadow_is_crossed_above_it():
                 assert (float(s1.position[2]) - TABLE >= height) == above
             crossed += 1
     assert crossed >= 2
+
+
+NORMAL_BOUND = np.radians(1.0)
+"""About the hand's bound of a face's normal and of an edge's direction (3 × their systematic 0.25° and scatter)."""
+
+
+def _touchable_changed_top(variant, base, pose: SE3, config: PlannerConfig = CONFIG) -> float:
+    """The highest point above the table where ``variant`` and ``base`` differ by more than 0.1 mm and a pad kept
+    clear of the table could touch it: at least the shadow of its own face's normal over the table (:func:`shadow_of`
+    of the triangle it lies on, in the surface it belongs to); -1 where there is none."""
+    from haptic.planning.verify import shadow_of
+
+    top = -1.0
+    for a, b in ((variant, base), (base, variant)):
+        for i, j, k in a.triangles:
+            p, q, r = a.vertices[i], a.vertices[j], a.vertices[k]
+            probe = np.array([p, q, r, (p + q) / 2, (q + r) / 2, (r + p) / 2, (p + q + r) / 3])
+            if float(surface_distance(b, probe).max()) < 1e-9:
+                continue  # a piece of the surface both share
+            u, w = np.meshgrid(np.linspace(0, 1, 21), np.linspace(0, 1, 21), indexing="ij")
+            keep = u + w <= 1
+            pts = p + u[keep][:, None] * (q - p) + w[keep][:, None] * (r - p)
+            n = np.cross(q - p, r - p)
+            height = shadow_of(float(pose.rotate(n / np.linalg.norm(n))[2]), config)
+            z = pose.apply(pts)[:, 2] - TABLE
+            off = (z >= height) & (surface_distance(b, pts) > 1e-4)
+            if off.any():
+                top = max(top, float(z[off].max()))
+    return top
+
+
+def _turn(a: np.ndarray, b: np.ndarray) -> float:
+    """The angle between two lines' directions (or two planes' normals) [rad]."""
+    c = abs(float(a @ b)) / (float(np.linalg.norm(a)) * float(np.linalg.norm(b)))
+    return float(np.arccos(min(c, 1.0)))
+
+
+def test_a_vertex_whose_corners_and_ridges_rise_out_of_the_shadow_is_taken_once_both_are_measured():
+    """An eight-sided trapezohedron (its zigzag 50 mm from the axis, 2.2 mm either side of the middle: trapezohedron_08
+    of the formula corpus) lying on a kite: two vertices 11 mm over the table, in their shadow, have two upright
+    kites whose corners run up to the apex, out of their shadows, and two edges rising out of theirs (to the apex,
+    and to a vertex 20 mm up); the third kite, leaning under 56°, has its corner in its shadow. With the two corners
+    measured within them and the two edges measured the table's shadow takes the vertex, up to 26 mm
+    (:func:`~haptic.planning.verify.table_shadow`), and with either left out it does not. The promise: every move of
+    the vertex by 2, 4 and 8 mm (:func:`~haptic.geometry.perturb.move_vertex`, along its normal, along and against
+    each face's normal and each edge) changes surface a pad clear of the table can touch only where it tilts one of
+    those corners or turns one of those edges by twice the hand's bound or more, and neither the corners alone nor
+    the edges alone see every such move; a chamfer of one of those edges (2, 4, 8 mm) cuts it where a crossing
+    measures it (:func:`~haptic.planning.verify.ridge_target`), and one of its other edge changes surface a pad can
+    touch only under the claim's height."""
+    from haptic.geometry.perturb import chamfer_edge
+    from haptic.geometry.shapes import trapezohedron
+    from haptic.matching.acceptance import corner_triangle
+    from haptic.planning.verify import (
+        TABLE_CONTACT,
+        corners_out_of_shadow,
+        ridge_target,
+        ridges_out_of_shadow,
+        shadow_of,
+    )
+    from tests.planning.test_verify_moves import _resting_on
+
+    poly = trapezohedron(8, 0.0499, 0.00222)
+    pose, _ = _resting_on(poly, 0)
+    z = pose.apply(poly.vertices)[:, 2] - TABLE
+    n = pose.rotate(poly.face_normals)
+    found = 0
+    for v in range(poly.n_vertices):
+        if z[v] <= TABLE_CONTACT or z[v] >= shadow_of(cone_top(n[[int(f) for f in poly.vertex_faces[v]]]), CONFIG):
+            continue
+        corners = corners_out_of_shadow(poly, pose, v, CONFIG)
+        ridges = ridges_out_of_shadow(poly, pose, v, CONFIG)
+        if not corners or not ridges:
+            continue
+        found += 1
+        height = table_shadow(poly, pose, v, CONFIG, corners, ridges)
+        assert height is not None and abs(height - 0.026) < 5e-4
+        assert table_shadow(poly, pose, v, CONFIG, corners, frozenset()) is None
+        assert table_shadow(poly, pose, v, CONFIG, frozenset(), ridges) is None
+        tris = {f: corner_triangle(poly, v, f) for f in corners}
+        ends = {e: poly.vertices[int(sum(poly.edges[e])) - v] for e in ridges}
+        directions = [None] + [s * poly.face_normals[int(f)] for f in poly.vertex_faces[v] for s in (1.0, -1.0)]
+        for e in (int(e) for e in poly.vertex_edges[v]):
+            d = poly.vertices[int(sum(poly.edges[e])) - v] - poly.vertices[v]
+            directions += [d / np.linalg.norm(d), -d / np.linalg.norm(d)]
+        alone = {"corners": False, "ridges": False}  # a move changing touchable surface that one alone misses
+        for d in directions:
+            for mm in (2, 4, 8):
+                variant = move_vertex(poly, v, mm * 1e-3, direction=d)
+                moved = variant.vertices[v]
+                tilt = max(_turn(np.cross(t[1] - t[0], t[2] - t[0]), np.cross(t[1] - moved, t[2] - moved))
+                           for t in tris.values())  # fmt: skip
+                turn = max(_turn(u - poly.vertices[v], u - moved) for u in ends.values())
+                if _touchable_changed_top(variant, poly, pose) < height:
+                    continue
+                assert max(tilt, turn) >= 2 * NORMAL_BOUND, (v, d, mm)
+                alone["corners"] |= tilt < 2 * NORMAL_BOUND
+                alone["ridges"] |= turn < 2 * NORMAL_BOUND
+        assert alone == {"corners": True, "ridges": True}
+        for e in (int(e) for e in poly.vertex_edges[v]):
+            for mm in (2, 4, 8):
+                variant = chamfer_edge(poly, e, mm * 1e-3)
+                if e in ridges:
+                    assert float(surface_distance(variant, ridge_target(poly, pose, e, CONFIG)[None])[0]) > 5e-4
+                else:
+                    assert _touchable_changed_top(variant, poly, pose) < height
+    assert found == 2
