@@ -410,9 +410,19 @@ def _robot_spec() -> mujoco.MjSpec:
     before adding to it)."""
     robot = _robot_scene().mjcf_model
     try:
-        return mujoco.MjSpec.from_string(robot.to_xml_string(), assets=robot.get_assets())
-    except ValueError as exc:  # mujoco parse errors
-        raise SceneError(f"scene {robot.model!r} does not parse: {exc}") from exc
+        spec = mujoco.MjSpec.from_string(robot.to_xml_string(), assets=robot.get_assets())
+        model = spec.copy().compile()
+    except ValueError as exc:  # mujoco parse and compile errors
+        raise SceneError(f"scene {robot.model!r} does not compile: {exc}") from exc
+    # the built-in textures (the sky's gradient, the floor's checker) as the pixels they compile to: generating
+    # them is most of a compilation, and they are the same in every scene
+    for i, texture in enumerate(spec.textures):
+        if texture.builtin != mujoco.mjtBuiltin.mjBUILTIN_NONE:
+            start = model.tex_adr[i]
+            size = model.tex_width[i] * model.tex_height[i] * model.tex_nchannel[i]
+            texture.builtin = mujoco.mjtBuiltin.mjBUILTIN_NONE
+            texture.data = model.tex_data[start : start + size].tobytes()
+    return spec
 
 
 def export_scene(scene: ComposedScene, path: str | os.PathLike) -> Path:
