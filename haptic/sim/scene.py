@@ -13,7 +13,7 @@ import os
 import shutil
 import tempfile
 import weakref
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from functools import cache, cached_property
 from pathlib import Path
@@ -223,6 +223,15 @@ def scene_object_from_polyhedron(poly) -> SceneObject:
     if parts is None:
         parts = _PIECES[poly] = tuple(convex_decomposition(poly))
     return scene_object_from_parts(poly.name, parts)
+
+
+def preload_scenes(models: Iterable = ()) -> None:
+    """Parse the object-less scene (:func:`_robot_spec`) and split the non-convex ``models`` (library polyhedra) into
+    their convex pieces now, as the process's first scene of each would: a process about to fork workers hands them
+    the work done."""
+    _robot_spec()
+    for poly in models:
+        scene_object_from_polyhedron(poly)
 
 
 def load_object(name: str, models_dir: str | os.PathLike | None = None, units: str | None = None) -> SceneObject:

@@ -161,3 +161,19 @@ def test_compiled_scene_is_the_composed_mjcf_model(name):
     compiled = scene.compile()
     assert _differences(compiled, mjcf_model) == []
     assert compiled.names == mjcf_model.names and compiled.ngeom == mjcf_model.ngeom
+
+
+def test_preloaded_scenes_need_no_decomposition(monkeypatch):
+    """After :func:`preload_scenes` (what a process does before forking its workers) the scenes of its models need
+    neither a decomposition nor a parse of the scene."""
+    from haptic.geometry import load_library
+
+    model = load_library()["FRAME01"]
+    monkeypatch.setattr(sc, "_PIECES", type(sc._PIECES)())
+    sc._robot_spec.cache_clear()
+    sc.preload_scenes([model])
+    calls = []
+    monkeypatch.setattr(sc, "convex_decomposition", lambda poly: calls.append(poly) or [])
+    monkeypatch.setattr(sc.mujoco.MjSpec, "from_string", lambda *a, **k: calls.append(a) or None)
+    scene = compose_scene(sc.scene_object_from_polyhedron(model), seed=1)
+    assert scene.compile().ngeom > 50 and not calls
