@@ -9,6 +9,7 @@ The arm (``assets/mjcf/arm``) is attached to the stand of ``scenes/tabletop.xml`
 
 from __future__ import annotations
 
+import hashlib
 import os
 import shutil
 import tempfile
@@ -178,8 +179,12 @@ class ComposedScene:
             scene_class = spec.find_default(OBJECT_CLASS)
             for i, part in enumerate(self.object.parts):
                 name = f"object_part{i}"
-                assets[name + ".stl"] = _mesh_asset(part).contents
-                spec.add_mesh(name=name, file=name + ".stl")
+                stl = _mesh_asset(part).contents
+                # the file named by its content, as dm_control names it: MuJoCo keeps the meshes it has read by file
+                # name for the process's next compilations, and one of the same name and size would be taken for it
+                file = f"{name}-{hashlib.sha1(stl).hexdigest()}.stl"
+                assets[file] = stl
+                spec.add_mesh(name=name, file=file)
                 slot.add_geom(name=name, type=mujoco.mjtGeom.mjGEOM_MESH, meshname=name, default=scene_class,
                               rgba=OBJECT_RGBA, group=0)  # fmt: skip
         spec.modelname = _model_name(self.object)

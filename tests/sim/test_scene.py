@@ -177,3 +177,16 @@ def test_preloaded_scenes_need_no_decomposition(monkeypatch):
     monkeypatch.setattr(sc.mujoco.MjSpec, "from_string", lambda *a, **k: calls.append(a) or None)
     scene = compose_scene(sc.scene_object_from_polyhedron(model), seed=1)
     assert scene.compile().ngeom > 50 and not calls
+
+
+def test_a_model_at_another_size_compiles_with_its_own_meshes():
+    """MuJoCo keeps the meshes it has read by file name for the process's next compilations: the same model at
+    another size, its convex pieces as many and their files as long, still compiles with its own meshes."""
+    from haptic.geometry import load_library
+    from haptic.geometry.perturb import scaled_to
+
+    model = load_library()["FRAME01"]
+    compose_scene(sc.scene_object_from_polyhedron(model), seed=1).compile()
+    small = compose_scene(sc.scene_object_from_polyhedron(scaled_to(model, 0.03, "FRAME01")), seed=1)
+    mjcf_model = mujoco.MjModel.from_xml_string(small.to_xml_string(), assets=small.mjcf_model.get_assets())
+    assert _differences(small.compile(), mjcf_model) == []
