@@ -23,6 +23,7 @@ Copy and adapt: one episode is ``run_episode(EpisodeSpec(model=..., seed=..., ex
 from __future__ import annotations
 
 import argparse
+import gc
 import json
 import math
 import re
@@ -39,6 +40,7 @@ from haptic.episode.worlds import Episode, build_episode, preload_physics
 from haptic.errors import HapticError
 from haptic.geometry import load_library
 from haptic.geometry.io import atomic_write
+from haptic.geometry.library_cache import cached_library
 from haptic.planning.efficiency import class_weights
 from haptic.planning.move_scores import bounded, predict_probe_moves
 from haptic.planning.registry import make_policy
@@ -380,8 +382,11 @@ def main(argv: list[str] | None = None) -> int:
     jobs = [(o, args.first_seed + k, args.policy, args.moves, args.verify, args.probe_costs, args.models,
              args.fingers) for o in objects for k in range(args.poses)]
     t0 = time.perf_counter()
+    preload_physics(cached_library(args.models)[o] for o in objects)  # the workers fork with it done
+    # what is loaded now lives as long as the process: out of the collector's reach, a full collection in an episode
+    # no longer traverses the modules' hundred thousand objects (nor touches a forked worker's copy of them)
+    gc.freeze()
     if args.jobs > 1:
-        preload_physics()  # the workers fork with it loaded
         with ProcessPoolExecutor(args.jobs) as pool:
             records = list(pool.map(one, *zip(*jobs, strict=True)))
     else:

@@ -9,7 +9,7 @@ pose are read here only to place it and, in :meth:`Episode.finish`, to score the
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -195,13 +195,17 @@ class PhysicsWorld:
         )  # fmt: skip
 
 
-def preload_physics() -> None:
+def preload_physics(models: Iterable[Polyhedron] = ()) -> None:
     """Import now what a physics episode loads on first use (MuJoCo, the simulated hand, its executor, the
-    scoring of perception): a process about to fork workers hands it to them loaded, where each would import it
-    again."""
+    scoring of perception), parse the scene and split the non-convex ``models`` into convex pieces
+    (:func:`~haptic.sim.scene.preload_scenes`): a process about to fork workers hands it to them done, where each
+    would do it again."""
     from haptic import sim  # noqa: F401
     from haptic.episode import evaluate  # noqa: F401
     from haptic.executor import physics, touch_config  # noqa: F401
+    from haptic.sim.scene import preload_scenes
+
+    preload_scenes(models)
 
 
 WORLDS = {w.name: w for w in (GeometricWorld, PhysicsWorld)}

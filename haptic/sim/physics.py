@@ -338,6 +338,7 @@ class Simulation:
         self._acc6 = np.zeros(6)
         self.home_key = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_KEY, "home")
         self._force6 = np.zeros(6)
+        self._contact_views: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = {}
         self._scratch: mujoco.MjData | None = None
         self.reset()
 
@@ -428,6 +429,19 @@ class Simulation:
         out -= np.dot(out - n, n) * n  # perturb in the tangent plane only
         return out / np.linalg.norm(out)
 
+    def _contacts(self) -> tuple[list[list[int]], np.ndarray, np.ndarray, np.ndarray]:
+        """The contacts now: their geom pairs (a list), constraint addresses (ncon,), frames (ncon, 9) and points
+        (ncon, 3). The arrays are views of the data's contact buffer, made once per number of contacts: MuJoCo puts
+        every step's contacts at the start of the data's arena, and making the views is most of reading a contact
+        (about 2 µs each, where reading their values is a tenth of that)."""
+        n = self.data.ncon
+        views = self._contact_views.get(n)
+        if views is None:
+            con = self.data.contact
+            views = self._contact_views[n] = (con.geom, con.efc_address, con.frame, con.pos)
+        geom, efc, frame, pos = views
+        return geom.tolist(), efc, frame, pos
+
     def _pad_contacts(self, finger: int | None):
         """Raw (finger, point, normal-out-of-surface, force-on-pad) for pad contacts, ideal sensing."""
         d = self.data
@@ -435,25 +449,24 @@ class Simulation:
         if d.ncon == 0:
             return out
         owner = self._geom_finger_list
-        contacts = d.contact
-        for i, (g1, g2) in enumerate(contacts.geom.tolist()):
+        geoms, efc, frames, points = self._contacts()
+        for i, (g1, g2) in enumerate(geoms):
             k1, k2 = owner[g1], owner[g2]
             if finger is None:
                 if k1 < 0 and k2 < 0:
                     continue
             elif k1 != finger and k2 != finger:
                 continue
-            c = contacts[i]
-            if c.efc_address < 0:  # excluded or inactive contact
+            if efc[i] < 0:  # excluded or inactive contact
                 continue
             mujoco.mj_contactForce(self.model, d, i, self._force6)
-            frame = c.frame.reshape(3, 3)
+            frame = frames[i].reshape(3, 3)
             f = self._force6[:3].dot(frame)  # force of geom1 on geom2, world frame
             if k1 >= 0 and (finger is None or k1 == finger):
                 # the pad is geom1: flip into "on the pad, out of the touched surface" (normal: geom1 -> geom2)
-                out.append((k1, c.pos.copy(), -frame[0], -f))
+                out.append((k1, points[i].copy(), -frame[0], -f))
             else:
-                out.append((k2, c.pos.copy(), frame[0].copy(), f))
+                out.append((k2, points[i].copy(), frame[0].copy(), f))
         return out
 
     def contact_summary(self, finger: int) -> ContactSummary:
@@ -542,19 +555,19 @@ class Simulation:
             return ()
         owner = self._geom_link_list
         out = []
-        for i, (g1, g2) in enumerate(d.contact.geom.tolist()):
+        geoms, efc, frames, points = self._contacts()
+        for i, (g1, g2) in enumerate(geoms):
             k1, k2 = owner[g1], owner[g2]
             if (k1 < 0) == (k2 < 0):  # neither a link, or link against link
                 continue
-            c = d.contact[i]
-            if c.efc_address < 0:
+            if efc[i] < 0:
                 continue
             mujoco.mj_contactForce(self.model, d, i, self._force6)
-            normal = c.frame.reshape(3, 3)[0].copy()  # geom1 -> geom2
+            normal = frames[i].reshape(3, 3)[0].copy()  # geom1 -> geom2
             link = k1 if k1 >= 0 else k2
             if k1 >= 0:
                 normal = -normal  # out of the touched surface, towards the link
-            point = c.pos.copy()
+            point = points[i].copy()
             if nz.point_std > 0:
                 point = point + nz.point_std * rng.standard_normal(3)
             out.append(LinkContact(LINK_NAMES[link], point, normal, float(self._force6[0])))

@@ -9,12 +9,14 @@ The arm (``assets/mjcf/arm``) is attached to the stand of ``scenes/tabletop.xml`
 
 from __future__ import annotations
 
+import hashlib
 import os
 import shutil
 import tempfile
 import weakref
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
+from functools import cache, cached_property
 from pathlib import Path
 
 import mujoco
@@ -80,6 +82,10 @@ STABLE_MARGIN = 0.002
 """A resting facet is stable when the solid's centroid projects into it at least this far from its border [m]."""
 OBJECT_RGBA = (0.25, 0.6, 0.35, 1.0)
 """Colour of the object's geoms (red, green, blue, alpha)."""
+OBJECT_BODY = "object"
+"""The body of ``scenes/tabletop.xml`` the object's geoms are placed in."""
+OBJECT_CLASS = "scene"
+"""The default class of the object's geoms."""
 
 OBJECT_REGION = ((0.46, 0.62), (-0.10, 0.10))
 """Where a random object centre is placed on the table: ((x_min, x_max), (y_min, y_max)) in world [m]."""
@@ -136,14 +142,18 @@ class SceneObject:
 
 @dataclass(frozen=True)
 class ComposedScene:
-    """A composed scene: the ``mjcf`` model and the ground truth it was built from (evaluation only)."""
+    """A composed scene: the object and its pose (the ground truth, evaluation only), its ``mjcf`` model and the
+    MuJoCo model compiled from it."""
 
-    mjcf_model: mjcf.RootElement
-    """The composed dm_control MJCF root."""
     object: SceneObject | None
     """The object placed on the table, or None for an empty table."""
     world_from_object: np.ndarray = field(default_factory=lambda: np.eye(4))
     """Homogeneous transform (4, 4) of the object in the world [m]."""
+
+    @cached_property
+    def mjcf_model(self) -> mjcf.RootElement:
+        """The composed dm_control MJCF root (composed on first use: :meth:`compile` does without it)."""
+        return _compose_mjcf(self.object, self.world_from_object)
 
     def to_xml_string(self) -> str:
         return self.mjcf_model.to_xml_string()
@@ -151,14 +161,38 @@ class ComposedScene:
     @property
     def workspace(self) -> Workspace:
         """What the robot knows of its workspace, read from this scene (never the object)."""
-        return Workspace(_table_top_z(self.mjcf_model), _pad_radius(self.mjcf_model, HAND_PREFIX))
+        robot = _robot_scene().mjcf_model  # the table and the hand are those of every scene
+        return Workspace(_table_top_z(robot), _pad_radius(robot, HAND_PREFIX))
 
     def compile(self) -> mujoco.MjModel:
-        """The plain MuJoCo model of this scene."""
+        """The plain MuJoCo model of this scene: the same model as the composed MJCF's (:attr:`mjcf_model`) compiles
+        to, built from the object-less scene parsed once per process (:func:`_robot_spec`) with the object's meshes
+        and geoms added, as :func:`_compose_mjcf` adds them: the dm_control composition and its XML were most of
+        the 0.1 s a scene took."""
+        spec = _robot_spec().copy()
+        assets: dict[str, bytes] = dict(spec.assets)
+        if self.object is not None:
+            pose = self.world_from_object
+            slot = spec.body(OBJECT_BODY)
+            slot.pos = pose[:3, 3]
+            slot.quat = _pose_quat(pose)
+            scene_class = spec.find_default(OBJECT_CLASS)
+            for i, part in enumerate(self.object.parts):
+                name = f"object_part{i}"
+                stl = _mesh_asset(part).contents
+                # the file named by its content, as dm_control names it: MuJoCo keeps the meshes it has read by file
+                # name for the process's next compilations, and one of the same name and size would be taken for it
+                file = f"{name}-{hashlib.sha1(stl).hexdigest()}.stl"
+                assets[file] = stl
+                spec.add_mesh(name=name, file=file)
+                slot.add_geom(name=name, type=mujoco.mjtGeom.mjGEOM_MESH, meshname=name, default=scene_class,
+                              rgba=OBJECT_RGBA, group=0)  # fmt: skip
+        spec.modelname = _model_name(self.object)
+        spec.assets = assets
         try:
-            return mujoco.MjModel.from_xml_string(self.to_xml_string(), assets=self.mjcf_model.get_assets())
+            return spec.compile()
         except ValueError as exc:  # mujoco compile errors
-            raise SceneError(f"scene {self.mjcf_model.model!r} does not compile: {exc}") from exc
+            raise SceneError(f"scene {spec.modelname!r} does not compile: {exc}") from exc
 
 
 def scene_object_from_parts(name: str, parts: Sequence[np.ndarray]) -> SceneObject:
@@ -194,6 +228,15 @@ def scene_object_from_polyhedron(poly) -> SceneObject:
     if parts is None:
         parts = _PIECES[poly] = tuple(convex_decomposition(poly))
     return scene_object_from_parts(poly.name, parts)
+
+
+def preload_scenes(models: Iterable = ()) -> None:
+    """Parse the object-less scene (:func:`_robot_spec`) and split the non-convex ``models`` (library polyhedra) into
+    their convex pieces now, as the process's first scene of each would: a process about to fork workers hands them
+    the work done."""
+    _robot_spec()
+    for poly in models:
+        scene_object_from_polyhedron(poly)
 
 
 def load_object(name: str, models_dir: str | os.PathLike | None = None, units: str | None = None) -> SceneObject:
@@ -308,6 +351,29 @@ def compose_scene(
 
     The composed model carries a keyframe ``home`` (``ARM_HOME`` + ``HAND_TRACE``).
     """
+    pose = np.eye(4)
+    if obj is not None:
+        pose = (
+            random_object_pose(obj, np.random.default_rng(seed))
+            if world_from_object is None
+            else (_check_pose(world_from_object))
+        )
+    return ComposedScene(object=obj, world_from_object=pose)
+
+
+def _pose_quat(pose: np.ndarray) -> np.ndarray:
+    """The unit quaternion (w, x, y, z) of the rotation of ``pose`` (4, 4)."""
+    quat = np.zeros(4)
+    mujoco.mju_mat2Quat(quat, pose[:3, :3].reshape(-1).copy())
+    return quat
+
+
+def _model_name(obj: SceneObject | None) -> str:
+    return f"haptic_{obj.name}" if obj is not None else "haptic_empty"
+
+
+def _compose_mjcf(obj: SceneObject | None, pose: np.ndarray) -> mjcf.RootElement:
+    """The dm_control composition of tabletop + arm + hand (+ ``obj`` at ``pose``, a checked transform)."""
     scene = _load_xml(TABLETOP_XML)
     arm = _load_xml(ARM_XML)
     hand = _load_xml(HAND_XML)
@@ -316,23 +382,15 @@ def compose_scene(
 
     flange = arm.find("site", "flange")
     mount = scene.find("site", "arm_mount")
-    slot = scene.find("body", "object")
+    slot = scene.find("body", OBJECT_BODY)
     if flange is None or mount is None or slot is None:
         raise SceneError(f"{ARM_XML} / {TABLETOP_XML}: sites 'flange', 'arm_mount' and body 'object' are required")
     flange.attach(hand)
     mount.attach(arm)
 
-    pose = np.eye(4)
     if obj is not None:
-        pose = (
-            random_object_pose(obj, np.random.default_rng(seed))
-            if world_from_object is None
-            else (_check_pose(world_from_object))
-        )
         slot.pos = pose[:3, 3]
-        quat = np.zeros(4)
-        mujoco.mju_mat2Quat(quat, pose[:3, :3].reshape(-1).copy())
-        slot.quat = quat
+        slot.quat = _pose_quat(pose)
         for i, part in enumerate(obj.parts):
             mesh_name = f"object_part{i}"
             scene.asset.add("mesh", name=mesh_name, file=_mesh_asset(part))
@@ -341,17 +399,44 @@ def compose_scene(
                 name=f"object_part{i}",
                 type="mesh",
                 mesh=mesh_name,
-                dclass="scene",
+                dclass=OBJECT_CLASS,
                 rgba=OBJECT_RGBA,
                 group=0,
             )
-    scene.model = f"haptic_{obj.name}" if obj is not None else "haptic_empty"
+    scene.model = _model_name(obj)
 
     n_arm = len(ARM_JOINTS)
     ctrl = np.zeros(n_arm + len(HAND_JOINTS))
     ctrl[n_arm:] = HAND_TRACE
     scene.keyframe.add("key", name="home", qpos=np.concatenate([ARM_HOME, HAND_TRACE]), ctrl=ctrl)
-    return ComposedScene(mjcf_model=scene, object=obj, world_from_object=pose)
+    return scene
+
+
+@cache
+def _robot_scene() -> ComposedScene:
+    """The scene without an object, composed once per process."""
+    return ComposedScene(object=None)
+
+
+@cache
+def _robot_spec() -> mujoco.MjSpec:
+    """The scene without an object as a MuJoCo spec, parsed once per process from its composed MJCF (copy it
+    before adding to it)."""
+    robot = _robot_scene().mjcf_model
+    try:
+        spec = mujoco.MjSpec.from_string(robot.to_xml_string(), assets=robot.get_assets())
+        model = spec.copy().compile()
+    except ValueError as exc:  # mujoco parse and compile errors
+        raise SceneError(f"scene {robot.model!r} does not compile: {exc}") from exc
+    # the built-in textures (the sky's gradient, the floor's checker) as the pixels they compile to: generating
+    # them is most of a compilation, and they are the same in every scene
+    for i, texture in enumerate(spec.textures):
+        if texture.builtin != mujoco.mjtBuiltin.mjBUILTIN_NONE:
+            start = model.tex_adr[i]
+            size = model.tex_width[i] * model.tex_height[i] * model.tex_nchannel[i]
+            texture.builtin = mujoco.mjtBuiltin.mjBUILTIN_NONE
+            texture.data = model.tex_data[start : start + size].tobytes()
+    return spec
 
 
 def export_scene(scene: ComposedScene, path: str | os.PathLike) -> Path:

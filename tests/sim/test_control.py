@@ -3,6 +3,7 @@ reachability."""
 
 from __future__ import annotations
 
+import mujoco
 import numpy as np
 import pytest
 from conftest import BOX_CENTRE, BOX_HALF
@@ -133,6 +134,7 @@ def test_stepping_computes_the_sensors_of_each_ticks_last_step_alone(box_scene):
     runs = []
     for every_step in (False, True):
         sim = Simulation(box_scene, noise=SimulatedSensorNoise.from_notes(), seed=0)
+        flags = sim.model.opt.disableflags
         ctl = Controller(sim)
         ctl.move_fingertip(np.array([0.56, 0.0, TOP_Z + 0.01]))
         ctl.step(60)
@@ -143,8 +145,32 @@ def test_stepping_computes_the_sensors_of_each_ticks_last_step_alone(box_scene):
                 sim.step(ctl.gains.control_every)
             else:
                 ctl.step(1)
-        assert sim.model.opt.disableflags == 0
+        assert sim.model.opt.disableflags == flags  # the sensors' flag restored
         runs.append((sim.data.qpos.copy(), sim.data.sensordata.copy(), sim.touch()))
     assert runs[0][1].any()  # the wrist and the pad sense the press
     for a, b in zip(*runs, strict=True):
         assert np.array_equal(a, b)
+
+
+def test_island_discovery_off_gives_the_same_steps(box_scene):
+    """The scene leaves MuJoCo's island discovery off (the robot is one kinematic tree, the object static: one
+    island): pressing and sliding on the box, every tick's state, contacts and sensors are those with it on."""
+    island = int(mujoco.mjtDisableBit.mjDSBL_ISLAND)
+    runs = []
+    for discover in (False, True):
+        sim = Simulation(box_scene, noise=SimulatedSensorNoise.from_notes(), seed=0)
+        assert sim.model.opt.disableflags & island
+        if discover:
+            sim.model.opt.disableflags &= ~island
+        ctl = Controller(sim)
+        ctl.move_fingertip(np.array([0.56, 0.0, TOP_Z + 0.01]))
+        ctl.step(60)
+        ctl.set_hybrid(1.0, np.array([0.01, 0.0, 0.0]), normal_hint=np.array([0.0, 0.0, 1.0]))
+        ticks = []
+        for _ in range(150):
+            ctl.step(1)
+            d = sim.data
+            ticks.append(np.concatenate([d.qpos, d.qvel, d.qacc, d.sensordata, [d.ncon, d.nefc]]))
+        runs.append(np.array(ticks))
+    assert runs[0][:, -2].max() > 0  # the pad touches the box
+    assert np.array_equal(runs[0], runs[1])

@@ -7,7 +7,7 @@ import dataclasses
 import mujoco
 import numpy as np
 import pytest
-from conftest import BOX_CENTRE, BOX_HALF, box_parts, box_pose
+from conftest import BOX_CENTRE, BOX_HALF, box_parts, box_pose, l_shape_parts
 
 from haptic.errors import SceneError
 from haptic.sim.control import Controller
@@ -156,3 +156,28 @@ def test_a_link_pushed_into_the_table_is_sensed_by_that_link(box_scene):
     for c in r.link_contacts:
         assert abs(c.point_in_world[2] - TABLE_TOP_Z) < 0.01
     assert len(r.contacts[0]) >= 1  # and the pad's own contact stays the pad's
+
+
+def test_the_contact_views_read_what_the_contacts_hold():
+    """The views of the contact buffer kept per number of contacts read, tick after tick, what MuJoCo's contact
+    structs hold then: their geoms, constraint addresses, frames and points. Lowered onto an L's slab and slid
+    into the corner under its block, the pad's contacts come and go and number none, one and two."""
+    pose = box_pose(np.array([0.56, 0.0, BOX_CENTRE[2] - BOX_HALF[2]]))
+    sim = Simulation(compose_scene(scene_object_from_parts("L", l_shape_parts()), pose))
+    ctl = Controller(sim)
+    top = pose[2, 3] + 0.03  # the slab's top
+    ctl.move_fingertip(np.array([0.53, 0.0, top + 0.01]))
+    ctl.step(60)
+    ctl.set_hybrid(1.0, np.array([0.03, 0.0, 0.0]), normal_hint=np.array([0.0, 0.0, 1.0]))
+    counts = set()
+    for _ in range(400):
+        ctl.step(1)
+        d = sim.data
+        counts.add(d.ncon)
+        geoms, efc, frames, points = sim._contacts()
+        assert geoms == [d.contact[i].geom.tolist() for i in range(d.ncon)]
+        for i in range(d.ncon):
+            c = d.contact[i]
+            assert efc[i] == c.efc_address
+            assert np.array_equal(frames[i], c.frame) and np.array_equal(points[i], c.pos)
+    assert {0, 1, 2} <= counts, counts

@@ -129,3 +129,64 @@ def test_a_non_convex_model_is_decomposed_once_per_process(monkeypatch):
     second = sc.scene_object_from_polyhedron(model)
     assert not calls and len(first.parts) == len(second.parts) > 1
     assert all(np.array_equal(a, b) for a, b in zip(first.parts, second.parts, strict=True))
+
+
+def _differences(a: mujoco.MjModel, b: mujoco.MjModel) -> list[str]:
+    """The model arrays and options in which ``a`` and ``b`` differ (the mesh files' names aside)."""
+    out = []
+    for name in dir(a):
+        if name.startswith("_") or name in ("mesh_pathadr", "paths"):
+            continue
+        x = getattr(a, name)
+        if isinstance(x, np.ndarray):
+            y = getattr(b, name)
+            if x.shape != y.shape or not np.array_equal(x, y, equal_nan=True):
+                out.append(name)
+    for name in dir(a.opt):
+        x = getattr(a.opt, name)
+        if not name.startswith("_") and not callable(x) and not np.array_equal(x, getattr(b.opt, name)):
+            out.append(f"opt.{name}")
+    return out
+
+
+@pytest.mark.parametrize("name", [None, "BOX01", "LBLOCK01"])
+def test_compiled_scene_is_the_composed_mjcf_model(name):
+    """The model compiled from the spec parsed once per process is the one the composed MJCF compiles to: every
+    array (bodies, geoms, meshes and their hulls, options, keyframe) equal, bit for bit, whatever scene was compiled
+    before."""
+    obj = load_object(name) if name else None
+    scene = compose_scene(obj, seed=4)
+    assert _differences(scene.compile(), compose_scene(load_object("FRAME01"), seed=1).compile())  # another scene
+    mjcf_model = mujoco.MjModel.from_xml_string(scene.to_xml_string(), assets=scene.mjcf_model.get_assets())
+    compiled = scene.compile()
+    assert _differences(compiled, mjcf_model) == []
+    assert compiled.names == mjcf_model.names and compiled.ngeom == mjcf_model.ngeom
+
+
+def test_preloaded_scenes_need_no_decomposition(monkeypatch):
+    """After :func:`preload_scenes` (what a process does before forking its workers) the scenes of its models need
+    neither a decomposition nor a parse of the scene."""
+    from haptic.geometry import load_library
+
+    model = load_library()["FRAME01"]
+    monkeypatch.setattr(sc, "_PIECES", type(sc._PIECES)())
+    sc._robot_spec.cache_clear()
+    sc.preload_scenes([model])
+    calls = []
+    monkeypatch.setattr(sc, "convex_decomposition", lambda poly: calls.append(poly) or [])
+    monkeypatch.setattr(sc.mujoco.MjSpec, "from_string", lambda *a, **k: calls.append(a) or None)
+    scene = compose_scene(sc.scene_object_from_polyhedron(model), seed=1)
+    assert scene.compile().ngeom > 50 and not calls
+
+
+def test_a_model_at_another_size_compiles_with_its_own_meshes():
+    """MuJoCo keeps the meshes it has read by file name for the process's next compilations: the same model at
+    another size, its convex pieces as many and their files as long, still compiles with its own meshes."""
+    from haptic.geometry import load_library
+    from haptic.geometry.perturb import scaled_to
+
+    model = load_library()["FRAME01"]
+    compose_scene(sc.scene_object_from_polyhedron(model), seed=1).compile()
+    small = compose_scene(sc.scene_object_from_polyhedron(scaled_to(model, 0.03, "FRAME01")), seed=1)
+    mjcf_model = mujoco.MjModel.from_xml_string(small.to_xml_string(), assets=small.mjcf_model.get_assets())
+    assert _differences(small.compile(), mjcf_model) == []
