@@ -115,6 +115,9 @@ def test_checked_in_scene_matches_the_composition():
     for attr in ("njnt", "nbody", "ngeom", "nsite", "nsensor", "nu", "nkey"):
         assert getattr(m, attr) == getattr(fresh, attr), attr
     np.testing.assert_allclose(m.body_pos, fresh.body_pos, atol=1e-9)
+    # the physics options too: a scene loaded from the export steps as the episodes' scenes do
+    for attr in ("timestep", "impratio", "integrator", "cone", "disableflags", "enableflags"):
+        assert getattr(m.opt, attr) == getattr(fresh.opt, attr), attr
 
 
 def test_a_non_convex_model_is_decomposed_once_per_process(monkeypatch):
