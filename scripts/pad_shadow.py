@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from haptic.episode.spec import EpisodeSpec
+from haptic.episode.spec import EpisodeSpec, episode_pairs
 from haptic.episode.worlds import build_episode
 from haptic.errors import HapticError, ModelError
 from haptic.geometry import Polyhedron, load_library
@@ -39,7 +39,7 @@ from haptic.geometry.kernels import contains
 from haptic.geometry.perturb import chamfer_edge, move_vertex
 from haptic.geometry.se3 import SE3
 from haptic.matching.acceptance import corner_triangle
-from haptic.planning.verify import TABLE_CONTACT, reachable_features, table_pins
+from haptic.planning.verify import out_of_reach
 
 SEVEN = "BOX01N:1,BOX01N:3,BOX01P:1,BOX01P:2,FRAME01:1,FRAME01:2,FRAME01:3"
 """The seed library's episodes whose default full verification ends with vertices out of the hand's reach."""
@@ -140,10 +140,8 @@ def study(model: str, seed: int, library, step: float) -> dict:
     with nothing in reach to pin them) and, per move of each, how deep a free pad feels it and where."""
     ep = build_episode(EpisodeSpec(model=model, seed=seed, executor="physics", verify="full"), library)
     poly, pose, cfg = ep.true_model, ep.world_from_model, ep.config
-    reach = reachable_features(poly, pose, cfg)
+    reach, hidden, unpinned = out_of_reach(poly, pose, cfg)
     z = pose.apply(poly.vertices)[:, 2] - cfg.table_z
-    hidden = [v for v in range(poly.n_vertices) if v not in reach[2] and z[v] > TABLE_CONTACT]
-    _, unpinned = table_pins(poly, pose, reach, cfg)
     out = {"model": model, "seed": seed, "faces_in_reach": sorted(int(f) for f in reach[0]), "vertices": []}
     for v in [*hidden, *(int(u) for u in unpinned)]:
         rows = []
@@ -174,11 +172,7 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     try:
         library = load_library(args.models) if args.models else None
-        if args.pairs:
-            pairs = [(p.split(":")[0], int(p.split(":")[1])) for p in args.pairs.split(",")]
-        else:
-            names = args.objects.split(",") if args.objects else sorted(library or load_library())
-            pairs = [(m, int(s)) for m in names for s in args.seeds.split(",")]
+        pairs = episode_pairs(args.pairs, args.objects, args.seeds, lambda: sorted(library or load_library()))
         rows, n_vertices, shadowed, worst = [], 0, 0, []
         for model, seed in pairs:
             r = study(model, seed, library, args.step * 1e-3)

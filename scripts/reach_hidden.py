@@ -41,13 +41,13 @@ from collections import Counter
 
 import numpy as np
 
-from haptic.episode.spec import EpisodeSpec
+from haptic.episode.spec import EpisodeSpec, episode_pairs
 from haptic.episode.worlds import build_episode
 from haptic.errors import HapticError
 from haptic.geometry import load_library
 from haptic.geometry.distance import surface_distance
 from haptic.geometry.io import atomic_write
-from haptic.planning.verify import TABLE_CONTACT, reachable_features, table_pins
+from haptic.planning.verify import TABLE_CONTACT, out_of_reach
 from haptic.sim import compose_scene
 from haptic.sim.reach import FingertipTarget, ReachSolver
 from haptic.sim.scene import FINGERS, PAD_RADIUS, scene_object_from_polyhedron
@@ -226,10 +226,8 @@ def study(model: str, seed: int, library, probe: bool = False) -> dict:
 
     ep = build_episode(EpisodeSpec(model=model, seed=seed, executor="physics", verify="full"), library)
     poly, pose, cfg = ep.true_model, ep.world_from_model, ep.config
-    reach = reachable_features(poly, pose, cfg)
+    reach, hidden, unpinned = out_of_reach(poly, pose, cfg)
     z = pose.apply(poly.vertices)[:, 2] - cfg.table_z
-    hidden = [v for v in range(poly.n_vertices) if v not in reach[2] and z[v] > TABLE_CONTACT]
-    _, unpinned = table_pins(poly, pose, reach, cfg)
     out = {"model": model, "seed": seed, "hidden": hidden, "unpinned": [int(v) for v in unpinned], "vertices": []}
     if not hidden and not unpinned:
         return out
@@ -291,11 +289,7 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     try:
         library = load_library(args.models) if args.models else None
-        if args.pairs:
-            pairs = [(p.split(":")[0], int(p.split(":")[1])) for p in args.pairs.split(",")]
-        else:
-            names = args.objects.split(",") if args.objects else sorted(library or load_library())
-            pairs = [(m, int(s)) for m in names for s in args.seeds.split(",")]
+        pairs = episode_pairs(args.pairs, args.objects, args.seeds, lambda: sorted(library or load_library()))
         rows, verdicts, by, fingers, probes = [], Counter(), Counter(), Counter(), Counter()
         placed = 0
         corners, shadows, shadow_parts = Counter(), Counter(), Counter()

@@ -61,3 +61,33 @@ def test_a_slot_corner_moved_in_its_end_faces_plane_is_felt_at_the_slots_rim():
                                                                           @ poly.face_normals[front]) < 1e-9)
     depth, faces = ps.felt(poly, moves[along], _on_table(poly), TABLE, RADIUS)
     assert depth > ps.FELT and front in faces
+
+
+def test_the_scripts_episodes_are_the_pairs_or_every_object_at_every_seed_and_a_bad_item_is_named():
+    import pytest
+
+    from haptic.episode.spec import episode_pairs
+    from haptic.errors import HapticError
+
+    assert episode_pairs("BOX01N:1,FRAME01:3", None, "1", lambda: []) == [("BOX01N", 1), ("FRAME01", 3)]
+    assert episode_pairs(None, "A,B", "1,2", lambda: []) == [("A", 1), ("A", 2), ("B", 1), ("B", 2)]
+    assert episode_pairs(None, None, "3", lambda: ["X"]) == [("X", 3)]
+    with pytest.raises(HapticError, match="BOX01N"):
+        episode_pairs("BOX01N", None, "1", lambda: [])
+
+
+def test_out_of_reach_is_the_verifications_hidden_vertices_before_any_move():
+    """The scripts' vertices out of reach at an episode's true pose are those the verification's own test counts
+    hidden when nothing is measured yet: FRAME01 standing on a side (seed 1), the corners of its hole."""
+    from types import SimpleNamespace
+
+    from haptic.episode.spec import EpisodeSpec
+    from haptic.episode.worlds import build_episode
+    from haptic.planning.verify import hidden_vertices, out_of_reach
+
+    ep = build_episode(EpisodeSpec(model="FRAME01", seed=1, executor="physics", verify="full"))
+    poly, pose, cfg = ep.true_model, ep.world_from_model, ep.config
+    reach, hidden, unpinned = out_of_reach(poly, pose, cfg)
+    cov = SimpleNamespace(reachable_vertices=reach[2], vertices=set())
+    assert hidden == hidden_vertices(poly, pose, cov, cfg) == list(range(8, 16))
+    assert all(isinstance(v, int) for v in unpinned)

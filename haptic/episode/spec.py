@@ -37,6 +37,26 @@ none, tracing moves, files read in metres, the index finger alone. Bench keys mi
 (:func:`~haptic.bench.runner.key_id`)."""
 
 
+def episode_pairs(
+    pairs: str | None, objects: str | None, seeds: str, names: Callable[[], list[str]]
+) -> list[tuple[str, int]]:
+    """The (model, seed) episodes an evaluation script's ``--pairs OBJECT:SEED,...``, or else its ``--objects A,B``
+    (default: every model, ``names()``) and ``--seeds 1,2``, name; a :class:`~haptic.errors.HapticError` naming
+    the item that is neither."""
+    try:
+        if pairs:
+            out = []
+            for item in pairs.split(","):
+                model, _, seed = item.partition(":")
+                out.append((model, int(seed)))
+            return out
+        listed = objects.split(",") if objects else names()
+        return [(m, int(s)) for m in listed for s in seeds.split(",")]
+    except ValueError:
+        raise HapticError(f"--pairs {pairs!r} / --seeds {seeds!r}: give OBJECT:SEED,... and SEED,... with whole "
+                          f"seeds, e.g. --pairs BOX01N:1,FRAME01:3 or --seeds 1,2") from None
+
+
 def python_option(name: str, value) -> str:
     """How Python spells a setting in messages: ``verify='fullish'``."""
     return f"{name}={value!r}"

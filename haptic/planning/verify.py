@@ -481,6 +481,18 @@ def hidden_vertices(poly: Polyhedron, world_from_model: SE3, cov, config: Planne
             if v not in cov.reachable_vertices and v not in cov.vertices and z[v] > TABLE_CONTACT]  # fmt: skip
 
 
+def out_of_reach(poly: Polyhedron, world_from_model: SE3, config: PlannerConfig):
+    """What the full verification cannot measure of ``poly`` at ``world_from_model`` before any move: the features
+    in its reach (:func:`reachable_features`), the vertices off the table out of that reach (farther than
+    :data:`TABLE_CONTACT` above it: :func:`hidden_vertices` with nothing measured yet) and the vertices on the table
+    it cannot pin (:func:`table_pins`). The evaluation scripts' question at an episode's true pose."""
+    reach = reachable_features(poly, world_from_model, config)
+    z = world_from_model.apply(poly.vertices)[:, 2] - config.table_z
+    hidden = [v for v in range(poly.n_vertices) if v not in reach[2] and z[v] > TABLE_CONTACT]
+    _, unpinned = table_pins(poly, world_from_model, reach, config)
+    return reach, hidden, [int(v) for v in unpinned]
+
+
 def _new_features(before: Hypothesis, after: Hypothesis) -> tuple[set[int], set[int], set[int]]:
     return (
         set(after.faces.values()) - set(before.faces.values()),
