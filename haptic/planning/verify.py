@@ -52,6 +52,7 @@ from haptic.planning.tour import (
     Tour,
     features,
     plan_tour,
+    spanning_tree_bound,
     tour_lower_bound,
 )
 
@@ -1119,6 +1120,16 @@ def _start_costs(h: Hypothesis, state: SensorState, table: StartCosts) -> np.nda
     return table(h.model_from_world.apply(state.position), h.faces.get(state.face), edge)
 
 
+def _first_vertices(h: Hypothesis, state: SensorState) -> frozenset[int] | None:
+    """The model vertices the sensor in ``state`` may measure by an edge move without a move onto an edge first
+    (:func:`~haptic.planning.tour.tour_lower_bound`): the ends of the model edge it is on; none when it is on no
+    edge (after a probe, on a face); None (any) when its edge has no model edge in ``h``."""
+    if state.edge is None:
+        return frozenset()
+    e = h.edges.get(state.edge)
+    return None if e is None else frozenset(int(v) for v in h.poly.edges[e])
+
+
 def _entries(
     poly: Polyhedron, tour: Tour, here: np.ndarray, keys: np.ndarray
 ) -> tuple[frozenset[int], frozenset[int], frozenset[int]]:
@@ -1315,6 +1326,9 @@ class Verifier:
         self.tour_bound: float | None = None
         """A lower bound of the verification's cost from there (:func:`~haptic.planning.tour.tour_lower_bound`;
         None: no pose, or no vertex to measure)."""
+        self.tour_tree_bound: float | None = None
+        """The weaker bound of the spanning tree, any vertex measured first without arriving on an edge
+        (:func:`~haptic.planning.tour.spanning_tree_bound`), for comparison [units]."""
         self.decision_times: list[float] = []
         """Wall time of each verification move's choice [s] (not in the record, which is the same on every run)."""
         self.middles: list[int] = []
@@ -1730,8 +1744,10 @@ class Verifier:
             legs = _legs(self.config)
             keys = features(h.poly).index(missing)
             self.tour_planned = now
-            bound = tour_lower_bound(h.poly, h.model_from_world.apply(state.position), keys, legs)
+            here, first = h.model_from_world.apply(state.position), _first_vertices(h, state)
+            bound = tour_lower_bound(h.poly, here, keys, legs, first)
             self.tour_bound = bound if bound > 0 else None
+            self.tour_tree_bound = spanning_tree_bound(h.poly, here, keys, legs) if bound > 0 else None
         self.decision_times.append(time.perf_counter() - t0)
         return move
 
@@ -1873,6 +1889,8 @@ class Verifier:
             out["tour_planned"] = round(self.tour_planned, 6)
         if self.tour_bound is not None:
             out["tour_bound"] = round(self.tour_bound, 6)
+        if self.tour_tree_bound is not None:
+            out["tour_tree_bound"] = round(self.tour_tree_bound, 6)
         if self.coverage is not None:
             out["move_budget"] = self.move_budget()
             out.update(self.coverage.record(self._model))
