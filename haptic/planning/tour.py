@@ -336,7 +336,13 @@ def least_path(w: np.ndarray, enter: np.ndarray, first: np.ndarray) -> float:
 
 
 def tour_lower_bound(
-    poly: Polyhedron, position: np.ndarray, targets: np.ndarray, legs: LegCosts, first: frozenset[int] | None = None
+    poly: Polyhedron,
+    position: np.ndarray,
+    targets: np.ndarray,
+    legs: LegCosts,
+    first: frozenset[int] | None = None,
+    middles: np.ndarray | None = None,
+    reach: float = 0.0,
 ) -> float:
     """A lower bound of the cost of measuring every vertex among ``targets`` from a sensor at ``position`` (model
     frame) [units]: each is measured by an edge move that ends at it (``c_k`` each), and the sensor's path passes
@@ -351,18 +357,40 @@ def tour_lower_bound(
     vertices it may measure first without arriving (the ends of the model edge the sensor is on; an empty set
     when it is on none; None, as by default, when that is not known: any).
 
-    The least path through the vertices in any order over those legs is a lower bound, and it is found exactly
-    for up to :data:`HELD_KARP_MOST` vertices (:func:`least_path`); beyond that, :func:`spanning_tree_bound`."""
+    ``middles`` (shape (m, 3), model frame) are points the path must also touch, each within ``reach``, by a
+    probe's contact (that no other move touches them is the caller's to show): the stretch into one ends with a
+    probe, at least ``c_p + c_s (d - reach)``, the stretch out of it is a leg as above over ``d - reach``, and it
+    adds no detection nor arrival. Any of them may be left out and the bound stays one: those past
+    :data:`HELD_KARP_MOST` nodes are.
+
+    The least path through the vertices and middles in any order over those legs is a lower bound, and it is
+    found exactly for up to :data:`HELD_KARP_MOST` of them (:func:`least_path`); beyond that many vertices,
+    :func:`spanning_tree_bound` (without the middles)."""
     feats = features(poly)
     vertex_ids = feats.ids[targets[feats.kinds[targets] == VERTEX]]
     if not len(vertex_ids):
         return 0.0
-    if len(vertex_ids) > HELD_KARP_MOST:
+    n = len(vertex_ids)
+    if n > HELD_KARP_MOST:
         return spanning_tree_bound(poly, position, targets, legs, first)
+    mids = np.zeros((0, 3)) if middles is None else np.asarray(middles, float).reshape(-1, 3)[: HELD_KARP_MOST - n]
     arrive = arrival_costs(poly, legs)[vertex_ids]
-    free = np.ones(len(vertex_ids), dtype=bool) if first is None else np.isin(vertex_ids, sorted(first))
+    free = np.ones(n, dtype=bool) if first is None else np.isin(vertex_ids, sorted(first))
     w = _bound_legs(poly, position, vertex_ids, legs)
-    return least_path(w, arrive, np.where(free, 0.0, arrive)) + legs.vertex_event * len(vertex_ids)
+    if len(mids):
+        p = np.vstack([np.asarray(position, float)[None], poly.vertices[vertex_ids], mids])
+        d = np.linalg.norm(p[:, None] - p[None], axis=2)
+        is_mid = np.arange(len(p)) > n
+        # each middle is touched within reach: the legs out of it and into it are that much shorter
+        d = np.maximum(d - reach * (is_mid[:, None].astype(float) + is_mid[None, :]), 0.0)
+        w = legs.face_rate * d
+        if legs.probes:
+            w = np.minimum(w, legs.probe_fixed + legs.probe_rate * d)
+        w[:, is_mid] = legs.probe_fixed + legs.probe_rate * d[:, is_mid]  # into a middle: a probe
+        np.fill_diagonal(w, 0.0)
+    enter = np.concatenate([arrive, np.zeros(len(mids))])
+    start = np.concatenate([np.where(free, 0.0, arrive), np.zeros(len(mids))])
+    return least_path(w, enter, start) + legs.vertex_event * n
 
 
 def spanning_tree_bound(

@@ -1204,6 +1204,40 @@ def _face_middle(poly: Polyhedron, f: int) -> np.ndarray:
     return candidates[int(np.argmax([inside(p) for p in candidates]))]
 
 
+TRACED_DEPTH = 9e-3
+"""How far in from its face's boundary a point the verification measures by a move other than a probe can lie [m]:
+an edge move's points lie on the edge, a face move's where it steps onto the next face, at most the geometric
+executor's ``step_onto_face`` (8 mm) in, a vertex move's on its circle round the vertex (``vertex_radius``, 8 mm), with
+a millimetre for the noise (``tests/planning/test_tour.py`` holds it to the executor's settings)."""
+_PROBE_ONLY: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def probe_only_middles(poly: Polyhedron) -> frozenset[int]:
+    """The faces of ``poly`` whose middle (:func:`face_middle`) only a probe's contact can measure: it lies more than
+    :data:`MIDDLE_REACH` + :data:`TRACED_DEPTH` from its face's boundary and more than :data:`MIDDLE_REACH` plus a
+    millimetre from every other face, so that no point a traced move measures is within :data:`MIDDLE_REACH` of
+    it. A verification that measures such a middle has made a probe that ends there: a cost every confirmation
+    under ``full`` with probes pays (:func:`~haptic.planning.tour.tour_lower_bound`). Computed once per model."""
+    if poly in _PROBE_ONLY:
+        return _PROBE_ONLY[poly]
+    from haptic.geometry.distance import point_triangle_distance
+
+    tri = poly.vertices[poly.triangles]
+    out = set()
+    for f in range(poly.n_faces):
+        m = face_middle(poly, f)
+        loop = poly.vertices[list(poly.faces[f])]
+        a, b = loop, np.roll(loop, -1, axis=0)
+        t = np.clip(np.einsum("ij,ij->i", m - a, b - a) / np.einsum("ij,ij->i", b - a, b - a), 0.0, 1.0)
+        edge = float(np.linalg.norm(m - a - t[:, None] * (b - a), axis=1).min())
+        others = tri[poly.triangle_faces != f]
+        other = float(point_triangle_distance(m[None], others).min()) if len(others) else np.inf
+        if edge > MIDDLE_REACH + TRACED_DEPTH and other > MIDDLE_REACH + 1e-3:
+            out.add(f)
+    _PROBE_ONLY[poly] = frozenset(out)
+    return _PROBE_ONLY[poly]
+
+
 def unmeasured_middles(poly: Polyhedron, world_from_model: SE3, data: Sequence[DataComponent],
                        faces: frozenset[int]) -> list[int]:
     """The ``faces`` of ``poly`` at pose ``world_from_model`` whose middle no measured point of ``data`` lies
@@ -1326,6 +1360,12 @@ class Verifier:
         self.tour_bound: float | None = None
         """A lower bound of the verification's cost from there (:func:`~haptic.planning.tour.tour_lower_bound`;
         None: no pose, or no vertex to measure)."""
+        self.tour_vertex_bound: float | None = None
+        """:attr:`tour_bound` for the vertices alone, without the faces' middles."""
+        self._bound_from: tuple | None = None
+        """What :attr:`tour_bound` is computed from once the verification ends (:meth:`_middles_bound`): the model,
+        the sensor's place, the targets, the leg costs, the vertices it may measure first and the faces whose middle
+        only a probe measures, still to be measured then."""
         self.tour_tree_bound: float | None = None
         """The weaker bound of the spanning tree, any vertex measured first without arriving on an edge
         (:func:`~haptic.planning.tour.spanning_tree_bound`), for comparison [units]."""
@@ -1627,6 +1667,20 @@ class Verifier:
         self.middles.remove(f)
         return preds[good[0][1]].move
 
+    def _middles_bound(self) -> float | None:
+        """:attr:`tour_bound` of a confirmed verification with the faces' middles it had to measure: those still to
+        be measured when it began that only a probe measures (:func:`probe_only_middles`), but for the faces no
+        probe was predicted to reach (:attr:`middles_unprobed`, not asked for), each touched within
+        :data:`MIDDLE_REACH` (:func:`~haptic.planning.tour.tour_lower_bound`)."""
+        if self._bound_from is None:
+            return self.tour_bound
+        poly, here, keys, legs, first, due = self._bound_from
+        faces = [f for f in due if f not in self.middles_unprobed]
+        if not faces:
+            return self.tour_bound
+        middles = np.array([face_middle(poly, f) for f in faces])
+        return tour_lower_bound(poly, here, keys, legs, first, middles, MIDDLE_REACH)
+
     def move_budget(self) -> int:
         """The verification moves this verification may make (:func:`verify_move_budget` of the recognised
         model's coverage target; :data:`STALL_MOVES` while no pose gives one)."""
@@ -1746,8 +1800,9 @@ class Verifier:
             self.tour_planned = now
             here, first = h.model_from_world.apply(state.position), _first_vertices(h, state)
             bound = tour_lower_bound(h.poly, here, keys, legs, first)
-            self.tour_bound = bound if bound > 0 else None
+            self.tour_bound = self.tour_vertex_bound = bound if bound > 0 else None
             self.tour_tree_bound = spanning_tree_bound(h.poly, here, keys, legs) if bound > 0 else None
+            self._bound_from = (h.poly, here, keys, legs, first, sorted(due & probe_only_middles(h.poly)))
         self.decision_times.append(time.perf_counter() - t0)
         return move
 
@@ -1887,8 +1942,12 @@ class Verifier:
             out["middles_cost"] = round(cost - self._middles_from, 6)
         if self.tour_planned is not None:
             out["tour_planned"] = round(self.tour_planned, 6)
+        if self.tour_bound is not None and self.status == "confirmed":
+            self.tour_bound = self._middles_bound()
         if self.tour_bound is not None:
             out["tour_bound"] = round(self.tour_bound, 6)
+        if self.tour_vertex_bound is not None:
+            out["tour_vertex_bound"] = round(self.tour_vertex_bound, 6)
         if self.tour_tree_bound is not None:
             out["tour_tree_bound"] = round(self.tour_tree_bound, 6)
         if self.coverage is not None:

@@ -195,6 +195,73 @@ def test_the_bound_is_the_best_order_over_its_legs_and_above_the_spanning_tree(l
     assert above > 0
 
 
+def test_middles_add_a_probe_each_and_the_bound_is_the_best_order_with_them():
+    """A property test: random vertices and faces' middles (up to 6 nodes) of the seed models; the bound with the
+    middles is the least cost over every order of the same legs (into a middle a probe over the distance less the
+    reach, out of it a leg over the distance less the reach), at least the bound without them, somewhere more by
+    nearly ``c_p`` a middle; a middle at the one vertex to measure, the sensor there, still costs a probe."""
+    from haptic.planning.verify import MIDDLE_REACH, face_middle
+
+    rng = np.random.default_rng(58)
+    names = sorted(LIB)
+    more = 0
+    for _ in range(40):
+        poly = LIB[names[int(rng.integers(len(names)))]]
+        keys = _vertices(poly)
+        n = int(rng.integers(1, 4))
+        m = int(rng.integers(1, 4))
+        chosen = np.sort(rng.choice(len(keys), n, replace=False))
+        faces = rng.choice(poly.n_faces, m, replace=False)
+        mids = np.array([face_middle(poly, int(f)) for f in faces])
+        here = poly.vertices[int(rng.integers(poly.n_vertices))] + rng.normal(0, 0.01, 3)
+        arrive = arrival_costs(poly, ALL)[chosen]
+        pts = np.vstack([here[None], poly.vertices[chosen], mids])
+        is_mid = np.arange(len(pts)) > n
+        d = np.linalg.norm(pts[:, None] - pts[None], axis=2)
+        d = np.maximum(d - MIDDLE_REACH * (is_mid[:, None].astype(float) + is_mid[None, :]), 0.0)
+        leg = np.minimum(ALL.face_rate * d, ALL.probe_fixed + ALL.probe_rate * d)
+        leg[:, is_mid] = ALL.probe_fixed + ALL.probe_rate * d[:, is_mid]
+        enter = np.concatenate([arrive, np.zeros(m)])
+        brute = min(
+            leg[0, o[0] + 1] + sum(leg[o[i - 1] + 1, o[i] + 1] + enter[o[i]] for i in range(1, n + m))
+            for o in itertools.permutations(range(n + m))
+        ) + n * ALL.vertex_event  # fmt: skip
+        bound = tour_lower_bound(poly, here, keys[chosen], ALL, None, mids, MIDDLE_REACH)
+        alone = tour_lower_bound(poly, here, keys[chosen], ALL)
+        assert bound == pytest.approx(brute, rel=1e-9, abs=1e-9)
+        assert bound >= alone - 1e-9
+        more += bound >= alone + m * (ALL.probe_fixed - 1.0)
+    assert more > 0
+    poly = LIB["BOX01"]
+    one = tour_lower_bound(poly, poly.vertices[0], _vertices(poly)[:1], ALL, None, poly.vertices[:1], MIDDLE_REACH)
+    assert one == pytest.approx(ALL.vertex_event + ALL.probe_fixed)
+
+
+def test_only_a_probe_reaches_the_middles_the_bound_counts():
+    """The faces whose middle the bound counts as a probe's (:func:`~haptic.planning.verify.probe_only_middles`):
+    no point a traced move measures on the geometric executor (stepping onto a face, a vertex move's circle) lies
+    within the middle's reach; some of FRAME01's faces, 16 mm wide, are not among them."""
+    from haptic.executor.geometric import GeometricSettings
+    from haptic.planning.verify import MIDDLE_REACH, TRACED_DEPTH, face_middle, probe_only_middles
+
+    g = GeometricSettings()
+    assert TRACED_DEPTH >= max(g.step_onto_face, g.vertex_radius, PlannerConfig().vertex_radius)
+    for name in ("BOX01", "TETRA01L", "FRAME01", "LBLOCK01"):
+        poly = LIB[name]
+        ok = probe_only_middles(poly)
+        for f in ok:
+            loop = poly.vertices[list(poly.faces[f])]
+            m = face_middle(poly, f)
+            # every point of the face within the traced depth of its boundary is farther than the reach from m
+            a, b = loop, np.roll(loop, -1, axis=0)
+            for s in np.linspace(0.0, 1.0, 21):
+                q = a + s * (b - a)
+                assert np.linalg.norm(q - m, axis=1).min() > MIDDLE_REACH + TRACED_DEPTH
+    assert len(probe_only_middles(LIB["BOX01"])) == LIB["BOX01"].n_faces
+    frame = LIB["FRAME01"]
+    assert 0 < len(probe_only_middles(frame)) < frame.n_faces  # the narrow faces' middles are near their edges
+
+
 def test_least_path_is_exact_on_random_legs():
     """Held-Karp against brute force on random asymmetric legs and node costs, up to 7 nodes."""
     rng = np.random.default_rng(5)
