@@ -70,13 +70,13 @@ def main(argv: list[str] | None = None) -> int:
           f"({np.median(cost / bound):.2f}) | {np.nanmean(plan):.2f} | {cost.mean() / np.nanmean(plan):.2f}× "
           f"({np.nanmedian(cost / plan):.2f}) | {probes:.1f}, {mid.mean():.2f} | "
           f"{(cost - mid).mean() / bound.mean():.2f}× ({np.median((cost - mid) / bound):.2f}) |")
-    for key, what in (("tour_vertex_bound", "the vertices' alone"), ("tour_tree_bound", "the spanning tree's")):
+    for key, what in (("tour_vertex_bound", "the vertices' bound"), ("tour_tree_bound", "the spanning tree's bound")):
         other = np.array([r["verified"].get(key, np.nan) for r in v])
         t = np.isfinite(other)
         if not t.any():
             continue
         ct, mt, bt = cost[t], (cost - mid)[t], other[t]
-        print(f"\n{what} bound ({key}, {int(t.sum())} episodes): {bt.mean():.2f}, the verification's cost "
+        print(f"\n{what} ({key}, {int(t.sum())} episodes): {bt.mean():.2f}, the verification's cost "
               f"{ct.mean() / bt.mean():.2f}× it (median {np.median(ct / bt):.2f}), less the middles "
               f"{mt.mean() / bt.mean():.2f}× (median {np.median(mt / bt):.2f})")
     done = np.array([r["verified"]["status"] == "confirmed" for r in v])

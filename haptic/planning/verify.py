@@ -1671,7 +1671,8 @@ class Verifier:
         """:attr:`tour_bound` of a confirmed verification with the faces' middles it had to measure: those still to
         be measured when it began that only a probe measures (:func:`probe_only_middles`), but for the faces no
         probe was predicted to reach (:attr:`middles_unprobed`, not asked for), each touched within
-        :data:`MIDDLE_REACH` (:func:`~haptic.planning.tour.tour_lower_bound`)."""
+        :data:`MIDDLE_REACH` (:func:`~haptic.planning.tour.tour_lower_bound`); the vertices' bound where that is
+        more (both are bounds: a middle's legs are shortened by its reach)."""
         if self._bound_from is None:
             return self.tour_bound
         poly, here, keys, legs, first, due = self._bound_from
@@ -1679,7 +1680,7 @@ class Verifier:
         if not faces:
             return self.tour_bound
         middles = np.array([face_middle(poly, f) for f in faces])
-        return tour_lower_bound(poly, here, keys, legs, first, middles, MIDDLE_REACH)
+        return max(self.tour_bound, tour_lower_bound(poly, here, keys, legs, first, middles, MIDDLE_REACH))
 
     def move_budget(self) -> int:
         """The verification moves this verification may make (:func:`verify_move_budget` of the recognised
