@@ -360,37 +360,67 @@ def tour_lower_bound(
     ``middles`` (shape (m, 3), model frame) are points the path must also touch, each within ``reach``, by a
     probe's contact (that no other move touches them is the caller's to show): the stretch into one ends with a
     probe, at least ``c_p + c_s (d - reach)``, the stretch out of it is a leg as above over ``d - reach``, and it
-    adds no detection nor arrival. Any of them may be left out and the bound stays one: those past
-    :data:`HELD_KARP_MOST` nodes are.
+    adds no detection nor arrival. Those beyond :data:`HELD_KARP_MOST` nodes in all are left out of the exact path
+    and count what taking each out of a path at least saves (:func:`_least_insertion`, the least over every two
+    nodes it could lie between): taking them out one by one leaves a path over the rest, itself at least the
+    exact one's (or the spanning tree's) cost.
 
     The least path through the vertices and middles in any order over those legs is a lower bound, and it is
     found exactly for up to :data:`HELD_KARP_MOST` of them (:func:`least_path`); beyond that many vertices,
-    :func:`spanning_tree_bound` (without the middles)."""
+    :func:`spanning_tree_bound` (and the middles as beyond the exact path)."""
     feats = features(poly)
     vertex_ids = feats.ids[targets[feats.kinds[targets] == VERTEX]]
     if not len(vertex_ids):
         return 0.0
     n = len(vertex_ids)
-    if n > HELD_KARP_MOST:
-        return spanning_tree_bound(poly, position, targets, legs, first)
-    mids = np.zeros((0, 3)) if middles is None else np.asarray(middles, float).reshape(-1, 3)[: HELD_KARP_MOST - n]
+    mids = np.zeros((0, 3)) if middles is None else np.asarray(middles, float).reshape(-1, 3)
     arrive = arrival_costs(poly, legs)[vertex_ids]
     free = np.ones(n, dtype=bool) if first is None else np.isin(vertex_ids, sorted(first))
     w = _bound_legs(poly, position, vertex_ids, legs)
-    if len(mids):
-        p = np.vstack([np.asarray(position, float)[None], poly.vertices[vertex_ids], mids])
-        d = np.linalg.norm(p[:, None] - p[None], axis=2)
-        is_mid = np.arange(len(p)) > n
-        # each middle is touched within reach: the legs out of it and into it are that much shorter
-        d = np.maximum(d - reach * (is_mid[:, None].astype(float) + is_mid[None, :]), 0.0)
-        w = legs.face_rate * d
-        if legs.probes:
-            w = np.minimum(w, legs.probe_fixed + legs.probe_rate * d)
-        w[:, is_mid] = legs.probe_fixed + legs.probe_rate * d[:, is_mid]  # into a middle: a probe
-        np.fill_diagonal(w, 0.0)
-    enter = np.concatenate([arrive, np.zeros(len(mids))])
-    start = np.concatenate([np.where(free, 0.0, arrive), np.zeros(len(mids))])
-    return least_path(w, enter, start) + legs.vertex_event * n
+    if not len(mids):
+        if n > HELD_KARP_MOST:
+            return spanning_tree_bound(poly, position, targets, legs, first)
+        return least_path(w, arrive, np.where(free, 0.0, arrive)) + legs.vertex_event * n
+    p = np.vstack([np.asarray(position, float)[None], poly.vertices[vertex_ids], mids])
+    d = np.linalg.norm(p[:, None] - p[None], axis=2)
+    is_mid = np.arange(len(p)) > n
+    # each middle is touched within reach: the legs out of it and into it are that much shorter
+    d = np.maximum(d - reach * (is_mid[:, None].astype(float) + is_mid[None, :]), 0.0)
+    w = legs.face_rate * d
+    if legs.probes:
+        w = np.minimum(w, legs.probe_fixed + legs.probe_rate * d)
+    w[:, is_mid] = legs.probe_fixed + legs.probe_rate * d[:, is_mid]  # into a middle: a probe
+    np.fill_diagonal(w, 0.0)
+    # the middles beyond the exact path's room: each at least the least a path's cost drops when it is taken out
+    # between any two nodes (or at the path's end), the weakest kept in the exact path
+    gain = _least_insertion(w, np.flatnonzero(is_mid))
+    room = max(HELD_KARP_MOST - n, 0)
+    kept = np.sort(np.argsort(gain, kind="stable")[:room])
+    out = float(np.delete(gain, kept).sum())
+    if n > HELD_KARP_MOST:
+        return spanning_tree_bound(poly, position, targets, legs, first) + out
+    nodes = np.concatenate([np.arange(n + 1), n + 1 + kept])
+    w = w[np.ix_(nodes, nodes)]
+    enter = np.concatenate([arrive, np.zeros(len(kept))])
+    start = np.concatenate([np.where(free, 0.0, arrive), np.zeros(len(kept))])
+    return least_path(w, enter, start) + legs.vertex_event * n + out
+
+
+def _least_insertion(w: np.ndarray, nodes: np.ndarray) -> np.ndarray:
+    """Per node ``k`` of ``nodes`` (indices of ``w``, node 0 the start), the least ``w[a, k] + w[k, b] - w[a, b]``
+    over the other nodes ``a`` before it and ``b`` after it (not the start), or ``w[a, k]`` with none after: what a
+    path over ``w`` at least saves when ``k`` is taken out of it, between whichever nodes it then lies [units]."""
+    out = np.empty(len(nodes))
+    size = len(w)
+    for i, k in enumerate(nodes):
+        through = w[:, k][:, None] + w[k, :][None, :] - w
+        ok = np.ones((size, size), dtype=bool)
+        ok[k, :] = ok[:, k] = False
+        ok[:, 0] = False
+        np.fill_diagonal(ok, False)
+        last = np.delete(w[:, k], k)
+        out[i] = min(float(through[ok].min()) if ok.any() else np.inf, float(last.min()))
+    return out
 
 
 def spanning_tree_bound(

@@ -199,6 +199,29 @@ def test_the_bound_is_the_best_order_over_its_legs_and_above_the_spanning_tree(l
     assert above > 0
 
 
+def test_middles_beyond_the_exact_path_keep_it_a_bound(monkeypatch):
+    """A property test: with room in the exact path for fewer nodes than there are (the rest counted by what taking
+    each out of a path at least saves), or for none (the spanning tree and every middle so), the bound stays at most
+    the best order's cost over the same legs (brute force), on random vertices and middles of the seed models."""
+    import haptic.planning.tour as tour_module
+    from haptic.planning.verify import MIDDLE_REACH, face_middle
+
+    rng = np.random.default_rng(7)
+    names = sorted(LIB)
+    for _ in range(30):
+        poly = LIB[names[int(rng.integers(len(names)))]]
+        keys = _vertices(poly)
+        n, m = int(rng.integers(1, 4)), int(rng.integers(1, 4))
+        chosen = np.sort(rng.choice(len(keys), n, replace=False))
+        mids = np.array([face_middle(poly, int(f)) for f in rng.choice(poly.n_faces, m, replace=False)])
+        here = poly.vertices[int(rng.integers(poly.n_vertices))] + rng.normal(0, 0.01, 3)
+        monkeypatch.setattr(tour_module, "HELD_KARP_MOST", 16)
+        exact = tour_lower_bound(poly, here, keys[chosen], ALL, None, mids, MIDDLE_REACH)
+        for room in (n + m - 1, n, 0):
+            monkeypatch.setattr(tour_module, "HELD_KARP_MOST", room)
+            assert tour_lower_bound(poly, here, keys[chosen], ALL, None, mids, MIDDLE_REACH) <= exact + 1e-9
+
+
 def test_middles_add_a_probe_each_and_the_bound_is_the_best_order_with_them():
     """A property test: random vertices and faces' middles (up to 6 nodes) of the seed models; the bound with the
     middles is the least cost over every order of the same legs (into a middle a probe over the distance less the
