@@ -784,16 +784,16 @@ def close_start(h: Hypothesis, move: ProbeMove, standoff: float = VERIFY_STANDOF
     return ProbeMove(start + cut * u, u, float(move.length) - cut)
 
 
-def same_line(a: Move, b: Move) -> bool:
-    """Whether probes ``a`` and ``b`` run along nearly one line (directions within ~8°, the lines within a probe
-    target's spacing of each other), wherever they start; False for other moves."""
+def same_line(a: Move, b: Move, spacing: float | None = None) -> bool:
+    """Whether probes ``a`` and ``b`` run along nearly one line (directions within ~8°, the lines within
+    ``spacing`` of each other, by default a probe target's spacing), wherever they start; False for other moves."""
     from haptic.planning.probe_lines import ProbeConfig
 
     if a.kind != "probe" or b.kind != "probe" or float(np.dot(a.direction, b.direction)) <= 0.99:
         return False
     d = np.asarray(b.start, float) - np.asarray(a.start, float)
     u = np.asarray(a.direction, float)
-    return float(np.linalg.norm(d - (d @ u) * u)) < ProbeConfig.target_spacing
+    return float(np.linalg.norm(d - (d @ u) * u)) < (ProbeConfig.target_spacing if spacing is None else spacing)
 
 
 LANDS_NEAR = 2 * PROBE_INSET
@@ -1448,8 +1448,10 @@ class Verifier:
             if self.status == "incomplete" and self._ridges_next(tree.data, it):
                 self.status = "verifying"
             if self.status == "confirmed" and self.mode == "full" and self._probes_admitted():
-                todo = [f for f in unmeasured_middles(cls.model, self.check.world_from_model, tree.data,
-                                                      self._reach[cls.name][0]) if f not in self.middles_unprobed]
+                due = [f for f in unmeasured_middles(cls.model, self.check.world_from_model, tree.data,
+                                                     self._reach[cls.name][0]) if f not in self.middles_unprobed]
+                self.middles_unprobed.update(self._blocked_middles(self._hyp, due))
+                todo = [f for f in due if f not in self.middles_unprobed]
                 self.middles = [f for f in todo if f not in self._middles_tried]
                 if self.middles:
                     self.status = "verifying"
@@ -1638,6 +1640,26 @@ class Verifier:
     def _probes_admitted(self) -> bool:
         return self.config.moves != "tracing" and self.config.table_z is None and MAX_VERIFY_PROBES > 0
 
+    def _blocked_middles(self, h: Hypothesis, faces: Sequence[int]) -> set[int]:
+        """The ``faces`` whose middle no probe can reach in hypothesis ``h``'s world: the line :meth:`_middle_probe`
+        would take (:func:`~haptic.planning.probe_lines.aimed_probes`, head-on first) meets another face of the model
+        first, or there is none (FRAME01's inner faces, behind the frame's other side). Known when the vertices are
+        done, such a middle is left out then (:attr:`middles_unprobed`), not after a decision that finds no probe for
+        it: that decision had no move of its own, and the episode took the opening's next instead (a face move or a
+        whole edge, measuring nothing the verification needed)."""
+        from haptic.planning.move_scores import probe_config
+        from haptic.planning.probe_lines import aimed_probes
+
+        if not faces or h is None or h.world_from_model is None:
+            return set()
+        targets = [(face_middle(h.poly, f), int(f)) for f in faces]
+        reached = set()
+        for mv, k in aimed_probes(h, targets, probe_config(self.config)):
+            start, u = h.model_from_world.apply(mv.start), h.model_from_world.rotate(mv.direction)
+            if int(line_hits(h.poly, start[None], u[None]).face[0]) == targets[k][1]:
+                reached.add(targets[k][1])
+        return {f for _, f in targets} - reached
+
     def _middle_probe(self, h: Hypothesis, state: SensorState, components: Mapping[int, DataComponent],
                       avoid: Sequence[Move], probed: Sequence[Move]) -> Move | None:
         """A probe at the middle of the next face of :attr:`middles` predicted to land on it (None: none left)."""
@@ -1650,10 +1672,12 @@ class Verifier:
             self.middles = []
             return None
         # the cheapest of the middles left next (a tour of them by nearest neighbour): in the faces' order the
-        # probes crossed the object back and forth
+        # probes crossed the object back and forth. A probe before along a line within a target's spacing of the
+        # middle's need not have landed within reach of it (one aimed beside a vertex of the face, head-on as this
+        # one): only a line within the reach is the same
         targets = [(face_middle(h.poly, f), f) for f in self.middles]
         lines = [(close_start(h, mv), targets[k][1]) for mv, k in aimed_probes(h, targets, probe_config(self.config))
-                 if not any(same_line(mv, done) for done in probed)]  # fmt: skip
+                 if not any(same_line(mv, done, MIDDLE_REACH) for done in probed)]  # fmt: skip
         preds = predict_probe_moves(Context((h,), state, components, self.noise, self.config), [m for m, _ in lines])
         good = sorted(((float(p.costs[0]), k) for k, p in enumerate(preds)
                        if bool(p.hit[0]) and int(p.face[0]) == lines[k][1] and p.risk() == 0.0))  # fmt: skip
@@ -1940,6 +1964,7 @@ class Verifier:
                 out["table_residual_mm"] = round(self.accept.table_residual * 1000.0, 3)
         if self._middles_from is not None:  # the faces' middles: probes and their cost
             out["middles_probed"] = len(self._middles_tried - self.middles_unprobed)
+            out["middles_unprobed"] = len(self.middles_unprobed)
             out["middles_cost"] = round(cost - self._middles_from, 6)
         if self.tour_planned is not None:
             out["tour_planned"] = round(self.tour_planned, 6)

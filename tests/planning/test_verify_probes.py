@@ -214,3 +214,45 @@ def test_a_probe_may_land_at_the_middle_still_to_be_probed_of_a_face_beside_a_mi
         # a face whose middle is measured already is not a target
         assert not at_middles(verification_probes(h, state, comps, missing, ex.noise, ALL,
                                                   middles=frozenset(landed) ^ beside)) & landed  # fmt: skip
+
+
+def test_a_middle_is_probed_where_a_probe_beside_a_vertex_went_along_a_near_line():
+    """A face's middle is probed after the vertices even when a probe before, aimed beside a vertex of that face
+    head-on as the middle's line is, went along a line within a target's spacing of it without landing within the
+    middle's reach: only a line within the reach counts as the same. Before, the look-alike tetrahedron's face 2
+    (LA_TETRA0R, seed 585528511) was left unprobed -- a slot across its middle would not have been caught -- and the
+    verification, with no move of its own, took the opening's next move, a whole edge traced for nothing."""
+    lib = load_library("assets/libraries/lookalike")
+    r = run_episode(EpisodeSpec(model="LA_TETRA0R", seed=585528511, verify="full", moves="all"), lib).to_json()
+    v = r["verified"]
+    assert v["status"] == "confirmed" and r["correct"]
+    assert v["middles_unprobed"] == 0 and v["middles_probed"] >= 1
+    assert r["move_kinds"][-1] == "probe"  # the last move a middle's probe, not the opening's fallback
+
+
+@pytest.mark.parametrize("name, seed", [("FRAME01", 1991575180), ("BOX01N", 924059490)])
+def test_middles_no_probe_reaches_are_left_out_when_the_vertices_are_done(name, seed):
+    """Faces whose middle no probe can reach (the line meets another face of the model first: FRAME01's inner faces,
+    BOX01N's notch) are left out when the vertices are done, not at a decision that then has no move: before, that
+    decision took the opening's next move, a face move measuring nothing, as the episode's last."""
+    r = run_episode(EpisodeSpec(model=name, seed=seed, verify="full", moves="all")).to_json()
+    v = r["verified"]
+    assert v["status"] == "confirmed" and r["correct"] and v["middles_unprobed"] >= 1
+    assert r["move_kinds"][-1] == "probe"  # the last middle's probe
+
+
+def test_blocked_middles_are_those_behind_another_face():
+    """:meth:`Verifier._blocked_middles`: none of a box's faces; of FRAME01's, some (behind the frame's other side),
+    never one a head-on line from outside reaches first."""
+    from haptic.geometry.se3 import SE3
+    from haptic.matching.components import SensorNoise
+    from haptic.planning.hypothesis import Hypothesis
+    from haptic.planning.verify import Verifier
+
+    ver = Verifier("full", SensorNoise(), ALL)
+    pose = SE3.identity()
+    for name in ("BOX01", "FRAME01"):
+        poly = LIB[name]
+        h = Hypothesis(name, poly, pose, {}, {}, {}, 1, (0,))
+        blocked = ver._blocked_middles(h, list(range(poly.n_faces)))
+        assert (not blocked) if name == "BOX01" else (0 < len(blocked) < poly.n_faces)
