@@ -1120,6 +1120,31 @@ def _start_costs(h: Hypothesis, state: SensorState, table: StartCosts) -> np.nda
     return table(h.model_from_world.apply(state.position), h.faces.get(state.face), edge)
 
 
+def _first_of_best_order(preds: Sequence, ks: Sequence[int], config: PlannerConfig) -> int:
+    """Of the probes ``preds[k]`` for ``k`` in ``ks`` (predictions from where the sensor is, each landing on its
+    face's middle), the first of the order in which all of them cost least: from here each its predicted cost, then
+    from one's contact to the next line's start and along it to its contact at ``c_p + c_s`` per metre (exact,
+    :func:`~haptic.planning.tour.least_path`)."""
+    from haptic.planning.tour import least_path
+
+    c = config.costs
+    starts = np.array([np.asarray(preds[k].move.start, float) for k in ks])
+    ends = np.array([starts[i] + float(preds[k].distance[0]) * np.asarray(preds[k].move.direction, float)
+                     for i, k in enumerate(ks)])  # fmt: skip
+    n = len(ks)
+    w = np.zeros((n + 1, n + 1))
+    w[0, 1:] = [float(preds[k].costs[0]) for k in ks]
+    along = np.linalg.norm(ends - starts, axis=1)
+    w[1:, 1:] = c.c_p + c.c_s * (np.linalg.norm(ends[:, None] - starts[None], axis=2) + along[None, :])
+    np.fill_diagonal(w[1:, 1:], 0.0)
+    zero = np.zeros(n - 1)
+    best = []
+    for i in range(n):  # first i, then the least path from its contact through the others
+        idx = [1 + i, *(1 + j for j in range(n) if j != i)]
+        best.append(w[0, 1 + i] + least_path(w[np.ix_(idx, idx)], zero, zero))
+    return int(ks[int(np.argmin(best))])
+
+
 def _first_vertices(h: Hypothesis, state: SensorState) -> frozenset[int] | None:
     """The model vertices the sensor in ``state`` may measure by an edge move without a move onto an edge first
     (:func:`~haptic.planning.tour.tour_lower_bound`): the ends of the model edge it is on; none when it is on no
@@ -1671,10 +1696,10 @@ class Verifier:
             self._middles_tried.update(self.middles)
             self.middles = []
             return None
-        # the cheapest of the middles left next (a tour of them by nearest neighbour): in the faces' order the
-        # probes crossed the object back and forth. A probe before along a line within a target's spacing of the
-        # middle's need not have landed within reach of it (one aimed beside a vertex of the face, head-on as this
-        # one): only a line within the reach is the same
+        # the first of the order in which the middles left cost least (in the faces' order the probes crossed the
+        # object back and forth; the cheapest first leaves the farthest for last). A probe before along a line
+        # within a target's spacing of the middle's need not have landed within reach of it (one aimed beside a
+        # vertex of the face, head-on as this one): only a line within the reach is the same
         targets = [(face_middle(h.poly, f), f) for f in self.middles]
         lines = [(close_start(h, mv), targets[k][1]) for mv, k in aimed_probes(h, targets, probe_config(self.config))
                  if not any(same_line(mv, done, MIDDLE_REACH) for done in probed)]  # fmt: skip
@@ -1686,10 +1711,11 @@ class Verifier:
             self._middles_tried.update(self.middles)
             self.middles = []
             return None
-        f = lines[good[0][1]][1]
+        k = _first_of_best_order(preds, [k for _, k in good], self.config) if len(good) > 1 else good[0][1]
+        f = lines[k][1]
         self._middles_tried.add(f)
         self.middles.remove(f)
-        return preds[good[0][1]].move
+        return preds[k].move
 
     def _middles_bound(self) -> float | None:
         """:attr:`tour_bound` of a confirmed verification with the faces' middles it had to measure: those still to

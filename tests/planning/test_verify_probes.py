@@ -256,3 +256,22 @@ def test_blocked_middles_are_those_behind_another_face():
         h = Hypothesis(name, poly, pose, {}, {}, {}, 1, (0,))
         blocked = ver._blocked_middles(h, list(range(poly.n_faces)))
         assert (not blocked) if name == "BOX01" else (0 < len(blocked) < poly.n_faces)
+
+
+def test_the_middles_are_probed_in_the_order_that_costs_least_not_the_cheapest_first():
+    """After the vertices, the next face's middle is the first of the best order of them all
+    (:func:`~haptic.planning.verify._first_of_best_order`), not the cheapest from here: from 0 on a line, with the
+    middles at -11, 10, 20 and 30 mm, the cheapest first (10) leaves the way back past 0 to -11 for last."""
+    from types import SimpleNamespace
+
+    from haptic.planning.verify import _first_of_best_order
+
+    c = ALL.costs
+    u = np.array([0.0, 0.0, -1.0])
+    preds = []
+    for x in (0.010, -0.011, 0.020, 0.030):  # each line starts 10 mm above its contact
+        start = np.array([x, 0.0, 0.01])
+        cost = c.c_p + c.c_s * (np.linalg.norm(start) + 0.01)
+        preds.append(SimpleNamespace(move=ProbeMove(start, u, 0.05), distance=np.array([0.01]), costs=np.array([cost])))
+    assert min(range(4), key=lambda k: preds[k].costs[0]) == 0  # the cheapest from here is at 10 mm
+    assert _first_of_best_order(preds, [0, 1, 2, 3], ALL) == 1  # the best order starts at -11 mm
