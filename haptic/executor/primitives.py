@@ -60,7 +60,10 @@ def _filtered(normal: np.ndarray, sample: np.ndarray, weight: float) -> np.ndarr
     (the vector form's arithmetic without numpy's per-call overhead; the norm's dot product by numpy)."""
     a0, a1, a2 = normal.tolist()
     b0, b1, b2 = sample.tolist()
-    return unit(np.array([a0 + weight * (b0 - a0), a1 + weight * (b1 - a1), a2 + weight * (b2 - a2)]))
+    f0, f1, f2 = a0 + weight * (b0 - a0), a1 + weight * (b1 - a1), a2 + weight * (b2 - a2)
+    v = np.array([f0, f1, f2])
+    n = math.sqrt(float(v.dot(v)))
+    return np.array([f0 / n, f1 / n, f2 / n]) if n > 0 else v  # unit(v), element by element
 
 
 def roll_settled(hist: list[tuple[float, np.ndarray]], travelled: float, normal: np.ndarray, window: float,

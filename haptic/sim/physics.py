@@ -275,6 +275,7 @@ class Simulation:
         self.model: mujoco.MjModel = scene.compile()
         self.data: mujoco.MjData = mujoco.MjData(self.model)
         self.noise = noise or SimulatedSensorNoise()
+        self._noisy = self.noise.any  # asked every tick (the noise is fixed)
         self._seed = seed
         self._rng = np.random.default_rng(seed)
         m = self.model
@@ -495,7 +496,7 @@ class Simulation:
             total = float(fn.sum())
             point, normal = merge_patches(np.array([p for _, p, _, _ in raw]), np.array([n for _, _, n, _ in raw]), fn)
         nz = self.noise
-        if nz.any:  # element by element on floats, the dot products by numpy: the vector form's arithmetic
+        if self._noisy:  # element by element on floats, the dot products by numpy: the vector form's arithmetic
             z0, z1, z2, z3, z4, z5, z6 = self._rng.standard_normal(7).tolist()
             total += nz.force_std * z0
             if nz.point_std > 0:
@@ -507,8 +508,10 @@ class Simulation:
                 e0, e1, e2 = s * z4, s * z5, s * z6
                 c = float(np.array([e0, e1, e2]).dot(normal))
                 n0, n1, n2 = normal.tolist()
-                normal = np.array([n0 + (e0 - c * n0), n1 + (e1 - c * n1), n2 + (e2 - c * n2)])  # tangent-plane
-                normal /= math.sqrt(float(normal.dot(normal)))
+                m0, m1, m2 = n0 + (e0 - c * n0), n1 + (e1 - c * n1), n2 + (e2 - c * n2)  # in the tangent plane
+                normal = np.array([m0, m1, m2])
+                size = math.sqrt(float(normal.dot(normal)))
+                normal = np.array([m0 / size, m1 / size, m2 / size])  # normal / size, element by element
         return total, normal, point, len(raw)
 
     def wrist_wrench(self, watch: bool = False) -> tuple[np.ndarray, np.ndarray]:
