@@ -382,7 +382,7 @@ def main(argv: list[str] | None = None) -> int:
     jobs = [(o, args.first_seed + k, args.policy, args.moves, args.verify, args.probe_costs, args.models,
              args.fingers) for o in objects for k in range(args.poses)]
     t0 = time.perf_counter()
-    preload_physics(cached_library(args.models)[o] for o in objects)  # the workers fork with it done
+    preload_physics((cached_library(args.models)[o] for o in objects), jobs=args.jobs)  # the workers fork with it done
     # what is loaded now lives as long as the process: out of the collector's reach, a full collection in an episode
     # no longer traverses the modules' hundred thousand objects (nor touches a forked worker's copy of them)
     gc.freeze()

@@ -177,3 +177,53 @@ def test_score_face_measures_only_the_faces_that_can_win(name):
             normal = poly.face_normals[f] + rng.normal(scale=rng.choice([1e-3, 0.1, 0.5]), size=3)
             c = DataFace(0, rot @ (normal / np.linalg.norm(normal)), pts @ rot.T + trans, 0.01, 0.001)
             assert score_face(c, poly, rot, trans, tol) == _score_face_every_face(c, poly, rot, trans, tol)
+
+
+def _score_edge_vector_form(c, model, rot, trans, tol):
+    """:func:`score_edge` with numpy's cross product, clip and norm (the form its per-edge arithmetic follows)."""
+    import math
+
+    from haptic.episode.evaluate import ComponentScore
+
+    def segment_distance(p, a, b):
+        ab = b - a
+        s = float(np.clip((p - a) @ ab / (ab @ ab), 0.0, 1.0))
+        return float(np.linalg.norm(p - (a + s * ab)))
+
+    best = None
+    for e in range(model.n_edges):
+        a = rot @ model.vertices[model.edges[e, 0]] + trans
+        b = rot @ model.vertices[model.edges[e, 1]] + trans
+        u = (b - a) / np.linalg.norm(b - a)
+        ang = math.degrees(math.acos(min(1.0, abs(float(u @ c.direction)))))
+        line = max(float(np.linalg.norm(np.cross(q - a, u))) for q in (c.point, c.end_point))
+        seg = max(segment_distance(q, a, b) for q in (c.point, c.end_point))
+        cost = ang / math.degrees(tol.direction) + seg / tol.position
+        if best is None or cost < best[0]:
+            best = (cost, e, ang, line, seg)
+    _, e, ang, line, seg = best
+    ok = ang <= math.degrees(tol.direction) and seg <= tol.position
+    return ComponentScore(c.id, "edge", e if ok else None, ang, line * 1e3)
+
+
+@pytest.mark.parametrize("name", sorted(LIB))
+def test_score_edge_is_its_vector_form_to_the_last_bit(name):
+    # data edges along each edge of the model, near it, off it and beyond its ends: the same edge and the same
+    # errors, bit for bit, as with numpy's cross product, clip and norm
+    from haptic.episode.evaluate import score_edge
+    from haptic.geometry import SE3
+    from haptic.matching.components import DataEdge
+
+    poly, tol = LIB[name], EvaluationTolerances()
+    rng = np.random.default_rng(11)
+    for _ in range(2):
+        pose = SE3.random(rng, 0.2)
+        rot, trans = pose.rotation, pose.translation
+        for e in range(poly.n_edges):
+            a, b = poly.vertices[poly.edges[e]]
+            start = a + rng.uniform(-0.3, 0.5) * (b - a) + rng.normal(scale=rng.choice([1e-4, 3e-3]), size=3)
+            direction = (b - a) + rng.normal(scale=rng.choice([1e-3, 0.3]) * np.linalg.norm(b - a), size=3)
+            direction /= np.linalg.norm(direction)
+            c = DataEdge(0, rot @ direction, rot @ start + trans, rng.uniform(0.3, 1.2) * np.linalg.norm(b - a),
+                         0.02, 0.001, 0.002)  # fmt: skip
+            assert score_edge(c, poly, rot, trans, tol) == _score_edge_vector_form(c, poly, rot, trans, tol)

@@ -31,7 +31,7 @@ import numpy as np
 from haptic.geometry import tracing
 from haptic.geometry.distance import point_triangle_distance, surface_distance
 from haptic.geometry.polyhedron import Polyhedron
-from haptic.geometry.se3 import SE3, plane_basis
+from haptic.geometry.se3 import SE3, cross, plane_basis
 from haptic.matching.acceptance import ROUND_OFF, residual_ratios
 from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex
 from haptic.matching.trace import PHASES
@@ -217,8 +217,14 @@ def _latest(components) -> list[DataComponent]:
 
 def _segment_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
     ab = b - a
-    s = float(np.clip((p - a) @ ab / (ab @ ab), 0.0, 1.0))
-    return float(np.linalg.norm(p - (a + s * ab)))
+    s = min(max(float((p - a) @ ab / (ab @ ab)), 0.0), 1.0)  # np.clip of one number, without its overhead
+    w = p - (a + s * ab)
+    return _length(w)
+
+
+def _length(w: np.ndarray) -> float:
+    """``np.linalg.norm`` of a vector (the square root of ``w @ w``, as numpy takes it), without its overhead."""
+    return math.sqrt(float(w @ w))
 
 
 def _outside_distance(model: Polyhedron, face: int, points_m: np.ndarray) -> float:
@@ -256,13 +262,14 @@ def score_face(c: DataFace, model: Polyhedron, rot: np.ndarray, trans: np.ndarra
 
 def score_edge(c: DataEdge, model: Polyhedron, rot: np.ndarray, trans: np.ndarray, tol: EvaluationTolerances):
     best = None
+    ends = (c.point, c.end_point)
     for e in range(model.n_edges):
         a = rot @ model.vertices[model.edges[e, 0]] + trans
         b = rot @ model.vertices[model.edges[e, 1]] + trans
         u = (b - a) / np.linalg.norm(b - a)
         ang = math.degrees(math.acos(min(1.0, abs(float(u @ c.direction)))))
-        line = max(float(np.linalg.norm(np.cross(q - a, u))) for q in (c.point, c.end_point))
-        seg = max(_segment_distance(q, a, b) for q in (c.point, c.end_point))
+        line = max(_length(cross(q - a, u)) for q in ends)
+        seg = max(_segment_distance(q, a, b) for q in ends)
         cost = ang / math.degrees(tol.direction) + seg / tol.position
         if best is None or cost < best[0]:
             best = (cost, e, ang, line, seg)

@@ -60,7 +60,10 @@ def _filtered(normal: np.ndarray, sample: np.ndarray, weight: float) -> np.ndarr
     (the vector form's arithmetic without numpy's per-call overhead; the norm's dot product by numpy)."""
     a0, a1, a2 = normal.tolist()
     b0, b1, b2 = sample.tolist()
-    return unit(np.array([a0 + weight * (b0 - a0), a1 + weight * (b1 - a1), a2 + weight * (b2 - a2)]))
+    f0, f1, f2 = a0 + weight * (b0 - a0), a1 + weight * (b1 - a1), a2 + weight * (b2 - a2)
+    v = np.array([f0, f1, f2])
+    n = math.sqrt(float(v.dot(v)))
+    return np.array([f0 / n, f1 / n, f2 / n]) if n > 0 else v  # unit(v), element by element
 
 
 def roll_settled(hist: list[tuple[float, np.ndarray]], travelled: float, normal: np.ndarray, window: float,
@@ -337,8 +340,8 @@ class Toucher:
         where it is by the joints."""
         off = self.tip - start
         if along is not None:
-            off = off - float(off @ along) * along
-        if float(off @ off) <= self.config.runaway**2:
+            off = off - float(off.dot(along)) * along
+        if float(off.dot(off)) <= self.config.runaway**2:
             return False
         self.hybrid = False
         self.robot.hold_posture()
@@ -422,7 +425,7 @@ class Toucher:
                 return self._result("unstable", "nan", 0.0)
             if s >= 1.0 and np.linalg.norm(self.tip - point) < tol:
                 return self._result("ok", "done", 0.0)
-            along = min(max(float((self.tip - start) @ path) / length2, 0.0), 1.0) if length2 > 0 else 0.0
+            along = min(max(float((self.tip - start).dot(path)) / length2, 0.0), 1.0) if length2 > 0 else 0.0
             if float(np.linalg.norm(self.tip - start - along * path)) > cfg.runaway:
                 self.robot.hold_posture()
                 self.tick("free")
@@ -483,7 +486,7 @@ class Toucher:
             self.tick(phase)
             if self._unhealthy:
                 return self._result("unstable", "nan", 0.0)
-            travel = float((self.tip - start) @ u)
+            travel = float((self.tip - start).dot(u))
             if self.touching:
                 self.robot.move_fingertip(self.tip.copy(), self.hand_rotation)
                 return self._result("ok", "contact", 0.0, finger=self.finger, point=self.contact[2].copy(),
@@ -523,7 +526,7 @@ class Toucher:
         step = speed * self.dt
         touched = False
         for _ in range(int(timeout / self.dt)):
-            if float((target - start) @ d) < max_distance:
+            if float((target - start).dot(d)) < max_distance:
                 target = target + step * d
             self.robot.move_fingertip(target, self.hand_rotation)
             self.tick("approach")
@@ -534,7 +537,7 @@ class Toucher:
             if self.touching:
                 touched = True
                 break
-            if float((self.tip - start) @ d) >= max_distance - cfg.approach_end_tol:
+            if float((self.tip - start).dot(d)) >= max_distance - cfg.approach_end_tol:
                 return self._result("no-contact", "done", 0.0)
         if not touched:
             return self._result("timeout", "limit", 0.0)
@@ -688,7 +691,7 @@ class Toucher:
             self.tick(phase)
             if self._unhealthy:
                 return self._result("unstable", "nan", 0.0)
-            travelled = float((self.tip - start) @ d)
+            travelled = float((self.tip - start).dot(d))
             progress.append(travelled)
             if self.below_floor(d):
                 return self._result("unreachable", "table", 0.0, face_normal=n_run, direction=d)
@@ -704,7 +707,7 @@ class Toucher:
                 if a > cfg.edge_angle:
                     over += 1
                     if over >= cfg.debounce:
-                        kind = "convex" if float((n - n_run) @ d) > 0 else "concave"
+                        kind = "convex" if float((n - n_run).dot(d)) > 0 else "concave"
                         return self._result("ok", f"{kind}-edge", 0.0, face_normal=n_run, direction=d, kind=kind)
                 else:
                     over = 0
@@ -747,13 +750,13 @@ class Toucher:
             n = self.normal if self.normal is not None else n_a
             if angle(n, n_a) > self.bounds.sample_cone:
                 e_new = cross(n_a, n)
-                if e_new @ e_new > cfg.turned_axis_sin2:
+                if e_new.dot(e_new) > cfg.turned_axis_sin2:
                     e = unit(e_new)
             t = unit(cross(n, e))
-            if sign * float(t @ n_a) < 0:
+            if sign * float(t.dot(n_a)) < 0:
                 t = -t
-            if kind == "convex" and float(t @ n_a) > 0:  # never climb back onto face a
-                t = unit(t - float(t @ n_a) * n_a)
+            if kind == "convex" and float(t.dot(n_a)) > 0:  # never climb back onto face a
+                t = unit(t - float(t.dot(n_a)) * n_a)
             self._press(cfg.roll_speed * t)
             self.tick("roll")
             if self._unhealthy:
@@ -784,8 +787,8 @@ class Toucher:
                 return self._result("unreachable", "table", 0.0)
             # leaning under past the limit, and further than face a (from a face near the limit, noise alone
             # must not end the roll)
-            limit = min(-math.sin(cfg.max_undercut), float(n_a @ back) - math.sin(cfg.undercut_slack))
-            if kind == "convex" and float(self.normal @ back) < limit:
+            limit = min(-math.sin(cfg.max_undercut), float(n_a.dot(back)) - math.sin(cfg.undercut_slack))
+            if kind == "convex" and float(self.normal.dot(back)) < limit:
                 self._press(np.zeros(3))
                 self.tick("roll")
                 return self._result("unreachable", "undercut", 0.0)
@@ -793,7 +796,7 @@ class Toucher:
                 if roll_settled(hist, travelled, self.normal, window, cfg.roll_settled):
                     n_b = self.normal.copy()
                     away = unit(cross(n_b, e))
-                    if float(away @ t) < 0:
+                    if float(away.dot(t)) < 0:
                         away = -away
                     return self._result("ok", "done", 0.0, normal=n_b, edge_direction=unit(cross(n_a, n_b)),
                                         away=away)  # fmt: skip
@@ -959,16 +962,16 @@ class Toucher:
         timeout += acquire_time
         for _ in range(int(timeout / self.dt)):
             n = self.normal if self.normal is not None else n_b
-            alpha = math.atan2(float(n @ m), float(n @ nb_p))
+            alpha = math.atan2(float(n.dot(m)), float(n.dot(nb_p)))
             err = target - alpha
             v_side = cfg.ridge_gain * self.pad_radius * err
             lim = cfg.ridge_side_speed
             v_side = max(-lim, min(lim, v_side))
-            s_dir = unit(side - float(side @ n) * n)
+            s_dir = unit(side - float(side.dot(n)) * n)
             ridge_ok = abs(err) < cone
             if concave:
                 ridge_ok = self.contact[1] is not None
-                v_side, s_dir = cfg.ridge_side_speed, into - float(into @ n) * n
+                v_side, s_dir = cfg.ridge_side_speed, into - float(into.dot(n)) * n
             v = v_side * s_dir + (self.ramp(on_ridge) * speed * u if (ridge_ok or on_ridge > 0) else 0.0 * u)
             self._press(v)
             self.tick("ridge")
@@ -978,7 +981,7 @@ class Toucher:
                 on_ridge += 1
                 if acquire_only and on_ridge >= cfg.ridge_acquired_ticks:
                     return self._result("ok", "done", 0.0, error=err)
-            travelled = float((self.tip - start) @ u)
+            travelled = float((self.tip - start).dot(u))
             progress.append(travelled)
             if on_ridge == 0:
                 if len(progress) * self.dt > acquire_time:
@@ -989,7 +992,7 @@ class Toucher:
                     return self._result("no-contact", "lost", 0.0, lean=lean)
                 return self._result("ok", "vertex", 0.0, event_sign=1, lost=True)
             if self.normal is not None:
-                c = float(self.normal @ u)
+                c = float(self.normal.dot(u))
                 if self.contact[1] is not None:
                     lean = max(lean, c)
                 if abs(c) > cfg.vertex_sin and (c > 0 or on_line):
@@ -1073,8 +1076,8 @@ class Toucher:
         for k in range(int(timeout / self.dt)):
             p = self.contact[2] if self.contact[2] is not None else self.tip - self.pad_radius * n_run
             r = p - vtx
-            r = r - (r @ n_f) * n_f
-            rad = math.sqrt(float(r @ r))
+            r = r - (r.dot(n_f)) * n_f
+            rad = math.sqrt(float(r.dot(r)))
             rh = r / rad if rad > AT_CENTRE else r0
             t = unit(cross(axis, rh))
             v = cfg.face_speed * t + cfg.circle_gain * (radius - rad) * rh
@@ -1088,7 +1091,7 @@ class Toucher:
             # signed about the circle's axis: the contact point's noise turns ``rh`` back and forth by a degree a
             # tick at the circle's radius, and unsigned turns summed that noise (trapezohedron_12 at 77 mm: a circle
             # that gave up after "sweeping" 342° had gone 137° round its vertex, short of the next edge)
-            swept += math.atan2(float(axis @ cross(prev, rh)), float(prev @ rh))
+            swept += math.atan2(float(axis.dot(cross(prev, rh))), float(prev.dot(rh)))
             prev = rh
             if (swept > max_sweep and max_sweep < full) or self.below_floor(t):
                 return self._result("unreachable", "table", 0.0, arc=swept)
@@ -1101,7 +1104,7 @@ class Toucher:
                 if a > cfg.edge_angle:
                     over += 1
                     if over >= cfg.debounce:
-                        kind = "convex" if float((n - n_run) @ t) > 0 else "concave"
+                        kind = "convex" if float((n - n_run).dot(t)) > 0 else "concave"
                         return self._result("ok", f"{kind}-edge", 0.0, face_normal=n_run, direction=t, kind=kind,
                                             arc=swept)  # fmt: skip
                 else:

@@ -233,6 +233,7 @@ class Controller:
         self._jac = np.zeros((6, m.nv))
         self._jacp, self._jacr = self._jac[:3], self._jac[3:]
         self._jac_arm = self._jac[:, :N_ARM]
+        self._jac_arm_pos_t = self._jac_arm[:3].T  # a view: the arm's position Jacobian transposed (3 of 6 rows)
         self._mfull = np.zeros((m.nv, m.nv))
         self._hand_lo = m.actuator_ctrlrange[sim.hand, 0].copy()
         self._hand_kp = sim.hand_kp
@@ -256,6 +257,7 @@ class Controller:
         self._hand_xmat = d.site_xmat[self._hand_site].reshape(3, 3)
         self._dt = self.gains.control_every * sim.timestep
         self._threshold = 0.0
+        self._threshold_of = math.nan  # the force target the contact threshold was worked out for
         self._finger = 0
         self.set_finger(finger)
         self._mode = "posture"
@@ -378,9 +380,14 @@ class Controller:
         self._hybrid = _Hybrid(force=float(force), velocity=v.copy(), normal=None, hint=hint, reference=x)
 
     def _contact_threshold(self, force: float) -> float:
-        """The sensed force above which the hybrid mode counts a contact, for a target ``force`` [N]."""
-        g = self.gains
-        return max(g.contact_fraction * float(force), g.contact_sigmas * self.sim.noise.force_std, g.min_contact_force)
+        """The sensed force above which the hybrid mode counts a contact, for a target ``force`` [N] (worked out again
+        only for another force: a slide sets the same one every tick)."""
+        if force != self._threshold_of:
+            g = self.gains
+            self._threshold_of = force
+            self._threshold_value = max(g.contact_fraction * float(force), g.contact_sigmas * self.sim.noise.force_std,
+                                        g.min_contact_force)  # fmt: skip
+        return self._threshold_value
 
     def hybrid_status(self) -> HybridStatus | None:
         """State of the hybrid mode, or None in another mode."""
@@ -499,7 +506,7 @@ class Controller:
             mujoco.mju_cholSolve(self._y6, jjt, a)
             tau = m6.dot(self._y6.dot(j))
             if force is not None:
-                tau += j[:3].T @ force
+                tau += self._jac_arm_pos_t @ force
             return tau
         a_pos = np.array(a_pos)
         d = self._d
@@ -526,18 +533,21 @@ class Controller:
         sensed = self.sim.sense_contact(self._finger)
         h.sensed = sensed
         force, normal = sensed[0], sensed[1]
+        n = h.normal
         if normal is not None and force > self._threshold:
-            if h.normal is None:
-                h.normal = normal
+            if n is None:
+                n = h.normal = normal
             else:
                 k = g.normal_filter
-                p0, p1, p2 = h.normal.tolist()
+                p0, p1, p2 = n.tolist()
                 q0, q1, q2 = normal.tolist()
-                nf = np.array([p0 + k * (q0 - p0), p1 + k * (q1 - p1), p2 + k * (q2 - p2)])
-                nf /= math.sqrt(float(nf.dot(nf)))
-                h.normal = nf
+                f0, f1, f2 = p0 + k * (q0 - p0), p1 + k * (q1 - p1), p2 + k * (q2 - p2)
+                nf = np.array([f0, f1, f2])
+                size = math.sqrt(float(nf.dot(nf)))
+                n = h.normal = np.array([f0 / size, f1 / size, f2 / size])  # nf / size, element by element
             h.last_contact = t
-        n = h.hint if h.normal is None else h.normal
+        if n is None:
+            n = h.hint
         n0, n1, n2 = n.tolist()
         x0, x1, x2 = x.tolist()
         v0, v1, v2 = v.tolist()
@@ -550,9 +560,8 @@ class Controller:
             d0, d1, d2 = d_ref.tolist()
             d0, d1, d2 = d0 - s * n0, d1 - s * n1, d2 - s * n2
             h.reference = np.array([x0 + d0, x1 + d1, x2 + d2])
-            e = np.array([kp * d0 - kd * v0, kp * d1 - kd * v1, kp * d2 - kd * v2])
-            c = kd * (-g.approach_speed - v_n) - float(n.dot(e))
-            e0, e1, e2 = e.tolist()
+            e0, e1, e2 = kp * d0 - kd * v0, kp * d1 - kd * v1, kp * d2 - kd * v2
+            c = kd * (-g.approach_speed - v_n) - float(n.dot(np.array([e0, e1, e2])))
             return [e0 + c * n0, e1 + c * n1, e2 + c * n2], None
         dt = self._dt
         err = h.force - force
@@ -563,16 +572,15 @@ class Controller:
         u0, u1, u2 = u.tolist()
         t0, t1, t2 = u0 - s * n0, u1 - s * n1, u2 - s * n2  # the velocity in the tangent plane
         r0, r1, r2 = h.reference.tolist()
-        lead = np.array([r0 - x0 + dt * t0, r1 - x1 + dt * t1, r2 - x2 + dt * t2])
-        s = float(n.dot(lead))
-        l0, l1, l2 = lead.tolist()
-        lead = np.array([l0 - s * n0, l1 - s * n1, l2 - s * n2])  # re-anchor on the tangent plane through the tip
+        l0, l1, l2 = r0 - x0 + dt * t0, r1 - x1 + dt * t1, r2 - x2 + dt * t2
+        s = float(n.dot(np.array([l0, l1, l2])))
+        l0, l1, l2 = l0 - s * n0, l1 - s * n1, l2 - s * n2  # re-anchor on the tangent plane through the tip
+        lead = np.array([l0, l1, l2])
         dist = math.sqrt(float(lead.dot(lead)))
         if dist > g.lead_cap:
-            lead *= g.lead_cap / dist  # cap the lead of the reference
-        l0, l1, l2 = lead.tolist()
+            k = g.lead_cap / dist  # cap the lead of the reference
+            l0, l1, l2 = l0 * k, l1 * k, l2 * k
         h.reference = np.array([x0 + l0, x1 + l1, x2 + l2])
-        e = np.array([kp * l0 + kd * (t0 - v0), kp * l1 + kd * (t1 - v1), kp * l2 + kd * (t2 - v2)])
-        c = float(n.dot(e)) + g.normal_kd * v_n
-        e0, e1, e2 = e.tolist()
+        e0, e1, e2 = kp * l0 + kd * (t0 - v0), kp * l1 + kd * (t1 - v1), kp * l2 + kd * (t2 - v2)
+        c = float(n.dot(np.array([e0, e1, e2]))) + g.normal_kd * v_n
         return [e0 - c * n0, e1 - c * n1, e2 - c * n2], np.array([-f_n * n0, -f_n * n1, -f_n * n2])

@@ -275,6 +275,7 @@ class Simulation:
         self.model: mujoco.MjModel = scene.compile()
         self.data: mujoco.MjData = mujoco.MjData(self.model)
         self.noise = noise or SimulatedSensorNoise()
+        self._noisy = self.noise.any  # asked every tick (the noise is fixed)
         self._seed = seed
         self._rng = np.random.default_rng(seed)
         m = self.model
@@ -338,7 +339,8 @@ class Simulation:
         self._acc6 = np.zeros(6)
         self.home_key = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_KEY, "home")
         self._force6 = np.zeros(6)
-        self._contact_views: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = {}
+        self._force3 = self._force6[:3]  # a view: the contact force's normal and tangential parts
+        self._contact_views: dict[int, tuple[np.ndarray, np.ndarray, list[np.ndarray], list[np.ndarray]]] = {}
         self._scratch: mujoco.MjData | None = None
         self.reset()
 
@@ -429,18 +431,19 @@ class Simulation:
         out -= np.dot(out - n, n) * n  # perturb in the tangent plane only
         return out / np.linalg.norm(out)
 
-    def _contacts(self) -> tuple[list[list[int]], np.ndarray, np.ndarray, np.ndarray]:
-        """The contacts now: their geom pairs (a list), constraint addresses (ncon,), frames (ncon, 9) and points
-        (ncon, 3). The arrays are views of the data's contact buffer, made once per number of contacts: MuJoCo puts
-        every step's contacts at the start of the data's arena, and making the views is most of reading a contact
-        (about 2 µs each, where reading their values is a tenth of that)."""
+    def _contacts(self) -> tuple[list[list[int]], np.ndarray, list[np.ndarray], list[np.ndarray]]:
+        """The contacts now: their geom pairs (a list), constraint addresses (ncon,), frames (each (3, 3), the normal
+        first) and points (each (3,)). The arrays are views of the data's contact buffer, made once per number of
+        contacts: MuJoCo puts every step's contacts at the start of the data's arena, and making the views is most
+        of reading a contact (about 2 µs each, where reading their values is a tenth of that)."""
         n = self.data.ncon
         views = self._contact_views.get(n)
         if views is None:
             con = self.data.contact
-            views = self._contact_views[n] = (con.geom, con.efc_address, con.frame, con.pos)
-        geom, efc, frame, pos = views
-        return geom.tolist(), efc, frame, pos
+            views = self._contact_views[n] = (con.geom, con.efc_address, [f.reshape(3, 3) for f in con.frame],
+                                              list(con.pos))  # fmt: skip
+        geom, efc, frames, points = views
+        return geom.tolist(), efc, frames, points
 
     def _pad_contacts(self, finger: int | None):
         """Raw (finger, point, normal-out-of-surface, force-on-pad) for pad contacts, ideal sensing."""
@@ -460,8 +463,8 @@ class Simulation:
             if efc[i] < 0:  # excluded or inactive contact
                 continue
             mujoco.mj_contactForce(self.model, d, i, self._force6)
-            frame = frames[i].reshape(3, 3)
-            f = self._force6[:3].dot(frame)  # force of geom1 on geom2, world frame
+            frame = frames[i]
+            f = self._force3.dot(frame)  # force of geom1 on geom2, world frame
             if k1 >= 0 and (finger is None or k1 == finger):
                 # the pad is geom1: flip into "on the pad, out of the touched surface" (normal: geom1 -> geom2)
                 out.append((k1, points[i].copy(), -frame[0], -f))
@@ -493,7 +496,7 @@ class Simulation:
             total = float(fn.sum())
             point, normal = merge_patches(np.array([p for _, p, _, _ in raw]), np.array([n for _, _, n, _ in raw]), fn)
         nz = self.noise
-        if nz.any:  # element by element on floats, the dot products by numpy: the vector form's arithmetic
+        if self._noisy:  # element by element on floats, the dot products by numpy: the vector form's arithmetic
             z0, z1, z2, z3, z4, z5, z6 = self._rng.standard_normal(7).tolist()
             total += nz.force_std * z0
             if nz.point_std > 0:
@@ -505,8 +508,10 @@ class Simulation:
                 e0, e1, e2 = s * z4, s * z5, s * z6
                 c = float(np.array([e0, e1, e2]).dot(normal))
                 n0, n1, n2 = normal.tolist()
-                normal = np.array([n0 + (e0 - c * n0), n1 + (e1 - c * n1), n2 + (e2 - c * n2)])  # tangent-plane
-                normal /= math.sqrt(float(normal.dot(normal)))
+                m0, m1, m2 = n0 + (e0 - c * n0), n1 + (e1 - c * n1), n2 + (e2 - c * n2)  # in the tangent plane
+                normal = np.array([m0, m1, m2])
+                size = math.sqrt(float(normal.dot(normal)))
+                normal = np.array([m0 / size, m1 / size, m2 / size])  # normal / size, element by element
         return total, normal, point, len(raw)
 
     def wrist_wrench(self, watch: bool = False) -> tuple[np.ndarray, np.ndarray]:
@@ -563,7 +568,7 @@ class Simulation:
             if efc[i] < 0:
                 continue
             mujoco.mj_contactForce(self.model, d, i, self._force6)
-            normal = frames[i].reshape(3, 3)[0].copy()  # geom1 -> geom2
+            normal = frames[i][0].copy()  # geom1 -> geom2
             link = k1 if k1 >= 0 else k2
             if k1 >= 0:
                 normal = -normal  # out of the touched surface, towards the link

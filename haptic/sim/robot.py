@@ -114,8 +114,18 @@ class RobotInterface:
     def move_fingertip(self, point_in_world: np.ndarray, rotation_in_world: np.ndarray | str | None = "hold") -> None:
         self._ctl.move_fingertip(point_in_world, rotation_in_world)
 
-    def set_hybrid(self, force: float, velocity_in_world: np.ndarray, **kwargs) -> None:
-        self._ctl.set_hybrid(force, velocity_in_world, **kwargs)
+    def set_hybrid(
+        self,
+        force: float,
+        velocity_in_world: np.ndarray,
+        *,
+        normal_hint: np.ndarray | None = None,
+        rotation_in_world: np.ndarray | str | None = "hold",
+        keep_state: bool = True,
+    ) -> None:
+        """:meth:`~haptic.sim.control.Controller.set_hybrid` (a slide sets it every tick)."""
+        self._ctl.set_hybrid(force, velocity_in_world, normal_hint=normal_hint, rotation_in_world=rotation_in_world,
+                             keep_state=keep_state)  # fmt: skip
 
     def hybrid_status(self) -> HybridStatus | None:
         return self._ctl.hybrid_status()

@@ -14,7 +14,7 @@ import os
 import shutil
 import tempfile
 import weakref
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cache, cached_property
 from pathlib import Path
@@ -230,11 +230,15 @@ def scene_object_from_polyhedron(poly) -> SceneObject:
     return scene_object_from_parts(poly.name, parts)
 
 
-def preload_scenes(models: Iterable = ()) -> None:
+def preload_scenes(models: Iterable = (), pieces: Mapping | None = None) -> None:
     """Parse the object-less scene (:func:`_robot_spec`) and split the non-convex ``models`` (library polyhedra) into
     their convex pieces now, as the process's first scene of each would: a process about to fork workers hands them
-    the work done."""
+    the work done. ``pieces``: the convex pieces of some of the models already split (by model; another process's
+    :func:`~haptic.geometry.convex_decomposition` of the same model, the same arrays), kept as they are."""
     _robot_spec()
+    for poly, parts in (pieces or {}).items():
+        if not poly.is_convex and poly not in _PIECES:
+            _PIECES[poly] = tuple(parts)
     for poly in models:
         scene_object_from_polyhedron(poly)
 

@@ -18,3 +18,21 @@ def test_cross_is_numpys_bit_for_bit(seed, shapes, scale):
     a, b = scale * rng.normal(size=shapes[0]), rng.normal(size=shapes[1])
     got, want = cross(a, b), np.cross(a, b)
     assert got.shape == want.shape and np.array_equal(got, want)
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), scale=st.sampled_from([1e-9, 1.0, 1e6]))
+def test_angle_is_the_matmul_forms_bit_for_bit(seed, scale):
+    """The angle of two vectors (arrays, views, a list) is the arccosine of their clipped ``@`` product to the last
+    bit: its array path takes the product with ``dot``, the same numpy routine at less overhead."""
+    import math
+
+    from haptic.geometry.se3 import angle
+
+    rng = np.random.default_rng(seed)
+    m = rng.normal(size=(4, 3))
+    a, b = scale * rng.normal(size=3), rng.normal(size=3)
+    for x, y in ((a, b), (m[1], m[2]), (m[:, 0][:3], b), (a, list(b)), (list(a), b)):
+        x = x / np.linalg.norm(x)
+        y = np.asarray(y) / np.linalg.norm(y) if not isinstance(y, list) else list(np.asarray(y) / np.linalg.norm(y))
+        assert angle(x, y) == math.acos(max(-1.0, min(1.0, float(np.asarray(x) @ np.asarray(y)))))

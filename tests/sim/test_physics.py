@@ -179,5 +179,5 @@ def test_the_contact_views_read_what_the_contacts_hold():
         for i in range(d.ncon):
             c = d.contact[i]
             assert efc[i] == c.efc_address
-            assert np.array_equal(frames[i], c.frame) and np.array_equal(points[i], c.pos)
+            assert np.array_equal(frames[i], c.frame.reshape(3, 3)) and np.array_equal(points[i], c.pos)
     assert {0, 1, 2} <= counts, counts

@@ -182,6 +182,29 @@ def test_preloaded_scenes_need_no_decomposition(monkeypatch):
     assert scene.compile().ngeom > 50 and not calls
 
 
+def test_preload_splits_the_non_convex_models_in_another_process(monkeypatch):
+    """:func:`~haptic.episode.worlds.preload_physics` splits the non-convex models in a process it forks while it
+    imports and parses the scene, and the scenes keep the pieces that process returns: the same arrays as this
+    process's own decomposition."""
+    import os
+
+    from haptic.episode import worlds
+    from haptic.geometry import load_library
+
+    model = load_library()["FRAME01"]
+    monkeypatch.setattr(sc, "_PIECES", type(sc._PIECES)())
+    worlds.preload_physics([model], jobs=2)
+    own = sc.convex_decomposition(model)
+    assert len(sc._PIECES[model]) == len(own)
+    assert all(a.dtype == b.dtype and a.tobytes() == b.tobytes() for a, b in zip(sc._PIECES[model], own, strict=True))
+    monkeypatch.setattr(sc, "_PIECES", type(sc._PIECES)())
+    tetrahedron = np.array([[0.0, 0.0, 0.0], [0.01, 0.0, 0.0], [0.0, 0.01, 0.0], [0.0, 0.0, 0.01]])
+    monkeypatch.setattr(worlds, "convex_decomposition", lambda poly: [tetrahedron + os.getpid()])  # who split it
+    worlds.preload_physics([model])
+    ((pid, *_), *_), *_ = sc._PIECES[model]
+    assert pid != os.getpid()
+
+
 def test_a_model_at_another_size_compiles_with_its_own_meshes():
     """MuJoCo keeps the meshes it has read by file name for the process's next compilations: the same model at
     another size, its convex pieces as many and their files as long, still compiles with its own meshes."""
