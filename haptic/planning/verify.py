@@ -1307,6 +1307,9 @@ class Verifier:
         "verifying", or "not needed" (no pose class was ever left alone)."""
         self._progress = (-1, 0)  # (features measured, verification moves then)
         self._measuring = 0
+        self._middles_seen: set[tuple[str, int]] = set()
+        """Under ``full`` with probes admitted, the (model, reachable face) whose middle a verdict found measured
+        (:meth:`_middles_measured`)."""
         self._no_move = 0
         """On the hand, verification decisions in a row that had no admissible move (:data:`NO_MOVE_DECISIONS`)."""
         self.stuck = False
@@ -1488,12 +1491,20 @@ class Verifier:
         else:
             self.status = "verifying"
             got = self.coverage.measured() if self.coverage is not None else 0
+            first = self._progress[0] < 0
+            middles = self._middles_measured(cls.name, tree.data) - self._middles_seen
+            self._middles_seen |= middles
             if got > self._progress[0]:
                 self._measuring += self._progress[0] >= 0  # not the first verdict, before any move
                 self._no_move = 0
                 self._progress = (got, self.moves)
                 self._travelled.clear()
                 self._visited.clear()
+            elif middles and not first:
+                # a face's middle still to be measured was: part of the target as a vertex is (a probe on the way to
+                # a vertex is credited for it: MIDDLE_CREDIT), and each face's counts once
+                self._measuring += 1
+                self._progress = (got, self.moves)
             elif self.moves - max(self._progress[1], self._relocated) >= self._stall_moves():
                 self.status = "incomplete"
             elif self._no_move >= NO_MOVE_DECISIONS:
@@ -1661,6 +1672,15 @@ class Verifier:
                                    floors=self.floors).ok:  # fmt: skip
             return False  # the data reject the model as they are: the verdict's acceptance test says so
         return cp.next(h, todo, self.coverage.edges, self.coverage.vertices, self.config, placing=False) is not None
+
+    def _middles_measured(self, name: str, data: Sequence[DataComponent]) -> set[tuple[str, int]]:
+        """Under ``full`` with probes admitted, the reachable faces of the model ``name`` at the checked pose whose
+        middle the data measure (:func:`unmeasured_middles`), each with the model's name; none otherwise."""
+        pose = self.check.world_from_model if self.check is not None else None
+        if self.mode != "full" or not self._probes_admitted() or pose is None or name not in self._reach:
+            return set()
+        faces = self._reach[name][0]
+        return {(name, int(f)) for f in faces - set(unmeasured_middles(self._model, pose, data, faces))}
 
     def _probes_admitted(self) -> bool:
         return self.config.moves != "tracing" and self.config.table_z is None and MAX_VERIFY_PROBES > 0
