@@ -57,9 +57,10 @@ from haptic.planning.tour import (
 )
 
 STALL_MOVES = 8
-"""Verification moves in a row that measure no missing feature after which the verification ends with what it
-has measured (status "incomplete": the episode ends as ambiguous, its record says what was not measured); on the
-hand counted from the last relocation too (:data:`RELOCATE_AFTER`), which puts the pad somewhere new."""
+"""Verification moves in a row that measure no missing feature (nor, under ``full`` with probes admitted, a face's
+middle for the first time: :meth:`Verifier.verdict`) after which the verification ends with what it has measured
+(status "incomplete": the episode ends as ambiguous, its record says what was not measured); on the hand counted from
+the last relocation too (:data:`RELOCATE_AFTER`), which puts the pad somewhere new."""
 HAND_STALL_MOVES = 16
 """On the hand, :data:`STALL_MOVES` there: a failed move is not asked again (an edge move along a model edge, a
 vertex move round a model vertex, a face move's crossing), and the way round to another way in -- back over the
