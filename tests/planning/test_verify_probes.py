@@ -294,3 +294,23 @@ def test_probes_that_measure_middles_on_the_way_to_a_vertex_do_not_stall_the_ver
     assert v["vertices"] == v["vertices_total"] == 10
     kinds = "".join(k[0] for k in r["move_kinds"])
     assert "p" * (STALL_MOVES + 1) in kinds  # the hops from middle to middle, more than the stall allows
+
+
+def test_beyond_the_exact_paths_reach_the_middles_are_probed_cheapest_first():
+    """The order of the faces' middles left after the vertices is exact up to ``HELD_KARP_MOST`` probes; beyond, the
+    cheapest from here is taken (the exact path over the 20-24 middles of the formula corpus's larger bipyramids took
+    minutes and gigabytes a decision). Middles on a line: one 1.1 behind the sensor, the others 1 to n ahead; the
+    least order starts behind, the cheapest is ahead."""
+    from types import SimpleNamespace
+
+    from haptic.planning.tour import HELD_KARP_MOST
+    from haptic.planning.verify import _first_of_best_order
+
+    def probe(x: float):
+        move = SimpleNamespace(start=np.array([x, 0.0, 0.01]), direction=np.array([0.0, 0.0, -1.0]))
+        return SimpleNamespace(move=move, distance=np.array([0.01]), costs=np.array([abs(x) * 100.0]))
+
+    for n in (HELD_KARP_MOST - 2, HELD_KARP_MOST + 1):
+        preds = [probe(-0.011), *(probe(0.01 * i) for i in range(1, n))]
+        first = _first_of_best_order(preds, list(range(n)), ALL)
+        assert first == (0 if n <= HELD_KARP_MOST else 1)
