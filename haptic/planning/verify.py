@@ -57,9 +57,10 @@ from haptic.planning.tour import (
 )
 
 STALL_MOVES = 8
-"""Verification moves in a row that measure no missing feature after which the verification ends with what it
-has measured (status "incomplete": the episode ends as ambiguous, its record says what was not measured); on the
-hand counted from the last relocation too (:data:`RELOCATE_AFTER`), which puts the pad somewhere new."""
+"""Verification moves in a row that measure no missing feature (nor, under ``full`` with probes admitted, a face's
+middle for the first time: :meth:`Verifier.verdict`) after which the verification ends with what it has measured
+(status "incomplete": the episode ends as ambiguous, its record says what was not measured); on the hand counted from
+the last relocation too (:data:`RELOCATE_AFTER`), which puts the pad somewhere new."""
 HAND_STALL_MOVES = 16
 """On the hand, :data:`STALL_MOVES` there: a failed move is not asked again (an edge move along a model edge, a
 vertex move round a model vertex, a face move's crossing), and the way round to another way in -- back over the
@@ -1124,8 +1125,13 @@ def _first_of_best_order(preds: Sequence, ks: Sequence[int], config: PlannerConf
     """Of the probes ``preds[k]`` for ``k`` in ``ks`` (predictions from where the sensor is, each landing on its
     face's middle), the first of the order in which all of them cost least: from here each its predicted cost, then
     from one's contact to the next line's start and along it to its contact at ``c_p + c_s`` per metre (exact,
-    :func:`~haptic.planning.tour.least_path`)."""
-    from haptic.planning.tour import least_path
+    :func:`~haptic.planning.tour.least_path`); beyond :data:`~haptic.planning.tour.HELD_KARP_MOST` probes, whose
+    orders the exact path takes too long for (``2^n n^2`` steps for each first: minutes, and gigabytes, at the 20-24
+    faces of a bipyramid's middles left), the cheapest from here."""
+    from haptic.planning.tour import HELD_KARP_MOST, least_path
+
+    if len(ks) > HELD_KARP_MOST:
+        return int(min(ks, key=lambda k: float(preds[k].costs[0])))
 
     c = config.costs
     starts = np.array([np.asarray(preds[k].move.start, float) for k in ks])
@@ -1307,6 +1313,9 @@ class Verifier:
         "verifying", or "not needed" (no pose class was ever left alone)."""
         self._progress = (-1, 0)  # (features measured, verification moves then)
         self._measuring = 0
+        self._middles_seen: set[tuple[str, int]] = set()
+        """Under ``full`` with probes admitted, the (model, reachable face) whose middle a verdict found measured
+        (:meth:`_middles_measured`)."""
         self._no_move = 0
         """On the hand, verification decisions in a row that had no admissible move (:data:`NO_MOVE_DECISIONS`)."""
         self.stuck = False
@@ -1488,12 +1497,20 @@ class Verifier:
         else:
             self.status = "verifying"
             got = self.coverage.measured() if self.coverage is not None else 0
+            first = self._progress[0] < 0
+            middles = self._middles_measured(cls.name, tree.data) - self._middles_seen
+            self._middles_seen |= middles
             if got > self._progress[0]:
                 self._measuring += self._progress[0] >= 0  # not the first verdict, before any move
                 self._no_move = 0
                 self._progress = (got, self.moves)
                 self._travelled.clear()
                 self._visited.clear()
+            elif middles and not first:
+                # a face's middle still to be measured was: part of the target as a vertex is (a probe on the way to
+                # a vertex is credited for it: MIDDLE_CREDIT), and each face's counts once
+                self._measuring += 1
+                self._progress = (got, self.moves)
             elif self.moves - max(self._progress[1], self._relocated) >= self._stall_moves():
                 self.status = "incomplete"
             elif self._no_move >= NO_MOVE_DECISIONS:
@@ -1661,6 +1678,15 @@ class Verifier:
                                    floors=self.floors).ok:  # fmt: skip
             return False  # the data reject the model as they are: the verdict's acceptance test says so
         return cp.next(h, todo, self.coverage.edges, self.coverage.vertices, self.config, placing=False) is not None
+
+    def _middles_measured(self, name: str, data: Sequence[DataComponent]) -> set[tuple[str, int]]:
+        """Under ``full`` with probes admitted, the reachable faces of the model ``name`` at the checked pose whose
+        middle the data measure (:func:`unmeasured_middles`), each with the model's name; none otherwise."""
+        pose = self.check.world_from_model if self.check is not None else None
+        if self.mode != "full" or not self._probes_admitted() or pose is None or name not in self._reach:
+            return set()
+        faces = self._reach[name][0]
+        return {(name, int(f)) for f in faces - set(unmeasured_middles(self._model, pose, data, faces))}
 
     def _probes_admitted(self) -> bool:
         return self.config.moves != "tracing" and self.config.table_z is None and MAX_VERIFY_PROBES > 0
