@@ -32,7 +32,7 @@ def test_the_report_gives_the_records_ratios(tmp_path):
     cost = sum(r["verified"]["cost"] for r in recs["full"])
     bound = sum(r["verified"]["tour_bound"] for r in recs["full"])
     assert row[8].strip().startswith(f"{cost / bound:.2f}×") and cost >= bound
-    assert "confirmed episodes below their bound (which is for measuring every vertex): 0 of 2" in run.stdout
+    assert "confirmed episodes below their bound: 0 of 2" in run.stdout
 
 
 def test_a_file_that_is_not_a_record_is_one_line_of_error(tmp_path):
