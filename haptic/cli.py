@@ -103,7 +103,9 @@ def _models_show(args: argparse.Namespace) -> int:
 
     from haptic.geometry import convex_decomposition, resolve_model, symmetry_group
     from haptic.geometry.io import scan_library, size_warning
+    from haptic.geometry.se3 import rotation_angle
     from haptic.geometry.symmetry import model_summary
+    from haptic.matching.recognition import near_symmetries
     from haptic.options import report_sizes
 
     lib = None
@@ -125,6 +127,16 @@ def _models_show(args: argparse.Namespace) -> int:
     print(f"  size {' x '.join(f'{x:g}' for x in s['extents_mm'])} mm; convex pieces: {len(convex_decomposition(m))}")
     angles = sorted(round(float(np.degrees(np.arccos(np.clip((np.trace(t.rotation) - 1) / 2, -1, 1))))) for t in sym)
     print(f"  symmetry group: {len(sym)} proper rotations (angles {angles} deg)")
+    near = near_symmetries(m)
+    if near:
+        worst = max(float(np.linalg.norm(t.apply(m.vertices)[:, None] - m.vertices[None], axis=2).min(axis=1).max())
+                    for t in near)  # fmt: skip
+        turns = sorted(round(float(np.degrees(rotation_angle(t.rotation)))) for t in near)
+        print(
+            f"  near-symmetries: {len(near)} more rotations (angles {turns} deg) map it onto itself within "
+            f"{worst * 1e3:.3g} mm, beyond its file's precision ({m.tolerances.match * 1e3:.3g} mm) but not touch's: "
+            "poses that differ by one are one pose class"
+        )
     print("  faces  (n, d [mm], vertex loop):")
     for f, loop in enumerate(m.faces):
         n = m.face_normals[f]

@@ -16,11 +16,11 @@ import time
 import numpy as np
 
 from haptic.executor.geometric import GeometricExecutor
-from haptic.geometry import SE3, load_library, symmetry_group
+from haptic.geometry import SE3, load_library
 from haptic.matching.components import SensorNoise
 from haptic.matching.library import LibraryArrays
 from haptic.matching.pose import pose_error
-from haptic.matching.recognition import recognize
+from haptic.matching.recognition import model_symmetries, recognize
 from haptic.matching.tree import InterpretationTree
 
 
@@ -56,7 +56,7 @@ def episode(model, arrays, rng, noise, max_moves, timings=None, trace=None):
             rec = recognize(tree)
     err = None
     if rec.status == "recognized" and rec.model == model.name:
-        err = pose_error(rec.world_from_model, truth, model, symmetry_group(model))
+        err = pose_error(rec.world_from_model, truth, model, model_symmetries(model))
     return rec.status, rec.model, counts["face"], counts["edge"], counts["vertex"], moves, err
 
 

@@ -1,10 +1,11 @@
 """Symmetry grouping and the recognition status (seed §2.3, §2.5).
 
 Interpretations of one model whose poses differ by a symmetry of the model (a proper rigid self-map,
-:func:`~haptic.geometry.symmetry_group`) describe the same solid in the world: they form one *pose class*, and
-no touch data can tell them apart (BOX01 has 4). The object is *recognized* when every survivor belongs to one
-model and one pose class; *ambiguous* when the survivors fall in several classes that all describe the same
-solid in the world (models congruent by a proper rigid motion), so no further data can separate them;
+:func:`~haptic.geometry.symmetry_group`, or one within touch's resolution, :func:`near_symmetries`) describe the
+same solid in the world: they form one *pose class*, and no touch data can tell them apart (BOX01 has 4). The
+object is *recognized* when every survivor belongs to one model and one pose class; *ambiguous* when the
+survivors fall in several classes that all describe the same solid in the world (models congruent by a proper
+rigid motion), so no further data can separate them;
 *no-match* when none survive; otherwise still *exploring*.
 """
 
@@ -29,10 +30,38 @@ _SYMMETRY_ARRAYS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 _CONGRUENCE: dict[tuple[int, int], list[SE3]] = {}
 
 
+NEAR_SYMMETRY = 0.5e-3
+"""Farthest [m] a rotation may carry each vertex of a model from another vertex and still be, for touch, a
+symmetry of it (:func:`near_symmetries`): a sixth of the smallest perturbation a verification promises to catch
+(3 mm), and below what one data component's position bound resolves."""
+NEAR_SYMMETRY_OF_SIZE = 0.01
+"""... and at most this fraction of the model's size (its bounding box's diagonal), for small models."""
+
+
+def near_symmetries(model: Polyhedron) -> list[SE3]:
+    """The proper rotations that map the model onto itself within :data:`NEAR_SYMMETRY` (vertices onto vertices,
+    edges onto edges, faces onto faces) but not within the precision of its file, so that
+    :func:`~haptic.geometry.symmetry_group` does not hold them: a solid written from inexact coordinates (a
+    snub disphenoid whose edges differ by 0.01 mm) or drawn nearly symmetric. No touch tells two poses that differ
+    by one apart, so for recognition they are symmetries; empty for most models."""
+    from haptic.geometry.symmetry import congruence_pairs
+
+    eps = min(NEAR_SYMMETRY, NEAR_SYMMETRY_OF_SIZE * float(np.linalg.norm(model.extents)))
+    exact = model.tolerances.match
+    if eps <= exact:
+        return []
+    near = []
+    for t, perm in congruence_pairs(model, model, eps):
+        if float(np.linalg.norm(t.apply(model.vertices) - model.vertices[perm], axis=1).max()) > exact:
+            near.append(t)
+    return near
+
+
 def model_symmetries(model: Polyhedron) -> list[SE3]:
-    """The model's symmetry group (cached per model object)."""
+    """The rotations that touch cannot tell from the identity (cached per model object): the model's symmetry
+    group (identity first), then its :func:`near_symmetries`."""
     if model not in _SYMMETRY:
-        _SYMMETRY[model] = symmetry_group(model)
+        _SYMMETRY[model] = symmetry_group(model) + near_symmetries(model)
     return _SYMMETRY[model]
 
 
@@ -287,6 +316,7 @@ __all__ = [
     "equivalent_by_symmetry",
     "group_pose_classes",
     "model_symmetries",
+    "near_symmetries",
     "recognize",
     "same_pose",
     "same_solid",
