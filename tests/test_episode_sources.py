@@ -339,8 +339,11 @@ def test_the_endings_are_checked_failed_in_a_row_first():
 
 
 def test_the_verdict_ends_on_a_final_recognition_and_waits_for_the_verifier_when_verifying():
-    for status in (RECOGNIZED, AMBIGUOUS, NO_MATCH):
+    for status in (RECOGNIZED, NO_MATCH):
         assert verdict(ending_view(rec=SimpleNamespace(status=status)), SPEC) == Ending(status)
+    alike = (SimpleNamespace(name="A"), SimpleNamespace(name="B"))
+    end = verdict(ending_view(rec=SimpleNamespace(status=AMBIGUOUS, classes=alike)), SPEC)
+    assert end.outcome == AMBIGUOUS and "A, B" in end.detail
     assert verdict(ending_view(rec=SimpleNamespace(status=EXPLORING)), SPEC) is None
 
     class Verdicts:
@@ -397,3 +400,22 @@ def test_a_successful_move_clears_what_failed_from_here_and_books_the_traces():
     assert state.failed_here == [] and state.failed_in_a_row == 0 and state.failed_total == 1
     assert len(state.kinds) == 1 and state.counts == [state.tree.count] and state.cum_cost == [state.cost]
     assert state.sensor is start.state and state.rec is not None
+
+
+def test_an_ambiguous_ending_says_why(tmp_path):
+    """Two library models that are one solid (WEDGE01 written twice under two names): the episode ends ambiguous
+    between them, and its detail names both and says no move tells them apart (it said nothing)."""
+    import shutil
+
+    from haptic import EpisodeSpec as Spec
+    from haptic import run_episode
+    from haptic.geometry.io import DEFAULT_LIBRARY
+
+    lib = tmp_path / "twins"
+    lib.mkdir()
+    for name in ("WEDGE01", "WEDGE02"):
+        shutil.copy(DEFAULT_LIBRARY / "WEDGE01.json", lib / f"{name}.json")
+    shutil.copy(DEFAULT_LIBRARY / "BOX01.json", lib / "BOX01.json")
+    r = run_episode(Spec(model="WEDGE01", models=str(lib), seed=1))
+    assert r.outcome == "ambiguous"
+    assert "WEDGE01, WEDGE02" in r.detail and "no move tells them apart" in r.detail, r.detail

@@ -332,8 +332,19 @@ def verdict(view: EpisodeState, spec: EpisodeSpec) -> Ending | None:
         v = view.verifier
         return None if v.verdict(view.tree, view.rec, view.cost) == "verifying" else Ending(v.outcome(), v.detail())
     if view.rec is not None and view.rec.status in (RECOGNIZED, AMBIGUOUS, NO_MATCH):
-        return Ending(view.rec.status)
+        return Ending(view.rec.status, ambiguity(view.rec) if view.rec.status == AMBIGUOUS else "")
     return None
+
+
+def ambiguity(rec: Recognition) -> str:
+    """Why an ambiguous verdict is final, in words: the pose classes left place solids alike wherever a finger
+    can touch (congruent models, or poses that differ only toward the table)."""
+    names = sorted({c.name for c in rec.classes})
+    if len(names) == 1:
+        return (f"{len(rec.classes)} poses of {names[0]} left that differ only where no finger reaches: no move tells "
+                "them apart")  # fmt: skip
+    return (f"{len(rec.classes)} pose classes of the models {', '.join(names)} left, alike wherever a finger "
+            "reaches: no move tells them apart")  # fmt: skip
 
 
 def out_of_budget(view: EpisodeState, spec: EpisodeSpec) -> Ending | None:
