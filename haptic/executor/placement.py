@@ -660,17 +660,24 @@ def _above_then_down(c: _Closing, names: list[str], axes: dict[str, np.ndarray],
 
 def _home_then(c: _Closing, path: np.ndarray, pieces: list[PrimitiveResult]) -> str | None:
     """The pad up and over to where it is in the path's first configuration (the tracing posture), that posture
-    taken in joint space, then the path followed; why it stopped, or None."""
+    taken in joint space, then the path followed; why it stopped, or None. The way up recovers as every rise does
+    (:func:`~haptic.executor.physics_probe.rise`: a joint at its limit pulls the pad off its line below a tall
+    object's top), and the way over, held back with nothing touching, goes by the arm's home posture above."""
     t = c.ex.toucher
     c.cfg.update(path[0])
     sid = mujoco.mj_name2id(c.model, mujoco.mjtObj.mjOBJ_SITE, c.solver.site_name(t.finger))
     above = c.cfg.data.site_xpos[sid].copy()
-    here = t.tip.copy()
-    for w in (np.array([here[0], here[1], max(here[2], above[2])]), above):
-        if float(np.linalg.norm(w - t.tip)) < t.config.target_tol:
-            continue
-        res = t.move_guarded(w, 0.15, max_lag=0.012)
+    top = max(float(t.tip[2]), float(above[2]))
+    if top - float(t.tip[2]) >= t.config.target_tol:
+        res = rise(t, top, 0.15, 0.012, pieces)
+        if not res.ok or res.event != "done":
+            return f"moving over to the tracing posture: {res.event}"
+    if float(np.linalg.norm(above - t.tip)) >= t.config.target_tol:
+        res = t.move_guarded(above, 0.15, max_lag=0.012)
         pieces.append(res)
+        if res.event == "blocked" and t.link_touch() is None and t.back_to_home_posture(above, at=above):
+            res = t.move_guarded(above, 0.15, max_lag=0.012)
+            pieces.append(res)
         if not res.ok or res.event != "done":
             return f"moving over to the tracing posture: {res.event}"
     return c.follow(_joint_path(c.q_now(), path[0], c.s.reach.max_speed * c.s.reach.dt)) or c.follow(path)
