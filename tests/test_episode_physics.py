@@ -1455,3 +1455,20 @@ def test_a_next_face_lost_after_a_slanted_crossing_is_touched_afresh_in_the_roll
     assert rolled and all(r.ok for r in rolled), [r.reason for r in face]
     assert not any(r.reason.startswith(NEXT_FACE_LOST) for r in face if not r.ok), [r.reason for r in face]
     assert _within_bounds(ep)
+
+
+@pytest.mark.slow
+def test_the_way_over_to_the_tracing_posture_recovers_from_a_joint_at_its_limit():
+    # square_antiprism of the public polyhedra (117 mm), seed 1, default options: the verification's last probes went
+    # by the reach solver's path, which starts in the tracing posture with the pad 55 mm higher than where it had
+    # risen to, 6 cm beyond the object's middle; straight up from there the arm's posture pulled the pad 2.6 cm off its
+    # line with nothing touching, and the move failed "moving over to the tracing posture: blocked", four probes in a
+    # row (by the index and the thumb). Up as every rise goes (by the arm's home posture where a joint holds it
+    # back), the first probe is made and the recognition confirmed in fewer moves.
+    failed = []
+    obs = EpisodeObserver(on_failed_move=lambda n, r: failed.append(f"{r.move.kind}: {r.reason}"))
+    rec = run_episode(EpisodeSpec(model="square_antiprism", models="assets/libraries/polyhedra", seed=1,
+                                  executor="physics"), observer=obs)  # fmt: skip
+    assert rec.outcome == "recognized" and rec.correct, rec.detail
+    assert not any("tracing posture" in why for why in failed), failed
+    assert rec.probes >= 1
