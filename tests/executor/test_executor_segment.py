@@ -131,6 +131,27 @@ def test_a_roll_round_another_edge_is_no_edge_between_the_faces():
     assert "too close" in seg.edge_inconsistency(fa, fc, True, roll)
 
 
+
+def test_a_quick_roll_off_the_line_where_the_planes_meet_is_no_edge_between_the_faces():
+    # a slide across a face between faces a and b, over two edges of 5.25° each (under the edge angle), then a
+    # roll too quick to leave contacts between a's normal and b's: the planes of a and b meet along the z axis,
+    # and the roll's contacts lie 13 mm from it on b's plane (metabiaugmented_hexagonal_prism of the public
+    # collection of Johnson solids, 70 mm, seed 1). A quick roll at the line itself is an edge.
+    half = math.radians(5.25)
+    n_a, n_b = np.array([math.cos(half), -math.sin(half), 0.0]), np.array([math.cos(half), math.sin(half), 0.0])
+    t_a, t_b = np.array([math.sin(half), math.cos(half), 0.0]), np.array([-math.sin(half), math.cos(half), 0.0])
+    fa, fb = _plane(n_a, -0.01 * t_a), _plane(n_b, 0.02 * t_b)
+    z = np.linspace(0.0, 0.001, 12)[:, None] * np.array([0.0, 0.0, 1.0])
+    at = 0.013 * t_b + z
+    crossed = _trace(at + R_PAD * n_b, np.repeat(n_b[None], len(z), axis=0), at)
+    why = Segmenter().edge_inconsistency(fa, fb, True, crossed)
+    assert why is not None and "its edges too shallow to feel" in why, why
+    on_a, on_line = -0.0003 * t_a + z, z
+    quick = _trace(np.vstack([on_a + R_PAD * n_a, on_line + R_PAD * n_b]),
+                   np.vstack([np.repeat(n_a[None], len(z), axis=0), np.repeat(n_b[None], len(z), axis=0)]),
+                   np.vstack([on_a, on_line]))  # fmt: skip
+    assert Segmenter().edge_inconsistency(fa, fb, True, quick) is None
+
 def _noisy_roll(
     axis: np.ndarray, n_a: np.ndarray, turn_deg: float, pivot: np.ndarray, rng, n: int = 60
 ) -> ContactTrace:
