@@ -41,7 +41,7 @@ from haptic.geometry.raycast import (
 )
 from haptic.geometry.se3 import SE3
 from haptic.matching import kernels
-from haptic.matching.acceptance import leaf_pose_check
+from haptic.matching.acceptance import leaf_pose_check, leaf_pose_checks
 from haptic.matching.components import DataFace, readonly_vector
 from haptic.matching.recognition import PoseTolerance
 from haptic.matching.tree import InterpretationTree
@@ -205,8 +205,11 @@ def consistent_leaves(
         return keep
     tol = tol if tol is not None else PoseTolerance.from_data(tree.data)
     tree.poses(range(n), refine=True)  # every leaf's pose in one batch; interpretation() reads them back
-    for leaf in range(n):
-        it = tree.interpretation(leaf, with_pose=True, refine=True)
+    its = [tree.interpretation(leaf, with_pose=True, refine=True) for leaf in range(n)]
+    # the pose checks of the leaves that pair a hit, all in one batch; the loop reads them back
+    leaf_pose_checks(tree, [leaf for leaf, it in enumerate(its) if it.world_from_model is not None
+                            and hits & set(it.faces)])  # fmt: skip
+    for leaf, it in enumerate(its):
         pose = it.world_from_model
         if pose is None:
             continue

@@ -297,7 +297,8 @@ def plan_tour(poly: Polyhedron, targets: np.ndarray, legs: LegCosts, previous: T
 HELD_KARP_MOST = 16
 """Vertices to measure up to which :func:`tour_lower_bound` takes the least path through them exactly (Held-Karp
 dynamic programming, ``2^n n^2`` steps: about 1.5 ms of CPU time at 10 vertices, 23 at 14, 100 at 16 in numpy,
-0.1, 2 and 10 ms compiled; once per verification and once for its record); beyond, the minimum spanning tree (:func:`spanning_tree_bound`)."""
+0.1, 2 and 10 ms compiled; once per verification and once for its record); beyond, the minimum spanning tree
+(:func:`spanning_tree_bound`)."""
 
 
 def _bound_legs(poly: Polyhedron, position: np.ndarray, vertex_ids: np.ndarray, legs: LegCosts) -> np.ndarray:
