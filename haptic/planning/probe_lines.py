@@ -221,21 +221,30 @@ def aimed_probes(
     balls = _hypothesis_balls([h])
     dirs = fibonacci_directions(config.n_directions)
     cos_max = np.cos(config.max_incidence)
+    # with a pad over a table the finger's clearance below may set a target's first lines aside, so every line is
+    # made; else a target's first admissible line is the one kept, and the directions after it are not tried
+    every = config.pad_radius > 0.0 and config.table_z is not None
     lines: list[tuple[ProbeMove, int]] = []
+
+    def directions(n: np.ndarray):
+        yield -n
+        near = dirs[dirs @ -n >= cos_max]
+        yield from near[np.argsort(-(near @ -n))]
+
     for k, (point, f) in enumerate(targets):
         n = t.rotate(h.poly.face_normals[f])
         if config.max_undercut is not None and n[2] < -np.sin(config.max_undercut):
             continue
         p = t.apply(point)
-        near = dirs[dirs @ -n >= cos_max]
-        near = near[np.argsort(-(near @ -n))]
-        for u in (-n, *near):
+        for u in directions(n):
             if config.table_z is not None and u[2] > config.max_climb:
                 continue
             move = _probe_line(p, u, centre, big, radius, balls, config)
             if move is not None:
                 lines.append((move, k))
-    if lines and config.pad_radius > 0.0 and config.table_z is not None:
+                if not every:
+                    break
+    if lines and every:
         clear = finger_clear([h], [mv for mv, _ in lines], config.pad_radius)
         lines = [x for x, ok in zip(lines, clear, strict=True) if ok]
     out, seen = [], set()
