@@ -406,13 +406,17 @@ def _face_point_distances_many(fc: Sequence[DataFace], its: Sequence[Interpretat
     return out
 
 
-def leaf_pose_checks(tree, leaves: Sequence[int]) -> None:
+def leaf_pose_checks(tree, leaves: Sequence[int], its: Sequence[Interpretation] | None = None) -> None:
     """:func:`leaf_pose_check` of every one of ``leaves`` not yet checked, computed together (:func:`pose_checks`)
-    and kept in ``tree.leaf_memo`` as it keeps them."""
+    and kept in ``tree.leaf_memo`` as it keeps them; ``its``: the tree's interpretations of every leaf (refined
+    poses) when the caller has them."""
     todo = [int(leaf) for leaf in leaves if ("pose check", int(leaf)) not in tree.leaf_memo]
     if not todo:
         return
-    its = [tree.interpretation(leaf, with_pose=True, refine=True) for leaf in todo]
+    if its is None:
+        its = [tree.interpretation(leaf, with_pose=True, refine=True) for leaf in todo]
+    else:
+        its = [its[leaf] for leaf in todo]
     for leaf, check in zip(todo, pose_checks(tree.data, its), strict=True):
         tree.leaf_memo[("pose check", leaf)] = check
 

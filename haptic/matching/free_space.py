@@ -201,14 +201,18 @@ def consistent_leaves(
     n = tree.count
     keep = np.ones(n, dtype=bool)
     hits = set(int(i) for i in probe_faces)
-    if n > max_posed or (not free and not hits) or position_span(tree.data) < MIN_SPAN:
+    if n > max_posed or (not free and not hits):
+        return keep
+    if "position span" not in tree.data_memo:  # of the data: the same until the next add
+        tree.data_memo["position span"] = position_span(tree.data)
+    if tree.data_memo["position span"] < MIN_SPAN:
         return keep
     tol = tol if tol is not None else PoseTolerance.from_data(tree.data)
     tree.poses(range(n), refine=True)  # every leaf's pose in one batch; interpretation() reads them back
     its = [tree.interpretation(leaf, with_pose=True, refine=True) for leaf in range(n)]
     # the pose checks of the leaves that pair a hit, all in one batch; the loop reads them back
     leaf_pose_checks(tree, [leaf for leaf, it in enumerate(its) if it.world_from_model is not None
-                            and hits & set(it.faces)])  # fmt: skip
+                            and hits & set(it.faces)], its)  # fmt: skip
     for leaf, it in enumerate(its):
         pose = it.world_from_model
         if pose is None:
