@@ -205,12 +205,17 @@ def _aimed_every_line(h, targets, config):
     return out
 
 
+def _bits(lines) -> list:
+    return [(k, mv.start.tobytes(), mv.direction.tobytes(), mv.length) for mv, k in lines]
+
+
 def test_aimed_probes_are_the_first_admissible_line_of_each_target():
     """:func:`aimed_probes` stops at a target's first admissible line where nothing sets lines aside afterwards, and
     makes them all with a pad over a table (the finger's clearance may drop the first): the same lines, to the bit,
     as making every line, on every seed model at random poses, aimed at each face's targets and at points beside
     its vertices, without a table, with a table, and with a pad over a table (where the finger's clearance sets some
-    targets' first lines aside: stopping at the first there fails this test)."""
+    targets' first lines aside: stopping at the first there fails this test); and, with a filter and a limit, the
+    first lines of those the filter keeps."""
     from haptic.planning.probe_lines import aimed_probes, face_targets
 
     rng = np.random.default_rng(8)
@@ -226,5 +231,11 @@ def test_aimed_probes_are_the_first_admissible_line_of_each_target():
                         for f in poly.vertex_faces[v]]  # fmt: skip
             for config in configs:
                 got, want = aimed_probes(h, targets, config), _aimed_every_line(h, targets, config)
-                assert [(k, mv.start.tobytes(), mv.direction.tobytes(), mv.length) for mv, k in got] == [
-                    (k, mv.start.tobytes(), mv.direction.tobytes(), mv.length) for mv, k in want], (name, config)
+                assert _bits(got) == _bits(want), (name, config)
+                for most in (1, 2, 5):  # the first lines a filter keeps: the targets after them not aimed at
+
+                    def keep(mv):
+                        return mv.direction[2] < 0.3
+
+                    got = aimed_probes(h, targets, config, keep=keep, most=most)
+                    assert _bits(got) == _bits([x for x in want if keep(x[0])][:most]), (name, config, most)
