@@ -243,14 +243,26 @@ def position_span(data: Sequence) -> float:
         if isinstance(c, DataFace):
             rows.extend([c.normal] * len(np.atleast_2d(c.points)))
         elif getattr(c, "kind", None) == "edge":
-            b = np.asarray(c.direction, dtype=float)
-            rows.extend(np.linalg.svd(np.eye(3) - np.outer(b, b))[0][:, :2].T)
+            rows.extend(_across(c))
         elif getattr(c, "kind", None) == "vertex":
             rows.extend(np.eye(3))
     if len(rows) < 3:
         return 0.0
     sv = np.linalg.svd(np.asarray(rows, dtype=float), compute_uv=False)
     return float(sv[-1] / sv[0]) if sv[0] > 0 else 0.0
+
+
+_ACROSS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _across(edge) -> np.ndarray:
+    """The two unit directions across a data edge's line that :func:`position_span` counts, shape (2, 3): of the
+    edge component itself (its direction does not change; a re-reported edge is a new component), computed once."""
+    rows = _ACROSS.get(edge)
+    if rows is None:
+        b = np.asarray(edge.direction, dtype=float)
+        rows = _ACROSS[edge] = np.linalg.svd(np.eye(3) - np.outer(b, b))[0][:, :2].T
+    return rows
 
 
 def apply_probes(

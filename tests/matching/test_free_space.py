@@ -347,3 +347,28 @@ def test_the_position_span_kept_in_the_tree_is_the_datas_own_after_every_add():
             assert tree.data_memo["position span"] == want
             seen.add(round(want, 6))
     assert len(seen) > 3  # the span changes along the walks
+
+
+def test_position_span_takes_each_edges_own_directions_across_it():
+    """:func:`position_span` keeps the directions across each data edge by the edge component: the span equals the
+    one computed afresh, to the bit, and a re-reported edge (the same id, a longer edge in another direction) is a
+    new component with its own directions."""
+    from dataclasses import replace
+
+    from haptic.matching.free_space import _ACROSS, position_span
+
+    rng = np.random.default_rng(3)
+    ex = GeometricExecutor(LIB["BOX01"], SE3.random(rng, 0.2), SensorNoise(), rng)
+    random_walk(ex, 6, rng)
+    data = list(ex.components)
+    edges = [k for k, c in enumerate(data) if c.kind == "edge"]
+    assert edges
+    first = position_span(data)
+    _ACROSS.clear()
+    assert position_span(data) == first
+    k = edges[0]
+    turned = SE3.random(rng).rotate(data[k].direction)
+    data[k] = replace(data[k], direction=turned / np.linalg.norm(turned), length=data[k].length + 0.01)
+    again = position_span(data)
+    _ACROSS.clear()
+    assert position_span(data) == again != first
