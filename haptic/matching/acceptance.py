@@ -250,13 +250,20 @@ def pose_check(model: Polyhedron, data: Sequence[DataComponent], it: Interpretat
 
 
 def _checked(model: Polyhedron, data: Sequence[DataComponent], it: Interpretation,
-             largest: tuple[float, int, str]) -> PoseCheck:  # fmt: skip
+             largest: tuple[float, int, str], free_memo: dict | None = None) -> PoseCheck:  # fmt: skip
     """:func:`pose_check` of ``it`` (posed) from its largest residual ratio at its pose: the slide where the data
-    leave a direction free and a residual a shift may change is beyond the bound."""
+    leave a direction free and a residual a shift may change is beyond the bound. ``free_memo``: the free
+    directions already found on ``data``, by the data ids paired (:func:`free_directions` reads only those)."""
     pose = it.world_from_model
     worst, cid, what = largest
     if worst > POSE_SAFETY and what not in ("face normal", "edge direction"):  # what a shift may change
-        free = free_directions(data, it)
+        if free_memo is None:
+            free = free_directions(data, it)
+        else:
+            key = (tuple(it.faces), tuple(it.edges), tuple(it.vertices))
+            if key not in free_memo:
+                free_memo[key] = free_directions(data, it)
+            free = free_memo[key]
         if len(free):
             slid = _slide(model, data, it, pose, free)
             if slid is not None:
@@ -272,9 +279,10 @@ def pose_checks(data: Sequence[DataComponent], its: Sequence[Interpretation]) ->
     out: list[PoseCheck | None] = [None] * len(its)
     posed = [k for k, it in enumerate(its) if it.world_from_model is not None]
     largest = _largest_ratios(data, [its[k] for k in posed]) if posed else []
+    free_memo: dict = {}  # the leaves pair the same data: the same free directions
     for k, top in zip(posed, largest, strict=True):
         if top is not None:
-            out[k] = _checked(its[k].model, data, its[k], top)
+            out[k] = _checked(its[k].model, data, its[k], top, free_memo)
     return [c if c is not None else pose_check(it.model, data, it) for c, it in zip(out, its, strict=True)]
 
 

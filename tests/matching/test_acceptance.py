@@ -340,3 +340,25 @@ def test_leaf_pose_checks_follow_the_tree_through_adds_and_retains():
         for leaf in leaves:
             it = tree.interpretation(leaf, with_pose=True, refine=True)
             assert _same_check(leaf_pose_check(tree, leaf), pose_check(it.model, tree.data, it)), (k, leaf)
+
+
+def test_pose_checks_that_slide_along_a_free_direction_are_each_leafs_own():
+    """Leaves whose data leave a direction free slide along it in :func:`pose_checks` as in :func:`pose_check`, to
+    the bit (the free directions found once per batch: every leaf pairs the same data), batch after batch on data
+    turned by a rotation (other free directions)."""
+    from dataclasses import replace
+
+    from haptic.matching.acceptance import pose_checks
+    from haptic.matching.tree import Interpretation
+
+    rng = np.random.default_rng(4)
+    for turn in (SE3.identity(), *(SE3(SE3.random(rng).rotation, np.zeros(3)) for _ in range(2))):
+        its, data = [], None
+        for shift in (-12e-3, -3e-3, 0.0, 8e-3):
+            model, raw, it, _ = _prism_data(shift)
+            data = [replace(c, normal=turn.rotate(c.normal), points=turn.apply(c.points)) for c in raw]
+            its.append(Interpretation(model, 0, it.faces, {}, {}, {}, turn @ it.world_from_model, 0))
+        got = pose_checks(data, its)
+        want = [pose_check(it.model, data, it) for it in its]
+        assert all(_same_check(g, w) for g, w in zip(got, want, strict=True))
+        assert any(w.world_from_model is not it.world_from_model for w, it in zip(want, its, strict=True))  # slid
