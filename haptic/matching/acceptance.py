@@ -246,14 +246,187 @@ def pose_check(model: Polyhedron, data: Sequence[DataComponent], it: Interpretat
     ratios = residual_ratios(model, data, it, pose)
     if not ratios:
         return PoseCheck(True, 0.0, None, "", pose)
-    worst, cid, what = max(ratios, key=lambda r: r[0])
+    return _checked(model, data, it, max(ratios, key=lambda r: r[0]))
+
+
+def _checked(model: Polyhedron, data: Sequence[DataComponent], it: Interpretation,
+             largest: tuple[float, int, str], free_memo: dict | None = None) -> PoseCheck:  # fmt: skip
+    """:func:`pose_check` of ``it`` (posed) from its largest residual ratio at its pose: the slide where the data
+    leave a direction free and a residual a shift may change is beyond the bound. ``free_memo``: the free
+    directions already found on ``data``, by the data ids paired (:func:`free_directions` reads only those)."""
+    pose = it.world_from_model
+    worst, cid, what = largest
     if worst > POSE_SAFETY and what not in ("face normal", "edge direction"):  # what a shift may change
-        free = free_directions(data, it)
+        if free_memo is None:
+            free = free_directions(data, it)
+        else:
+            key = (tuple(it.faces), tuple(it.edges), tuple(it.vertices))
+            if key not in free_memo:
+                free_memo[key] = free_directions(data, it)
+            free = free_memo[key]
         if len(free):
             slid = _slide(model, data, it, pose, free)
             if slid is not None:
                 return slid
     return PoseCheck(bool(worst <= POSE_SAFETY), float(worst), cid, what, pose)
+
+
+def pose_checks(data: Sequence[DataComponent], its: Sequence[Interpretation]) -> list[PoseCheck]:
+    """:func:`pose_check` of each of ``its`` (interpretations of one tree, the same data paired in each) on
+    ``data``, their residuals at their poses computed together (:func:`_largest_ratios`): the same checks to the
+    bit, without the cost of one small array operation per component kind and interpretation, which the free-space
+    test pays for every leaf after every move."""
+    out: list[PoseCheck | None] = [None] * len(its)
+    posed = [k for k, it in enumerate(its) if it.world_from_model is not None]
+    largest = _largest_ratios(data, [its[k] for k in posed]) if posed else []
+    free_memo: dict = {}  # the leaves pair the same data: the same free directions
+    for k, top in zip(posed, largest, strict=True):
+        if top is not None:
+            out[k] = _checked(its[k].model, data, its[k], top, free_memo)
+    return [c if c is not None else pose_check(it.model, data, it) for c, it in zip(out, its, strict=True)]
+
+
+def _largest_ratios(data: Sequence[DataComponent], its: Sequence[Interpretation]) -> list[tuple | None]:
+    """For each of ``its`` (posed), ``max(residual_ratios(...), key=ratio)`` at its pose, the same float operations
+    on arrays stacked over the interpretations (each matrix product the same (k, 3) by (3, 3) one, each
+    elementwise operation the same, the reductions over the same rows in the same order); None for one to be
+    measured alone: the data pairing differs from the first's, a ratio is NaN or the largest is -inf, no ratio,
+    without the compiled kernels, or a rotation not stored row by row."""
+    its = list(its)
+    if not its or not kernels.COMPILED:
+        return [None] * len(its)
+    first = its[0]
+    shape = (tuple(first.faces), tuple(first.edges), tuple(first.vertices))
+    fids, eids, vids = (list(x) for x in shape)
+    if not (fids or eids or vids):
+        return [None] * len(its)
+    same = [(tuple(it.faces), tuple(it.edges), tuple(it.vertices)) == shape for it in its]
+    invs = [it.world_from_model.inverse() for it in its]
+    rots = [inv.rotation.T for inv in invs]
+    ok = [k for k, r in enumerate(rots) if same[k] and r.flags.c_contiguous]
+    if len(ok) < len(its):  # the others alone
+        out: list[tuple | None] = [None] * len(its)
+        for k, top in zip(ok, _largest_ratios(data, [its[k] for k in ok]), strict=True):
+            out[k] = top
+        return out
+    n = len(its)
+    rot = np.stack(rots)  # (L, 3, 3): each leaf's ``rot_t`` of :func:`residual_ratios`
+    shift = np.stack([inv.translation for inv in invs])  # (L, 3)
+    mbs = [_model_bounds(it.model) for it in its]
+    columns: list[np.ndarray] = []
+    labels: list[tuple[int, str]] = []
+    if fids:
+        fc = [data[i] for i in fids]
+        assert all(isinstance(c, DataFace) for c in fc)
+        k = len(fids)
+        mf = np.array([[it.faces[i] for i in fids] for it in its])  # (L, K) model faces
+        mn = np.stack([it.model.face_normals[row] for it, row in zip(its, mf, strict=True)])
+        turned = np.matmul(np.array([c.normal for c in fc]), rot)  # (L, K, 3)
+        turn = _angles(turned.reshape(n * k, 3), mn.reshape(n * k, 3)).reshape(n, k)
+        nb = np.array([c.normal_bound for c in fc])
+        pb = np.array([c.position_bound for c in fc])
+        normal = turn / (np.hypot(nb[None, :], np.array([mb.normal for mb in mbs])[:, None]) + ROUND_OFF)
+        point = _face_point_distances_many(fc, its, mf, rot, shift) / (
+            np.hypot(pb[None, :], np.array([mb.position for mb in mbs])[:, None]) + ROUND_OFF)  # fmt: skip
+        for j, i in enumerate(fids):
+            columns += [normal[:, j], point[:, j]]
+            labels += [(i, "face normal"), (i, "face point")]
+    if eids:
+        ec = [data[i] for i in eids]
+        assert all(isinstance(c, DataEdge) for c in ec)
+        e = len(eids)
+        em = np.array([[it.edges[i] for i in eids] for it in its])  # (L, E) model edges
+        b_m = np.stack([it.model.edge_directions[row] for it, row in zip(its, em, strict=True)])
+        l_m = np.stack([it.model.edge_lengths[row] for it, row in zip(its, em, strict=True)])
+        p_m = np.stack([it.model.edge_points[row] for it, row in zip(its, em, strict=True)])
+        senses = np.array([[it.edge_senses.get(i, 0) for i in eids] for it in its])
+        beta = np.hypot(np.array([c.direction_bound for c in ec])[None, :],
+                        np.array([mb.direction for mb in mbs])[:, None])  # fmt: skip
+        turned = np.matmul(np.array([c.direction for c in ec]), rot)
+        direction = _angles(turned.reshape(n * e, 3), (senses[:, :, None] * b_m).reshape(n * e, 3)).reshape(n, e) / (
+            beta + ROUND_OFF)  # fmt: skip
+        ends = np.matmul(np.array([(c.point, c.end_point) for c in ec]), rot[:, None]) + shift[:, None, None] - (
+            p_m[:, :, None])  # fmt: skip
+        flat_ends, flat_b = ends.reshape(n * e, 2, 3), b_m.reshape(n * e, 3)
+        along = np.einsum("eak,ek->ea", flat_ends, flat_b)
+        perp = np.linalg.norm(flat_ends - along[..., None] * flat_b[:, None], axis=2).reshape(n, e, 2)
+        along = along.reshape(n, e, 2)
+        rho = np.hypot(np.array([c.position_bound for c in ec])[None, :],
+                       np.array([mb.position for mb in mbs])[:, None]) + ROUND_OFF  # fmt: skip
+        start = perp[:, :, 0] / rho
+        end = perp[:, :, 1] / (rho + np.array([c.length for c in ec])[None, :] * beta)
+        beyond = np.maximum(np.maximum(-along, along - l_m[:, :, None]).max(axis=2), 0.0)
+        extent = beyond / (np.hypot(np.array([c.length_bound for c in ec])[None, :],
+                                    np.array([mb.position for mb in mbs])[:, None]) + ROUND_OFF)  # fmt: skip
+        for j, i in enumerate(eids):
+            columns += [np.where(senses[:, j] != 0, direction[:, j], -np.inf), start[:, j], end[:, j], extent[:, j]]
+            labels += [(i, "edge direction"), (i, "edge line"), (i, "edge line"), (i, "edge extent")]
+    if vids:
+        vc = [data[i] for i in vids]
+        assert all(isinstance(c, DataVertex) for c in vc)
+        v = len(vids)
+        mv = np.array([[it.vertices[i] for i in vids] for it in its])
+        at = np.stack([it.model.vertices[row] for it, row in zip(its, mv, strict=True)])
+        off = np.matmul(np.array([c.position for c in vc]), rot) + shift[:, None] - at
+        ratio = np.linalg.norm(off.reshape(n * v, 3), axis=1).reshape(n, v) / (
+            np.hypot(np.array([c.position_bound for c in vc])[None, :],
+                     np.array([mb.position for mb in mbs])[:, None]) + ROUND_OFF)  # fmt: skip
+        for j, i in enumerate(vids):
+            columns.append(ratio[:, j])
+            labels.append((i, "vertex"))
+    out = []
+    table = np.stack(columns, axis=1)  # (L, ratios) in residual_ratios' order; -inf: no direction measured
+    col = np.argmax(table, axis=1)  # the first largest, as max() keeps
+    for row, c in zip(table, col, strict=True):
+        worst = row[c]
+        if np.isnan(row).any() or worst == -np.inf:
+            out.append(None)
+        else:
+            out.append((float(worst), *labels[c]))
+    return out
+
+
+def _face_point_distances_many(fc: Sequence[DataFace], its: Sequence[Interpretation], mf: np.ndarray, rot: np.ndarray,
+                               shift: np.ndarray) -> np.ndarray:  # fmt: skip
+    """:func:`_face_point_distances` of each of ``its`` (model faces ``mf`` (L, K) paired with the data faces ``fc``,
+    ``rot`` and ``shift`` the inverse poses' as :func:`residual_ratios` applies them), shape (L, K): each face's
+    points mapped by the same matrix product per leaf, the (point, triangle) pairs of the leaves of one model
+    measured in one kernel call, each point's nearest and each face's largest taken over the same values."""
+    n, k = mf.shape
+    pts = [np.matmul(np.atleast_2d(c.points), rot) + shift[:, None] for c in fc]  # each (L, P_k, 3)
+    owner = np.repeat(np.arange(k), [p.shape[1] for p in pts])
+    allp = np.concatenate(pts, axis=1)  # (L, P, 3)
+    out = np.full((n, k), -np.inf)
+    models: dict[int, list[int]] = {}
+    for row, it in enumerate(its):
+        models.setdefault(id(it.model), []).append(row)
+    for rows in models.values():
+        model = its[rows[0]].model
+        allowed = _plane_triangles(model)[mf[rows]][:, owner]  # (Lm, P, T)
+        leaf, point, tri = np.nonzero(allowed)
+        at = np.ascontiguousarray(allp[np.asarray(rows)[leaf], point], float)
+        d = kernels.paired_point_triangle_distance(at, np.ascontiguousarray(_triangles(model)[tri]))
+        starts = np.flatnonzero(np.diff(leaf * len(owner) + point, prepend=-1))  # each (leaf, point)'s first pair
+        nearest = np.minimum.reduceat(d, starts)
+        block = np.full((len(rows), k), -np.inf)
+        np.maximum.at(block, (leaf[starts], owner[point[starts]]), nearest)
+        out[rows] = block
+    return out
+
+
+def leaf_pose_checks(tree, leaves: Sequence[int], its: Sequence[Interpretation] | None = None) -> None:
+    """:func:`leaf_pose_check` of every one of ``leaves`` not yet checked, computed together (:func:`pose_checks`)
+    and kept in ``tree.leaf_memo`` as it keeps them; ``its``: the tree's interpretations of every leaf (refined
+    poses) when the caller has them."""
+    todo = [int(leaf) for leaf in leaves if ("pose check", int(leaf)) not in tree.leaf_memo]
+    if not todo:
+        return
+    if its is None:
+        its = [tree.interpretation(leaf, with_pose=True, refine=True) for leaf in todo]
+    else:
+        its = [its[leaf] for leaf in todo]
+    for leaf, check in zip(todo, pose_checks(tree.data, its), strict=True):
+        tree.leaf_memo[("pose check", leaf)] = check
 
 
 def leaf_pose_check(tree, leaf: int) -> PoseCheck:

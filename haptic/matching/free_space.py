@@ -41,7 +41,7 @@ from haptic.geometry.raycast import (
 )
 from haptic.geometry.se3 import SE3
 from haptic.matching import kernels
-from haptic.matching.acceptance import leaf_pose_check
+from haptic.matching.acceptance import leaf_pose_check, leaf_pose_checks
 from haptic.matching.components import DataFace, readonly_vector
 from haptic.matching.recognition import PoseTolerance
 from haptic.matching.tree import InterpretationTree
@@ -201,12 +201,19 @@ def consistent_leaves(
     n = tree.count
     keep = np.ones(n, dtype=bool)
     hits = set(int(i) for i in probe_faces)
-    if n > max_posed or (not free and not hits) or position_span(tree.data) < MIN_SPAN:
+    if n > max_posed or (not free and not hits):
+        return keep
+    if "position span" not in tree.data_memo:  # of the data: the same until the next add
+        tree.data_memo["position span"] = position_span(tree.data)
+    if tree.data_memo["position span"] < MIN_SPAN:
         return keep
     tol = tol if tol is not None else PoseTolerance.from_data(tree.data)
     tree.poses(range(n), refine=True)  # every leaf's pose in one batch; interpretation() reads them back
-    for leaf in range(n):
-        it = tree.interpretation(leaf, with_pose=True, refine=True)
+    its = [tree.interpretation(leaf, with_pose=True, refine=True) for leaf in range(n)]
+    # the pose checks of the leaves that pair a hit, all in one batch; the loop reads them back
+    leaf_pose_checks(tree, [leaf for leaf, it in enumerate(its) if it.world_from_model is not None
+                            and hits & set(it.faces)], its)  # fmt: skip
+    for leaf, it in enumerate(its):
         pose = it.world_from_model
         if pose is None:
             continue
@@ -236,14 +243,26 @@ def position_span(data: Sequence) -> float:
         if isinstance(c, DataFace):
             rows.extend([c.normal] * len(np.atleast_2d(c.points)))
         elif getattr(c, "kind", None) == "edge":
-            b = np.asarray(c.direction, dtype=float)
-            rows.extend(np.linalg.svd(np.eye(3) - np.outer(b, b))[0][:, :2].T)
+            rows.extend(_across(c))
         elif getattr(c, "kind", None) == "vertex":
             rows.extend(np.eye(3))
     if len(rows) < 3:
         return 0.0
     sv = np.linalg.svd(np.asarray(rows, dtype=float), compute_uv=False)
     return float(sv[-1] / sv[0]) if sv[0] > 0 else 0.0
+
+
+_ACROSS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _across(edge) -> np.ndarray:
+    """The two unit directions across a data edge's line that :func:`position_span` counts, shape (2, 3): of the
+    edge component itself (its direction does not change; a re-reported edge is a new component), computed once."""
+    rows = _ACROSS.get(edge)
+    if rows is None:
+        b = np.asarray(edge.direction, dtype=float)
+        rows = _ACROSS[edge] = np.linalg.svd(np.eye(3) - np.outer(b, b))[0][:, :2].T
+    return rows
 
 
 def apply_probes(

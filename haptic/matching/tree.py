@@ -228,6 +228,9 @@ class InterpretationTree:
         self.leaf_memo: dict[tuple[str, int], object] = {}
         """Results computed from one leaf and the data so far, by ``(what, leaf)`` (the pose check of
         :func:`~haptic.matching.acceptance.leaf_pose_check`), emptied by every ``add`` and renumbered by ``retain``."""
+        self.data_memo: dict[str, object] = {}
+        """Results computed from the data alone, by name (the position span of
+        :func:`~haptic.matching.free_space.consistent_leaves`), emptied by every ``add``; a ``retain`` keeps them."""
         self._initial: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
         """The closed-form poses of every leaf as arrays (:meth:`initial_poses`), emptied by every ``add`` and
         renumbered by ``retain``."""
@@ -309,6 +312,7 @@ class InterpretationTree:
         self.counts.append(self.count)
         self._pose_cache.clear()  # poses are of the data before this add
         self.leaf_memo.clear()
+        self.data_memo.clear()
         self._initial = None
         self._stack = None
         return self.count

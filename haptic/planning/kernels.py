@@ -77,4 +77,35 @@ def face_outcomes(dirs, rots, start, normal, a_all, seg_all, real, b_all, p_all,
 face_outcomes = _geometry.compile_kernel(face_outcomes)
 
 
-__all__ = ["COMPILED", "face_outcomes"]
+def least_path(start, step):
+    """The Held-Karp table of :func:`~haptic.planning.tour.least_path` by the same sums: ``start`` (n,), the cost of
+    each node taken first, and ``step`` (n, n), from node ``j`` to node ``k``; the least over the last node of the
+    full subset's row. Every entry is the least of the same float sums ``best[subset, j] + step[j, k]`` over every
+    ``j`` as the numpy form's (+inf for ``j`` outside the subset, the costs being finite), subsets in increasing
+    order (each entry's subsets are smaller numbers): the same value to the bit."""
+    n = start.shape[0]
+    full = 1 << n
+    best = np.full((full, n), np.inf)
+    for j in range(n):
+        best[1 << j, j] = start[j]
+    for mask in range(1, full):
+        for k in range(n):
+            if (mask >> k) & 1:
+                continue
+            low = np.inf
+            for j in range(n):
+                v = best[mask, j] + step[j, k]
+                if v < low:
+                    low = v
+            best[mask | (1 << k), k] = low
+    out = np.inf
+    for j in range(n):
+        if best[full - 1, j] < out:
+            out = best[full - 1, j]
+    return out
+
+
+least_path = _geometry.compile_kernel(least_path)
+
+
+__all__ = ["COMPILED", "face_outcomes", "least_path"]

@@ -13,7 +13,7 @@ of the opening, before any hypothesis has a pose, are :mod:`haptic.planning.open
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -204,14 +204,17 @@ def _probe_line(p: np.ndarray, u: np.ndarray, centre: np.ndarray, big: float, ra
 
 
 def aimed_probes(
-    h: Hypothesis, targets: Sequence[tuple[np.ndarray, int]], config: ProbeConfig | None = None
+    h: Hypothesis, targets: Sequence[tuple[np.ndarray, int]], config: ProbeConfig | None = None,
+    keep: Callable[[ProbeMove], bool] | None = None, most: int | None = None,
 ) -> list[tuple[ProbeMove, int]]:
     """Probe lines at chosen points of hypothesis ``h``'s posed model: for each ``(point, face)`` (model frame,
     the point on that face), the line through the point head-on (along the face's inward normal) or, where that
     one is not admissible (the table, the hand's way down, the finger above the pad, :func:`candidate_probes`'
     rules), along the admissible one of the discrete directions within ``max_incidence`` of head-on nearest to
     it; at most one line per target, with its target's index. A verification uses them to carry the sensor to
-    a part of the model still to be measured (:mod:`haptic.planning.verify`)."""
+    a part of the model still to be measured (:mod:`haptic.planning.verify`). ``keep`` (None: every line) and
+    ``most`` (None: no limit): of those lines, the first ``most`` that ``keep`` keeps, in the targets' order (the
+    targets after them are not aimed at where the lines are made target by target)."""
     config = config or ProbeConfig()
     if h.world_from_model is None or not len(targets):
         return []
@@ -221,21 +224,33 @@ def aimed_probes(
     balls = _hypothesis_balls([h])
     dirs = fibonacci_directions(config.n_directions)
     cos_max = np.cos(config.max_incidence)
+    # with a pad over a table the finger's clearance below may set a target's first lines aside, so every line is
+    # made; else a target's first admissible line is the one kept, and the directions after it are not tried
+    every = config.pad_radius > 0.0 and config.table_z is not None
     lines: list[tuple[ProbeMove, int]] = []
+
+    def directions(n: np.ndarray):
+        yield -n
+        near = dirs[dirs @ -n >= cos_max]
+        yield from near[np.argsort(-(near @ -n))]
+
     for k, (point, f) in enumerate(targets):
+        if not every and most is not None and len(lines) >= most:
+            break
         n = t.rotate(h.poly.face_normals[f])
         if config.max_undercut is not None and n[2] < -np.sin(config.max_undercut):
             continue
         p = t.apply(point)
-        near = dirs[dirs @ -n >= cos_max]
-        near = near[np.argsort(-(near @ -n))]
-        for u in (-n, *near):
+        for u in directions(n):
             if config.table_z is not None and u[2] > config.max_climb:
                 continue
             move = _probe_line(p, u, centre, big, radius, balls, config)
             if move is not None:
-                lines.append((move, k))
-    if lines and config.pad_radius > 0.0 and config.table_z is not None:
+                if every or keep is None or keep(move):
+                    lines.append((move, k))
+                if not every:
+                    break
+    if lines and every:
         clear = finger_clear([h], [mv for mv, _ in lines], config.pad_radius)
         lines = [x for x, ok in zip(lines, clear, strict=True) if ok]
     out, seen = [], set()
@@ -243,7 +258,9 @@ def aimed_probes(
         if k not in seen:
             seen.add(k)
             out.append((mv, k))
-    return out
+    if every:
+        out = [x for x in out if keep is None or keep(x[0])]
+    return out[:most] if most is not None else out
 
 
 def _hypothesis_balls(hypotheses: Sequence[Hypothesis]) -> tuple[np.ndarray, np.ndarray]:

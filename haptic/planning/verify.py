@@ -821,18 +821,23 @@ def _verification_probes(
     targets = [(p, f) for p, f in _probe_targets(h.poly, missing, faces_ok)
                if float(np.linalg.norm(p - here)) >= MIN_PROBE_TRANSFER]  # fmt: skip
     targets.sort(key=lambda pf: float(np.linalg.norm(pf[0] - here)))
+    def new_line(mv: ProbeMove) -> bool:
+        return not any(same_line(mv, done) for done in probed)
+
+    # the first ``most`` lines not probed before, nearest target first (the farther targets are not aimed at)
     if config.table_z is not None:  # the hand's relocation: lines from outside the sphere, as the recognition's
-        lines = [(mv, targets[k]) for mv, k in aimed_probes(h, targets, probe_config(config))
-                 if not any(same_move(mv, done) for done in probed)][:most]  # fmt: skip
+        lines = [(mv, targets[k]) for mv, k in aimed_probes(
+            h, targets, probe_config(config), keep=lambda mv: not any(same_move(mv, done) for done in probed),
+            most=most)]  # fmt: skip
     else:
-        lines = [(close_start(h, mv), targets[k]) for mv, k in aimed_probes(h, targets, probe_config(config))
-                 if not any(same_line(mv, done) for done in probed)][:most]  # fmt: skip
+        lines = [(close_start(h, mv), targets[k])
+                 for mv, k in aimed_probes(h, targets, probe_config(config), keep=new_line, most=most)]  # fmt: skip
     beside = sorted({int(f) for v in missing[2] for f in h.poly.vertex_faces[v]} & set(middles))
     if beside:  # a face at a vertex to measure whose middle is still to be probed: landing there measures both
         mids = [(face_middle(h.poly, f), f) for f in beside]
         mids = [t for t in mids if float(np.linalg.norm(t[0] - here)) >= MIN_PROBE_TRANSFER]
-        lines += [(close_start(h, mv), mids[k]) for mv, k in aimed_probes(h, mids, probe_config(config))
-                  if not any(same_line(mv, done) for done in probed)][:most]  # fmt: skip
+        lines += [(close_start(h, mv), mids[k])
+                  for mv, k in aimed_probes(h, mids, probe_config(config), keep=new_line, most=most)]  # fmt: skip
     preds = predict_probe_moves(Context((h,), state, components, noise, config), [mv for mv, _ in lines])
     poly = h.poly
     mf, me, mv = missing
@@ -1279,11 +1284,13 @@ def unmeasured_middles(poly: Polyhedron, world_from_model: SE3, data: Sequence[D
     if not pts:
         return sorted(faces)
     p = world_from_model.inverse().apply(np.concatenate(pts))
-    out = []
-    for f in sorted(faces):
-        if float(np.linalg.norm(p - face_middle(poly, f), axis=1).min()) > MIDDLE_REACH:
-            out.append(int(f))
-    return out
+    fs = sorted(faces)
+    if not fs:
+        return []
+    # every face's middle against every point at once: per face the same distances and least as face by face
+    middles = np.array([face_middle(poly, f) for f in fs])
+    near = np.linalg.norm(p[None] - middles[:, None], axis=2).min(axis=1)
+    return [int(f) for f, d in zip(fs, near, strict=True) if float(d) > MIDDLE_REACH]
 
 
 class Verifier:

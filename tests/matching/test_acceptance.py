@@ -287,3 +287,78 @@ def test_the_acceptance_tests_sigma_follows_the_noise_level_where_the_noise_domi
     a = acceptance(box, data, it, it.world_from_model, k_sigma=K_SIGMA_PHYSICS)
     b = acceptance(box, data, it, it.world_from_model, k_sigma=K_SIGMA_PHYSICS, floors=floors)
     assert a.ok and b.statistic == pytest.approx(a.statistic)
+
+
+def _same_check(a, b) -> bool:
+    """Two pose checks equal to the bit (the pose by its arrays)."""
+    pa, pb = a.world_from_model, b.world_from_model
+    same_pose = (pa is None and pb is None) or (pa is not None and pb is not None and np.array_equal(
+        pa.rotation, pb.rotation) and np.array_equal(pa.translation, pb.translation))  # fmt: skip
+    return (a.ok == b.ok and float(a.worst).hex() == float(b.worst).hex() and a.component == b.component
+            and a.what == b.what and same_pose)  # fmt: skip
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_pose_checks_of_many_leaves_are_each_leafs_own(seed):
+    """The pose checks computed together (:func:`pose_checks`) are :func:`pose_check` of each leaf to the bit --
+    largest ratio, its component and kind, verdict and pose -- on every posed leaf of random walks over the seed
+    library (faces, edges of known and unknown sense, vertices, several models at once, noise up to 8x, the
+    leaves' residuals far beyond their bounds included), and with an unposed interpretation among them."""
+    from haptic.matching.acceptance import pose_checks
+    from haptic.matching.tree import Interpretation
+
+    rng = np.random.default_rng(100 + seed)
+    name = NAMES[seed % len(NAMES)]
+    ex = _walk(LIB[name], seed, int(rng.integers(3, 7)), float(rng.choice([0.0, 1.0, 8.0])), bool(seed % 2))
+    tree = InterpretationTree(ARRAYS)
+    tree.add_all(ex.components)
+    its = tree.interpretations(with_pose=True, refine=True, limit=300)
+    its = [it for it in its if it.world_from_model is not None]
+    assert its, name
+    unposed = Interpretation(its[0].model, its[0].model_index, its[0].faces, its[0].edges, its[0].vertices,
+                             its[0].edge_senses, None, 0)  # fmt: skip
+    batch = [*its, unposed]
+    got = pose_checks(tree.data, batch)
+    want = [pose_check(it.model, tree.data, it) for it in batch]
+    assert all(_same_check(g, w) for g, w in zip(got, want, strict=True))
+
+
+def test_leaf_pose_checks_follow_the_tree_through_adds_and_retains():
+    """The pose checks kept in the tree (:func:`leaf_pose_checks`) are a fresh :func:`pose_check` of each leaf after
+    every add (which empties them: the poses change) and after a retain (which renumbers them)."""
+    from haptic.matching.acceptance import leaf_pose_check, leaf_pose_checks
+
+    ex = _walk(LIB["BOX01"], 3, 6, 1.0, False)
+    tree = InterpretationTree(ARRAYS)
+    for k, c in enumerate(ex.components):
+        tree.add(c)
+        leaves = list(range(min(tree.count, 200)))
+        leaf_pose_checks(tree, leaves)
+        if k % 2 and tree.count > 1:
+            tree.retain(np.arange(tree.count) % 2 == 0)
+            leaves = list(range(min(tree.count, 200)))
+        for leaf in leaves:
+            it = tree.interpretation(leaf, with_pose=True, refine=True)
+            assert _same_check(leaf_pose_check(tree, leaf), pose_check(it.model, tree.data, it)), (k, leaf)
+
+
+def test_pose_checks_that_slide_along_a_free_direction_are_each_leafs_own():
+    """Leaves whose data leave a direction free slide along it in :func:`pose_checks` as in :func:`pose_check`, to
+    the bit (the free directions found once per batch: every leaf pairs the same data), batch after batch on data
+    turned by a rotation (other free directions)."""
+    from dataclasses import replace
+
+    from haptic.matching.acceptance import pose_checks
+    from haptic.matching.tree import Interpretation
+
+    rng = np.random.default_rng(4)
+    for turn in (SE3.identity(), *(SE3(SE3.random(rng).rotation, np.zeros(3)) for _ in range(2))):
+        its, data = [], None
+        for shift in (-12e-3, -3e-3, 0.0, 8e-3):
+            model, raw, it, _ = _prism_data(shift)
+            data = [replace(c, normal=turn.rotate(c.normal), points=turn.apply(c.points)) for c in raw]
+            its.append(Interpretation(model, 0, it.faces, {}, {}, {}, turn @ it.world_from_model, 0))
+        got = pose_checks(data, its)
+        want = [pose_check(it.model, data, it) for it in its]
+        assert all(_same_check(g, w) for g, w in zip(got, want, strict=True))
+        assert any(w.world_from_model is not it.world_from_model for w, it in zip(want, its, strict=True))  # slid

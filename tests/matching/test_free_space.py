@@ -314,3 +314,61 @@ def test_a_leafs_pose_check_kept_for_the_data_is_a_fresh_one_and_follows_retain(
             assert (got.ok, got.worst, got.component, got.what) == (fresh.ok, fresh.worst, fresh.component, fresh.what)
             checked += 1
     assert checked > 10
+
+
+def test_the_position_span_kept_in_the_tree_is_the_datas_own_after_every_add():
+    """The free-space test reads the data's position span from the tree (``tree.data_memo``, computed once per
+    add): after every add and every retain it is :func:`position_span` of the data then, to the bit, on random
+    walks with probes; an add that kept the span of the data before it would fail here."""
+    from haptic.matching.free_space import consistent_leaves, position_span
+
+    seen = set()
+    for seed in range(4):
+        rng = np.random.default_rng(seed)
+        ex = GeometricExecutor(LIB[NAMES[seed]], SE3.random(rng, 0.2), SensorNoise(), rng)
+        random_walk(ex, 3, rng)
+        tree = InterpretationTree(ARRAYS)
+        free, hits = [], []
+        moves = [(c,) for c in ex.components]
+        for _ in range(3):
+            res = ex.execute(random_probe(ex, rng))
+            if res.ok:
+                free.extend(res.free_space)
+                moves.append(tuple(res.components))
+                hits.extend(c.id for c in res.components)
+        for cs in moves:
+            for c in cs:
+                tree.add(c)
+            if tree.count == 0:
+                break
+            far = [FreeSegment(np.full(3, 1.0), np.array([1.0, 0, 0]), 0.1, 1e-3)]  # a miss far from the object
+            tree.retain(consistent_leaves(tree, free or far, hits, max_posed=10**6))
+            want = position_span(tree.data)
+            assert tree.data_memo["position span"] == want
+            seen.add(round(want, 6))
+    assert len(seen) > 3  # the span changes along the walks
+
+
+def test_position_span_takes_each_edges_own_directions_across_it():
+    """:func:`position_span` keeps the directions across each data edge by the edge component: the span equals the
+    one computed afresh, to the bit, and a re-reported edge (the same id, a longer edge in another direction) is a
+    new component with its own directions."""
+    from dataclasses import replace
+
+    from haptic.matching.free_space import _ACROSS, position_span
+
+    rng = np.random.default_rng(3)
+    ex = GeometricExecutor(LIB["BOX01"], SE3.random(rng, 0.2), SensorNoise(), rng)
+    random_walk(ex, 6, rng)
+    data = list(ex.components)
+    edges = [k for k, c in enumerate(data) if c.kind == "edge"]
+    assert edges
+    first = position_span(data)
+    _ACROSS.clear()
+    assert position_span(data) == first
+    k = edges[0]
+    turned = SE3.random(rng).rotate(data[k].direction)
+    data[k] = replace(data[k], direction=turned / np.linalg.norm(turned), length=data[k].length + 0.01)
+    again = position_span(data)
+    _ACROSS.clear()
+    assert position_span(data) == again != first

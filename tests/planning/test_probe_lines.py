@@ -170,3 +170,72 @@ def test_the_finger_above_the_pad_must_clear_every_hypothesis():
     at_face = ProbeMove(np.array([lo[0] - 0.03, 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])]),
                         np.array([1.0, 0.0, 0.0]), 0.2)  # fmt: skip
     assert finger_clear(hyps, [under, beside, at_face], 0.012).tolist() == [False, True, True]
+
+
+def _aimed_every_line(h, targets, config):
+    """:func:`aimed_probes` making every admissible line of every target before keeping the first of each (the
+    form before a target's first line ended its directions)."""
+    from haptic.planning.finger_clearance import finger_clear
+    from haptic.planning.probe_lines import _hypothesis_balls, _probe_line, _region, fibonacci_directions
+
+    t = h.world_from_model
+    centre, radius = _region([h])
+    big, balls = radius + config.standoff, _hypothesis_balls([h])
+    dirs = fibonacci_directions(config.n_directions)
+    lines = []
+    for k, (point, f) in enumerate(targets):
+        n = t.rotate(h.poly.face_normals[f])
+        if config.max_undercut is not None and n[2] < -np.sin(config.max_undercut):
+            continue
+        near = dirs[dirs @ -n >= np.cos(config.max_incidence)]
+        for u in (-n, *near[np.argsort(-(near @ -n))]):
+            if config.table_z is not None and u[2] > config.max_climb:
+                continue
+            move = _probe_line(t.apply(point), u, centre, big, radius, balls, config)
+            if move is not None:
+                lines.append((move, k))
+    if lines and config.pad_radius > 0.0 and config.table_z is not None:
+        clear = finger_clear([h], [mv for mv, _ in lines], config.pad_radius)
+        lines = [x for x, ok in zip(lines, clear, strict=True) if ok]
+    out, seen = [], set()
+    for mv, k in lines:
+        if k not in seen:
+            seen.add(k)
+            out.append((mv, k))
+    return out
+
+
+def _bits(lines) -> list:
+    return [(k, mv.start.tobytes(), mv.direction.tobytes(), mv.length) for mv, k in lines]
+
+
+def test_aimed_probes_are_the_first_admissible_line_of_each_target():
+    """:func:`aimed_probes` stops at a target's first admissible line where nothing sets lines aside afterwards, and
+    makes them all with a pad over a table (the finger's clearance may drop the first): the same lines, to the bit,
+    as making every line, on every seed model at random poses, aimed at each face's targets and at points beside
+    its vertices, without a table, with a table, and with a pad over a table (where the finger's clearance sets some
+    targets' first lines aside: stopping at the first there fails this test); and, with a filter and a limit, the
+    first lines of those the filter keeps."""
+    from haptic.planning.probe_lines import aimed_probes, face_targets
+
+    rng = np.random.default_rng(8)
+    configs = [ProbeConfig(), ProbeConfig(table_z=-0.05), ProbeConfig(table_z=-0.05, pad_radius=0.012,
+                                                                      max_undercut=np.deg2rad(30.0))]  # fmt: skip
+    for name in sorted(LIB):
+        poly = LIB[name]
+        for _ in range(3):
+            h = _hyp(name, SE3.random(rng, 0.02))
+            centres = face_targets(poly)
+            targets = [(centres[f], f) for f in range(poly.n_faces)]
+            targets += [(0.8 * poly.vertices[v] + 0.2 * centres[f], int(f)) for v in range(poly.n_vertices)
+                        for f in poly.vertex_faces[v]]  # fmt: skip
+            for config in configs:
+                got, want = aimed_probes(h, targets, config), _aimed_every_line(h, targets, config)
+                assert _bits(got) == _bits(want), (name, config)
+                for most in (1, 2, 5):  # the first lines a filter keeps: the targets after them not aimed at
+
+                    def keep(mv):
+                        return mv.direction[2] < 0.3
+
+                    got = aimed_probes(h, targets, config, keep=keep, most=most)
+                    assert _bits(got) == _bits([x for x in want if keep(x[0])][:most]), (name, config, most)

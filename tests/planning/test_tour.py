@@ -9,6 +9,7 @@ import pytest
 from haptic.episode.spec import EpisodeSpec
 from haptic.episode.worlds import run_episode
 from haptic.geometry import load_library
+from haptic.planning import kernels as planning_kernels
 from haptic.planning.config import PlannerConfig
 from haptic.planning.tour import (
     VERTEX,
@@ -302,3 +303,24 @@ def test_least_path_is_exact_on_random_legs():
         )
         assert least_path(w, enter, first) == pytest.approx(brute)
     assert least_path(np.zeros((1, 1)), np.zeros(0), np.zeros(0)) == 0.0
+
+
+@pytest.mark.skipif(not planning_kernels.COMPILED, reason="numba not installed")
+def test_compiled_least_path_is_the_numpy_one_to_the_bit(monkeypatch):
+    """The compiled Held-Karp table gives the numpy form's value to the last bit, on random legs up to 12 nodes, on
+    legs with many ties (small integers) and on the lower bounds' own legs (a box's vertices and faces' middles)."""
+    rng = np.random.default_rng(11)
+    cases = []
+    for _ in range(150):
+        n = int(rng.integers(1, 13))
+        w = rng.random((n + 1, n + 1)) * rng.choice([1e-3, 1.0, 1e3])
+        cases.append((w, rng.random(n), rng.random(n)))
+        k = rng.integers(0, 4, (n + 1, n + 1)).astype(float)
+        cases.append((k, rng.integers(0, 3, n).astype(float), np.zeros(n)))
+    box = LIB["BOX01"]
+    w = np.linalg.norm(box.vertices[:, None] - box.vertices[None], axis=2) * 7.3
+    cases.append((w[:7, :7], arrival_costs(box, ALL)[1:7], np.zeros(6)))
+    compiled = [least_path(w, e, f) for w, e, f in cases]
+    monkeypatch.setattr(planning_kernels, "COMPILED", False)
+    reference = [least_path(w, e, f) for w, e, f in cases]
+    assert [float(x).hex() for x in compiled] == [float(x).hex() for x in reference]

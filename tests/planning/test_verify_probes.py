@@ -314,3 +314,40 @@ def test_beyond_the_exact_paths_reach_the_middles_are_probed_cheapest_first():
         preds = [probe(-0.011), *(probe(0.01 * i) for i in range(1, n))]
         first = _first_of_best_order(preds, list(range(n)), ALL)
         assert first == (0 if n <= HELD_KARP_MOST else 1)
+
+
+def test_unmeasured_middles_of_every_face_at_once_are_face_by_faces():
+    """:func:`~haptic.planning.verify.unmeasured_middles` measures every face's middle against every point at once:
+    the same faces as face by face, on points placed at the middles' reach to within round-off either way (where
+    another sum would tip a face over), on every seed model at random poses."""
+    from haptic.geometry import SE3
+    from haptic.matching.components import DataEdge, DataFace
+    from haptic.planning.verify import MIDDLE_REACH, face_middle, unmeasured_middles
+
+    def face_by_face(poly, pose, data, faces):
+        pts = [np.atleast_2d(c.points) for c in data if isinstance(c, DataFace) and len(c.points)]
+        pts += [np.stack([c.point, c.point + c.length * c.direction]) for c in data if isinstance(c, DataEdge)]
+        p = pose.inverse().apply(np.concatenate(pts))
+        return [int(f) for f in sorted(faces)
+                if float(np.linalg.norm(p - face_middle(poly, f), axis=1).min()) > MIDDLE_REACH]  # fmt: skip
+
+    rng = np.random.default_rng(12)
+    tipped = 0
+    for name in sorted(LIB):
+        poly = LIB[name]
+        for _ in range(4):
+            pose = SE3.random(rng, 0.1)
+            data = []
+            for f in range(poly.n_faces):
+                u = rng.normal(size=3)
+                u /= np.linalg.norm(u)
+                scale = MIDDLE_REACH * (1.0 + float(rng.choice([-1e-15, 0.0, 1e-15, -0.5, 0.5])))
+                q = pose.apply(face_middle(poly, f) + scale * u)
+                data.append(DataFace(len(data), poly.face_normals[f], q[None], 0.01, 1e-3))
+            data.append(DataEdge(len(data), pose.apply(poly.edge_points[0]), pose.rotate(poly.edge_directions[0]),
+                                 float(poly.edge_lengths[0]), 0.01, 1e-3, 1e-3))  # fmt: skip
+            faces = frozenset(int(f) for f in rng.choice(poly.n_faces, size=max(1, poly.n_faces - 1), replace=False))
+            want = face_by_face(poly, pose, data, faces)
+            assert unmeasured_middles(poly, pose, data, faces) == want, name
+            tipped += len(want)
+    assert tipped  # some faces' middles left unmeasured by points at their reach
