@@ -125,7 +125,7 @@ def _models_show(args: argparse.Namespace) -> int:
         f"convex={'yes' if s['convex'] else 'no'}  volume={s['volume_cm3']:g} cm^3"
     )
     print(f"  size {' x '.join(f'{x:g}' for x in s['extents_mm'])} mm; convex pieces: {len(convex_decomposition(m))}")
-    angles = sorted(round(float(np.degrees(np.arccos(np.clip((np.trace(t.rotation) - 1) / 2, -1, 1))))) for t in sym)
+    angles = sorted(round(float(np.degrees(rotation_angle(t.rotation)))) for t in sym)
     print(f"  symmetry group: {len(sym)} proper rotations (angles {angles} deg)")
     near = near_symmetries(m)
     if near:
