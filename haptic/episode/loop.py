@@ -243,7 +243,7 @@ def _start(view: EpisodeState, executor: Executor, obs: Observer) -> Ending | No
     """The executor finds the object: its first data are booked (an ending when it cannot)."""
     first = executor.start()
     if not first.ok:
-        return Ending("failed", f"start: {first.status}")
+        return Ending("failed", f"start: {first.status}" + (f" ({first.reason})" if first.reason else ""))
     view.took(first)
     if obs.on_move:
         obs.on_move(0, first, view.tree.count, view.rec)

@@ -42,7 +42,20 @@ class LandingSearch:
         budget = s.max_landings if s.max_landings is not None else len(landings) + s.edge_retries
         i = -1
         stuck = 0  # moves across, at the highest approach, that timed out in a row
-        while i + 1 < min(len(landings), budget):
+        passes = 1  # passes over the landing grid begun
+        touches = strokes = 0  # landings that touched the object; of them, those whose L stroke measured no face
+        while True:
+            if i + 1 >= min(len(landings), budget):
+                if passes >= s.search_passes:
+                    break
+                # the grid's points all missed an object that stands between them: again at its cells' centres
+                # (drawn only now, so that a first pass that finds a face draws what it always did)
+                passes += 1
+                more = landing_points(s.search_spacing, s.search_margin, self.rng, s.search_jitter,
+                                      s.search_order_jitter, offset=0.5 * ((passes - 1) % 2))  # fmt: skip
+                landings.extend(more)
+                budget += len(more) if s.max_landings is None else 0
+                continue
             i += 1
             xy = landings[i]
             above = np.array([xy[0], xy[1], z_top])
@@ -88,8 +101,10 @@ class LandingSearch:
                 continue
             if self.workspace.is_table(r.info["normal"], r.info["point"]):
                 continue
+            touches += 1
             fit, trace = self._normal_stroke(r.info["normal"], pieces)
             if fit is None:  # touched the object near an edge: try close by first
+                strokes += 1
                 near = r.info["point"][:2] + self.rng.normal(0.0, s.landing_jitter, (s.near_landings, 2))
                 landings[i + 1 : i + 1] = list(near)
                 continue
@@ -100,7 +115,9 @@ class LandingSearch:
             return MoveResult(move=move, status="ok", components=(face,), state=self.state,
                               info={"travel": sum(p.distance for p in pieces)})  # fmt: skip
         return MoveResult(move=move, status=last if last != "ok" else "no-contact", state=None,
-                          reason="no face found over the object region")  # fmt: skip
+                          reason=f"no face found over the object region: {i + 1} landings in {passes} passes over "
+                                 f"the grid touched the object {touches} times, {strokes} of them where the L "
+                                 "stroke measured no face")  # fmt: skip
 
     def _normal_stroke(self, n0: np.ndarray, pieces: list[PrimitiveResult]) -> tuple[FaceFit | None, ContactTrace]:
         """An L stroke from the landing point for the face's normal; tries other headings when it meets an edge."""

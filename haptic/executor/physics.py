@@ -139,6 +139,12 @@ class PhysicsSettings:
     """Start: spacing of the landing grid over the object region [m]."""
     search_margin: float = 0.04
     """Start: the grid extends this far beyond the object region [m]."""
+    search_passes: int = 2
+    """Start: passes over the landing grid while no face is found, the second (and every other) at the centres of
+    its cells (shifted by half the spacing along both axes): the pad, descending to
+    ``search_floor``, catches a low object within about its radius of its centre, and a 30 mm object standing on
+    a 15 mm foot (the elongated triangular pyramid upright) or lying 10 mm high stood between the points of the
+    25 mm grid."""
     max_landings: int | None = None
     """Start: landing attempts before giving up (None: every point of the landing grid -- the object may rest
     anywhere over the region, out to its corners -- plus ``edge_retries`` landings close to an edge touched)."""

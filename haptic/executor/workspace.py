@@ -118,14 +118,16 @@ class Workspace:
 
 
 def landing_points(
-    spacing: float, margin: float, rng: np.random.Generator, jitter: float, order_jitter: float
-) -> list[np.ndarray]:
+    spacing: float, margin: float, rng: np.random.Generator, jitter: float, order_jitter: float,
+    offset: float = 0.0,
+) -> list[np.ndarray]:  # fmt: skip
     """The start's landing grid over the object region (a workspace prior), ``spacing`` apart and ``margin``
     beyond the region, jittered by up to ``jitter`` × ``spacing``, nearest the region's centre first (to
-    within ``order_jitter`` [m])."""
+    within ``order_jitter`` [m]); ``offset`` (a fraction of ``spacing``) shifts the grid along both axes: 0.5
+    puts its points at the centres of the cells of the grid without it."""
     (x0, x1), (y0, y1) = OBJECT_REGION
-    xs = np.arange(x0 - margin, x1 + margin + GRID_END, spacing)
-    ys = np.arange(y0 - margin, y1 + margin + GRID_END, spacing)
+    xs = np.arange(x0 - margin + offset * spacing, x1 + margin + GRID_END, spacing)
+    ys = np.arange(y0 - margin + offset * spacing, y1 + margin + GRID_END, spacing)
     centre = np.array([(x0 + x1) / 2, (y0 + y1) / 2])
     pts = np.array([[x, y] for x in xs for y in ys])
     pts = pts + rng.uniform(-jitter, jitter, pts.shape) * spacing
