@@ -249,6 +249,35 @@ def test_start_finds_an_object_at_a_corner_of_the_region(corner):
     assert r.ok, r.reason
 
 
+@pytest.mark.parametrize("passes", [1, 2])
+def test_start_finds_a_small_object_between_the_landings_of_the_grid(passes):
+    """A small object standing between the points of the landing grid (the elongated triangular pyramid of the
+    public polyhedra at 30 mm stood between those of the 25 mm grid, seed 1): no landing touches it, and the
+    search passes over the grid again at its cells' centres. Here a 50 mm grid, unjittered, and BOX01 30 mm
+    across at the centre of its cell nearest the region's centre, 35 mm from every landing of the first pass;
+    one pass alone says what it touched."""
+    from haptic.executor.physics import PhysicsSettings
+    from haptic.geometry.perturb import scaled_to
+    from haptic.sim.scene import OBJECT_REGION
+
+    obj = scene_object_from_polyhedron(scaled_to(load_library()["BOX01"], 0.03))
+    pose = random_object_pose(obj, np.random.default_rng(1))
+    v = obj.vertices @ pose[:3, :3].T + pose[:3, 3]
+    spacing = 0.05
+    (x0, _), (y0, _) = OBJECT_REGION
+    cell = np.array([x0 + 1.5 * spacing, y0 + 2.5 * spacing])  # the cell's centre nearest the region's centre
+    pose[:2, 3] += cell - 0.5 * (v.min(axis=0) + v.max(axis=0))[:2]
+    sim = Simulation(compose_scene(obj, pose), noise=SimulatedSensorNoise.from_notes(), seed=1)
+    settings = PhysicsSettings(search_spacing=spacing, search_margin=0.0, search_jitter=0.0, search_order_jitter=0.0,
+                               search_passes=passes)  # fmt: skip
+    r = PhysicsExecutor(RobotInterface(sim), rng=np.random.default_rng(1), settings=settings).start()
+    if passes == 1:
+        assert not r.ok and "touched the object 0 times" in r.reason, r.reason
+        return
+    assert r.ok, r.reason
+    assert np.linalg.norm(r.state.position[:2] - cell) < 0.02, r.state.position
+
+
 def test_start_lands_again_when_the_l_stroke_rolled_on_an_edge():
     """HEXPRISM01 at the pose of episode seed 7: the first landing is next to an edge and the L stroke rolls
     on it (the normal turns slowly, below the edge detector's threshold); the rows within the face cone then
