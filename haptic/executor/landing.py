@@ -48,8 +48,9 @@ class LandingSearch:
             if i + 1 >= min(len(landings), budget):
                 if passes >= s.search_passes:
                     break
-                # the grid's points all missed an object that stands between them: again at its cells' centres
-                # (drawn only now, so that a first pass that finds a face draws what it always did)
+                # the grid's points all missed an object that stands between them, or touched only a ridge or an
+                # apex of a low one: again at its cells' centres, descending lower (drawn only now, so that a first
+                # pass that finds a face draws what it always did)
                 passes += 1
                 more = landing_points(s.search_spacing, s.search_margin, self.rng, s.search_jitter,
                                       s.search_order_jitter, offset=0.5 * ((passes - 1) % 2))  # fmt: skip
@@ -81,9 +82,8 @@ class LandingSearch:
                     break
                 continue
             # fast guarded descent to just above the table, then back off and touch again slowly
-            r = t.approach(
-                np.array([0.0, 0.0, -1.0]), z_top - TABLE_TOP_Z - s.search_floor, speed=s.search_speed, settle=False
-            )
+            floor = s.search_floor if passes == 1 else s.low_search_floor
+            r = t.approach(np.array([0.0, 0.0, -1.0]), z_top - TABLE_TOP_Z - floor, speed=s.search_speed, settle=False)
             pieces.append(r)
             if r.ok and r.info["point"][2] > z_top - s.touched_at_once - t.pad_radius and can_raise:
                 # touched at once (the side of something reaching up to the approach height): go higher

@@ -133,6 +133,11 @@ class PhysicsSettings:
     """Start: the pad centre descends from this height above the table [m]."""
     search_floor: float = 0.018
     """Start: ... down to this height of the pad centre above the table (nothing touched: no object there) [m]."""
+    low_search_floor: float = 0.015
+    """Start: ... and in the passes over the landing grid after the first, down to this (the pad's radius and
+    ``pad_clearance`` and 1 mm): descending to ``search_floor`` the pad touches a low object's sloping faces only
+    near its top, where a ridge or an apex leaves no room for the L stroke (the public polyhedra's pentagonal
+    pyramid at 30 mm, 9.8 mm high, its sides sloping 39°: every touch within 1.1 mm of the apex's height) [m]."""
     search_speed: float = 0.10
     """Start: speed of the fast guarded descent [m/s]."""
     search_spacing: float = 0.025
