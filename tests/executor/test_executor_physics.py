@@ -278,6 +278,48 @@ def test_start_finds_a_small_object_between_the_landings_of_the_grid(passes):
     assert np.linalg.norm(r.state.position[:2] - cell) < 0.02, r.state.position
 
 
+@pytest.mark.parametrize("low", [True, False], ids=["lower", "as-the-first"])
+def test_start_passes_over_the_grid_again_lower_on_a_low_sloping_object(low):
+    """The pentagonal pyramid of the public polyhedra at 30 mm resting on its base is 9.8 mm high, its sides sloping
+    39°: the pad descending to ``search_floor`` (18 mm) touches them only within about 1 mm below the apex, where the L
+    stroke rolls over the apex's edges at every heading (episode seed 1 touched it 19 times over two passes and
+    measured no face). The passes after the first descend to ``low_search_floor`` (15 mm), onto the sides below.
+    Here the 50 mm grid of the test above, a landing of its second pass 12.5 mm from the apex toward the middle of a
+    side: descending to ``search_floor`` the pad passes beside the pyramid, lower it lands on that side."""
+    from scipy.spatial import ConvexHull
+
+    from haptic.executor.physics import PhysicsSettings
+    from haptic.geometry.perturb import scaled_to
+    from haptic.sim.scene import OBJECT_REGION, TABLE_TOP_Z, stable_resting_rotations
+
+    poly = scaled_to(load_library("assets/libraries/polyhedra")["pentagonal_pyramid"], 0.03)
+    obj = scene_object_from_polyhedron(poly)
+    rot = min(stable_resting_rotations(obj), key=lambda r: np.ptp((obj.vertices @ r.T)[:, 2]))  # on its base
+    v = obj.vertices @ rot.T
+    assert np.ptp(v[:, 2]) < 0.011
+    apex = v[np.argmax(v[:, 2])]
+    base = v[v[:, 2] < v[:, 2].min() + 1e-6]
+    pair = min(((a, b) for a in base for b in base if np.linalg.norm(a - b) > 1e-6),
+               key=lambda ab: np.linalg.norm(0.5 * (ab[0] + ab[1]) - apex) + np.linalg.norm(ab[0] - ab[1]))  # fmt: skip
+    toward = 0.5 * (pair[0] + pair[1])[:2] - apex[:2]  # from the apex toward the middle of a base edge
+    spacing = 0.05
+    (x0, _), (y0, _) = OBJECT_REGION
+    landing = np.array([x0 + 1.5 * spacing, y0 + 2.5 * spacing])  # the cell's centre nearest the region's centre
+    pose = np.eye(4)
+    pose[:3, :3] = rot
+    pose[:2, 3] = landing - 0.0125 * toward / np.linalg.norm(toward) - apex[:2]
+    pose[2, 3] = TABLE_TOP_Z - v[:, 2].min()
+    sim = Simulation(compose_scene(obj, pose), noise=SimulatedSensorNoise.from_notes(), seed=1)
+    settings = PhysicsSettings(search_spacing=spacing, search_margin=0.0, search_jitter=0.0, search_order_jitter=0.0)
+    if not low:
+        settings = dataclasses.replace(settings, low_search_floor=settings.search_floor)
+    r = PhysicsExecutor(RobotInterface(sim), rng=np.random.default_rng(1), settings=settings).start()
+    assert r.ok == low, r.reason
+    if low:
+        truth = ConvexHull(obj.vertices @ pose[:3, :3].T + pose[:3, 3]).equations[:, :3]
+        assert np.degrees(np.arccos(np.clip(truth @ r.components[0].normal, -1.0, 1.0))).min() < 1.0
+
+
 def test_start_lands_again_when_the_l_stroke_rolled_on_an_edge():
     """HEXPRISM01 at the pose of episode seed 7: the first landing is next to an edge and the L stroke rolls
     on it (the normal turns slowly, below the edge detector's threshold); the rows within the face cone then
