@@ -677,19 +677,48 @@ across a face."""
 
 _CORNERS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
+ROOM_FRACTION = 0.85
+"""A verification probe's target lies at most this fraction of the way across its face: from a corner's two edges
+toward where the corner's bisector leaves the face, from an edge's middle toward the far side (:func:`inset_room`).
+:data:`PROBE_INSET` is kept where that leaves it room (every corner of the seed and look-alike libraries: their
+narrowest, LA_NOTCH_30x12's 12 mm slot walls, put it 10.2 mm in); a narrower corner of a smaller model, such as a
+pentagon of a 30 mm dodecahedron (7.4 mm in to its middle), is aimed that much nearer its edges."""
+
+
+def inset_room(loop: np.ndarray, normal: np.ndarray, origin: np.ndarray, direction: np.ndarray,
+               skip: Sequence[int]) -> float:  # fmt: skip
+    """How far the ray from ``origin`` along ``direction`` (both in the plane of the face of vertex loop ``loop``
+    (n, 3), counter-clockwise about ``normal``) runs before it crosses the loop's boundary, leaving out the sides
+    ``skip`` (side ``i`` from ``loop[i]`` to ``loop[i + 1]``: those at the ray's origin) [m]; inf if it crosses
+    none. Measured in the face's plane, so that a face written to a few decimals, not quite flat, has the room
+    its polygon has."""
+    u, w = plane_basis(normal)
+    a2 = np.stack([loop @ u, loop @ w], axis=1)
+    d2 = np.roll(a2, -1, axis=0) - a2
+    o2 = np.array([origin @ u, origin @ w])
+    r2 = np.array([direction @ u, direction @ w])
+    rel = a2 - o2
+    den = d2[:, 0] * r2[1] - d2[:, 1] * r2[0]
+    ok = np.abs(den) > 1e-15
+    den = np.where(ok, den, 1.0)
+    t = (d2[:, 0] * rel[:, 1] - d2[:, 1] * rel[:, 0]) / den  # along the ray
+    s = (r2[0] * rel[:, 1] - r2[1] * rel[:, 0]) / den  # along the side
+    ok &= (t > 0.0) & (s >= -1e-12) & (s <= 1.0 + 1e-12)
+    ok[list(skip)] = False
+    return float(t[ok].min()) if ok.any() else np.inf
+
 
 def _corner_points(poly: Polyhedron) -> dict[tuple[int, int], np.ndarray]:
     """For each corner ``(vertex, face)`` of ``poly`` that has one, the point of the face :data:`PROBE_INSET`
-    from both edges at the vertex, on the corner's bisector (model frame); none at a straight or reflex corner,
-    or where the face is too narrow there. Computed once per model."""
-    from haptic.geometry.distance import point_triangle_distance
-
+    from both edges at the vertex, on the corner's bisector (model frame), or nearer the edges where the bisector
+    leaves the face before :data:`ROOM_FRACTION` of the way to there; none at a straight or reflex corner.
+    Computed once per model."""
     if poly in _CORNERS:
         return _CORNERS[poly]
     out: dict[tuple[int, int], np.ndarray] = {}
     for f in range(poly.n_faces):
         loop = [int(x) for x in poly.faces[f]]
-        tri = poly.vertices[poly.triangles[poly.triangle_faces == f]]
+        pts = poly.vertices[loop]
         for k, v in enumerate(loop):
             e1 = poly.vertices[loop[k - 1]] - poly.vertices[v]
             e2 = poly.vertices[loop[(k + 1) % len(loop)]] - poly.vertices[v]
@@ -698,10 +727,12 @@ def _corner_points(poly: Polyhedron) -> dict[tuple[int, int], np.ndarray]:
             if np.linalg.norm(w) < 1e-9 or np.cross(e1, e2) @ poly.face_normals[f] > 0:
                 continue  # a straight or reflex corner (the loop runs counter-clockwise about the normal)
             w /= np.linalg.norm(w)
-            sin_half = float(np.linalg.norm(np.cross(e1, w)))
-            p = poly.vertices[v] + PROBE_INSET / max(sin_half, 1e-3) * w
-            if float(point_triangle_distance(p[None], tri).min()) < 1e-9:
-                out[(v, f)] = p
+            sin_half = max(float(np.linalg.norm(np.cross(e1, w))), 1e-3)
+            # the room along the bisector, as a distance from the two edges at the vertex
+            room = sin_half * inset_room(pts, poly.face_normals[f], poly.vertices[v], w, ((k - 1) % len(loop), k))
+            inset = min(PROBE_INSET, ROOM_FRACTION * room)
+            if inset > poly.tolerances.merge:
+                out[(v, f)] = poly.vertices[v] + inset / sin_half * w
     _CORNERS[poly] = out
     return out
 
@@ -712,9 +743,8 @@ def _probe_targets(
     """Points (model frame) on the faces at the missing features, each with its face, that a probe may land on to
     measure them next: for a missing vertex, the point of each face at it :data:`PROBE_INSET` from both edges at
     the vertex (:func:`_corner_points`); for a missing edge, a point that far in from its midpoint on each face
-    along it; for a missing face, the centroid of its largest triangle. Only faces of ``faces_ok`` (None: all)."""
-    from haptic.geometry.distance import point_triangle_distance
-
+    along it (nearer where the face is narrower: :data:`ROOM_FRACTION`); for a missing face, the centroid of its
+    largest triangle. Only faces of ``faces_ok`` (None: all)."""
     mf, me, mv = missing
     corners = _corner_points(poly)
     out: list[tuple[np.ndarray, int]] = []
@@ -728,19 +758,28 @@ def _probe_targets(
         for f in (int(poly.edge_left_face[e]), int(poly.edge_right_face[e])):
             if faces_ok is not None and f not in faces_ok:
                 continue
-            tri = poly.vertices[poly.triangles[poly.triangle_faces == f]]
-            inward = np.cross(poly.face_normals[f], poly.edge_directions[e])
-            for sign in (1.0, -1.0):
-                p = mid + sign * PROBE_INSET * inward
-                if float(point_triangle_distance(p[None], tri).min()) < 1e-9:
-                    out.append((p, f))
-                    break
+            p = _edge_inset(poly, f, e, mid)
+            if p is not None:
+                out.append((p, f))
     if mf:
         from haptic.planning.probe_lines import face_targets
 
         centres = face_targets(poly)
         out += [(centres[f], int(f)) for f in sorted(mf) if faces_ok is None or f in faces_ok]
     return out
+
+
+def _edge_inset(poly: Polyhedron, f: int, e: int, mid: np.ndarray) -> np.ndarray | None:
+    """The point of face ``f`` :data:`PROBE_INSET` in from the point ``mid`` of its edge ``e``, square to the edge,
+    or :data:`ROOM_FRACTION` of the way across where the face is narrower there; None where the face has no room."""
+    loop = [int(x) for x in poly.faces[f]]
+    pts = poly.vertices[loop]
+    a, b = poly.edges[e]
+    side = next(i for i in range(len(loop)) if {loop[i], loop[(i + 1) % len(loop)]} == {int(a), int(b)})
+    along = pts[(side + 1) % len(loop)] - pts[side]
+    inward = np.cross(poly.face_normals[f], along / np.linalg.norm(along))  # the loop runs counter-clockwise
+    inset = min(PROBE_INSET, ROOM_FRACTION * inset_room(pts, poly.face_normals[f], mid, inward, (side,)))
+    return mid + inset * inward if inset > poly.tolerances.merge else None
 
 
 def verification_probes(
@@ -1228,7 +1267,7 @@ def _face_middle(poly: Polyhedron, f: int) -> np.ndarray:
     a, b = loop, np.roll(loop, -1, axis=0)
 
     def inside(p: np.ndarray) -> float:
-        if float(point_triangle_distance(p[None], tri).min()) > 1e-9:
+        if float(point_triangle_distance(p[None], tri).min()) > poly.tolerances.planar:
             return -1.0
         t = np.clip(np.einsum("ij,ij->i", p - a, b - a) / np.einsum("ij,ij->i", b - a, b - a), 0.0, 1.0)
         return float(np.linalg.norm(p - a - t[:, None] * (b - a), axis=1).min())
