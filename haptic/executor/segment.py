@@ -761,6 +761,57 @@ class Segmenter:
                 f"more than its bound ({bound * MM:.1f} mm): the pad crossed a face between them, its edges too "
                 "shallow to feel")  # fmt: skip
 
+    def face_crossed(self, slide: ContactTrace, fit_a: FaceFit) -> tuple[FaceFit, ContactTrace] | None:
+        """The face a slide from face a went onto over an edge too shallow to feel before it met the edge it stopped
+        at, fitted from its last steady rows, and those rows; None when the slide's normals show none.
+
+        The slide stops at an edge where its normal turns from face a's by :attr:`min_edge_angle`; an edge of a
+        smaller turn it slides over, onto a face between a and the edge it rolls over next, whose line then lies
+        nowhere near ``n_a × n_b`` (:meth:`roll_off_line`), the rolling normals leaning along it by the shallow turn.
+        The slide's normals tell that face: the last of its rows (``slide``, time order) to hold one normal over two
+        :attr:`steady_window` running means (within :attr:`steady_sigmas` of their σ), turned from ``n_a`` by more
+        than :attr:`sample_cone` (the primitives' own cut for a normal off the face) and less than the edge angle, and
+        the rows about them amid running means as close to theirs (not those at either end of such a mean, which
+        may have begun to turn). They are a face only as any stroke's rows
+        are (:meth:`fit_face_trace`: enough rows, extent, no turn along them, no spread), turned from face a by more
+        than the bound of the two fits' difference. metabiaugmented_hexagonal_prism at 70 mm (of the public
+        collection of Johnson solids), seed 1: slides from a square of the prism over its 5.3° edge onto a pyramid's
+        triangle and on over the triangle's 73° edge, their rolling normals leaning 2.4-3.6° along ``n_a × n_b``."""
+        b = self.bounds
+        w = b.steady_window
+        idx = np.flatnonzero(slide.in_contact)
+        if len(idx) < 2 * w:
+            return None
+        n = slide.normal_in_world[idx]
+        c = np.concatenate([np.zeros((1, 3)), np.cumsum(n, axis=0)])
+        run = c[w:] - c[:-w]
+        run /= np.linalg.norm(run, axis=1)[:, None]
+        cut = math.cos(b.steady_sigmas * math.sqrt(b.normal_sigma**2 / w + b.normal_floor**2))
+        off = run @ fit_a.normal
+        steady = np.flatnonzero((np.einsum("ij,ij->i", run[:-w], run[w:]) >= cut) & (off[:-w] < math.cos(b.sample_cone))
+                                & (off[:-w] > math.cos(b.min_edge_angle)))  # fmt: skip
+        if not len(steady):
+            return None
+        i = int(steady[-1])
+        guess = unit(run[i] + run[i + w])
+        near = run @ guess >= cut
+        lo, hi = i, i + w
+        while lo > 0 and near[lo - 1]:
+            lo -= 1
+        while hi + 1 < len(run) and near[hi + 1]:
+            hi += 1
+        rows = slide.select(idx[lo + w // 2 : hi + w // 2 + 1])  # the rows amid those windows: none turning
+        refusal = self.face_refusal
+        fit = self.fit_face_trace(rows, guess)
+        self.face_refusal = refusal
+        if fit is None:
+            return None
+        if angle_between(fit.normal, fit_a.normal) <= max(
+            b.sample_cone, b.bound(math.hypot(fit.normal_sigma, fit_a.normal_sigma), b.normal_floor)
+        ):
+            return None
+        return fit, rows
+
     def ridge_ridden(self, fit_a: FaceFit, fit_b: FaceFit, rolled: np.ndarray) -> str | None:
         """Why the rows of ``fit_b`` are the ridge of the convex edge rolled over (contact points ``rolled``), not
         the next face (None: they lie on the face, off the edge).
