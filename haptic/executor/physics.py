@@ -493,8 +493,11 @@ class PhysicsExecutor(LandingSearch):
         (:meth:`~haptic.executor.segment.Segmenter.face_crossed`) rolled off that face: the fit returned is then
         that face's (no data face yet), the line that of its edge with the face of ``fit_b`` when the roll can have
         been over it, and :attr:`_crossed` holds the face's fit and rows (None otherwise). The shallow edge itself
-        was not located: nothing joins that face to ``face``. When the roll cannot have been over that edge either,
-        the fit, line and reason are those of ``face`` as without it."""
+        was not located: nothing joins that face to ``face``. When the roll cannot have been over that edge, no line
+        and why, with that face's fit: a move that crosses again takes its way from the roll's lean off the face it
+        rolled off (sphenomegacorona of the public collection of Johnson solids, seed 1: from a triangle over an
+        8.3° edge onto the next, and on round a vertex onto a face sharing neither an edge). A next face within the
+        edge angle of that face was met over another shallow edge: face ``face``'s test then says so."""
         seg = self.segmenter
         self._crossed = None
         fit_a = self._face_fit(face, trace)
@@ -503,7 +506,11 @@ class PhysicsExecutor(LandingSearch):
         roll_all = ContactTrace.concatenate([lead, roll])
         convex = kind == "convex"
         crossed = seg.face_crossed(slide, fit_a) if convex else None
-        if crossed is not None and seg.edge_inconsistency(crossed[0], fit_b, convex, roll_all) is None:
+        if crossed is not None and angle(crossed[0].normal, fit_b.normal) >= self.bounds.min_edge_angle:
+            # (closer, the roll went over another shallow edge, and face a's test names it)
+            why = seg.edge_inconsistency(crossed[0], fit_b, convex, roll_all)
+            if why is not None:
+                return crossed[0], None, f"no edge between the faces: {why}"
             self._crossed = crossed
             return crossed[0], seg.edge_line(crossed[0], fit_b, convex, roll_all, corner), ""
         why = seg.edge_inconsistency(fit_a, fit_b, convex, roll_all)

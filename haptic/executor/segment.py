@@ -532,7 +532,9 @@ class Segmenter:
     Conventions, shared with the geometric executor: a face move reports the new edge (adjacent to the face
     traced from) and then the new face (adjacent to the edge); an edge move re-reports its edge with the
     explored interval extended to the vertex, then the new vertex (adjacent to the edge); a vertex move
-    reports the new edge (adjacent to the vertex and the face circled across) and the new face.
+    reports the new edge (adjacent to the vertex and the face circled across) and the new face. A face or vertex
+    move whose slide crossed a face over an edge too shallow to feel (:meth:`face_crossed`) reports that face first
+    (adjacent to nothing: the shallow edge was not located), then the edge rolled over from it and the new face.
     """
 
     def __init__(self, bounds: SegmentBounds | None = None) -> None:
@@ -794,11 +796,13 @@ class Segmenter:
             return None
         i = int(steady[-1])
         guess = unit(run[i] + run[i + w])
-        near = run @ guess >= cut
+        # back to the shallow edge: every running mean within the face cone of theirs, nearer it than face a; on to
+        # the roll: those within the noise of theirs (the roll's first degrees are within the cone)
+        back = (run @ guess >= math.cos(b.row_cone)) & (run @ guess > run @ fit_a.normal)
         lo, hi = i, i + w
-        while lo > 0 and near[lo - 1]:
+        while lo > 0 and back[lo - 1]:
             lo -= 1
-        while hi + 1 < len(run) and near[hi + 1]:
+        while hi + 1 < len(run) and run[hi + 1] @ guess >= cut:
             hi += 1
         rows = slide.select(idx[lo + w // 2 : hi + w // 2 + 1])  # the rows amid those windows: none turning
         refusal = self.face_refusal
