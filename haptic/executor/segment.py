@@ -773,8 +773,12 @@ class Segmenter:
         The slide's normals tell that face: the last of its rows (``slide``, time order) to hold one normal over two
         :attr:`steady_window` running means (within :attr:`steady_sigmas` of their σ), turned from ``n_a`` by more
         than :attr:`sample_cone` (the primitives' own cut for a normal off the face) and less than the edge angle, and
-        the rows about them amid running means as close to theirs (not those at either end of such a mean, which
-        may have begun to turn). They are a face only as any stroke's rows
+        the rows about them amid running means as close to theirs (back to the shallow edge, within the face cone and
+        nearer theirs than face a's; on to the roll, within the noise), not those at either end of such a mean, which
+        may have begun to turn. The roll's first rows may hold a normal as steadily (a slow turn at a slant: on the
+        augmented sphenocorona of the same collection, seed 1, 9.5° off the start face and 3° round from the face
+        before them) and give no face: then the stretch before them, if the pad slid on past it, those rows aside, by
+        no more than :attr:`min_face_extent`. They are a face only as any stroke's rows
         are (:meth:`fit_face_trace`: enough rows, extent, no turn along them, no spread), turned from face a by more
         than the bound of the two fits' difference. metabiaugmented_hexagonal_prism at 70 mm (of the public
         collection of Johnson solids), seed 1: slides from a square of the prism over its 5.3° edge onto a pyramid's
@@ -792,29 +796,35 @@ class Segmenter:
         off = run @ fit_a.normal
         steady = np.flatnonzero((np.einsum("ij,ij->i", run[:-w], run[w:]) >= cut) & (off[:-w] < math.cos(b.sample_cone))
                                 & (off[:-w] > math.cos(b.min_edge_angle)))  # fmt: skip
-        if not len(steady):
-            return None
-        i = int(steady[-1])
-        guess = unit(run[i] + run[i + w])
-        # back to the shallow edge: every running mean within the face cone of theirs, nearer it than face a; on to
-        # the roll: those within the noise of theirs (the roll's first degrees are within the cone)
-        back = (run @ guess >= math.cos(b.row_cone)) & (run @ guess > run @ fit_a.normal)
-        lo, hi = i, i + w
-        while lo > 0 and back[lo - 1]:
-            lo -= 1
-        while hi + 1 < len(run) and run[hi + 1] @ guess >= cut:
-            hi += 1
-        rows = slide.select(idx[lo + w // 2 : hi + w // 2 + 1])  # the rows amid those windows: none turning
+        tips = slide.tip_in_world[idx]
         refusal = self.face_refusal
-        fit = self.fit_face_trace(rows, guess)
-        self.face_refusal = refusal
-        if fit is None:
-            return None
-        if angle_between(fit.normal, fit_a.normal) <= max(
-            b.sample_cone, b.bound(math.hypot(fit.normal_sigma, fit_a.normal_sigma), b.normal_floor)
-        ):
-            return None
-        return fit, rows
+        past = np.ones(len(idx), dtype=bool)  # rows after the stretch tried, but those of stretches that were no face
+        while len(steady):
+            i = int(steady[-1])
+            guess = unit(run[i] + run[i + w])
+            # back to the shallow edge: every running mean within the face cone of theirs, nearer it than face a's;
+            # on to the roll: those within the noise of theirs (the roll's first degrees are within the cone)
+            back = (run @ guess >= math.cos(b.row_cone)) & (run @ guess > run @ fit_a.normal)
+            lo, hi = i, i + w
+            while lo > 0 and back[lo - 1]:
+                lo -= 1
+            while hi + 1 < len(run) and run[hi + 1] @ guess >= cut:
+                hi += 1
+            steady = steady[steady <= i - w]  # (next, a window back: the first guess may lie on a slow turn)
+            first, last = lo + w // 2, hi + w // 2  # the rows amid those windows: none turning
+            after = past.copy()
+            after[: last + 1] = False
+            if after.any() and float(np.max(np.linalg.norm(tips[after] - tips[last], axis=1))) > b.min_face_extent:
+                return None  # the pad slid on past these rows: they are not the face the roll left
+            rows = slide.select(idx[first : last + 1])
+            fit = self.fit_face_trace(rows, guess)
+            self.face_refusal = refusal
+            if fit is not None and angle_between(fit.normal, fit_a.normal) > max(
+                b.sample_cone, b.bound(math.hypot(fit.normal_sigma, fit_a.normal_sigma), b.normal_floor)
+            ):
+                return fit, rows
+            past[first : last + 1] = fit is not None  # a stretch that was a face, though too close to a's, counts
+        return None
 
     def ridge_ridden(self, fit_a: FaceFit, fit_b: FaceFit, rolled: np.ndarray) -> str | None:
         """Why the rows of ``fit_b`` are the ridge of the convex edge rolled over (contact points ``rolled``), not
