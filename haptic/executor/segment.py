@@ -780,7 +780,9 @@ class Segmenter:
         before them) and give no face: then the stretch before them, if the pad slid on past it, those rows aside, by
         no more than :attr:`min_face_extent`. They are a face only as any stroke's rows
         are (:meth:`fit_face_trace`: enough rows, extent, no turn along them, no spread), turned from face a by more
-        than the bound of the two fits' difference. metabiaugmented_hexagonal_prism at 70 mm (of the public
+        than the bound of the two fits' difference, their contacts off the line where the two planes meet (on
+        average, by more than that line's bound: a ride along a rim of face a leaves them on it).
+        metabiaugmented_hexagonal_prism at 70 mm (of the public
         collection of Johnson solids), seed 1: slides from a square of the prism over its 5.3° edge onto a pyramid's
         triangle and on over the triangle's 73° edge, their rolling normals leaning 2.4-3.6° along ``n_a × n_b``."""
         b = self.bounds
@@ -822,6 +824,18 @@ class Segmenter:
             if fit is not None and angle_between(fit.normal, fit_a.normal) > max(
                 b.sample_cone, b.bound(math.hypot(fit.normal_sigma, fit_a.normal_sigma), b.normal_floor)
             ):
+                # across the face from the shallow edge, not on it: a stroke that rode the rim of an edge of face a at a
+                # glance holds a turned normal as steadily, its contacts on that edge, where the planes meet (BOX01
+                # seed 2: 42 rows turned 8.6°, 0.37 mm from that line on average against a bound of 2.7 mm; the
+                # faces crossed on the collection's solids 3-20 mm from it against 1.1-1.3 mm)
+                pts = rows.point_in_world[rows.in_contact]
+                p, s_p = plane_intersection(fit_a, fit, pts.mean(axis=0), b)
+                e = unit(np.cross(fit_a.normal, fit.normal))
+                q = pts - p
+                q -= np.outer(q @ e, e)
+                off = float(np.mean(np.linalg.norm(q, axis=1)))
+                if off <= b.bound(math.hypot(s_p, b.point_sigma), b.position_floor):
+                    return None
                 return fit, rows
             past[first : last + 1] = fit is not None  # a stretch that was a face, though too close to a's, counts
         return None
