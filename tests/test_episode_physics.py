@@ -1490,3 +1490,27 @@ def test_a_face_move_across_a_face_between_two_shallow_edges_reports_no_edge(tmp
     assert any("the pad crossed a face between them" in w for w in failed), failed
     assert _within_bounds(ep)
     assert rec.outcome != "no-match", rec.detail
+
+
+@pytest.mark.slow
+def test_a_move_that_slid_over_an_edge_too_shallow_to_feel_reports_the_face_it_rolled_off(tmp_path):
+    # metabiaugmented_hexagonal_prism at 70 mm, seed 1 (alone in its library): face and vertex moves slide from a
+    # square of the prism over its 5.3° edge onto a pyramid's triangle and roll over the triangle's next edge. The
+    # edge was taken between the square and the face past the roll, its rolling normals leaning 2.4-3.6° along that
+    # line: no edge between faces that share none, and the move failed ("a roll round a vertex"). The slide's last
+    # steady rows are the triangle's: the move reports that face (adjacent to nothing: the shallow edge was not
+    # located), the edge between it and the next face, and that face, every one within its bounds.
+    shutil.copy("assets/libraries/polyhedra/metabiaugmented_hexagonal_prism.obj", tmp_path)
+    crossed, failed = [], []
+    obs = EpisodeObserver(on_move=lambda n, r, *a: crossed.append(r) if "crossed_face" in r.info else None,
+                          on_failed_move=lambda n, r: failed.append(r.reason))  # fmt: skip
+    ep = build_episode(EpisodeSpec(model="metabiaugmented_hexagonal_prism", seed=1, executor="physics",
+                                   verify="full", models=str(tmp_path)))  # fmt: skip
+    rec = ep.run(None, obs)
+    assert crossed, failed
+    for r in crossed:
+        face, edge, _ = r.components
+        assert face.id == r.info["crossed_face"] and face.kind == "face" and face.adjacent == ()
+        assert edge.kind == "edge" and edge.adjacent[-1] == face.id
+    assert _within_bounds(ep)
+    assert rec.outcome != "no-match", rec.detail

@@ -458,9 +458,18 @@ def _missed(
 
 def _face_check(r, prev_state, model: Polyhedron, rot: np.ndarray, trans: np.ndarray, by_id: dict,
                 tol: EvaluationTolerances) -> tuple | None:  # fmt: skip
-    """A face move: its edge must be the first true edge the pad feels from where the straight trace began."""
+    """A face move: its edge must be the first true edge the pad feels from where the straight trace began; one
+    whose slide crossed a face over an edge too shallow to feel (``crossed_face``, reported before the edge) rolled
+    off that face, and its edge must bound that face's true face."""
+    e_comp = next((c for c in r.components if c.kind == "edge"), None)
+    e_score = by_id.get(e_comp.id) if e_comp is not None else None
+    crossed = by_id.get(r.info.get("crossed_face"))
+    if crossed is not None:
+        if e_score is None or None in (crossed.true_id, e_score.true_id):
+            return None
+        return ("face", e_comp.id, crossed.true_id, e_score.true_id,
+                crossed.true_id in model.edge_faces(e_score.true_id))  # fmt: skip
     f_score = by_id.get(prev_state.face)
-    e_score = by_id.get(r.components[0].id) if r.components else None
     trace = r.trace
     if not (f_score and f_score.true_id is not None and e_score and trace is not None):
         return None
@@ -500,13 +509,15 @@ def _vertex_check(r, prev_state, model: Polyhedron, rot: np.ndarray, trans: np.n
     if prev_state.vertex is None:
         return None
     v_score = by_id.get(prev_state.vertex)
-    f_score = by_id.get(r.move.across_face)
-    e_score = by_id.get(r.components[0].id)
+    # a circle that crossed a face over an edge too shallow to feel rolled off that face (reported before the edge)
+    f_score = by_id.get(r.info.get("crossed_face", r.move.across_face))
+    e_comp = next((c for c in r.components if c.kind == "edge"), None)
+    e_score = by_id.get(e_comp.id) if e_comp is not None else None
     if not (v_score and f_score and e_score and None not in (v_score.true_id, f_score.true_id, e_score.true_id)):
         return None
     e = e_score.true_id
     ok = v_score.true_id in (int(model.edges[e, 0]), int(model.edges[e, 1])) and f_score.true_id in model.edge_faces(e)
-    return ("vertex", r.components[0].id, v_score.true_id, e, ok)
+    return ("vertex", e_comp.id, v_score.true_id, e, ok)
 
 
 _FEATURE_CHECKS = {"face": _face_check, "edge": _edge_check, "vertex": _vertex_check}

@@ -270,9 +270,11 @@ class ClosureMoves(MoveSource):
     def on_result(self, view: EpisodeState, move: Move, result: MoveResult) -> None:
         """Every move made while the learning is under way counts against its budget, whichever source chose it
         (when none of the learning's measures anything new, the episode's other sources move on). Every face
-        move's path is kept for the fold check."""
+        move's path is kept for the fold check (not one that slid over an edge too shallow to feel onto another face
+        before the edge it stopped at: its path left the face it started on)."""
         before, self._sensor = self._sensor, view.sensor
-        if isinstance(move, FaceMove) and result.ok and before is not None and result.state is not None:
+        if isinstance(move, FaceMove) and result.ok and before is not None and result.state is not None \
+                and "crossed_face" not in result.info:  # fmt: skip
             self.strokes.append(Stroke(before.face, np.array(before.position, float),
                                        np.array(result.state.position, float)))  # fmt: skip
         if not self.active:

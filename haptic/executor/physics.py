@@ -363,6 +363,7 @@ class PhysicsExecutor(LandingSearch):
         self._met: PrimitiveResult | None = None  # the last crossing a link of the finger stopped
         self._roll: ContactTrace | None = None  # the last crossing's roll (or climb) over the edge
         self._past: list[np.ndarray] = []  # normals the last crossing's touches afresh met past the edge
+        self._crossed: tuple[FaceFit, ContactTrace] | None = None  # the face the last slide crossed onto, unfelt
         self._links_until: float | None = None  # sim time of the last hand-link sample reported
         self._radii: dict[str, float] | None = None  # per link, the bound of a point its readout reports
 
@@ -497,15 +498,46 @@ class PhysicsExecutor(LandingSearch):
                       kind: str, corner: np.ndarray) -> tuple[FaceFit, LineFit | None, str]:  # fmt: skip
         """The fit of data face ``face`` from the ``phase`` rows of ``trace``, and the line of the edge the pad
         rolled over (the last rows on the face, then ``roll``) onto the face of ``fit_b``; no line, and why,
-        when the roll cannot have been over an edge between the two faces."""
+        when the roll cannot have been over an edge between the two faces.
+
+        A slide that went over an edge too shallow to feel onto another face before the roll
+        (:meth:`~haptic.executor.segment.Segmenter.face_crossed`) rolled off that face: the fit returned is then
+        that face's (no data face yet), the line that of its edge with the face of ``fit_b`` when the roll can have
+        been over it, and :attr:`_crossed` holds the face's fit and rows (None otherwise). The shallow edge itself
+        was not located: nothing joins that face to ``face``. When the roll cannot have been over that edge, no line
+        and why, with that face's fit: a move that crosses again takes its way from the roll's lean off the face it
+        rolled off (sphenomegacorona of the public collection of Johnson solids, seed 1: from a triangle over an
+        8.3° edge onto the next, and on round a vertex onto a face sharing neither an edge). A next face within the
+        edge angle of that face was met over another shallow edge: face ``face``'s test then says so."""
         seg = self.segmenter
+        self._crossed = None
         fit_a = self._face_fit(face, trace)
-        lead = trace.select(trace.phase == PHASES.index(phase)).tail(self.settings.roll_lead_rows)
+        slide = trace.select(trace.phase == PHASES.index(phase))
+        lead = slide.tail(self.settings.roll_lead_rows)
         roll_all = ContactTrace.concatenate([lead, roll])
-        why = seg.edge_inconsistency(fit_a, fit_b, kind == "convex", roll_all)
+        convex = kind == "convex"
+        crossed = seg.face_crossed(slide, fit_a) if convex else None
+        if crossed is not None and angle(crossed[0].normal, fit_b.normal) >= self.bounds.min_edge_angle:
+            # (closer, the roll went over another shallow edge, and face a's test names it)
+            why = seg.edge_inconsistency(crossed[0], fit_b, convex, roll_all)
+            if why is not None:
+                return crossed[0], None, f"no edge between the faces: {why}"
+            self._crossed = crossed
+            return crossed[0], seg.edge_line(crossed[0], fit_b, convex, roll_all, corner), ""
+        why = seg.edge_inconsistency(fit_a, fit_b, convex, roll_all)
         if why is not None:
             return fit_a, None, f"no edge between the faces: {why}"
-        return fit_a, seg.edge_line(fit_a, fit_b, kind == "convex", roll_all, corner), ""
+        return fit_a, seg.edge_line(fit_a, fit_b, convex, roll_all, corner), ""
+
+    def _add_crossed(self) -> int | None:
+        """Report the face a move's slide crossed onto over an edge too shallow to feel (:attr:`_crossed`), adjacent
+        to nothing yet, and keep its rows; its id (None when the slide crossed none)."""
+        if self._crossed is None:
+            return None
+        fit, rows = self._crossed
+        face = self.segmenter.add_face(fit)
+        self.store_face(face.id, rows, fit)
+        return face.id
 
     def failed_result(self, move: Move, res: PrimitiveResult | str, reason: str) -> MoveResult:
         """A failed move: the status of ``res`` (a primitive's result, or a status), the state before the move;
@@ -1116,17 +1148,22 @@ class PhysicsExecutor(LandingSearch):
             self.recoveries.append(f"{why}: crossed again {np.linalg.norm(shift) * 1000:.0f} mm along the edge"
                                    f"{square}{'' if way is across else FROM_TOUCHED}")  # fmt: skip
             heading = way
+        # the slide crossed a face over an edge too shallow to feel: that face, then the edge rolled over from it
+        crossed = self._add_crossed()
+        left = st.face if crossed is None else crossed
         new_face = seg.next_id + 1
-        edge = seg.add_edge(line, (st.face, new_face), kind == "convex", (fit_a.normal, fit_b.normal),
-                            adjacent=(st.face,))  # fmt: skip
+        edge = seg.add_edge(line, (left, new_face), kind == "convex", (fit_a.normal, fit_b.normal),
+                            adjacent=(left,))  # fmt: skip
         face = seg.add_face(fit_b, adjacent=(edge.id,))
         self.store_face(face.id, stroke, fit_b)
         self.on_face = face.id
         self.state = SensorState(position=self.contact_point(), face=face.id, edge=edge.id,
-                                 edge_faces=(st.face, face.id))  # fmt: skip
+                                 edge_faces=(left, face.id))  # fmt: skip
         run = lead + r.distance
-        return MoveResult(move=move, status="ok", components=(edge, face), distance=run,
-                          cost=self.costs.face_move(run), state=self.state, info={"kind": kind})  # fmt: skip
+        comps = (edge, face) if crossed is None else (seg.faces[crossed].component, edge, face)
+        info = {"kind": kind} if crossed is None else {"kind": kind, "crossed_face": crossed}
+        return MoveResult(move=move, status="ok", components=comps, distance=run, cost=self.costs.face_move(run),
+                          state=self.state, info=info)  # fmt: skip
 
     def _held_from_above(self, r: PrimitiveResult, heading: np.ndarray):
         """The link contact that held a slide heading down across a face (``r`` stalled, event ``"blocked"``): a
@@ -2087,7 +2124,6 @@ class PhysicsExecutor(LandingSearch):
             return self.failed_result(move, "unreachable", "the edge met lies along the current edge's line, the "
                                                            "next face parallel to its other face: it leaves another "
                                                            "vertex")  # fmt: skip
-        new_face = seg.next_id + 1
         s_vtx = float((vtx - line.point) @ line.direction)
         b = self.bounds
         off = float(np.linalg.norm(vtx - line.point - s_vtx * line.direction))
@@ -2102,15 +2138,21 @@ class PhysicsExecutor(LandingSearch):
             # the circle crossed an edge that does not leave the vertex (on a face narrower than the circle)
             return self.failed_result(move, "unreachable", f"the edge met passes {off * MM:.1f} mm from the vertex "
                                                            "circled: it leaves another vertex")  # fmt: skip
-        edge = seg.add_edge(line, (f, new_face), kind == "convex", (fit_f.normal, fit_g.normal),
-                            adjacent=(st.vertex, f), vertex=(st.vertex, s_vtx))  # fmt: skip
+        # the circle crossed a face over an edge too shallow to feel: that face, then the edge rolled over from it
+        crossed = self._add_crossed()
+        left = f if crossed is None else crossed
+        new_face = seg.next_id + 1
+        edge = seg.add_edge(line, (left, new_face), kind == "convex", (fit_f.normal, fit_g.normal),
+                            adjacent=(st.vertex, left), vertex=(st.vertex, s_vtx))  # fmt: skip
         face = seg.add_face(fit_g, adjacent=(edge.id,))
         self.store_face(face.id, stroke, fit_g)
         self.on_face = face.id
         self.state = SensorState(position=self.contact_point(), face=face.id, edge=edge.id, vertex=st.vertex,
-                                 edge_faces=(f, face.id))  # fmt: skip
-        return MoveResult(move=move, status="ok", components=(edge, face), distance=r.distance,
-                          cost=self.costs.vertex_move(r.distance), state=self.state, info={"kind": kind})  # fmt: skip
+                                 edge_faces=(left, face.id))  # fmt: skip
+        comps = (edge, face) if crossed is None else (seg.faces[crossed].component, edge, face)
+        info = {"kind": kind} if crossed is None else {"kind": kind, "crossed_face": crossed}
+        return MoveResult(move=move, status="ok", components=comps, distance=r.distance,
+                          cost=self.costs.vertex_move(r.distance), state=self.state, info=info)  # fmt: skip
 
     def _outward(self, n_f: np.ndarray, roll: ContactTrace | None, corner: np.ndarray, vtx: np.ndarray
                  ) -> np.ndarray | None:  # fmt: skip

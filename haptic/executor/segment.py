@@ -532,7 +532,9 @@ class Segmenter:
     Conventions, shared with the geometric executor: a face move reports the new edge (adjacent to the face
     traced from) and then the new face (adjacent to the edge); an edge move re-reports its edge with the
     explored interval extended to the vertex, then the new vertex (adjacent to the edge); a vertex move
-    reports the new edge (adjacent to the vertex and the face circled across) and the new face.
+    reports the new edge (adjacent to the vertex and the face circled across) and the new face. A face or vertex
+    move whose slide crossed a face over an edge too shallow to feel (:meth:`face_crossed`) reports that face first
+    (adjacent to nothing: the shallow edge was not located), then the edge rolled over from it and the new face.
     """
 
     def __init__(self, bounds: SegmentBounds | None = None) -> None:
@@ -760,6 +762,83 @@ class Segmenter:
         return (f"the roll's contacts lie {near * MM:.1f} mm or more from the line where the faces' planes meet, "
                 f"more than its bound ({bound * MM:.1f} mm): the pad crossed a face between them, its edges too "
                 "shallow to feel")  # fmt: skip
+
+    def face_crossed(self, slide: ContactTrace, fit_a: FaceFit) -> tuple[FaceFit, ContactTrace] | None:
+        """The face a slide from face a went onto over an edge too shallow to feel before it met the edge it stopped
+        at, fitted from its last steady rows, and those rows; None when the slide's normals show none.
+
+        The slide stops at an edge where its normal turns from face a's by :attr:`min_edge_angle`; an edge of a
+        smaller turn it slides over, onto a face between a and the edge it rolls over next, whose line then lies
+        nowhere near ``n_a × n_b`` (:meth:`roll_off_line`), the rolling normals leaning along it by the shallow turn.
+        The slide's normals tell that face: the last of its rows (``slide``, time order) to hold one normal over two
+        :attr:`steady_window` running means (within :attr:`steady_sigmas` of their σ), turned from ``n_a`` by more
+        than :attr:`sample_cone` (the primitives' own cut for a normal off the face) and less than the edge angle, and
+        the rows about them amid running means as close to theirs (back to the shallow edge, within the face cone and
+        nearer theirs than face a's; on to the roll, within the noise), not those at either end of such a mean, which
+        may have begun to turn. The roll's first rows may hold a normal as steadily (a slow turn at a slant: on the
+        augmented sphenocorona of the same collection, seed 1, 9.5° off the start face and 3° round from the face
+        before them) and give no face: then the stretch before them, if the pad slid on past it, those rows aside, by
+        no more than :attr:`min_face_extent`. They are a face only as any stroke's rows
+        are (:meth:`fit_face_trace`: enough rows, extent, no turn along them, no spread), turned from face a by more
+        than the bound of the two fits' difference, their contacts off the line where the two planes meet (on
+        average, by more than that line's bound: a ride along a rim of face a leaves them on it).
+        metabiaugmented_hexagonal_prism at 70 mm (of the public
+        collection of Johnson solids), seed 1: slides from a square of the prism over its 5.3° edge onto a pyramid's
+        triangle and on over the triangle's 73° edge, their rolling normals leaning 2.4-3.6° along ``n_a × n_b``."""
+        b = self.bounds
+        w = b.steady_window
+        idx = np.flatnonzero(slide.in_contact)
+        if len(idx) < 2 * w:
+            return None
+        n = slide.normal_in_world[idx]
+        c = np.concatenate([np.zeros((1, 3)), np.cumsum(n, axis=0)])
+        run = c[w:] - c[:-w]
+        run /= np.linalg.norm(run, axis=1)[:, None]
+        cut = math.cos(b.steady_sigmas * math.sqrt(b.normal_sigma**2 / w + b.normal_floor**2))
+        off = run @ fit_a.normal
+        steady = np.flatnonzero((np.einsum("ij,ij->i", run[:-w], run[w:]) >= cut) & (off[:-w] < math.cos(b.sample_cone))
+                                & (off[:-w] > math.cos(b.min_edge_angle)))  # fmt: skip
+        tips = slide.tip_in_world[idx]
+        refusal = self.face_refusal
+        past = np.ones(len(idx), dtype=bool)  # rows after the stretch tried, but those of stretches that were no face
+        while len(steady):
+            i = int(steady[-1])
+            guess = unit(run[i] + run[i + w])
+            # back to the shallow edge: every running mean within the face cone of theirs, nearer it than face a's;
+            # on to the roll: those within the noise of theirs (the roll's first degrees are within the cone)
+            back = (run @ guess >= math.cos(b.row_cone)) & (run @ guess > run @ fit_a.normal)
+            lo, hi = i, i + w
+            while lo > 0 and back[lo - 1]:
+                lo -= 1
+            while hi + 1 < len(run) and run[hi + 1] @ guess >= cut:
+                hi += 1
+            steady = steady[steady <= i - w]  # (next, a window back: the first guess may lie on a slow turn)
+            first, last = lo + w // 2, hi + w // 2  # the rows amid those windows: none turning
+            after = past.copy()
+            after[: last + 1] = False
+            if after.any() and float(np.max(np.linalg.norm(tips[after] - tips[last], axis=1))) > b.min_face_extent:
+                return None  # the pad slid on past these rows: they are not the face the roll left
+            rows = slide.select(idx[first : last + 1])
+            fit = self.fit_face_trace(rows, guess)
+            self.face_refusal = refusal
+            if fit is not None and angle_between(fit.normal, fit_a.normal) > max(
+                b.sample_cone, b.bound(math.hypot(fit.normal_sigma, fit_a.normal_sigma), b.normal_floor)
+            ):
+                # across the face from the shallow edge, not on it: a stroke that rode the rim of an edge of face a at a
+                # glance holds a turned normal as steadily, its contacts on that edge, where the planes meet (BOX01
+                # seed 2: 42 rows turned 8.6°, 0.37 mm from that line on average against a bound of 2.7 mm; the
+                # faces crossed on the collection's solids 3-20 mm from it against 1.1-1.3 mm)
+                pts = rows.point_in_world[rows.in_contact]
+                p, s_p = plane_intersection(fit_a, fit, pts.mean(axis=0), b)
+                e = unit(np.cross(fit_a.normal, fit.normal))
+                q = pts - p
+                q -= np.outer(q @ e, e)
+                off = float(np.mean(np.linalg.norm(q, axis=1)))
+                if off <= b.bound(math.hypot(s_p, b.point_sigma), b.position_floor):
+                    return None
+                return fit, rows
+            past[first : last + 1] = fit is not None  # a stretch that was a face, though too close to a's, counts
+        return None
 
     def ridge_ridden(self, fit_a: FaceFit, fit_b: FaceFit, rolled: np.ndarray) -> str | None:
         """Why the rows of ``fit_b`` are the ridge of the convex edge rolled over (contact points ``rolled``), not

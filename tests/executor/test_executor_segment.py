@@ -588,3 +588,44 @@ def test_a_stroke_riding_a_rim_over_half_its_length_widens_the_faces_bound_to_ho
         face = seg.add_face(seg.fit_face_trace(trace, z))
         err = math.acos(min(1.0, float(face.normal @ z)))
         assert (err <= face.normal_bound) == holds, (sigmas, math.degrees(err), math.degrees(face.normal_bound))
+
+
+def _slide_over(turns_deg: list[float], lengths: list[float], rng, roll_deg: float = 9.0) -> ContactTrace:
+    """Rows (σn 1°, σp 0.2 mm; the pad centre from the encoders, noiseless) of a pad sliding along +x from face a
+    (normal +z) over edges along y, each turning the normal by the next of ``turns_deg`` about +y after the length
+    before it, then beginning to roll ``roll_deg`` over the next edge (the slide's stop), a row per 0.1 mm."""
+    y = np.array([0.0, 1.0, 0.0])
+    n, p, rows = np.array([0.0, 0.0, 1.0]), np.zeros(3), []
+    for k, length in enumerate(lengths):
+        along = unit(np.cross(y, n))
+        rows += [(p + s * along, n) for s in np.arange(0.0, length, 1e-4)]
+        p = p + length * along
+        th = math.radians(turns_deg[k] if k < len(turns_deg) else roll_deg)
+        w = np.cross(y, n)
+        rows += [(p, math.cos(a) * n + math.sin(a) * w) for a in np.linspace(0.0, th, 12)]
+        n = unit(math.cos(th) * n + math.sin(th) * w)
+    points, clean = (np.array(c) for c in zip(*rows, strict=True))
+    normals = clean + rng.normal(0.0, math.radians(1.0), clean.shape)
+    normals /= np.linalg.norm(normals, axis=1)[:, None]
+    return _trace(points + R_PAD * clean, normals, points + rng.normal(0.0, 2e-4, points.shape))
+
+
+def test_a_slide_over_an_edge_too_shallow_to_feel_crossed_the_face_beyond_it():
+    # metabiaugmented_hexagonal_prism at 70 mm: from a square over its 5.3° edge onto a pyramid's triangle, the slide
+    # goes on to the triangle's next edge; the face it rolls off is the triangle, fitted from the slide's last rows
+    rng = np.random.default_rng(5)
+    seg = Segmenter()
+    fa = _plane(np.array([0.0, 0.0, 1.0]), np.zeros(3))
+    n_h = np.array([math.sin(math.radians(5.3)), 0.0, math.cos(math.radians(5.3))])
+    got = seg.face_crossed(_slide_over([5.3], [0.010, 0.015], rng), fa)
+    assert got is not None
+    fit, rows = got
+    assert math.degrees(math.acos(float(fit.normal @ n_h))) < math.degrees(seg.bounds.bound(fit.normal_sigma,
+                                                                                            seg.bounds.normal_floor))
+    assert np.all(rows.normal_in_world @ np.array([0.0, 0.0, 1.0]) < math.cos(math.radians(2.0)))  # none of a's rows
+    # a slide on face a alone, or one leaning 2° as beside a rim, crossed none; nor did one whose turn is an edge's
+    assert seg.face_crossed(_slide_over([], [0.025], rng), fa) is None
+    assert seg.face_crossed(_slide_over([2.0], [0.010, 0.015], rng), fa) is None
+    assert seg.face_crossed(_slide_over([12.0], [0.010, 0.015], rng), fa) is None
+    # too short a stretch of the face beyond (under the face extent) is no face either
+    assert seg.face_crossed(_slide_over([5.3], [0.020, 0.002], rng), fa) is None
