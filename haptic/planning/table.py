@@ -13,6 +13,7 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
+from haptic.geometry.distance import point_triangle_distance
 from haptic.geometry.polyhedron import Polyhedron
 from haptic.geometry.raycast import line_hits
 from haptic.geometry.se3 import SE3
@@ -40,6 +41,9 @@ LEVEL_MIN_SLOPE = np.deg2rad(20.0)
 LEVEL_MIN_HEADING = np.deg2rad(20.0)
 """... when the slide headed at least this much from straight down the face [rad]."""
 _UP = np.array([0.0, 0.0, 1.0])
+CROWD_SLACK = 0.001
+"""A pad stepping onto a face whose centre lies nearer another face than its radius by more than this touches that
+face too (:func:`crowded`): the hand's pad, its contact and the pose known to about a millimetre [m]."""
 FINGER_ABOVE = 0.03
 """How far above the pad's centre a face of the object over it blocks the finger pointing down: its distal link
 runs 26.7 mm from the pad's centre to the DIP joint, the medial link 38.4 mm on (``assets/mjcf/hand/README.md``).
@@ -183,13 +187,14 @@ def table_conflict(
 
 
 MADE, EDGE_ONLY, TABLE, UNDERCUT, CONCAVE = "made", "edge only", "table", "undercut", "concave"
-OVERHANG = "overhang"
+OVERHANG, CROWDED = "overhang", "crowded"
 """What a hypothesis predicts of a move on the hand (:func:`move_outlook`): carried out; a face move ending at its
 edge, the next face leaning under out of the pad's reach (a success that reports the edge alone); stopped by the
 table (the pad would come onto it, or the next face is too close to it); stopped at a convex edge onto a face
 leaning under further than the pad reaches; stopped at a concave edge's end or vertex the hand cannot tell; stopped
-stepping onto a face the object overhangs, where the finger's links meet it (:func:`overhung`)."""
-STOPS = (TABLE, UNDERCUT, CONCAVE, OVERHANG)
+stepping onto a face the object overhangs, where the finger's links meet it (:func:`overhung`); stopped stepping
+onto a face where the pad would touch another face too, a wall rising beside it (:func:`crowded`)."""
+STOPS = (TABLE, UNDERCUT, CONCAVE, OVERHANG, CROWDED)
 """The outlooks of a move the hand is predicted not to carry out."""
 
 
@@ -232,7 +237,9 @@ def move_outlook(
         q_m = at_m + TABLE_STEP_ONTO * _inward(poly, e_m, g_m)
         if pad_clearance(t.apply(q_m), t.rotate(poly.face_normals[g_m]), config) < lim:
             return TABLE
-        return OVERHANG if overhung(h, q_m, g_m, config) else MADE
+        if overhung(h, q_m, g_m, config):
+            return OVERHANG
+        return CROWDED if crowded(poly, q_m, g_m, config) else MADE
 
     if isinstance(move, FaceMove):
         tr = trace_in(h, move, state)
@@ -302,6 +309,25 @@ def overhung(h: Hypothesis, at_m: np.ndarray, face: int, config: PlannerConfig) 
     centre = at_m + config.pad_radius * poly.face_normals[face]
     hits = line_hits(poly, centre[None], h.model_from_world.rotate(_UP)[None])
     return bool(hits.first[0] < FINGER_ABOVE and int(hits.face[0]) != face)
+
+
+def crowded(poly: Polyhedron, at_m: np.ndarray, face: int, config: PlannerConfig) -> bool:
+    """Whether the pad touching face ``face`` of ``poly`` at ``at_m`` (model frame, on the face) would touch
+    another face too, deeper than :data:`CROWD_SLACK`: its centre, a pad's radius off the face, lies nearer another
+    face than that radius. A wall rising beside the face (the stem of a T where the pad steps onto the underside of
+    its bar, near the concave edge's end) holds the pad on its rim, and the stroke that measures the face reads a
+    normal partway between the two (the hand's move fails "stepping onto the next face, the pad reached the rim of
+    another edge"). Not checked on a convex model, where a pad resting on a face touches no other, nor where
+    ``at_m`` lies off the face (near an acute corner)."""
+    if poly.is_convex:
+        return False
+    own = poly.triangle_faces == face
+    tri = poly.vertices[poly.triangles]
+    at = np.asarray(at_m, dtype=float)[None]
+    if float(point_triangle_distance(at, tri[own]).min()) > poly.tolerances.planar:
+        return False
+    centre = at + config.pad_radius * poly.face_normals[face]
+    return float(point_triangle_distance(centre, tri[~own]).min()) < config.pad_radius - CROWD_SLACK
 
 
 def rolls_to_edge(h: Hypothesis, tr: FaceTrace, config: PlannerConfig) -> bool:
