@@ -239,7 +239,7 @@ def move_outlook(
             return TABLE
         if overhung(h, q_m, g_m, config):
             return OVERHANG
-        return CROWDED if crowded(poly, q_m, g_m, config) else MADE
+        return CROWDED if crowded(poly, q_m, g_m, config, _other_face(poly, e_m, g_m)) else MADE
 
     if isinstance(move, FaceMove):
         tr = trace_in(h, move, state)
@@ -311,14 +311,22 @@ def overhung(h: Hypothesis, at_m: np.ndarray, face: int, config: PlannerConfig) 
     return bool(hits.first[0] < FINGER_ABOVE and int(hits.face[0]) != face)
 
 
-def crowded(poly: Polyhedron, at_m: np.ndarray, face: int, config: PlannerConfig) -> bool:
+def _other_face(poly: Polyhedron, edge: int, face: int) -> int:
+    """The face of ``edge`` that is not ``face``."""
+    left = int(poly.edge_left_face[edge])
+    return int(poly.edge_right_face[edge]) if left == face else left
+
+
+def crowded(poly: Polyhedron, at_m: np.ndarray, face: int, config: PlannerConfig, came_from: int | None = None
+            ) -> bool:  # fmt: skip
     """Whether the pad touching face ``face`` of ``poly`` at ``at_m`` (model frame, on the face) would touch
     another face too, deeper than :data:`CROWD_SLACK`: its centre, a pad's radius off the face, lies nearer another
-    face than that radius. A wall rising beside the face (the stem of a T where the pad steps onto the underside of
-    its bar, near the concave edge's end) holds the pad on its rim, and the stroke that measures the face reads a
-    normal partway between the two (the hand's move fails "stepping onto the next face, the pad reached the rim of
-    another edge"). Not checked on a convex model, where a pad resting on a face touches no other, nor where
-    ``at_m`` lies off the face (near an acute corner)."""
+    face than that radius; the face ``came_from`` across the edge just crossed aside (out of a concave corner the
+    pad steps off the wall it slid down, and the hand handles that). A wall rising beside the face (the stem of a
+    T where the pad steps onto the underside of its bar, near the concave edge's end) holds the pad on its rim, and
+    the stroke that measures the face reads a normal partway between the two (the hand's move fails "stepping onto
+    the next face, the pad reached the rim of another edge"). Not checked on a convex model, where a pad resting on
+    a face touches no other, nor where ``at_m`` lies off the face (near an acute corner)."""
     if poly.is_convex:
         return False
     own = poly.triangle_faces == face
@@ -327,7 +335,8 @@ def crowded(poly: Polyhedron, at_m: np.ndarray, face: int, config: PlannerConfig
     if float(point_triangle_distance(at, tri[own]).min()) > poly.tolerances.planar:
         return False
     centre = at + config.pad_radius * poly.face_normals[face]
-    return float(point_triangle_distance(centre, tri[~own]).min()) < config.pad_radius - CROWD_SLACK
+    rest = ~own if came_from is None else ~own & (poly.triangle_faces != came_from)
+    return float(point_triangle_distance(centre, tri[rest]).min()) < config.pad_radius - CROWD_SLACK
 
 
 def rolls_to_edge(h: Hypothesis, tr: FaceTrace, config: PlannerConfig) -> bool:
