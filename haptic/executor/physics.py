@@ -88,6 +88,9 @@ episode went on to fail four moves in a row at the slot (with ``--verify none``,
 FROM_TOUCHED = ", from where the face was touched"
 """Said of a crossing made again from a point the face was touched at, its start beside the first lying off the face."""
 TABLE_BEFORE_NEXT = "the pad reached the table's clearance before the next face"
+# how the segmenter ends the reasons of a roll whose normals leaned along the line between the faces
+# (:meth:`~haptic.executor.segment.Segmenter.edge_inconsistency`)
+ROUND_A_VERTEX = "(a roll round a vertex)"
 """How a roll over a convex edge that the table stopped ends (:meth:`PhysicsExecutor._cross_and_acquire`)."""
 
 
@@ -273,6 +276,13 @@ class PhysicsSettings:
     edge's rim at that glancing angle back to the same end (prism_09 of the formula corpus, seed 1: slides 11° from
     the edge met it at the vertex, 0.2 mm from its end, and two crossings made again 9 mm inside it met the same vertex
     again, 0.3 mm from it) [rad]."""
+    recross_turn_axis: float = math.radians(12.0)
+    """A face move whose roll went round a vertex crosses again along the axis the roll first turned about, not the
+    line between the faces, where the two lie more than this apart (:meth:`PhysicsExecutor._edge_turned_to`). Round
+    an apex of many kites they lie 3-20° apart: at 5° trapezohedron_11 of the formula corpus at 30-150 mm, seed 1,
+    crossed again over a kite's edge where the line between the faces had put the crossing 6.4 mm off the kite
+    (10.7° apart), but trapezohedron_12 went another way and crossed a 9 mm edge 1.9 mm from its end, reporting it
+    5.6 bounds off (no-match) [rad]."""
     recross_slant: float = math.radians(60.0)
     """A crossing made again from a point the face was touched at (the start beside the first crossing off the face,
     on a face narrowing to a vertex) heads at least this far from along the edge: at 30° such a slanted crossing
@@ -1145,7 +1155,11 @@ class PhysicsExecutor(LandingSearch):
                 if shift is not None:  # the next face met lies round the vertex: crossed again square to the edge
                     across = self._square_to(heading, shift, n_from)
                 else:
-                    shift = self._away_from_vertex(fit_a.normal, self._edge_turned_to(fit_a.normal, fit_b, roll), roll)
+                    # (a roll that turned about another axis altogether crosses again along the line between the faces,
+                    # as before: along the first turn's axis, FRAME01 seed 2 failed two moves it made)
+                    n_b = self._edge_turned_to(fit_a.normal, fit_b, roll) if why.endswith(ROUND_A_VERTEX) \
+                        else fit_b.normal
+                    shift = self._away_from_vertex(fit_a.normal, n_b, roll)
                     if shift is not None and abs(float(unit(shift) @ unit(heading))) > math.cos(
                         self.settings.recross_glancing
                     ):  # slid at a glancing angle, the pad rode the rim to the edge's end: crossed again square to it
@@ -1373,10 +1387,10 @@ class PhysicsExecutor(LandingSearch):
 
     def _edge_turned_to(self, n_a: np.ndarray, fit_b: FaceFit, roll: ContactTrace | None) -> np.ndarray:
         """The normal past the edge a roll off face ``n_a`` met, whose line a crossing made again follows: the next
-        face's (``fit_b``), or, its line with face a more than :attr:`PhysicsSettings.reacquire_cone` from the axis of
-        the roll's first turn (:meth:`_first_turn`), that turn's. Met near its end, the pad rolled over the edge there
-        and on round the vertex onto a face sharing only the vertex with face a, whose line with face a runs along no
-        edge of it: a shift along that line put the crossing made again off the face (snub_square_antiprism of the
+        face's (``fit_b``), or, its line with face a more than :attr:`PhysicsSettings.recross_turn_axis` from the axis
+        of the roll's first turn (:meth:`_first_turn`), that turn's. Met near its end, the pad rolled over the edge
+        there and on round the vertex onto a face sharing only the vertex with face a, whose line with face a runs along
+        no edge of it: a shift along that line put the crossing made again off the face (snub_square_antiprism of the
         public collection of Johnson solids, seed 1: a triangle's edge met 1.5 mm from its end, the start 8 mm back
         and 8 mm aside off the triangle, the touch there reading a normal 15° off it; sphenomegacorona, seed 1: the
         crossing made again 6.5 mm past the triangle's far edge). Along the first turn's axis, both crossed again
@@ -1389,7 +1403,7 @@ class PhysicsExecutor(LandingSearch):
         if float(e_t @ e_t) < small or float(e_b @ e_b) < small:
             return fit_b.normal
         # (the axes, not the normals: over a steep edge the first turn stands halfway to the next face)
-        if abs(float(unit(e_t) @ unit(e_b))) >= math.cos(self.settings.reacquire_cone):
+        if abs(float(unit(e_t) @ unit(e_b))) >= math.cos(self.settings.recross_turn_axis):
             return fit_b.normal
         return n_t
 
