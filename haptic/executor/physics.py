@@ -88,10 +88,10 @@ episode went on to fail four moves in a row at the slot (with ``--verify none``,
 FROM_TOUCHED = ", from where the face was touched"
 """Said of a crossing made again from a point the face was touched at, its start beside the first lying off the face."""
 TABLE_BEFORE_NEXT = "the pad reached the table's clearance before the next face"
-# how the segmenter ends the reasons of a roll whose normals leaned along the line between the faces
-# (:meth:`~haptic.executor.segment.Segmenter.edge_inconsistency`)
-ROUND_A_VERTEX = "(a roll round a vertex)"
 """How a roll over a convex edge that the table stopped ends (:meth:`PhysicsExecutor._cross_and_acquire`)."""
+ROUND_A_VERTEX = "(a roll round a vertex)"
+"""How the segmenter ends the reasons of a roll whose normals leaned along the line between the faces
+(:meth:`~haptic.executor.segment.Segmenter.edge_inconsistency`)."""
 
 
 TOUCH_PHASES = ("face", "circle")
