@@ -1517,3 +1517,25 @@ def test_a_move_that_slid_over_an_edge_too_shallow_to_feel_reports_the_face_it_r
         assert edge.kind == "edge" and edge.adjacent[-1] == face.id
     assert _within_bounds(ep)
     assert rec.outcome != "no-match", rec.detail
+
+
+def test_a_step_onto_the_next_face_stopped_by_the_table_gives_the_edge_alone(tmp_path):
+    # augmented_triangular_prism of the public polyhedra at 30 mm, seed 1: face moves rolled over an edge onto a
+    # side face whose strip above the table was narrower than the pad's step onto it; the step met the table, and
+    # two moves failed "stepping onto the next face, the pad met the table at the edge". The roll had turned over
+    # the edge: the move now gives the edge from it alone, as where the roll itself reaches the table's clearance
+    from haptic.geometry import load_library
+    from haptic.geometry.io import save_model
+    from haptic.geometry.perturb import scaled_to
+
+    for name, poly in load_library("assets/libraries/polyhedra").items():
+        save_model(scaled_to(poly, 0.03, name), tmp_path / f"{name}.json")
+    alone, failed = [], []
+    obs = EpisodeObserver(on_move=lambda n, r, *a: alone.extend([r] if (r.info or {}).get("next_face") else []),
+                          on_failed_move=lambda n, r: failed.append(r.reason))  # fmt: skip
+    ep = build_episode(EpisodeSpec(model="augmented_triangular_prism", seed=1, executor="physics", verify="full",
+                                   models=str(tmp_path)))  # fmt: skip
+    rec = ep.run(None, obs)
+    assert not any(why.startswith("stepping onto the next face, the pad met the table") for why in failed), failed
+    assert alone, "no edge reported alone"
+    assert rec.outcome != "no-match" and _within_bounds(ep)
