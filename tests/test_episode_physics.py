@@ -908,10 +908,14 @@ def test_a_roll_at_an_edges_end_with_the_next_face_out_of_reach_reports_no_edge(
     # verification on the hand now leaves out unless nothing else is left (verify.GRAZING; the episode then ends as
     # before, one vertex unmeasured, with a failed move less): the replay asks it as recorded, the rule switched off.
     # Such a face move now crosses again farther inside the edge when the roll went on down to the table's clearance
-    # (as here): it says why, and recovers.
+    # (as here): it says why, and recovers. The planner now also leaves out an edge move along an edge whose faces
+    # the pad cannot touch next to it off the table (table.edge_return_in_reach), which took the episode another
+    # way, with no failed move (recognised): the replay switches that rule off too.
+    import haptic.planning.table as table
     import haptic.planning.verify as verify
 
     monkeypatch.setattr(verify, "_grazing", lambda *args: False)
+    monkeypatch.setattr(table, "edge_return_in_reach", lambda *args: True)
     said = []
     spec = EpisodeSpec(model="HEXPRISM01", seed=2, executor="physics", models=_scaled_library(tmp_path, 0.03))
     ep = build_episode(spec)

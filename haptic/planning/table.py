@@ -464,14 +464,54 @@ def vertex_sweep_off_table(
     )
 
 
+EDGE_REENTRY = 0.004
+"""How far in from an edge the hand touches one of its faces again before following it (the physics executor's
+``PhysicsSettings.edge_reentry``) [m] ..."""
+REENTRY_STEP = 0.002
+"""... at points this far apart along the explored interval, the first clear of the table taken [m]."""
+
+
+def edge_return_in_reach(state: SensorState, components: Mapping[int, DataComponent], config: PlannerConfig) -> bool:
+    """From the data alone: whether the pad, to follow the current convex edge, can touch one of its faces
+    :data:`EDGE_REENTRY` in from it somewhere along its explored interval with its lowest point
+    ``config.table_clearance`` above the table (the hand sets off along an edge so; where no such point is, the edge
+    move fails at once, "the edge next to the table is out of the pad's reach"). True where the data cannot say: no
+    edge, no face of it known, or a concave edge (the hand returns into its corner instead). On the public polyhedra
+    at 30 mm (elongated_triangular_bipyramid, seed 1) an edge reported alone, the roll over it stopped by the table,
+    had its one face's strip along it within 2 mm of the table, and both moves along it failed so."""
+    edge = components.get(state.edge) if state.edge is not None else None
+    if not isinstance(edge, DataEdge):
+        return True
+    b, sides = edge.direction, dict(edge.side_points)
+    faces = [(f, components[f]) for f in edge.adjacent if isinstance(components.get(f), DataFace) and f in sides]
+    if not faces:
+        return True
+    for (f, face), (g, _) in zip(faces, faces[::-1], strict=True):
+        if f != g and float((sides[g] - edge.point) @ face.normal) > 0.0:
+            return True  # concave: each face's side point lies outside the other's plane
+    ss = np.append(np.arange(0.0, edge.length, REENTRY_STEP), edge.length)
+    for f, face in faces:
+        w = np.cross(face.normal, b)
+        w = w / max(float(np.linalg.norm(w)), 1e-12)
+        if float((sides[f] - edge.point) @ w) < 0.0:
+            w = -w
+        if any(pad_clearance(edge.point + s * b + EDGE_REENTRY * w, face.normal, config) >= config.table_clearance
+               for s in ss):  # fmt: skip
+            return True
+    return False
+
+
 def data_table_conflict(
     move: Move, state: SensorState, components: Mapping[int, DataComponent], config: PlannerConfig
 ) -> bool:
     """What the data alone say about the table, whatever the model: a face move heading down from a point
-    already within the pad's reach of the table with no side to go on to level (:func:`level_heading`), or a
-    vertex move whose circle cannot even start off it."""
+    already within the pad's reach of the table with no side to go on to level (:func:`level_heading`), an edge
+    move along an edge whose faces the pad cannot touch next to it off the table (:func:`edge_return_in_reach`), or
+    a vertex move whose circle cannot even start off it."""
     if config.table_z is None:
         return False
+    if isinstance(move, EdgeMove):
+        return not edge_return_in_reach(state, components, config)
     if isinstance(move, FaceMove):
         face = components.get(state.face)
         d = np.asarray(move.direction, dtype=float)

@@ -1,5 +1,6 @@
 """The table on a small object: a face move's slide goes on over an edge too shallow for the pad to feel, and what
-the table lets it do is judged where it ends."""
+the table lets it do is judged where it ends; an edge move sets off only where the pad can touch a face of the edge
+next to it off the table."""
 
 from dataclasses import replace
 
@@ -7,11 +8,11 @@ import numpy as np
 
 from haptic.geometry import SE3
 from haptic.geometry.shapes import convex_hull
-from haptic.matching.components import DataFace
+from haptic.matching.components import DataEdge, DataFace
 from haptic.planning.config import PlannerConfig
 from haptic.planning.hypothesis import Hypothesis, trace_in
-from haptic.planning.moves import FaceMove, SensorState
-from haptic.planning.table import MADE, TABLE, move_outlook, over_shallow
+from haptic.planning.moves import EdgeMove, FaceMove, SensorState
+from haptic.planning.table import MADE, TABLE, data_table_conflict, move_outlook, over_shallow
 
 CFG = PlannerConfig(table_z=0.0, pad_radius=0.012, table_clearance=0.004)
 
@@ -50,3 +51,29 @@ def test_a_slide_over_an_edge_too_shallow_to_feel_is_judged_where_it_ends():
     assert over_shallow(h, tr, replace(CFG, felt_edge=np.deg2rad(5.0))) is tr
     assert move_outlook(h, move, state, comps, replace(CFG, felt_edge=np.deg2rad(5.0)))[0] == MADE
 
+
+def _edge_alone(height: float):
+    """An edge along x at ``height`` above the table, reported alone from a face sloping up from it at 30° (its
+    outward normal leaning 30° toward -y), the sensor on the face next to it."""
+    n = np.array([0.0, -np.sin(np.deg2rad(30.0)), np.cos(np.deg2rad(30.0))])
+    w = np.array([0.0, np.cos(np.deg2rad(30.0)), np.sin(np.deg2rad(30.0))])  # into the face, up the slope
+    p = np.array([0.0, 0.0, height])
+    face = DataFace(0, n, np.array([p + 0.006 * w, p + 0.01 * w + [0.01, 0.0, 0.0]]), 0.01, 1e-3)
+    edge = DataEdge(1, np.array([1.0, 0.0, 0.0]), p, 0.012, 0.01, 1e-3, 1e-3, adjacent=(0,),
+                    side_points=((0, p + [0.006, 0.0, 0.0] + 0.002 * w),))  # fmt: skip
+    return {0: face, 1: edge}, SensorState(position=p + 0.002 * w, face=0, edge=1)
+
+
+def test_an_edge_move_is_refused_where_the_pad_cannot_touch_a_face_next_to_the_edge_off_the_table():
+    """The hand sets off along an edge touching a face of it 4 mm in from it: 2 mm above the table, on a face
+    sloping 30°, the pad's lowest point there is 0.4 mm above the table (its limit 2, the planner's 4), and the move
+    fails at once (elongated_triangular_bipyramid of the public polyhedra at 30 mm, seed 1: an edge reported alone,
+    the roll over it stopped by the table, and both moves along it failed so). 6 mm above the table it has room."""
+    comps, state = _edge_alone(0.002)
+    assert data_table_conflict(EdgeMove(1), state, comps, CFG)
+    assert data_table_conflict(EdgeMove(-1), state, comps, CFG)
+    comps, state = _edge_alone(0.006)
+    assert not data_table_conflict(EdgeMove(1), state, comps, CFG)
+    # without a table nothing is refused
+    comps, state = _edge_alone(0.002)
+    assert not data_table_conflict(EdgeMove(1), state, comps, PlannerConfig())
