@@ -476,14 +476,16 @@ def edge_return_in_reach(state: SensorState, components: Mapping[int, DataCompon
     :data:`EDGE_REENTRY` in from it somewhere along its explored interval with its lowest point
     ``config.table_clearance`` above the table (the hand sets off along an edge so; where no such point is, the edge
     move fails at once, "the edge next to the table is out of the pad's reach"). True where the data cannot say: no
-    edge, no face of it known, or a concave edge (the hand returns into its corner instead). On the public polyhedra
-    at 30 mm (elongated_triangular_bipyramid, seed 1) an edge reported alone, the roll over it stopped by the table,
-    had its one face's strip along it within 2 mm of the table, and both moves along it failed so."""
+    edge, no face of it known beside it (:attr:`~haptic.matching.components.DataEdge.side_points`: the faces the
+    hand knows the way into from the edge), or a concave edge (the hand returns into its corner instead). On the
+    public polyhedra at 30 mm (elongated_triangular_bipyramid, seed 1) an edge reported alone, the roll over it
+    stopped by the table, had its one face's strip along it within 2 mm of the table, and both moves along it failed
+    so."""
     edge = components.get(state.edge) if state.edge is not None else None
     if not isinstance(edge, DataEdge):
         return True
     b, sides = edge.direction, dict(edge.side_points)
-    faces = [(f, components[f]) for f in edge.adjacent if isinstance(components.get(f), DataFace) and f in sides]
+    faces = [(f, components[f]) for f in sides if isinstance(components.get(f), DataFace)]
     if not faces:
         return True
     for (f, face), (g, _) in zip(faces, faces[::-1], strict=True):
