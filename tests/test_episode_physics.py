@@ -908,10 +908,14 @@ def test_a_roll_at_an_edges_end_with_the_next_face_out_of_reach_reports_no_edge(
     # verification on the hand now leaves out unless nothing else is left (verify.GRAZING; the episode then ends as
     # before, one vertex unmeasured, with a failed move less): the replay asks it as recorded, the rule switched off.
     # Such a face move now crosses again farther inside the edge when the roll went on down to the table's clearance
-    # (as here): it says why, and recovers.
+    # (as here): it says why, and recovers. The planner now also leaves out an edge move along an edge whose faces
+    # the pad cannot touch next to it off the table (table.edge_return_in_reach), which took the episode another
+    # way, with no failed move (recognised): the replay switches that rule off too.
+    import haptic.planning.table as table
     import haptic.planning.verify as verify
 
     monkeypatch.setattr(verify, "_grazing", lambda *args: False)
+    monkeypatch.setattr(table, "edge_return_in_reach", lambda *args: True)
     said = []
     spec = EpisodeSpec(model="HEXPRISM01", seed=2, executor="physics", models=_scaled_library(tmp_path, 0.03))
     ep = build_episode(spec)
@@ -1565,3 +1569,25 @@ def test_a_face_move_rolling_over_an_edges_end_round_the_vertex_crosses_again_al
     assert any("(a roll round a vertex): crossed again" in x for x in said), said
     assert not failed, failed
     assert _within_bounds(ep)
+
+
+def test_a_step_onto_the_next_face_stopped_by_the_table_gives_the_edge_alone(tmp_path):
+    # augmented_triangular_prism of the public polyhedra at 30 mm, seed 1: face moves rolled over an edge onto a
+    # side face whose strip above the table was narrower than the pad's step onto it; the step met the table, and
+    # two moves failed "stepping onto the next face, the pad met the table at the edge". The roll had turned over
+    # the edge: the move now gives the edge from it alone, as where the roll itself reaches the table's clearance
+    from haptic.geometry import load_library
+    from haptic.geometry.io import save_model
+    from haptic.geometry.perturb import scaled_to
+
+    for name, poly in load_library("assets/libraries/polyhedra").items():
+        save_model(scaled_to(poly, 0.03, name), tmp_path / f"{name}.json")
+    alone, failed = [], []
+    obs = EpisodeObserver(on_move=lambda n, r, *a: alone.extend([r] if (r.info or {}).get("next_face") else []),
+                          on_failed_move=lambda n, r: failed.append(r.reason))  # fmt: skip
+    ep = build_episode(EpisodeSpec(model="augmented_triangular_prism", seed=1, executor="physics", verify="full",
+                                   models=str(tmp_path)))  # fmt: skip
+    rec = ep.run(None, obs)
+    assert not any(why.startswith("stepping onto the next face, the pad met the table") for why in failed), failed
+    assert alone, "no edge reported alone"
+    assert rec.outcome != "no-match" and _within_bounds(ep)

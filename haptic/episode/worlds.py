@@ -158,6 +158,7 @@ class PhysicsWorld:
             config = replace(
                 config, table_z=ws.table_top_z, pad_radius=ws.pad_radius, steep_descent_risk=STEEP_DESCENT_RISK,
                 max_undercut=TouchConfig().reach_undercut, touch_evidence=True,
+                felt_edge=TouchConfig().edge_angle,
             )  # fmt: skip
         if config.fingers > 1 and config.placement_reach is None:  # placements the reach solver reaches alone
             from haptic.executor.placement import PlacementReach

@@ -92,6 +92,9 @@ TABLE_BEFORE_NEXT = "the pad reached the table's clearance before the next face"
 ROUND_A_VERTEX = "(a roll round a vertex)"
 """How the segmenter ends the reasons of a roll whose normals leaned along the line between the faces
 (:meth:`~haptic.executor.segment.Segmenter.edge_inconsistency`)."""
+STEP_AT_TABLE = "stepping onto the next face, the pad met the table at the edge"
+"""How a crossing ends whose roll settled but whose step in off the edge the table stopped (a face move then gives the
+edge alone, from the roll)."""
 
 
 TOUCH_PHASES = ("face", "circle")
@@ -757,8 +760,11 @@ class PhysicsExecutor(LandingSearch):
         if kind == "convex" and st.ok and st.info["at_table"]:
             # the table may have stopped the roll short of the next face (one leaning under, the edge low): the pad
             # settled on the ridge, its normal partway round (bipyramid_06 at 60 mm: 7-9° short of the face, the pad
-            # 1 mm above the table), and the legs along the edge, never off it, rode the ridge with that normal
-            return "unreachable", "stepping onto the next face, the pad met the table at the edge", None, None, None
+            # 1 mm above the table), and the legs along the edge, never off it, rode the ridge with that normal. The
+            # next face is as good as hidden by the table, and a face move gives the edge from the roll alone, as
+            # where the roll itself reached the table's clearance (the planner predicts so: its strip above the table
+            # narrower than the pad's step onto it, on the polyhedra at 30 mm the side faces under a low edge)
+            return "undercut", STEP_AT_TABLE, r.trace, None, None
         if overhang and st.info.get("held"):
             return self._overhung(kind, st.info["held"], r.trace)
         rim = st.ok and st.info["rim"]

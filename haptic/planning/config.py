@@ -52,6 +52,11 @@ class PlannerConfig:
     executor) [rad]. A face move predicted to roll over an edge onto a face leaning further ends there and
     reports the edge alone (:attr:`~haptic.planning.predict.Prediction.edge_only`); a vertex move doing so
     counts as refused like one running into the table. None: no limit."""
+    felt_edge: float | None = None
+    """With a table, the least turn between two faces' normals that the pad sliding across their convex edge feels
+    (the physics executor's ``TouchConfig.edge_angle``): over a shallower edge the slide goes on onto the next face,
+    and what the table lets the move do is judged where it ends (:func:`~haptic.planning.table.move_outlook`). None:
+    every edge is felt."""
     concave_end_block: float | None = None
     """With a table, where the hand can tell a concave edge's end: only where a face there blocks the pad
     travelling along the edge (its outward normal against the travel by more than this cosine). Past an end

@@ -1,0 +1,79 @@
+"""The table on a small object: a face move's slide goes on over an edge too shallow for the pad to feel, and what
+the table lets it do is judged where it ends; an edge move sets off only where the pad can touch a face of the edge
+next to it off the table."""
+
+from dataclasses import replace
+
+import numpy as np
+
+from haptic.geometry import SE3
+from haptic.geometry.shapes import convex_hull
+from haptic.matching.components import DataEdge, DataFace
+from haptic.planning.config import PlannerConfig
+from haptic.planning.hypothesis import Hypothesis, trace_in
+from haptic.planning.moves import EdgeMove, FaceMove, SensorState
+from haptic.planning.table import MADE, TABLE, data_table_conflict, move_outlook, over_shallow
+
+CFG = PlannerConfig(table_z=0.0, pad_radius=0.012, table_clearance=0.004)
+
+
+def _roof():
+    """A block 40 mm long, 20 mm wide, resting on the table, its top two faces sloping down along +x, 20° then 27°
+    (a convex edge turning 7° between them, at x = 20 mm, 12.7 mm high), the lower one ending 2.5 mm above the
+    table; the sensor on the upper one at x = 5 mm, and the true hypothesis."""
+    x_mid, h3 = 0.02, 0.02
+    h2 = h3 - x_mid * np.tan(np.deg2rad(20.0))
+    h1 = h2 - 0.02 * np.tan(np.deg2rad(27.0))
+    profile = [(0.0, 0.0), (0.04, 0.0), (0.04, h1), (x_mid, h2), (0.0, h3)]
+    poly = convex_hull([(x, y, z) for x, z in profile for y in (0.0, 0.02)], name="roof")
+    n_up = np.array([np.sin(np.deg2rad(20.0)), 0.0, np.cos(np.deg2rad(20.0))])
+    upper = int(np.argmax(poly.face_normals @ n_up))
+    at = np.array([0.005, 0.01, h3 - 0.005 * np.tan(np.deg2rad(20.0))])
+    comps = {0: DataFace(0, n_up, np.array([at, at + [0.002, 0.0, -0.0007]]), 0.01, 1e-3)}
+    h = Hypothesis("roof", poly, SE3(np.eye(3), np.zeros(3)), {0: upper}, {}, {})
+    return h, SensorState(position=at, face=0), comps
+
+
+def test_a_slide_over_an_edge_too_shallow_to_feel_is_judged_where_it_ends():
+    """Straight across the 7° edge the pad steps onto the lower face 10 mm above the table's clearance, made; the
+    hand does not feel that edge, slides on down the lower face and meets the table's clearance before its far edge
+    (augmented_sphenocorona of the public polyhedra at 30 mm, seed 1: two face moves so predicted made failed)."""
+    h, state, comps = _roof()
+    move = FaceMove(np.array([1.0, 0.0, 0.0]))
+    tr = trace_in(h, move, state)
+    assert move_outlook(h, move, state, comps, CFG)[0] == MADE  # every edge felt (no felt_edge)
+    felt = replace(CFG, felt_edge=np.deg2rad(10.0))
+    beyond = over_shallow(h, tr, felt)
+    assert beyond is not tr and beyond.face == tr.hit.next_face and np.isclose(beyond.hit.point[0], 0.04)
+    why, reach, _ = move_outlook(h, move, state, comps, felt)
+    assert why == TABLE and np.isclose(reach, tr.hit.distance)  # it touches all of the face it set off on
+    # an edge turning more than the pad feels stops the slide there, as before
+    assert over_shallow(h, tr, replace(CFG, felt_edge=np.deg2rad(5.0))) is tr
+    assert move_outlook(h, move, state, comps, replace(CFG, felt_edge=np.deg2rad(5.0)))[0] == MADE
+
+
+def _edge_alone(height: float):
+    """An edge along x at ``height`` above the table, reported alone from a face sloping up from it at 30° (its
+    outward normal leaning 30° toward -y), the sensor on the face next to it."""
+    n = np.array([0.0, -np.sin(np.deg2rad(30.0)), np.cos(np.deg2rad(30.0))])
+    w = np.array([0.0, np.cos(np.deg2rad(30.0)), np.sin(np.deg2rad(30.0))])  # into the face, up the slope
+    p = np.array([0.0, 0.0, height])
+    face = DataFace(0, n, np.array([p + 0.006 * w, p + 0.01 * w + [0.01, 0.0, 0.0]]), 0.01, 1e-3)
+    edge = DataEdge(1, np.array([1.0, 0.0, 0.0]), p, 0.012, 0.01, 1e-3, 1e-3, adjacent=(0,),
+                    side_points=((0, p + [0.006, 0.0, 0.0] + 0.002 * w),))  # fmt: skip
+    return {0: face, 1: edge}, SensorState(position=p + 0.002 * w, face=0, edge=1)
+
+
+def test_an_edge_move_is_refused_where_the_pad_cannot_touch_a_face_next_to_the_edge_off_the_table():
+    """The hand sets off along an edge touching a face of it 4 mm in from it: 2 mm above the table, on a face
+    sloping 30°, the pad's lowest point there is 0.4 mm above the table (its limit 2, the planner's 4), and the move
+    fails at once (elongated_triangular_bipyramid of the public polyhedra at 30 mm, seed 1: an edge reported alone,
+    the roll over it stopped by the table, and both moves along it failed so). 6 mm above the table it has room."""
+    comps, state = _edge_alone(0.002)
+    assert data_table_conflict(EdgeMove(1), state, comps, CFG)
+    assert data_table_conflict(EdgeMove(-1), state, comps, CFG)
+    comps, state = _edge_alone(0.006)
+    assert not data_table_conflict(EdgeMove(1), state, comps, CFG)
+    # without a table nothing is refused
+    comps, state = _edge_alone(0.002)
+    assert not data_table_conflict(EdgeMove(1), state, comps, PlannerConfig())
