@@ -1523,54 +1523,6 @@ def test_a_move_that_slid_over_an_edge_too_shallow_to_feel_reports_the_face_it_r
     assert rec.outcome != "no-match", rec.detail
 
 
-def _recovered(spec: EpisodeSpec):
-    """Run the episode of ``spec``: the episode, its record, the made moves' recoveries, the failed moves'
-    reasons and the made moves that report a face crossed over an edge too shallow to feel."""
-    said, failed, crossed = [], [], []
-
-    def made(n, r, *a) -> None:
-        said.extend(r.info.get("recoveries", ()))
-        if "crossed_face" in r.info:
-            crossed.append(r)
-
-    obs = EpisodeObserver(on_move=made, on_failed_move=lambda n, r: failed.append(r.reason))
-    ep = build_episode(spec)
-    return ep, ep.run(None, obs), said, failed, crossed
-
-
-@pytest.mark.slow
-def test_a_face_move_past_a_shallow_edge_and_round_a_vertex_crosses_again_from_the_face_past_it():
-    # sphenomegacorona of the public polyhedra (37 mm across), seed 1: two face moves of the verification slid from a
-    # triangle over its 8.3° edge onto the next triangle and met that one's corner, 0.1-0.3 mm from the vertex, the pad
-    # rolling round it onto a face sharing only the vertex ("a roll round a vertex"). The crossing made again was
-    # shifted along the line between the triangle and that face, along no edge, and set off on the first triangle: its
-    # start 8 mm back lay off it (touched 16-17° off), and the crossing itself 6.5 mm past the second triangle's far
-    # edge; both moves failed, and the verification ended incomplete with 2 vertices not measured. Now the crossing made
-    # again follows the edge the roll first turned about and sets off on the triangle past the shallow edge: it rolls
-    # over that edge 6.6 mm from the vertex and the move reports the triangle, the edge and the face past it.
-    ep, rec, said, failed, crossed = _recovered(EpisodeSpec(model="sphenomegacorona", seed=1, executor="physics",
-                                                            models="assets/libraries/polyhedra"))  # fmt: skip
-    assert any(x.endswith("from the face past the shallow edge") for x in said), said
-    assert not any(w.endswith("(a roll round a vertex)") for w in failed), failed
-    assert crossed
-    assert _within_bounds(ep)
-
-
-@pytest.mark.slow
-def test_a_face_move_rolling_over_an_edges_end_round_the_vertex_crosses_again_along_that_edge():
-    # snub_square_antiprism of the public polyhedra (51 mm across), seed 1: the first face move met a triangle's edge
-    # 1.5 mm from its end, rolled over it and on round the vertex onto a face sharing only the vertex with the triangle.
-    # The crossing made again was shifted along the line between the triangle and that face, and its start (8 mm back, 8
-    # mm aside) lay off the triangle (touched 15° off): the move failed. Along the axis the roll first turned about, the
-    # start lies 4.8 mm inside the triangle, and the crossing made again measures the edge.
-    ep, rec, said, failed, _ = _recovered(EpisodeSpec(model="snub_square_antiprism", seed=1, executor="physics",
-                                                      models="assets/libraries/polyhedra", max_moves=1,
-                                                      verify="none"))  # fmt: skip
-    assert any("(a roll round a vertex): crossed again" in x for x in said), said
-    assert not failed, failed
-    assert _within_bounds(ep)
-
-
 def test_a_step_onto_the_next_face_stopped_by_the_table_gives_the_edge_alone(tmp_path):
     # augmented_triangular_prism of the public polyhedra at 30 mm, seed 1: face moves rolled over an edge onto a
     # side face whose strip above the table was narrower than the pad's step onto it; the step met the table, and

@@ -89,9 +89,6 @@ FROM_TOUCHED = ", from where the face was touched"
 """Said of a crossing made again from a point the face was touched at, its start beside the first lying off the face."""
 TABLE_BEFORE_NEXT = "the pad reached the table's clearance before the next face"
 """How a roll over a convex edge that the table stopped ends (:meth:`PhysicsExecutor._cross_and_acquire`)."""
-ROUND_A_VERTEX = "(a roll round a vertex)"
-"""How the segmenter ends the reasons of a roll whose normals leaned along the line between the faces
-(:meth:`~haptic.executor.segment.Segmenter.edge_inconsistency`)."""
 STEP_AT_TABLE = "stepping onto the next face, the pad met the table at the edge"
 """How a crossing ends whose roll settled but whose step in off the edge the table stopped (a face move then gives the
 edge alone, from the roll)."""
@@ -279,13 +276,6 @@ class PhysicsSettings:
     edge's rim at that glancing angle back to the same end (prism_09 of the formula corpus, seed 1: slides 11° from
     the edge met it at the vertex, 0.2 mm from its end, and two crossings made again 9 mm inside it met the same vertex
     again, 0.3 mm from it) [rad]."""
-    recross_turn_axis: float = math.radians(12.0)
-    """A face move whose roll went round a vertex crosses again along the axis the roll first turned about, not the
-    line between the faces, where the two lie more than this apart (:meth:`PhysicsExecutor._edge_turned_to`). Round
-    an apex of many kites they lie 3-20° apart: at 5° trapezohedron_11 of the formula corpus at 30-150 mm, seed 1,
-    crossed again over a kite's edge where the line between the faces had put the crossing 6.4 mm off the kite
-    (10.7° apart), but trapezohedron_12 went another way and crossed a 9 mm edge 1.9 mm from its end, reporting it
-    5.6 bounds off (no-match) [rad]."""
     recross_slant: float = math.radians(60.0)
     """A crossing made again from a point the face was touched at (the start beside the first crossing off the face,
     on a face narrowing to a vertex) heads at least this far from along the edge: at 30° such a slanted crossing
@@ -377,7 +367,6 @@ class PhysicsExecutor(LandingSearch):
         self._roll: ContactTrace | None = None  # the last crossing's roll (or climb) over the edge
         self._past: list[np.ndarray] = []  # normals the last crossing's touches afresh met past the edge
         self._crossed: tuple[FaceFit, ContactTrace] | None = None  # the face the last slide crossed onto, unfelt
-        self._rolled_off: tuple[FaceFit, ContactTrace] | None = None  # that face, the roll off it an edge or not
         self._links_until: float | None = None  # sim time of the last hand-link sample reported
         self._radii: dict[str, float] | None = None  # per link, the bound of a point its readout reports
 
@@ -509,8 +498,7 @@ class PhysicsExecutor(LandingSearch):
                          self.robot.link_geoms())  # fmt: skip
 
     def _edge_between(self, face: int, trace: ContactTrace, phase: str, roll: ContactTrace, fit_b: FaceFit,
-                      kind: str, corner: np.ndarray, set_off: tuple[FaceFit, ContactTrace] | None = None
-                      ) -> tuple[FaceFit, LineFit | None, str]:  # fmt: skip
+                      kind: str, corner: np.ndarray) -> tuple[FaceFit, LineFit | None, str]:  # fmt: skip
         """The fit of data face ``face`` from the ``phase`` rows of ``trace``, and the line of the edge the pad
         rolled over (the last rows on the face, then ``roll``) onto the face of ``fit_b``; no line, and why,
         when the roll cannot have been over an edge between the two faces.
@@ -520,25 +508,20 @@ class PhysicsExecutor(LandingSearch):
         that face's (no data face yet), the line that of its edge with the face of ``fit_b`` when the roll can have
         been over it, and :attr:`_crossed` holds the face's fit and rows (None otherwise). The shallow edge itself
         was not located: nothing joins that face to ``face``. When the roll cannot have been over that edge, no line
-        and why, with that face's fit (:attr:`_rolled_off` holds it and its rows whenever the fit returned is that
-        face's): a move that crosses again takes its way from the roll's lean off the face it rolled off, and sets off
-        on that face (``set_off``: the face and rows of the crossing before, taken when the slide's own rows show none)
-        (sphenomegacorona of the public collection of Johnson solids, seed 1: from a triangle over an
+        and why, with that face's fit: a move that crosses again takes its way from the roll's lean off the face it
+        rolled off (sphenomegacorona of the public collection of Johnson solids, seed 1: from a triangle over an
         8.3° edge onto the next, and on round a vertex onto a face sharing neither an edge). A next face within the
         edge angle of that face was met over another shallow edge: face ``face``'s test then says so."""
         seg = self.segmenter
-        self._crossed = self._rolled_off = None
+        self._crossed = None
         fit_a = self._face_fit(face, trace)
         slide = trace.select(trace.phase == PHASES.index(phase))
         lead = slide.tail(self.settings.roll_lead_rows)
         roll_all = ContactTrace.concatenate([lead, roll])
         convex = kind == "convex"
         crossed = seg.face_crossed(slide, fit_a) if convex else None
-        if crossed is None and convex and set_off is not None:
-            crossed = set_off
         if crossed is not None and angle(crossed[0].normal, fit_b.normal) >= self.bounds.min_edge_angle:
             # (closer, the roll went over another shallow edge, and face a's test names it)
-            self._rolled_off = crossed
             why = seg.edge_inconsistency(crossed[0], fit_b, convex, roll_all)
             if why is not None:
                 return crossed[0], None, f"no edge between the faces: {why}"
@@ -1045,10 +1028,8 @@ class PhysicsExecutor(LandingSearch):
         recrosses, tilted, levelled, resumed = 0, False, False, False
         lead = 0.0
         heading = inplane  # crossed again from a point the face was touched at, the slide heads from there
-        n_slide = n_a  # the face the slide sets off on: a crossing made again sets off past a shallow edge
-        set_off = None  # that face and its rows
         while True:
-            r = t.trace_face(heading, n_slide, self.settings.max_face_trace)
+            r = t.trace_face(heading, n_a, self.settings.max_face_trace)
             pieces.append(r)
             level = level_heading(heading, n_a) if r.event == "table" and not levelled else None
             if level is not None:
@@ -1137,7 +1118,7 @@ class PhysicsExecutor(LandingSearch):
                         continue
             if status != "ok":
                 return self.failed_result(move, status, reason)
-            fit_a, line, why = self._edge_between(st.face, r.trace, "face", roll, fit_b, kind, corner, set_off)
+            fit_a, line, why = self._edge_between(st.face, r.trace, "face", roll, fit_b, kind, corner)
             travel = unit(r.info["direction"])
             square = line is not None and abs(float(line.direction @ travel)) < math.sin(self.settings.square_crossing)
             if line is not None and kind == "convex" and (self._stroke_blocked or square):
@@ -1151,38 +1132,28 @@ class PhysicsExecutor(LandingSearch):
             if line is not None:
                 break
             shift, across = None, heading
-            # the slide went over an edge too shallow to feel and rolled off the face past it (sphenomegacorona of the
-            # public collection of Johnson solids, seed 1: from a triangle over an 8.3° edge onto the next, and round
-            # its corner): the edge met is that face's, and the crossing made again sets off on it, not on the face the
-            # move began on, whose plane the start 8 mm back lies off (the touch there read a normal 17° off it)
-            fid, n_from = (st.face, n_a) if self._rolled_off is None else (None, self._rolled_off[0].normal)
             if recrosses < self.settings.recrosses:
                 shift = self._past_the_vertex(fit_a.normal, fit_b, roll, corner)
                 if shift is not None:  # the next face met lies round the vertex: crossed again square to the edge
-                    across = self._square_to(heading, shift, n_from)
+                    across = self._square_to(heading, shift, n_a)
                 else:
-                    # (a roll that turned about another axis altogether crosses again along the line between the faces,
-                    # as before: along the first turn's axis, FRAME01 seed 2 failed two moves it made)
-                    n_b = self._edge_turned_to(fit_a.normal, fit_b, roll) if why.endswith(ROUND_A_VERTEX) \
-                        else fit_b.normal
-                    shift = self._away_from_vertex(fit_a.normal, n_b, roll)
+                    shift = self._away_from_vertex(fit_a.normal, fit_b.normal, roll)
                     if shift is not None and abs(float(unit(shift) @ unit(heading))) > math.cos(
                         self.settings.recross_glancing
                     ):  # slid at a glancing angle, the pad rode the rim to the edge's end: crossed again square to it
-                        across = self._square_to(heading, shift, n_from)
+                        across = self._square_to(heading, shift, n_a)
             recrosses += 1
             if shift is None:
                 return self.failed_result(move, "unreachable", why)
             # the roll went round the edge's end: cross again farther along the edge, inside it
-            way = self._recross_start(fid, n_from, corner, across, shift, self.settings.recross_back, r.trace,
+            way = self._recross_start(st.face, n_a, corner, across, shift, self.settings.recross_back, r.trace,
                                       pieces)  # fmt: skip
             if way is None:
                 return self.failed_result(move, "unreachable", why)
             square = " square to it" if across is not heading and way is across else ""
-            past = "" if fid is not None else ", from the face past the shallow edge"
             self.recoveries.append(f"{why}: crossed again {np.linalg.norm(shift) * 1000:.0f} mm along the edge"
-                                   f"{square}{'' if way is across else FROM_TOUCHED}{past}")  # fmt: skip
-            heading, n_slide, set_off = way, n_from, self._rolled_off
+                                   f"{square}{'' if way is across else FROM_TOUCHED}")  # fmt: skip
+            heading = way
         # the slide crossed a face over an edge too shallow to feel: that face, then the edge rolled over from it
         crossed = self._add_crossed()
         left = st.face if crossed is None else crossed
@@ -1222,11 +1193,9 @@ class PhysicsExecutor(LandingSearch):
         last = trace.point_in_world[ok[-1]] if len(ok) else self._faces[fid].anchor
         return last - self.settings.recross_back * d
 
-    def _recross_start(self, fid: int | None, n: np.ndarray, corner: np.ndarray, heading: np.ndarray,
-                       shift: np.ndarray, back: float, trace: ContactTrace, pieces: list[PrimitiveResult]
-                       ) -> np.ndarray | None:  # fmt: skip
-        """Put the pad on data face ``fid`` (normal ``n``; None: the face a slide crossed onto over an edge too
-        shallow to feel, no data face yet) to cross its edge again at ``corner + shift`` (``shift``
+    def _recross_start(self, fid: int, n: np.ndarray, corner: np.ndarray, heading: np.ndarray, shift: np.ndarray,
+                       back: float, trace: ContactTrace, pieces: list[PrimitiveResult]) -> np.ndarray | None:
+        """Put the pad on data face ``fid`` (normal ``n``) to cross its edge again at ``corner + shift`` (``shift``
         along the edge, away from the vertex the first crossing rolled round): ``back`` before that point against
         ``heading``; else, that start lying off the face (a face narrowing to the vertex: the pad touched a normal
         turned off it), at the point the face was touched at (``trace``'s rows on it, then its stored contacts; that
@@ -1390,28 +1359,6 @@ class PhysicsExecutor(LandingSearch):
         if need > self.toucher.pad_radius + s.recross_shift:
             return None
         return -math.copysign(need, lean) * e
-
-    def _edge_turned_to(self, n_a: np.ndarray, fit_b: FaceFit, roll: ContactTrace | None) -> np.ndarray:
-        """The normal past the edge a roll off face ``n_a`` met, whose line a crossing made again follows: the next
-        face's (``fit_b``), or, its line with face a more than :attr:`PhysicsSettings.recross_turn_axis` from the axis
-        of the roll's first turn (:meth:`_first_turn`), that turn's. Met near its end, the pad rolled over the edge
-        there and on round the vertex onto a face sharing only the vertex with face a, whose line with face a runs along
-        no edge of it: a shift along that line put the crossing made again off the face (snub_square_antiprism of the
-        public collection of Johnson solids, seed 1: a triangle's edge met 1.5 mm from its end, the start 8 mm back
-        and 8 mm aside off the triangle, the touch there reading a normal 15° off it; sphenomegacorona, seed 1: the
-        crossing made again 6.5 mm past the triangle's far edge). Along the first turn's axis, both crossed again
-        inside the edge and rolled over it."""
-        if roll is None or not roll.in_contact.any():
-            return fit_b.normal
-        n_t = self._first_turn(n_a, roll)
-        e_t, e_b = np.cross(n_a, n_t), np.cross(n_a, fit_b.normal)
-        small = math.sin(self.bounds.min_edge_angle) ** 2
-        if float(e_t @ e_t) < small or float(e_b @ e_b) < small:
-            return fit_b.normal
-        # (the axes, not the normals: over a steep edge the first turn stands halfway to the next face)
-        if abs(float(unit(e_t) @ unit(e_b))) >= math.cos(self.settings.recross_turn_axis):
-            return fit_b.normal
-        return n_t
 
     def _away_from_vertex(self, n_a: np.ndarray, n_b: np.ndarray, roll: ContactTrace) -> np.ndarray | None:
         """After a roll whose normals leaned along the edge between faces ``n_a`` and ``n_b`` (the pad rolled

@@ -14,7 +14,6 @@ from dataclasses import replace
 
 import numpy as np
 
-from haptic.geometry.distance import point_triangle_distance
 from haptic.geometry.polyhedron import Polyhedron
 from haptic.geometry.raycast import line_hits
 from haptic.geometry.se3 import SE3
@@ -42,9 +41,6 @@ LEVEL_MIN_SLOPE = np.deg2rad(20.0)
 LEVEL_MIN_HEADING = np.deg2rad(20.0)
 """... when the slide headed at least this much from straight down the face [rad]."""
 _UP = np.array([0.0, 0.0, 1.0])
-CROWD_SLACK = 0.001
-"""A pad stepping onto a face whose centre lies nearer another face than its radius by more than this touches that
-face too (:func:`crowded`): the hand's pad, its contact and the pose known to about a millimetre [m]."""
 FINGER_ABOVE = 0.03
 """How far above the pad's centre a face of the object over it blocks the finger pointing down: its distal link
 runs 26.7 mm from the pad's centre to the DIP joint, the medial link 38.4 mm on (``assets/mjcf/hand/README.md``).
@@ -84,23 +80,6 @@ def level_heading(d: np.ndarray, n: np.ndarray) -> np.ndarray | None:
     return np.copysign(np.cos(LEVEL_RISE), across) * side + np.sin(LEVEL_RISE) * up
 
 
-def slide_end_clearance(h: Hypothesis, tr: FaceTrace, config: PlannerConfig) -> float:
-    """The pad's clearance of the table (:func:`pad_clearance`) where face move trace ``tr`` of ``h`` meets its
-    edge: on the face, at the edge; at a concave edge, in the corner, where the pad sliding down the face meets the
-    next face first, its centre a radius from both planes (sliding down the upright leg of an L bracket standing on
-    its foot, the pad meets the foot's top 10 mm above the table, its lowest point there, not 12 mm lower).
-    +inf without a table."""
-    poly, t, hit = h.poly, h.world_from_model, tr.hit
-    n_f = poly.face_normals[tr.face]
-    if config.table_z is not None and poly.edge_convexity[hit.edge] < 0:
-        n_g = poly.face_normals[hit.next_face]
-        k = 1.0 + float(n_f @ n_g)
-        if k > 1e-6:
-            centre = t.apply(hit.point + config.pad_radius * (n_f + n_g) / k)
-            return float(centre[2] - config.pad_radius - config.table_z)
-    return pad_clearance(t.apply(hit.point), t.rotate(n_f), config)
-
-
 def level_leg(h: Hypothesis, tr: FaceTrace, config: PlannerConfig) -> tuple[bool, FaceTrace | None]:
     """Whether face move trace ``tr`` of ``h`` goes on level (:func:`level_heading`): its slide heads down and
     comes within ``config.table_clearance`` of the table before its edge, on a face with a side to go to; and
@@ -117,7 +96,7 @@ def level_leg(h: Hypothesis, tr: FaceTrace, config: PlannerConfig) -> tuple[bool
         return False, None
     u_m = u_m / norm
     n_w, u_w = t.rotate(n_m), t.rotate(u_m)
-    if float(u_w[2]) >= 0.0 or slide_end_clearance(h, tr, config) >= lim:
+    if float(u_w[2]) >= 0.0 or pad_clearance(t.apply(hit.point), n_w, config) >= lim:
         return False, None
     level = level_heading(u_w, n_w)
     if level is None:
@@ -241,14 +220,13 @@ def table_conflict(
 
 
 MADE, EDGE_ONLY, TABLE, UNDERCUT, CONCAVE = "made", "edge only", "table", "undercut", "concave"
-OVERHANG, CROWDED = "overhang", "crowded"
+OVERHANG = "overhang"
 """What a hypothesis predicts of a move on the hand (:func:`move_outlook`): carried out; a face move ending at its
 edge, the next face leaning under out of the pad's reach (a success that reports the edge alone); stopped by the
 table (the pad would come onto it, or the next face is too close to it); stopped at a convex edge onto a face
 leaning under further than the pad reaches; stopped at a concave edge's end or vertex the hand cannot tell; stopped
-stepping onto a face the object overhangs, where the finger's links meet it (:func:`overhung`); stopped stepping
-onto a face where the pad would touch another face too, a wall rising beside it (:func:`crowded`)."""
-STOPS = (TABLE, UNDERCUT, CONCAVE, OVERHANG, CROWDED)
+stepping onto a face the object overhangs, where the finger's links meet it (:func:`overhung`)."""
+STOPS = (TABLE, UNDERCUT, CONCAVE, OVERHANG)
 """The outlooks of a move the hand is predicted not to carry out."""
 
 
@@ -284,17 +262,14 @@ def move_outlook(
             return False
         return float(t.rotate(poly.face_normals[g_m])[2]) < -np.sin(config.max_undercut)
 
-    def onto(e_m: int, g_m: int, at_m: np.ndarray, crowd: bool = True) -> str:
-        """Stepping over edge ``e_m`` onto face ``g_m`` at ``at_m``: made, or stopped by an undercut, the table, an
-        overhang or (``crowd``) a wall beside the face."""
+    def onto(e_m: int, g_m: int, at_m: np.ndarray) -> str:
+        """Stepping over edge ``e_m`` onto face ``g_m`` at ``at_m``: made, or stopped by an undercut or the table."""
         if leans_under(e_m, g_m):
             return UNDERCUT
         q_m = at_m + TABLE_STEP_ONTO * _inward(poly, e_m, g_m)
         if pad_clearance(t.apply(q_m), t.rotate(poly.face_normals[g_m]), config) < lim:
             return TABLE
-        if overhung(h, q_m, g_m, config):
-            return OVERHANG
-        return CROWDED if crowd and crowded(poly, q_m, g_m, config, _other_face(poly, e_m, g_m)) else MADE
+        return OVERHANG if overhung(h, q_m, g_m, config) else MADE
 
     if isinstance(move, FaceMove):
         tr = trace_in(h, move, state)
@@ -313,7 +288,7 @@ def move_outlook(
             tr, levelled, d_z = beyond, False, float(t.rotate(beyond.direction)[2])
         hit = tr.hit
         n_w = t.rotate(poly.face_normals[tr.face])
-        if not levelled and d_z < 0.0 and slide_end_clearance(h, tr, config) < lim:
+        if not levelled and d_z < 0.0 and pad_clearance(t.apply(hit.point), n_w, config) < lim:
             # the slide stops where the pad comes too close to the table
             if crossed:
                 return TABLE, first, 0.0
@@ -358,10 +333,7 @@ def move_outlook(
             return TABLE, np.nan, np.nan
         away = poly.edge_directions[hit.edge] * (1.0 if poly.edges[hit.edge, 0] == v_m else -1.0)
         at = poly.vertices[v_m] + config.vertex_radius * away
-        # (a vertex move's step is not judged crowded: its circle, a vertex radius out, meets the edge where the hand
-        # steps onto the next face past walls at a concave vertex that a point 3 mm in would touch -- BOX01N seed 3,
-        # such a move made as predicted before, predicted crowded, the episode took another course and 27 more moves)
-        return onto(hit.edge, hit.next_face, at, crowd=False), np.nan, np.nan
+        return onto(hit.edge, hit.next_face, at), np.nan, np.nan
     raise TypeError(f"unknown move {move!r}")
 
 
@@ -377,34 +349,6 @@ def overhung(h: Hypothesis, at_m: np.ndarray, face: int, config: PlannerConfig) 
     centre = at_m + config.pad_radius * poly.face_normals[face]
     hits = line_hits(poly, centre[None], h.model_from_world.rotate(_UP)[None])
     return bool(hits.first[0] < FINGER_ABOVE and int(hits.face[0]) != face)
-
-
-def _other_face(poly: Polyhedron, edge: int, face: int) -> int:
-    """The face of ``edge`` that is not ``face``."""
-    left = int(poly.edge_left_face[edge])
-    return int(poly.edge_right_face[edge]) if left == face else left
-
-
-def crowded(poly: Polyhedron, at_m: np.ndarray, face: int, config: PlannerConfig, came_from: int | None = None
-            ) -> bool:  # fmt: skip
-    """Whether the pad touching face ``face`` of ``poly`` at ``at_m`` (model frame, on the face) would touch
-    another face too, deeper than :data:`CROWD_SLACK`: its centre, a pad's radius off the face, lies nearer another
-    face than that radius; the face ``came_from`` across the edge just crossed aside (out of a concave corner the
-    pad steps off the wall it slid down, and the hand handles that). A wall rising beside the face (the stem of a
-    T where the pad steps onto the underside of its bar, near the concave edge's end) holds the pad on its rim, and
-    the stroke that measures the face reads a normal partway between the two (the hand's move fails "stepping onto
-    the next face, the pad reached the rim of another edge"). Not checked on a convex model, where a pad resting on
-    a face touches no other, nor where ``at_m`` lies off the face (near an acute corner)."""
-    if poly.is_convex:
-        return False
-    own = poly.triangle_faces == face
-    tri = poly.vertices[poly.triangles]
-    at = np.asarray(at_m, dtype=float)[None]
-    if float(point_triangle_distance(at, tri[own]).min()) > poly.tolerances.planar:
-        return False
-    centre = at + config.pad_radius * poly.face_normals[face]
-    rest = ~own if came_from is None else ~own & (poly.triangle_faces != came_from)
-    return float(point_triangle_distance(centre, tri[rest]).min()) < config.pad_radius - CROWD_SLACK
 
 
 def rolls_to_edge(h: Hypothesis, tr: FaceTrace, config: PlannerConfig) -> bool:

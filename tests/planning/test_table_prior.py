@@ -12,11 +12,9 @@ from haptic.planning.config import PlannerConfig
 from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.moves import CostModel, FaceMove, SensorState
 from haptic.planning.table import (
-    CROWDED,
     MADE,
     OVERHANG,
     TABLE,
-    crowded,
     hand_trace,
     move_outlook,
     rests_on_table,
@@ -110,34 +108,3 @@ def test_a_face_move_onto_the_floor_of_an_overhung_slot_is_predicted_to_stop():
     top = next(f for f in range(plain.n_faces) if plain.face_normals[f][2] > 0.99)
     h = Hypothesis(plain.name, plain, pose, {0: top}, {}, {})
     assert move_outlook(h, up, state, comps, config)[0] == MADE
-
-
-def test_a_pad_stepping_onto_a_face_beside_a_wall_is_crowded_and_the_move_predicted_to_stop():
-    """LBLOCK01 (an L extruded 50 mm up; its notch's walls meet in a concave edge at x = y = 35 mm): the pad touching
-    the notch's wall y = 35 mm within its radius (12 mm) of the other wall touches that wall too; 45 mm along, alone.
-    A face move across the top meeting the wall's top edge 5 mm from the notch's corner is predicted to stop there,
-    one meeting it 45 mm from the corner to be made; a convex model's faces are never crowded."""
-    lb, config = LIB["LBLOCK01"], PlannerConfig(table_z=TABLE_Z)
-    wall = next(f for f in range(lb.n_faces) if np.allclose(lb.face_normals[f], [0, 1, 0])
-                and lb.vertices[list(lb.faces[f])][:, 0].min() > 0.03)  # fmt: skip
-    assert crowded(lb, np.array([0.040, 0.035, 0.025]), wall, config)
-    assert not crowded(lb, np.array([0.080, 0.035, 0.025]), wall, config)
-    assert not crowded(lb, np.array([0.040, 0.030, 0.025]), wall, config)  # off the face: cannot say
-    other = next(f for f in range(lb.n_faces) if np.allclose(lb.face_normals[f], [1, 0, 0])
-                 and lb.vertices[list(lb.faces[f])][:, 1].min() > 0.03)  # fmt: skip
-    # out of the notch's corner, stepping off the wall the pad slid down: that wall is not in its way
-    assert not crowded(lb, np.array([0.040, 0.035, 0.025]), wall, config, came_from=other)
-    box = LIB["BOX01"]
-    top = int(np.argmax(box.face_normals[:, 2]))
-    middle = box.vertices[list(box.faces[top])].mean(axis=0)
-    assert not crowded(box, middle, top, config)
-
-    pose = SE3(np.eye(3), np.array([0.5, 0.0, TABLE_Z]))
-    top = int(np.argmax(lb.face_normals[:, 2]))
-    h = Hypothesis(lb.name, lb, pose, {0: top}, {}, {})
-    face = DataFace(id=0, normal=np.array([0.0, 0.0, 1.0]), points=pose.apply(np.array([[0.04, 0.01, 0.05]])),
-                    normal_bound=0.01, position_bound=0.001)  # fmt: skip
-    up_y = FaceMove(np.array([0.0, 1.0, 0.0]))
-    for x, outlook in ((0.040, CROWDED), (0.080, MADE)):
-        state = SensorState(position=pose.apply(np.array([x, 0.01, 0.05])), face=0)
-        assert move_outlook(h, up_y, state, {0: face}, config)[0] == outlook
