@@ -36,8 +36,10 @@ LIFT = 0.08
 MARGIN = 0.0005
 """Slack of the pad-clearance test against the object [m]."""
 TRACE_ROOM = 0.006
-"""Room a trace needs: a point the pad could touch only within this of its limit above the table counts as
-out of reach (a face move there would be refused as too close to the table) [m]."""
+"""Room a trace needs: a point of an upright face the pad could touch only within this of its limit above the
+table counts as out of reach (a face move there would be refused as too close to the table); of a sloping face, this
+times the sine of its slope, and of a level face none (a trace across it stays as high as it touched: an L bracket's
+foot, 10 mm high, is touched from above or by sliding down the upright leg into the corner) [m]."""
 MEASURE_ROOM = 0.0
 """Room the verification asks of a face, beyond the pad's clearance of the table, to count it in reach
 (:func:`haptic.planning.verify.reachable_features`): none. Its vertices are measured at the ends of edge moves along
@@ -83,11 +85,13 @@ def touch_distance(poly: Polyhedron, world_from_model: SE3, points: np.ndarray, 
 
 
 def touchable(
-    poly: Polyhedron, world_from_model: SE3, pts: np.ndarray, nrm: np.ndarray, config: PlannerConfig, room: float
+    poly: Polyhedron, world_from_model: SE3, pts: np.ndarray, nrm: np.ndarray, config: PlannerConfig,
+    room: float | np.ndarray,
 ) -> np.ndarray:
     """Which world points ``pts`` of faces of normals ``nrm`` the pad can touch: clear of the table by
-    ``config.table_clearance`` plus ``room``, not leaning under past ``config.max_undercut``, the pad clear
-    of the rest of the object and free to come down from above. Shape (P,) bool."""
+    ``config.table_clearance`` plus ``room`` (one, or one per point), not leaning under past
+    ``config.max_undercut``, the pad clear of the rest of the object and free to come down from above. Shape (P,)
+    bool."""
     r = config.pad_radius
     ok = np.ones(len(pts), dtype=bool)
     centre = pts + r * nrm
@@ -114,7 +118,9 @@ def reachable(
     """The reachable sample points of ``poly`` at ``world_from_model``, world frame, and their normals."""
     pts_m, nrm_m = surface_samples(poly, spacing)
     pts, nrm = world_from_model.apply(pts_m), world_from_model.rotate(nrm_m)
-    ok = touchable(poly, world_from_model, pts, nrm, config, TRACE_ROOM)
+    # a trace needs the room where it heads down a sloping face; on a level one it stays as high as it touched
+    room = TRACE_ROOM * np.sqrt(np.clip(1.0 - nrm[:, 2] ** 2, 0.0, 1.0))
+    ok = touchable(poly, world_from_model, pts, nrm, config, room)
     return pts[ok], nrm[ok]
 
 

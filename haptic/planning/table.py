@@ -80,6 +80,23 @@ def level_heading(d: np.ndarray, n: np.ndarray) -> np.ndarray | None:
     return np.copysign(np.cos(LEVEL_RISE), across) * side + np.sin(LEVEL_RISE) * up
 
 
+def slide_end_clearance(h: Hypothesis, tr: FaceTrace, config: PlannerConfig) -> float:
+    """The pad's clearance of the table (:func:`pad_clearance`) where face move trace ``tr`` of ``h`` meets its
+    edge: on the face, at the edge; at a concave edge, in the corner, where the pad sliding down the face meets the
+    next face first, its centre a radius from both planes (sliding down the upright leg of an L bracket standing on
+    its foot, the pad meets the foot's top 10 mm above the table, its lowest point there, not 12 mm lower).
+    +inf without a table."""
+    poly, t, hit = h.poly, h.world_from_model, tr.hit
+    n_f = poly.face_normals[tr.face]
+    if config.table_z is not None and poly.edge_convexity[hit.edge] < 0:
+        n_g = poly.face_normals[hit.next_face]
+        k = 1.0 + float(n_f @ n_g)
+        if k > 1e-6:
+            centre = t.apply(hit.point + config.pad_radius * (n_f + n_g) / k)
+            return float(centre[2] - config.pad_radius - config.table_z)
+    return pad_clearance(t.apply(hit.point), t.rotate(n_f), config)
+
+
 def level_leg(h: Hypothesis, tr: FaceTrace, config: PlannerConfig) -> tuple[bool, FaceTrace | None]:
     """Whether face move trace ``tr`` of ``h`` goes on level (:func:`level_heading`): its slide heads down and
     comes within ``config.table_clearance`` of the table before its edge, on a face with a side to go to; and
@@ -96,7 +113,7 @@ def level_leg(h: Hypothesis, tr: FaceTrace, config: PlannerConfig) -> tuple[bool
         return False, None
     u_m = u_m / norm
     n_w, u_w = t.rotate(n_m), t.rotate(u_m)
-    if float(u_w[2]) >= 0.0 or pad_clearance(t.apply(hit.point), n_w, config) >= lim:
+    if float(u_w[2]) >= 0.0 or slide_end_clearance(h, tr, config) >= lim:
         return False, None
     level = level_heading(u_w, n_w)
     if level is None:
@@ -288,7 +305,7 @@ def move_outlook(
             tr, levelled, d_z = beyond, False, float(t.rotate(beyond.direction)[2])
         hit = tr.hit
         n_w = t.rotate(poly.face_normals[tr.face])
-        if not levelled and d_z < 0.0 and pad_clearance(t.apply(hit.point), n_w, config) < lim:
+        if not levelled and d_z < 0.0 and slide_end_clearance(h, tr, config) < lim:
             # the slide stops where the pad comes too close to the table
             if crossed:
                 return TABLE, first, 0.0
