@@ -5,14 +5,16 @@ next to it off the table."""
 from dataclasses import replace
 
 import numpy as np
+import pytest
 
 from haptic.geometry import SE3
-from haptic.geometry.shapes import convex_hull
+from haptic.geometry.shapes import convex_hull, l_bracket
 from haptic.matching.components import DataEdge, DataFace
 from haptic.planning.config import PlannerConfig
 from haptic.planning.hypothesis import Hypothesis, trace_in
 from haptic.planning.moves import EdgeMove, FaceMove, SensorState
-from haptic.planning.table import MADE, TABLE, data_table_conflict, move_outlook, over_shallow
+from haptic.planning.reach import TRACE_ROOM, reachable
+from haptic.planning.table import MADE, TABLE, data_table_conflict, move_outlook, over_shallow, slide_end_clearance
 
 CFG = PlannerConfig(table_z=0.0, pad_radius=0.012, table_clearance=0.004)
 
@@ -77,3 +79,40 @@ def test_an_edge_move_is_refused_where_the_pad_cannot_touch_a_face_next_to_the_e
     # without a table nothing is refused
     comps, state = _edge_alone(0.002)
     assert not data_table_conflict(EdgeMove(1), state, comps, PlannerConfig())
+
+
+def _bracket():
+    """An L bracket standing on its foot (40 mm long, 8 mm thick; the upright leg 60 mm tall, 30 mm wide), its
+    bottom on the table, and its upright leg's inner face (facing +x, at x = 8 mm)."""
+    poly = l_bracket(0.040, 0.060, 0.008, 0.030, name="bracket")
+    inner = next(f for f in range(poly.n_faces) if poly.face_normals[f][0] > 0.99
+                 and poly.vertices[list(poly.faces[f])][:, 0].max() < 0.009)  # fmt: skip
+    return poly, SE3(np.eye(3), np.zeros(3)), inner
+
+
+def test_a_slide_down_into_a_concave_corner_is_judged_where_the_pad_meets_the_next_face():
+    """Sliding down the bracket's upright leg, the pad meets the foot's top first, its centre a radius from both
+    faces: its lowest point there 8 mm above the table, not 4 mm under it as at the edge on the leg alone. The move
+    is made (part_lbracket of scripts/make_parts.py, seed 1: such a move predicted stopped by the table, the two
+    poses it would tell apart were left)."""
+    poly, pose, inner = _bracket()
+    at = np.array([0.008, 0.015, 0.040])
+    n = np.array([1.0, 0.0, 0.0])
+    comps = {0: DataFace(0, n, np.array([at, at + [0.0, 0.002, 0.002]]), 0.01, 1e-3)}
+    h = Hypothesis("bracket", poly, pose, {0: inner}, {}, {})
+    state, down = SensorState(position=at, face=0), FaceMove(np.array([0.0, 0.0, -1.0]))
+    tr = trace_in(h, down, state)
+    assert poly.edge_convexity[tr.hit.edge] < 0
+    assert slide_end_clearance(h, tr, CFG) == pytest.approx(0.008)
+    assert move_outlook(h, down, state, comps, CFG)[0] == MADE
+
+
+def test_a_level_face_low_beside_the_table_counts_in_reach_to_tell_poses_apart():
+    """The foot's top, 8 mm above the table, is touched from above (a trace across it stays that high): its points
+    clear of the upright leg count in reach; a face rising from the table is out of reach below the trace's room."""
+    poly, pose, inner = _bracket()
+    pts, nrm = reachable(poly, pose, CFG)
+    foot = (nrm[:, 2] > 0.99) & (np.abs(pts[:, 2] - 0.008) < 1e-9)
+    assert foot.any() and pts[foot, 0].min() >= 0.008 + CFG.pad_radius - 1e-3
+    side = np.abs(nrm[:, 2]) < 1e-9
+    assert side.any() and pts[side, 2].min() >= CFG.table_clearance + TRACE_ROOM
