@@ -532,6 +532,31 @@ class PhysicsExecutor(LandingSearch):
             return fit_a, None, f"no edge between the faces: {why}"
         return fit_a, seg.edge_line(fit_a, fit_b, convex, roll_all, corner), ""
 
+    def _rolled_onto(
+        self, move: Move, left: int, line: LineFit, kind: str, normals: tuple[np.ndarray, np.ndarray], fit: FaceFit,
+        stroke: ContactTrace, distance: float, cost: float, vertex: tuple[int, float] | None = None,
+    ) -> MoveResult:  # fmt: skip
+        """The result of a face or vertex move that rolled over an edge (``line``, ``kind``, the faces' ``normals``)
+        from face ``left`` and stroked the next face (``fit`` from ``stroke``): the face its slide crossed onto over
+        an edge too shallow to feel first, when it did (:meth:`_add_crossed`; the edge was then rolled over from
+        that face), the edge, adjacent to the face it was rolled over from and to ``vertex`` (the data vertex the
+        move circled and its parameter along the line), and the next face, where the sensor now rests."""
+        seg = self.segmenter
+        crossed = self._add_crossed()
+        left = left if crossed is None else crossed
+        new_face = seg.next_id + 1
+        adjacent = (left,) if vertex is None else (vertex[0], left)
+        edge = seg.add_edge(line, (left, new_face), kind == "convex", normals, adjacent=adjacent, vertex=vertex)
+        face = seg.add_face(fit, adjacent=(edge.id,))
+        self.store_face(face.id, stroke, fit)
+        self.on_face = face.id
+        self.state = SensorState(position=self.contact_point(), face=face.id, edge=edge.id,
+                                 vertex=None if vertex is None else vertex[0], edge_faces=(left, face.id))  # fmt: skip
+        comps = (edge, face) if crossed is None else (seg.faces[crossed].component, edge, face)
+        info = {"kind": kind} if crossed is None else {"kind": kind, "crossed_face": crossed}
+        return MoveResult(move=move, status="ok", components=comps, distance=distance, cost=cost, state=self.state,
+                          info=info)  # fmt: skip
+
     def _add_crossed(self) -> int | None:
         """Report the face a move's slide crossed onto over an edge too shallow to feel (:attr:`_crossed`), adjacent
         to nothing yet, and keep its rows; its id (None when the slide crossed none)."""
@@ -1154,22 +1179,9 @@ class PhysicsExecutor(LandingSearch):
             self.recoveries.append(f"{why}: crossed again {np.linalg.norm(shift) * 1000:.0f} mm along the edge"
                                    f"{square}{'' if way is across else FROM_TOUCHED}")  # fmt: skip
             heading = way
-        # the slide crossed a face over an edge too shallow to feel: that face, then the edge rolled over from it
-        crossed = self._add_crossed()
-        left = st.face if crossed is None else crossed
-        new_face = seg.next_id + 1
-        edge = seg.add_edge(line, (left, new_face), kind == "convex", (fit_a.normal, fit_b.normal),
-                            adjacent=(left,))  # fmt: skip
-        face = seg.add_face(fit_b, adjacent=(edge.id,))
-        self.store_face(face.id, stroke, fit_b)
-        self.on_face = face.id
-        self.state = SensorState(position=self.contact_point(), face=face.id, edge=edge.id,
-                                 edge_faces=(left, face.id))  # fmt: skip
         run = lead + r.distance
-        comps = (edge, face) if crossed is None else (seg.faces[crossed].component, edge, face)
-        info = {"kind": kind} if crossed is None else {"kind": kind, "crossed_face": crossed}
-        return MoveResult(move=move, status="ok", components=comps, distance=run, cost=self.costs.face_move(run),
-                          state=self.state, info=info)  # fmt: skip
+        return self._rolled_onto(move, st.face, line, kind, (fit_a.normal, fit_b.normal), fit_b, stroke, run,
+                                 self.costs.face_move(run))  # fmt: skip
 
     def _held_from_above(self, r: PrimitiveResult, heading: np.ndarray):
         """The link contact that held a slide heading down across a face (``r`` stalled, event ``"blocked"``): a
@@ -2144,21 +2156,8 @@ class PhysicsExecutor(LandingSearch):
             # the circle crossed an edge that does not leave the vertex (on a face narrower than the circle)
             return self.failed_result(move, "unreachable", f"the edge met passes {off * MM:.1f} mm from the vertex "
                                                            "circled: it leaves another vertex")  # fmt: skip
-        # the circle crossed a face over an edge too shallow to feel: that face, then the edge rolled over from it
-        crossed = self._add_crossed()
-        left = f if crossed is None else crossed
-        new_face = seg.next_id + 1
-        edge = seg.add_edge(line, (left, new_face), kind == "convex", (fit_f.normal, fit_g.normal),
-                            adjacent=(st.vertex, left), vertex=(st.vertex, s_vtx))  # fmt: skip
-        face = seg.add_face(fit_g, adjacent=(edge.id,))
-        self.store_face(face.id, stroke, fit_g)
-        self.on_face = face.id
-        self.state = SensorState(position=self.contact_point(), face=face.id, edge=edge.id, vertex=st.vertex,
-                                 edge_faces=(left, face.id))  # fmt: skip
-        comps = (edge, face) if crossed is None else (seg.faces[crossed].component, edge, face)
-        info = {"kind": kind} if crossed is None else {"kind": kind, "crossed_face": crossed}
-        return MoveResult(move=move, status="ok", components=comps, distance=r.distance,
-                          cost=self.costs.vertex_move(r.distance), state=self.state, info=info)  # fmt: skip
+        return self._rolled_onto(move, f, line, kind, (fit_f.normal, fit_g.normal), fit_g, stroke, r.distance,
+                                 self.costs.vertex_move(r.distance), vertex=(st.vertex, s_vtx))  # fmt: skip
 
     def _outward(self, n_f: np.ndarray, roll: ContactTrace | None, corner: np.ndarray, vtx: np.ndarray
                  ) -> np.ndarray | None:  # fmt: skip

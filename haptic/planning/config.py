@@ -57,6 +57,11 @@ class PlannerConfig:
     (the physics executor's ``TouchConfig.edge_angle``): over a shallower edge the slide goes on onto the next face,
     and what the table lets the move do is judged where it ends (:func:`~haptic.planning.table.move_outlook`). None:
     every edge is felt."""
+    edge_reentry: float | None = None
+    """With a table, how far in from an edge the hand touches one of its faces again before following it (the
+    physics executor's ``PhysicsSettings.edge_reentry``): an edge move along a convex edge whose faces the pad cannot
+    touch that far in off the table counts as refused (:func:`~haptic.planning.table.edge_return_in_reach`) [m].
+    None: every edge's return counts as in reach."""
     concave_end_block: float | None = None
     """With a table, where the hand can tell a concave edge's end: only where a face there blocks the pad
     travelling along the edge (its outward normal against the travel by more than this cosine). Past an end

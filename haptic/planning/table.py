@@ -481,23 +481,18 @@ def vertex_sweep_off_table(
     )
 
 
-EDGE_REENTRY = 0.004
-"""How far in from an edge the hand touches one of its faces again before following it, somewhere along the explored
-interval (the physics executor's ``PhysicsSettings.edge_reentry``) [m]."""
-
-
 def edge_return_in_reach(state: SensorState, components: Mapping[int, DataComponent], config: PlannerConfig) -> bool:
     """From the data alone: whether the pad, to follow the current convex edge, can touch one of its faces
-    :data:`EDGE_REENTRY` in from it somewhere along its explored interval with its lowest point
+    :attr:`PlannerConfig.edge_reentry` in from it somewhere along its explored interval with its lowest point
     ``config.table_clearance`` above the table (the hand sets off along an edge so; where no such point is, the edge
-    move fails at once, "the edge next to the table is out of the pad's reach"). True where the data cannot say: no
-    edge, no face of it known beside it (:attr:`~haptic.matching.components.DataEdge.side_points`: the faces the
-    hand knows the way into from the edge), or a concave edge (the hand returns into its corner instead). On the
-    public polyhedra at 30 mm (elongated_triangular_bipyramid, seed 1) an edge reported alone, the roll over it
-    stopped by the table, had its one face's strip along it within 2 mm of the table, and both moves along it failed
-    so."""
+    move fails at once, "the edge next to the table is out of the pad's reach"). True without
+    ``config.edge_reentry`` and where the data cannot say: no edge, no face of it known beside it
+    (:attr:`~haptic.matching.components.DataEdge.side_points`: the faces the hand knows the way into from the edge),
+    or a concave edge (the hand returns into its corner instead). On the public polyhedra at 30 mm
+    (elongated_triangular_bipyramid, seed 1) an edge reported alone, the roll over it stopped by the table, had its
+    one face's strip along it within 2 mm of the table, and both moves along it failed so."""
     edge = components.get(state.edge) if state.edge is not None else None
-    if not isinstance(edge, DataEdge):
+    if config.edge_reentry is None or not isinstance(edge, DataEdge):
         return True
     b, sides = edge.direction, dict(edge.side_points)
     faces = [(f, components[f]) for f in sides if isinstance(components.get(f), DataFace)]
@@ -512,7 +507,8 @@ def edge_return_in_reach(state: SensorState, components: Mapping[int, DataCompon
         if float((sides[f] - edge.point) @ w) < 0.0:
             w = -w
         # the clearance is linear along the edge: highest at one end of the explored interval
-        if any(pad_clearance(edge.point + s * b + EDGE_REENTRY * w, face.normal, config) >= config.table_clearance
+        inward = config.edge_reentry * w
+        if any(pad_clearance(edge.point + s * b + inward, face.normal, config) >= config.table_clearance
                for s in (0.0, edge.length)):  # fmt: skip
             return True
     return False

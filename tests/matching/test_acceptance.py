@@ -20,6 +20,7 @@ from haptic.geometry.perturb import scale_dimension
 from haptic.matching.acceptance import (
     K_SIGMA_PHYSICS,
     POSE_SAFETY,
+    Coverage,
     acceptance,
     check_verify_mode,
     coverage,
@@ -118,6 +119,20 @@ def test_coverage_counts_what_the_interpretation_pairs():
     assert cov.met("fast") == (ff == fe == 1.0)
     rec = cov.record(LIB["BOX01"])
     assert rec["faces_total"] == 6 and rec["faces"] == len(cov.faces)
+
+
+def test_the_coverage_targets_progress_counts_only_its_features():
+    """What the verification counts as progress (:meth:`Coverage.target_measured`): under ``full`` the vertices, not
+    the faces and edges measured on the way to them; under ``fast`` the faces and edges; nothing under ``none``."""
+    every = frozenset(range(6)), frozenset(range(12)), frozenset(range(8))
+    cov = Coverage(frozenset({0, 1}), frozenset({0, 1, 2}), frozenset({4}), *every)
+    more = Coverage(frozenset({0, 1, 2}), frozenset({0, 1, 2, 3}), frozenset({4}), *every)
+    assert cov.target_measured("full") == more.target_measured("full") == 1
+    assert (cov.target_measured("fast"), more.target_measured("fast")) == (5, 7)
+    assert cov.target_measured("none") == 0
+    assert more.measured() > cov.measured()  # every feature, as before
+    vertex = Coverage(cov.faces, cov.edges, frozenset({4, 5}), *every)
+    assert vertex.target_measured("full") == 2
 
 
 def test_verify_mode_is_checked():

@@ -71,14 +71,27 @@ def test_an_edge_move_is_refused_where_the_pad_cannot_touch_a_face_next_to_the_e
     sloping 30°, the pad's lowest point there is 0.4 mm above the table (its limit 2, the planner's 4), and the move
     fails at once (elongated_triangular_bipyramid of the public polyhedra at 30 mm, seed 1: an edge reported alone,
     the roll over it stopped by the table, and both moves along it failed so). 6 mm above the table it has room."""
+    hand = replace(CFG, edge_reentry=0.004)
     comps, state = _edge_alone(0.002)
-    assert data_table_conflict(EdgeMove(1), state, comps, CFG)
-    assert data_table_conflict(EdgeMove(-1), state, comps, CFG)
+    assert data_table_conflict(EdgeMove(1), state, comps, hand)
+    assert data_table_conflict(EdgeMove(-1), state, comps, hand)
     comps, state = _edge_alone(0.006)
-    assert not data_table_conflict(EdgeMove(1), state, comps, CFG)
-    # without a table nothing is refused
+    assert not data_table_conflict(EdgeMove(1), state, comps, hand)
+    # without a table, or without the hand's way back to the edge, nothing is refused
     comps, state = _edge_alone(0.002)
-    assert not data_table_conflict(EdgeMove(1), state, comps, PlannerConfig())
+    assert not data_table_conflict(EdgeMove(1), state, comps, replace(hand, table_z=None))
+    assert not data_table_conflict(EdgeMove(1), state, comps, CFG)
+
+
+def test_the_hand_world_gives_the_planner_the_executors_way_back_to_an_edge():
+    """The planner judges an edge move's return with the physics executor's own distance in from the edge."""
+    pytest.importorskip("mujoco")
+    from haptic.episode.spec import EpisodeSpec
+    from haptic.episode.worlds import build_episode
+    from haptic.executor.physics import PhysicsSettings
+
+    episode = build_episode(EpisodeSpec(model="BOX01", seed=1, executor="physics"))
+    assert episode.config.edge_reentry == PhysicsSettings().edge_reentry
 
 
 def _bracket():
