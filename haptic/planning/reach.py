@@ -51,7 +51,13 @@ verification ended incomplete at once; the hand measures every one of them) [m].
 def surface_samples(poly: Polyhedron, spacing: float = SPACING) -> tuple[np.ndarray, np.ndarray]:
     """Points over every face (a barycentric grid per triangle, corners and edges included) and their faces'
     outward normals, model frame: shapes (P, 3), (P, 3)."""
-    pts, nrm = [], []
+    pts, faces = surface_samples_on_faces(poly, spacing)
+    return pts, poly.face_normals[faces]
+
+
+def surface_samples_on_faces(poly: Polyhedron, spacing: float = SPACING) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`surface_samples`' points and the face each lies on: shapes (P, 3), (P,)."""
+    pts, faces = [], []
     for (i, j, k), f in zip(poly.triangles, poly.triangle_faces, strict=True):
         a, b, c = poly.vertices[i], poly.vertices[j], poly.vertices[k]
         n = max(1, int(np.ceil(max(np.linalg.norm(b - a), np.linalg.norm(c - a), np.linalg.norm(c - b)) / spacing)))
@@ -59,8 +65,8 @@ def surface_samples(poly: Polyhedron, spacing: float = SPACING) -> tuple[np.ndar
         keep = u + v <= n
         u, v = u[keep] / n, v[keep] / n
         pts.append(a + u[:, None] * (b - a) + v[:, None] * (c - a))
-        nrm.append(np.broadcast_to(poly.face_normals[f], (len(u), 3)))
-    return np.concatenate(pts), np.concatenate(nrm)
+        faces.append(np.full(len(u), int(f)))
+    return np.concatenate(pts), np.concatenate(faces)
 
 
 FACING = np.cos(np.deg2rad(20.0))

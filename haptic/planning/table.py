@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
+from functools import lru_cache
 
 import numpy as np
 
@@ -237,14 +238,37 @@ def table_conflict(
 
 
 MADE, EDGE_ONLY, TABLE, UNDERCUT, CONCAVE = "made", "edge only", "table", "undercut", "concave"
-OVERHANG = "overhang"
+OVERHANG, NARROW = "overhang", "narrow"
 """What a hypothesis predicts of a move on the hand (:func:`move_outlook`): carried out; a face move ending at its
 edge, the next face leaning under out of the pad's reach (a success that reports the edge alone); stopped by the
 table (the pad would come onto it, or the next face is too close to it); stopped at a convex edge onto a face
 leaning under further than the pad reaches; stopped at a concave edge's end or vertex the hand cannot tell; stopped
-stepping onto a face the object overhangs, where the finger's links meet it (:func:`overhung`)."""
-STOPS = (TABLE, UNDERCUT, CONCAVE, OVERHANG)
+stepping onto a face the object overhangs, where the finger's links meet it (:func:`overhung`); stopped stepping
+onto a face the pad touches nowhere without touching the object elsewhere (:func:`pad_fits`)."""
+STOPS = (TABLE, UNDERCUT, CONCAVE, OVERHANG, NARROW)
 """The outlooks of a move the hand is predicted not to carry out."""
+
+
+@lru_cache(maxsize=4096)
+def _faces_the_pad_fits(poly: Polyhedron, radius: float) -> frozenset[int]:
+    """:func:`pad_fits` for every face of ``poly`` at once (model frame: the pose does not enter)."""
+    if poly.is_convex:  # the pad a radius off any face of a convex solid is a radius off all of it
+        return frozenset(range(poly.n_faces))
+    from haptic.geometry.distance import surface_distance
+    from haptic.planning.reach import MARGIN, SPACING, surface_samples_on_faces
+
+    pts, faces = surface_samples_on_faces(poly, SPACING / 2.0)
+    clear = surface_distance(poly, pts + radius * poly.face_normals[faces]) >= radius - MARGIN
+    return frozenset(int(f) for f in np.unique(faces[clear]))
+
+
+def pad_fits(poly: Polyhedron, face: int, config: PlannerConfig) -> bool:
+    """Whether the pad (radius ``config.pad_radius``) can touch face ``face`` of ``poly`` somewhere without touching
+    another face: its centre a radius off the face, no nearer the rest of the object. A face narrower than the pad
+    between walls or beside a step (the 7 mm riser of a small stepped block, the floor of a channel as wide as the
+    pad) it touches nowhere: the hand stepping onto it meets the rim of the face beyond (the stroke's first leg
+    turns its normal), and the move fails."""
+    return face in _faces_the_pad_fits(poly, float(config.pad_radius))
 
 
 def table_prediction(
@@ -286,7 +310,9 @@ def move_outlook(
         q_m = at_m + TABLE_STEP_ONTO * _inward(poly, e_m, g_m)
         if pad_clearance(t.apply(q_m), t.rotate(poly.face_normals[g_m]), config) < lim:
             return TABLE
-        return OVERHANG if overhung(h, q_m, g_m, config) else MADE
+        if overhung(h, q_m, g_m, config):
+            return OVERHANG
+        return MADE if pad_fits(poly, g_m, config) else NARROW
 
     if isinstance(move, FaceMove):
         tr = trace_in(h, move, state)
