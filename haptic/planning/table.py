@@ -304,15 +304,16 @@ def move_outlook(
         return float(t.rotate(poly.face_normals[g_m])[2]) < -np.sin(config.max_undercut)
 
     def onto(e_m: int, g_m: int, at_m: np.ndarray) -> str:
-        """Stepping over edge ``e_m`` onto face ``g_m`` at ``at_m``: made, or stopped by an undercut or the table."""
+        """Stepping over edge ``e_m`` onto face ``g_m`` at ``at_m``: made, or stopped by an undercut, a face too narrow
+        for the pad, the table or an overhang."""
         if leans_under(e_m, g_m):
             return UNDERCUT
+        if not pad_fits(poly, g_m, config):  # the pad steps onto the rim beyond first, the table or not
+            return NARROW
         q_m = at_m + TABLE_STEP_ONTO * _inward(poly, e_m, g_m)
         if pad_clearance(t.apply(q_m), t.rotate(poly.face_normals[g_m]), config) < lim:
             return TABLE
-        if overhung(h, q_m, g_m, config):
-            return OVERHANG
-        return MADE if pad_fits(poly, g_m, config) else NARROW
+        return OVERHANG if overhung(h, q_m, g_m, config) else MADE
 
     if isinstance(move, FaceMove):
         tr = trace_in(h, move, state)

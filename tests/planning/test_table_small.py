@@ -8,13 +8,22 @@ import numpy as np
 import pytest
 
 from haptic.geometry import SE3
-from haptic.geometry.shapes import convex_hull, l_bracket
+from haptic.geometry.shapes import convex_hull, extrusion_xz, l_bracket
 from haptic.matching.components import DataEdge, DataFace
 from haptic.planning.config import PlannerConfig
 from haptic.planning.hypothesis import Hypothesis, trace_in
 from haptic.planning.moves import EdgeMove, FaceMove, SensorState
 from haptic.planning.reach import TRACE_ROOM, reachable
-from haptic.planning.table import MADE, TABLE, data_table_conflict, move_outlook, over_shallow, slide_end_clearance
+from haptic.planning.table import (
+    MADE,
+    NARROW,
+    TABLE,
+    data_table_conflict,
+    move_outlook,
+    over_shallow,
+    pad_fits,
+    slide_end_clearance,
+)
 
 CFG = PlannerConfig(table_z=0.0, pad_radius=0.012, table_clearance=0.004)
 
@@ -129,3 +138,29 @@ def test_a_level_face_low_beside_the_table_counts_in_reach_to_tell_poses_apart()
     assert foot.any() and pts[foot, 0].min() >= 0.008 + CFG.pad_radius - 1e-3
     side = np.abs(nrm[:, 2]) < 1e-9
     assert side.any() and pts[side, 2].min() >= CFG.table_clearance + TRACE_ROOM
+
+
+def test_a_step_onto_a_face_the_pad_touches_nowhere_alone_is_predicted_to_stop():
+    """A small stepped block (scripts/make_parts.py's part_small_step: 30 mm long, its upper part 18 mm long and
+    15 mm high, the step 8 mm high): the 7 mm riser between them is touched nowhere by the 12 mm pad without it
+    touching the step's top too, and a face move across the upper top onto it is predicted to stop there (seed 1 on
+    the hand: seven such moves failed, "stepping onto the next face, the pad reached the rim of another edge");
+    the step's top, 12 mm long, and every face of a convex solid fit the pad."""
+    outline = [(0.0, 0.0), (0.030, 0.0), (0.030, 0.008), (0.018, 0.008), (0.018, 0.015), (0.0, 0.015)]
+    poly = extrusion_xz(outline, 0.020, name="step")
+    riser = next(f for f in range(poly.n_faces) if poly.face_normals[f][0] > 0.99
+                 and poly.vertices[list(poly.faces[f])][:, 0].max() < 0.019)  # fmt: skip
+    tread = next(f for f in range(poly.n_faces) if poly.face_normals[f][2] > 0.99
+                 and poly.vertices[list(poly.faces[f])][:, 2].max() < 0.009)  # fmt: skip
+    top = next(f for f in range(poly.n_faces) if poly.face_normals[f][2] > 0.99
+               and poly.vertices[list(poly.faces[f])][:, 2].min() > 0.014)  # fmt: skip
+    assert not pad_fits(poly, riser, CFG)
+    assert pad_fits(poly, tread, CFG) and pad_fits(poly, top, CFG)
+    hull, _, _ = _roof()
+    assert all(pad_fits(hull.poly, f, CFG) for f in range(hull.poly.n_faces))
+
+    at = np.array([0.008, 0.010, 0.015])
+    comps = {0: DataFace(0, np.array([0.0, 0.0, 1.0]), np.array([at, at + [0.002, 0.0, 0.0]]), 0.01, 1e-3)}
+    h = Hypothesis("step", poly, SE3(np.eye(3), np.zeros(3)), {0: top}, {}, {})
+    move = FaceMove(np.array([1.0, 0.0, 0.0]))
+    assert move_outlook(h, move, SensorState(position=at, face=0), comps, CFG)[0] == NARROW
