@@ -249,25 +249,58 @@ STOPS = (TABLE, UNDERCUT, CONCAVE, OVERHANG, NARROW)
 """The outlooks of a move the hand is predicted not to carry out."""
 
 
+PAD_ROOM = 0.003
+"""Room the pad needs on a face to stroke it (:func:`pad_fits`): some place on it from which it can move this far
+across the face in every direction touching no other face [m]. A stroke's legs run a few millimetres; a wall 12 mm
+tall above a step 7 mm deep (part_small_step of ``scripts/make_parts.py`` standing on its end) leaves the pad 2 mm
+at its top, and the floor of a channel 24 mm wide (part_uchannel's) 0.6 mm: steps onto both failed on the hand
+("the pad reached the rim of another edge", 11 of 12 tries)."""
+FIT_SPACING = 0.001
+"""Spacing of the points :func:`pad_fits` tries on a face [m]."""
+
+
 @lru_cache(maxsize=4096)
 def _faces_the_pad_fits(poly: Polyhedron, radius: float) -> frozenset[int]:
     """:func:`pad_fits` for every face of ``poly`` at once (model frame: the pose does not enter)."""
     if poly.is_convex:  # the pad a radius off any face of a convex solid is a radius off all of it
         return frozenset(range(poly.n_faces))
-    from haptic.geometry.distance import surface_distance
-    from haptic.planning.reach import MARGIN, SPACING, surface_samples_on_faces
+    from scipy.spatial import cKDTree
 
-    pts, faces = surface_samples_on_faces(poly, SPACING / 2.0)
-    clear = surface_distance(poly, pts + radius * poly.face_normals[faces]) >= radius - MARGIN
-    return frozenset(int(f) for f in np.unique(faces[clear]))
+    from haptic.geometry.distance import point_triangle_distance
+    from haptic.planning.reach import MARGIN, surface_samples_on_faces
+
+    pts, faces = surface_samples_on_faces(poly, FIT_SPACING)
+    tri = poly.vertices[poly.triangles]
+    fits = set()
+    for f in range(poly.n_faces):
+        n = poly.face_normals[f]
+        p_f = pts[faces == f]
+        # the faces that can touch the pad on this one rise in front of its plane (across a convex edge they fall
+        # away behind it)
+        front = (poly.triangle_faces != f) & (((tri - p_f[0]) @ n).max(axis=1) > 1e-9)
+        if not front.any():
+            fits.add(f)
+            continue
+        centre = p_f + radius * n
+        clear = np.ones(len(p_f), dtype=bool)
+        for start in range(0, len(p_f), 2048):
+            d = point_triangle_distance(centre[start : start + 2048], tri[front]).min(axis=1)
+            clear[start : start + 2048] = d >= radius - MARGIN
+        if clear.all():
+            fits.add(f)
+        elif clear.any():
+            room, _ = cKDTree(p_f[~clear]).query(p_f[clear])
+            if float(room.max()) >= PAD_ROOM:
+                fits.add(f)
+    return frozenset(fits)
 
 
 def pad_fits(poly: Polyhedron, face: int, config: PlannerConfig) -> bool:
-    """Whether the pad (radius ``config.pad_radius``) can touch face ``face`` of ``poly`` somewhere without touching
-    another face: its centre a radius off the face, no nearer the rest of the object. A face narrower than the pad
-    between walls or beside a step (the 7 mm riser of a small stepped block, the floor of a channel as wide as the
-    pad) it touches nowhere: the hand stepping onto it meets the rim of the face beyond (the stroke's first leg
-    turns its normal), and the move fails."""
+    """Whether the pad (radius ``config.pad_radius``) can stroke face ``face`` of ``poly`` touching no other face:
+    somewhere on it, its centre a radius off the face, no nearer the rest of the object, with :data:`PAD_ROOM` to
+    move in every direction along the face. A face narrower than that between walls or above a step (the floor of a
+    channel as wide as the pad, a wall above a step less deep than the pad's radius) the hand stepping onto it meets
+    the rim of the face beyond (the stroke's first leg turns its normal), and the move fails."""
     return face in _faces_the_pad_fits(poly, float(config.pad_radius))
 
 

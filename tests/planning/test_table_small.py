@@ -143,9 +143,8 @@ def test_a_level_face_low_beside_the_table_counts_in_reach_to_tell_poses_apart()
 def test_a_step_onto_a_face_the_pad_touches_nowhere_alone_is_predicted_to_stop():
     """A small stepped block (scripts/make_parts.py's part_small_step: 30 mm long, its upper part 18 mm long and
     15 mm high, the step 8 mm high): the 7 mm riser between them is touched nowhere by the 12 mm pad without it
-    touching the step's top too, and a face move across the upper top onto it is predicted to stop there (seed 1 on
-    the hand: seven such moves failed, "stepping onto the next face, the pad reached the rim of another edge");
-    the step's top, 12 mm long, and every face of a convex solid fit the pad."""
+    touching the step's top too, and a face move across the upper top onto it is predicted to stop there; the upper
+    top and every face of a convex solid fit the pad."""
     outline = [(0.0, 0.0), (0.030, 0.0), (0.030, 0.008), (0.018, 0.008), (0.018, 0.015), (0.0, 0.015)]
     poly = extrusion_xz(outline, 0.020, name="step")
     riser = next(f for f in range(poly.n_faces) if poly.face_normals[f][0] > 0.99
@@ -155,9 +154,18 @@ def test_a_step_onto_a_face_the_pad_touches_nowhere_alone_is_predicted_to_stop()
     top = next(f for f in range(poly.n_faces) if poly.face_normals[f][2] > 0.99
                and poly.vertices[list(poly.faces[f])][:, 2].min() > 0.014)  # fmt: skip
     assert not pad_fits(poly, riser, CFG)
-    assert pad_fits(poly, tread, CFG) and pad_fits(poly, top, CFG)
+    assert not pad_fits(poly, tread, CFG)  # 12 mm long beside the riser: the pad clear of it only 1.6 mm from the end
+    assert pad_fits(poly, top, CFG)
     hull, _, _ = _roof()
     assert all(pad_fits(hull.poly, f, CFG) for f in range(hull.poly.n_faces))
+    # a channel's floor as wide as the pad (part_uchannel: 24 mm between walls 16 mm tall) leaves it 0.6 mm to move
+    channel = [(0.0, 0.0), (0.060, 0.0), (0.060, 0.030), (0.042, 0.030), (0.042, 0.014), (0.018, 0.014),
+               (0.018, 0.030), (0.0, 0.030)]  # fmt: skip
+    u = extrusion_xz(channel, 0.035, name="channel")
+    floor = next(f for f in range(u.n_faces) if u.face_normals[f][2] > 0.99
+                 and u.vertices[list(u.faces[f])][:, 2].max() < 0.015)  # fmt: skip
+    assert not pad_fits(u, floor, CFG)
+    assert pad_fits(extrusion_xz([(x + 0.006 * (x > 0.03), z) for x, z in channel], 0.035), floor, CFG)  # 36 mm
 
     at = np.array([0.008, 0.010, 0.015])
     comps = {0: DataFace(0, np.array([0.0, 0.0, 1.0]), np.array([at, at + [0.002, 0.0, 0.0]]), 0.01, 1e-3)}
