@@ -1543,3 +1543,25 @@ def test_a_step_onto_the_next_face_stopped_by_the_table_gives_the_edge_alone(tmp
     assert not any(why.startswith("stepping onto the next face, the pad met the table") for why in failed), failed
     assert alone, "no edge reported alone"
     assert rec.outcome != "no-match" and _within_bounds(ep)
+
+
+def test_an_l_bracket_on_its_foot_is_told_apart_by_the_foots_top_and_its_verification_stalls_on_its_target(tmp_path):
+    # part_lbracket of scripts/make_parts.py (the foot 40 mm long and 10 mm thick, the leg 60 mm tall), seed 1:
+    # standing on its foot, two poses turned 180° about the leg were left after 4 moves, "differ only where no finger
+    # reaches" -- but the foot's top is touched from above, and a slide down the leg meets it 10 mm above the table.
+    # Now one pose is left; the verification measures the vertices off the table it can, and the four at the foot's
+    # top ends it, 16 moves after the last vertex it measured, rather than tracing the top's edges on and on.
+    import sys
+    from pathlib import Path
+
+    from haptic.planning.verify import HAND_STALL_MOVES
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "scripts"))
+    import make_parts
+
+    assert make_parts.main([str(tmp_path / "parts")]) == 0
+    rec = run_episode(EpisodeSpec(model="part_lbracket", seed=1, executor="physics", models=str(tmp_path / "parts")))
+    assert rec.classes[-1] == 1 and "no finger reaches" not in rec.detail
+    v = rec.verified
+    assert v["status"] == "incomplete" and v["vertices_reachable"] - v["vertices"] == 4, rec.detail
+    assert v["moves"] <= 2 * HAND_STALL_MOVES
