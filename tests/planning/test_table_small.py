@@ -1,6 +1,7 @@
 """The table on a small object: a face move's slide goes on over an edge too shallow for the pad to feel, and what
 the table lets it do is judged where it ends; an edge move sets off only where the pad can touch a face of the edge
-next to it off the table."""
+next to it off the table; a slide down into a concave corner is judged where the pad meets the next face; a level
+face low beside the table counts in reach; a step onto a face the pad cannot stroke is predicted to stop."""
 
 from dataclasses import replace
 
