@@ -253,8 +253,8 @@ PAD_ROOM = 0.003
 """Room the pad needs on a face to stroke it (:func:`pad_fits`): some place on it from which it can move this far
 across the face in every direction touching no other face [m]. A stroke's legs run a few millimetres; a wall 12 mm
 tall above a step 7 mm deep (part_small_step of ``scripts/make_parts.py`` standing on its end) leaves the pad 2 mm
-at its top, and the floor of a channel 24 mm wide (part_uchannel's) 0.6 mm: steps onto both failed on the hand
-("the pad reached the rim of another edge", 11 of 12 tries)."""
+at its top, and face moves onto it failed 6 times of 7 on the hand ("the pad reached the rim of another edge"); the
+floor of a channel 24 mm wide (part_uchannel's) leaves it 0.6 mm."""
 FIT_SPACING = 0.001
 """Spacing of the points :func:`pad_fits` tries on a face [m]."""
 
