@@ -25,16 +25,14 @@ from __future__ import annotations
 import numpy as np
 
 from haptic.geometry import SE3, Polyhedron
-from haptic.geometry.distance import point_triangle_distance, surface_distance
+from haptic.geometry.distance import point_triangle_distance, surface_distance, surface_samples_on_faces
 from haptic.planning.config import PlannerConfig
-from haptic.planning.table import EDGE_ONLY_CLEARANCE, EDGE_ROLL
+from haptic.planning.table import EDGE_ONLY_CLEARANCE, EDGE_ROLL, MARGIN
 
 SPACING = 0.004
 """Spacing of the sample points over the faces [m]."""
 LIFT = 0.08
 """Height over the pad through which the finger must be free [m]."""
-MARGIN = 0.0005
-"""Slack of the pad-clearance test against the object [m]."""
 TRACE_ROOM = 0.006
 """Room a trace needs: a point of an upright face the pad could touch only within this of its limit above the
 table counts as out of reach (a face move there would be refused as too close to the table); of a sloping face, this
@@ -53,20 +51,6 @@ def surface_samples(poly: Polyhedron, spacing: float = SPACING) -> tuple[np.ndar
     outward normals, model frame: shapes (P, 3), (P, 3)."""
     pts, faces = surface_samples_on_faces(poly, spacing)
     return pts, poly.face_normals[faces]
-
-
-def surface_samples_on_faces(poly: Polyhedron, spacing: float = SPACING) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`surface_samples`' points and the face each lies on: shapes (P, 3), (P,)."""
-    pts, faces = [], []
-    for (i, j, k), f in zip(poly.triangles, poly.triangle_faces, strict=True):
-        a, b, c = poly.vertices[i], poly.vertices[j], poly.vertices[k]
-        n = max(1, int(np.ceil(max(np.linalg.norm(b - a), np.linalg.norm(c - a), np.linalg.norm(c - b)) / spacing)))
-        u, v = np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij")
-        keep = u + v <= n
-        u, v = u[keep] / n, v[keep] / n
-        pts.append(a + u[:, None] * (b - a) + v[:, None] * (c - a))
-        faces.append(np.full(len(u), int(f)))
-    return np.concatenate(pts), np.concatenate(faces)
 
 
 FACING = np.cos(np.deg2rad(20.0))

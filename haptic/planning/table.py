@@ -15,6 +15,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from haptic.geometry.distance import point_triangle_distance, surface_samples_on_faces
 from haptic.geometry.polyhedron import Polyhedron
 from haptic.geometry.raycast import line_hits
 from haptic.geometry.se3 import SE3
@@ -249,6 +250,9 @@ STOPS = (TABLE, UNDERCUT, CONCAVE, OVERHANG, NARROW)
 """The outlooks of a move the hand is predicted not to carry out."""
 
 
+MARGIN = 0.0005
+"""Slack of the pad-clearance tests against the object (:func:`pad_fits`,
+:func:`~haptic.planning.reach.touchable`) [m]."""
 PAD_ROOM = 0.003
 """Room the pad needs on a face to stroke it (:func:`pad_fits`): some place on it from which it can move this far
 across the face in every direction touching no other face [m]. A stroke's legs run a few millimetres; a wall 12 mm
@@ -265,9 +269,6 @@ def _faces_the_pad_fits(poly: Polyhedron, radius: float) -> frozenset[int]:
     if poly.is_convex:  # the pad a radius off any face of a convex solid is a radius off all of it
         return frozenset(range(poly.n_faces))
     from scipy.spatial import cKDTree
-
-    from haptic.geometry.distance import point_triangle_distance
-    from haptic.planning.reach import MARGIN, surface_samples_on_faces
 
     pts, faces = surface_samples_on_faces(poly, FIT_SPACING)
     tri = poly.vertices[poly.triangles]
