@@ -64,7 +64,14 @@ def _distance(q: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.
 def surface_grid(poly: Polyhedron, spacing: float) -> np.ndarray:
     """Points over every face of ``poly`` about ``spacing`` apart [m], shape (P, 3): its vertices, and on each of its
     triangles a grid whose rows are at most ``spacing`` apart along its longest side (edges included)."""
-    return np.concatenate([np.asarray(poly.vertices, dtype=float), surface_samples_on_faces(poly, spacing)[0]])
+    out = [np.asarray(poly.vertices, dtype=float)]
+    for i, j, k in poly.triangles:
+        a, b, c = (np.asarray(poly.vertices[x], dtype=float) for x in (i, j, k))
+        n = max(1, int(np.ceil(max(np.linalg.norm(b - a), np.linalg.norm(c - a), np.linalg.norm(c - b)) / spacing)))
+        u, v = np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij")
+        keep = u + v <= n
+        out.append(a + (u[keep] / n)[:, None] * (b - a) + (v[keep] / n)[:, None] * (c - a))
+    return np.concatenate(out)
 
 
 def surface_samples_on_faces(poly: Polyhedron, spacing: float) -> tuple[np.ndarray, np.ndarray]:
