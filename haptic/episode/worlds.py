@@ -174,8 +174,9 @@ class PhysicsWorld:
         # the circle the executor makes; the concave edges' ends it can tell; no move from a concave vertex
         clearance = max(config.min_vertex_clearance, settings.crossing_clearance)
         config = replace(config, vertex_radius=settings.vertex_radius, min_vertex_clearance=clearance,
-                         edge_reentry=config.edge_reentry or settings.edge_reentry,
-                         concave_end_block=config.concave_end_block or settings.min_block_cos,
+                         edge_reentry=settings.edge_reentry if config.edge_reentry is None else config.edge_reentry,
+                         concave_end_block=(settings.min_block_cos if config.concave_end_block is None
+                                            else config.concave_end_block),
                          leave_concave_vertices=False)  # fmt: skip
         results: list[MoveResult] = []  # every move's result, for scoring perception
 

@@ -61,16 +61,22 @@ def _distance(q: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.
     return np.where(inside, d_in, d_edge)
 
 
+def _triangle_grid(a: np.ndarray, b: np.ndarray, c: np.ndarray, spacing: float) -> np.ndarray:
+    """A barycentric grid on triangle ``abc`` (corners and edges included) whose rows are at most ``spacing`` apart
+    along its longest side, shape (P, 3)."""
+    n = max(1, int(np.ceil(max(np.linalg.norm(b - a), np.linalg.norm(c - a), np.linalg.norm(c - b)) / spacing)))
+    u, v = np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij")
+    keep = u + v <= n
+    return a + (u[keep] / n)[:, None] * (b - a) + (v[keep] / n)[:, None] * (c - a)
+
+
 def surface_grid(poly: Polyhedron, spacing: float) -> np.ndarray:
     """Points over every face of ``poly`` about ``spacing`` apart [m], shape (P, 3): its vertices, and on each of its
     triangles a grid whose rows are at most ``spacing`` apart along its longest side (edges included)."""
     out = [np.asarray(poly.vertices, dtype=float)]
     for i, j, k in poly.triangles:
         a, b, c = (np.asarray(poly.vertices[x], dtype=float) for x in (i, j, k))
-        n = max(1, int(np.ceil(max(np.linalg.norm(b - a), np.linalg.norm(c - a), np.linalg.norm(c - b)) / spacing)))
-        u, v = np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij")
-        keep = u + v <= n
-        out.append(a + (u[keep] / n)[:, None] * (b - a) + (v[keep] / n)[:, None] * (c - a))
+        out.append(_triangle_grid(a, b, c, spacing))
     return np.concatenate(out)
 
 
@@ -79,11 +85,7 @@ def surface_samples_on_faces(poly: Polyhedron, spacing: float) -> tuple[np.ndarr
     included) and the face each lies on, model frame: shapes (P, 3), (P,)."""
     pts, faces = [], []
     for (i, j, k), f in zip(poly.triangles, poly.triangle_faces, strict=True):
-        a, b, c = poly.vertices[i], poly.vertices[j], poly.vertices[k]
-        n = max(1, int(np.ceil(max(np.linalg.norm(b - a), np.linalg.norm(c - a), np.linalg.norm(c - b)) / spacing)))
-        u, v = np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij")
-        keep = u + v <= n
-        u, v = u[keep] / n, v[keep] / n
-        pts.append(a + u[:, None] * (b - a) + v[:, None] * (c - a))
-        faces.append(np.full(len(u), int(f)))
+        grid = _triangle_grid(poly.vertices[i], poly.vertices[j], poly.vertices[k], spacing)
+        pts.append(grid)
+        faces.append(np.full(len(grid), int(f)))
     return np.concatenate(pts), np.concatenate(faces)
