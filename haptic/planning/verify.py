@@ -23,7 +23,7 @@ from __future__ import annotations
 import time
 import weakref
 from collections.abc import Mapping, Sequence
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -358,9 +358,9 @@ def table_shadow(poly: Polyhedron, world_from_model: SE3, v: int, config: Planne
         return None
     for e in poly.vertex_edges[v]:
         e = int(e)
-        h = shadow_of(cone_top(n[[int(poly.edge_left_face[e]), int(poly.edge_right_face[e])]]), config)
-        if max(z[v], z[int(sum(poly.edges[e])) - v]) < h:
-            height = max(height, h)
+        if not _edge_rises(poly, z, n, v, e, config):
+            height = max(height, shadow_of(cone_top(n[[int(poly.edge_left_face[e]), int(poly.edge_right_face[e])]]),
+                                           config))  # fmt: skip
         elif e not in edges:
             return None
     for f in faces:
@@ -496,41 +496,68 @@ def hidden_vertices(poly: Polyhedron, world_from_model: SE3, cov, config: Planne
 
 
 def lost_vertices(
-    poly: Polyhedron, world_from_model: SE3, reachable: frozenset[int], config: PlannerConfig
-) -> dict[int, list[int]]:
+    poly: Polyhedron, world_from_model: SE3, reach: tuple[frozenset[int], frozenset[int], frozenset[int]],
+    config: PlannerConfig,
+) -> dict[int, LostVertex]:
     """The vertices of ``poly`` at ``world_from_model`` that a full verification can tell nothing of, whatever it
-    measures, each with its faces the pad touches nowhere within their corner at it: off the table (farther than
-    :data:`TABLE_CONTACT` above it) and out of the verification's reach (not in ``reachable``: :func:`hidden_vertices`
-    with nothing measured); not to be placed by the planes of their faces
-    (:class:`~haptic.planning.finger_faces.CornerProbes`): fewer than three faces spanning space (an empty list), or
-    a face with no pad position within its corner at the vertex clear of the table with room for a stroke
-    (:func:`~haptic.planning.finger_faces.corner_lines`); and never taken on trust in the table's shadow
-    (:func:`table_shadow`): above it, or with such a face's corner rising out of it. Geometry alone, so that the
-    verification can name them before its first move: with one it can end no other way than incomplete. Without a
-    table, none."""
+    measures, each with why (:class:`LostVertex`): off the table (farther than :data:`TABLE_CONTACT` above it) and out
+    of the verification's reach (``reach``: :func:`reachable_features`' faces, edges and vertices; not among its
+    vertices, :func:`hidden_vertices` with nothing measured); not to be placed by the planes of their faces
+    (:class:`~haptic.planning.finger_faces.CornerProbes`): fewer than three faces spanning space, a face with no pad
+    position within its corner at the vertex clear of the table with room for a stroke
+    (:func:`~haptic.planning.finger_faces.corner_lines`), or an edge at it between two faces out of reach whose
+    other end is out of reach too (neither measured: a chamfer there is not seen); and never taken on trust in the
+    table's shadow (:func:`table_shadow`): above it, or with such a face's corner or such an edge rising out of it.
+    Geometry alone, so that the verification can name them before its first move: with one it can end no other way
+    than incomplete. Without a table, none."""
     if config.table_z is None:
         return {}
     from haptic.matching.acceptance import corner_spans
 
     z = world_from_model.apply(poly.vertices)[:, 2] - config.table_z
     n = world_from_model.rotate(poly.face_normals)
-    out: dict[int, list[int]] = {}
+    faces_in_reach, _, reachable = reach
+    out: dict[int, LostVertex] = {}
     for v in range(poly.n_vertices):
         if v in reachable or z[v] <= TABLE_CONTACT:
             continue
         faces = [int(f) for f in poly.vertex_faces[v]]
         bare = [f for f in faces if not corner_lines(poly, world_from_model, v, f, config, most=1)]
         spans = corner_spans(poly, v)
-        if spans and not bare:
+        # an edge at it between two faces out of reach, its other end out of reach too: neither is measured
+        shut = [int(e) for e in poly.vertex_edges[v]
+                if not {int(poly.edge_left_face[e]), int(poly.edge_right_face[e])} & set(faces_in_reach)
+                and int(sum(poly.edges[e])) - v not in reachable]  # fmt: skip
+        if spans and not bare and not shut:
             continue  # its faces' planes could place it
         # in its own shadow, the shadow takes it once what rises out of it is measured, unless that is a face's
-        # corner with no pad position
+        # corner with no pad position or such an edge
         if z[v] < shadow_of(cone_top(n[faces]), config) and not any(
             _corner_rises(poly, world_from_model, z, n, v, f, config) for f in bare
-        ):
+        ) and not any(_edge_rises(poly, z, n, v, e, config) for e in shut):
             continue
-        out[v] = bare if spans else []
+        out[v] = LostVertex(spans, tuple(bare), tuple(shut))
     return out
+
+
+@dataclass(frozen=True)
+class LostVertex:
+    """Why nothing the verification measures places a vertex (:func:`lost_vertices`)."""
+
+    spans: bool
+    """Whether its faces are three or more with normals spanning space."""
+    faces: tuple[int, ...]
+    """Its faces with no pad position within their corner at it."""
+    edges: tuple[int, ...]
+    """Its edges between two faces out of reach whose other end is out of reach too."""
+
+
+def _edge_rises(poly: Polyhedron, z: np.ndarray, n: np.ndarray, v: int, e: int, config: PlannerConfig) -> bool:
+    """Whether edge ``e`` at vertex ``v`` rises out of its shadow (:func:`shadow_of` for the steepest contact normal
+    between its faces, :func:`cone_top`). ``z``: the vertices' heights above the table; ``n``: the face normals,
+    world frame."""
+    h = shadow_of(cone_top(n[[int(poly.edge_left_face[e]), int(poly.edge_right_face[e])]]), config)
+    return max(float(z[v]), float(z[int(sum(poly.edges[e])) - v])) >= h
 
 
 def out_of_reach(poly: Polyhedron, world_from_model: SE3, config: PlannerConfig):
@@ -1483,7 +1510,7 @@ class Verifier:
         self._model: Polyhedron | None = None
         self._reach: dict[str, tuple[frozenset[int], frozenset[int], frozenset[int]]] = {}
         self._pins: dict[str, tuple[tuple[TablePin, ...], list[int]]] = {}
-        self._lost_at: dict[str, dict[int, list[int]]] = {}
+        self._lost_at: dict[str, dict[int, LostVertex]] = {}
         """Per model: :func:`lost_vertices` at the pose its reachable features were found for."""
         """Per model: :func:`table_pins` at the pose its reachable features were found for."""
         self._tour: Tour | None = None
@@ -1689,15 +1716,17 @@ class Verifier:
                 or cls.name not in self._reach):  # fmt: skip
             return []
         if cls.name not in self._lost_at:
-            self._lost_at[cls.name] = lost_vertices(cls.model, pose, self._reach[cls.name][2], self.config)
-        lost = {v: faces for v, faces in self._lost_at[cls.name].items() if v not in self.coverage.vertices
+            self._lost_at[cls.name] = lost_vertices(cls.model, pose, self._reach[cls.name], self.config)
+        lost = {v: why for v, why in self._lost_at[cls.name].items() if v not in self.coverage.vertices
                 and not placed_near(cls.model, data, it, pose, v, self.coverage.edges, self.coverage.vertices)}
         cp = self.corner_probes
         if cp is not None:
-            for v, faces in lost.items():
-                if not faces and v not in cp.too_few:
+            for v, why in lost.items():
+                if not why.spans and v not in cp.too_few:
                     cp.too_few.append(v)
-                cp.no_position.extend((v, f) for f in faces if (v, f) not in cp.no_position)
+                if why.edges and v not in cp.open_edges:
+                    cp.open_edges.append(v)
+                cp.no_position.extend((v, f) for f in why.faces if (v, f) not in cp.no_position)
         return sorted(lost)
 
     def _take_shadowed(self, model: Polyhedron, data: Sequence[DataComponent], it) -> None:
