@@ -168,16 +168,6 @@ def _replay(directory, model: str, extent: float, max_moves: int, corpus: bool =
     return ep, failed, results
 
 
-@pytest.fixture
-def past_lost_vertices(monkeypatch):
-    """Verifications that go on past vertices nothing could place, as they did before such vertices were named ahead
-    of the verification's first move (:func:`haptic.planning.verify.lost_vertices`): the replays of what the hand did
-    in the moves that followed, which a verification still makes wherever there is no such vertex."""
-    from haptic.planning import verify
-
-    monkeypatch.setattr(verify, "lost_vertices", lambda *args: {})
-
-
 def _within_bounds(ep) -> bool:
     from haptic.episode.evaluate import bound_ratios
 
