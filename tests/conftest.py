@@ -30,13 +30,3 @@ def small_library(tmp_path_factory):
         src = next(DEFAULT_LIBRARY.glob(f"{name}.*"))
         shutil.copy(src, d / src.name)
     return str(d)
-
-
-@pytest.fixture
-def past_lost_vertices(monkeypatch):
-    """Verifications that go on past vertices nothing could place, as they did before such vertices were named ahead
-    of the verification's first move (:func:`haptic.planning.verify.lost_vertices`): the replays of what the hand did
-    in the moves that followed, which a verification still makes wherever there is no such vertex."""
-    from haptic.planning import verify
-
-    monkeypatch.setattr(verify, "lost_vertices", lambda *args: {})

@@ -67,14 +67,12 @@ def _readings(links: bool = False, wrist: bool = False) -> tuple:
 
 
 @pytest.mark.slow
-@pytest.mark.usefixtures("past_lost_vertices")
 def test_the_hands_contacts_lie_within_their_links_bound_and_spoil_no_component():
     # FRAME01 seed 1: its verification reaches toward the hole, and the index finger's phalanges touch the rim while
     # the pad measures (5 moves, 28 points). Every point lies within a small part of its bound (8.5 mm: the links'
     # radius; 0.06 at most), and the components those moves report are within their own bounds (0.41 at most): what
     # the matcher gets from such a contact is its point with the link's bound; the pad's components stand. (Seed 2
-    # went into the hole until the verification named the hole's corners out of reach up front; seed 1's verification
-    # now ends before its first move, nothing being able to place them, and goes on here as it did.)
+    # went into the hole until the verification named the hole's corners out of reach up front.)
     from haptic.episode.spec import EpisodeSpec
     from haptic.episode.worlds import run_episode
 
@@ -128,7 +126,6 @@ def test_watching_the_wrist_changes_no_other_reading():
 
 
 @pytest.mark.slow
-@pytest.mark.usefixtures("past_lost_vertices")
 def test_the_wrist_feels_the_links_contacts_and_nothing_else_touches():
     # FRAME01 seed 1 (above): with the pad free, the wrist's force sensor feels the links pressing the hole's rim
     # (off the hand's weight and motion by more than 1.5 N), and it feels no contact that neither the pad nor a link

@@ -23,7 +23,7 @@ from __future__ import annotations
 import time
 import weakref
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 import numpy as np
 
@@ -34,7 +34,7 @@ from haptic.geometry.tracing import corner_angle, inside_polygon
 from haptic.matching.acceptance import TablePin, corner_triangle, faces_measured_near, placed_near
 from haptic.matching.components import DataComponent, DataEdge, DataFace, SensorNoise
 from haptic.planning.config import PlannerConfig
-from haptic.planning.finger_faces import CornerProbes, TableFaceProbes, corner_lines
+from haptic.planning.finger_faces import CornerProbes, TableFaceProbes
 from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.move_scores import same_move
 from haptic.planning.moves import EdgeMove, FaceMove, Move, ProbeMove, SensorState, VertexMove
@@ -358,33 +358,23 @@ def table_shadow(poly: Polyhedron, world_from_model: SE3, v: int, config: Planne
         return None
     for e in poly.vertex_edges[v]:
         e = int(e)
-        if not _edge_rises(poly, z, n, v, e, config):
-            height = max(height, shadow_of(cone_top(n[[int(poly.edge_left_face[e]), int(poly.edge_right_face[e])]]),
-                                           config))  # fmt: skip
+        h = shadow_of(cone_top(n[[int(poly.edge_left_face[e]), int(poly.edge_right_face[e])]]), config)
+        if max(z[v], z[int(sum(poly.edges[e])) - v]) < h:
+            height = max(height, h)
         elif e not in edges:
             return None
     for f in faces:
-        rises = _corner_rises(poly, world_from_model, z, n, v, f, config)
-        if rises is None:
+        loop = [int(u) for u in poly.faces[f]]
+        if np.all(z[loop] <= TABLE_CONTACT):
             continue  # the face on the table
-        if not rises:
-            height = max(height, shadow_of(float(n[f, 2]), config))
+        tri = corner_triangle(poly, v, f)
+        top = float(z[loop].max()) if tri is None else float((world_from_model.apply(tri)[:, 2] - config.table_z).max())
+        h = shadow_of(float(n[f, 2]), config)
+        if top < h:
+            height = max(height, h)
         elif f not in near:
             return None
     return height
-
-
-def _corner_rises(poly: Polyhedron, world_from_model: SE3, z: np.ndarray, n: np.ndarray, v: int, f: int,
-                  config: PlannerConfig) -> bool | None:  # fmt: skip
-    """Whether face ``f``'s corner at vertex ``v`` (:func:`~haptic.matching.acceptance.corner_triangle`; the whole
-    face where that is reflex) rises out of the face's shadow (:func:`shadow_of`); None for a face on the table.
-    ``z``: the vertices' heights above the table; ``n``: the face normals, world frame."""
-    loop = [int(u) for u in poly.faces[f]]
-    if np.all(z[loop] <= TABLE_CONTACT):
-        return None
-    tri = corner_triangle(poly, v, f)
-    top = float(z[loop].max()) if tri is None else float((world_from_model.apply(tri)[:, 2] - config.table_z).max())
-    return top >= shadow_of(float(n[f, 2]), config)
 
 
 def ridges_out_of_shadow(poly: Polyhedron, world_from_model: SE3, v: int, config: PlannerConfig,
@@ -493,71 +483,6 @@ def hidden_vertices(poly: Polyhedron, world_from_model: SE3, cov, config: Planne
     z = world_from_model.apply(poly.vertices)[:, 2] - config.table_z
     return [v for v in range(poly.n_vertices)
             if v not in cov.reachable_vertices and v not in cov.vertices and z[v] > TABLE_CONTACT]  # fmt: skip
-
-
-def lost_vertices(
-    poly: Polyhedron, world_from_model: SE3, reach: tuple[frozenset[int], frozenset[int], frozenset[int]],
-    config: PlannerConfig,
-) -> dict[int, LostVertex]:
-    """The vertices of ``poly`` at ``world_from_model`` that a full verification can tell nothing of, whatever it
-    measures, each with why (:class:`LostVertex`): off the table (farther than :data:`TABLE_CONTACT` above it) and out
-    of the verification's reach (``reach``: :func:`reachable_features`' faces, edges and vertices; not among its
-    vertices, :func:`hidden_vertices` with nothing measured); not to be placed by the planes of their faces
-    (:class:`~haptic.planning.finger_faces.CornerProbes`): fewer than three faces spanning space, a face with no pad
-    position within its corner at the vertex clear of the table with room for a stroke
-    (:func:`~haptic.planning.finger_faces.corner_lines`), or an edge at it between two faces out of reach whose
-    other end is out of reach too (neither measured: a chamfer there is not seen); and never taken on trust in the
-    table's shadow (:func:`table_shadow`): above it, or with such a face's corner or such an edge rising out of it.
-    Geometry alone, so that the verification can name them before its first move: with one it can end no other way
-    than incomplete. Without a table, none."""
-    if config.table_z is None:
-        return {}
-    from haptic.matching.acceptance import corner_spans
-
-    z = world_from_model.apply(poly.vertices)[:, 2] - config.table_z
-    n = world_from_model.rotate(poly.face_normals)
-    faces_in_reach, _, reachable = reach
-    out: dict[int, LostVertex] = {}
-    for v in range(poly.n_vertices):
-        if v in reachable or z[v] <= TABLE_CONTACT:
-            continue
-        faces = [int(f) for f in poly.vertex_faces[v]]
-        bare = [f for f in faces if not corner_lines(poly, world_from_model, v, f, config, most=1)]
-        spans = corner_spans(poly, v)
-        # an edge at it between two faces out of reach, its other end out of reach too: neither is measured
-        shut = [int(e) for e in poly.vertex_edges[v]
-                if not {int(poly.edge_left_face[e]), int(poly.edge_right_face[e])} & set(faces_in_reach)
-                and int(sum(poly.edges[e])) - v not in reachable]  # fmt: skip
-        if spans and not bare and not shut:
-            continue  # its faces' planes could place it
-        # in its own shadow, the shadow takes it once what rises out of it is measured, unless that is a face's
-        # corner with no pad position or such an edge
-        if z[v] < shadow_of(cone_top(n[faces]), config) and not any(
-            _corner_rises(poly, world_from_model, z, n, v, f, config) for f in bare
-        ) and not any(_edge_rises(poly, z, n, v, e, config) for e in shut):
-            continue
-        out[v] = LostVertex(spans, tuple(bare), tuple(shut))
-    return out
-
-
-@dataclass(frozen=True)
-class LostVertex:
-    """Why nothing the verification measures places a vertex (:func:`lost_vertices`)."""
-
-    spans: bool
-    """Whether its faces are three or more with normals spanning space."""
-    faces: tuple[int, ...]
-    """Its faces with no pad position within their corner at it."""
-    edges: tuple[int, ...]
-    """Its edges between two faces out of reach whose other end is out of reach too."""
-
-
-def _edge_rises(poly: Polyhedron, z: np.ndarray, n: np.ndarray, v: int, e: int, config: PlannerConfig) -> bool:
-    """Whether edge ``e`` at vertex ``v`` rises out of its shadow (:func:`shadow_of` for the steepest contact normal
-    between its faces, :func:`cone_top`). ``z``: the vertices' heights above the table; ``n``: the face normals,
-    world frame."""
-    h = shadow_of(cone_top(n[[int(poly.edge_left_face[e]), int(poly.edge_right_face[e])]]), config)
-    return max(float(z[v]), float(z[int(sum(poly.edges[e])) - v])) >= h
 
 
 def out_of_reach(poly: Polyhedron, world_from_model: SE3, config: PlannerConfig):
@@ -1510,8 +1435,6 @@ class Verifier:
         self._model: Polyhedron | None = None
         self._reach: dict[str, tuple[frozenset[int], frozenset[int], frozenset[int]]] = {}
         self._pins: dict[str, tuple[tuple[TablePin, ...], list[int]]] = {}
-        self._lost_at: dict[str, dict[int, LostVertex]] = {}
-        """Per model: :func:`lost_vertices` at the pose its reachable features were found for."""
         """Per model: :func:`table_pins` at the pose its reachable features were found for."""
         self._tour: Tour | None = None
         self._tour_model: Polyhedron | None = None
@@ -1666,11 +1589,6 @@ class Verifier:
                 self.unreached = self._unreached()
                 if self.unreached:
                     self.status = "incomplete"
-            if self.status == "verifying":
-                lost = self._lost(cls, tree.data, it)
-                if lost:
-                    self.hidden = lost
-                    self.status = "incomplete"
         if self.status in ("confirmed", "incomplete"):  # the final word: the statistical acceptance test
             self.accept = acceptance(cls.model, tree.data, it, self.check.world_from_model, k_sigma=self.k_sigma,
                                      table_z=self.config.table_z, floors=self.floors)  # fmt: skip
@@ -1702,32 +1620,6 @@ class Verifier:
                 return {}
             out[int(v)] = [(e, self._failed_toward[(e, v)]) for e in sorted(ways)]
         return out
-
-    def _lost(self, cls, data: Sequence[DataComponent], it) -> list[int]:
-        """On the hand under ``full``, while the coverage is still to be met: the vertices the verification can tell
-        nothing of whatever it measures (:func:`lost_vertices`, found once per model at its pose), not measured all
-        the same and not placed by what is. With one, the verification cannot end confirmed, and it ends incomplete
-        at once rather than after measuring everything else in reach (the formula corpus at 30-150 mm, seed 1: 16
-        of its 26 incomplete verifications now end so within the episode's first 2-4 moves, where they took 4-52,
-        trapezohedron_11 45; its 32 confirmations unchanged). The corner probes' record says why
-        (:meth:`~haptic.planning.finger_faces.CornerProbes.unmeasured`)."""
-        pose = self.check.world_from_model if self.check is not None else None
-        if (self.config.table_z is None or self.mode != "full" or pose is None or self.coverage is None
-                or cls.name not in self._reach):  # fmt: skip
-            return []
-        if cls.name not in self._lost_at:
-            self._lost_at[cls.name] = lost_vertices(cls.model, pose, self._reach[cls.name], self.config)
-        lost = {v: why for v, why in self._lost_at[cls.name].items() if v not in self.coverage.vertices
-                and not placed_near(cls.model, data, it, pose, v, self.coverage.edges, self.coverage.vertices)}
-        cp = self.corner_probes
-        if cp is not None:
-            for v, why in lost.items():
-                if not why.spans and v not in cp.too_few:
-                    cp.too_few.append(v)
-                if why.edges and v not in cp.open_edges:
-                    cp.open_edges.append(v)
-                cp.no_position.extend((v, f) for f in why.faces if (v, f) not in cp.no_position)
-        return sorted(lost)
 
     def _take_shadowed(self, model: Polyhedron, data: Sequence[DataComponent], it) -> None:
         """Of the vertices out of reach (:attr:`hidden`, :attr:`unpinnable`), take on trust those whose moves change

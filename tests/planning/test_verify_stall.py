@@ -8,7 +8,6 @@ import numpy as np
 
 from haptic.executor.geometric import GeometricExecutor
 from haptic.geometry import SE3, Polyhedron, load_library
-from haptic.geometry.shapes import box, extrusion_xz
 from haptic.matching.acceptance import Coverage
 from haptic.matching.components import SensorNoise
 from haptic.planning.config import PlannerConfig
@@ -20,7 +19,6 @@ from haptic.planning.verify import (
     _grazing,
     aimed_face_moves,
     hidden_vertices,
-    lost_vertices,
     plan_verification_move,
     reachable_features,
 )
@@ -247,36 +245,3 @@ def test_a_face_move_that_ended_off_the_edge_it_was_to_cross_counts_as_a_failed_
     for _ in range(CROSSING_FAILURES):
         v._missed(h, state, (), (move, (h.faces[state.face], other)))
     assert (h.faces[state.face], other) in v._failed_crossings
-
-
-def test_vertices_that_nothing_measured_could_place_are_found_from_the_geometry_alone():
-    """A T standing on its stem (part_tblock of scripts/make_parts.py: a bar 49 mm wide and 12 mm thick on a stem
-    15 mm wide, 28 mm high): the four corners where the stem meets the bar's underside lie out of the verification's
-    reach and above the table's shadow, and the bar's underside, facing down, has no pad position within its corner
-    at them (nor the T's ends, reflex there). Nothing the hand measures places them: a full verification can end
-    only incomplete, and it says so before its moves rather than after them. A box has none, and without a table
-    nothing is lost."""
-    profile = [(0, 0), (15, 0), (15, 28), (32, 28), (32, 40), (-17, 40), (-17, 28), (0, 28)]
-    tee = extrusion_xz([(x / 1000, z / 1000) for x, z in profile], 0.03, name="tee")
-    pose = SE3(np.eye(3), np.array([0.55, 0.0, 0.35]))
-    lost = lost_vertices(tee, pose, reachable_features(tee, pose, HAND), HAND)
-    junction = {i for i, p in enumerate(tee.vertices) if abs(p[2] - 0.028) < 1e-9 and p[0] in (0.0, 0.015)}
-    assert set(lost) == junction and len(junction) == 4
-    under = {f for f in range(tee.n_faces) if tee.face_normals[f][2] < -0.99}
-    assert all(why.spans and set(why.faces) & under for why in lost.values())
-    block = box(0.06, 0.04, 0.03)
-    on_table = SE3(np.eye(3), np.array([0.55, 0.0, 0.365]))
-    assert lost_vertices(block, on_table, reachable_features(block, on_table, HAND), HAND) == {}
-    assert lost_vertices(tee, pose, (frozenset(),) * 3, PlannerConfig()) == {}
-
-
-def test_the_corners_of_a_tunnel_out_of_reach_are_lost_by_its_edges():
-    """FRAME01 standing on an end (seeds 1 and 2 of the seed library): its hole is a tunnel whose walls no finger
-    pointing down reaches. Each of the hole's corners has pad positions within its faces' corners, but an edge
-    between two walls out of reach, its other end another such corner: neither is ever measured, so a chamfer there
-    would not be seen, and the corners are never placed."""
-    poly = LIB["FRAME01"]
-    pose = _resting_on(poly, 8)
-    lost = lost_vertices(poly, pose, reachable_features(poly, pose, HAND), HAND)
-    assert set(lost) == set(range(8, 16))
-    assert all(why.edges for why in lost.values())
