@@ -38,12 +38,12 @@ import numpy as np
 from haptic.bench.runner import plan_sweep, run_sweep
 from haptic.episode.spec import DEFAULT_POLICY, EpisodeSpec
 from haptic.errors import HapticError, ModelError, SceneError
-from haptic.geometry import Polyhedron, are_congruent, convex_decomposition, load_library, save_model
+from haptic.geometry import Polyhedron, are_congruent, load_library, save_model
 from haptic.geometry.io import atomic_write
 from haptic.geometry.perturb import chamfer_edge, move_vertex, scale_dimension
 from haptic.planning.moves import MOVE_SETS, CostModel, default_moves
 from haptic.planning.registry import POLICY_NAMES
-from haptic.sim.scene import scene_object_from_parts
+from haptic.sim.scene import scene_object_from_polyhedron
 
 SCALES = (0.97, 1.03, 1.05, 1.10)
 VERTEX_MM = (2.0, 4.0, 8.0)
@@ -79,11 +79,12 @@ def variants(poly: Polyhedron, rng: np.random.Generator) -> list[tuple[str, str,
 
 
 def unsimulated(poly: Polyhedron) -> str | None:
-    """Why the simulated scene cannot hold ``poly`` (built from its convex pieces), or None when it can. A variant
+    """Why the simulated scene cannot hold ``poly`` (as the physics world builds it: :func:`~haptic.sim.scene.
+    scene_object_from_polyhedron`, convex pieces for a non-convex one), or None when it can. A variant
     may decompose into a piece too thin for the simulator (FRAME01 with a vertex moved 2 mm: a sliver of 0.1 mm^3);
     it is left out of a run on the hand, said on stderr, rather than ending the run."""
     try:
-        scene_object_from_parts(poly.name, convex_decomposition(poly))
+        scene_object_from_polyhedron(poly)
     except SceneError as exc:
         return str(exc)
     return None
