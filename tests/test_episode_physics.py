@@ -595,6 +595,29 @@ def test_a_face_move_onto_a_face_under_an_overhang_reports_the_edge_alone():
     assert _within_bounds(ep)
 
 
+def test_a_vertex_move_whose_next_face_is_out_of_reach_reports_the_edge_alone(tmp_path):
+    # PYR01 30 mm across, seed 2: a vertex move circled the apex of the pyramid and rolled over a slant edge onto
+    # the next side, which runs down to the table: the roll reached the table's clearance before the pad settled
+    # on it and the move failed ("crossing the convex edge: the pad reached the table's clearance before the next
+    # face"), as vertex moves did on the polyhedra at 30 mm 9 times in 71. The roll gives the edge leaving the
+    # vertex, as a face move's does: reported alone, adjacent to the vertex, within its bounds.
+    done, failed = [], []
+    obs = EpisodeObserver(on_move=lambda n, r, *a: done.append(r), on_failed_move=lambda n, r: failed.append(r))
+    spec = EpisodeSpec(model="PYR01", seed=2, executor="physics", verify="none",
+                       models=_scaled_library(tmp_path, 0.03))  # fmt: skip
+    ep = build_episode(spec)
+    rec = ep.run(None, obs)
+    alone = [r for r in done
+             if r.move is not None and r.move.kind == "vertex" and r.info.get("next_face") == "out of reach"]
+    assert alone, [(r.move, r.info) for r in done]
+    edge = alone[0].components[0]
+    by_id = {c.id: c for c in ep.executor.components}
+    assert edge.kind == "edge" and any(by_id[i].kind == "vertex" for i in edge.adjacent), edge.adjacent
+    assert not [r for r in failed if r.move.kind == "vertex"], [r.reason for r in failed]
+    assert rec.outcome == "recognized" and rec.correct, rec.detail
+    assert _within_bounds(ep)
+
+
 def test_a_roll_that_finds_the_pad_still_on_the_face_lets_the_slide_go_on():
     # LBLOCK01 seed 3, verifying: a face move's slide lost its contact on the face and took that for a convex edge;
     # the roll, its normal still the face's, headed back over the face until its travel ran out ("crossing the convex

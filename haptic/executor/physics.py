@@ -1095,12 +1095,14 @@ class PhysicsExecutor(LandingSearch):
                                                                           overhang=True)  # fmt: skip
             if status in ("undercut", "overhang"):
                 alone = self._edge_only(move, r, roll, reason, pieces)
-                if alone.ok or not reason.endswith(TABLE_BEFORE_NEXT) or recrosses >= self.settings.recrosses:
+                at_table = reason.endswith(TABLE_BEFORE_NEXT) or reason == STEP_AT_TABLE
+                if alone.ok or not at_table or recrosses >= self.settings.recrosses:
                     return alone
                 # met near the edge's end, the pad rolled round the vertex and down the faces there to the table's
                 # clearance, high above it where the crossing met the edge (platonic_octahedron and bipyramid_04 of
-                # the formula corpus, seed 1: from a level top face, 4 mm from a vertex, 15-20 mm above the table):
-                # crossed again farther inside the edge, away from that vertex, as after a roll that gave no edge
+                # the formula corpus, seed 1: from a level top face, 4 mm from a vertex, 15-20 mm above the table),
+                # or settled there and its step in met the table (the polyhedra at 30 mm): crossed again farther
+                # inside the edge, away from that vertex, as after a roll that gave no edge
                 shift = self._round_the_vertex(r.info["face_normal"], roll)
                 way = None
                 if shift is not None:  # as far back as aside: inside the face narrowing to the vertex
@@ -1393,15 +1395,20 @@ class PhysicsExecutor(LandingSearch):
         return -math.copysign(1.0, lean) * (self.settings.recross_shift + over) * e
 
     def _edge_only(
-        self, move: FaceMove, r: PrimitiveResult, roll: ContactTrace, reason: str, pieces: list[PrimitiveResult]
+        self, move: FaceMove | VertexMove, r: PrimitiveResult, roll: ContactTrace, reason: str,
+        pieces: list[PrimitiveResult], circled: tuple[int, np.ndarray] | None = None,
     ) -> MoveResult:
         """A face move that rolled over a convex edge onto a face leaning under, out of the pad's reach: the
         edge alone, from the face and the roll, checked and refined by following it a little each way (a
         roll round a vertex turns about one axis too, but no edge runs along it); the sensor stays on the face
-        it traced."""
+        it traced. ``circled``: a vertex move's face and the data vertex it circled (its position), the roll from
+        the circle: the edge is then one leaving that vertex, within the bounds :meth:`_at_circled` allows, or
+        the move fails."""
         st, seg = self.state, self.segmenter
-        fit_a = self._face_fit(st.face, r.trace)
-        lead = r.trace.select(r.trace.phase == PHASES.index("face")).tail(self.settings.roll_lead_rows)
+        face = st.face if circled is None else circled[0]
+        fit_a = self._face_fit(face, r.trace)
+        phase = PHASES.index("face" if circled is None else "circle")
+        lead = r.trace.select(r.trace.phase == phase).tail(self.settings.roll_lead_rows)
         got = seg.edge_from_roll(fit_a, ContactTrace.concatenate([lead, roll]))
         if isinstance(got, str):
             return self.failed_result(move, "unreachable", f"{reason}; no edge from the roll: {got}")
@@ -1420,12 +1427,38 @@ class PhysicsExecutor(LandingSearch):
             return self.failed_result(move, "unreachable", f"{reason}; the ridge followed left the roll's line (the "
                                                            "pad met the table or a face round the edge's end)")
         line = line_from_points(ridge, line.direction, line.direction_sigma, seg.bounds)
-        edge = seg.add_edge(line, (st.face, None), True, (fit_a.normal, n_last), adjacent=(st.face,))
+        vertex = None
+        if circled is not None:
+            vertex = self._at_circled(line, circled[1])
+            if isinstance(vertex, str):
+                return self.failed_result(move, "unreachable", f"{reason}; {vertex}")
+            vertex = (st.vertex, vertex)
+        adjacent = (face,) if vertex is None else (vertex[0], face)
+        edge = seg.add_edge(line, (face, None), True, (fit_a.normal, n_last), adjacent=adjacent, vertex=vertex)
         self.on_face = None
-        self.state = SensorState(position=line.point + line.direction * 0.5 * sum(line.s_range), face=st.face)
-        return MoveResult(move=move, status="ok", components=(edge,), distance=r.distance,
-                          cost=self.costs.face_move(r.distance), state=self.state,
-                          info={"kind": "convex", "next_face": "out of reach"})  # fmt: skip
+        self.state = SensorState(position=line.point + line.direction * 0.5 * sum(line.s_range), face=face)
+        cost = self.costs.face_move(r.distance) if circled is None else self.costs.vertex_move(r.distance)
+        return MoveResult(move=move, status="ok", components=(edge,), distance=r.distance, cost=cost,
+                          state=self.state, info={"kind": "convex", "next_face": "out of reach"})  # fmt: skip
+
+    def _at_circled(self, line, vtx: np.ndarray) -> float | str:
+        """Where the vertex a vertex move circled (at ``vtx``, located on an earlier edge) lies along the ``line``
+        its circle met (its parameter), or why that line leaves another vertex: it passes farther from ``vtx`` than
+        their bounds allow. The vertex and the line are independent estimates, so their bounds add in quadrature.
+        Added up, they let through an edge 1.9 mm off the vertex on trapezohedron_10 at 30 mm (a kite's edge 4.2 mm
+        long inside the 8 mm circle, the edge beyond it met), whose errors were 0.16 and 0.14 mm against bounds of
+        1.2 and 0.75 mm; the tree pruned the truth (no-match)."""
+        seg, b = self.segmenter, self.bounds
+        s_vtx = float((vtx - line.point) @ line.direction)
+        off = float(np.linalg.norm(vtx - line.point - s_vtx * line.direction))
+        lever = abs(s_vtx - float(np.clip(s_vtx, *line.s_range)))  # from the explored interval to the vertex
+        allowed = math.hypot(seg.vertices[self.state.vertex].position_bound,
+                             b.bound(line.position_sigma, b.position_floor),
+                             lever * b.bound(line.direction_sigma, b.direction_floor))  # fmt: skip
+        if off > allowed:
+            # the circle crossed an edge that does not leave the vertex (on a face narrower than the circle)
+            return f"the edge met passes {off * MM:.1f} mm from the vertex circled: it leaves another vertex"
+        return s_vtx
 
     def _on_roll_line(self, ridge: np.ndarray, line) -> np.ndarray | None:
         """The contacts of ``ridge`` on the line of the roll that gave an edge alone (within a point's bound of it);
@@ -2109,6 +2142,10 @@ class PhysicsExecutor(LandingSearch):
                 self.recoveries.append(f"{reason}: crossed again {shifted * MM:.0f} mm out along the edge"
                                        f"{FROM_TOUCHED if touched else ''}")  # fmt: skip
                 break
+            if status == "undercut":
+                # the next face out of the pad's reach (leaning under, or down to the table's clearance): the edge
+                # alone, from the roll, as a face move gives it
+                return self._edge_only(move, r, roll, reason, pieces, circled=(f, vtx))
             if status != "ok":
                 return self.failed_result(move, status, reason)
             fit_f, line, why = self._edge_between(f, r.trace, "circle", roll, fit_g, kind, corner)
@@ -2142,20 +2179,9 @@ class PhysicsExecutor(LandingSearch):
             return self.failed_result(move, "unreachable", "the edge met lies along the current edge's line, the "
                                                            "next face parallel to its other face: it leaves another "
                                                            "vertex")  # fmt: skip
-        s_vtx = float((vtx - line.point) @ line.direction)
-        b = self.bounds
-        off = float(np.linalg.norm(vtx - line.point - s_vtx * line.direction))
-        lever = abs(s_vtx - float(np.clip(s_vtx, *line.s_range)))  # from the explored interval to the vertex
-        # the vertex (located on the earlier edge) and the line (the circle's roll) are independent estimates: their
-        # bounds add in quadrature. Added up, they let through an edge 1.9 mm off the vertex on trapezohedron_10 at
-        # 30 mm (a kite's edge 4.2 mm long inside the 8 mm circle, the edge beyond it met), whose errors were 0.16 and
-        # 0.14 mm against bounds of 1.2 and 0.75 mm; the tree pruned the truth (no-match)
-        allowed = math.hypot(seg.vertices[st.vertex].position_bound, b.bound(line.position_sigma, b.position_floor),
-                             lever * b.bound(line.direction_sigma, b.direction_floor))  # fmt: skip
-        if off > allowed:
-            # the circle crossed an edge that does not leave the vertex (on a face narrower than the circle)
-            return self.failed_result(move, "unreachable", f"the edge met passes {off * MM:.1f} mm from the vertex "
-                                                           "circled: it leaves another vertex")  # fmt: skip
+        s_vtx = self._at_circled(line, vtx)
+        if isinstance(s_vtx, str):
+            return self.failed_result(move, "unreachable", s_vtx)
         return self._rolled_onto(move, f, line, kind, (fit_f.normal, fit_g.normal), fit_g, stroke, r.distance,
                                  self.costs.vertex_move(r.distance), vertex=(st.vertex, s_vtx))  # fmt: skip
 

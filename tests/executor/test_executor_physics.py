@@ -341,9 +341,9 @@ def test_start_lands_again_when_the_l_stroke_rolled_on_an_edge():
 
 
 def test_a_vertex_move_whose_next_face_leans_under_fails_as_unreachable(monkeypatch):
-    """Crossing an edge onto a face that leans under the pad's reach ends a face move with the edge alone; a
-    vertex move circling onto such a face fails cleanly, naming it, with a move status (not the primitive's
-    "undercut" event)."""
+    """Crossing an edge onto a face that leans under the pad's reach ends a face move or a vertex move with the
+    edge alone, from the roll; where the roll gives none, the vertex move fails cleanly, naming the face out of
+    reach, with a move status (not the primitive's "undercut" event)."""
     from haptic.executor.primitives import PrimitiveResult
     from haptic.matching.trace import empty_trace
 
