@@ -8,8 +8,10 @@ so a failed export never leaves a half-written file.
 from __future__ import annotations
 
 import json
+import math
 import os
 import tempfile
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -536,9 +538,25 @@ def atomic_write(path: str | os.PathLike, data: bytes | str) -> None:
         raise
 
 
+def written_coordinate(poly: Polyhedron, finest: Callable[[float], str] = lambda x: f"{float(x):.9g}"
+                       ) -> Callable[[float], str]:  # fmt: skip
+    """How a file written of ``poly`` writes a coordinate [m]: as ``finest`` (to a nanometre), or to the decimal
+    place its :attr:`~haptic.geometry.polyhedron.Polyhedron.precision` rounds to where that is coarser, so that the
+    file read back has the model's precision (:func:`text_quantum`) and its tolerances. A model scaled up carries
+    its source's rounding scaled with it (:func:`~haptic.geometry.perturb.scaled_to`): the 30 mm dodecahedron of
+    ``assets/libraries/polyhedra``, written to 0.5 µm, scaled to 150 mm and written to the nanometre, read back as
+    not planar (a face 1.6 µm off its plane, 1 µm allowed for a file that precise)."""
+    if poly.precision <= 0.0 or decimal_quantum(9) >= poly.precision:
+        return finest
+    decimals = max(0, math.floor(-math.log10(2.0 * poly.precision)))
+    return lambda x: f"{float(x):.{decimals}f}"
+
+
 def to_native(poly: Polyhedron) -> str:
-    """The native JSON text of a model (metres, CCW-from-outside face loops)."""
-    verts = ",\n    ".join(json.dumps([round(float(x), 9) for x in p]) for p in poly.vertices)
+    """The native JSON text of a model (metres, CCW-from-outside face loops; coordinates as
+    :func:`written_coordinate` writes them)."""
+    fmt = written_coordinate(poly, lambda x: json.dumps(round(float(x), 9)))
+    verts = ",\n    ".join("[" + ", ".join(fmt(x) for x in p) + "]" for p in poly.vertices)
     faces = ",\n    ".join(json.dumps(list(f)) for f in poly.faces)
     return (
         f'{{\n  "format": "haptic-polyhedron",\n  "version": {FORMAT_VERSION},\n  "name": {json.dumps(poly.name)},\n'
@@ -547,9 +565,11 @@ def to_native(poly: Polyhedron) -> str:
 
 
 def to_obj(poly: Polyhedron) -> str:
-    """Polygonal Wavefront OBJ text (faces kept as polygons)."""
+    """Polygonal Wavefront OBJ text (faces kept as polygons; coordinates as :func:`written_coordinate` writes
+    them)."""
+    fmt = written_coordinate(poly)
     lines = [f"# {poly.name}: V={poly.n_vertices} E={poly.n_edges} F={poly.n_faces}, metres"]
-    lines += [f"v {x:.9g} {y:.9g} {z:.9g}" for x, y, z in poly.vertices]
+    lines += [f"v {fmt(x)} {fmt(y)} {fmt(z)}" for x, y, z in poly.vertices]
     lines += ["f " + " ".join(str(i + 1) for i in f) for f in poly.faces]
     return "\n".join(lines) + "\n"
 
