@@ -9,7 +9,8 @@ command, ends it):
 1. *Leave the surface*: lift along the sensed normal (``ProbeSettings.lift``).
 2. *Transfer, up and over*: rise straight up to a safe height -- the highest contact sensed so far plus the pad
    radius and ``ProbeSettings.clearance`` (the object rests on the table and was touched only below it), at
-   least the line's start; never above the hand's reach over the region --, across, and straight down to the
+   least the line's start; never above the hand's reach over the region, where the clearance is cut short
+   (``ProbeSettings.min_clearance`` at least) --, across, and straight down to the
    pad centre's place at the line's start. A touch on the way is a failed move (``unreachable``), never a hit.
    The path is the planner's (:mod:`haptic.planning.handpath`: :func:`~haptic.planning.handpath.safe_height`,
    :func:`~haptic.planning.handpath.over_the_top`), so its cost prediction follows the hand.
@@ -59,7 +60,14 @@ class ProbeSettings:
     lift: float = LIFT
     """Lift off the surface along its normal before the transfer [m]."""
     clearance: float = CLEARANCE
-    """The transfer passes this far above the highest contact sensed so far (plus the pad radius) [m]."""
+    """The transfer passes this far above the highest contact sensed so far (plus the pad radius) [m], and no
+    higher than the hand's reach over the region (``PhysicsSettings.max_approach_height``), as a placement's rise;
+    ..."""
+    min_clearance: float = 0.01
+    """... where the reach leaves less than this, the probe fails (the line's start above the reach fails it too)
+    [m]. Over a 150 mm solid standing 160 mm tall (augmented_truncated_tetrahedron of the public polyhedra at 150 mm,
+    seed 2) the full clearance put the transfer 3 mm above the reach, and all four probes its verification asked
+    for failed; the reach leaves 33 mm."""
     transfer_speed: float = 0.15
     """Speed of the transfer [m/s]."""
     probe_speed: float = 0.05
@@ -161,9 +169,13 @@ def probe_move(ex: PhysicsExecutor, move: ProbeMove, pieces: list[PrimitiveResul
     if min(centre0[2], centre1[2]) - r < floor:
         return ex.invalid_result(move, "the line would bring the pad onto the table")
     z_reach = TABLE_TOP_Z + ex.settings.max_approach_height
-    z_safe = safe_height(_highest_contact(ex), r, centre0, t.tip, settings.clearance)
-    if z_safe > z_reach:
+    highest = _highest_contact(ex)
+    if float(centre0[2]) > z_reach:
         return ex.failed_result(move, "unreachable", "the line's start is above the hand's reach over the region")
+    if z_reach < highest + r + settings.min_clearance:
+        return ex.failed_result(move, "unreachable", "the hand's reach over the region leaves the pad no way over "
+                                                     "the object")  # fmt: skip
+    z_safe = min(safe_height(highest, r, centre0, t.tip, settings.clearance), z_reach)
     was_on = ex.on_face if (ex.on_face == st.face and t.contact[1] is not None) else None
     free: list[PrimitiveResult] = []  # the pieces through free space, for the distance
 

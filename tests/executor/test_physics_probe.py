@@ -110,3 +110,35 @@ def test_a_probe_past_the_object_misses_and_returns_to_the_face(probed):
     # the sensor is back on the face the probe left, as the state says
     assert miss.state.face == state_before.face and miss.info["returned"]
     assert miss.distance > 2 * seg.length
+
+
+def test_a_transfer_the_hands_reach_cuts_short_still_probes():
+    """Over an object as tall as the hand's reach over the region allows, the transfer's clearance above the
+    highest contact is cut short at that reach instead of failing the probe (a 150 mm solid standing 160 mm tall:
+    every probe its verification asked for failed); where the reach leaves the pad less than
+    ``ProbeSettings.min_clearance`` over the object, the probe fails, saying so."""
+    from dataclasses import replace
+
+    from haptic.executor.physics_probe import SETTINGS, _highest_contact
+
+    poly = load_library()["BOX01"]
+    obj = scene_object_from_polyhedron(poly)
+    pose = random_object_pose(obj, np.random.default_rng(4))
+    sim = Simulation(compose_scene(obj, pose), noise=SimulatedSensorNoise.from_notes(), seed=4)
+    ex = PhysicsExecutor(RobotInterface(sim), rng=np.random.default_rng(4))
+    assert ex.start().ok
+    truth = SE3.from_matrix(sim.ground_truth().world_from_object)
+    normals = truth.rotate(poly.face_normals)
+    f = max((k for k in range(poly.n_faces) if abs(normals[k, 2]) < 0.1), key=lambda k: normals[k, 0])
+    n = normals[f]
+    target = truth.apply(poly.vertices[list(poly.faces[f])]).mean(axis=0)
+    target[2] = max(target[2], TABLE_TOP_Z + PAD_RADIUS + 0.008)
+    move = ProbeMove(target + 0.05 * n, -n, 0.08)
+    over = _highest_contact(ex) + PAD_RADIUS - TABLE_TOP_Z  # the pad's centre just clear of the highest contact
+    assert float(move.start[2]) - TABLE_TOP_Z < over
+    ex.settings = replace(ex.settings, max_approach_height=over + 0.5 * (SETTINGS.clearance + SETTINGS.min_clearance))
+    hit = ex.execute(move)
+    assert hit.ok and hit.components, hit.reason
+    ex.settings = replace(ex.settings, max_approach_height=over + 0.5 * SETTINGS.min_clearance)
+    low = ex.execute(move)
+    assert not low.ok and "leaves the pad no way over the object" in low.reason
