@@ -135,13 +135,20 @@ def _score_all(ctx: Context) -> list[tuple[Prediction | ProbePrediction | Placem
     return out + probes + score_placements(ctx, weights, lines if ctx.config.moves != "tracing" else None, beat)
 
 
-def alone_edges(h: Hypothesis, components: Mapping[int, DataComponent]) -> frozenset[int]:
-    """The model edges ``h`` pairs with a data edge the hand reported alone: met from one face, the next face out of
-    the pad's reach (leaning under, or the table's), no data face adjacent to it. Crossing such an edge again the
-    pad meets it again out of reach."""
+def alone_data_edges(components: Mapping[int, DataComponent]) -> frozenset[int]:
+    """The data edges the hand reported alone: met from one face, the next face out of the pad's reach (leaning
+    under, or the table's), no data face adjacent to it. Crossing such an edge again the pad meets it again out of
+    reach."""
     listed = {int(a) for c in components.values() if isinstance(c, DataFace) for a in c.adjacent}
-    return frozenset(int(m) for d, m in h.edges.items()
-                     if d not in listed and isinstance(components.get(d), DataEdge))  # fmt: skip
+    return frozenset(int(d) for d, c in components.items() if isinstance(c, DataEdge) and int(d) not in listed)
+
+
+def alone_edges(h: Hypothesis, components: Mapping[int, DataComponent],
+                alone: frozenset[int] | None = None) -> frozenset[int]:  # fmt: skip
+    """The model edges ``h`` pairs with a data edge the hand reported alone (:func:`alone_data_edges`, or ``alone``
+    when already known)."""
+    alone = alone_data_edges(components) if alone is None else alone
+    return frozenset(int(m) for d, m in h.edges.items() if d in alone)
 
 
 def remeasures(ctx: Context, move: Move) -> bool:
@@ -161,6 +168,7 @@ def remeasures(ctx: Context, move: Move) -> bool:
     if not ctx.hypotheses or not isinstance(move, FaceMove | EdgeMove):
         return False
     state = ctx.state
+    alone = None  # the data edges reported alone, found when first asked
     for h in ctx.hypotheses:
         if h.world_from_model is None:
             return False
@@ -178,8 +186,10 @@ def remeasures(ctx: Context, move: Move) -> bool:
             tr = hand_trace(h, move, state, ctx.config)
             if tr is None or tr.hit.edge not in set(h.edges.values()):
                 return False
-            if tr.hit.next_face not in set(h.faces.values()) and tr.hit.edge not in alone_edges(h, ctx.components):
-                return False
+            if tr.hit.next_face not in set(h.faces.values()):
+                alone = alone_data_edges(ctx.components) if alone is None else alone
+                if tr.hit.edge not in alone_edges(h, ctx.components, alone):
+                    return False
     return True
 
 
@@ -368,12 +378,13 @@ def fresh_moves(ctx: Context) -> list[Move]:
     move that failed from here was to cross: the pad did not get over it, and at another angle seldom does."""
     out, again = [], []
     failed_face = [bad for bad in ctx.avoid if isinstance(bad, FaceMove)]
+    alone = alone_data_edges(ctx.components)
     for move in candidate_moves(ctx.state, ctx.components, ctx.config):
         if any(same_move(move, bad) for bad in ctx.avoid):
             continue
         if move.kind == "vertex" and ctx.hypotheses and all(
             (hit := circled_vertex(h, move, ctx.state, ctx.config)) is None
-            or hit.edge in alone_edges(h, ctx.components)
+            or hit.edge in alone_edges(h, ctx.components, alone)
             for h in ctx.hypotheses
         ):
             continue
