@@ -143,11 +143,9 @@ def alone_data_edges(components: Mapping[int, DataComponent]) -> frozenset[int]:
     return frozenset(int(d) for d, c in components.items() if isinstance(c, DataEdge) and int(d) not in listed)
 
 
-def alone_edges(h: Hypothesis, components: Mapping[int, DataComponent],
-                alone: frozenset[int] | None = None) -> frozenset[int]:  # fmt: skip
-    """The model edges ``h`` pairs with a data edge the hand reported alone (:func:`alone_data_edges`, or ``alone``
-    when already known)."""
-    alone = alone_data_edges(components) if alone is None else alone
+def alone_edges(h: Hypothesis, alone: frozenset[int]) -> frozenset[int]:
+    """The model edges ``h`` pairs with the data edges ``alone`` (those the hand reported alone:
+    :func:`alone_data_edges`)."""
     return frozenset(int(m) for d, m in h.edges.items() if d in alone)
 
 
@@ -155,7 +153,7 @@ def remeasures(ctx: Context, move: Move) -> bool:
     """Whether ``move`` is predicted, in every hypothesis's world, to measure again what that hypothesis has
     already paired with data: an edge move running to a model vertex paired with a data vertex, a face move
     crossing a model edge paired with a data edge onto a model face paired with a data face, or over a model edge
-    paired with a data edge the hand reported alone (:func:`alone_edges`: the hypotheses that predict the pad
+    paired with a data edge the hand reported alone (:func:`alone_data_edges`: the hypotheses that predict the pad
     steps onto the next face there would be told apart by its angle, and none is, the hand meeting the edge alone
     again; on the public polyhedra at 30 mm, metabiaugmented_hexagonal_prism seed 1 made face moves from one face
     over such edges 9 times in a row with four pose classes left, to the move budget). Each hypothesis has
@@ -188,7 +186,7 @@ def remeasures(ctx: Context, move: Move) -> bool:
                 return False
             if tr.hit.next_face not in set(h.faces.values()):
                 alone = alone_data_edges(ctx.components) if alone is None else alone
-                if tr.hit.edge not in alone_edges(h, ctx.components, alone):
+                if tr.hit.edge not in alone_edges(h, alone):
                     return False
     return True
 
@@ -373,7 +371,7 @@ def bounded(ctx: Context) -> Context:
 
 def fresh_moves(ctx: Context) -> list[Move]:
     """Candidate moves, less vertex moves that every hypothesis says circle back to an explored edge (or to one
-    the hand reported alone, :func:`alone_edges`), and
+    the hand reported alone, :func:`alone_data_edges`), and
     (while others remain) face moves that the hypotheses, by at least half their weight, say cross the edge a face
     move that failed from here was to cross: the pad did not get over it, and at another angle seldom does."""
     out, again = [], []
@@ -384,7 +382,7 @@ def fresh_moves(ctx: Context) -> list[Move]:
             continue
         if move.kind == "vertex" and ctx.hypotheses and all(
             (hit := circled_vertex(h, move, ctx.state, ctx.config)) is None
-            or hit.edge in alone_edges(h, ctx.components, alone)
+            or hit.edge in alone_edges(h, alone)
             for h in ctx.hypotheses
         ):
             continue
