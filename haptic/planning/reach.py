@@ -5,7 +5,8 @@ normal ``n`` is *reachable* when the pad touching it, centred at ``c = p + r n``
 
 - stays clear of the table with room to trace (its lowest point ``config.table_clearance`` plus
   :data:`TRACE_ROOM` above the top),
-- does not dig into the object elsewhere (``c`` is at least ``r`` from the whole surface, within a margin),
+- does not dig into the object elsewhere (``c`` is at least ``r`` from the whole surface, within a margin, and
+  :data:`~haptic.planning.table.PAD_GAP` more from a face turned towards the point's),
 - can be lowered there from above (the vertical line over ``c`` stays outside the object), and
 - meets a face it can press on (the normal leans under by no more than ``config.max_undercut``).
 
@@ -27,7 +28,7 @@ import numpy as np
 from haptic.geometry import SE3, Polyhedron
 from haptic.geometry.distance import point_triangle_distance, surface_distance, surface_samples_on_faces
 from haptic.planning.config import PlannerConfig
-from haptic.planning.table import EDGE_ONLY_CLEARANCE, EDGE_ROLL, MARGIN
+from haptic.planning.table import EDGE_ONLY_CLEARANCE, EDGE_ROLL, MARGIN, clear_of_facing
 
 SPACING = 0.004
 """Spacing of the sample points over the faces [m]."""
@@ -94,6 +95,8 @@ def touchable(
         model_from_world = world_from_model.inverse()
         c_m = model_from_world.apply(centre[idx])
         clear = surface_distance(poly, c_m) >= r - MARGIN
+        if clear.any():  # and clear of a face turned towards it by PAD_GAP (a slot as wide as the pad)
+            clear[clear] = clear_of_facing(poly, c_m[clear], model_from_world.rotate(nrm[idx][clear]), r)
         up = model_from_world.rotate(np.array([0.0, 0.0, 1.0]))
         for h in np.linspace(r, LIFT, 6):
             above = c_m + h * up

@@ -245,7 +245,8 @@ edge, the next face leaning under out of the pad's reach (a success that reports
 table (the pad would come onto it, or the next face is too close to it); stopped at a convex edge onto a face
 leaning under further than the pad reaches; stopped at a concave edge's end or vertex the hand cannot tell; stopped
 stepping onto a face the object overhangs, where the finger's links meet it (:func:`overhung`); stopped stepping
-onto a face the pad touches nowhere without touching the object elsewhere (:func:`pad_fits`)."""
+onto a face the pad touches nowhere without touching the object elsewhere (:func:`pad_fits`), or not where the move
+steps onto it (:func:`crowded`)."""
 STOPS = (TABLE, UNDERCUT, CONCAVE, OVERHANG, NARROW)
 """The outlooks of a move the hand is predicted not to carry out."""
 
@@ -259,6 +260,13 @@ across the face in every direction touching no other face [m]. A stroke's legs r
 tall above a step 7 mm deep (part_small_step of ``scripts/make_parts.py`` standing on its end) leaves the pad 2 mm
 at its top, and face moves onto it failed 6 times of 7 on the hand ("the pad reached the rim of another edge"); the
 floor of a channel 24 mm wide (part_uchannel's) leaves it 0.6 mm."""
+PAD_GAP = 0.0005
+"""Room :func:`pad_fits` asks between the pad and a face turned towards the one it strokes [m]. Where two
+walls stand the pad's diameter apart (the slot of part_uchannel in ``scripts/make_parts.py``, 24 mm) the pad pressing
+on one touches the other: at seed 2 moves into the slot failed 12 times in 67 moves ("the pad reached the rim of another
+edge", "crossing the concave edge: limit", "could not reach the face next to the vertex"), the verification stalling
+at its corners; with the walls out of the pad's reach the episode ends in 18 moves, naming those corners out of
+reach."""
 FIT_SPACING = 0.001
 """Spacing of the points :func:`pad_fits` tries on a face [m]."""
 
@@ -287,6 +295,7 @@ def _faces_the_pad_fits(poly: Polyhedron, radius: float) -> frozenset[int]:
         for start in range(0, len(p_f), 2048):
             d = point_triangle_distance(centre[start : start + 2048], tri[front]).min(axis=1)
             clear[start : start + 2048] = d >= radius - MARGIN
+        clear[clear] = clear_of_facing(poly, centre[clear], n, radius)
         if clear.all():
             fits.add(f)
         elif clear.any():
@@ -294,6 +303,30 @@ def _faces_the_pad_fits(poly: Polyhedron, radius: float) -> frozenset[int]:
             if float(room.max()) >= PAD_ROOM:
                 fits.add(f)
     return frozenset(fits)
+
+
+def clear_of_facing(poly: Polyhedron, centres: np.ndarray, normals: np.ndarray, radius: float) -> np.ndarray:
+    """Whether the pad centred at each of ``centres`` (model frame), touching a face of outward normal ``normals``,
+    clears every face turned towards that one (a slot's far wall) by :data:`PAD_GAP`; shape (P,) bool. A face
+    beside it the pad need only not touch (within :data:`MARGIN`), which the callers test against the whole
+    surface."""
+    centres = np.atleast_2d(np.asarray(centres, dtype=float))
+    out = np.ones(len(centres), dtype=bool)
+    if poly.is_convex or not len(centres):  # a convex solid's far faces lie behind it
+        return out
+    normals = np.broadcast_to(np.asarray(normals, dtype=float), centres.shape)
+    tri = poly.vertices[poly.triangles]
+    tri_n = poly.face_normals[poly.triangle_faces]
+    keys, group = np.unique(np.round(normals, 9), axis=0, return_inverse=True)  # a face's points share its normal
+    for g, n in enumerate(keys):
+        facing = tri_n @ n < -0.5
+        if not facing.any():
+            continue
+        at = np.flatnonzero(group.ravel() == g)
+        for start in range(0, len(at), 2048):
+            idx = at[start : start + 2048]
+            out[idx] = point_triangle_distance(centres[idx], tri[facing]).min(axis=1) >= radius + PAD_GAP
+    return out
 
 
 def pad_fits(poly: Polyhedron, face: int, config: PlannerConfig) -> bool:
@@ -345,6 +378,8 @@ def move_outlook(
         if not pad_fits(poly, g_m, config):  # the pad steps onto the rim beyond first, the table or not
             return NARROW
         q_m = at_m + TABLE_STEP_ONTO * _inward(poly, e_m, g_m)
+        if crowded(poly, e_m, g_m, q_m, config):  # the pad steps on next to a wall or under an overhang there
+            return NARROW
         if pad_clearance(t.apply(q_m), t.rotate(poly.face_normals[g_m]), config) < lim:
             return TABLE
         return OVERHANG if overhung(h, q_m, g_m, config) else MADE
@@ -413,6 +448,29 @@ def move_outlook(
         at = poly.vertices[v_m] + config.vertex_radius * away
         return onto(hit.edge, hit.next_face, at), np.nan, np.nan
     raise TypeError(f"unknown move {move!r}")
+
+
+def crowded(poly: Polyhedron, edge: int, face: int, at_m: np.ndarray, config: PlannerConfig) -> bool:
+    """Whether the pad stepped over ``edge`` onto ``face`` of ``poly``, touching it at ``at_m`` (model frame), would
+    dig into a face other than the edge's two there by more than :data:`PAD_ROOM`: a face the pad fits somewhere
+    (:func:`pad_fits`) may still be crowded where a move steps onto it (part_tblock of ``scripts/make_parts.py``: a
+    face move across the T's top crossing onto the stem's side 4 mm under the bar, the pad jammed in the corner under
+    it and the move failed, "the pad reached the rim of another edge", 3 times in an episode). Less than that the
+    pad may settle beside it: cad_slotted of the formula corpus, crossed onto a wall of its slot 10 mm above the floor
+    (the pad 2.1 mm into the floor), measures the wall, and predicting such steps stopped cost that episode its
+    confirmation; part_tblock's stem side crossed onto 10.4 mm under the bar (1.6 mm) failed. The depth alone does
+    not tell the two apart, and the test takes the one that costs no confirmation. Over a convex edge only (into a
+    concave corner the pad meets the next face at the corner, touching both), and not on a convex model, where the pad
+    a radius off any face is a radius off all of it."""
+    if poly.is_convex or poly.edge_convexity[edge] <= 0:  # into a concave corner the pad meets the next face there
+        return False
+    own = (int(poly.edge_left_face[edge]), int(poly.edge_right_face[edge]))
+    rest = (poly.triangle_faces != own[0]) & (poly.triangle_faces != own[1])
+    if not rest.any():
+        return False
+    centre = np.asarray(at_m, dtype=float) + config.pad_radius * poly.face_normals[face]
+    d = point_triangle_distance(centre[None], poly.vertices[poly.triangles[rest]]).min()
+    return bool(d < config.pad_radius - PAD_ROOM)
 
 
 def overhung(h: Hypothesis, at_m: np.ndarray, face: int, config: PlannerConfig) -> bool:
