@@ -223,3 +223,31 @@ def test_a_crossing_under_an_overhang_is_predicted_to_stop_where_the_pad_would_j
                                      comps, CFG)[0])  # fmt: skip
     assert outlooks == [NARROW, MADE]
 
+
+def test_the_verification_takes_no_step_onto_a_face_too_narrow_for_the_pad():
+    """With touched points as evidence the planner counts a face move predicted to stop as telling how far its face
+    reaches; the verification, which measures edges and vertices, counts one that steps onto a face too narrow for
+    the pad as refused (part_tblock, seed 2: five such moves of its verification failed). Its risk is 1 where the
+    planner's is 0, and it is offered only when nothing else is."""
+    from haptic.matching.components import SensorNoise
+    from haptic.planning.move_scores import refusal
+    from haptic.planning.predict import candidate_moves, predict_moves
+    from haptic.planning.verify import _moves
+
+    outline = [(0.0, 0.0), (0.015, 0.0), (0.015, 0.028), (0.032, 0.028), (0.032, 0.040), (-0.017, 0.040),
+               (-0.017, 0.028), (0.0, 0.028)]  # fmt: skip
+    poly = extrusion_xz(outline, 0.030, name="tblock")
+    lie = SE3(np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]]), np.array([0.0, 0.0, 0.030]))
+    top = next(f for f in range(poly.n_faces) if poly.face_normals[f][1] < -0.99)
+    h = Hypothesis("tblock", poly, lie, {0: top}, {}, {})
+    at = lie.apply(np.array([0.005, 0.0, 0.024]))
+    comps = {0: DataFace(0, np.array([0.0, 0.0, 1.0]), np.array([at, at + [0.002, 0.0, 0.0]]), 0.01, 1e-3)}
+    state = SensorState(position=at, face=0)
+    cfg = replace(CFG, touch_evidence=True)
+    moves = candidate_moves(state, comps, cfg)
+    narrow = [m for m in moves if move_outlook(h, m, state, comps, cfg)[0] == NARROW]
+    assert narrow
+    preds = predict_moves([h], narrow, state, comps, SensorNoise(), cfg)
+    assert any(refusal(p, cfg) == 0.0 for p in preds)  # the planner's: its trace tells the face
+    offered = [m for m, _, _ in _moves(h, state, comps, SensorNoise(), cfg, ())]
+    assert offered and not any(move_outlook(h, m, state, comps, cfg)[0] == NARROW for m in offered)
