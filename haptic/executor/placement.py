@@ -411,18 +411,25 @@ must span across, in every heading; an 8 mm one put the pad on the table."""
 STROKE_ACROSS_MIN = 0.002
 """The least second leg of a probe's L stroke kept within a face's room (:func:`stroke_within`) [m]: 1.5 mm across
 the face is what a face's stroke must span (``SegmentBounds.min_face_width``), and the servo trails its targets."""
+STROKE_REACH = 0.5
+"""How much of its commanded L a probe's pad travels on the face: the servo trails its targets, the pad held back by
+friction (about half: an L of 8 × 3 mm spanned 6.5 × 2.0 mm on a face of the cuboctahedron of
+``assets/libraries/polyhedra`` at 60 mm, and one kept within 4 mm, 3.6 × 2 mm, spanned 1.2-4.7 × 0.7-1.3 mm, under
+what a face's stroke must span, at each of four headings) [-]."""
 
 
 def stroke_within(settings: PlacementSettings, room: float) -> PlacementSettings:
-    """``settings`` with the L stroke's legs shortened to stay within ``room`` of where the pad touched (the planner's
-    ``ProbeMove.room`` of the hypothesised face): the second leg its own or at least :data:`STROKE_ACROSS_MIN`, the
-    first what is left of the room; unchanged where the room holds the whole L."""
+    """``settings`` with the L stroke's legs shortened so that the pad's travel stays within ``room`` of where it
+    touched (the planner's ``ProbeMove.room`` of the hypothesised face): the commanded L within ``room`` over
+    :data:`STROKE_REACH`, its second leg its own or at least :data:`STROKE_ACROSS_MIN`, the first what is left;
+    unchanged where that holds the whole L."""
     along = settings.stroke
     across = settings.stroke if settings.stroke_across is None else settings.stroke_across
-    if math.hypot(along, across) <= room:
+    reach = room / STROKE_REACH
+    if math.hypot(along, across) <= reach:
         return settings
-    across = min(across, max(STROKE_ACROSS_MIN, room / 3.0))
-    along = math.sqrt(max(room * room - across * across, 0.0))
+    across = min(across, max(STROKE_ACROSS_MIN, reach / 3.0))
+    along = math.sqrt(max(reach * reach - across * across, 0.0))
     return replace(settings, stroke=max(along, across), stroke_across=across)
 
 

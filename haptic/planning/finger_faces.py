@@ -47,8 +47,9 @@ one to the next where the object is in the hand's way)."""
 MIN_ROOM = 0.0035
 """Pad positions with less room than this to the face's rim are not weighed [m]: the stroke that measures the face
 must span 3 mm along its principal axis and 1.5 mm across (``SegmentBounds.min_face_extent``, ``min_face_width``);
-an L of 2.9 × 2 mm (:func:`haptic.executor.placement.stroke_within`) spans 3.5 mm along its diagonal and 1.6 mm
-across, and stays on the face with this much room about its start."""
+the pad travels about half the L it is commanded (:data:`haptic.executor.placement.STROKE_REACH`), an L kept within
+twice the room (:func:`haptic.executor.placement.stroke_within`), and a travel of 3.5 mm along its diagonal stays on
+the face with this much room about its start."""
 ROOM = 0.008
 """A pad position whose contact is at least this far from the face's rim is preferred [m]: the probe's stroke runs
 8 mm level along the face (:data:`haptic.executor.placement.PROBE_SETTINGS`), and one that leaves the face over an

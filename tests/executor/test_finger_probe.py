@@ -194,3 +194,31 @@ def test_a_finger_whose_link_would_lie_on_the_face_above_is_not_sent(tmp_path):
     h = Hypothesis(model="antiprism_08", poly=poly, world_from_model=pose, faces={}, edges={}, vertices={})
     for line in table_face_lines(poly, pose, *PRESSED_FROM_BEHIND, ep.config):
         assert finger_probe(line, [h], tilts=(math.radians(30.0),)) is None
+
+
+@pytest.mark.slow
+def test_a_probe_with_little_room_on_its_face_strokes_enough_of_it(tmp_path):
+    # The cuboctahedron of assets/libraries/polyhedra at 60 mm, seed 1, rests with three vertices on the table; the
+    # verification probes the faces at them, leaning under 19°, where the pad touches one clear of the table only about
+    # 4 mm from its rim. An L kept within those 4 mm (3.6 × 2 mm commanded) spanned 1.2-4.7 × 0.7-1.3 mm at each of its
+    # four headings -- the servo trails its targets -- under the 3 × 1.5 mm a face's stroke must span, and the probe
+    # measured nothing ("the stroke found no face"); commanded within twice the room, it measures the face.
+    from haptic.geometry import load_library, save_model
+    from haptic.geometry.perturb import scaled_to
+    from haptic.planning.verify import TABLE_CONTACT
+
+    save_model(scaled_to(load_library("assets/libraries/polyhedra")["cuboctahedron"], 0.06),
+               tmp_path / "cuboctahedron.json")  # fmt: skip
+    ep = _episode("cuboctahedron", str(tmp_path))
+    poly, pose, face = ep.true_model, ep.world_from_model, 3
+    z = pose.apply(poly.vertices)[:, 2] - ep.config.table_z
+    lines = [line for v in poly.faces[face] if z[v] < TABLE_CONTACT
+             for line in table_face_lines(poly, pose, int(v), face, ep.config)]  # fmt: skip
+    assert lines and min(line.room for line in lines) < 0.005, "the face has room for a whole stroke after all"
+    h = Hypothesis(model="cuboctahedron", poly=poly, world_from_model=pose, faces={}, edges={}, vertices={})
+    move = finger_probe(min(lines, key=lambda line: line.room), [h])
+    assert move is not None, "no finger reaches the line"
+    res = ep.executor.execute(move)
+    assert res.ok and res.components, res.reason
+    n = pose.rotate(poly.face_normals[face])
+    assert np.degrees(np.arccos(np.clip(res.components[0].normal @ n, -1.0, 1.0))) < 1.0

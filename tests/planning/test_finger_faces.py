@@ -149,12 +149,14 @@ def test_the_probes_ask_each_line_once_and_name_what_no_finger_reaches():
 
 
 def test_the_stroke_is_kept_within_the_faces_room():
-    from haptic.executor.placement import PROBE_SETTINGS, stroke_within
+    from haptic.executor.placement import PROBE_SETTINGS, STROKE_REACH, stroke_within
 
     assert stroke_within(PROBE_SETTINGS, 0.02) == PROBE_SETTINGS
     s = stroke_within(PROBE_SETTINGS, MIN_ROOM)
-    assert math.hypot(s.stroke, s.stroke_across) <= MIN_ROOM + 1e-9
-    # the L still spans what a face's stroke must: 3 mm along its diagonal, 1.5 mm across
+    # the pad travels about STROKE_REACH of the L commanded: that travel is kept within the room
+    assert math.hypot(s.stroke, s.stroke_across) * STROKE_REACH <= MIN_ROOM + 1e-9
+    assert math.hypot(s.stroke, s.stroke_across) < math.hypot(PROBE_SETTINGS.stroke, PROBE_SETTINGS.stroke_across)
+    # and the L commanded spans what a face's stroke must: 3 mm along its diagonal, 1.5 mm across
     assert math.hypot(s.stroke, s.stroke_across) >= 0.003
     assert s.stroke * s.stroke_across / math.hypot(s.stroke, s.stroke_across) >= 0.0015
 
