@@ -85,6 +85,10 @@ class PlacementSettings:
     """... down to at most this [m]."""
     dwell_steps: int = 12
     """At the end of each leg the targets stay this many steps (the joints' servo trails them) [-]."""
+    stroke_overrun: float = 1.0
+    """Above 1, a leg of the L ends once the pad has travelled its length, its targets running on to at most this many
+    times it while the pad trails them, then held where the pad is; 1: the targets run the length and the pad follows
+    as far as the servo takes it [-]."""
     stroke_headings: int = 4
     """A finger whose stroke finds no face strokes again in up to this many headings in all, a quarter turn
     apart (its stroke may have left a narrow face)."""
@@ -400,7 +404,7 @@ def _placement(ex: PhysicsExecutor, move: PlacementMove, pieces: list[PrimitiveR
                    info={**result.info, "travel": {k: round(v, 4) for k, v in way.items()}})  # fmt: skip
 
 
-PROBE_SETTINGS = replace(SETTINGS, stroke=0.008, stroke_across=0.003, level_stroke=True)
+PROBE_SETTINGS = replace(SETTINGS, stroke=0.008, stroke_across=0.003, level_stroke=True, stroke_overrun=3.0)
 """A probe by another finger (:func:`finger_probe_move`) strokes an L of 8 mm level along the face, then 3 mm up: a
 pad that came in under an overhang close above the table has room along the face, little up or down (BOX01P, seed 1,
 the side under its step, 35 mm high: the pad's centre has 5 mm up to the step and 5 mm down to the table's
@@ -411,25 +415,26 @@ must span across, in every heading; an 8 mm one put the pad on the table."""
 STROKE_ACROSS_MIN = 0.002
 """The least second leg of a probe's L stroke kept within a face's room (:func:`stroke_within`) [m]: 1.5 mm across
 the face is what a face's stroke must span (``SegmentBounds.min_face_width``), and the servo trails its targets."""
-STROKE_REACH = 0.5
-"""How much of its commanded L a probe's pad travels on the face: the servo trails its targets, the pad held back by
-friction (about half: an L of 8 × 3 mm spanned 6.5 × 2.0 mm on a face of the cuboctahedron of
-``assets/libraries/polyhedra`` at 60 mm, and one kept within 4 mm, 3.6 × 2 mm, spanned 1.2-4.7 × 0.7-1.3 mm, under
-what a face's stroke must span, at each of four headings) [-]."""
 
 
-def stroke_within(settings: PlacementSettings, room: float) -> PlacementSettings:
-    """``settings`` with the L stroke's legs shortened so that the pad's travel stays within ``room`` of where it
-    touched (the planner's ``ProbeMove.room`` of the hypothesised face): the commanded L within ``room`` over
-    :data:`STROKE_REACH`, its second leg its own or at least :data:`STROKE_ACROSS_MIN`, the first what is left;
-    unchanged where that holds the whole L."""
+def stroke_within(settings: PlacementSettings, room: float, room_up: float | None = None) -> PlacementSettings:
+    """``settings`` with the L stroke's legs shortened to stay within ``room`` of where the pad touched (the planner's
+    ``ProbeMove.room`` of the hypothesised face): the second leg its own or at least :data:`STROKE_ACROSS_MIN`, the
+    first what is left of the room; unchanged where the room holds the whole L. The legs are the pad's travel where
+    ``settings.stroke_overrun`` runs the targets on (a probe's): cut to the room, targets alone moved the pad less than
+    a face's stroke must span (the servo trails them, the pad held back by friction: 1.2-4.7 × 0.7-1.3 mm of an L of
+    3.6 × 2 mm on a face of the cuboctahedron of ``assets/libraries/polyhedra`` at 60 mm), and an L commanded longer
+    than the room ran off the face where the pad slid freely (hull_04 of the formula corpus). With ``room_up`` (the
+    planner's ``ProbeMove.room_up``: the level stroke, ``room`` then how far the pad can slide level either way), each
+    leg within its own: level, then up."""
     along = settings.stroke
     across = settings.stroke if settings.stroke_across is None else settings.stroke_across
-    reach = room / STROKE_REACH
-    if math.hypot(along, across) <= reach:
+    if room_up is not None and settings.level_stroke:
+        return replace(settings, stroke=min(along, room), stroke_across=min(across, room_up))
+    if math.hypot(along, across) <= room:
         return settings
-    across = min(across, max(STROKE_ACROSS_MIN, reach / 3.0))
-    along = math.sqrt(max(reach * reach - across * across, 0.0))
+    across = min(across, max(STROKE_ACROSS_MIN, room / 3.0))
+    along = math.sqrt(max(room * room - across * across, 0.0))
     return replace(settings, stroke=max(along, across), stroke_across=across)
 
 
@@ -448,7 +453,7 @@ def finger_probe_move(ex: PhysicsExecutor, move: ProbeMove, pieces: list[Primiti
                               np.asarray(move.direction, dtype=float), float(move.length))  # fmt: skip
     place = PlacementMove((approach,), path=move.path)
     if move.room is not None:
-        settings = stroke_within(settings, float(move.room))
+        settings = stroke_within(settings, float(move.room), None if move.room_up is None else float(move.room_up))
     res = _placement(ex, place, pieces, settings, single=True)
     info = dict(res.info)
     fingers = info.pop("fingers", [])
@@ -713,6 +718,9 @@ def _stroke(c: _Closing, fingers: Sequence[FingerApproach], held: dict[str, np.n
     depth = {f.finger: s.stroke_press for f in fingers}
     along = s.stroke
     across = s.stroke if s.stroke_across is None else s.stroke_across
+    if s.stroke_overrun > 1.0:
+        _stroke_travelled(c, fingers, held, normals, contacts, radius, depth, legs, (along, across))
+        return {f.finger: c.trace(f.finger, first[f.finger]) for f in fingers}
     for leg, length in enumerate((along, across)):
         steps = max(1, int(round(length / s.stroke_step)))
         for k in range(1, steps + 1 + s.dwell_steps):
@@ -723,6 +731,38 @@ def _stroke(c: _Closing, fingers: Sequence[FingerApproach], held: dict[str, np.n
                 off[f.finger] = (k * s.stroke_step * d1) if leg == 0 else (along * d1 + k * s.stroke_step * d2)
             _pressing_step(c, fingers, held, normals, contacts, radius, depth, off, "stroke")
     return {f.finger: c.trace(f.finger, first[f.finger]) for f in fingers}
+
+
+def _stroke_travelled(c: _Closing, fingers: Sequence[FingerApproach], held: dict[str, np.ndarray],
+                      normals: dict[str, np.ndarray], contacts: dict[str, np.ndarray], radius: dict[str, float],
+                      depth: dict[str, float], legs: dict[str, tuple[np.ndarray, np.ndarray]],
+                      lengths: tuple[float, float]) -> None:  # fmt: skip
+    """:func:`_stroke`'s legs as far as each pad travels: a finger's targets step on along its leg until its pad
+    centre has moved the leg's length along it (or the targets ran :attr:`PlacementSettings.stroke_overrun` times
+    it), then stay where the pad is; the next leg sets off from there."""
+    s = c.s
+    base = {f.finger: np.zeros(3) for f in fingers}
+    for leg, length in enumerate(lengths):
+        cap = max(1, int(round(s.stroke_overrun * length / s.stroke_step)))
+        start = {f.finger: np.asarray(c.rows[f.finger][-1][1], dtype=float) for f in fingers}
+        steps = {f.finger: 0 for f in fingers}
+        stop: dict[str, np.ndarray | None] = {f.finger: None for f in fingers}
+        dwell = 0
+        while dwell <= s.dwell_steps:
+            off = {}
+            for f in fingers:
+                name, d = f.finger, legs[f.finger][leg]
+                if stop[name] is None:
+                    moved = float((np.asarray(c.rows[name][-1][1], dtype=float) - start[name]) @ d)
+                    if moved >= length or steps[name] >= cap:
+                        stop[name] = base[name] + max(moved, 0.0) * d
+                    else:
+                        steps[name] += 1
+                off[name] = stop[name] if stop[name] is not None else base[name] + steps[name] * s.stroke_step * d
+            _pressing_step(c, fingers, held, normals, contacts, radius, depth, off, "stroke")
+            if all(v is not None for v in stop.values()):
+                dwell += 1
+        base = {name: v for name, v in stop.items() if v is not None}
 
 
 def _pressing_step(c: _Closing, fingers: Sequence[FingerApproach], held: dict[str, np.ndarray],

@@ -27,6 +27,7 @@ import numpy as np
 from haptic.geometry.distance import surface_distance
 from haptic.geometry.polyhedron import Polyhedron
 from haptic.geometry.se3 import SE3
+from haptic.geometry.tracing import inside_polygon
 from haptic.matching.acceptance import corner_spans, corner_triangle, in_corner
 from haptic.planning.config import PlannerConfig
 from haptic.planning.moves import ProbeMove
@@ -123,19 +124,63 @@ def _rim_distance(pts: np.ndarray, loop: np.ndarray) -> np.ndarray:
 
 
 def face_line(world_from_model: SE3, poly: Polyhedron, f: int, pad_point: np.ndarray, r: float,
-              rim: np.ndarray | None = None) -> ProbeMove:  # fmt: skip
+              rim: np.ndarray | None = None, config: PlannerConfig | None = None) -> ProbeMove:  # fmt: skip
     """A probe line to the pad touching face ``f`` at ``pad_point`` (world): level toward the face (along its inward
     normal when the face is level), starting :data:`RUN_UP` before the touch and ending :data:`RUN_ON` past it; its
     ``room`` the point's distance to the face's rim (to the polygon ``rim``, world frame, where given: the stroke
-    kept within it)."""
+    kept within it); with ``config``, on a face steep enough for the probe's level stroke, how far the pad can slide
+    level either way and (``room_up``) up from there touching the face alone (:func:`slide_room`)."""
     n = world_from_model.rotate(poly.face_normals[f])
     u = -n * np.array([1.0, 1.0, 0.0])
     u = u / np.linalg.norm(u) if float(np.linalg.norm(u)) > 0.1 else -n
-    centre = np.asarray(pad_point, dtype=float) + r * n
+    p = np.asarray(pad_point, dtype=float)
+    centre = p + r * n
     if rim is None:
         rim = world_from_model.apply(poly.vertices[list(poly.faces[f])])
-    room = float(_rim_distance(np.asarray(pad_point, dtype=float)[None], rim)[0])
-    return ProbeMove(centre + (r - RUN_UP) * u, u, RUN_UP + RUN_ON, room=room)
+    room = float(_rim_distance(p[None], rim)[0])
+    room_up = None
+    level = np.cross(np.array([0.0, 0.0, 1.0]), n)
+    if config is not None and float(level @ level) > LEVEL_STROKE:  # the probe's stroke runs level, then up
+        level = level / np.linalg.norm(level)
+        up = np.cross(n, level)
+        up = up if up[2] >= 0.0 else -up
+        room = min(slide_room(poly, world_from_model, f, p, d, rim, config) for d in (level, -level))
+        room_up = slide_room(poly, world_from_model, f, p, up, rim, config)
+    return ProbeMove(centre + (r - RUN_UP) * u, u, RUN_UP + RUN_ON, room=room, room_up=room_up)
+
+
+LEVEL_STROKE = 0.25
+"""A probe's L runs level along a face, then up it, where ``|z × n|²`` exceeds this (the face leans under 60° from
+horizontal, at least: ``PlacementSettings.level_stroke``, :func:`haptic.executor.placement._stroke`) [-]."""
+SLIDE_MOST = 0.012
+"""How far :func:`slide_room` looks [m]: past the probe's longest leg (8 mm)."""
+
+
+def slide_room(poly: Polyhedron, world_from_model: SE3, f: int, pad_point: np.ndarray, d: np.ndarray,
+               rim: np.ndarray, config: PlannerConfig) -> float:  # fmt: skip
+    """How far the pad touching face ``f`` at ``pad_point`` (world) can slide along ``d`` (unit, in the face's plane)
+    and still touch that face alone, within the polygon ``rim`` and its lowest point clear of the table (the tests of
+    :func:`pad_positions`), in steps of :data:`GRID` up to :data:`SLIDE_MOST` [m]. The rim's distance alone does not
+    say it: beside a concave edge the pad meets the face across a pad's radius before its contact reaches the edge
+    (the back wall of BOX01N's slot at seed 1, 30 mm tall: a stroke 7.5 mm up from a contact 8 mm from the corner's
+    side climbed the slot's floor)."""
+    r = config.pad_radius
+    n = world_from_model.rotate(poly.face_normals[f])
+    a = np.cross(n, [1.0, 0.0, 0.0]) if abs(n[0]) < 0.9 else np.cross(n, [0.0, 1.0, 0.0])
+    a /= np.linalg.norm(a)
+    b = np.cross(n, a)
+    loop2 = np.column_stack([(rim - pad_point) @ a, (rim - pad_point) @ b])
+    inv = world_from_model.inverse()
+    steps = np.arange(GRID, SLIDE_MOST + 1e-9, GRID)
+    pts = np.asarray(pad_point, dtype=float) + steps[:, None] * np.asarray(d, dtype=float)
+    centres = pts + r * n
+    ok = (surface_distance(poly, inv.apply(centres)) >= r - PAD_ALONE) & ~poly.contains(inv.apply(centres))
+    if config.table_z is not None:
+        ok &= centres[:, 2] - r - config.table_z >= config.table_clearance
+    ok &= np.array([inside_polygon(np.array([float((q - pad_point) @ a), float((q - pad_point) @ b)]), loop2)
+                    for q in pts])  # fmt: skip
+    bad = np.flatnonzero(~ok)
+    return float(steps[bad[0]] - GRID) if len(bad) else SLIDE_MOST
 
 
 def table_face_lines(poly: Polyhedron, world_from_model: SE3, v: int, f: int, config: PlannerConfig,
@@ -143,13 +188,33 @@ def table_face_lines(poly: Polyhedron, world_from_model: SE3, v: int, f: int, co
     """Up to ``most`` probe lines (:func:`face_line`) to face ``f`` near vertex ``v``, at pad positions
     (:func:`pad_positions`) at least :data:`SPREAD` apart, the nearest the vertex first; none where the pad cannot
     touch the face alone clear of the table."""
+    return _spread_lines(poly, world_from_model, f, pad_positions(poly, world_from_model, v, f, config), config, most)
+
+
+MIN_LEVEL_ROOM = 0.0035
+"""A line whose pad can slide level less than this either way touching its face alone is not weighed [m]: the level
+leg must span 3 mm (``SegmentBounds.min_face_extent``) ..."""
+MIN_UP_ROOM = 0.002
+"""... and one whose pad can slide up less than this (:data:`haptic.executor.placement.STROKE_ACROSS_MIN`: 1.5 mm
+across the face, and the servo's lag) [m]."""
+
+
+def _spread_lines(poly: Polyhedron, world_from_model: SE3, f: int, positions: np.ndarray, config: PlannerConfig,
+                  most: int, rim: np.ndarray | None = None) -> list[ProbeMove]:  # fmt: skip
+    """Lines (:func:`face_line`) to face ``f`` at the first of ``positions`` at least :data:`SPREAD` apart whose
+    stroke has room on the face (where it runs level, then up: :data:`MIN_LEVEL_ROOM`, :data:`MIN_UP_ROOM`), up to
+    ``most``."""
     picked: list[np.ndarray] = []
-    for p in pad_positions(poly, world_from_model, v, f, config):
-        if all(float(np.linalg.norm(p - q)) >= SPREAD for q in picked):
-            picked.append(p)
-            if len(picked) >= most:
-                break
-    return [face_line(world_from_model, poly, f, p, config.pad_radius) for p in picked]
+    lines: list[ProbeMove] = []
+    for p in positions:
+        if len(lines) >= most or not all(float(np.linalg.norm(p - q)) >= SPREAD for q in picked):
+            continue
+        line = face_line(world_from_model, poly, f, p, config.pad_radius, rim, config)
+        if line.room_up is not None and (line.room < MIN_LEVEL_ROOM or line.room_up < MIN_UP_ROOM):
+            continue
+        picked.append(p)
+        lines.append(line)
+    return lines
 
 
 def _first_reached(probes, lines: list[ProbeMove], key, h, avoid: Sequence[str] = ()) -> ProbeMove | None:
@@ -261,15 +326,10 @@ def corner_lines(poly: Polyhedron, world_from_model: SE3, v: int, f: int, config
     """Up to ``most`` probe lines (:func:`face_line`) to face ``f`` within its corner at vertex ``v``
     (:func:`corner_positions`), at least :data:`SPREAD` apart, each line's room that to the corner's sides; none
     where the pad cannot touch the face alone there clear of the table with room for a stroke."""
-    picked: list[np.ndarray] = []
-    for p in corner_positions(poly, world_from_model, v, f, config):
-        if all(float(np.linalg.norm(p - q)) >= SPREAD for q in picked):
-            picked.append(p)
-            if len(picked) >= most:
-                break
     tri = corner_triangle(poly, v, f)
     rim = world_from_model.apply(tri) if tri is not None else None
-    return [face_line(world_from_model, poly, f, p, config.pad_radius, rim) for p in picked]
+    return _spread_lines(poly, world_from_model, f, corner_positions(poly, world_from_model, v, f, config), config,
+                         most, rim)  # fmt: skip
 
 
 @dataclass

@@ -200,7 +200,12 @@ class ProbeMove:
     room: float | None = None
     """With ``finger``: how far the hypothesised face the line is aimed at extends around where the pad is to touch
     it (its contact's distance to the face's rim) [m]: the finger's stroke on it is kept within (a face leaning under
-    is pressed clear of the table only near its top, often a narrow corner); None: the executor's own stroke."""
+    is pressed clear of the table only near its top, often a narrow corner); None: the executor's own stroke. Where
+    the face is steep enough for the level stroke (:attr:`room_up` given), how far the pad can slide level either way
+    from there touching the face alone."""
+    room_up: float | None = None
+    """With ``room`` on a face steep enough for the level stroke: how far the pad can slide up the face from its
+    contact touching it alone (the L's second leg) [m]."""
 
     kind = "probe"
 

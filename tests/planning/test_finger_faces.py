@@ -149,16 +149,38 @@ def test_the_probes_ask_each_line_once_and_name_what_no_finger_reaches():
 
 
 def test_the_stroke_is_kept_within_the_faces_room():
-    from haptic.executor.placement import PROBE_SETTINGS, STROKE_REACH, stroke_within
+    from haptic.executor.placement import PROBE_SETTINGS, stroke_within
 
     assert stroke_within(PROBE_SETTINGS, 0.02) == PROBE_SETTINGS
     s = stroke_within(PROBE_SETTINGS, MIN_ROOM)
-    # the pad travels about STROKE_REACH of the L commanded: that travel is kept within the room
-    assert math.hypot(s.stroke, s.stroke_across) * STROKE_REACH <= MIN_ROOM + 1e-9
-    assert math.hypot(s.stroke, s.stroke_across) < math.hypot(PROBE_SETTINGS.stroke, PROBE_SETTINGS.stroke_across)
-    # and the L commanded spans what a face's stroke must: 3 mm along its diagonal, 1.5 mm across
+    assert math.hypot(s.stroke, s.stroke_across) <= MIN_ROOM + 1e-9
+    # the L still spans what a face's stroke must: 3 mm along its diagonal, 1.5 mm across, as the pad's travel (a
+    # probe's legs run on until the pad has travelled them)
+    assert s.stroke_overrun > 1.0
     assert math.hypot(s.stroke, s.stroke_across) >= 0.003
     assert s.stroke * s.stroke_across / math.hypot(s.stroke, s.stroke_across) >= 0.0015
+    # with a room per leg (the level stroke), each leg within its own
+    s = stroke_within(PROBE_SETTINGS, 0.02, 0.002)
+    assert (s.stroke, s.stroke_across) == (PROBE_SETTINGS.stroke, 0.002)
+
+
+def test_a_line_on_a_wall_between_two_faces_has_the_room_the_pad_has_between_them():
+    # BOX01N at seed 1 lies with its slot on a side: the slot's back wall stands upright, 30 mm tall between the slot's
+    # floor and ceiling, and the 12 mm pad touches it alone only within 6 mm of height, whatever the distance to the
+    # wall's rim; the stroke there runs level along the slot, then up, each leg within the pad's room
+    from haptic.episode.spec import EpisodeSpec
+    from haptic.episode.worlds import build_episode
+    from haptic.planning.finger_faces import MIN_LEVEL_ROOM, MIN_UP_ROOM, corner_lines
+
+    ep = build_episode(EpisodeSpec(model="BOX01N", seed=1, executor="physics", verify="full"))
+    poly, pose, config = ep.true_model, ep.world_from_model, ep.config
+    back = 6
+    assert abs(float(pose.rotate(poly.face_normals[back])[2])) < 1e-6  # upright
+    lines = [line for v in (4, 5, 12, 13) for line in corner_lines(poly, pose, v, back, config)]
+    assert lines
+    for line in lines:
+        assert line.room_up is not None and MIN_UP_ROOM <= line.room_up <= 0.006 + 1e-9
+        assert line.room >= MIN_LEVEL_ROOM
 
 
 @pytest.mark.slow
@@ -205,8 +227,18 @@ def test_a_line_to_a_corner_touches_the_face_within_the_corner_with_room_for_a_s
             touch = inv.apply((centre - config.pad_radius * n)[None])
             assert in_corner(touch, tri, poly.face_normals[f], slack=-MIN_ROOM + 1e-6)[0]
             assert MIN_ROOM - 1e-9 <= line.room
-            # its room is the corner's, less than the face's where the corner's far side crosses the face
-            assert in_corner(touch, tri, poly.face_normals[f], slack=-line.room + 1e-6)[0]
+            if line.room_up is None:
+                # its room is the corner's, less than the face's where the corner's far side crosses the face
+                assert in_corner(touch, tri, poly.face_normals[f], slack=-line.room + 1e-6)[0]
+                continue
+            # the stroke runs level, then up: the pad slid that far each way still touches the corner
+            level = np.cross([0.0, 0.0, 1.0], n)
+            level /= np.linalg.norm(level)
+            up = np.cross(n, level)
+            up = up if up[2] >= 0 else -up
+            t = (centre - config.pad_radius * n)
+            ends = [t + line.room * level, t - line.room * level, t + line.room_up * up]
+            assert np.all(in_corner(inv.apply(np.array(ends)), tri, poly.face_normals[f], slack=1e-6))
 
 
 def test_the_corner_probes_ask_nothing_while_some_vertex_cannot_be_placed():
