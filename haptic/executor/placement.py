@@ -44,6 +44,7 @@ from haptic.executor.primitives import PrimitiveResult
 from haptic.geometry.distance import surface_distance
 from haptic.geometry.se3 import perpendicular, unit
 from haptic.matching.trace import PHASES, ContactTrace
+from haptic.planning.finger_faces import LEVEL_STROKE
 from haptic.planning.handpath import CLEARANCE, LIFT, safe_height
 from haptic.planning.moves import FingerApproach, MoveResult, PlacementMove, ProbeMove, SensorState
 from haptic.sim.reach import FingertipTarget, ReachSettings, ReachSolver
@@ -708,7 +709,7 @@ def _stroke(c: _Closing, fingers: Sequence[FingerApproach], held: dict[str, np.n
         phi = heading[f.finger]
         d1 = math.cos(phi) * a + math.sin(phi) * np.cross(n, a)
         level = np.cross(np.array([0.0, 0.0, 1.0]), n)
-        if s.level_stroke and float(level @ level) > 0.25:  # the face leans under 60° from horizontal, at least
+        if s.level_stroke and float(level @ level) > LEVEL_STROKE:  # the face leans 60° from horizontal, at least
             d1 = unit(level) * (1.0 if math.cos(phi) >= 0.0 else -1.0)
             d2 = np.cross(n, d1)
             legs[f.finger] = (d1, d2 if d2[2] >= 0.0 else -d2)

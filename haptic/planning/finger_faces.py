@@ -26,7 +26,7 @@ import numpy as np
 
 from haptic.geometry.distance import surface_distance
 from haptic.geometry.polyhedron import Polyhedron
-from haptic.geometry.se3 import SE3
+from haptic.geometry.se3 import SE3, plane_basis
 from haptic.geometry.tracing import inside_polygon
 from haptic.matching.acceptance import corner_spans, corner_triangle, in_corner
 from haptic.planning.config import PlannerConfig
@@ -166,9 +166,7 @@ def slide_room(poly: Polyhedron, world_from_model: SE3, f: int, pad_point: np.nd
     side climbed the slot's floor)."""
     r = config.pad_radius
     n = world_from_model.rotate(poly.face_normals[f])
-    a = np.cross(n, [1.0, 0.0, 0.0]) if abs(n[0]) < 0.9 else np.cross(n, [0.0, 1.0, 0.0])
-    a /= np.linalg.norm(a)
-    b = np.cross(n, a)
+    a, b = plane_basis(n)
     loop2 = np.column_stack([(rim - pad_point) @ a, (rim - pad_point) @ b])
     inv = world_from_model.inverse()
     steps = np.arange(GRID, SLIDE_MOST + 1e-9, GRID)
