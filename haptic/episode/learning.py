@@ -58,7 +58,7 @@ from haptic.matching.recognition import NO_MATCH
 from haptic.planning.config import PlannerConfig
 from haptic.planning.hypothesis import Hypothesis, trace_in
 from haptic.planning.move_scores import same_move
-from haptic.planning.moves import EdgeMove, FaceMove, Move, MoveResult, SensorState
+from haptic.planning.moves import EdgeMove, FaceMove, Move, MoveResult, SensorState, start_state
 from haptic.planning.predict import candidate_moves
 from haptic.planning.simulate import simulate
 
@@ -275,7 +275,7 @@ class ClosureMoves(MoveSource):
         before, self._sensor = self._sensor, view.sensor
         if isinstance(move, FaceMove) and result.ok and before is not None and result.state is not None \
                 and "crossed_face" not in result.info:  # fmt: skip
-            self.strokes.append(Stroke(before.face, np.array(before.position, float),
+            self.strokes.append(Stroke(start_state(move, before).face, np.array(before.position, float),
                                        np.array(result.state.position, float)))  # fmt: skip
         if not self.active:
             return
@@ -400,7 +400,7 @@ class ClosurePlan:
         """What a face move's crossing of diagonals not crossed before is worth (each counted once, ``counted``)."""
         if not self.folds or not isinstance(move, FaceMove):
             return 0.0
-        f = h.faces.get(before.face)
+        f = h.faces.get(start_state(move, before).face)
         g = 0.0
         for i, (face, a, b) in enumerate(self.folds):
             if face == f and ("d", i) not in counted and crosses(before.position, after.position, a, b,

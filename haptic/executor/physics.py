@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -49,6 +49,8 @@ from haptic.matching.acceptance import BoundFloors
 from haptic.matching.components import DataComponent
 from haptic.matching.trace import PHASES, ContactTrace
 from haptic.planning.moves import (
+    FACE_RETURN_FAILED,
+    VERTEX_FACE_FAILED,
     VERTEX_RADIUS,
     CostModel,
     EdgeMove,
@@ -1043,13 +1045,25 @@ class PhysicsExecutor(LandingSearch):
         d = np.asarray(move.direction, dtype=float)
         if d.shape != (3,) or not np.all(np.isfinite(d)):
             return self.invalid_result(move, "direction must be a finite 3-vector")
+        near = None
+        if move.face is not None and move.face != st.face:  # across the other face of the edge the pad is on
+            rec = seg.edges.get(st.edge) if st.edge is not None else None
+            if rec is None or move.face not in rec.faces or move.face not in rec.inward or move.face not in seg.faces:
+                return self.invalid_result(move, f"face {move.face} is not a face of the current edge (faces "
+                                                 f"{st.edge_faces})")  # fmt: skip
+            if move.start is not None:
+                near = np.asarray(move.start, dtype=float)
+            else:
+                at = rec.at(float(np.clip(rec.param(st.position), *rec.interval)))
+                near = at + self.settings.reacquire_inset * rec.inward[move.face]
+            self.state = st = replace(st, face=move.face)
         n_a = seg.faces[st.face].component.normal
         inplane = in_plane(d, n_a)
         if inplane is None:
             return self.invalid_result(move, "direction is not in the plane of the current face")
-        status = self._ensure_on_face(st.face, pieces, retilt=True)
+        status = self._ensure_on_face(st.face, pieces, near=near, retilt=True)
         if status != "ok":
-            return self.failed_result(move, status, f"could not return to the current face: {self._why}")
+            return self.failed_result(move, status, f"{FACE_RETURN_FAILED}: {self._why}")
         recrosses, tilted, levelled, resumed = 0, False, False, False
         lead = 0.0
         heading = inplane  # crossed again from a point the face was touched at, the slide heads from there
@@ -2103,7 +2117,7 @@ class PhysicsExecutor(LandingSearch):
                                            "halfway to the edge")  # fmt: skip
                 p0 = p1
         if status != "ok":
-            return self.failed_result(move, status, f"could not reach the face next to the vertex: {self._why}")
+            return self.failed_result(move, status, f"{VERTEX_FACE_FAILED}: {self._why}")
         tangent = math.sin(beta) * u + math.cos(beta) * w_f
         tilted = False
         while True:

@@ -16,7 +16,7 @@ import numpy as np
 from haptic.geometry.polyhedron import Polyhedron
 from haptic.geometry.se3 import SE3
 from haptic.geometry.tracing import FaceHit, trace_face
-from haptic.planning.moves import FaceMove, SensorState
+from haptic.planning.moves import FaceMove, SensorState, start_state
 
 
 @dataclass(frozen=True, eq=False)
@@ -69,6 +69,7 @@ class FaceTrace:
 def trace_in(h: Hypothesis, move: FaceMove, state: SensorState) -> FaceTrace | None:
     """Face move ``move`` from ``state`` traced in hypothesis ``h``'s world; None when ``h`` cannot say (no
     pose, the current face not matched, no single edge met)."""
+    state = start_state(move, state)
     f_m = h.faces.get(state.face)
     if h.world_from_model is None or f_m is None:
         return None

@@ -8,7 +8,7 @@ A move is chosen by the planner and carried out by an executor (geometric or phy
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from enum import StrEnum
 
 import numpy as np
@@ -130,7 +130,13 @@ class FaceMove:
     onto the next face for its normal; end near that edge (§4 item 1)."""
 
     direction: np.ndarray
-    """Unit direction of travel in the world frame, in the plane of the current face, shape (3,)."""
+    """Unit direction of travel in the world frame, in the plane of the face traced, shape (3,)."""
+    face: int | None = None
+    """The data face traced when it is not the current one: the other face of the edge the sensor is on (one of
+    :attr:`SensorState.edge_faces`); None: the current face ..."""
+    start: np.ndarray | None = None
+    """... and the point of it, beside that edge, the sensor moves to first and traces from (world frame, shape (3,);
+    with ``face``)."""
 
     kind = "face"
 
@@ -165,6 +171,25 @@ MIN_IN_PLANE = 0.1
 """A face move's direction must keep at least this fraction of its length in the plane of the face [-]."""
 ZERO_LENGTH = 1e-12
 """A direction shorter than this has no length (round-off) [-]."""
+
+
+FACE_RETURN_FAILED = "could not return to the current face"
+"""How the reason of a face move that failed touching its face again, before tracing it, begins: every face move
+across that face from there would fail the same way."""
+
+
+VERTEX_FACE_FAILED = "could not reach the face next to the vertex"
+"""... and that of a vertex move that failed touching the face it circles across."""
+
+
+def start_state(move: Move, state: SensorState) -> SensorState:
+    """The sensor state ``move`` starts from: ``state``, or on the face a face move names (:attr:`FaceMove.face`), at
+    its start."""
+    face = getattr(move, "face", None)
+    if face is None or face == state.face:
+        return state
+    start = getattr(move, "start", None)
+    return replace(state, face=face, position=state.position if start is None else np.asarray(start, float))
 
 
 def in_plane(direction: np.ndarray, normal: np.ndarray) -> np.ndarray | None:

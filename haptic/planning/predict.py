@@ -22,7 +22,7 @@ from haptic.matching.components import DataComponent, DataEdge, DataFace, Sensor
 from haptic.planning import kernels
 from haptic.planning.config import PlannerConfig
 from haptic.planning.hypothesis import FaceTrace, Hypothesis, trace_in
-from haptic.planning.moves import EdgeMove, FaceMove, Move, SensorState, VertexMove
+from haptic.planning.moves import EdgeMove, FaceMove, Move, SensorState, VertexMove, start_state
 from haptic.planning.table import data_table_conflict, hand_trace, table_prediction
 
 
@@ -123,6 +123,42 @@ def candidate_moves(
         if state.vertex is not None:
             moves.extend(VertexMove(f) for f in state.edge_faces if isinstance(components.get(f), DataFace))
     return moves
+
+
+CONVEX_SIN = math.sin(math.radians(5.0))
+"""An edge is convex between its faces when the way from it into the other face heads at least asin of this under
+the current face's plane [-]."""
+OTHER_FACE_INSET = 0.005
+"""A face move across the other face of the edge the sensor is on starts this far from the edge on that face [m]
+(:func:`other_face_start`; the hand's touch afresh beside an edge, ``PhysicsSettings.reacquire_inset``)."""
+
+
+def other_face_start(state: SensorState, components: Mapping[int, DataComponent], face: int
+                     ) -> tuple[np.ndarray, np.ndarray] | None:  # fmt: skip
+    """Where a face move across data face ``face``, the other face of the edge the sensor is on, starts
+    (:attr:`FaceMove.start`): beside the sensor's foot on the edge's explored interval, :data:`OTHER_FACE_INSET`
+    into that face (toward the point the edge has on its side, else its points' middle); with the unit direction
+    in the face's plane away from the edge. None without the edge or the face, or where the edge is not convex
+    between the two: in a concave corner the pad touches both faces (the current face's moves start a pad's radius
+    out of the corner)."""
+    edge, f = components.get(state.edge) if state.edge is not None else None, components.get(face)
+    here = components.get(state.face)
+    if not isinstance(edge, DataEdge) or not isinstance(f, DataFace) or not isinstance(here, DataFace):
+        return None
+    b = np.asarray(edge.direction, float)
+    w = cross(f.normal, b)
+    norm = float(np.linalg.norm(w))
+    if norm < 0.5:  # the face's normal near the edge's line: not a face of it
+        return None
+    w /= norm
+    foot = edge.point + float(np.clip((state.position - edge.point) @ b, 0.0, edge.length)) * b
+    side = dict(edge.side_points).get(face)
+    ref = side if side is not None else f.points.mean(axis=0)
+    if float((ref - foot) @ w) < 0.0:
+        w = -w
+    if float(w @ here.normal) > -CONVEX_SIN:  # into a convex edge's other face is down from the current face
+        return None
+    return foot + OTHER_FACE_INSET * w, w
 
 
 def face_directions(
@@ -352,6 +388,7 @@ def predict(
 ) -> Prediction:
     """Every hypothesis's predicted outcome and cost for one candidate move (``traces``: a face move's traces in
     every hypothesis, :func:`trace_moves`, when already computed)."""
+    state = start_state(move, state)
     rows, costs, clear = [], [], []
     if traces is None:
         traces = trace_all(hypotheses, move, state) if isinstance(move, FaceMove) else [False] * len(hypotheses)
@@ -396,7 +433,15 @@ def predict_moves(
     config: PlannerConfig,
 ) -> list[Prediction]:
     """:func:`predict` for each of ``moves``; the face moves' outcomes, costs and clearances in every hypothesis
-    at once (:func:`face_outcomes`), their traces (:func:`trace_moves`) only where a table asks for them."""
+    at once (:func:`face_outcomes`), their traces (:func:`trace_moves`) only where a table asks for them; a face
+    move on another face than the current one (:attr:`~haptic.planning.moves.FaceMove.face`) from there."""
+    elsewhere = [m for m in moves if start_state(m, state) is not state]
+    if elsewhere:
+        on = [m for m in moves if start_state(m, state) is state]
+        got = dict(zip(map(id, on), predict_moves(hypotheses, on, state, components, noise, config), strict=True))
+        for m in elsewhere:
+            got[id(m)] = predict(hypotheses, m, state, components, noise, config)
+        return [got[id(m)] for m in moves]
     faces = [m for m in moves if isinstance(m, FaceMove)]
     if config.table_z is not None:
         traced = dict(zip(map(id, faces), trace_moves(hypotheses, faces, state), strict=True))

@@ -22,7 +22,7 @@ from haptic.geometry.tracing import VertexHit, circle_vertex, trace_edge
 from haptic.matching.components import DataComponent, DataEdge, DataFace, DataVertex, SensorNoise
 from haptic.planning.config import PlannerConfig
 from haptic.planning.hypothesis import Hypothesis
-from haptic.planning.moves import EdgeMove, FaceMove, Move, ProbeMove, SensorState, VertexMove
+from haptic.planning.moves import EdgeMove, FaceMove, Move, ProbeMove, SensorState, VertexMove, start_state
 from haptic.planning.table import hand_trace
 
 STEP_ONTO = 0.003
@@ -61,6 +61,7 @@ def simulate(
     state and the new (noiseless) data components; None when ``h`` cannot say (no pose, meets a vertex) or
     when a vertex move would only circle back to an edge and face already explored. A probe:
     :func:`simulate_probe`."""
+    state = start_state(move, state)
     if h.world_from_model is None:
         return None
     if isinstance(move, ProbeMove):

@@ -23,7 +23,7 @@ from haptic.geometry.tracing import FaceHit, circle_vertex, trace_face
 from haptic.matching.components import DataComponent, DataEdge, DataFace
 from haptic.planning.config import PlannerConfig
 from haptic.planning.hypothesis import FaceTrace, Hypothesis, trace_in
-from haptic.planning.moves import EdgeMove, FaceMove, Move, SensorState, VertexMove
+from haptic.planning.moves import EdgeMove, FaceMove, Move, SensorState, VertexMove, start_state
 
 EDGE_ROLL = np.deg2rad(12.0)
 """How far the pad's normal must turn over an edge, before it leans under past ``max_undercut``, for the
@@ -136,7 +136,7 @@ def hand_trace(
     """Face move ``move`` traced in ``h``'s world as the hand follows it (``tr``: its :func:`trace_in`, when already
     computed): the straight trace, or where the table stops it heading down, its level leg (:func:`level_leg`);
     None when ``h`` cannot say. The straight trace without a table."""
-    tr = trace_in(h, move, state) if tr is False else tr
+    tr = trace_in(h, move, start_state(move, state)) if tr is False else tr
     if tr is None or config.table_z is None:
         return tr
     levelled, leg = level_leg(h, tr, config)
@@ -359,6 +359,7 @@ def move_outlook(
     a table (``config.table_z`` None) every move it can say of is made."""
     if config.table_z is None:
         return MADE, np.nan, np.nan
+    state = start_state(move, state)
     t = h.world_from_model
     if t is None:
         return None, np.nan, np.nan
@@ -645,7 +646,7 @@ def data_table_conflict(
     if isinstance(move, EdgeMove):
         return not edge_return_in_reach(state, components, config)
     if isinstance(move, FaceMove):
-        face = components.get(state.face)
+        face = components.get(start_state(move, state).face)
         d = np.asarray(move.direction, dtype=float)
         if not isinstance(face, DataFace) or float(d[2]) >= 0.0 or level_heading(d, face.normal) is not None:
             return False

@@ -37,8 +37,18 @@ from haptic.planning.config import PlannerConfig
 from haptic.planning.finger_faces import CornerProbes, TableFaceProbes
 from haptic.planning.hypothesis import Hypothesis
 from haptic.planning.move_scores import same_move
-from haptic.planning.moves import EdgeMove, FaceMove, Move, ProbeMove, SensorState, VertexMove
-from haptic.planning.predict import candidate_moves, predict_moves
+from haptic.planning.moves import (
+    FACE_RETURN_FAILED,
+    VERTEX_FACE_FAILED,
+    EdgeMove,
+    FaceMove,
+    Move,
+    ProbeMove,
+    SensorState,
+    VertexMove,
+    start_state,
+)
+from haptic.planning.predict import candidate_moves, other_face_start, predict_moves
 from haptic.planning.table import NARROW, _inward, descent_risk, hidden_concave_end, move_outlook
 from haptic.planning.tour import (
     AIM_NEAR_VERTEX,
@@ -517,7 +527,8 @@ def aimed_face_moves(
     config: PlannerConfig | None = None,
     ridges: frozenset[int] = frozenset(),
 ) -> list[FaceMove]:
-    """Face moves across the current face aimed, in hypothesis ``h``'s world, at what of it is missing: a point
+    """Face moves across the current face (and, on an edge, across its other face) aimed, in hypothesis ``h``'s
+    world, at what of it is missing: a point
     :data:`AIM_NEAR_VERTEX` from each missing vertex of the face on either edge at it, and the midpoint of each
     missing edge of the face (of its part above the table's shadow for an edge of ``ridges``: :func:`ridge_target`,
     however steeply the move heads down to it). The planner's fixed directions (§4.1) rarely end near a vertex;
@@ -546,9 +557,34 @@ def _aimed_face_moves(
     missing: tuple[frozenset[int], frozenset[int], frozenset[int]],
     config: PlannerConfig | None = None,
     ridges: frozenset[int] = frozenset(),
+    other_faces: bool = True,
 ) -> list[tuple[FaceMove, float, bool]]:
     """:func:`aimed_face_moves`, each with the length of the model edge it is aimed at [m] and whether it is aimed
-    at an edge's part above the table's shadow (:func:`ridge_target`)."""
+    at an edge's part above the table's shadow (:func:`ridge_target`). On an edge and with ``other_faces``, those
+    across its other face too (:attr:`FaceMove.face`): the features missing there may be none of the current face's,
+    and from a convex edge the pad steps onto either face (part_small_step of the parts, seed 2: on the edges of the
+    side faces below an L face's missing corner, the verification went round them until the stall rule ended it)."""
+    out = _aimed_on(h, state, components, missing, config, ridges)
+    for f in state.edge_faces if other_faces else ():
+        got = other_face_start(state, components, f) if f != state.face else None
+        if got is not None:
+            start, away = got
+            there = replace(state, face=f, position=start)
+            out += [(FaceMove(m.direction, face=f, start=start), length, up)
+                    for m, length, up in _aimed_on(h, there, components, missing, config, ridges)
+                    if float(m.direction @ away) > 0.0]  # not back over the edge  # fmt: skip
+    return out
+
+
+def _aimed_on(
+    h: Hypothesis,
+    state: SensorState,
+    components: Mapping[int, DataComponent],
+    missing: tuple[frozenset[int], frozenset[int], frozenset[int]],
+    config: PlannerConfig | None = None,
+    ridges: frozenset[int] = frozenset(),
+) -> list[tuple[FaceMove, float, bool]]:
+    """:func:`_aimed_face_moves` across the current face."""
     face = components.get(state.face)
     f_m = h.faces.get(state.face)
     if not isinstance(face, DataFace) or f_m is None or h.world_from_model is None:
@@ -638,6 +674,8 @@ def _moves(
     missing: tuple[frozenset[int], frozenset[int], frozenset[int]] | None = None,
     fixed_faces: bool = True,
     ridges: frozenset[int] = frozenset(),
+    unreturned: frozenset[int] = frozenset(),
+    other_faces: bool = False,
 ) -> list[tuple[Move, float, float]]:
     """Fresh candidate moves (the planner's, and those aimed at ``missing``) with their predicted cost and risk
     (the planner's, but all of it for a move predicted to step onto a face too narrow for the pad: a face move's trace
@@ -648,17 +686,21 @@ def _moves(
     edges were never asked for (of the 9 such moves its verification then made, 6 ended on the edge aimed at).
     The planner's face moves in fixed directions are left out when moves are aimed at something of the current
     face, and always with ``fixed_faces`` False (the second move of a look-ahead): what they can measure the
-    aimed moves measure more cheaply, and each costs a prediction."""
+    aimed moves measure more cheaply, and each costs a prediction. ``other_faces``: the aimed moves across the other
+    face of the edge the sensor is on too; no face or vertex move across a face of ``unreturned``."""
     from haptic.planning.move_scores import refusal, same_move
 
     out = []
-    aimed_at = _aimed_face_moves(h, state, components, missing, config, ridges) if missing is not None else []
+    aimed_at = (_aimed_face_moves(h, state, components, missing, config, ridges, other_faces)
+                if missing is not None else [])  # fmt: skip
     aimed = [m for m, _, _ in aimed_at]
     # a move to an edge's part above the table's shadow heads down to it as steeply as it must: no other reaches it
     ridge = {id(m) for m, _, up in aimed_at if up}
-    fixed_faces = fixed_faces and not aimed
+    fixed_faces = fixed_faces and not any(m.face is None for m in aimed)
     planner = [m for m in candidate_moves(state, components, config) if fixed_faces or m.kind != "face"]
-    fresh = [m for m in planner + aimed if not any(same_move(m, bad) for bad in avoid)]
+    fresh = [m for m in planner + aimed if not any(same_move(m, bad) for bad in avoid)
+             and not (m.kind == "face" and start_state(m, state).face in unreturned)
+             and not (isinstance(m, VertexMove) and m.across_face in unreturned)]  # fmt: skip
     # on the hand, a move aimed at the middle of an edge too short for the hand's crossing clearance either side
     # crosses it there, as near its ends as any crossing of it can (:attr:`PlannerConfig.min_crossed_edge`)
     middle = {id(m) for m, length, _ in aimed_at if config.table_z is not None
@@ -680,6 +722,9 @@ def _moves(
     return good or [(m, c, r) for m, c, r, _ in out]
 
 
+TOUCH_FAILURES = 2
+"""After this many failed touches of one data face in a verification, no face or vertex move across it is offered
+again (:meth:`Verifier._unreturned`)."""
 MAX_VERIFY_PROBES = 2
 """Probes a verification decision weighs (:func:`verification_probes`), the nearest targets first."""
 MIN_PROBE_TRANSFER = 0.02
@@ -945,6 +990,7 @@ def plan_verification_move(
     failed_crossings: frozenset[tuple[int, int]] | set[tuple[int, int]] = frozenset(),
     middles: frozenset[int] = frozenset(),
     ridges: frozenset[int] = frozenset(),
+    unreturned: frozenset[int] = frozenset(),
 ) -> tuple[Move | None, Tour | None, float]:
     """:func:`choose_verification_move`, with the tour it planned over ``missing`` (from ``previous``'s order,
     when given) and that tour's cost from the sensor as it is [units] (None and 0 without a pose). A candidate
@@ -966,12 +1012,13 @@ def plan_verification_move(
     follow (a vertex move that circles back to what is explored) made :data:`HAND_WAYS_AGAIN` times from one place
     since the last feature measured (:func:`unpredicted_key` in ``travelled``) is left out as going back.
     ``middles``: faces whose middle is still to be probed (under ``full`` with probes admitted); a probe predicted
-    to land at one of them scores :data:`MIDDLE_CREDIT` less."""
+    to land at one of them scores :data:`MIDDLE_CREDIT` less. ``unreturned``: data faces the hand failed to touch
+    (:meth:`Verifier._unreturned`): no face or vertex move across them is offered."""
     from haptic.planning.search import simulate
     from haptic.planning.simulate import simulate_probe
 
     if h.world_from_model is None:
-        first = _moves(h, state, components, noise, config, avoid, missing, ridges=ridges)
+        first = _moves(h, state, components, noise, config, avoid, missing, ridges=ridges, unreturned=unreturned)
         return (first[0][0] if first else None), None, 0.0
     poly, legs = h.poly, _legs(config)
     if relocate:
@@ -981,7 +1028,11 @@ def plan_verification_move(
     table = StartCosts(poly, keys, legs)
     here = _start_costs(h, state, table)
     now = tour.cost_from(here)
-    first = _moves(h, state, components, noise, config, avoid, missing, ridges=ridges)
+    # stalled, the moves across the other face of the edge the pad is on too: where the current face leads nowhere
+    # new, the other may (offered at every decision, each priced as a trace from the edge though the hand lifts off
+    # and touches that face afresh, they made the formula corpus's verifications longer and confirmed one fewer)
+    first = _moves(h, state, components, noise, config, avoid, missing, ridges=ridges, unreturned=unreturned,
+                   other_faces=relocate)
     if relocate:  # any missing feature, the nearest first
         landing = _verification_probes(h, state, components, missing, noise, config, avoid, probed, faces_ok, True,
                                        RELOCATE_PROBES)  # fmt: skip
@@ -1017,7 +1068,7 @@ def plan_verification_move(
             (again if unpredicted_key(h, m, state) in travelled else ends).append((m, None, c))
             continue
         h1, s1, _ = sim
-        if m.kind == "face" and (_crossing(h, state, h1, s1) in failed_crossings
+        if m.kind == "face" and (_crossing(h, m, state, h1, s1) in failed_crossings
                                  or config.table_z is not None and _grazing(h, m, h1, s1)):
             refused.append((m, h.world_from_model.inverse().apply(s1.position), c))
             continue
@@ -1120,10 +1171,11 @@ def arc_leaves_face(poly: Polyhedron, v: int, f: int, radius: float) -> bool:
     return cache[key]
 
 
-def _crossing(h: Hypothesis, state: SensorState, after: Hypothesis, end: SensorState) -> tuple[int, int] | None:
-    """The model face a face move starts on and the model edge it is predicted to end on, in hypothesis ``h``'s
-    world (None when either is unknown)."""
-    f = h.faces.get(state.face)
+def _crossing(h: Hypothesis, move: Move, state: SensorState, after: Hypothesis, end: SensorState
+              ) -> tuple[int, int] | None:  # fmt: skip
+    """The model face face ``move`` from ``state`` starts on and the model edge it is predicted to end on, in
+    hypothesis ``h``'s world (None when either is unknown)."""
+    f = h.faces.get(start_state(move, state).face)
     e = after.edges.get(end.edge) if end.edge is not None else None
     return None if f is None or e is None else (int(f), int(e))
 
@@ -1140,6 +1192,7 @@ verification last measured something goes back there (:func:`plan_verification_m
 def outcome_key(h: Hypothesis, move: Move, state: SensorState, after: Hypothesis, end: SensorState) -> tuple:
     """A move's way in hypothesis ``h``'s world, predicted from ``state`` to ``end``: its kind, the model face
     and edge it starts on, and the model face, edge and vertex it ends at."""
+    state = start_state(move, state)
     return (move.kind, h.faces.get(state.face), h.edges.get(state.edge) if state.edge is not None else None,
             after.faces.get(end.face), after.edges.get(end.edge) if end.edge is not None else None,
             after.vertices.get(end.vertex) if end.vertex is not None else None)  # fmt: skip
@@ -1155,6 +1208,7 @@ def unpredicted_key(h: Hypothesis, move: Move, state: SensorState) -> tuple:
     the verification took it as the way nearest what is missing again and again: round one vertex between two of
     its edges, an edge move back to it and the circle again (platonic_dodecahedron and trapezohedron_09 of the
     formula corpus, seed 1: 6 and 4 times, until the budget ended them)."""
+    state = start_state(move, state)
     start = (move.kind, h.faces.get(state.face), h.edges.get(state.edge) if state.edge is not None else None,
              h.vertices.get(state.vertex) if state.vertex is not None else None)  # fmt: skip
     if isinstance(move, VertexMove):  # round one vertex across one face, from either edge of it there
@@ -1382,6 +1436,8 @@ class Verifier:
         """Verification moves after which more of the coverage target was measured than before."""
         self._relocated = 0
         self._failed_crossings: set[tuple[int, int]] = set()
+        self._touch_failures: dict[int, int] = {}  # data face -> touches of it that failed (:meth:`_unreturned`)
+        self._touches_counted: set[int] = set()
         """On the hand, the (model face, model edge) that face moves failed to cross :data:`CROSSING_FAILURES`
         times (:meth:`_fail_crossings`)."""
         self._crossing_failures: dict[tuple[int, int], int] = {}
@@ -1609,6 +1665,28 @@ class Verifier:
     def failed(self, move: Move, reason: str) -> None:
         """Note that ``move`` failed for ``reason`` (named where the verification ends without what it led to)."""
         self._reasons[id(move)] = reason
+
+    def _unreturned(self, state: SensorState, failed: Sequence[Move]) -> frozenset[int]:
+        """The data faces no face or vertex move is to start across: those a move from here (``failed``) could not
+        touch (:data:`~haptic.planning.moves.FACE_RETURN_FAILED`, :data:`~haptic.planning.moves.VERTEX_FACE_FAILED`),
+        and those touches failed on :data:`TOUCH_FAILURES` times in the verification. Every face move across a face
+        starts with a touch of it, whatever its direction, and so does a vertex move across it: inside FRAME01's hole
+        (seed 1) eight face moves from one face and four vertex moves, from three places along its edges, each failed
+        so, until the stall rule ended the verification."""
+        here = set()
+        for m in failed:
+            why = self._reasons.get(id(m), "")
+            if m.kind == "face" and why.startswith(FACE_RETURN_FAILED):
+                f = start_state(m, state).face
+            elif isinstance(m, VertexMove) and why.startswith(VERTEX_FACE_FAILED):
+                f = m.across_face
+            else:
+                continue
+            here.add(f)
+            if id(m) not in self._touches_counted:
+                self._touches_counted.add(id(m))
+                self._touch_failures[f] = self._touch_failures.get(f, 0) + 1
+        return frozenset(here | {f for f, n in self._touch_failures.items() if n >= TOUCH_FAILURES})
 
     def _unreached(self) -> dict[int, list[tuple[int, str]]]:
         """On the hand, with only vertices of the coverage target missing: those vertices, when along every edge at
@@ -1924,7 +2002,7 @@ class Verifier:
         move, self._tour, now = plan_verification_move(h, state, components, missing, self.noise, self.config,
                                                        avoid, probed, faces_ok, previous, self._ways_done(),
                                                        self._visited, relocate, self._failed_crossings,
-                                                       due, self.ridges)  # fmt: skip
+                                                       due, self.ridges, self._unreturned(state, failed))  # fmt: skip
         if relocate and move is not None and move.kind == "probe":
             self._relocated = self.moves
         if self.config.table_z is not None and h.world_from_model is not None:
@@ -1936,7 +2014,7 @@ class Verifier:
 
             sim = simulate(h, move, state, components, self.config)
             if move.kind == "face" and sim is not None and self.config.table_z is not None:
-                crossing = _crossing(h, state, sim[0], sim[1])
+                crossing = _crossing(h, move, state, sim[0], sim[1])
                 self._asked = (move, crossing) if crossing is not None else None
             key = None
             if sim is not None and _gain(_new_features(h, sim[0]), missing) == 0:
@@ -1979,7 +2057,7 @@ class Verifier:
                 continue
             self._failures_seen.add(seen)
             sim = simulate(h, m, state, components, self.config)
-            key = _crossing(h, state, sim[0], sim[1]) if sim is not None else None
+            key = _crossing(h, m, state, sim[0], sim[1]) if sim is not None else None
             if key is not None:
                 self._crossing_failures[key] = self._crossing_failures.get(key, 0) + 1
                 if self._crossing_failures[key] >= CROSSING_FAILURES:

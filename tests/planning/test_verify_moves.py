@@ -4,10 +4,11 @@ import numpy as np
 
 from haptic.executor.geometric import GeometricExecutor
 from haptic.geometry import SE3, load_library
-from haptic.matching.components import SensorNoise
+from haptic.matching.components import DataEdge, DataFace, SensorNoise
 from haptic.planning.config import PlannerConfig
 from haptic.planning.hypothesis import Hypothesis
-from haptic.planning.moves import CostModel, EdgeMove
+from haptic.planning.moves import CostModel, EdgeMove, FaceMove, SensorState
+from haptic.planning.predict import OTHER_FACE_INSET, face_directions, other_face_start
 from haptic.planning.search import simulate
 from haptic.planning.verify import AIM_NEAR_VERTEX, aimed_face_moves
 
@@ -483,3 +484,63 @@ def test_a_move_aimed_at_a_short_edge_crosses_it_at_its_middle():
         assert after.edges[end.edge] in shorts
     longer = replace(config, min_crossed_edge=0.008)
     assert not [m for m, _, _ in _moves(h, state, comps, SensorNoise(), longer, (), missing) if m.kind == "face"]
+
+
+def _truth(name: str, ex: GeometricExecutor, comps: dict) -> Hypothesis:
+    """The true hypothesis of the components measured so far."""
+    kinds: dict[str, dict[int, int]] = {"face": {}, "edge": {}, "vertex": {}}
+    for cid in comps:
+        kind, true = ex.truth[cid]
+        kinds[kind][cid] = int(true)
+    return Hypothesis(name, LIB[name], ex.world_from_model, kinds["face"], kinds["edge"], kinds["vertex"])
+
+
+def test_from_an_edge_moves_are_aimed_across_its_other_face_too():
+    """On an edge whose current face has nothing missing, the vertices missing on the edge's other face are aimed at
+    across that face (``FaceMove.face``); the geometric executor makes such a move from the edge, and it ends on the
+    edge predicted, beside the vertex aimed at."""
+    for name, seed in [("BOX01", 0), ("HEXPRISM01", 1), ("LBLOCK01", 2)]:
+        h0, state0, comps, ex = _on_a_face(name, seed)
+        first = state0.face
+        f0 = h0.faces[first]
+        crossed = ex.execute(FaceMove(face_directions(state0, comps, 8)[0]))
+        assert crossed.ok
+        comps.update({c.id: c for c in crossed.components})
+        state, h = crossed.state, _truth(name, ex, comps)
+        assert state.face != first and set(state.edge_faces) == {first, state.face}
+        g = h.faces[state.face]
+        far = frozenset(int(v) for v in h.poly.faces[f0]) - frozenset(int(v) for v in h.poly.faces[g])
+        assert far
+        moves = aimed_face_moves(h, state, comps, (frozenset(), frozenset(), far))
+        assert moves and all(m.face == first for m in moves), name
+        m = moves[0]
+        h1, s1, _ = simulate(h, m, state, comps, PlannerConfig())
+        done = ex.execute(m)
+        assert done.ok, done.reason
+        new_edge = next(c.id for c in done.components if c.kind == "edge")
+        assert ex.truth[new_edge][1] == h1.edges[s1.edge]
+        end = h.world_from_model.inverse().apply(done.state.position)
+        assert float(np.linalg.norm(h.poly.vertices[sorted(far)] - end, axis=1).min()) < 3 * AIM_NEAR_VERTEX
+        # a face move naming a face of no edge the sensor is on is refused, the state unchanged
+        bad = ex.execute(FaceMove(m.direction, face=max(comps) + 7))
+        assert bad.status == "invalid" and bad.state == done.state
+
+
+def test_a_face_move_across_the_other_face_starts_beside_a_convex_edge_only():
+    """:func:`other_face_start`: past a convex edge the other face's start lies ``OTHER_FACE_INSET`` into it from the
+    sensor's foot on the edge; in a concave corner there is none (the pad there touches both faces)."""
+    y = np.array([0.0, 1.0, 0.0])
+    top = DataFace(0, np.array([0.0, 0.0, 1.0]), np.array([[-0.02, 0.0, 0.0]]), 0.02, 1e-3)
+    for side_normal, side_point, convex in ((np.array([1.0, 0.0, 0.0]), np.array([0.0, 0.0, -0.02]), True),
+                                            (np.array([-1.0, 0.0, 0.0]), np.array([0.0, 0.0, 0.02]), False)):
+        side = DataFace(1, side_normal, side_point[None, :], 0.02, 1e-3)
+        edge = DataEdge(2, y, np.zeros(3), 0.03, 0.02, 1e-3, 1e-3, side_points=((0, top.points[0]), (1, side_point)))
+        comps = {0: top, 1: side, 2: edge}
+        state = SensorState(np.array([-0.001, 0.01, 0.0]), 0, 2, None, (0, 1))
+        got = other_face_start(state, comps, 1)
+        if not convex:
+            assert got is None
+            continue
+        start, away = got
+        assert np.allclose(away, [0.0, 0.0, -1.0])
+        assert np.allclose(start, [0.0, 0.01, -OTHER_FACE_INSET])
