@@ -511,6 +511,15 @@ def test_a_decision_without_candidates_says_what_it_was():
     assert UNSCORED in decision_table(3, Decision(move))
 
 
+def test_a_face_move_across_the_other_face_of_an_edge_is_named_so():
+    from haptic.planning.moves import FaceMove
+    from haptic.recording.drawing import move_name
+
+    d = np.array([1.0, 0.0, 0.0])
+    assert move_name(FaceMove(d)) == "face (+1.00, +0.00, +0.00)"
+    assert move_name(FaceMove(d, face=3, start=np.zeros(3))) == "face (+1.00, +0.00, +0.00) across f3"
+
+
 def test_a_placement_is_drawn_finger_by_finger_with_its_candidate_table(tmp_path):
     """An episode where the planner places fingers (four fingers, tracing moves, no verification): each finger's
     closings in its own colour under ``world/placements/<finger>``, and a table of the candidate placements in a

@@ -282,12 +282,14 @@ def placement_table(i: int, decision: Decision) -> str:
 
 
 def move_name(move: Move) -> str:
-    """The move's kind and direction: ``face (+0.92, +0.33, -0.22)`` (a world direction), ``edge +``,
-    ``vertex across f2``, ``probe (+0.00, -0.71, -0.71) 12 cm`` (the approach direction and the line's length)."""
+    """The move's kind and direction: ``face (+0.92, +0.33, -0.22)`` (a world direction; ``... across f3`` when it
+    traces the other face of the edge the sensor is on), ``edge +``, ``vertex across f2``, ``probe (+0.00, -0.71,
+    -0.71) 12 cm`` (the approach direction and the line's length)."""
     kind = getattr(move, "kind", "?")
     if kind == "face":
         d = np.asarray(move.direction, dtype=float)
-        return f"face ({d[0]:+.2f}, {d[1]:+.2f}, {d[2]:+.2f})"
+        face = getattr(move, "face", None)
+        return f"face ({d[0]:+.2f}, {d[1]:+.2f}, {d[2]:+.2f})" + (f" across f{face}" if face is not None else "")
     if kind == "edge":
         return f"edge {'+' if move.sense > 0 else '-'}"
     if kind == "vertex":

@@ -373,7 +373,7 @@ class EpisodeRecorder:
                 rec.log("world/estimate", transform(recognition.world_from_model))
                 rec.log("world/estimate/edges", wireframe(model, ESTIMATE_COLOR, EDGE_RADIUS))
         if i not in s.decided:
-            self._no_decision(i, kind)
+            self._no_decision(i, kind, result.move)
 
         status = recognition.status if recognition is not None else "-"
         s.status = status
@@ -658,9 +658,10 @@ class EpisodeRecorder:
         rec.log(f"plots/moves/{kind if kind in KIND_COLORS else 'start'}", rr.Scalars(interpretations))
         self._s.counts = (interpretations, classes)
 
-    def _no_decision(self, i: int, kind: str) -> None:
+    def _no_decision(self, i: int, kind: str, move=None) -> None:
         """The candidate table at a move the planner did not choose (the start, an opening move, a verification
-        move: one chosen while the matcher had recognised the object)."""
+        move: one chosen while the matcher had recognised the object); a face move across the other face of the
+        edge the sensor was on says so."""
         s = self._s
         if s.decision_shown:
             self.stream.log("world/decision", rr.Clear(recursive=True))
@@ -669,6 +670,8 @@ class EpisodeRecorder:
             what = "the start"
         elif s.status == "recognized":
             what = f"a verification {kind} move (what the recognised model predicts and is not measured yet)"
+            if getattr(move, "face", None) is not None:
+                what += f", across data face {move.face}, the other face of the edge the sensor was on"
         else:
             what = f"an opening {kind} move"
         self.stream.log("decision/scores", rr.TextDocument(f"**move {i}**: {what}, not a planner decision",
