@@ -381,6 +381,10 @@ class GeometricExecutor:
 
     def _face_move(self, move: FaceMove) -> MoveResult:
         m, st = self.model, self.state
+        d = np.asarray(move.direction, dtype=float)
+        if d.shape != (3,) or not np.all(np.isfinite(d)):
+            return self._invalid(move, "direction must be a finite 3-vector")
+        pos = self._pos
         if move.face is not None and move.face != st.face:  # across the other face of the edge the sensor is on
             if st.edge is None or move.face not in st.edge_faces or move.face not in self._true_face:
                 return self._invalid(move, f"face {move.face} is not a face of the current edge (faces "
@@ -388,20 +392,19 @@ class GeometricExecutor:
             e, g = self._edges[st.edge].true_edge, self._true_face[move.face]
             if move.start is not None:  # the start asked for, on the face's plane
                 p = self.world_from_model.inverse().apply(np.asarray(move.start, dtype=float))
-                self._pos = p - float(p @ m.face_normals[g] - m.face_offsets[g]) * m.face_normals[g]
+                pos = p - float(p @ m.face_normals[g] - m.face_offsets[g]) * m.face_normals[g]
             else:  # as far in from the edge on that face as the sensor was on this one
                 p0, b = m.edge_points[e], m.edge_directions[e]
-                on = p0 + float(np.clip((self._pos - p0) @ b, 0.0, m.edge_lengths[e])) * b
-                self._pos = on + max(float(np.linalg.norm(self._pos - on)), INSIDE) * self._inward(g, e)
-            self.state = st = self._state(face=move.face, edge=st.edge, vertex=st.vertex, edge_faces=st.edge_faces)
-        f = self._true_face[st.face]
-        d = np.asarray(move.direction, dtype=float)
-        if d.shape != (3,) or not np.all(np.isfinite(d)):
-            return self._invalid(move, "direction must be a finite 3-vector")
+                on = p0 + float(np.clip((pos - p0) @ b, 0.0, m.edge_lengths[e])) * b
+                pos = on + max(float(np.linalg.norm(pos - on)), INSIDE) * self._inward(g, e)
+        f = self._true_face[st.face if move.face is None else move.face]
         d_m = self.world_from_model.inverse().rotate(d)
         inplane = in_plane(d_m, m.face_normals[f])
         if inplane is None:
             return self._invalid(move, "direction is not in the plane of the current face")
+        if pos is not self._pos:  # the sensor steps onto that face
+            self._pos = pos
+            self.state = st = self._state(face=move.face, edge=st.edge, vertex=st.vertex, edge_faces=st.edge_faces)
         hit = tracing.trace_face(m, f, self._pos, inplane)
         if hit is None:
             return MoveResult(move=move, status="unreachable", state=st, reason="trace met a vertex")

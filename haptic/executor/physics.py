@@ -1056,11 +1056,12 @@ class PhysicsExecutor(LandingSearch):
             else:
                 at = rec.at(float(np.clip(rec.param(st.position), *rec.interval)))
                 near = at + self.settings.reacquire_inset * rec.inward[move.face]
-            self.state = st = replace(st, face=move.face)
-        n_a = seg.faces[st.face].component.normal
+        n_a = seg.faces[st.face if near is None else move.face].component.normal
         inplane = in_plane(d, n_a)
         if inplane is None:
             return self.invalid_result(move, "direction is not in the plane of the current face")
+        if near is not None:  # the pad goes onto that face
+            self.state = st = replace(st, face=move.face)
         status = self._ensure_on_face(st.face, pieces, near=near, retilt=True)
         if status != "ok":
             return self.failed_result(move, status, f"{FACE_RETURN_FAILED}: {self._why}")
