@@ -389,14 +389,11 @@ class GeometricExecutor:
             if st.edge is None or move.face not in st.edge_faces or move.face not in self._true_face:
                 return self._invalid(move, f"face {move.face} is not a face of the current edge (faces "
                                            f"{st.edge_faces})")  # fmt: skip
-            e, g = self._edges[st.edge].true_edge, self._true_face[move.face]
-            if move.start is not None:  # the start asked for, on the face's plane
-                p = self.world_from_model.inverse().apply(np.asarray(move.start, dtype=float))
-                pos = p - float(p @ m.face_normals[g] - m.face_offsets[g]) * m.face_normals[g]
-            else:  # as far in from the edge on that face as the sensor was on this one
-                p0, b = m.edge_points[e], m.edge_directions[e]
-                on = p0 + float(np.clip((pos - p0) @ b, 0.0, m.edge_lengths[e])) * b
-                pos = on + max(float(np.linalg.norm(pos - on)), INSIDE) * self._inward(g, e)
+            if move.start is None:
+                return self._invalid(move, "a face move across another face needs its start")
+            g = self._true_face[move.face]  # the start, on the face's plane
+            p = self.world_from_model.inverse().apply(np.asarray(move.start, dtype=float))
+            pos = p - float(p @ m.face_normals[g] - m.face_offsets[g]) * m.face_normals[g]
         f = self._true_face[st.face if move.face is None else move.face]
         d_m = self.world_from_model.inverse().rotate(d)
         inplane = in_plane(d_m, m.face_normals[f])

@@ -1048,14 +1048,12 @@ class PhysicsExecutor(LandingSearch):
         near = None
         if move.face is not None and move.face != st.face:  # across the other face of the edge the pad is on
             rec = seg.edges.get(st.edge) if st.edge is not None else None
-            if rec is None or move.face not in rec.faces or move.face not in rec.inward or move.face not in seg.faces:
+            if rec is None or move.face not in rec.faces or move.face not in seg.faces:
                 return self.invalid_result(move, f"face {move.face} is not a face of the current edge (faces "
                                                  f"{st.edge_faces})")  # fmt: skip
-            if move.start is not None:
-                near = np.asarray(move.start, dtype=float)
-            else:
-                at = rec.at(float(np.clip(rec.param(st.position), *rec.interval)))
-                near = at + self.settings.reacquire_inset * rec.inward[move.face]
+            if move.start is None:
+                return self.invalid_result(move, "a face move across another face needs its start")
+            near = np.asarray(move.start, dtype=float)
         n_a = seg.faces[st.face if near is None else move.face].component.normal
         inplane = in_plane(d, n_a)
         if inplane is None:

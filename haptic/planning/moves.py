@@ -136,7 +136,7 @@ class FaceMove:
     :attr:`SensorState.edge_faces`); None: the current face ..."""
     start: np.ndarray | None = None
     """... and the point of it, beside that edge, the sensor moves to first and traces from (world frame, shape (3,);
-    with ``face``)."""
+    required with ``face``: the executors refuse a move across another face without it)."""
 
     kind = "face"
 

@@ -136,7 +136,7 @@ def hand_trace(
     """Face move ``move`` traced in ``h``'s world as the hand follows it (``tr``: its :func:`trace_in`, when already
     computed): the straight trace, or where the table stops it heading down, its level leg (:func:`level_leg`);
     None when ``h`` cannot say. The straight trace without a table."""
-    tr = trace_in(h, move, start_state(move, state)) if tr is False else tr
+    tr = trace_in(h, move, state) if tr is False else tr
     if tr is None or config.table_z is None:
         return tr
     levelled, leg = level_leg(h, tr, config)

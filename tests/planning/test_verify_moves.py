@@ -524,6 +524,10 @@ def test_from_an_edge_moves_are_aimed_across_its_other_face_too():
         # a face move naming a face of no edge the sensor is on is refused, the state unchanged
         bad = ex.execute(FaceMove(m.direction, face=max(comps) + 7))
         assert bad.status == "invalid" and bad.state == done.state
+        # ... and so is one across the other face without the point it starts from
+        other = next(f for f in done.state.edge_faces if f != done.state.face)
+        bad = ex.execute(FaceMove(m.direction, face=other))
+        assert bad.status == "invalid" and "start" in bad.reason and bad.state == done.state
 
 
 def test_a_face_move_across_the_other_face_starts_beside_a_convex_edge_only():
