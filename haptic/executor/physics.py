@@ -310,6 +310,12 @@ class PhysicsSettings:
     plus ``table_margin``) [-] ..."""
     table_contact_cos: float = 0.95
     """... a fingertip's contact, as sensed during a move, when it exceeds this [-]."""
+    tilt_step_in: float = 0.006
+    """A link that met the object where no tilt of the hand lands the pad back on the face (within the retouch
+    cone: it lands on the rim of the edge the link met) tilts it again this far farther in on the face, away from
+    the link's contact [m] ..."""
+    tilt_step_in_sin: float = 0.2
+    """... when the link's contact normal has at least this component in the face's plane [-]."""
     upright_retract: float = 0.12
     """After a move made tilted, the pad below the highest point touched backs out along the finger's axis at
     most this far before the hand turns upright [m]."""
@@ -453,6 +459,19 @@ class PhysicsExecutor(LandingSearch):
             self.recoveries.append(f"the finger's {met.info['link']} met the object: the hand tilted "
                                    f"{math.degrees(a):.0f}° away")  # fmt: skip
             return True
+        # the link met the edge above the face where the pad rests just under it (a face leaning under, crossed onto
+        # over that edge): tilted there, the pad lands on the edge's rim; a little farther in, on the face
+        ln = np.asarray(met.info["link_normal"], dtype=float)
+        away = ln - float(ln @ n) * n
+        size = math.sqrt(float(away @ away))
+        if size >= self.settings.tilt_step_in_sin:
+            inner = target - self.settings.tilt_step_in * away / size
+            for a, _ in self._tilted_touches(ln, inner, n, pieces):
+                self.on_face = fid
+                self.recoveries.append(f"the finger's {met.info['link']} met the object: the hand tilted "
+                                       f"{math.degrees(a):.0f}° away, {self.settings.tilt_step_in * 1000:.0f} mm "
+                                       f"farther in from it")  # fmt: skip
+                return True
         self.toucher.hand_rotation = np.array(self.toucher.config.hand_rotation, dtype=float)
         return False
 
