@@ -313,7 +313,7 @@ class PhysicsSettings:
     tilt_step_in: float = 0.006
     """A link that met the object where no tilt of the hand lands the pad back on the face (within the retouch
     cone: it lands on the rim of the edge the link met) tilts it again this far farther in on the face, away from
-    the link's contact [m] ..."""
+    the link's contact, then (a face move) on along the slide [m] ..."""
     tilt_step_in_sin: float = 0.2
     """... when the link's contact normal has at least this component in the face's plane [-]."""
     upright_retract: float = 0.12
@@ -448,11 +448,13 @@ class PhysicsExecutor(LandingSearch):
         tops = [float(fd.points[:, 2].max()) for fd in self._faces.values() if len(fd.points)]
         return max(tops, default=TABLE_TOP_Z)
 
-    def _tilt_away(self, met: PrimitiveResult, fid: int, target: np.ndarray, pieces: list[PrimitiveResult]) -> bool:
+    def _tilt_away(self, met: PrimitiveResult, fid: int, target: np.ndarray, pieces: list[PrimitiveResult],
+                   ahead: np.ndarray | None = None) -> bool:
         """After a link of the finger met the object (``met``, event ``"hand"``): tilt the hand, the finger leaning
         away from that contact, by the first of :attr:`TouchConfig.tilt_angles` at which the pad still reaches data
-        face ``fid`` and touches it at ``target``. True when the pad rests on the face, tilted; else the hand is
-        upright again."""
+        face ``fid`` and touches it at ``target``; where none lands on the face there, the same a little farther in
+        (:attr:`PhysicsSettings.tilt_step_in`): away from the link's contact, then on along the slide's heading
+        ``ahead`` (a face move's). True when the pad rests on the face, tilted; else the hand is upright again."""
         n = self.segmenter.faces[fid].component.normal
         for a, _ in self._tilted_touches(met.info["link_normal"], target, n, pieces):
             self.on_face = fid
@@ -472,6 +474,18 @@ class PhysicsExecutor(LandingSearch):
                                        f"{math.degrees(a):.0f}° away, {self.settings.tilt_step_in * 1000:.0f} mm "
                                        f"farther in from it")  # fmt: skip
                 return True
+        if ahead is not None:
+            # the link's contact beside the slide rather than above it (a face leaning under beside the next lateral
+            # face): farther in from it the pad lands on that face's rim again; on along the way the slide went, not
+            way = np.asarray(ahead, dtype=float) - float(np.asarray(ahead, dtype=float) @ n) * n
+            if float(way @ way) > 1e-6:
+                inner = target + self.settings.tilt_step_in * way / math.sqrt(float(way @ way))
+                for a, _ in self._tilted_touches(ln, inner, n, pieces):
+                    self.on_face = fid
+                    self.recoveries.append(f"the finger's {met.info['link']} met the object: the hand tilted "
+                                           f"{math.degrees(a):.0f}° away, {self.settings.tilt_step_in * 1000:.0f} mm "
+                                           f"on along the slide")  # fmt: skip
+                    return True
         self.toucher.hand_rotation = np.array(self.toucher.config.hand_rotation, dtype=float)
         return False
 
@@ -1108,7 +1122,8 @@ class PhysicsExecutor(LandingSearch):
                 held = self._held_from_above(r, heading)
             if r.event == "hand":
                 why = f"trace across the face: the finger's {r.info['link']} met the object"
-                if tilted or not self._tilt_away(r, st.face, self._last_on(r.trace, st.face, heading), pieces):
+                if tilted or not self._tilt_away(r, st.face, self._last_on(r.trace, st.face, heading), pieces,
+                                                 ahead=heading):
                     return self.failed_result(move, r, why)
                 tilted = True
                 continue
