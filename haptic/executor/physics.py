@@ -456,38 +456,33 @@ class PhysicsExecutor(LandingSearch):
         (:attr:`PhysicsSettings.tilt_step_in`): away from the link's contact, then on along the slide's heading
         ``ahead`` (a face move's). True when the pad rests on the face, tilted; else the hand is upright again."""
         n = self.segmenter.faces[fid].component.normal
-        for a, _ in self._tilted_touches(met.info["link_normal"], target, n, pieces):
-            self.on_face = fid
-            self.recoveries.append(f"the finger's {met.info['link']} met the object: the hand tilted "
-                                   f"{math.degrees(a):.0f}° away")  # fmt: skip
-            return True
-        # the link met the edge above the face where the pad rests just under it (a face leaning under, crossed onto
-        # over that edge): tilted there, the pad lands on the edge's rim; a little farther in, on the face
         ln = np.asarray(met.info["link_normal"], dtype=float)
-        away = ln - float(ln @ n) * n
-        size = math.sqrt(float(away @ away))
-        if size >= self.settings.tilt_step_in_sin:
-            inner = target - self.settings.tilt_step_in * away / size
-            for a, _ in self._tilted_touches(ln, inner, n, pieces):
+        for where, at in self._tilt_targets(target, n, ln, ahead):
+            for a, _ in self._tilted_touches(ln, at, n, pieces):
                 self.on_face = fid
                 self.recoveries.append(f"the finger's {met.info['link']} met the object: the hand tilted "
-                                       f"{math.degrees(a):.0f}° away, {self.settings.tilt_step_in * 1000:.0f} mm "
-                                       f"farther in from it")  # fmt: skip
+                                       f"{math.degrees(a):.0f}° away{where}")  # fmt: skip
                 return True
-        if ahead is not None:
-            # the link's contact beside the slide rather than above it (a face leaning under beside the next lateral
-            # face): farther in from it the pad lands on that face's rim again; on along the way the slide went, not
-            way = np.asarray(ahead, dtype=float) - float(np.asarray(ahead, dtype=float) @ n) * n
-            if float(way @ way) > 1e-6:
-                inner = target + self.settings.tilt_step_in * way / math.sqrt(float(way @ way))
-                for a, _ in self._tilted_touches(ln, inner, n, pieces):
-                    self.on_face = fid
-                    self.recoveries.append(f"the finger's {met.info['link']} met the object: the hand tilted "
-                                           f"{math.degrees(a):.0f}° away, {self.settings.tilt_step_in * 1000:.0f} mm "
-                                           f"on along the slide")  # fmt: skip
-                    return True
         self.toucher.hand_rotation = np.array(self.toucher.config.hand_rotation, dtype=float)
         return False
+
+    def _tilt_targets(self, target: np.ndarray, n: np.ndarray, link_normal: np.ndarray, ahead: np.ndarray | None):
+        """For :meth:`_tilt_away`: where the tilted pad touches the face of normal ``n`` again, in turn, each with
+        what its recovery adds. First ``target``. Then :attr:`PhysicsSettings.tilt_step_in` farther in, away from the
+        link's contact (``link_normal``'s part in the face's plane): where the link met the edge above a face leaning
+        under, the pad resting just under that edge, tilted at ``target`` it lands on the edge's rim. Then as far on
+        along ``ahead`` (a face move's heading): where the link's contact lay beside the slide (on the edge with the
+        next lateral face), farther in from it the pad lands on that face's rim again."""
+        yield "", target
+        step = self.settings.tilt_step_in
+        away = link_normal - float(link_normal @ n) * n
+        size = math.sqrt(float(away @ away))
+        if size >= self.settings.tilt_step_in_sin:
+            yield f", {step * 1000:.0f} mm farther in from it", target - step * away / size
+        if ahead is not None:
+            way = np.asarray(ahead, dtype=float) - float(np.asarray(ahead, dtype=float) @ n) * n
+            if float(way @ way) > 1e-6:
+                yield f", {step * 1000:.0f} mm on along the slide", target + step * way / math.sqrt(float(way @ way))
 
     def _tilted_touches(self, link_normal: np.ndarray, target: np.ndarray, n: np.ndarray,
                         pieces: list[PrimitiveResult], held: np.ndarray | None = None):  # fmt: skip
