@@ -435,9 +435,11 @@ def predict_moves(
     """:func:`predict` for each of ``moves``; the face moves' outcomes, costs and clearances in every hypothesis
     at once (:func:`face_outcomes`), their traces (:func:`trace_moves`) only where a table asks for them; a face
     move on another face than the current one (:attr:`~haptic.planning.moves.FaceMove.face`) from there."""
-    elsewhere = [m for m in moves if start_state(m, state) is not state]
+    on: list[Move] = []
+    elsewhere: list[Move] = []
+    for m in moves:
+        (on if start_state(m, state) is state else elsewhere).append(m)
     if elsewhere:
-        on = [m for m in moves if start_state(m, state) is state]
         got = dict(zip(map(id, on), predict_moves(hypotheses, on, state, components, noise, config), strict=True))
         for m in elsewhere:
             got[id(m)] = predict(hypotheses, m, state, components, noise, config)

@@ -1436,10 +1436,10 @@ class Verifier:
         """Verification moves after which more of the coverage target was measured than before."""
         self._relocated = 0
         self._failed_crossings: set[tuple[int, int]] = set()
-        self._touch_failures: dict[int, int] = {}  # data face -> touches of it that failed (:meth:`_unreturned`)
-        self._touches_counted: set[int] = set()
         """On the hand, the (model face, model edge) that face moves failed to cross :data:`CROSSING_FAILURES`
         times (:meth:`_fail_crossings`)."""
+        self._touch_failures: dict[int, int] = {}  # data face -> touches of it that failed (:meth:`_unreturned`)
+        self._touches_counted: set[int] = set()
         self._crossing_failures: dict[tuple[int, int], int] = {}
         self._asked: tuple[Move, tuple[int, int]] | None = None
         """On the hand, the last face move chosen and the crossing it was predicted to make (:meth:`_missed`)."""
